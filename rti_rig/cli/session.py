@@ -12,7 +12,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.markup import escape
@@ -24,6 +24,9 @@ from rti_rig.core.errors import RtiRigError
 # the help's figures (numpy-free)
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, NORMAL_ERROR_LIMIT_DEG, NORMAL_NOISE
 from rti_rig.runtime.deferred_signals import handlers_settable, put_back, signal_handlers
+
+if TYPE_CHECKING:
+    from rti_rig.runtime.run_ending import RunEnding
 
 #: ``--max-saturated`` of ``run`` and ``preview``: None when not given (only metering reads it,
 #: so it is refused without ``--auto-exposure``: :func:`refuse_unmetered_limit`).
@@ -686,25 +689,6 @@ def _cannot_resume(rig) -> str | None:  # type: ignore[no-untyped-def]
     return None if why is None else f"It cannot be resumed: {why}."
 
 
-def _end_unrecorded(manifest: dict) -> str | None:  # type: ignore[type-arg]
-    """What a session whose images are all in has not recorded of its end (None: its run
-    recorded it completed): "its end" or, of an adaptive one, "its end and its adaptive
-    outcome (why it stopped, its error estimate)".
-
-    Why: a stop as the last image was committed (its journal line written, the run's end not
-    yet recorded) was told "the session is complete, nothing is left to resume", while its
-    manifest recorded an emergency stop (a stop later, in the teardown or an arm's final park,
-    records "completed" and is not this case): `rti-rig fit` then called it "not finished …
-    continue it with rti-rig run --resume", and an adaptive session's outcome was recorded only
-    by that resume."""
-    if (manifest.get("runner") or {}).get("finish_reason") == "completed":
-        return None
-    adaptive = manifest.get("adaptive")
-    if isinstance(adaptive, dict) and not adaptive.get("result"):
-        return "its end and its adaptive outcome (why it stopped, its error estimate)"
-    return "its end"
-
-
 def _dead_led_hint(opened, exc: BaseException) -> str | None:  # type: ignore[no-untyped-def]
     """How to go on from a stop at an LED the board refused as dead (None: another error).
     A resume lights that LED first and stops there again, so "Continue with: rti-rig run
@@ -780,106 +764,182 @@ def _open_resumed(req: Any, on_note: Any) -> Any:
         ) from None
 
 
-def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
-    """What a stopped session left on disk and how to go on (never a resume hint for nothing)."""
-    from rti_rig.runtime.session import LP_NAME, holds_no_image
+@dataclass(frozen=True)
+class _Stop:
+    """A stopped run as its stop wording reads it: the folder's facts (read once, by
+    :func:`rti_rig.runtime.run_ending.read_run_ending`) and the run's own (resumed? can this
+    rig resume? the resume hint).
 
-    folder, out_dir = opened.folder, opened.out_dir
-    if _reshoot_not_begun(opened):
-        resume_hint = f"Continue with: {_resume_before_begin(opened)}"
-    if folder.images_kept:
-        whole, listed = folder.lp_listing()
-        if whole and (folder.images_kept >= opened.total_steps or _run_completed(folder)):
-            # every image was in when the stop came (a SIGTERM or a park stopped in the
-            # teardown; an adaptive session its stopping rule ended short of its maximum):
-            # "Continue with: rti-rig run --resume" had been said of a complete session, which
-            # has nothing left to resume (the resume refused it as "already completed")
-            disowned = _labels_disowned(out_dir)
-            if disowned is not None:
-                return (
-                    f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}, their "
-                    f"labels NOT verified: {disowned} says why (fit and export-lp refuse this "
-                    f"session). {resume_hint}"
-                )
-            unrecorded = _end_unrecorded(folder.manifest)
-            if unrecorded:
-                head = (
-                    f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: "
-                    f"every image is in, but the stop came before the run recorded {unrecorded}"
-                    ", so `rti-rig fit` calls it not finished"
-                )
-                fit_it = f"`rti-rig fit {_arg(out_dir)} --out FOLDER` fits the images as they are"
-                cannot = _cannot_resume(opened.rig)
-                if cannot:  # an image sequence: it had been said complete, fit contradicting
-                    return f"{head}; {fit_it}. {cannot}"
-                return (
-                    f"{head}. `rti-rig run --resume {_arg(out_dir)}` records it complete without "
-                    f"shooting anything again; {fit_it}"
-                )
-            if folder.images_kept < opened.total_steps:
-                return (
-                    f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: the "
-                    f"session is complete (its stopping rule ended it at {folder.images_kept} "
-                    f"of at most {opened.total_steps} lights), nothing is left to resume. Next: "
-                    f"rti-rig fit {_arg(out_dir)} --out FOLDER"
-                )
-            return (
-                f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: the "
-                "session is complete, nothing is left to resume. Next: rti-rig fit "
-                f"{_arg(out_dir)} --out FOLDER"
-            )
-        if whole:
-            return (
-                f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}. "
-                f"{resume_hint}"
-            )
-        # its write failed (a full disk): "listed in lights.lp" had been said of a lights.lp
-        # that was missing, or listed fewer images than the folder holds
-        state = f"lists only {listed} of them" if listed else "is missing"
-        if _cannot_resume(opened.rig):
-            remedy = (
-                f"`rti-rig export-lp {_arg(out_dir)} --out FILE.lp` writes one from the journal"
-            )
-        else:
-            remedy = "the resume writes it again"
-        return (
-            f"{folder.images_kept} image(s) kept in {out_dir}, each journaled with its "
-            f"checksum, but its {LP_NAME} could not be written and {state}: do not open the "
-            f"folder in relight or RTIBuilder before it is whole again ({remedy}). "
-            f"{resume_hint}"
-        )
-    if opened.resumed:
-        return f"No new image was captured. {resume_hint}"
-    if not folder.begun:
-        return f"Nothing was captured and nothing was written to {out_dir}."
-    if holds_no_image(out_dir):
-        return f"Nothing was captured: {out_dir} holds no image and may be used again."
+    Why: the ~10 outcomes had each read the folder inline inside one long function; each is
+    now one row of :data:`_STOP_SAID`, a condition over these facts and its sentence."""
+
+    ending: RunEnding
+    out_dir: Path
+    resumed: bool
+    #: what is said instead of a resume of a session this rig cannot resume (None: it can)
+    cannot: str | None
+    resume_hint: str
+
+    @property
+    def kept(self) -> str:
+        return f"{self.ending.images_kept} image(s) kept in {self.out_dir}"
+
+    @property
+    def lp(self) -> str:
+        from rti_rig.runtime.session import LP_NAME
+
+        return LP_NAME
+
+    @property
+    def unrecorded(self) -> str:
+        """What a session whose images are all in has not recorded of its end."""
+        if self.ending.adaptive_outcome_unrecorded:
+            return "its end and its adaptive outcome (why it stopped, its error estimate)"
+        return "its end"
+
+    @property
+    def fit_it(self) -> str:
+        return f"`rti-rig fit {_arg(self.out_dir)} --out FOLDER` fits the images as they are"
+
+
+def _said_disowned(s: _Stop) -> str:
+    # a camera-triggered dome's run stopped once its last image was in, before its
+    # end-of-run proof frame, was told "the session is complete, nothing is left to resume.
+    # Next: rti-rig fit", and fit then refused it as labelled with unverified lights
+    return (
+        f"{s.kept}, listed in {s.lp}, their labels NOT verified: {s.ending.labels_disowned} says "
+        f"why (fit and export-lp refuse this session). {s.resume_hint}"
+    )
+
+
+def _said_end_unrecorded(s: _Stop) -> str:
+    # a stop as the last image was committed (its journal line written, the run's end not yet
+    # recorded) was told "the session is complete, nothing is left to resume", while its
+    # manifest recorded an emergency stop (a stop later, in the teardown or an arm's final
+    # park, records "completed" and is not this case): `rti-rig fit` then called it "not
+    # finished … continue it with rti-rig run --resume", and an adaptive session's outcome
+    # was recorded only by that resume
+    head = (
+        f"{s.kept}, listed in {s.lp}: every image is in, but the stop came before the run "
+        f"recorded {s.unrecorded}, so `rti-rig fit` calls it not finished"
+    )
+    if s.cannot:  # an image sequence: it had been said complete, fit contradicting
+        return f"{head}; {s.fit_it}. {s.cannot}"
+    return (
+        f"{head}. `rti-rig run --resume {_arg(s.out_dir)}` records it complete without "
+        f"shooting anything again; {s.fit_it}"
+    )
+
+
+def _said_stopping_rule(s: _Stop) -> str:
+    # an adaptive session that stopped itself short of its maximum (its estimate met
+    # --until-error) and was then stopped during its teardown (a second Ctrl-C) was told to
+    # "Continue with: rti-rig run --resume", its images counted against the maximum
+    n = s.ending.images_kept
+    return (
+        f"{s.kept}, listed in {s.lp}: the session is complete (its stopping rule ended it at {n} "
+        f"of at most {s.ending.total_steps} lights), nothing is left to resume. Next: "
+        f"rti-rig fit {_arg(s.out_dir)} --out FOLDER"
+    )
+
+
+def _said_complete(s: _Stop) -> str:
+    # a SIGTERM or a park stopped in the teardown: "Continue with: rti-rig run --resume" had
+    # been said of a complete session, which the resume refused as "already completed"
+    return (
+        f"{s.kept}, listed in {s.lp}: the session is complete, nothing is left to resume. "
+        f"Next: rti-rig fit {_arg(s.out_dir)} --out FOLDER"
+    )
+
+
+def _said_lp_unwritten(s: _Stop) -> str:
+    # its write failed (a full disk): "listed in lights.lp" had been said of a lights.lp that
+    # was missing, or listed fewer images than the folder holds
+    listed = s.ending.lp_listed
+    state = f"lists only {listed} of them" if listed else "is missing"
+    if s.cannot:
+        remedy = f"`rti-rig export-lp {_arg(s.out_dir)} --out FILE.lp` writes one from the journal"
+    else:
+        remedy = "the resume writes it again"
+    return (
+        f"{s.kept}, each journaled with its checksum, but its {s.lp} could not be written and "
+        f"{state}: do not open the folder in relight or RTIBuilder before it is whole again "
+        f"({remedy}). {s.resume_hint}"
+    )
+
+
+#: What a stopped run says, the first row whose condition holds (the order matters: a
+#: complete session's rows come before a merely listed one's). Never a resume hint for
+#: nothing: a session with every image in is told what is left (fit, or recording its end).
+_STOP_SAID: tuple[tuple[Callable[[_Stop], object], Callable[[_Stop], str]], ...] = (
+    (lambda s: s.ending.every_image_in and s.ending.labels_disowned is not None, _said_disowned),
+    (lambda s: s.ending.every_image_in and not s.ending.end_recorded, _said_end_unrecorded),
+    (lambda s: s.ending.every_image_in and s.ending.stopped_short, _said_stopping_rule),
+    (lambda s: s.ending.every_image_in, _said_complete),
+    (
+        lambda s: s.ending.images_kept and s.ending.lp_whole,
+        lambda s: f"{s.kept}, listed in {s.lp}. {s.resume_hint}",
+    ),
+    (lambda s: s.ending.images_kept, _said_lp_unwritten),
+    (lambda s: s.resumed, lambda s: f"No new image was captured. {s.resume_hint}"),
+    (
+        lambda s: not s.ending.begun,
+        lambda s: f"Nothing was captured and nothing was written to {s.out_dir}.",
+    ),
+    (
+        lambda s: s.ending.holds_no_image,
+        lambda s: f"Nothing was captured: {s.out_dir} holds no image and may be used again.",
+    ),
     # e.g. a camera's file downloaded for a step that then failed: kept, never deleted
-    return f"No image was completed, but {out_dir} holds files of the camera. {resume_hint}"
+    (
+        lambda s: True,
+        lambda s: (
+            f"No image was completed, but {s.out_dir} holds files of the camera. {s.resume_hint}"
+        ),
+    ),
+)
 
 
-def _reshoot_not_begun(opened) -> bool:  # type: ignore[no-untyped-def]
+def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
+    """What a stopped session left on disk and how to go on (never a resume hint for nothing):
+    the first row of :data:`_STOP_SAID` that the folder's facts meet."""
+    from rti_rig.runtime.run_ending import read_run_ending
+
+    ending = read_run_ending(opened.folder, opened.total_steps)
+    cannot = _cannot_resume(opened.rig)
+    if _reshoot_not_begun(opened, ending, cannot):
+        resume_hint = f"Continue with: {_resume_before_begin(opened, ending)}"
+    stop = _Stop(ending, opened.out_dir, opened.resumed, cannot, resume_hint)
+    return next(said(stop) for holds, said in _STOP_SAID if holds(stop))
+
+
+def _reshoot_not_begun(opened: Any, ending: RunEnding, cannot: str | None) -> bool:
     """Whether ``opened`` is a resume of a completed session (a --reshoot-lost) stopped before
-    it wrote anything: the session is still the completed one, which a plain --resume
-    refuses."""
-    folder = opened.folder
-    if not opened.resumed or folder.begun or _cannot_resume(opened.rig):
+    it wrote anything (``ending``: its folder's facts; ``cannot``: :func:`_cannot_resume`):
+    the session is still the completed one, which a plain --resume refuses."""
+    if not opened.resumed or ending.begun or cannot:
         return False
-    return _last_run_completed(folder)
+    return ending.last_run_completed
 
 
-def _resume_before_begin(opened) -> str:  # type: ignore[no-untyped-def]
+def _resume_before_begin(opened: Any, ending: RunEnding | None = None) -> str:
     """The resume command for a resume stopped before it wrote anything: the one the user
     gave (:func:`_resume_command`), or with --reshoot-lost when the session is a completed
-    one (:func:`_reshoot_not_begun`).
+    one (:func:`_reshoot_not_begun`; ``ending``: the folder's facts if read already).
 
     Why: a --reshoot-lost stopped as the capture took over from the opening was told a plain
     ``rti-rig run --resume S``, which refuses a completed session; then ``--resume S
     --reshoot-lost``, without the rig config, --accept-rig-change or --rebuild-journal given
     with it, each of which the resume needs again."""
+    from rti_rig.runtime.run_ending import read_run_ending
+
     if opened.request is not None:
         return _resume_command(opened.request)
-    tail = " --reshoot-lost" if _reshoot_not_begun(opened) else ""
+    if ending is None:
+        ending = read_run_ending(opened.folder, opened.total_steps)
+    tail = (
+        " --reshoot-lost" if _reshoot_not_begun(opened, ending, _cannot_resume(opened.rig)) else ""
+    )
     return f"rti-rig run --resume {_arg(opened.out_dir)}{tail}"
 
 
@@ -899,38 +959,6 @@ def _continue_command(opened) -> str:  # type: ignore[no-untyped-def]
     if not opened.folder.begun:
         return _resume_command(req)
     return _resume_command(replace(req, reshoot_lost=False, rebuild_journal=False))
-
-
-def _labels_disowned(out_dir: Path) -> Path | None:
-    """The marker that disowns the session's labels (None: there is none).
-
-    Why: a camera-triggered dome's run stopped once its last image was in, before its
-    end-of-run proof frame, was told "the session is complete, nothing is left to resume.
-    Next: rti-rig fit", and fit then refused it as labelled with unverified lights."""
-    from rti_rig.runtime.disowned import MARKER
-
-    marker = Path(out_dir) / MARKER
-    return marker if marker.is_file() else None
-
-
-def _run_completed(folder) -> bool:  # type: ignore[no-untyped-def]
-    """Whether this run's own entry in the manifest (its last, written by the teardown's
-    ``finish``) says the session completed: the capture's end was reached before the stop.
-
-    Why: an adaptive session that stopped itself short of its maximum (its estimate met
-    --until-error) and was then stopped during its teardown (a second Ctrl-C) was told to
-    "Continue with: rti-rig run --resume", its images counted against the maximum; the
-    manifest, written before the stop acts, is what says the capture was over."""
-    if not folder.begun:  # the manifest's last run is an earlier one (a --reshoot-lost's)
-        return False
-    return _last_run_completed(folder)
-
-
-def _last_run_completed(folder) -> bool:  # type: ignore[no-untyped-def]
-    """Whether the manifest's last run entry says the session completed: this run's once it
-    began (:func:`_run_completed`), an earlier run's before (:func:`_reshoot_not_begun`)."""
-    runs = (folder.manifest or {}).get("runs") or []
-    return bool(runs) and runs[-1].get("finish_reason") == "completed"
 
 
 def _print_teardown_failures(  # type: ignore[no-untyped-def]
