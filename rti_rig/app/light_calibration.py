@@ -443,6 +443,25 @@ def calibrate_dome(
     )
 
 
+def evened_sentence(cal: LightCalibration, digits: int) -> str:
+    """What the correction evens out, as the report and the file's comment say it.
+
+    Why "every measured LED" on a partial card session: an LED the card did not shoot is only
+    assumed at the median (or at the figure of the correction in force), so its correction
+    dims it by a guess. "Every LED gives 0.74 of the median" was said from a 12-LED card
+    session of a dome whose unmeasured LED 38 then still gave 1.17 (the full card shot under
+    that correction spread 16 % RMS)."""
+    light = f"{cal.evened_light:.{digits}f} of the median LED's light"
+    stops = f"({cal.stops_lost:.2f} stop(s) more exposure)"
+    if cal.measured.all():
+        return f"Evened out, every LED gives {light} {stops}"
+    unmeasured = int((~cal.measured).sum())
+    return (
+        f"Evened out, every measured LED gives {light} {stops}; the {unmeasured} not "
+        "measured are dimmed by a guess of their light, so they stay as uneven as they were"
+    )
+
+
 def calibration_toml(
     cal: LightCalibration, rig_name: str, session: Path, names: Sequence[str]
 ) -> str:
@@ -469,8 +488,7 @@ def calibration_toml(
         "are assumed to give the median LED's light under the correction in force.",
         f"# Spread of the lights as shot (RMS of ln gain): {cal.shot_spread:.3f}; weakest LED "
         f"{weakest} ({names[weakest]}) at {cal.output[weakest]:.3f} of the median.",
-        f"# Evened out, every LED gives {cal.evened_light:.3f} of the median LED's light "
-        f"({cal.stops_lost:.2f} stop(s) more exposure).",
+        f"# {evened_sentence(cal, 3)}.",
         f'format = "{FORMAT}"',
         f"rig = {_toml_string(rig_name)}",
         f"session = {_toml_string(str(session))}",

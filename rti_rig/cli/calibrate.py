@@ -116,6 +116,7 @@ def calibrate_lights(
 
     import numpy as np
 
+    from rti_rig.app.light_calibration import evened_sentence
     from rti_rig.app.usecases.calibrate import CalibrateRequest, calibrate_lights
 
     try:
@@ -186,10 +187,7 @@ def calibrate_lights(
             f"from {cal.output[low]:.2f} ({escape(led(low))}) to "
             f"{cal.output[high]:.2f} ({escape(led(high))}) of the median."
         )
-    out.print(
-        f"Evened out, every LED gives {cal.evened_light:.2f} of the median LED's light "
-        f"({cal.stops_lost:.2f} stop(s) more exposure)."
-    )
+    out.print(evened_sentence(cal, 2) + ".")
     if not cal.measured.all():
         skipped = ", ".join(names[i] for i in np.flatnonzero(~cal.measured))
         err.print(
