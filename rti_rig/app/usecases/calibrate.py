@@ -130,6 +130,39 @@ def _without_led(req: CalibrateRequest, loaded: LoadedRig, which: str) -> str:
     )
 
 
+#: The identity keys that say which LED a number is: the correction is a list by LED number.
+LED_KEYS = ("lights", "light_positions", "light_directions", "dome_firmware")
+
+
+def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> None:
+    """Refuse a card session shot while the rig's LEDs were others than ``--rig`` gives now.
+
+    Why: the correction is written per LED number and only the rig's name was compared. A
+    config of the same name whose ``.lp`` lists the LEDs in another order (or another count,
+    or another controller board, which may number them otherwise) had its LED 18 (led_42.jpg)
+    given the correction measured under the card session's LED 18 (led_18.jpg), with no word.
+    A session recorded before identities were is not asked (as a resume does not ask it)."""
+    from rti_rig.app.rig_identity import identity_differences, rig_identity
+    from rti_rig.runtime.session import read_manifest
+
+    recorded = (read_manifest(req.card_session).get("rig") or {}).get("identity")
+    if not isinstance(recorded, dict):
+        return
+    now = rig_identity(loaded)
+    diffs = identity_differences(
+        {k: recorded[k] for k in LED_KEYS if k in recorded},
+        {k: now.get(k) for k in LED_KEYS if k in recorded},
+    )
+    if diffs:
+        raise RtiRigError(
+            f"{req.card_session} was shot when the dome's LEDs were others than "
+            f"{req.rig_config} gives now ({'; '.join(diffs)}): the correction is a list by LED "
+            "number, so it would dim other LEDs than the ones the card measured. Calibrate "
+            "with the rig config the card was shot with, or shoot the card again on the rig "
+            "as it is now"
+        )
+
+
 def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     """Check, measure, and write the calibration file; returns what was measured."""
     loaded = load_rig_config(req.rig_config)
@@ -145,6 +178,7 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             else "that LED"
         )
         raise RtiRigError(f"{exc}. {_without_led(req, loaded, which)}") from None
+    _refuse_other_leds(req, loaded)
     target = req.target
     if req.out_file is None and target.exists():
         raise RtiRigError(

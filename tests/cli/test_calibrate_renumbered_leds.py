@@ -1,0 +1,55 @@
+"""`calibrate-lights` refuses a rig config whose LEDs are numbered otherwise than the card's.
+
+Why: the correction is a list by LED number, and only the rig's name was compared with the
+card session's. A config of the same name whose `.lp` lists the LEDs in another order was
+given the correction measured under other LEDs (its LED 18, led_42.jpg, corrected by what the
+card measured under led_18.jpg), with no word; the session's recorded rig identity says which
+LED each number was.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from card_support import card_rig, shoot
+from conftest import CONFIGS, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+def test_a_card_session_calibrated_against_reordered_leds_is_refused(tmp_path: Path) -> None:
+    rig = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(rig, card)
+    count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
+    reordered = tmp_path / "reordered.lp"
+    reordered.write_text("\n".join([count, *rows[24:], *rows[:24]]) + "\n")
+    text = rig.read_text().replace(f"{CONFIGS}/example_dome_48.lp", str(reordered))
+    assert str(reordered) in text
+    other = tmp_path / "other.toml"
+    other.write_text(text)
+    out = tmp_path / "cal.toml"
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(other), "--out", str(out)])
+
+    assert r.exit_code == 2, r.output
+    message = said(r)
+    assert "Traceback" not in r.output
+    assert "light positions: 48 of 48 LEDs moved" in message, message
+    assert "shoot the card again on the rig as it is now" in message, message
+    assert not out.exists()
+
+
+def test_the_rig_config_the_card_was_shot_with_still_calibrates(tmp_path: Path) -> None:
+    rig = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(rig, card)
+    out = tmp_path / "cal.toml"
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(rig), "--out", str(out)])
+
+    assert r.exit_code == 0, r.output
+    assert out.is_file()
