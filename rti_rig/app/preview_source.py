@@ -28,8 +28,12 @@ from typing import Any
 
 import numpy as np
 
-from rti_rig.core.errors import ScheduleError
-from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
+from rti_rig.core.errors import RtiRigError, ScheduleError
+from rti_rig.core.geometry import (
+    angle_between_deg,
+    az_el_from_direction,
+    direction_from_az_el,
+)
 from rti_rig.core.lp_format import LpEntry, image_path
 from rti_rig.runtime.session import (
     LINEAR_DIR,
@@ -48,6 +52,10 @@ RigLp = tuple[Path, Sequence[LpEntry]]
 
 #: Two records of one preview's light more than this far apart (degrees) disagree.
 AGREE_DEG = 0.5
+
+#: A --preview-light more than this far (degrees) from the light recorded for the preview is
+#: said to differ from it: a light typed by hand is rounded to a degree or so.
+GIVEN_DIFFERS_DEG = 1.0
 
 
 @dataclass(frozen=True)
@@ -253,3 +261,33 @@ def resolve_preview(
                 "it with --preview-light AZ,EL"
             )
     return PreviewSource(path, _lit_from_above(first, first_where, path), f"recorded by {short}")
+
+
+def given_light_differs(
+    path: Path, given_az_el: tuple[float, float], rig_lp: RigLp | None = None
+) -> str | None:
+    """A note when ``--preview-light`` is more than :data:`GIVEN_DIFFERS_DEG` from the light a
+    session or the ``--rig`` ``.lp`` records for the preview, else None.
+
+    Why: the given light wins, silently, and the relief is read from the shading as that light
+    would make it. ``rti-rig plan PREVIEW_DIR --preview-light 135,50`` (the preview's default
+    light, typed as the older docs did) planned from a light 14.5° off the LED the dome fired,
+    saying only "(given)". Read at its best: a record that cannot be read says nothing, as the
+    given light stands in for it (:func:`resolve_preview`)."""
+    try:
+        source = resolve_preview(path, rig_lp)
+    except RtiRigError:
+        return None
+    if source.light_az_el_deg is None:
+        return None
+    given = direction_from_az_el(*given_az_el)
+    recorded = direction_from_az_el(*source.light_az_el_deg)
+    off = float(angle_between_deg(np.asarray(given), np.asarray(recorded)))
+    if off <= GIVEN_DIFFERS_DEG:
+        return None
+    az, el = source.light_az_el_deg
+    return (
+        f"--preview-light {given_az_el[0]:g},{given_az_el[1]:g} is {off:.1f}° from the light "
+        f"{source.light_source} (az {az:.1f}°, el {el:.1f}°): the plan used the light given; "
+        "leave --preview-light out to plan with the recorded one"
+    )

@@ -29,7 +29,7 @@ from rti_rig.app.output_files import (
     recorded_images,
     rig_inputs,
 )
-from rti_rig.app.preview_source import resolve_preview
+from rti_rig.app.preview_source import given_light_differs, resolve_preview
 from rti_rig.app.usecases.fit_outlook import fit_needs, fit_outlook
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import direction_from_az_el
@@ -193,6 +193,10 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         if az_el is None and source.light_az_el_deg is not None:
             az_el, light_note = source.light_az_el_deg, source.light_source
         unrecorded = source.unrecorded
+        if az_el is not None and light_note is None:
+            differs = given_light_differs(req.preview, az_el, rig_lp)
+            if differs is not None:
+                notes.append(differs)
         image = read_preview_image(source.image)
     schedule, report = plan(
         PlanRequest(
