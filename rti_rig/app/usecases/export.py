@@ -12,9 +12,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rti_rig.app.output_files import check_output_file, lp_name_note
+from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
+    MANIFEST,
     JournalScan,
     files_lost_since_capture,
     image_names,
@@ -86,6 +88,7 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     total = planned_steps(manifest)  # an adaptive session's maximum, not its starting layout
     scan = scan_journal(root, image_names(total) if total else None)
     entries, left_out = session_lp_report(root, req.linear, scan, manifest)
+    _refuse_another_session(Path(req.out_file), root, entries[0].name if entries else None)
     check_output_file(req.out_file, req.force, {})
     write_lp(req.out_file, entries)
     # lights.lp one image short of the session (a run stopped between a step's record file
@@ -116,6 +119,28 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
         ),
         misnamed=lp_name_note(Path(req.out_file)) or "",
     )
+
+
+def _refuse_another_session(out_file: Path, root: Path, first: str | None) -> None:
+    """Refuse an ``--out`` inside another session's folder than the one exported.
+
+    Why: every session names its images alike (image_001.jpg, ...), and relight, RTIBuilder
+    and ``rti-rig fit`` read an ``.lp``'s names beside it. ``export-lp A --out B/a.lp`` was
+    written with a note to move it, and left in B, relight or RTIBuilder given it paired B's
+    images with A's lights without a word (``rti-rig fit B/a.lp`` fitted them too, its verdict
+    saying "a.lp gives image_002 ... another light than the journal records")."""
+    own = root.resolve()
+    folder = out_file.resolve().parent
+    for f in (folder, *folder.parents):
+        if f == own:  # its own session: names resolve there (the note says where they do)
+            return
+        if (f / MANIFEST).is_file():
+            raise RtiRigError(
+                f"--out {out_file} is in another session ({f}): this .lp names {root}'s "
+                f"images ({first or 'image_001.jpg'}, ...), and relight, RTIBuilder and rti-rig "
+                f"fit read those names beside it, where {f.name}'s own images of the same names "
+                f"lie; write it into {root} or outside any session"
+            )
 
 
 def _raw_lost(root: Path, listed: set[str], scan: JournalScan, adaptive: bool) -> str:

@@ -1,0 +1,50 @@
+"""`export-lp A --out B/x.lp` is refused when B is another session's folder.
+
+Why: every session names its images alike (image_001.jpg, ...), and relight, RTIBuilder and
+`rti-rig fit` read an `.lp`'s names beside it. The file was written there with a note to move
+it; left in B, relight or RTIBuilder given it paired B's images with A's lights without a word
+(`rti-rig fit B/x.lp` fitted them too, its verdict naming the lights the journal disagrees on).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from conftest import CONFIGS, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+RIG = CONFIGS / "simulated_dome.toml"
+
+
+def _session(tmp_path: Path, name: str, lights: str) -> Path:
+    s = tmp_path / name
+    r = runner.invoke(app, ["run", str(RIG), "--out", str(s), "--lights", lights, "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    return s
+
+
+def test_an_export_into_another_sessions_folder_is_refused(tmp_path: Path) -> None:
+    a, b = _session(tmp_path, "séance a", "6"), _session(tmp_path, "séance b", "8")
+    before = sorted(p.name for p in b.iterdir())
+
+    for out in (b / "a.lp", b / "linear" / "a.lp"):
+        r = runner.invoke(app, ["export-lp", str(a), "--out", str(out), "--linear"])
+
+        assert r.exit_code == 2, r.output
+        assert "Traceback" not in r.output
+        text = said(r)
+        assert f"--out {out} is in another session ({b})" in text, text
+        assert "names " + str(a) + "'s images (linear/image_001.tif, ...)" in text, text
+        assert not out.exists()
+    assert sorted(p.name for p in b.iterdir()) == before
+
+
+def test_an_export_into_its_own_session_or_outside_any_is_written(tmp_path: Path) -> None:
+    a = _session(tmp_path, "a", "6")
+    for out in (a / "mine.lp", tmp_path / "outside.lp"):
+        r = runner.invoke(app, ["export-lp", str(a), "--out", str(out)])
+        assert r.exit_code == 0, r.output
+        assert out.is_file()
