@@ -21,6 +21,7 @@ from rti_rig.core.fit_minimums import (
 
 @app.command()
 def plan(
+    ctx: typer.Context,
     preview: Annotated[
         Path | None,
         typer.Argument(
@@ -172,6 +173,9 @@ def plan(
             rig=rig or default_config_path(),
             out_file=out_file,
             lights=lights,
+            # the default had been refused as if asked for ("asked for 12 lights but the dome
+            # has only 8 LEDs") on the shipped 8-LED configs
+            lights_given=_given(ctx, "lights"),
             preview=preview,
             method=method,
             objective=objective,
@@ -204,3 +208,12 @@ def plan(
         except RtiRigError as exc:
             raise fail(exc) from None
         out.print(f"Map of the plan → {figure}")
+
+
+def _given(ctx: typer.Context, name: str) -> bool:
+    """Whether option ``name`` was on the command line (or in the environment), not defaulted.
+
+    By the source's name: typer's context may be its own click's, whose enum is not
+    ``click.core.ParameterSource``."""
+    source = ctx.get_parameter_source(name)
+    return source is not None and source.name not in ("DEFAULT", "DEFAULT_MAP")

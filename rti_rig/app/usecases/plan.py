@@ -55,6 +55,9 @@ class PlanLightsRequest:
     rig: Path
     out_file: Path = Path("plan.lp")
     lights: int = 12
+    #: False where ``lights`` is the command's default, not the user's: a rig with fewer
+    #: lights is then told what the default is (it was told it had "asked for 12 lights").
+    lights_given: bool = True
     #: A preview image or the session folder ``rti-rig preview`` wrote (None: plan without one).
     preview: Path | None = None
     #: None: ``optimal`` with a preview, ``uniform`` without.
@@ -185,6 +188,15 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     else:
         geometry = rig_geometry(loaded)
         arm_order = arm_order_for(loaded)
+    if (
+        not req.lights_given
+        and isinstance(geometry, DomeGeometry)
+        and MIN_PLAN_LIGHTS <= geometry.count < req.lights
+    ):
+        raise RtiRigError(
+            f"{req.rig}: the dome has {geometry.count} LEDs, fewer than the {req.lights} lights "
+            f"plan plans when --lights is not given: give --lights {geometry.count} or fewer"
+        )
     signal_noise = _signal_noise(req, loaded, objective)
     az_el, light_note, image, unrecorded = req.preview_light, None, None, None
     if req.preview is not None:
