@@ -169,5 +169,12 @@ def check_figure_path(path: Path) -> None:
 def write_layout_figure(path: Path, figure: Figure) -> Path:
     """Write ``figure`` to ``path`` (format from the suffix, see :data:`FIGURE_SUFFIXES`)."""
     check_figure_path(path)
-    figure.savefig(path, dpi=150)
+    # atomically, as the plan itself: a Ctrl-C while matplotlib wrote the file had left a
+    # partial map under the name asked, which the next run refused to replace without --force
+    tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
+    try:
+        figure.savefig(tmp, dpi=150, format=path.suffix.lower().lstrip("."))
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
     return path

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from rti_rig.cli.app import app, fail, out, parse_az_el, print_notes
+from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_notes
 from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free): a plan's minimum is the normal's (planner.make_plan)
@@ -192,22 +192,35 @@ def plan(
         planned = plan_lights(request)
     except RtiRigError as exc:
         raise fail(exc) from None
-    print_notes(planned.notes)
-    for line in planned.report.lines():
-        out.print(line, highlight=False, markup=False)
-    out.print(  # the path as it is: a folder named "coin [draft]" is no markup
-        f"Planned {len(planned.schedule)} lights ({planned.method}, {planned.objective}) → "
-        f"{out_file}",
-        markup=False,
-        highlight=False,
-    )
-    if figure is not None:
-        # after the report: a map that cannot be drawn must not hide a plan that was written
-        try:
-            draw_plan_figure(request, planned)
-        except RtiRigError as exc:
-            raise fail(exc) from None
-        out.print(f"Map of the plan → {figure}")
+    try:
+        print_notes(planned.notes)
+        for line in planned.report.lines():
+            out.print(line, highlight=False, markup=False)
+        out.print(  # the path as it is: a folder named "coin [draft]" is no markup
+            f"Planned {len(planned.schedule)} lights ({planned.method}, {planned.objective}) → "
+            f"{out_file}",
+            markup=False,
+            highlight=False,
+        )
+        if figure is not None:
+            # after the report: a map that cannot be drawn must not hide a plan that was written
+            try:
+                draw_plan_figure(request, planned)
+            except RtiRigError as exc:
+                raise fail(exc) from None
+            out.print(f"Map of the plan → {figure}")
+    except KeyboardInterrupt:
+        # the plan is on disk by now: a Ctrl-C while the report or the map was printed or drawn
+        # had said only "rti-rig: stopped (Ctrl-C)", and the next run refused the --out
+        map_said = "" if figure is None else f"; the map {figure} was not drawn"
+        err.print(
+            f"Stopped (Ctrl-C): the plan {out_file} is written ({len(planned.schedule)} "
+            f"lights){map_said}",
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
+        raise typer.Exit(code=130) from None
 
 
 def _given(ctx: typer.Context, name: str) -> bool:
