@@ -208,8 +208,17 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     except DeadLightError as exc:
         raise RtiRigError(_dead_led_advice(req, card, geometry.names, exc)) from None
     text = calibration_toml(cal, loaded.config.name, req.card_session.resolve(), geometry.names)
+    # atomically: a write cut off (a full disk, a Ctrl-C) had left a partial file under the
+    # name, and a card session's own light_calibration.toml is never replaced, so every later
+    # calibrate-lights of the session was refused as "calibrated already"
+    tmp = target.with_name(f".{target.name}.tmp")
     try:
-        target.write_text(text, encoding="utf-8")
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(target)
     except OSError as exc:
-        raise RtiRigError(f"cannot write {target}: {exc.strerror or exc}") from None
+        raise RtiRigError(
+            f"cannot write {target}: {exc.strerror or exc}; nothing was written there"
+        ) from None
+    finally:
+        tmp.unlink(missing_ok=True)
     return CalibrationWritten(cal, card, loaded, geometry, target)
