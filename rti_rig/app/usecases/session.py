@@ -1496,6 +1496,9 @@ def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> Op
     from rti_rig.app.flash_sync import refuse_options
 
     refuse_options(loaded, preview=True)
+    # the folder before the light: a note on which LED stands in for the light asked had been
+    # printed above the refusal of an --out that is not empty or lies in a session
+    SessionFolder.check_new(req.out_dir)
     schedule, notes = preview_schedule(
         rig_geometry(loaded),
         req.light_az_el_deg,
