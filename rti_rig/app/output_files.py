@@ -118,7 +118,15 @@ def lp_name_note(out_file: Path, *, run_reads_it: bool = False) -> str | None:
         return None
     run = "rti-rig run --plan reads it as it is, but " if run_reads_it else ""
     named = out_file.with_suffix(".lp")
+    # a rename onto a file that is there replaces it: said, as the advice had led to it
+    taken = (
+        f" ({named} exists: a rename replaces it, so move that one aside first or choose "
+        "another name ending in .lp)"
+        if named.exists()
+        else ""
+    )
     return (
         f"{out_file} holds light positions in the .lp format but is not named .lp: {run}relight, "
-        f"RTIBuilder and rti-rig fit find an .lp by its name; name it {named} to use it there"
+        f"RTIBuilder and rti-rig fit find an .lp by its name; name it {named} to use it "
+        f"there{taken}"
     )

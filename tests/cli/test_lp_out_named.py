@@ -44,3 +44,22 @@ def test_an_export_written_under_another_name_says_so(tmp_path: Path) -> None:
     assert "run --plan" not in said(r)
     r = runner.invoke(app, ["export-lp", str(s), "--out", str(s / "x.lp")])
     assert r.exit_code == 0 and "not named .lp" not in said(r), r.output
+
+
+def test_the_lp_name_advised_says_when_a_file_has_it_already(tmp_path: Path) -> None:
+    """Why: "name it p.lp to use it there" was said with p.lp already there, and a rename
+    replaces it (a plan of the same object, say)."""
+    kept = tmp_path / "p.lp"
+    r = runner.invoke(app, ["plan", "--lights", "8", "--out", str(kept)])
+    assert r.exit_code == 0, r.output
+    before = kept.read_text()
+    txt = tmp_path / "p.txt"
+
+    r = runner.invoke(app, ["plan", "--lights", "9", "--out", str(txt)])
+
+    assert r.exit_code == 0, r.output
+    assert (
+        f"name it {kept} to use it there ({kept} exists: a rename replaces it, so move that one "
+        "aside first or choose another name ending in .lp)"
+    ) in said(r), said(r)
+    assert kept.read_text() == before
