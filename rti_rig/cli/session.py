@@ -1694,4 +1694,5 @@ def export_lp(
         )
     # escaped: a file in a folder named 'coin [draft]' had been said as 'coin .lp' (rich read
     # '[draft]' as markup)
-    out.print(f"{len(done.entries)} lights → {escape(str(out_file))}")
+    n = len(done.entries)
+    out.print(f"{n} light{'' if n == 1 else 's'} → {escape(str(out_file))}")
