@@ -87,6 +87,7 @@ def _identity_function(
         # In a wheel the mapped packages sit inside rti_rig/: each is hashed under its own name.
         nested = {folder for name, folder in folders.items() if name != "rti_rig" and folder}
         digest = hashlib.sha256()
+        everything: list[tuple[str, Path]] = []
         for name in roots:
             folder = folders[name]
             digest.update(f"package {name}\0".encode())
@@ -105,10 +106,34 @@ def _identity_function(
             for relative, path in sorted(files):
                 digest.update(relative.encode() + b"\0")
                 digest.update(path.read_bytes() + b"\0")
+            where = name.replace(".", "/")
+            everything.extend((f"{where}/{relative}", path) for relative, path in files)
+        fingerprint = digest.hexdigest()[:12]
         version = getattr(rti_rig, "__version__", None)
+        # The code this process runs is what it imported, not what its files say now: the
+        # fingerprint of its first check is kept in the process, and a file changed since
+        # rti-rig was imported here (or since that first check) makes it another code.
+        first = vars(rti_rig).setdefault("_rti_rig_code_first_checked", fingerprint)
+        imported_at = getattr(rti_rig, "IMPORTED_AT_NS", None)
+        changed = sorted(
+            relative
+            for relative, path in everything
+            if isinstance(imported_at, int) and path.stat().st_mtime_ns > imported_at
+        )
+        if changed or first != fingerprint:
+            named = ", ".join(changed[:3]) + (" …" if len(changed) > 3 else "")
+            return {
+                "version": None if version is None else str(version),
+                "fingerprint": first,
+                "problem": (
+                    "its rti-rig source changed after this process imported it"
+                    + (f" ({named})" if named else "")
+                    + ": it runs the code it imported, not the files there now; restart it"
+                ),
+            }
         return {
             "version": None if version is None else str(version),
-            "fingerprint": digest.hexdigest()[:12],
+            "fingerprint": fingerprint,
             "problem": None,
         }
 
@@ -144,11 +169,13 @@ def worker_identities(client: Any) -> dict[str, WorkerCode | Unasked]:
 
 
 def describe(code: WorkerCode) -> str:
-    """``rti-rig 0.1.0, code 1a2b3c4d5e6f`` (or what kept it from being known)."""
-    if code.problem is not None:
+    """``rti-rig 0.1.0, code 1a2b3c4d5e6f`` (or what kept it from being known, or why the
+    code it runs is not what its files say)."""
+    if code.problem is not None and code.version is None and code.fingerprint is None:
         return f"no rti-rig ({code.problem})"
     version = "(no version)" if code.version is None else code.version
-    return f"rti-rig {version}, code {code.fingerprint}"
+    said = f"rti-rig {version}, code {code.fingerprint}"
+    return said if code.problem is None else f"{said}, but {code.problem}"
 
 
 #: The Dask resource a worker holds once its own rti-rig was found to be this code
@@ -164,11 +191,19 @@ def tag_for(code: WorkerCode) -> str:
     return f"{TAG_PREFIX}{code.fingerprint}"
 
 
+#: What a worker's :func:`tagging_plugin` found there (its ``outcome``), read back by the client
+#: to say why a worker still in the cluster holds no tag.
+TAGGED = "tagged"
+#: ... or how it begins when the worker runs other code (then it is refused, not failed).
+OTHER_CODE = "it runs other code than this fit"
+
+
 def tagging_plugin(code: WorkerCode) -> Any:
     """A Dask ``WorkerPlugin`` that, on every worker it is set up on — those there when it is
     registered and every one that joins or restarts later, before that worker takes any task —
     computes that worker's own rti-rig and, only if it is ``code``, gives the worker the
-    resource :func:`tag_for` names.
+    resource :func:`tag_for` names (and takes it back from a worker holding it whose code is
+    no longer ``code``: its source changed since it was tagged).
 
     Why: tasks had been kept to the checked workers by address. A worker restarted by its
     nanny (after a memory kill) comes back on another address, and the fit stopped although
@@ -178,9 +213,20 @@ def tagging_plugin(code: WorkerCode) -> Any:
     ``cloudpickle`` sends it by value (as :func:`_identity_function`): a worker with another
     rti-rig, or none, still reads it, and is simply not tagged.
 
-    Why the pause: Dask reconsiders a task no worker may run (``no-worker``) when a worker
-    joins or resumes, not when one gains a resource; the tagged worker pauses and resumes so
-    that tasks waiting for a tagged worker are given to it."""
+    What it found is kept on the worker, in the plugin's ``outcome``: :data:`TAGGED`, the other
+    code found there, or the error that kept the tag from being given (read by
+    :func:`plugin_outcomes`), so that a worker left untagged is named with its reason.
+
+    Why the pause and resume: Dask's scheduler reconsiders a task no worker may run
+    (``no-worker``) when a worker joins or goes from paused to running, not when a worker gains
+    a resource. A worker that joins (a nanny's restart mid-fit) is set up *after* it joined,
+    so tasks already waiting for a tagged worker would wait for ever. A worker newly tagged
+    while ``running`` is therefore set ``paused`` then ``running`` again, in one step of its
+    event loop (nothing runs between the two: no task is held back, the memory monitor cannot
+    interleave); the scheduler logs the two status changes as a ``worker-status-change``
+    event. A worker that is not ``running`` (paused for memory, or by a user's
+    ``client.run``; closing) is left as it is: it is tagged, and Dask gives it the waiting
+    tasks when it resumes by itself — the tag never resumes a paused worker."""
     from distributed import WorkerPlugin
 
     expected = {"version": code.version, "fingerprint": code.fingerprint, "problem": None}
@@ -195,22 +241,49 @@ def tagging_plugin(code: WorkerCode) -> Any:
             self.expected = expected
             self.resource = resource
             self.amount = TAG_AMOUNT
+            self.outcome: str | None = None
 
         async def setup(self, worker: Any) -> None:
             """Never raises: a worker whose check fails is left untagged, given no task (an
-            error here had failed the registration, and with it the fit, for every worker)."""
+            error here had failed the registration, and with it the fit, for every worker);
+            what happened is kept in ``outcome``."""
             from distributed.core import Status
 
             try:
-                if worker.state.total_resources.get(self.resource) == self.amount:
-                    return  # tagged already (by another fit of this code)
-                if self.identity() != self.expected:
-                    return  # other code (or none): never tagged, given no task of this fit
-                await worker.set_resources(**{self.resource: self.amount})
-                if worker.status == Status.running:
-                    worker.status = Status.paused
-                    worker.status = Status.running
-            except Exception:  # e.g. its scheduler lost meanwhile: untagged
-                return
+                held = worker.state.total_resources.get(self.resource, 0)
+                found = self.identity()
+                if found != self.expected:  # other code (or none, or changed): no task
+                    if held:  # tagged earlier (this code then): taken back
+                        await worker.set_resources(**{self.resource: 0})
+                    said = f"rti-rig {found.get('version')}, code {found.get('fingerprint')}"
+                    if found.get("problem"):
+                        said += f" ({found['problem']})"
+                    self.outcome = f"{OTHER_CODE}: {said}"
+                    return
+                if held != self.amount:
+                    await worker.set_resources(**{self.resource: self.amount})
+                    if worker.status == Status.running:  # see tagging_plugin: wakes tasks
+                        worker.status = Status.paused
+                        worker.status = Status.running
+                self.outcome = TAGGED
+            except Exception as exc:  # e.g. its scheduler lost meanwhile: untagged
+                self.outcome = f"{type(exc).__name__}: {exc}"
 
     return RtiRigCodeTag()
+
+
+def plugin_outcomes(client: Any, name: str, workers: list[str]) -> dict[str, str]:
+    """What the plugin registered as ``name`` found on each of ``workers`` (its ``outcome``;
+    :data:`TAGGED`, or why the worker was not tagged), or why that could not be asked."""
+
+    def outcome(dask_worker: Any) -> str:
+        plugin = dask_worker.plugins.get(name)
+        if plugin is None:
+            return "the rti-rig check was never set up there"
+        return str(getattr(plugin, "outcome", None) or "the rti-rig check has not finished there")
+
+    answers = client.run(outcome, workers=workers, on_error="return")
+    return {
+        w: a if isinstance(a, str) else f"it could not be asked ({type(a).__name__}: {a})"
+        for w, a in answers.items()
+    }
