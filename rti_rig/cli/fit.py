@@ -194,8 +194,9 @@ def fit(
             "--scheduler",
             help="Fit on Dask: 'threads' (this machine's cores, nothing to set up) or the "
             "address of a Dask scheduler (tcp://host:8786; its workers must see the session "
-            "files at the same paths). On a cluster, a batch runs its sessions as parallel "
-            "tasks.",
+            "files at the same paths, and run this same rti-rig, imported since its last "
+            "change: restart them after editing an editable install). On a cluster, a batch "
+            "runs its sessions as parallel tasks.",
         ),
     ] = None,
 ) -> None:

@@ -34,7 +34,6 @@ import os
 import socket
 import threading
 import time
-import uuid
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager, suppress
@@ -77,10 +76,12 @@ from rti_rig.app.usecases.scheduler_probe import (
     unreachable_scheduler,
 )
 from rti_rig.app.usecases.worker_code import (
+    OTHER_CODE,
     Unasked,
     WorkerCode,
     describe,
     local_identity,
+    plugin_outcomes,
     tag_for,
     tagging_plugin,
     worker_identities,
@@ -220,6 +221,8 @@ class Cluster:
     address: str
     workers: frozenset[str]
     tag: str
+    #: the name of this fit's tagging plugin on the scheduler (asked why a worker is untagged)
+    plugin: str = ""
 
     def restrictions(self) -> dict[str, Any]:
         """The keywords of ``Client.submit`` / ``Client.compute`` that keep a task to the
@@ -237,21 +240,39 @@ def workers_by_tag(cluster: Cluster) -> tuple[set[str], set[str]]:
 
 def checked_gone(cluster: Cluster, kept: str) -> str:
     """What is said when no worker checked to run this rti-rig has been in the cluster for
-    :data:`CHECKED_GRACE_S` (the tasks wait for no one), naming the workers there, refused."""
+    :data:`CHECKED_GRACE_S` (the tasks wait for no one), naming the workers there and why each
+    holds no tag: other code, or a check that failed on a worker still there (which had been
+    said to have left)."""
     try:
         others: set[str] | None = workers_by_tag(cluster)[1]
     except Exception:  # the scheduler lost meanwhile: who is there is not known
         others = None
+    why: dict[str, str] = {}
+    if others:
+        try:
+            why = plugin_outcomes(cluster.client, cluster.plugin, sorted(others))
+        except Exception:  # the scheduler lost meanwhile: the workers are named alone
+            why = {}
+    failed = sorted(w for w, o in why.items() if not o.startswith(OTHER_CODE))
+    named = ", ".join(f"{w} ({why[w]})" if w in why else w for w in sorted(others or ()))
     if others is None:  # not "no worker is there now": the scheduler did not say
         there = "which workers are there now is not known (the scheduler did not answer)"
+    elif failed:
+        there = "the workers there now were not tagged, the rti-rig check failing on "
+        there += f"{', '.join(failed)} (see their logs, restart them): {named}"
     elif others:
-        there = "the workers there now were refused, their rti-rig being another or none: "
-        there += ", ".join(sorted(others))
+        there = f"the workers there now were refused, their rti-rig being another or none: {named}"
     else:
         there = "no worker is there now"
-    return (
+    lead = (
         f"the {len(cluster.workers)} worker(s) of the Dask cluster at {cluster.address!r} whose "
-        "rti-rig was checked when the fit began have all left it, and no worker running this "
+        "rti-rig was checked when the fit began have all left it"
+        if not failed
+        else f"no worker of the Dask cluster at {cluster.address!r} holds the tag of this "
+        "rti-rig any longer"
+    )
+    return (
+        f"{lead}, and no worker running this "
         f"rti-rig ({describe(local_identity())}) joined in the {CHECKED_GRACE_S:.0f} s after; "
         f"{there}. A worker is checked as it joins and given tasks only if it runs this same "
         f"rti-rig, so the fit cannot go on: {kept}; run the same command again once workers "
@@ -350,7 +371,10 @@ def scheduler_client(address: str) -> Iterator[Cluster | None]:
             ) from None
         checked = _refuse_other_code(client, address)
         mine = local_identity()
-        plugin_name = f"rti-rig-code-check-{uuid.uuid4().hex}"  # this fit's, removed after it
+        _remove_stale_plugins(client)
+        # This fit's, named after its client: removed after it, or by a later fit once this
+        # client is gone from the scheduler (killed before it could remove it).
+        plugin_name = f"{PLUGIN_PREFIX}{client.id}"
         try:
             # A worker lost during the registration fails it (Dask's CommClosedError), but the
             # scheduler keeps the plugin before telling the workers, so every worker that joins
@@ -358,7 +382,9 @@ def scheduler_client(address: str) -> Iterator[Cluster | None]:
             # said by the waiting code, and no tagged worker by _CheckedWatch, in their words.
             with suppress(Exception):
                 client.register_plugin(tagging_plugin(mine), name=plugin_name)
-            yield Cluster(client, address, checked, tag_for(mine))
+            cluster = Cluster(client, address, checked, tag_for(mine), plugin_name)
+            _refuse_none_tagged(cluster)
+            yield cluster
         finally:
             with suppress(Exception):  # the scheduler lost: it took the plugin with it
                 client.unregister_worker_plugin(plugin_name)
@@ -366,11 +392,81 @@ def scheduler_client(address: str) -> Iterator[Cluster | None]:
         _close_quietly(client)
 
 
+#: The name of a fit's worker plugin, before its client's id (``Client-…``). Plugins named
+#: ``rti-rig-code-check-`` followed by 32 hex digits (before 2026-12-01) named no client.
+PLUGIN_PREFIX = "rti-rig-code-check-"
+
+
+def _remove_stale_plugins(client: Any) -> None:
+    """Remove from the scheduler the tagging plugins of fits whose client is gone.
+
+    Why: a fit removes its plugin when it ends, but a client killed (SIGKILL, a lost machine)
+    cannot, and the scheduler kept the plugin for ever: every worker joining later ran it (an
+    rti-rig check of other code, its tag, its pause and resume), plugins of older rti-rig
+    versions included, each fit adding one. A plugin is this fit's if its name holds the id of
+    a client the scheduler still has; any other with :data:`PLUGIN_PREFIX` is stale. Asked on
+    the scheduler (``run_on_scheduler``, a nested function sent by value); a scheduler that
+    refuses it (``distributed.scheduler.pickle`` off) keeps them, as before."""
+    prefix = PLUGIN_PREFIX
+
+    def stale(dask_scheduler: Any) -> list[str]:
+        clients = [c for c in dask_scheduler.clients if c.startswith("Client-")]
+        return [
+            name
+            for name in dask_scheduler.worker_plugins
+            if name.startswith(prefix) and not any(name == prefix + c for c in clients)
+        ]
+
+    try:
+        names = client.run_on_scheduler(stale)
+    except Exception:  # pickled functions refused there, or the scheduler lost: kept
+        return
+    for name in names:
+        with suppress(Exception):  # removed meanwhile by another fit
+            client.unregister_worker_plugin(name)
+
+
+def _refuse_none_tagged(cluster: Cluster) -> None:
+    """Refuse, naming each worker and what failed there, a cluster where no worker holds the
+    tag once the plugin is registered although the checked workers are there.
+
+    Why: a check that fails on a worker still there (its resource refused by the scheduler,
+    its files unreadable) leaves it untagged; with none tagged the fit waited
+    :data:`CHECKED_GRACE_S`, then said every checked worker had left the cluster."""
+    try:
+        tagged, untagged = workers_by_tag(cluster)
+    except Exception:  # the scheduler lost: said by the waiting code, in its words
+        return
+    present = untagged & cluster.workers
+    if tagged or not present:
+        return  # a worker to run the tasks, or the checked ones gone: _CheckedWatch's to say
+    try:
+        why = plugin_outcomes(cluster.client, cluster.plugin, sorted(present))
+    except Exception:  # the scheduler lost: said by the waiting code, in its words
+        return
+    failed = {w: o for w, o in why.items() if not o.startswith(OTHER_CODE)}
+    if not failed:  # replaced by workers of other code: _CheckedWatch's to say, as refused
+        return
+    named = "; ".join(f"{w} ({o})" for w, o in sorted(failed.items()))
+    raise SchedulerError(
+        f"the rti-rig check could not tag any of the {len(present)} worker(s) of the Dask "
+        f"cluster at {cluster.address!r} checked to run this rti-rig "
+        f"({describe(local_identity())}), though they are still in it: {named}. Nothing was "
+        "sent: see those workers' logs, restart them (`dask worker ADDRESS`), and run the "
+        "same command"
+    )
+
+
 def _refuse_other_code(client: Any, address: str) -> frozenset[str]:
     """Refuse a cluster whose workers run another rti-rig than this machine, before any task
     is sent (:mod:`rti_rig.app.usecases.worker_code` says why); the workers checked."""
-    workers = worker_identities(client)
     mine = local_identity()
+    if mine.problem is not None:  # this process's own code is not its files' any more
+        raise SchedulerError(
+            f"this machine's {describe(mine)}: the workers cannot be checked against the code "
+            "this command runs. Nothing was sent: run the same command again"
+        )
+    workers = worker_identities(client)
     untold = {w: ident for w, ident in workers.items() if isinstance(ident, Unasked)}
     differ = {
         w: ident for w, ident in workers.items() if isinstance(ident, WorkerCode) and ident != mine
