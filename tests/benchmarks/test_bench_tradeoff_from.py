@@ -556,7 +556,9 @@ def test_a_folder_of_links_to_the_acquisitions_images_is_refused_as_out_even_wit
     """Images linked into a project's jpeg-exports/ from where the shots lie (a card's copy),
     the `.lp` in assembly-files/: the refusal compared `--out` with the folders the links
     resolve to only, so `--out` jpeg-exports/ with `--force` wrote results.csv, summary.md and
-    the plots among the linked images (which RTIBuilder imports by folder)."""
+    the plots among the linked images (which RTIBuilder imports by folder). Both folders are
+    refused: the one the links are listed in (jpeg-exports/), and the one they resolve to
+    (the card's copy, where the images themselves lie)."""
     shots = _acquisition(tmp_path / "card").parent
     project = tmp_path / "project"
     (project / "jpeg-exports").mkdir(parents=True)
@@ -568,5 +570,7 @@ def test_a_folder_of_links_to_the_acquisitions_images_is_refused_as_out_even_wit
         lines[i] = f"H:\\RTI\\project\\jpeg-exports\\{name} {rest}"  # RTIBuilder's
     lp = project / "assembly-files" / "dirs.lp"
     lp.write_text("\n".join(lines) + "\n")
-    out = project / "jpeg-exports"
-    _refused_as_out(lp, out)
+    links = list((project / "jpeg-exports").iterdir())
+    assert links and all(p.is_symlink() for p in links)
+    _refused_as_out(lp, project / "jpeg-exports")
+    _refused_as_out(lp, shots)  # the links' targets: only the links, resolved, name it
