@@ -87,6 +87,7 @@ def _identity_function(
         # In a wheel the mapped packages sit inside rti_rig/: each is hashed under its own name.
         nested = {folder for name, folder in folders.items() if name != "rti_rig" and folder}
         digest = hashlib.sha256()
+        code = hashlib.sha256()  # the .py files alone: what a process imports and keeps
         everything: list[tuple[str, Path]] = []
         for name in roots:
             folder = folders[name]
@@ -103,24 +104,29 @@ def _identity_function(
                     and not any(parent in nested for parent in path.parents if parent != folder)
                 ):
                     files.append((path.relative_to(folder).as_posix(), path))
-            for relative, path in sorted(files):
-                digest.update(relative.encode() + b"\0")
-                digest.update(path.read_bytes() + b"\0")
             where = name.replace(".", "/")
-            everything.extend((f"{where}/{relative}", path) for relative, path in files)
+            for relative, path in sorted(files):
+                content = path.read_bytes()
+                digest.update(relative.encode() + b"\0" + content + b"\0")
+                if path.suffix == ".py":
+                    code.update(f"{where}/{relative}".encode() + b"\0" + content + b"\0")
+                    everything.append((f"{where}/{relative}", path))
         fingerprint = digest.hexdigest()[:12]
         version = getattr(rti_rig, "__version__", None)
-        # The code this process runs is what it imported, not what its files say now: the
-        # fingerprint of its first check is kept in the process, and a file changed since
-        # rti-rig was imported here (or since that first check) makes it another code.
-        first = vars(rti_rig).setdefault("_rti_rig_code_first_checked", fingerprint)
+        # The code this process runs is what it imported, not what its .py files say now (the
+        # .toml and .lp are read when used): the .py digest of its first check is kept in the
+        # process, and a .py file changed since rti-rig was imported here (or since that first
+        # check) makes it another code.
+        first, first_code = vars(rti_rig).setdefault(
+            "_rti_rig_code_first_checked", (fingerprint, code.hexdigest())
+        )
         imported_at = getattr(rti_rig, "IMPORTED_AT_NS", None)
         changed = sorted(
             relative
             for relative, path in everything
             if isinstance(imported_at, int) and path.stat().st_mtime_ns > imported_at
         )
-        if changed or first != fingerprint:
+        if changed or first_code != code.hexdigest():
             named = ", ".join(changed[:3]) + (" …" if len(changed) > 3 else "")
             return {
                 "version": None if version is None else str(version),
