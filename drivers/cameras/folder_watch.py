@@ -1128,6 +1128,16 @@ class FolderWatchCamera:
                         "is no TIFF (its first bytes are written and are not a TIFF header: a "
                         "damaged file, or another kind saved under a TIFF name)",
                     ) from exc
+                if isinstance(exc, ImageReadError) and exc.several:
+                    # two full-size images, both written: more bytes cannot make one of them
+                    # a thumbnail, and "is it complete?" or "damaged" would be untrue
+                    raise self._damaged(
+                        message,
+                        path,
+                        "is a whole TIFF that reads",
+                        "In the program saving the shots, save one image per TIFF (a "
+                        "thumbnail or preview page besides it is fine)",
+                    ) from exc
                 extent = tiff_extent(path) if tiff else None
                 steady = tried is not None and _identity(path) == tried  # still what was read
                 if (

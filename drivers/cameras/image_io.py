@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import CaptureError
+from rti_rig.core.image_files import SeveralFullSizeImages, tiff_main_image
 from rti_rig.drivers.cameras.tiff_ifd import header_size
 from rti_rig.drivers.cameras.tiff_structure import (
     COMPLETE_TIFF_ADVICE,
@@ -89,7 +90,8 @@ class ImageReadError(CaptureError):
     reads past, logging; only its bytes tell which), ``compression`` (the name of a TIFF
     compression the reader does not decode, None otherwise) and ``contradicts`` (its own tags
     contradict each other: :func:`tiff_contradiction`; a damaged file, unless its bytes are
-    not all written yet).
+    not all written yet) and ``several`` (a whole TIFF of two or more full-size images, which
+    one is the photograph not known: no wait or copy mends it, saving one image does).
 
     Why fields: a caller that words the failure its own way (a watched folder naming the
     folder's file, not the session's copy it read, and whether waiting can help) had cut this
@@ -105,6 +107,7 @@ class ImageReadError(CaptureError):
         no_pixels: bool = False,
         compression: str | None = None,
         contradicts: bool = False,
+        several: bool = False,
     ) -> None:
         self.path = path
         self.reason = reason
@@ -112,8 +115,13 @@ class ImageReadError(CaptureError):
         self.no_pixels = no_pixels
         self.compression = compression
         self.contradicts = contradicts
+        self.several = several
         advice = (
-            f": {SAVE_READABLE}" if compression else f": {COMPLETE_TIFF_ADVICE}" if is_tiff else ""
+            f": {SAVE_READABLE}"
+            if compression
+            else f": {COMPLETE_TIFF_ADVICE}"
+            if is_tiff and not several
+            else ""
         )
         detail = f" ({reason})" if reason else ""
         super().__init__(device, f"cannot read image file {path}{detail}{advice}", "read")
@@ -192,8 +200,16 @@ def read_image_file(path: Path, device: str) -> NDArray:
             raise ImageReadError(device, path, cut, is_tiff=True)
         try:
             with tifffile.TiffFile(path) as tif:
-                image = tif.asarray()
-                contradiction = tiff_contradiction(tif.pages[0]) if len(tif.pages) else None
+                # the full-resolution image, not IFD0: a camera or tethering program may put
+                # a thumbnail first (it had been taken as the shot, at thumbnail size)
+                main = tiff_main_image(tif) if tif.series else None
+                image = main.asarray() if main is not None else tif.asarray()
+                page = main.keyframe if main is not None else None
+                if page is None and len(tif.pages):
+                    page = tif.pages[0]
+                contradiction = tiff_contradiction(page) if page is not None else None
+        except SeveralFullSizeImages as exc:
+            raise ImageReadError(device, path, str(exc), is_tiff=True, several=True) from exc
         except (ValueError, OSError, RuntimeError, struct.error) as exc:
             # a TIFF cut short or not a TIFF at all (tifffile raises ValueError, TiffFileError
             # among them), or compressed data that will not decompress (imagecodecs' errors

@@ -277,6 +277,12 @@ def image_truncation(path: Path) -> str | None:
     return jpeg_truncation(p)
 
 
+class SeveralFullSizeImages(ValueError):
+    """A TIFF holding more than one full-size image, none a thumbnail of another (raised by
+    :func:`tiff_main_image`). Its own kind, not a damaged file's: the file is whole and reads,
+    so "copy it again" or "wait for it" would not help; saving it as a TIFF of one image does."""
+
+
 def tiff_main_image(tif: Any) -> Any:
     """The full-resolution image of an open :class:`tifffile.TiffFile`, as a page series
     (``.keyframe`` its first page, ``.asarray()`` its pixels, ``.pages`` its pages).
@@ -306,11 +312,35 @@ def tiff_main_image(tif: Any) -> Any:
             f"{int(s.keyframe.imagewidth)}x{int(s.keyframe.imagelength)} {s.dtype}"
             for s in (best, *rivals)
         )
-        raise ValueError(
+        raise SeveralFullSizeImages(
             f"it holds {1 + len(rivals)} full-size images ({sizes}) and which one is the "
             "photograph is not known; save it again as a TIFF of one image"
         )
     return best
+
+
+def tiff_several_images(path: Path) -> str | None:
+    """Why the TIFF at ``path`` cannot give one image, when it holds two or more full-size
+    images (:class:`SeveralFullSizeImages`: the file's name, then its words); None for any
+    other file, or a TIFF tifffile cannot parse (its reader names that problem).
+
+    Why apart from the unreadable files: such a file is whole and reads, so a check that
+    listed it with them had advised copying it again from the camera or card, which gives
+    the same two images back."""
+    p = Path(path)
+    with open(p, "rb") as fh:
+        if fh.read(4) not in TIFF_MAGIC:
+            return None
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(p) as tif:
+            tiff_main_image(tif)
+    except SeveralFullSizeImages as exc:
+        return f"{p.name}: {exc}"
+    except Exception:  # tifffile raises many kinds; the decoder names the problem later
+        return None
+    return None
 
 
 def tiff_extent(
