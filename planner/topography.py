@@ -35,7 +35,15 @@ from numpy.typing import NDArray
 
 from rti_rig.core.errors import ConfigError, ScheduleError
 from rti_rig.core.geometry import direction_from_az_el, normalize
-from rti_rig.core.image_files import jpeg_truncation
+from rti_rig.core.image_files import (
+    TIFF_MAGIC,
+    SeveralFullSizeImages,
+    colour_or_grey,
+    jpeg_truncation,
+    tiff_is_planar,
+    tiff_main_image,
+    tiff_samples_last,
+)
 
 #: Long side, in pixels, of the image the planner works on.
 PLANNING_SIDE_PX = 256
@@ -94,12 +102,39 @@ def read_preview(path: Path) -> NDArray:
     why = jpeg_truncation(p)  # OpenCV decodes a cut-short JPEG, its missing part grey
     if why is not None:
         raise ScheduleError(f"{p}: damaged JPEG: {why}; copy it again from the camera or card")
+    tiff = _read_tiff_preview(p)
+    if tiff is not None:
+        return tiff
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise ScheduleError(f"{p}: cannot read this file as an image (JPEG, PNG or TIFF)")
     if img.ndim == 3 and img.shape[2] >= 3:
         img = cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2RGB)
     return img
+
+
+def _read_tiff_preview(p: Path) -> NDArray | None:
+    """A TIFF preview's full-resolution image in RGB order, its type kept; None when ``p`` is
+    no TIFF or tifffile cannot read it (OpenCV then tries, and names the failure).
+
+    Why not OpenCV: it reads IFD0, and some cameras and tethering programs put a small
+    thumbnail there, the photograph in a later IFD or a SubIFD: the plan had been made from
+    the thumbnail. :func:`~rti_rig.core.image_files.tiff_main_image` picks the image, as the
+    replay rig and the watched folder do."""
+    with open(p, "rb") as fh:
+        if fh.read(4) not in TIFF_MAGIC:
+            return None
+    import tifffile  # on a TIFF only: planning from a JPEG never needs it
+
+    try:
+        with tifffile.TiffFile(p) as tif:
+            image = tiff_main_image(tif)
+            pixels = tiff_samples_last(image.asarray(), tiff_is_planar(image.keyframe))
+    except SeveralFullSizeImages as exc:
+        raise ScheduleError(f"preview {p}: {exc}") from None
+    except Exception:  # tifffile raises many kinds for a damaged file; OpenCV's turn
+        return None
+    return np.ascontiguousarray(colour_or_grey(pixels))
 
 
 def downsample(image: NDArray[np.float64], max_side: int = PLANNING_SIDE_PX) -> NDArray:
