@@ -20,6 +20,7 @@ from rti_rig.core.image_files import (
     is_camera_raw,
     read_image_any,
     tiff_sample_problem,
+    tiff_several_images,
 )
 from rti_rig.core.lp_format import LpEntry, image_paths, missing_images_advice
 
@@ -151,10 +152,16 @@ def check_image_files(
     layouts: dict[str, tuple[int, int, bool]] = {}
     unreadable: list[str] = []
     unsupported: list[str] = []
+    several: list[str] = []
     for n in present:
         path = paths[n]
         if why_cut[n] is not None:
             continue  # said above (or, headers_only, by the reader)
+        many = tiff_several_images(path)  # whole and readable: not "copy it again"
+        if many is not None:
+            if not headers_only:
+                several.append(many)
+            continue
         problem = tiff_sample_problem(path)  # a float TIFF has a header like any other
         if problem is not None:
             if not headers_only:
@@ -176,6 +183,12 @@ def check_image_files(
             f"{len(unreadable)} of {len(names)} image(s) beside it cannot be read "
             f"({'; '.join(unreadable[:5])}{' ...' if len(unreadable) > 5 else ''}); copy them "
             "again from the camera or card, or list only the others"
+        )
+    if several:
+        problems.append(
+            f"{len(several)} of {len(names)} image(s) beside it are whole TIFFs of more than "
+            f"one full-size image, not damaged ({'; '.join(several[:3])}"
+            f"{' ...' if len(several) > 3 else ''}), or list only the others"
         )
     if unsupported:
         problems.append(

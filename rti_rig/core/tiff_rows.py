@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.errors import ImageFileError
 from rti_rig.core.image_files import (
+    SeveralFullSizeImages,
     colour_or_grey,
     pixels_hasher,
     tiff_is_planar,
@@ -227,7 +228,10 @@ def _identity(st: os.stat_result) -> tuple[int, ...]:
 
 def _unreadable(path: Path, exc: BaseException) -> ImageFileError:
     """A TIFF tifffile cannot read, named with tifffile's reason and what to do (it had
-    reached the user as a traceback)."""
+    reached the user as a traceback). A whole TIFF of several full-size images is said as
+    that: copying it again gives the same images back."""
+    if isinstance(exc, SeveralFullSizeImages):
+        return ImageFileError(f"{path}: {exc}, or leave it out of the .lp")
     return ImageFileError(
         f"{path}: cannot be read as a TIFF ({type(exc).__name__}: {exc}); copy it again from "
         "the original, save it again as an uncompressed or zlib/LZW 8- or 16-bit TIFF, or "

@@ -81,7 +81,15 @@ def test_a_tiff_with_two_different_full_size_images_is_refused_by_name(tmp_path:
     assert "img03.tif" in said and "2 full-size images" in said, said
     assert "save it again as a TIFF of one image" in said, said
     assert said.endswith("RESULT: FAIL") and "Traceback" not in said
+    # what it is (whole, two images), not an unreadable file to copy again from the card
+    assert "whole TIFFs of more than one full-size image" in said, said
+    assert "cannot be read" not in said and "copy them again" not in said, said
     r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")])
     said = " ".join(r.output.split())
     assert r.exit_code == 2 and "img03.tif" in said and "2 full-size images" in said, said
     assert not (tmp_path / "s" / "linear").exists() and "Traceback" not in said
+    r = runner.invoke(app, ["fit", str(acq / "dirs.lp"), "--out", str(tmp_path / "f")])
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0 and "img03.tif" in said and "2 full-size images" in said, said
+    assert "save it again as a TIFF of one image" in said and "Traceback" not in said, said
+    assert "cannot be read" not in said and "copy it again" not in said, said
