@@ -152,3 +152,35 @@ def test_more_lights_than_the_band_holds_are_refused_with_a_band_that_holds_them
     assert r.exit_code == 0, said(r)
     lit = _elevations(tmp_path / "wide")
     assert len(lit) == 14 and max(lit) <= float(ceiling) + 1e-6, lit
+
+
+@pytest.mark.slow
+def test_more_lights_than_an_arm_offers_are_refused_with_a_command_that_runs(
+    tmp_path: Path,
+) -> None:
+    """`--adaptive --lights 130 --max-elevation-deg 30` on the virtual arm: "give at most 120
+    (or widen --min/--max-elevation-deg)" gave no value, and no value would do: an arm's
+    candidates are a fixed number of directions spread over whatever band is asked, so a wider
+    band holds no more. The refusal says so and gives the command with the count it offers,
+    which runs in the band."""
+    arm = CONFIGS / "virtual_arm.toml"
+    r = runner.invoke(
+        app,
+        ["run", str(arm), "--out", str(tmp_path / "s"), "--adaptive", "--lights", "130",
+         "--max-elevation-deg", "30"],
+    )  # fmt: skip
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "widen --min/--max-elevation-deg" not in text and "a wider band holds no" in text, text
+    offered = int(text.split("this rig offers ", 1)[1].split(" lights between 0° and 30°")[0])
+    assert offered < 130
+    # true of every band: asked at every elevation, the arm offers as many
+    r = runner.invoke(app, ["run", str(arm), "--out", str(tmp_path / "s"), "--adaptive",
+                            "--lights", "130"])  # fmt: skip
+    assert f"this rig offers {offered} lights an adaptive" in said(r), said(r)
+    argv = _advised(text, "lighting rules): ", tmp_path, "advised")
+    assert argv[argv.index("--lights") + 1] == str(offered), argv
+    r = runner.invoke(app, [*argv, "--no-verdict"])
+    assert r.exit_code == 0, said(r)
+    lit = _elevations(tmp_path / "advised")
+    assert len(lit) == offered and max(lit) <= 30.0 + 1e-6, lit

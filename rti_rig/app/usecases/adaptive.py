@@ -63,7 +63,7 @@ from rti_rig.planner.adaptive import (
 from rti_rig.planner.adaptive_bias import simulate_error_deg
 from rti_rig.planner.adaptive_relight import OBJECTIVES
 from rti_rig.planner.adaptive_until import choose_until, reaches_target, upper_error_deg
-from rti_rig.planner.objectives import candidates_for, snap_unique
+from rti_rig.planner.objectives import ARM_CANDIDATES, candidates_for, snap_unique
 from rti_rig.planner.uniform import band_run_options, select_uniform_leds
 
 #: Width (px) of the grey copies the decisions are fitted on (a 24-MP image is shrunk once).
@@ -848,9 +848,7 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     else:
         assert isinstance(geometry, ArmGeometry)
         arm = arm_below(geometry, hi)
-        dirs = candidates_for(arm, lo).directions
-        ok = [rig.lighting.problem(LightStep(tuple(d))) is None for d in dirs]
-        dirs, leds = dirs[np.asarray(ok, dtype=bool)], None
+        dirs, leds = _arm_candidates(rig, geometry, band), None
         cap = ARM_MAX_LIGHTS
     if default_max is not None:
         cap = min(cap, default_max)
@@ -1251,14 +1249,17 @@ def _check_min_within(
     offered: int,
     band: tuple[float, float] = _FULL_BAND,
     el: NDArray[np.float64] | None = None,
+    advice: Callable[[], str] | None = None,
 ) -> None:
     """``--min-lights M`` above what the rig offers (in the band) is refused; ``el``: a dome's
-    LED elevations (°), for the band that would hold M (:func:`_widen_to_hold`)."""
+    LED elevations (°), for the band that would hold M (:func:`_widen_to_hold`); ``advice``:
+    what follows "give at most …" instead (an arm's, :func:`_arm_widen_to_hold`), asked only
+    when the request is refused."""
     if min_lights > offered:
+        widen = advice() if advice is not None else _widen_to_hold(min_lights, band, el)
         raise RtiRigError(
             f"--min-lights {min_lights}: this rig offers {offered} lights{_band_words(band)} "
-            f"an adaptive session can use; give at most {offered}"
-            f"{_widen_to_hold(min_lights, band, el)}"
+            f"an adaptive session can use; give at most {offered}{widen}"
         )
 
 
@@ -1288,14 +1289,16 @@ def _check_lights_within(
     offered: int,
     band: tuple[float, float] = _FULL_BAND,
     el: NDArray[np.float64] | None = None,
+    advice: Callable[[], str] | None = None,
 ) -> None:
     """``--lights N`` above what the rig offers is refused, as a planned session's is (it was
-    capped without a word: 100 asked of a 48-LED dome ran 48); ``el`` as
+    capped without a word: 100 asked of a 48-LED dome ran 48); ``el`` and ``advice`` as
     :func:`_check_min_within`'s."""
     if lights is not None and lights > offered:
+        widen = advice() if advice is not None else _widen_to_hold(lights, band, el)
         raise RtiRigError(
             f"--lights {lights}: this rig offers {offered} lights{_band_words(band)} an "
-            f"adaptive session can use; give at most {offered}{_widen_to_hold(lights, band, el)}"
+            f"adaptive session can use; give at most {offered}{widen}"
         )
 
 
@@ -1406,6 +1409,56 @@ def _band_holding(
     return None
 
 
+def _arm_candidates(rig, geometry: ArmGeometry, band: tuple[float, float]) -> NDArray[np.float64]:  # type: ignore[no-untyped-def]
+    """An arm's candidate directions in ``band`` that its rig's own lighting rules accept:
+    the lights an adaptive session on it chooses from (:func:`adaptive_plan`)."""
+    from rti_rig.planner.uniform import arm_below
+
+    dirs = candidates_for(arm_below(geometry, band[1]), band[0]).directions
+    ok = [rig.lighting.problem(LightStep(tuple(d))) is None for d in dirs]
+    return dirs[np.asarray(ok, dtype=bool)]
+
+
+def _arm_widen_to_hold(  # type: ignore[no-untyped-def]
+    rig,
+    loaded,
+    need: int,
+    offered: int,
+    band: tuple[float, float],
+    asked: Callable[[int], str],
+) -> str:
+    """The advice after "give at most ``offered``" for an arm asked ``need`` lights in
+    ``band``: the band widened to hold them where one would (its ceiling raised to the top,
+    else its floor lowered to 0, else every elevation: counted with the rig's own rules), else
+    why none would and the working command, ``asked(offered)`` being the session's options with
+    ``offered`` in place of the count refused.
+
+    Why: the dome's refusal names the band that holds the session; an arm's said "widen
+    --min/--max-elevation-deg" with no value, and a wider band holds no more lights on an arm:
+    its candidates are :data:`ARM_CANDIDATES` directions spread over whatever band is asked,
+    so widening only spreads them further apart (the virtual arm offers 120 below 30° and 120
+    at every elevation)."""
+    lo, hi = band
+    tried: list[tuple[float, float]] = []
+    for wider in ((lo, 90.0), (0.0, hi), _FULL_BAND):
+        if wider == tuple(band) or wider in tried:
+            continue
+        tried.append(wider)
+        try:
+            held = len(_arm_candidates(rig, rig.geometry, wider))
+        except RtiRigError:  # a band the arm cannot light at all
+            continue
+        if held >= need:
+            return f" (or widen the band to hold {need}:{_band_options(wider)})"
+    config = shlex.quote(str(loaded.path))
+    widening = "; a wider band holds no more on this arm" if tuple(band) != _FULL_BAND else ""
+    return (
+        f"{widening} (an arm's lights are its {ARM_CANDIDATES} candidate directions spread over "
+        f"the band asked, {offered} of them within its reach and lighting rules): rti-rig run "
+        f"{config} --out DIR {asked(offered)}{_band_options(band)}"
+    )
+
+
 def open_adaptive_session(  # type: ignore[no-untyped-def]
     loaded,
     out_dir: Path,
@@ -1470,9 +1523,35 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
             default_max=None if lights is not None else default_max_lights(loaded, until_error_deg),
         )
         if not isinstance(geometry, DomeGeometry):  # an arm's reachable lights need the rig's
-            _check_lights_within(lights, len(plan.candidates), band)  # own rules
+            in_reach = len(plan.candidates)  # own rules
+
+            def options(lights_now: int | None, min_now: int | None) -> str:
+                """The session's options as given, with these counts."""
+                words = (
+                    f"--until-error {until_error_deg:g}"
+                    if until_error_deg is not None
+                    else "--adaptive"
+                )
+                words += f" --lights {lights_now}" if lights_now is not None else ""
+                words += f" --min-lights {min_now}" if min_now is not None else ""
+                return words + (f" --objective {objective}" if objective != "normals" else "")
+
+            def widen(need: int, asked: Callable[[int], str]) -> Callable[[], str]:
+                return lambda: _arm_widen_to_hold(rig, loaded, need, in_reach, band, asked)
+
+            _check_lights_within(
+                lights,
+                in_reach,
+                band,
+                advice=widen(lights or 0, lambda n: options(n, min_lights)),
+            )
             if min_lights is not None:
-                _check_min_within(min_lights, len(plan.candidates), band)
+                _check_min_within(
+                    min_lights,
+                    in_reach,
+                    band,
+                    advice=widen(min_lights, lambda n: options(lights, n)),
+                )
         source = AdaptiveSteps(rig, plan, until_error_deg, objective, min_lights=min_lights)
         schedule = source.start_schedule()
         validate_schedule(rig, schedule)  # the starting layout, before anything moves
