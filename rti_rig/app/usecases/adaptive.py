@@ -1265,7 +1265,8 @@ def _check_min_within(
 
 def _widen_to_hold(need: int, band: tuple[float, float], el: NDArray[np.float64] | None) -> str:
     """`` (or widen the band to hold N: --max-elevation-deg C)`` for a band asked for, where a
-    dome's elevations ``el`` say which would (a generic "widen" where they do not: an arm);
+    dome's elevations ``el`` say which would (a generic "widen" where they do not: an arm's
+    refusal words its own, :func:`_arm_widen_to_hold`);
     nothing over every elevation. Why: "widen --min/--max-elevation-deg" gave no value."""
     if tuple(band) == _FULL_BAND:
         return ""
@@ -1409,7 +1410,9 @@ def _band_holding(
     return None
 
 
-def _arm_candidates(rig, geometry: ArmGeometry, band: tuple[float, float]) -> NDArray[np.float64]:  # type: ignore[no-untyped-def]
+def _arm_candidates(  # type: ignore[no-untyped-def]
+    rig, geometry: ArmGeometry, band: tuple[float, float]
+) -> NDArray[np.float64]:
     """An arm's candidate directions in ``band`` that its rig's own lighting rules accept:
     the lights an adaptive session on it chooses from (:func:`adaptive_plan`)."""
     from rti_rig.planner.uniform import arm_below
