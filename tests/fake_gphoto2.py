@@ -136,6 +136,10 @@ class Body:
     chatter_s: float = 0.0
     chatter_clock: Any = None
     chatter_limit: int = 10_000
+    #: the computer's disk takes this many more downloads, then is full: libgphoto2's
+    #: ``gp_file_save`` then fails its ``fwrite``, unlinks the partial file and returns
+    #: GP_ERROR (-1, "Unspecified error"), which python-gphoto2 raises (None: never full)
+    disk_free_saves: int | None = None
     powered: bool = True
     off_at_shot: int | None = None  # switched off when asked for this shot (1-based)
     shots: int = 0
@@ -244,6 +248,10 @@ def make_module(body: Body) -> types.ModuleType:
             self._data = data
 
         def save(self, target: str) -> None:
+            if body.disk_free_saves is not None:
+                if body.disk_free_saves <= 0:
+                    raise GPhoto2Error(-1)
+                body.disk_free_saves -= 1
             with open(target, "wb") as fh:
                 fh.write(self._data)
 

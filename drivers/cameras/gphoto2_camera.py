@@ -648,7 +648,7 @@ class Gphoto2Camera:
                 raise  # said already: images taken are kept, resume continues
             except CaptureError as exc:
                 raise self._download_failed(exc, folder, name) from exc
-            camera_file.save(str(target))
+            self._save(camera_file, target, folder, name)
             saved[name] = target
         # pictures the body took behind a busy answer: downloaded too (nothing captured is
         # lost), handed over as strays, never as this shot's files
@@ -662,7 +662,7 @@ class Gphoto2Camera:
             camera_file = self._call(
                 "download", lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL)
             )
-            camera_file.save(str(target))
+            self._save(camera_file, target, folder, name)
             stray_saved.append(
                 {
                     "path": str(target),
@@ -737,6 +737,47 @@ class Gphoto2Camera:
             metadata=metadata,
         )
 
+    def _save(self, camera_file: Any, target: Path, folder: str, name: str) -> None:
+        """Write a downloaded file to ``target``, or raise the error that says the computer's
+        disk refused it, where the shot is now, and what to do.
+
+        Why: libgphoto2's ``gp_file_save`` answers a short write (a full disk) by unlinking
+        the file and returning GP_ERROR (-1), which python-gphoto2 raises as ``GPhoto2Error``.
+        Uncaught, the session stopped with "unexpected GPhoto2Error: [-1] … please report it":
+        the user was not told the disk was full, nor that a shot in the camera's RAM was
+        lost, nor that a resume reshoots it once there is room."""
+        try:
+            camera_file.save(str(target))
+        except (self._gp.GPhoto2Error, OSError) as exc:
+            with contextlib.suppress(OSError):
+                target.unlink(missing_ok=True)  # never a partial file: ``_unused`` made it new
+            free = ""
+            with contextlib.suppress(OSError):
+                free = f": {shutil.disk_usage(target.parent).free / 1e6:.0f} MB free there now"
+            code = getattr(exc, "code", None)
+            why = f"gphoto2 error {code} ({exc})" if code is not None else str(exc)
+            where = self._where(folder, name)
+            raise CaptureError(
+                self.name,
+                f"{folder.rstrip('/')}/{name} came from the camera but could not be written "
+                f"into {target.parent} ({why}); the disk holding the session refused it (full, "
+                f"read-only or failing{free}). {where[0].upper()}{where[1:]}. Its step is not "
+                "recorded: free space on that disk (or fix it), then "
+                "'rti-rig run --resume SESSION' shoots it again",
+                "download",
+            ) from exc
+
+    def _where(self, folder: str, name: str) -> str:
+        """Where a shot whose file did not reach the session is now: lost with the camera's
+        RAM, or on its card (a card's copy is deleted only once downloaded)."""
+        on_camera = f"{folder.rstrip('/')}/{name}"
+        if self.settings.capture_target == "Internal RAM":
+            return (
+                f"the shot was taken into the camera's RAM (capture_target = 'Internal RAM'), "
+                f"so it is lost: {on_camera} existed only there"
+            )
+        return f"the shot's copy stays on the camera's card at {on_camera}"
+
     def _download_failed(self, exc: CaptureError, folder: str, name: str) -> CaptureError:
         """The error for a shot's file that would not download: where the shot is now, and
         that a resume shoots it again.
@@ -748,13 +789,7 @@ class Gphoto2Camera:
         there (it is deleted only once downloaded). Either way the step is not recorded, so
         ``rti-rig run --resume SESSION`` shoots it again under its own light."""
         on_camera = f"{folder.rstrip('/')}/{name}"
-        if self.settings.capture_target == "Internal RAM":
-            where = (
-                f"the shot was taken into the camera's RAM (capture_target = 'Internal RAM'), "
-                f"so it is lost: {on_camera} existed only there"
-            )
-        else:
-            where = f"the shot's copy stays on the camera's card at {on_camera}"
+        where = self._where(folder, name)
         return CaptureError(
             self.name,
             f"{exc.message}; downloading {on_camera} failed, {where}. Its step is not "

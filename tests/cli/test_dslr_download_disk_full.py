@@ -1,0 +1,88 @@
+"""A tethered DSLR session whose disk fills while a RAW is downloaded, through `rti-rig run`
+on the shipped DSLR example (its dome firmware emulated on a pty, python-gphoto2 replaced at
+its API boundary by tests/fake_gphoto2.py), then `--resume` once there is room.
+
+libgphoto2's ``gp_file_save`` answers a short write by unlinking the file and returning
+GP_ERROR (-1), which python-gphoto2 raises. Uncaught, the run stopped with "unexpected
+GPhoto2Error: [-1] libgphoto2 error (… please report it …)": not a word of the full disk, of
+the shot lost with the camera's RAM, or that a resume shoots it again.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import CONFIGS, shipped_dome_on_pty
+from dng_spec_writer import dng, mosaic_from_rgb
+from fake_gphoto2 import Body, make_module
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+
+def _config(tmp_path: Path, target: str) -> Path:
+    """The shipped DSLR example beside its .lp, small frames, shooting into ``target``."""
+    shutil.copy(CONFIGS / "example_dome_48.lp", tmp_path / "example_dome_48.lp")
+    text = (CONFIGS / "example_dome_48.toml").read_text()
+    old = 'capture_target = "Internal RAM"'
+    assert old in text
+    text = text.replace(old, f'capture_target = "{target}"')
+    text = text.replace("width = 6000", "width = 48").replace("height = 4000", "height = 32")
+    cfg = tmp_path / "dslr.toml"
+    cfg.write_text(text)
+    return cfg
+
+
+def _raw(body: Body) -> bytes:
+    rgb = np.broadcast_to(np.array([0.2, 0.5, 0.8]), (32, 48, 3))
+    return dng(mosaic_from_rgb(np.array(rgb), "RGGB", (0,) * 4, 4095), "RGGB", (0,) * 4, 4095)
+
+
+@pytest.mark.parametrize("target", ["Internal RAM", "Memory card"])
+def test_a_disk_full_at_a_download_is_said_and_the_resume_shoots_the_light_again(
+    tmp_path, monkeypatch, target
+):
+    cfg = _config(tmp_path, target)
+    body = Body(render=_raw, disk_free_saves=2)  # the third RAW finds the disk full
+    monkeypatch.setitem(sys.modules, "gphoto2", make_module(body))
+    out = tmp_path / "s"
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+        lit_at_end = firmware.lit
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "unexpected" not in said and "please report" not in said, said
+    assert "Traceback" not in said and lit_at_end is None, said
+    assert "IMG_0003.CR2 came from the camera but could not be written" in said, said
+    assert "full, read-only or failing" in said and "MB free there now" in said, said
+    assert "rti-rig run --resume" in said, said
+    if target == "Internal RAM":
+        assert "so it is lost" in said, said
+    else:  # the card's copy is the only one: never deleted
+        assert "stays on the camera's card at /store_00020001/DCIM/100CANON/IMG_0003" in said
+        assert "IMG_0003.CR2" in body.card and not any("IMG_0003" in d for d in body.deleted)
+    assert not list((out / "raw" / ".incoming").glob("*IMG_0003*")), "a partial download"
+    lp = (out / "lights.lp").read_text().split()
+    assert lp[0] == "2", lp
+
+    body.disk_free_saves = None  # room again
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    lines = (out / "lights.lp").read_text().splitlines()
+    assert lines[0].strip() == "4", lines
+    for k in range(1, 5):
+        assert (out / f"raw/image_{k:03d}.cr2").is_file()
+        record = json.loads((out / f"records/image_{k:03d}.json").read_text())
+        assert record["image"] == f"image_{k:03d}.jpg"
