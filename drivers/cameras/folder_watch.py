@@ -515,6 +515,45 @@ class FolderWatchCamera:
         except OSError:
             return []
 
+    def _earlier_files_said(self) -> str:
+        """The files that were in the folder before this run and have been saved over since,
+        said with the fix: empty the folder.
+
+        Why: a folder holding an earlier shoot's ``IMG_0001.CR2`` … and a camera whose file
+        numbers start again (a new or formatted card, a counter reset, its wrap from IMG_9999
+        to IMG_0001) has the tethering program save this run's shots over them. A name is used
+        once, so the shot is not taken; the timeout said "have the tethering program give every
+        shot its own file name" (which it did) and "an earlier shot had it" (none had), and
+        every resume stopped again at the next number."""
+        replaced = sorted(self._reused_names & self._at_connect)
+        rewritten = sorted(self._rewritten_names & self._at_connect)
+        if not replaced and not rewritten:
+            return ""
+        parts = []
+        if replaced:
+            many = len(replaced) > 1
+            parts.append(
+                f"{', '.join(replaced)} {'were' if many else 'was'} in the folder before this "
+                f"run began and another file has taken {'their names' if many else 'its name'} "
+                "since (the file that was there is no longer in the folder under that name)"
+            )
+        if rewritten:
+            many = len(rewritten) > 1
+            parts.append(
+                f"{', '.join(rewritten)} {'were' if many else 'was'} in the folder before this "
+                f"run began and {'have' if many else 'has'} been written again in place since "
+                "(saved over by a shot of the same name, or still being written when the run "
+                "began)"
+            )
+        return (
+            f"; {'; '.join(parts)}: the camera's file numbers may have started again (a new or "
+            "formatted card, a counter reset, or its wrap from IMG_9999 to IMG_0001) onto an "
+            "earlier shoot's names. A name is used once, so such a file is never taken as a "
+            f"light's image: move the files already in {self.settings.folder} elsewhere (the "
+            "session keeps its own images in its raw/ folder), or point folder in "
+            "[camera.device] at an empty folder"
+        )
+
     def _unmatched_said(self) -> str:
         """The files that came since connect but match no pattern, said with the fix.
 
@@ -623,19 +662,19 @@ class FolderWatchCamera:
                         return path
             if self._clock.now() - start >= s.timeout_s:
                 growing = f"; {last[0]} appeared but was still being written" if last else ""
-                reused = ""
-                if self._reused_names:
-                    names = ", ".join(sorted(self._reused_names))
+                reused = self._earlier_files_said()
+                if self._reused_names - self._at_connect:
+                    names = ", ".join(sorted(self._reused_names - self._at_connect))
                     reused = (
                         f"; {names} appeared again as another file, but a name is used once "
                         "(an earlier shot had it): have the tethering program give every shot "
                         "its own file name"
                     )
-                if self._rewritten_names:
+                if self._rewritten_names - self._at_connect:
                     # saved over in place: the camera was firing and saving there, but the
                     # timeout had asked whether it was (gphoto2 --force-overwrite, a program
                     # set to one file name for every shot)
-                    names = ", ".join(sorted(self._rewritten_names))
+                    names = ", ".join(sorted(self._rewritten_names - self._at_connect))
                     reused += (
                         f"; {names} was written again after the session had seen it (saved "
                         "over under the same name, or still being written when the session "

@@ -1,0 +1,72 @@
+"""A watched folder that holds an earlier shoot's files, and a camera whose file numbers start
+again onto their names, through `rti-rig run` on the shipped folder-watch example (its dome
+firmware emulated on a pty, its camera a thread that saves a DNG into the folder for each
+shutter pulse the board saw).
+
+A new or formatted card, a counter reset or the wrap from IMG_9999 to IMG_0001 has the
+tethering program save this run's shots over the earlier shoot's ``IMG_0001.DNG`` …: in place
+(the same file written again) or as a new file renamed over the old one. A name is used once,
+so the shot is not taken, rightly; but the timeout said "an earlier shot had it" (none had)
+and "have the tethering program give every shot its own file name" (it did), and a resume
+stopped again at the next number: the fix, emptying the folder, was never said.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import Tether, folder_watch_config, tethered_run
+from dng_spec_writer import dng, mosaic_from_rgb
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+
+def _shot(level: float) -> bytes:
+    mosaic = mosaic_from_rgb(np.full((32, 48, 3), level), "RGGB", (0,) * 4, 4095)
+    return dng(mosaic, "RGGB", (0,) * 4, 4095)
+
+
+class RenamingTether(Tether):
+    """A tethering program that saves each shot to a hidden temporary and renames it over
+    the final name (a new file under the old name, as rsync and many programs save)."""
+
+    def run(self) -> None:
+        saved = 0
+        while not self.stop.is_set() and saved < len(self.files):
+            pulses = sum(e.what == "shutter" for e in list(self.firmware.history))
+            if pulses > saved:
+                name, data = self.files[saved]
+                temporary = self.folder / f".{name}.tmp"
+                temporary.write_bytes(data)
+                os.replace(temporary, self.folder / name)
+                saved += 1
+            self.stop.wait(0.02)
+
+
+@pytest.mark.parametrize("saving", ["in place", "renamed over"])
+def test_an_earlier_shoots_file_saved_over_is_said_with_the_folder_to_empty(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, saving: str
+) -> None:
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    for k in range(1, 4):  # the earlier shoot
+        (tether / f"IMG_{k:04d}.DNG").write_bytes(_shot(0.1) + b"earlier shoot")
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    files = [(f"IMG_{k:04d}.DNG", _shot(0.3)) for k in range(1, 4)]
+    camera = (lambda fw: RenamingTether(fw, tether, files)) if saving == "renamed over" else None
+    run = tethered_run(monkeypatch, cfg, tether, files, tmp_path / "s", camera=camera)
+    said = run.said
+    assert run.result.exit_code == 2, said
+    assert "Traceback" not in said and not run.lit_at_end, said
+    assert "IMG_0001.DNG was in the folder before this run began" in said, said
+    assert "an earlier shot had it" not in said, said
+    assert "give every shot its own file name" not in said, said
+    assert f"move the files already in {tether} elsewhere" in said, said
+    assert "IMG_9999 to IMG_0001" in said, said
