@@ -760,7 +760,7 @@ class Gphoto2Camera:
             raise CaptureError(
                 self.name,
                 f"{folder.rstrip('/')}/{name} came from the camera but could not be written "
-                f"into {target.parent} ({why}); the disk holding the session refused it (full, "
+                f"into {target.parent} ({why}); that disk refused it (full, "
                 f"read-only or failing{free}). {where[0].upper()}{where[1:]}. Its step is not "
                 "recorded: free space on that disk (or fix it), then "
                 "'rti-rig run --resume SESSION' shoots it again",
