@@ -146,8 +146,10 @@ def dng(
     big_endian: bool = False,
     model: str = "spec-writer test camera",
     color_matrix: np.ndarray | None = None,
+    date_time: str | None = None,
 ) -> bytes:
-    """An uncompressed 16-bit CFA DNG of ``mosaic`` (raw codes, black included)."""
+    """An uncompressed 16-bit CFA DNG of ``mosaic`` (raw codes, black included); ``date_time``
+    is the camera clock's capture time, TIFF 6.0 DateTime (306) "YYYY:MM:DD HH:MM:SS"."""
     entries = _one_sample_image(mosaic.shape, 32803, model)  # CFA
     entries |= {
         274: (SHORT, [orientation]),
@@ -161,6 +163,8 @@ def dng(
     }
     if exposure_s is not None:
         entries[33434] = (RATIONAL, [exposure_s])
+    if date_time is not None:
+        entries[306] = (ASCII, [date_time])
     if color_matrix is not None:  # ColorMatrix1 (XYZ → camera), CalibrationIlluminant1 = D65
         entries[50721] = (SRATIONAL, [float(v) for v in np.ravel(color_matrix)])
         entries[50778] = (SHORT, [21])

@@ -392,6 +392,9 @@ class _Pending:
     #: of ``out_of_step``, those shot before this run connected (by the camera clock an earlier
     #: run of the session learned): name -> how many seconds before
     before_connect: dict[str, float] = field(default_factory=dict)
+    #: of ``out_of_step``, those shot before this run's first image, by the camera clock that
+    #: image anchored: name -> how many seconds before
+    before_first: dict[str, float] = field(default_factory=dict)
     #: the capture time of the file taken, in step with the pulse (None: not checked)
     taken: float | None = None
 
@@ -451,6 +454,9 @@ class FolderWatchCamera:
         #: (capture time, pulse time) of the last image whose file had a capture time: the
         #: camera clock's anchor to the pulses
         self._anchor: tuple[float, float, float] | None = None
+        #: the first such anchor of this run: a file shot before it is no late file of a pulse
+        #: of this run
+        self._first_anchor: tuple[float, float, float] | None = None
         #: (capture time, the pulse before) of the last file set aside as out of step: a late
         #: file of the previous pulse, if the next file fits it
         self._orphan: tuple[float, float, float] | None = None
@@ -476,6 +482,7 @@ class FolderWatchCamera:
         self._rewritten_names = set()
         self._taken_stems = set()
         self._anchor = None
+        self._first_anchor = None
         self._orphan = None
         self._learned = _LearnedClock.load(self._clock_file())
         self._connected_wall, self._wall_allowance_s = self._connect_on_learned_wall()
@@ -631,8 +638,11 @@ class FolderWatchCamera:
             new.append((ident[3], p.name, p))
         return [p for _, _, p in sorted(new)]
 
-    def wait_for_file(self) -> Path:
-        """Block (on the injected clock) until the next complete new file, or time out."""
+    def wait_for_file(self, *, came: bool = False) -> Path:
+        """Block (on the injected clock) until the next complete new file, or time out.
+
+        ``came``: files came after the pulse and were set aside (out of step), so the timeout
+        does not ask whether the camera is firing and saving there: it did both."""
         if self._seen is None:
             raise CaptureError(self.name, "not connected; call connect() first", "capture")
         s = self.settings
@@ -682,7 +692,11 @@ class FolderWatchCamera:
                         "every shot its own file name instead of saving over one"
                     )
                 unmatched = self._unmatched_said()
-                ask = "" if unmatched or reused else ": is the camera firing and saving there?"
+                ask = (
+                    ""
+                    if unmatched or reused or came
+                    else ": is the camera firing and saving there?"
+                )
                 if not s.folder.is_dir():
                     # a network share that dropped, a card reader unplugged: the question
                     # about the camera had sent the user to check a camera that was firing
@@ -799,10 +813,12 @@ class FolderWatchCamera:
         recorded under a light it was not taken under."""
         while True:
             try:
-                path = self.wait_for_file()
+                path = self.wait_for_file(came=bool(pending.out_of_step))
             except CaptureError as exc:
                 said = exc.message
-                if pending.out_of_step:
+                late = [n for n in pending.out_of_step if n not in pending.before_first]
+                if late:
+                    pending.out_of_step = late  # those shot before the first are said below
                     said += (
                         f"; {', '.join(pending.out_of_step)} came after the pulse but "
                         f"{'were' if len(pending.out_of_step) > 1 else 'was'} shot out of step "
@@ -810,6 +826,7 @@ class FolderWatchCamera:
                         f"{self.settings.folder}"
                     )
                     said += self._before_connect_said(pending)
+                said += self._before_first_said(pending)
                 if pending.unconfirmed is not None:
                     said += f"; the trigger was not confirmed either ({pending.unconfirmed})"
                 if said == exc.message:
@@ -833,6 +850,8 @@ class FolderWatchCamera:
             pending.out_of_step.append(path.name)
             if early is not None:
                 pending.before_connect[path.name] = early
+            elif (before := self._shot_before_first(taken, pending.pulse_window_s)) is not None:
+                pending.before_first[path.name] = before
             if len(pending.out_of_step) > MAX_OUT_OF_STEP:
                 raise CaptureError(
                     self.name,
@@ -928,7 +947,49 @@ class FolderWatchCamera:
                 "were the same then"
             )
         self._anchor, self._orphan = (taken, pulsed_at, window_s), None
+        if self._first_anchor is None:
+            self._first_anchor = self._anchor
         return notes
+
+    def _shot_before_first(self, taken: float, window_s: float) -> float | None:
+        """How many seconds before this run's first image a file was shot, by the camera clock
+        that image anchored; None when it may be a late file of one of this run's pulses."""
+        first = self._first_anchor
+        if first is None:
+            return None
+        allowance = CAPTURE_TIME_RESOLUTION_S + self.settings.shutter_lag_s + window_s + first[2]
+        early = first[0] - taken
+        return early if early > allowance else None
+
+    def _before_first_said(self, pending: _Pending) -> str:
+        """The files of ``pending`` shot before this run's first image, said with what that
+        means and the way out.
+
+        Why: a camera whose clock was set back mid-session (a time-zone or daylight-saving
+        change made on the body) gives the pulse's own picture a capture time before the run
+        began. It is rightly not taken (the check cannot tell it from an older file), but the
+        stop asked "is the camera firing and saving there?" of a camera that was doing both,
+        called the file "a late file of an earlier pulse?" (no pulse of the run came before
+        it), and the resume stopped again on the clock the run had learned."""
+        if not pending.before_first:
+            return ""
+        shown = ", ".join(f"{n} {s:.0f} s" for n, s in pending.before_first.items())
+        many = len(pending.before_first) > 1
+        clock_file = self._clock_file()
+        way_out = (
+            f"delete {clock_file} and resume (its first image is then unchecked)"
+            if clock_file is not None
+            else "run again"
+        )
+        return (
+            f"; {', '.join(pending.before_first)} came after the pulse but "
+            f"{'were' if many else 'was'} shot before this run's first image ({shown} before, "
+            "by the camera clock that image anchored), so no pulse of this run took "
+            f"{'them' if many else 'it'}: the camera's clock was set back since (a time-zone "
+            "or daylight-saving change on the camera?) or an older picture was copied into the "
+            f"folder. Not used, left in {self.settings.folder}. If the camera's clock was set "
+            f"back, {way_out}"
+        )
 
     def _before_connect_said(self, pending: _Pending) -> str:
         """The files of ``pending`` refused as shot before this run connected, said with how
