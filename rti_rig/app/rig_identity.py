@@ -150,7 +150,11 @@ def _dome_protocol_digest(serial: Any) -> str | None:
         return None
     from rti_rig.drivers.led_dome.factory import protocol_for
 
-    spec = protocol_for(serial).model_dump(mode="json")
+    return _protocol_digest(protocol_for(serial).model_dump(mode="json"))
+
+
+def _protocol_digest(spec: dict[str, Any]) -> str:
+    """The digest of a protocol description's defining parts (``spec``: its JSON dump)."""
     defining: dict[str, Any] = {k: spec.get(k) for k in _ADDRESSING_KEYS}
     for key in _COMMAND_KEYS:
         command = spec.get(key)
@@ -159,6 +163,23 @@ def _dome_protocol_digest(serial: Any) -> str | None:
         else:
             defining[key] = None if command is None else command.get("send")
     return _digest(defining)
+
+
+def _builtin_protocol_digest(profile: Any) -> str | None:
+    """The digest a built-in firmware's own protocol has (no table or LED map laid over it),
+    None for a profile that is not a built-in description.
+
+    Why: a built-in profile without a ``[dome.serial.protocol]`` table is recorded as None. A
+    table that changes nothing defining (a timeout, a delay, the built-in's own LED count)
+    laid over it on resume had been refused as "dome protocol described in the config:
+    none → 4d016391974ed4e4", though it is the same protocol."""
+    from rti_rig.drivers.led_dome.dome_profiles import builtin_spec, described_profiles
+    from rti_rig.drivers.led_dome.protocol_spec import ProtocolSpec
+
+    if not isinstance(profile, str) or profile not in described_profiles():
+        return None
+    spec = ProtocolSpec.model_validate(builtin_spec(profile))
+    return _protocol_digest(spec.model_dump(mode="json"))
 
 
 def _recorded_images_digest(loaded: LoadedRig, geometry: DomeGeometry) -> str:
@@ -205,6 +226,10 @@ def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[st
             continue  # a session begun before the firmware profile (protocol) was part of it
         if key == "dome_protocol" and before.get("dome_firmware") != now.get("dome_firmware"):
             continue  # another profile: "dome firmware profile" says it
+        if key == "dome_protocol":
+            builtin = _builtin_protocol_digest(now.get("dome_firmware"))
+            if (old or builtin) == (new or builtin):
+                continue  # a built-in's own protocol, with or without a table restating it
         if key == "light_directions":
             continue  # said under "light positions"
         if key == "light_positions":
@@ -227,8 +252,6 @@ def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[st
                 f"{label}: changed (its commands or LED numbering differ under the same "
                 f"profile name '{now.get('dome_firmware') or before.get('dome_firmware')}': the "
                 "same LED index may be another light)"
-                if old and new
-                else f"{label}: {_show(old)} → {_show(new)}"
             )
         elif key == "dome_firmware":
             out.append(

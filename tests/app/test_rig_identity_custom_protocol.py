@@ -77,3 +77,58 @@ def test_a_custom_session_recorded_before_the_protocol_digest_resumes(tmp_path: 
     before = _identity(tmp_path, "a")
     assert before.pop("dome_protocol")
     assert identity_differences(before, _identity(tmp_path, "b", light="ON {index}\\n")) == []
+
+
+BUILTIN = """
+name = "minirti-64"
+kind = "dome"
+backend = "hardware"
+
+[dome]
+layout = "fibonacci"
+count = 64
+min_elevation_deg = 15.0
+
+[dome.serial]
+port = "/dev/ttyACM0"
+profile = "minirti"
+{table}
+[camera]
+width = 64
+height = 48
+exposure_s = 0.05
+
+[camera.device]
+kind = "folder_watch"
+folder = "{folder}"
+"""
+
+
+def _builtin_identity(tmp_path: Path, name: str, table: str) -> dict[str, object]:
+    path = tmp_path / f"{name}.toml"
+    path.write_text(BUILTIN.format(table=table, folder=tmp_path / "shots"))
+    return rig_identity(load_rig_config(path))
+
+
+def test_a_table_restating_a_builtin_protocol_keeps_the_rig(tmp_path: Path) -> None:
+    """A built-in profile without a ``[dome.serial.protocol]`` table is recorded without a
+    digest; a table laid over it on resume that changes nothing defining (the built-in's own
+    LED count, a boot wait) had been refused as "none → 4d016391974ed4e4". One that does
+    change the addressing is named as changed, in words, not as a digest."""
+    bare = _builtin_identity(tmp_path, "bare", "")
+    assert bare["dome_protocol"] is None
+    for name, table in (
+        ("count", "[dome.serial.protocol]\nled_count = 64\n"),
+        ("wait", "[dome.serial.protocol]\nboot_wait_s = 3.0\n"),
+    ):
+        restated = _builtin_identity(tmp_path, name, table)
+        assert restated["dome_protocol"] is not None
+        assert identity_differences(bare, restated) == []
+        assert identity_differences(restated, bare) == []
+    other = _builtin_identity(
+        tmp_path, "lsb", '[dome.serial.protocol]\nmask_bit_order = "lsb-first"\n'
+    )
+    for said in (identity_differences(bare, other), identity_differences(other, bare)):
+        assert len(said) == 1, said
+        assert said[0].startswith("dome protocol described in the config: changed"), said
+        assert "profile name 'minirti'" in said[0] and "none" not in said[0], said
