@@ -120,8 +120,18 @@ def is_absolute_name(name: str) -> bool:
 
 def image_file_name(name: str) -> str:
     """The file name alone of an image an `.lp` line names, whichever system wrote the path
-    (``H:\\RTI\\jpeg-exports\\a_01.jpg`` -> ``a_01.jpg``)."""
-    return PureWindowsPath(name).name if "\\" in name else PurePosixPath(name).name
+    (``H:\\RTI\\jpeg-exports\\a_01.jpg`` -> ``a_01.jpg``, ``C:IMG.JPG`` -> ``IMG.JPG``)."""
+    return _pure_name(name).name
+
+
+def _pure_name(name: str) -> PurePosixPath | PureWindowsPath:
+    """``name`` as the system that wrote it reads it: Windows' where it has a ``\\`` or a
+    drive (``C:IMG.JPG``, ``C:sub/IMG.JPG``, ``//server/share/IMG.JPG``), POSIX otherwise.
+
+    Why the drive: a drive-relative name without a ``\\`` had been read as POSIX, whose one
+    component ``C:IMG.JPG`` was looked for as such beside the .lp and said to be missing."""
+    windows = PureWindowsPath(name)
+    return windows if "\\" in name or windows.drive else PurePosixPath(name)
 
 
 def image_path(lp_dir: Path, name: str) -> Path:
@@ -151,7 +161,7 @@ def image_path(lp_dir: Path, name: str) -> Path:
 def _trailing_parts(name: str) -> list[str]:
     """The plain folder and file names at the end of an absolute image name, outermost first,
     stopping at its root or at a ``.``/``..`` (never followed out of the `.lp`'s folder)."""
-    pure = PureWindowsPath(name) if "\\" in name else PurePosixPath(name)
+    pure = _pure_name(name)
     parts: list[str] = []
     for part in reversed(pure.parts[1:] if pure.anchor else pure.parts):
         if part in ("", ".", "..") or "/" in part or "\\" in part:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -79,3 +80,25 @@ def test_an_image_in_none_of_the_folders_tried_is_said_missing_with_where_it_was
     said = " ".join(r.output.split())
     assert r.exit_code == 1 and "1 of 18 image(s) missing" in said, said
     assert "trailing folders and file name under the .lp's folder" in said, said
+
+
+@pytest.mark.parametrize("prefix,folder", [("C:", "."), ("C:sub/", "sub"), ("C:sub\\", "sub")])
+def test_drive_relative_names_are_looked_for_under_the_lp_folder(
+    tmp_path: Path, prefix: str, folder: str
+) -> None:
+    """A drive-relative Windows name (``C:image01.jpg``: the current folder of drive C:) had
+    been read, without a ``\\``, as one POSIX component ``C:image01.jpg`` and said missing
+    although ``image01.jpg`` was beside the .lp; with ``/`` its folder was never tried."""
+    acq = tmp_path / "acq"
+    (acq / folder).mkdir(parents=True, exist_ok=True)
+    lines = (ACQ / "dirs.lp").read_text().splitlines()
+    out = [lines[0]]
+    for line in lines[1:]:
+        name, *xyz = line.split()
+        shutil.copy(ACQ / name, acq / folder / name)
+        out.append(" ".join([f"{prefix}{name}", *xyz]))
+    (acq / "dirs.lp").write_text("\n".join(out) + "\n")
+    r = runner.invoke(app, ["check", str(acq / "dirs.lp")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "RESULT: PASS" in said, said
+    assert "18 listed in dirs.lp" in said, said
