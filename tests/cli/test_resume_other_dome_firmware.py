@@ -26,8 +26,9 @@ NICHLOCK = CONFIGS / "emulated_nichlock.toml"
 MINIRTI = CONFIGS / "emulated_minirti.toml"
 
 
-def _cut(out: Path) -> None:
-    """A 6-light session on the nichlock dome, cancelled after three images as Ctrl-C does."""
+def _cut(out: Path, config: Path = NICHLOCK) -> None:
+    """A 6-light session on ``config`` (the nichlock dome), cancelled after three images as
+    Ctrl-C does."""
     from rti_rig.app.usecases.session import (
         NewSessionRequest,
         open_new_session,
@@ -41,7 +42,7 @@ def _cut(out: Path) -> None:
         if isinstance(event, StepCompleted) and event.index == 2:
             cancel.cancel()
 
-    run_opened_session(open_new_session(NewSessionRequest(NICHLOCK, out, 6)), cancel, on_event)
+    run_opened_session(open_new_session(NewSessionRequest(config, out, 6)), cancel, on_event)
     assert len(journal(out)) == 3
 
 
@@ -117,5 +118,29 @@ def test_a_resume_whose_config_describes_another_protocol_under_one_name_is_refu
     assert data["rig"]["identity"].pop("dome_protocol")
     manifest.write_text(json.dumps(data, indent=1), encoding="utf-8")
     r = _resume(out, NICHLOCK)
+    assert r.exit_code == 0 and "dome protocol" not in said(r), r.output
+    assert len(journal(out)) == 6
+
+
+def _minirti_64(tmp_path: Path, name: str, table: str) -> Path:
+    """The shipped minirti dome with all 64 LEDs its firmware addresses: without a
+    [dome.serial.protocol] table the built-in protocol is the board's, as named."""
+    text = MINIRTI.read_text().replace("count = 12\n", "count = 64\n", 1)
+    head, sep, rest = text.partition("[dome.serial.protocol]\n")
+    assert sep and rest.startswith("led_count = 12 ")
+    rest = rest.split("\n", 1)[1]
+    cfg = tmp_path / f"{name}.toml"
+    cfg.write_text(head + (sep + table if table else "") + rest)
+    return cfg
+
+
+@pytest.mark.e2e
+def test_a_table_restating_the_builtin_protocol_resumes_as_the_same_rig(tmp_path: Path) -> None:
+    """A session begun without a protocol table, resumed with one that changes nothing that
+    addresses the LEDs (a longer boot wait), had been refused as "dome protocol described in
+    the config: none → 4d016391974ed4e4"; reply timeouts and delays are not the rig."""
+    out = tmp_path / "S"
+    _cut(out, _minirti_64(tmp_path, "bare", ""))
+    r = _resume(out, _minirti_64(tmp_path, "wait", "boot_wait_s = 3.0\n"))
     assert r.exit_code == 0 and "dome protocol" not in said(r), r.output
     assert len(journal(out)) == 6
