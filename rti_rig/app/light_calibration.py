@@ -456,9 +456,16 @@ def evened_sentence(cal: LightCalibration, digits: int) -> str:
     if cal.measured.all():
         return f"Evened out, every LED gives {light} {stops}"
     unmeasured = int((~cal.measured).sum())
+    # one is the common case (a card shot under all but a dead LED, as its refusal advises):
+    # it had been said as "the 1 not measured are dimmed by a guess of their light"
+    they = (
+        "is dimmed by a guess of its light, so it stays as uneven as it was"
+        if unmeasured == 1
+        else "are dimmed by a guess of their light, so they stay as uneven as they were"
+    )
     return (
         f"Evened out, every measured LED gives {light} {stops}; the {unmeasured} not "
-        "measured are dimmed by a guess of their light, so they stay as uneven as they were"
+        f"measured {they}"
     )
 
 

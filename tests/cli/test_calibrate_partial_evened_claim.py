@@ -51,3 +51,25 @@ def test_a_full_card_session_still_says_every_led(tmp_path: Path) -> None:
 
     assert re.search(r"Evened out, every LED gives 0\.\d\d of the median", text), text
     assert "not measured are dimmed" not in text, text
+
+
+def test_one_led_not_measured_is_said_in_the_singular(tmp_path: Path) -> None:
+    # the dead-LED advice's card (every LED but one) is the common partial session: here the
+    # lowest LED (9.6° above the card) is left out by --min-elevation-deg, as a card shot
+    # without it would leave it out
+    rig = card_rig(tmp_path)
+    full = tmp_path / "full"
+    shoot(rig, full)
+    out = tmp_path / "one.toml"
+    argv = ["calibrate-lights", str(full), "--rig", str(rig), "--out", str(out)]
+
+    r = runner.invoke(app, [*argv, "--min-elevation-deg", "9.65"])
+
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "47 of 48 LEDs measured" in text, text
+    assert (
+        "the 1 not measured is dimmed by a guess of its light, so it stays as uneven as it was"
+        in text
+    ), text
+    assert "1 not measured are" not in out.read_text()
