@@ -192,6 +192,7 @@ def plan(
         planned = plan_lights(request)
     except RtiRigError as exc:
         raise fail(exc) from None
+    drawn = False
     try:
         print_notes(planned.notes)
         for line in planned.report.lines():
@@ -208,11 +209,20 @@ def plan(
                 draw_plan_figure(request, planned)
             except RtiRigError as exc:
                 raise fail(exc) from None
+            drawn = True
             out.print(f"Map of the plan → {figure}")
     except KeyboardInterrupt:
         # the plan is on disk by now: a Ctrl-C while the report or the map was printed or drawn
         # had said only "rti-rig: stopped (Ctrl-C)", and the next run refused the --out
-        map_said = "" if figure is None else f"; the map {figure} was not drawn"
+        # a Ctrl-C as the map's line is printed finds the map written: it had been said "not
+        # drawn" beside the map on disk
+        map_said = (
+            ""
+            if figure is None
+            else f"; the map {figure} is written"
+            if drawn
+            else f"; the map {figure} was not drawn"
+        )
         err.print(
             f"Stopped (Ctrl-C): the plan {out_file} is written ({len(planned.schedule)} "
             f"lights){map_said}",

@@ -50,3 +50,28 @@ def test_a_ctrl_c_while_the_map_is_written_says_the_plan_is_written(
     assert len(read_lp(plan)) == 12
     assert not figure.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == [plan.name]
+
+
+def test_a_ctrl_c_once_the_map_is_written_says_it_is_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from rti_rig.cli import plan as plan_cli
+
+    printed = plan_cli.out.print
+
+    def interrupted(*args: Any, **kwargs: Any) -> None:
+        if args and str(args[0]).startswith("Map of the plan"):
+            raise KeyboardInterrupt  # the user's Ctrl-C, as the map's line is printed
+        printed(*args, **kwargs)
+
+    monkeypatch.setattr(plan_cli.out, "print", interrupted)
+    plan, figure = tmp_path / "plan.lp", tmp_path / "map.png"
+    argv = ["plan", "--rig", str(CONFIGS / "virtual_arm.toml"), "--method", "optimal"]
+
+    r = CliRunner().invoke(app, [*argv, "--out", str(plan), "--figure", str(figure)])
+
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    assert f"the plan {plan} is written (12 lights); the map {figure} is written" in said, said
+    assert "not drawn" not in said, said
+    assert figure.read_bytes().startswith(b"\x89PNG")
