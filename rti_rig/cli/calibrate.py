@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out
+from rti_rig.cli.app import app, err, fail, out, print_notes
 from rti_rig.core.errors import RtiRigError
 
 
@@ -140,6 +140,7 @@ def calibrate_lights(
         done.geometry,
         done.target,
     )
+    print_notes(done.notes)
     normal = np.asarray(_parse_normal(card_normal))
     measured = np.flatnonzero(cal.measured)
     elevation = np.degrees(np.arcsin(np.clip(geometry.directions[measured] @ normal, -1, 1)))

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 from card_support import card_rig, shoot
 from conftest import CONFIGS, said
 from typer.testing import CliRunner
@@ -52,4 +53,37 @@ def test_the_rig_config_the_card_was_shot_with_still_calibrates(tmp_path: Path) 
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(rig), "--out", str(out)])
 
     assert r.exit_code == 0, r.output
+    assert out.is_file()
+
+
+def test_leds_re_measured_in_place_still_calibrate(tmp_path: Path) -> None:
+    """The same LEDs with re-measured positions (each still nearest its own recorded one, a
+    finer .lp written after the card was shot) are not "other LEDs": the correction by LED
+    number holds. They were refused as LEDs "others than the rig config gives now"."""
+    rig = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(rig, card)
+    count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
+    turn = np.radians(0.5)  # the whole dome measured 0.5° further round: every LED moved
+    c, s = np.cos(turn), np.sin(turn)
+    moved = []
+    for row in rows:
+        name, x, y, z = row.split()
+        xf, yf = float(x), float(y)
+        moved.append(f"{name} {c * xf - s * yf:.6f} {s * xf + c * yf:.6f} {z}")
+    remeasured = tmp_path / "remeasured.lp"
+    remeasured.write_text("\n".join([count, *moved]) + "\n")
+    text = rig.read_text().replace(f"{CONFIGS}/example_dome_48.lp", str(remeasured))
+    assert str(remeasured) in text
+    other = tmp_path / "other.toml"
+    other.write_text(text)
+    out = tmp_path / "cal.toml"
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(other), "--out", str(out)])
+
+    assert r.exit_code == 0, r.output
+    message = said(r)
+    assert "others than" not in message, message
+    assert "48 of 48 LEDs moved" in message, message
+    assert "each still nearest its own recorded position" in message, message
     assert out.is_file()

@@ -13,6 +13,9 @@ import shlex
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
 from rti_rig.app.light_calibration import (
@@ -57,6 +60,8 @@ class CalibrationWritten:
     loaded: LoadedRig
     geometry: DomeGeometry | ArmGeometry
     target: Path
+    #: What the user should know of how the card session was read (LEDs re-measured since).
+    notes: tuple[str, ...] = ()
 
 
 def _check_dome_can_dim(req: CalibrateRequest, loaded: LoadedRig) -> None:
@@ -134,33 +139,65 @@ def _without_led(req: CalibrateRequest, loaded: LoadedRig, which: str) -> str:
 LED_KEYS = ("lights", "light_positions", "light_directions", "dome_firmware")
 
 
-def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> None:
-    """Refuse a card session shot while the rig's LEDs were others than ``--rig`` gives now.
+def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> str | None:
+    """Refuse a card session shot while the rig's LEDs were others than ``--rig`` gives now;
+    the note to say where they are the same LEDs re-measured, else None.
 
     Why: the correction is written per LED number and only the rig's name was compared. A
     config of the same name whose ``.lp`` lists the LEDs in another order (or another count,
     or another controller board, which may number them otherwise) had its LED 18 (led_42.jpg)
     given the correction measured under the card session's LED 18 (led_18.jpg), with no word.
-    A session recorded before identities were is not asked (as a resume does not ask it)."""
+    A session recorded before identities were is not asked (as a resume does not ask it).
+    LEDs that moved only as a re-measured ``.lp`` moves them (each still nearest its own
+    recorded position) are the same LEDs: they had been refused as "others", though the
+    correction by LED number holds for them (:func:`_same_leds_re_measured`)."""
     from rti_rig.app.rig_identity import identity_differences, rig_identity
     from rti_rig.runtime.session import read_manifest
 
     recorded = (read_manifest(req.card_session).get("rig") or {}).get("identity")
     if not isinstance(recorded, dict):
-        return
+        return None
     now = rig_identity(loaded)
     diffs = identity_differences(
         {k: recorded[k] for k in LED_KEYS if k in recorded},
         {k: now.get(k) for k in LED_KEYS if k in recorded},
     )
-    if diffs:
-        raise RtiRigError(
-            f"{req.card_session} was shot when the dome's LEDs were others than "
-            f"{req.rig_config} gives now ({'; '.join(diffs)}): the correction is a list by LED "
-            "number, so it would dim other LEDs than the ones the card measured. Calibrate "
-            "with the rig config the card was shot with, or shoot the card again on the rig "
-            "as it is now"
+    if not diffs:
+        return None
+    if _same_leds_re_measured(recorded, now):
+        return (
+            f"{req.card_session} recorded the dome's LEDs elsewhere than {req.rig_config} "
+            f"places them now ({'; '.join(diffs)}), each still nearest its own recorded "
+            "position: taken as the same LEDs re-measured (the correction is by LED number, "
+            "and the card is read at the positions it recorded)"
         )
+    raise RtiRigError(
+        f"{req.card_session} was shot when the dome's LEDs were others than "
+        f"{req.rig_config} gives now ({'; '.join(diffs)}): the correction is a list by LED "
+        "number, so it would dim other LEDs than the ones the card measured. Calibrate "
+        "with the rig config the card was shot with, or shoot the card again on the rig "
+        "as it is now"
+    )
+
+
+def _same_leds_re_measured(recorded: dict[str, Any], now: dict[str, Any]) -> bool:
+    """True where only the LEDs' positions differ, and each LED's position now is nearer its
+    own recorded position than any other LED's: a finer ``.lp`` of the same LEDs, not LEDs
+    listed in another order (which puts an LED nearest another's recorded position)."""
+    from rti_rig.app.rig_identity import identity_differences
+
+    others = [k for k in LED_KEYS if k in recorded and k not in _POSITION_KEYS]
+    if identity_differences({k: recorded[k] for k in others}, {k: now.get(k) for k in others}):
+        return False
+    before, after = recorded.get("light_directions"), now.get("light_directions")
+    if not isinstance(before, list) or not isinstance(after, list) or len(before) != len(after):
+        return False  # a session recorded with a digest alone: its positions are not known
+    nearest = np.argmax(np.asarray(after, float) @ np.asarray(before, float).T, axis=1)
+    return bool(np.array_equal(nearest, np.arange(len(after))))
+
+
+#: The identity keys that hold the LEDs' positions (compared as positions when both are held).
+_POSITION_KEYS = ("light_positions", "light_directions")
 
 
 def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
@@ -178,7 +215,7 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             else "that LED"
         )
         raise RtiRigError(f"{exc}. {_without_led(req, loaded, which)}") from None
-    _refuse_other_leds(req, loaded)
+    same_leds = _refuse_other_leds(req, loaded)
     target = req.target
     if req.out_file is None and target.exists():
         raise RtiRigError(
@@ -221,4 +258,5 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
         ) from None
     finally:
         tmp.unlink(missing_ok=True)
-    return CalibrationWritten(cal, card, loaded, geometry, target)
+    notes = () if same_leds is None else (same_leds,)
+    return CalibrationWritten(cal, card, loaded, geometry, target, notes)
