@@ -276,7 +276,9 @@ def given_light_differs(
     given light stands in for it (:func:`resolve_preview`)."""
     try:
         source = resolve_preview(path, rig_lp)
-    except RtiRigError:
+    except (RtiRigError, KeyError, IndexError, TypeError, ValueError):
+        # a record damaged or written otherwise (a step without its light had raised a
+        # KeyError out of plan, where the light given had always stood in for it)
         return None
     if source.light_az_el_deg is None:
         return None

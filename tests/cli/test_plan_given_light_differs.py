@@ -57,3 +57,23 @@ def test_a_given_light_that_is_the_recorded_one_says_nothing_more(tmp_path: Path
 
     assert "(given)" in text, text
     assert "from the light recorded" not in text, text
+
+
+def test_a_record_that_cannot_be_read_leaves_the_given_light_alone(tmp_path: Path) -> None:
+    """The note reads the session's record at its best: a step recorded without its light (a
+    manifest damaged or edited, no journal beside it) had raised a KeyError out of plan, where
+    the light given had always stood in for the record."""
+    import json
+    import shutil
+
+    session = _preview(tmp_path)
+    (session / "journal.jsonl").unlink()
+    shutil.rmtree(session / "records", ignore_errors=True)
+    manifest = json.loads((session / "manifest.json").read_text())
+    del manifest["steps"][0]["actual_direction"]
+    (session / "manifest.json").write_text(json.dumps(manifest))
+
+    text = _plan(tmp_path, session, "112.5,55")
+
+    assert "(given)" in text, text
+    assert "from the light recorded" not in text, text
