@@ -9,9 +9,11 @@ LED each number was.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 from card_support import card_rig, shoot
 from conftest import CONFIGS, said
 from typer.testing import CliRunner
@@ -86,4 +88,32 @@ def test_leds_re_measured_in_place_still_calibrate(tmp_path: Path) -> None:
     assert "others than" not in message, message
     assert "48 of 48 LEDs moved" in message, message
     assert "each still nearest its own recorded position" in message, message
+    assert out.is_file()
+
+
+@pytest.mark.parametrize(
+    "era",
+    [("identity",), ("light_directions", "dome_firmware", "dome_protocol")],
+    ids=["before-identities", "before-positions-and-firmware"],
+)
+def test_a_card_session_recorded_before_the_keys_it_lacks_still_calibrates(
+    tmp_path: Path, era: tuple[str, ...]
+) -> None:
+    """A card session written before the rig identity (or before its positions and firmware
+    profile were part of it) is not asked what it does not record, as a resume does not ask."""
+    rig = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(rig, card)
+    manifest = json.loads((card / "manifest.json").read_text())
+    for key in era:
+        if key == "identity":
+            del manifest["rig"]["identity"]
+        else:
+            del manifest["rig"]["identity"][key]
+    (card / "manifest.json").write_text(json.dumps(manifest))
+    out = tmp_path / "cal.toml"
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(rig), "--out", str(out)])
+
+    assert r.exit_code == 0, r.output
     assert out.is_file()
