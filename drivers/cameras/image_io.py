@@ -17,7 +17,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import CaptureError
-from rti_rig.core.image_files import SeveralFullSizeImages, tiff_main_image
+from rti_rig.core.image_files import (
+    SeveralFullSizeImages,
+    tiff_is_planar,
+    tiff_main_image,
+    tiff_samples_last,
+)
 from rti_rig.drivers.cameras.tiff_ifd import header_size
 from rti_rig.drivers.cameras.tiff_structure import (
     COMPLETE_TIFF_ADVICE,
@@ -187,7 +192,8 @@ def tiff_contradiction(page: Any) -> str | None:
 
 def read_image_file(path: Path, device: str) -> NDArray:
     """Read a non-RAW image file with its bit depth kept, colour in **RGB** order whatever the
-    format (OpenCV decodes PNG/JPEG as BGR, tifffile TIFF as RGB: one order for callers).
+    format (OpenCV decodes PNG/JPEG as BGR, tifffile TIFF as RGB: one order for callers), and
+    samples last, (H, W) or (H, W, samples), whatever a TIFF's planar configuration.
 
     Raises :class:`ImageReadError` for a file that will not read."""
     suffix = path.suffix.lower()
@@ -225,7 +231,9 @@ def read_image_file(path: Path, device: str) -> NDArray:
             raise ImageReadError(device, path, "it holds no pixels", is_tiff=True, no_pixels=True)
         if contradiction is not None:  # never taken as the other image it reads as
             raise ImageReadError(device, path, contradiction, is_tiff=True, contradicts=True)
-        return image
+        # a planar TIFF (Photoshop's "Per Channel") decodes samples first, (3, H, W): it had
+        # been refused mid-run as an image of the wrong shape, as the core reader puts it right
+        return tiff_samples_last(image, page is not None and tiff_is_planar(page))
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise ImageReadError(device, path, "", is_tiff=False)
