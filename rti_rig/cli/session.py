@@ -1686,8 +1686,9 @@ def export_lp(
         err.print(
             f"[yellow]note:[/] its image names are relative to {escape(str(session_dir))}, "
             "and tools (relight, RTIBuilder, rti-rig fit) read them beside the .lp: move "
-            f"{escape(str(out_file))} into {escape(str(session_dir))} to use it; for relight-cli, "
-            "which reads the first .lp of a folder, move that folder's lights.lp out too ("
+            f"{escape(_arg(out_file))} into {escape(_arg(session_dir))} to use it; for "
+            "relight-cli, which reads the first .lp of a folder, move that folder's lights.lp "
+            "out too ("
             f"`rti-rig export-lp {escape(_arg(session_dir))} --out "
             f"{escape(_arg(session_dir / 'lights.lp'))}` writes it again)",
             soft_wrap=True,

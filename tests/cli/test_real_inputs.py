@@ -9,6 +9,7 @@ as a traceback.
 from __future__ import annotations
 
 import json
+import shlex
 import shutil
 from pathlib import Path
 
@@ -283,6 +284,27 @@ def test_export_lp_outside_the_session_says_where_its_names_resolve(tmp_path: Pa
     inside = session / "linear.lp"
     r = runner.invoke(app, ["export-lp", str(session), "--out", str(inside), "--linear"])
     assert r.exit_code == 0 and "move" not in r.output, r.output
+
+
+def test_export_lp_outside_the_session_says_paths_with_spaces_as_shell_words(
+    tmp_path: Path,
+) -> None:
+    """A session folder "Object 12 recto" exported to "my exports/a b.lp": the note to move the
+    .lp into the session had said both paths bare, so pasted into a shell they split apart
+    (the export-lp command in the same note was quoted)."""
+    cfg = REPO / "rig_configs" / "simulated_dome.toml"
+    session = tmp_path / "Object 12 recto"
+    args = ["run", str(cfg), "--out", str(session), "--lights", "4", "--no-verdict"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    (tmp_path / "my exports").mkdir()
+    outside = tmp_path / "my exports" / "a b.lp"
+    r = runner.invoke(app, ["export-lp", str(session), "--out", str(outside)], terminal_width=400)
+    assert r.exit_code == 0, r.output
+    said = " ".join(r.output.split())
+    assert f"move {shlex.quote(str(outside))} into {shlex.quote(str(session))} to use it" in said, (
+        said
+    )
 
 
 def test_export_lp_says_a_path_with_brackets_as_it_is(tmp_path: Path) -> None:
