@@ -20,6 +20,7 @@ Everything that would fire the camera outside the sequence steps the dome too, s
 from __future__ import annotations
 
 import json
+import shlex
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Literal
@@ -441,7 +442,9 @@ def build_flash_sync_rig(loaded, geometry: DomeGeometry, clock: Clock, camera=No
 
 
 def refuse_options(loaded, **given: bool) -> None:  # type: ignore[no-untyped-def]
-    """Refuse, by name, what would fire the camera outside the firmware's sequence."""
+    """Refuse, by name, what would fire the camera outside the firmware's sequence, with the
+    run that shoots the whole sequence on this config (its path as one shell word: the advice
+    had said ``rti-rig run CONFIG``, leaving the user to find which config)."""
     fs = flash_sync_of(loaded)
     if fs is None:
         return
@@ -460,7 +463,8 @@ def refuse_options(loaded, **given: bool) -> None:  # type: ignore[no-untyped-de
             raise RtiRigError(
                 f"{loaded.path}: {option} cannot be used with a camera-triggered dome "
                 f"({fs.firmware}): {why[option]}. Long-press the dome's start button to rewind "
-                "it, then run the whole sequence: rti-rig run CONFIG --out DIR"
+                f"it, then run the whole sequence: rti-rig run {shlex.quote(str(loaded.path))} "
+                "--out DIR"
             )
 
 

@@ -9,6 +9,7 @@ correctly labelled images.
 from __future__ import annotations
 
 import json
+import shlex
 from pathlib import Path
 
 import numpy as np
@@ -423,3 +424,25 @@ def test_a_check_frame_the_camera_fails_leaves_both_causes_named(  # type: ignor
     assert "could not be shot (camera: the USB link dropped)" in text
     assert "Traceback" not in text
     assert (out / "unlabelled" / "image_006.tif").is_file()
+
+
+def test_refusals_give_the_run_of_the_config_actually_used(tmp_path: Path, rigs) -> None:  # type: ignore[no-untyped-def]
+    """The preview refusal (and a finished session's resume) had said "rti-rig run CONFIG
+    --out DIR", leaving the user to find which config: it names the one given, as one shell
+    word (a folder with a space in its name)."""
+    folder = tmp_path / "my rigs"
+    folder.mkdir()
+    cfg = folder / "cceh dome.toml"
+    cfg.write_text(SHIPPED.read_text(encoding="utf-8"), encoding="utf-8")
+    run_it = f"rti-rig run {shlex.quote(str(cfg))} --out"
+    result = runner.invoke(app, ["preview", str(cfg), "--out", str(tmp_path / "p")])
+    assert result.exit_code == 2, result.output
+    text = " ".join(result.output.split())
+    assert f"run the whole sequence: {run_it} DIR" in text, text
+    assert "CONFIG" not in text and rigs == []
+    out = tmp_path / "s"
+    assert runner.invoke(app, ["run", str(cfg), "--out", str(out), "--no-verdict"]).exit_code == 0
+    result = runner.invoke(app, ["run", "--resume", str(out)])
+    assert result.exit_code == 2, result.output
+    text = " ".join(result.output.split())
+    assert f"then {run_it} NEWDIR)" in text and "CONFIG" not in text, text

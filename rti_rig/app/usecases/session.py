@@ -1381,7 +1381,8 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
             f"{req.session_dir}: this session already completed all "
             f"{runner.get('steps_planned', len(manifest.get('steps') or []))} steps; nothing "
             "to resume (a camera-triggered dome cannot reshoot single images either: to shoot "
-            "again, long-press the dome's start button, then rti-rig run CONFIG --out NEWDIR)"
+            "again, long-press the dome's start button, then rti-rig run "
+            f"{shlex.quote(str(config_path))} --out NEWDIR)"
         )
     refuse_options(loaded, **{"--resume": True})
     _refuse_image_sequence_resume(loaded, Path(req.session_dir))
