@@ -531,3 +531,39 @@ def test_an_acquisition_of_camera_raw_files_is_refused_by_check_run_and_fit_befo
     fitted = runner.invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"])
     fit_text = " ".join(fitted.output.split())
     assert fitted.exit_code == 2 and said in fit_text and "OpenCV" not in fit_text, fit_text
+
+
+def test_a_plan_of_an_acquisition_with_spaced_accented_names_replays_on_it(
+    tmp_path: Path,
+) -> None:
+    """`plan --rig ACQ/dirs.lp` writes "my image é00.jpg" as "my_image_e00.jpg" (the .lp it
+    writes is read by tools that split names at spaces); `run ACQ/dirs.lp --plan` matches the
+    plan to the rig's lights by direction, not by name, so each planned light replays the
+    recorded image of its own light."""
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lines = (ACQ / "dirs.lp").read_text(encoding="utf-8").splitlines()
+    renamed = [lines[0]]
+    for n, line in enumerate(lines[1:]):
+        name, *xyz = line.split()
+        shutil.copyfile(ACQ / name, acq / f"my image é{n:02d}.jpg")
+        renamed.append(" ".join([f"my image é{n:02d}.jpg", *xyz]))
+    (acq / "dirs.lp").write_text("\n".join(renamed) + "\n", encoding="utf-8")
+    plan = tmp_path / "plan.lp"
+    r = runner.invoke(
+        app, ["plan", "--rig", str(acq / "dirs.lp"), "--lights", "6", "--out", str(plan)]
+    )
+    assert r.exit_code == 0, r.output
+    assert all(" " not in e.name for e in read_lp(plan))  # the names as the plan writes them
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--plan", str(plan), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    source = read_lp(acq / "dirs.lp")
+    steps = _journal(out)
+    assert len(steps) == 6
+    for step, planned in zip(steps, read_lp(plan), strict=True):
+        src = source[step["led"]]
+        np.testing.assert_allclose(planned.direction, src.direction, atol=2e-6)
+        decoded = read_jpeg_rgb(acq / src.name)
+        mine = linear_to_srgb8(read_linear_tiff(out / step["linear_image"]), 65535)
+        assert np.array_equal(mine, decoded), src.name
