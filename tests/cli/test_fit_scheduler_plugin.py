@@ -190,3 +190,72 @@ def test_a_check_that_fails_on_a_worker_still_there_names_it_and_the_error(
     assert "restart them" in said, said
     assert "Traceback" not in r.output
     assert not out.exists()
+
+
+def _fit_on_a_worker_of(where: Path, session: Path, out: Path, then: Any = None) -> Any:
+    """Fit ``session`` into ``out`` on a scheduler of one ``dask worker`` process importing
+    rti-rig from ``where``: the worker imports rti-rig's batch fit first (as for an earlier
+    fit's tasks), then ``then()`` runs. Returns the CLI's result, the worker's address and the
+    scheduler's; the worker is killed and reaped whatever happens."""
+    worker = None
+    try:
+        with _tcp_cluster(0) as cluster:
+            worker = subprocess.Popen(
+                [sys.executable, "-m", "distributed.cli.dask_worker", cluster.scheduler_address,
+                 "--nthreads", "1", "--no-nanny", "--no-dashboard"],
+                cwd=where.parent, env={**os.environ, "PYTHONPATH": str(where)},
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            )  # fmt: skip
+            _until(lambda: len(cluster.scheduler.workers) == 1, "the worker never joined")
+            from distributed import Client
+
+            with Client(cluster.scheduler_address, set_as_default=False) as client:
+                (loaded,) = client.run(exec, "import rti_rig.app.usecases.fit_batch").values()
+                assert loaded is None
+            if then is not None:
+                then()
+            r = runner.invoke(
+                app,
+                ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps",
+                 "--scheduler", cluster.scheduler_address],
+            )  # fmt: skip
+            (address,) = cluster.scheduler.workers
+            return r, address, cluster.scheduler_address
+    finally:
+        if worker is not None:  # killed: a SIGTERM'd dask worker may take minutes to close
+            worker.kill()
+            worker.wait(timeout=120)
+
+
+@pytest.mark.slow
+def test_a_worker_holding_an_rti_rig_that_kept_no_import_time_is_refused(tmp_path: Path) -> None:
+    """A worker imported an rti-rig of this version number from before the import time was
+    kept (for an earlier fit's tasks); its files were then replaced by this rti-rig with their
+    dates kept (`cp -a`, `rsync -a`). Its files are this code and none is dated after the
+    import, yet it runs the other: it was tagged and fitted with it."""
+    session = make_session(tmp_path / "S", size=(24, 32))[0]
+    where = _other_rti_rig(tmp_path / "other")
+    mine = Path(rti_rig.__file__).parents[1]
+    init, fit_py = Path("rti_rig", "__init__.py"), Path("rti_rig", "app", "usecases", "fit.py")
+    text = (where / init).read_text(encoding="utf-8")
+    assert text.count("IMPORTED_AT_NS = ") == 1
+    older = text.replace("IMPORTED_AT_NS = ", "_WAS = ").replace(
+        '"0.0.9-other"', f'"{rti_rig.__version__}"'
+    )  # the same version number: an earlier commit of it
+    (where / init).write_text(older, encoding="utf-8")
+
+    def replaced_dates_kept() -> None:
+        for name in (init, fit_py):
+            shutil.copy2(mine / name, where / name)
+
+    out = tmp_path / "FIT"
+    r, address, scheduler = _fit_on_a_worker_of(where, session, out, replaced_dates_kept)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert f"1 of the 1 workers of the Dask cluster at '{scheduler}'" in said, said
+    assert (
+        f"{address} (rti-rig {rti_rig.__version__}, code {local_identity().fingerprint}, but it "
+        "imported rti-rig before this check, from an rti-rig that kept no record of when: it "
+        "may run other code than the files there now; restart it)"
+    ) in said, said
+    assert not out.exists(), said  # nothing was sent

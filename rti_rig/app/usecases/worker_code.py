@@ -72,8 +72,10 @@ def _identity_function(
     def rti_rig_identity() -> dict[str, str | None]:
         import hashlib
         import importlib.util
+        import sys
         from pathlib import Path
 
+        already = "rti_rig" in sys.modules  # imported before this check, from files then
         try:
             import rti_rig
         except Exception as exc:  # a worker without rti-rig says so
@@ -135,6 +137,18 @@ def _identity_function(
                     "its rti-rig source changed after this process imported it"
                     + (f" ({named})" if named else "")
                     + ": it runs the code it imported, not the files there now; restart it"
+                ),
+            }
+        if already and not isinstance(imported_at, int):
+            # Imported before this check ran, by an rti-rig that kept no import time (one
+            # older than IMPORTED_AT_NS, e.g. for an earlier fit's tasks): its files may have
+            # been replaced since by any others, their dates kept (a pull, `cp -a`).
+            return {
+                "version": None if version is None else str(version),
+                "fingerprint": first,
+                "problem": (
+                    "it imported rti-rig before this check, from an rti-rig that kept no "
+                    "record of when: it may run other code than the files there now; restart it"
                 ),
             }
         return {
