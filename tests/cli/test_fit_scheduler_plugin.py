@@ -20,6 +20,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 from typing import Any
 
@@ -258,4 +259,37 @@ def test_a_worker_holding_an_rti_rig_that_kept_no_import_time_is_refused(tmp_pat
         "imported rti-rig before this check, from an rti-rig that kept no record of when: it "
         "may run other code than the files there now; restart it)"
     ) in said, said
+    assert not out.exists(), said  # nothing was sent
+
+
+@pytest.mark.slow
+def test_a_worker_whose_source_is_dated_after_the_clock_is_told_to_date_it_not_only_restart(
+    tmp_path: Path,
+) -> None:
+    """A worker's copy of this very rti-rig with one file dated a day ahead (a file server's
+    clock ahead, a copy that kept a future date): it was said to have changed since the
+    worker imported it and to restart, and a restart was refused the same way until the clock
+    passed that date. Whether it changed cannot be told; the file is named to be dated now."""
+    session = make_session(tmp_path / "S", size=(24, 32))[0]
+    where = tmp_path / "same"
+    shutil.copytree(
+        Path(rti_rig.__file__).parent,
+        where / "rti_rig",
+        ignore=shutil.ignore_patterns("__pycache__"),
+    )
+    ahead = (where / "rti_rig" / "app" / "usecases" / "fit.py").resolve()
+    day = 86_400 * 10**9
+    os.utime(ahead, ns=(time.time_ns() + day, time.time_ns() + day))
+    out = tmp_path / "FIT"
+    r, address, scheduler = _fit_on_a_worker_of(where, session, out)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert f"1 of the 1 workers of the Dask cluster at '{scheduler}'" in said, said
+    assert (
+        f"{address} (rti-rig {rti_rig.__version__}, code {local_identity().fingerprint}, but its "
+        f"rti-rig source file(s) {ahead} are dated after this computer's clock, so whether they "
+        "changed since this process imported rti-rig cannot be told: give them the present "
+        "date (`touch FILE`; set the clocks right if a file server's runs ahead), then restart it)"
+    ) in said, said
+    assert "changed after this process imported it" not in said, said
     assert not out.exists(), said  # nothing was sent

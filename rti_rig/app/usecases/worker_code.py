@@ -73,6 +73,7 @@ def _identity_function(
         import hashlib
         import importlib.util
         import sys
+        import time
         from pathlib import Path
 
         already = "rti_rig" in sys.modules  # imported before this check, from files then
@@ -123,11 +124,15 @@ def _identity_function(
             "_rti_rig_code_first_checked", (fingerprint, code.hexdigest())
         )
         imported_at = getattr(rti_rig, "IMPORTED_AT_NS", None)
-        changed = sorted(
-            relative
-            for relative, path in everything
-            if isinstance(imported_at, int) and path.stat().st_mtime_ns > imported_at
-        )
+        now = time.time_ns()
+        changed: list[str] = []
+        ahead: list[str] = []  # dated after this clock: when they changed is not known
+        for relative, path in sorted(everything) if isinstance(imported_at, int) else ():
+            modified = path.stat().st_mtime_ns
+            if modified > now:
+                ahead.append(str(path))
+            elif modified > imported_at:
+                changed.append(relative)
         if changed or first_code != code.hexdigest():
             named = ", ".join(changed[:3]) + (" …" if len(changed) > 3 else "")
             return {
@@ -137,6 +142,21 @@ def _identity_function(
                     "its rti-rig source changed after this process imported it"
                     + (f" ({named})" if named else "")
                     + ": it runs the code it imported, not the files there now; restart it"
+                ),
+            }
+        if ahead:
+            # Not "changed after the import": a date to come says nothing of when (a file
+            # server's clock ahead, a copy that kept a future date), and a restart alone would
+            # be refused the same way until the clock passed it.
+            named = ", ".join(ahead[:3]) + (" …" if len(ahead) > 3 else "")
+            return {
+                "version": None if version is None else str(version),
+                "fingerprint": first,
+                "problem": (
+                    f"its rti-rig source file(s) {named} are dated after this computer's clock, "
+                    "so whether they changed since this process imported rti-rig cannot be "
+                    "told: give them the present date (`touch FILE`; set the clocks right if "
+                    "a file server's runs ahead), then restart it"
                 ),
             }
         if already and not isinstance(imported_at, int):
