@@ -21,6 +21,8 @@ import subprocess
 import sys
 import textwrap
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -193,11 +195,10 @@ def test_a_check_that_fails_on_a_worker_still_there_names_it_and_the_error(
     assert not out.exists()
 
 
-def _fit_on_a_worker_of(where: Path, session: Path, out: Path, then: Any = None) -> Any:
-    """Fit ``session`` into ``out`` on a scheduler of one ``dask worker`` process importing
-    rti-rig from ``where``: the worker imports rti-rig's batch fit first (as for an earlier
-    fit's tasks), then ``then()`` runs. Returns the CLI's result, the worker's address and the
-    scheduler's; the worker is killed and reaped whatever happens."""
+@contextmanager
+def _one_worker_of(where: Path) -> Iterator[Any]:
+    """A scheduler (the ``LocalCluster``) of one ``dask worker`` process importing rti-rig from
+    ``where``, once it joined; the worker is killed and reaped whatever happens."""
     worker = None
     try:
         with _tcp_cluster(0) as cluster:
@@ -208,24 +209,36 @@ def _fit_on_a_worker_of(where: Path, session: Path, out: Path, then: Any = None)
                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
             )  # fmt: skip
             _until(lambda: len(cluster.scheduler.workers) == 1, "the worker never joined")
-            from distributed import Client
-
-            with Client(cluster.scheduler_address, set_as_default=False) as client:
-                (loaded,) = client.run(exec, "import rti_rig.app.usecases.fit_batch").values()
-                assert loaded is None
-            if then is not None:
-                then()
-            r = runner.invoke(
-                app,
-                ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps",
-                 "--scheduler", cluster.scheduler_address],
-            )  # fmt: skip
-            (address,) = cluster.scheduler.workers
-            return r, address, cluster.scheduler_address
+            yield cluster
     finally:
         if worker is not None:  # killed: a SIGTERM'd dask worker may take minutes to close
             worker.kill()
             worker.wait(timeout=120)
+
+
+def _fit(session: Path, out: Path, scheduler: str) -> Any:
+    return runner.invoke(
+        app,
+        ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps",
+         "--scheduler", scheduler],
+    )  # fmt: skip
+
+
+def _fit_on_a_worker_of(where: Path, session: Path, out: Path, then: Any = None) -> Any:
+    """Fit ``session`` into ``out`` on :func:`_one_worker_of` ``where``, the worker having
+    imported rti-rig's batch fit first (as for an earlier fit's tasks), then ``then()`` run.
+    Returns the CLI's result, the worker's address and the scheduler's."""
+    from distributed import Client
+
+    with _one_worker_of(where) as cluster:
+        with Client(cluster.scheduler_address, set_as_default=False) as client:
+            (loaded,) = client.run(exec, "import rti_rig.app.usecases.fit_batch").values()
+            assert loaded is None
+        if then is not None:
+            then()
+        r = _fit(session, out, cluster.scheduler_address)
+        (address,) = cluster.scheduler.workers
+        return r, address, cluster.scheduler_address
 
 
 @pytest.mark.slow
@@ -293,3 +306,42 @@ def test_a_worker_whose_source_is_dated_after_the_clock_is_told_to_date_it_not_o
     ) in said, said
     assert "changed after this process imported it" not in said, said
     assert not out.exists(), said  # nothing was sent
+
+
+@pytest.mark.slow
+def test_a_worker_checked_once_is_judged_by_its_files_contents_not_their_dates(
+    tmp_path: Path,
+) -> None:
+    """A worker that imported this rti-rig for its first check, one of its files then written
+    again unchanged (an editor's save, `git stash && git stash pop`, the same wheel installed
+    again): it runs this code still, yet was called changed since its import and refused. A
+    file edited, its date kept (`cp -a`, `rsync -a`), is still refused, and named."""
+    session = make_session(tmp_path / "S", size=(24, 32))[0]
+    where = tmp_path / "same"
+    shutil.copytree(
+        Path(rti_rig.__file__).parent,
+        where / "rti_rig",
+        ignore=shutil.ignore_patterns("__pycache__"),
+    )
+    fit_py = where / "rti_rig" / "app" / "usecases" / "fit.py"
+    with _one_worker_of(where) as cluster:
+        first = _fit(session, tmp_path / "FIT1", cluster.scheduler_address)
+        assert first.exit_code == 0, first.output
+        dated = fit_py.stat()
+        os.utime(fit_py, ns=(dated.st_atime_ns, time.time_ns()))  # written again, unchanged
+        assert fit_py.stat().st_mtime_ns > dated.st_mtime_ns
+        again = _fit(session, tmp_path / "FIT2", cluster.scheduler_address)
+        assert again.exit_code == 0, " ".join(again.output.split())
+        text = fit_py.read_text(encoding="utf-8")
+        fit_py.write_text(text + "\n# edited\n", encoding="utf-8")
+        os.utime(fit_py, ns=(dated.st_atime_ns, dated.st_mtime_ns))  # its date kept
+        edited = _fit(session, tmp_path / "FIT3", cluster.scheduler_address)
+        (address,) = cluster.scheduler.workers
+    said = " ".join(edited.output.split())
+    assert edited.exit_code == 2, said
+    assert (
+        f"{address} (rti-rig {rti_rig.__version__}, code {local_identity().fingerprint}, but its "
+        "rti-rig source changed after this process imported it (rti_rig/app/usecases/fit.py): "
+        "it runs the code it imported, not the files there now; restart it)"
+    ) in said, said
+    assert not (tmp_path / "FIT3").exists(), said

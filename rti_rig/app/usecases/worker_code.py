@@ -73,7 +73,6 @@ def _identity_function(
         import hashlib
         import importlib.util
         import sys
-        import time
         from pathlib import Path
 
         already = "rti_rig" in sys.modules  # imported before this check, from files then
@@ -90,7 +89,7 @@ def _identity_function(
         # In a wheel the mapped packages sit inside rti_rig/: each is hashed under its own name.
         nested = {folder for name, folder in folders.items() if name != "rti_rig" and folder}
         digest = hashlib.sha256()
-        code = hashlib.sha256()  # the .py files alone: what a process imports and keeps
+        code: dict[str, str] = {}  # the .py files alone, by path: what a process imports
         everything: list[tuple[str, Path]] = []
         for name in roots:
             folder = folders[name]
@@ -112,70 +111,83 @@ def _identity_function(
                 content = path.read_bytes()
                 digest.update(relative.encode() + b"\0" + content + b"\0")
                 if path.suffix == ".py":
-                    code.update(f"{where}/{relative}".encode() + b"\0" + content + b"\0")
+                    code[f"{where}/{relative}"] = hashlib.sha256(content).hexdigest()
                     everything.append((f"{where}/{relative}", path))
         fingerprint = digest.hexdigest()[:12]
         version = getattr(rti_rig, "__version__", None)
+        said = None if version is None else str(version)
         # The code this process runs is what it imported, not what its .py files say now (the
-        # .toml and .lp are read when used): the .py digest of its first check is kept in the
-        # process, and a .py file changed since rti-rig was imported here (or since that first
-        # check) makes it another code.
-        first, first_code = vars(rti_rig).setdefault(
-            "_rti_rig_code_first_checked", (fingerprint, code.hexdigest())
+        # .toml and .lp are read when used). The .py files' contents at this process's first
+        # check are kept in it, with what that check found; every later check compares
+        # contents with them, not dates (a file saved again unchanged is the same code; one
+        # edited with its date kept is not).
+        first = vars(rti_rig).get("_rti_rig_first_check")
+        if first is None:
+            first = vars(rti_rig).setdefault(
+                "_rti_rig_first_check",
+                (fingerprint, code, None if not already else imported_problem(rti_rig, everything)),
+            )
+        first_fingerprint, first_code, first_problem = first
+        changed = sorted(
+            relative
+            for relative in set(code) | set(first_code)
+            if code.get(relative) != first_code.get(relative)
         )
+        if changed:
+            named = ", ".join(changed[:3]) + (" …" if len(changed) > 3 else "")
+            problem: str | None = (
+                f"its rti-rig source changed after this process imported it ({named}): it runs "
+                "the code it imported, not the files there now; restart it"
+            )
+        else:
+            problem = first_problem
+        if problem is not None:
+            return {"version": said, "fingerprint": first_fingerprint, "problem": problem}
+        return {"version": said, "fingerprint": fingerprint, "problem": None}
+
+    def imported_problem(rti_rig: Any, everything: list[tuple[str, Any]]) -> str | None:
+        """Why the files of a process that imported rti-rig before its first check may not be
+        the code it imported (by their dates against the time of the import), or ``None``.
+        Only then are dates asked: a first check that imports rti-rig itself reads the very
+        files it imports."""
+        import time
+
         imported_at = getattr(rti_rig, "IMPORTED_AT_NS", None)
+        if not isinstance(imported_at, int):
+            # Imported by an rti-rig that kept no import time (one older than IMPORTED_AT_NS,
+            # e.g. for an earlier fit's tasks): its files may have been replaced since by any
+            # others, their dates kept (a pull, `cp -a`).
+            return (
+                "it imported rti-rig before this check, from an rti-rig that kept no record of "
+                "when: it may run other code than the files there now; restart it"
+            )
         now = time.time_ns()
         changed: list[str] = []
         ahead: list[str] = []  # dated after this clock: when they changed is not known
-        for relative, path in sorted(everything) if isinstance(imported_at, int) else ():
+        for relative, path in sorted(everything):
             modified = path.stat().st_mtime_ns
             if modified > now:
                 ahead.append(str(path))
             elif modified > imported_at:
                 changed.append(relative)
-        if changed or first_code != code.hexdigest():
+        if changed:
             named = ", ".join(changed[:3]) + (" …" if len(changed) > 3 else "")
-            return {
-                "version": None if version is None else str(version),
-                "fingerprint": first,
-                "problem": (
-                    "its rti-rig source changed after this process imported it"
-                    + (f" ({named})" if named else "")
-                    + ": it runs the code it imported, not the files there now; restart it"
-                ),
-            }
+            return (
+                f"its rti-rig source changed after this process imported it ({named}): it runs "
+                "the code it imported, not the files there now; restart it"
+            )
         if ahead:
             # Not "changed after the import": a date to come says nothing of when (a file
             # server's clock ahead, a copy that kept a future date), and a restart alone would
             # be refused the same way until the clock passed it.
             named = ", ".join(ahead[:3]) + (" …" if len(ahead) > 3 else "")
-            return {
-                "version": None if version is None else str(version),
-                "fingerprint": first,
-                "problem": (
-                    f"its rti-rig source file(s) {named} are dated after this computer's clock, "
-                    "so whether they changed since this process imported rti-rig cannot be "
-                    "told: give them the present date (`touch FILE`; set the clocks right if "
-                    "a file server's runs ahead), then restart it"
-                ),
-            }
-        if already and not isinstance(imported_at, int):
-            # Imported before this check ran, by an rti-rig that kept no import time (one
-            # older than IMPORTED_AT_NS, e.g. for an earlier fit's tasks): its files may have
-            # been replaced since by any others, their dates kept (a pull, `cp -a`).
-            return {
-                "version": None if version is None else str(version),
-                "fingerprint": first,
-                "problem": (
-                    "it imported rti-rig before this check, from an rti-rig that kept no "
-                    "record of when: it may run other code than the files there now; restart it"
-                ),
-            }
-        return {
-            "version": None if version is None else str(version),
-            "fingerprint": fingerprint,
-            "problem": None,
-        }
+            return (
+                f"its rti-rig source file(s) {named} are dated after this computer's clock, so "
+                "whether they changed since this process imported rti-rig cannot be told: give "
+                "them the present date (`touch FILE`; set the clocks right if a file server's "
+                "runs ahead), then restart it"
+            )
+        return None
 
     return rti_rig_identity
 
