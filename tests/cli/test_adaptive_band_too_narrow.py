@@ -184,3 +184,32 @@ def test_more_lights_than_an_arm_offers_are_refused_with_a_command_that_runs(
     assert r.exit_code == 0, said(r)
     lit = _elevations(tmp_path / "advised")
     assert len(lit) == offered and max(lit) <= 30.0 + 1e-6, lit
+
+
+@pytest.mark.parametrize(
+    ("asked", "lead", "lit"),
+    [
+        # kept as given, --lights 4 in the widened band was refused: "give at least 5"
+        (["--lights", "4", "--max-elevation-deg", "20"], "Widen the band to hold 5: ", 5),
+        # more than the dome's 12 LEDs in a band of none: no command had been given at all
+        (
+            ["--lights", "14", "--max-elevation-deg", "12"],
+            "No band holds 14 (the dome has 12 LEDs): ask for 12 in one that holds them: ",
+            12,
+        ),
+    ],
+)
+def test_the_lights_asked_for_are_advised_as_a_session_can_take_them(
+    tmp_path: Path, asked: list[str], lead: str, lit: int
+) -> None:
+    """The --lights a band too narrow was asked with are advised within what an adaptive
+    session takes (at least 5, at most the dome's LEDs), and the advised command runs."""
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(NAB), "--out", str(out), "--adaptive", *asked])
+    text = said(r)
+    assert r.exit_code == 2, text
+    argv = _advised(text, lead, tmp_path, "wide")
+    assert argv[argv.index("--lights") + 1] == str(lit), argv
+    r = runner.invoke(app, [*argv, "--no-verdict"])
+    assert r.exit_code == 0, said(r)
+    assert len(_elevations(tmp_path / "wide")) == lit

@@ -1322,7 +1322,9 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
     The advice is a band that holds the session (:func:`_band_holding`), as a command with
     the user's own options, and the planned run of the band's lights as the other way: the
     planned run alone had been advised, ``--lights 1`` on the Nab dome below 20°, a session
-    no fit can use."""
+    no fit can use. The advised ``--lights``/``--min-lights`` are what a session can take: at
+    least 5 (a ``--lights 4`` kept was refused "give at least 5") and at most the dome's LEDs
+    (``--lights 14`` of a 12-LED dome was left with no command)."""
     if offered > START_LIGHTS:
         return
     if lights is None and until_error_deg is not None and offered >= fit_minimums.NORMAL_MIN_LIGHTS:
@@ -1344,17 +1346,26 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
         f"{el.min():.1f}°–{el.max():.1f}° elevation), and {session}: it starts from "
         f"{START_LIGHTS} and chooses the next ones: there is none left to choose here"
     ]
-    wider = _band_holding(el, need, band)
+    # what the advised band is to hold: no band holds more than the dome's LEDs (a --lights 14
+    # on a 12-LED dome had been left with no command, or only a test shot of the band's one)
+    hold = min(need, len(el))
+    wider = _band_holding(el, hold, band) if hold > START_LIGHTS else None
     if wider is not None:
         asked = (
             f"--until-error {until_error_deg:g}" if until_error_deg is not None else "--adaptive"
         )
-        if lights is not None:
-            asked += f" --lights {lights}"
+        if lights is not None:  # a --lights 4 kept as given was refused: "give at least 5"
+            asked += f" --lights {min(max(lights, START_LIGHTS + 1), hold)}"
         if min_lights is not None:
-            asked += f" --min-lights {min_lights}"
+            asked += f" --min-lights {min(min_lights, hold)}"
+        lead = (
+            f"Widen the band to hold {need}"
+            if hold == need
+            else f"No band holds {need} (the dome has {len(el)} LEDs): ask for {hold} in one "
+            "that holds them"
+        )
         words.append(
-            f"Widen the band to hold {need}: rti-rig run {config} --out DIR {asked}"
+            f"{lead}: rti-rig run {config} --out DIR {asked}"
             f"{_band_options(wider)} ({_held(el, wider)} lights"
             f"{_band_words(wider) or ' at every elevation'})"
         )
