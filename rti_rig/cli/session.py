@@ -1210,6 +1210,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         raise EmergencyStop("SIGTERM")
 
     def on_sigusr1(signum, frame):  # type: ignore[no-untyped-def]
+        if ended:  # as the session's end is reported: "Pausing after this image" had been said
+            err.print("[yellow]SIGUSR1 ignored: a session pauses only while it captures.[/]")
+            return
         if cancel.paused:
             cancel.resume()
             err.print("[green]Resuming.[/]")

@@ -146,3 +146,18 @@ def test_two_ctrl_c_as_a_session_stopped_before_its_capture_closes_are_answered(
     assert said.count("Ctrl-C while the session stopped before its first image") == 1, said
     assert "Stopped (Ctrl-C) before the first image: nothing was captured" in said, said
     assert r.exit_code == 130, said
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGUSR1"), reason="no SIGUSR1")
+def test_a_pause_asked_as_the_end_is_reported_is_said_to_be_ignored(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """SIGUSR1 (pause) in the same window, once every image is in: it had been told "Pausing
+    after this image", of a session with no image left to pause before."""
+    raised = _signal_as_ctrl_c_is_ignored(monkeypatch, signal.SIGUSR1)
+    r, said, _ = _run(tmp_path)
+    assert raised == [signal.SIGUSR1], said
+    assert r.exit_code == 0, said
+    assert "Pausing after this image" not in said, said
+    assert "SIGUSR1 ignored: a session pauses only while it captures." in said, said
+    assert "6 image(s) in the session" in said, said
