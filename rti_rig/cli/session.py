@@ -1181,7 +1181,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             # EmergencyStop where nothing caught it: a traceback, the summary and resume unsaid
             if not late_said:
                 late_said = True
-                err.print(f"[yellow]{_LATE_CTRL_C if started else _CLOSING_CTRL_C}[/]")
+                closing = _CLOSING_RESUME_CTRL_C if opened.resumed else _CLOSING_CTRL_C
+                err.print(f"[yellow]{_LATE_CTRL_C if started else closing}[/]")
             return
         if cancel.cancelled:
             ended = not started  # stopped before the capture began: it never will
@@ -1341,9 +1342,15 @@ _LATE_CTRL_C = (
     "Ctrl-C after the capture had ended: there was nothing left to stop, and the rig's "
     "teardown has run (what it did is said below)."
 )
-#: What a Ctrl-C is told while a session stopped before its capture began closes its rig.
+#: What a Ctrl-C is told while a session stopped before its capture began closes its rig, a
+#: new one's and a resumed one's (which has images: "before its first image" had been said of
+#: it too, above "Stopped (Ctrl-C) before the session went on").
 _CLOSING_CTRL_C = (
     "Ctrl-C while the session stopped before its first image: the rig is being closed (said below)."
+)
+_CLOSING_RESUME_CTRL_C = (
+    "Ctrl-C while the resumed session stopped before it went on: the rig is being closed (said "
+    "below)."
 )
 
 

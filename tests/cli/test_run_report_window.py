@@ -161,3 +161,35 @@ def test_a_pause_asked_as_the_end_is_reported_is_said_to_be_ignored(
     assert "Pausing after this image" not in said, said
     assert "SIGUSR1 ignored: a session pauses only while it captures." in said, said
     assert "6 image(s) in the session" in said, said
+
+
+def test_two_ctrl_c_as_a_resume_stopped_before_it_went_on_closes_are_not_told_first_image(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same of a resume (its first 2 images in): the Ctrl-C as its rig closes had been told
+    "the session stopped before its first image", of a session with images kept."""
+    _first_ctrl_c_at_image(monkeypatch, 2)
+    r, said, out = _run(tmp_path)
+    assert r.exit_code == 130 and "2 image(s) in the session" in said, said
+    monkeypatch.undo()
+    real_execute, real_stopped = cli_session._execute, cli_session._stopped_before_capture
+
+    def execute(*args: Any, **kwargs: Any) -> Any:
+        signal.raise_signal(signal.SIGINT)  # held by the hand-over: the capture never begins
+        return real_execute(*args, **kwargs)
+
+    def stopped_before_capture(*args: Any, **kwargs: Any) -> Any:
+        signal.raise_signal(signal.SIGINT)
+        signal.raise_signal(signal.SIGINT)
+        return real_stopped(*args, **kwargs)
+
+    monkeypatch.setattr(cli_session, "_execute", execute)
+    monkeypatch.setattr(cli_session, "_stopped_before_capture", stopped_before_capture)
+    argv = ["run", "--resume", str(out), "--no-verdict"]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert "first image" not in said, said
+    assert said.count("Ctrl-C while the resumed session stopped before it went on") == 1, said
+    assert "Stopped (Ctrl-C) before the session went on: no new image was captured" in said, said
+    assert r.exit_code == 130, said
