@@ -1172,6 +1172,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     #: function's except or finally clauses, where nothing catches it (see ``on_sigint``)
     ended = False
     late_said = False
+    #: the stop's line of what the teardown did (the lights) is out: a Ctrl-C after it is
+    #: pointed above, not below
+    teardown_said = False
 
     def on_sigint(signum, frame):  # type: ignore[no-untyped-def]
         nonlocal ended, late_said
@@ -1182,7 +1185,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             if not late_said:
                 late_said = True
                 closing = _CLOSING_RESUME_CTRL_C if opened.resumed else _CLOSING_CTRL_C
-                err.print(f"[yellow]{_LATE_CTRL_C if started else closing}[/]")
+                late = _LATE_CTRL_C_SAID_ABOVE if teardown_said else _LATE_CTRL_C
+                err.print(f"[yellow]{late if started else closing}[/]")
             return
         if cancel.cancelled:
             ended = not started  # stopped before the capture began: it never will
@@ -1305,6 +1309,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         err.print(
             f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig, failed))}."
         )
+        teardown_said = True
         err.print(_after_stop(opened, resume_hint()), markup=False, soft_wrap=True)
         raise typer.Exit(code=stop_exit_code(str(exc))) from None
     except RtiRigError as exc:
@@ -1342,6 +1347,9 @@ _LATE_CTRL_C = (
     "Ctrl-C after the capture had ended: there was nothing left to stop, and the rig's "
     "teardown has run (what it did is said below)."
 )
+#: The same once the stop has said what the teardown did: "said below" had pointed at the
+#: images kept and the resume, under the line of the lights.
+_LATE_CTRL_C_SAID_ABOVE = _LATE_CTRL_C.replace("said below", "said above")
 #: What a Ctrl-C is told while a session stopped before its capture began closes its rig, a
 #: new one's and a resumed one's (which has images: "before its first image" had been said of
 #: it too, above "Stopped (Ctrl-C) before the session went on").

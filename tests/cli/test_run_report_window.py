@@ -193,3 +193,36 @@ def test_two_ctrl_c_as_a_resume_stopped_before_it_went_on_closes_are_not_told_fi
     assert said.count("Ctrl-C while the resumed session stopped before it went on") == 1, said
     assert "Stopped (Ctrl-C) before the session went on: no new image was captured" in said, said
     assert r.exit_code == 130, said
+
+
+def test_a_ctrl_c_once_the_stop_said_the_lights_points_above(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Two Ctrl-C at image 3 stop the run at once; a third as the stop reads what the folder
+    holds, after its line of the lights: it had said the teardown's doing was "said below",
+    above the images kept and the resume."""
+    real_shoot, shots = controller.shoot_step, []
+
+    def shoot_step(*args: Any, **kwargs: Any) -> Any:
+        shots.append(1)
+        if len(shots) == 3:
+            signal.raise_signal(signal.SIGINT)
+            signal.raise_signal(signal.SIGINT)
+        return real_shoot(*args, **kwargs)
+
+    real_after = cli_session._after_stop
+
+    def after_stop(*args: Any, **kwargs: Any) -> Any:
+        signal.raise_signal(signal.SIGINT)
+        return real_after(*args, **kwargs)
+
+    monkeypatch.setattr(controller, "shoot_step", shoot_step)
+    monkeypatch.setattr(cli_session, "_after_stop", after_stop)
+    r, said, out = _run(tmp_path)
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    lights = said.index("Emergency stop (second Ctrl-C): lights were switched off.")
+    late = said.index("Ctrl-C after the capture had ended")
+    assert lights < late, said
+    assert "teardown has run (what it did is said above)" in said, said
+    assert f"Continue with: rti-rig run --resume {out}" in said[late:], said
+    assert r.exit_code == 130, said
