@@ -1313,8 +1313,10 @@ class FolderWatchCamera:
                         "its end written, but its tags contradict each other)",
                         SAVE_AGAIN,
                     ) from exc
+                thumbnail = isinstance(exc, ImageReadError) and exc.thumbnail_only
                 if (
                     extent is not None
+                    and not thumbnail  # whole so far: libtiff links the full image's IFD last
                     and tried is not None
                     and steady
                     and extent[1] <= tried[2]
@@ -1333,6 +1335,11 @@ class FolderWatchCamera:
                     ) from exc
                 if tiff:
                     message += f": {COMPLETE_TIFF_ADVICE}"
+                if thumbnail:
+                    message += (
+                        " If it is, have the program saving the shots save the full-size "
+                        "image in it"
+                    )
                 failure = exc
             if not self._changed_and_settled(path, tried, deadline):
                 raise CaptureError(

@@ -96,7 +96,9 @@ class ImageReadError(CaptureError):
     compression the reader does not decode, None otherwise) and ``contradicts`` (its own tags
     contradict each other: :func:`tiff_contradiction`; a damaged file, unless its bytes are
     not all written yet) and ``several`` (a whole TIFF of two or more full-size images, which
-    one is the photograph not known: no wait or copy mends it, saving one image does).
+    one is the photograph not known: no wait or copy mends it, saving one image does) and
+    ``thumbnail_only`` (a TIFF whose every image is marked reduced-resolution: a thumbnail
+    with the full image not written after it yet, as a libtiff writer leaves it mid-file).
 
     Why fields: a caller that words the failure its own way (a watched folder naming the
     folder's file, not the session's copy it read, and whether waiting can help) had cut this
@@ -113,6 +115,7 @@ class ImageReadError(CaptureError):
         compression: str | None = None,
         contradicts: bool = False,
         several: bool = False,
+        thumbnail_only: bool = False,
     ) -> None:
         self.path = path
         self.reason = reason
@@ -121,6 +124,7 @@ class ImageReadError(CaptureError):
         self.compression = compression
         self.contradicts = contradicts
         self.several = several
+        self.thumbnail_only = thumbnail_only
         advice = (
             f": {SAVE_READABLE}"
             if compression
@@ -214,6 +218,9 @@ def read_image_file(path: Path, device: str) -> NDArray:
                 if page is None and len(tif.pages):
                     page = tif.pages[0]
                 contradiction = tiff_contradiction(page) if page is not None else None
+                # every image a thumbnail (NewSubfileType bit 0): no shot yet, never taken as
+                # one (a thumbnail-first file a writer paused in had gone in at 16x16)
+                reduced = page is not None and int(getattr(page, "subfiletype", 0) or 0) & 1
         except SeveralFullSizeImages as exc:
             raise ImageReadError(device, path, str(exc), is_tiff=True, several=True) from exc
         except (ValueError, OSError, RuntimeError, struct.error) as exc:
@@ -229,6 +236,15 @@ def read_image_file(path: Path, device: str) -> NDArray:
             raise ImageReadError(device, path, str(exc), is_tiff=True) from exc
         if image.size == 0:  # a damaged IFD tifffile reads past, logging, as no pixels
             raise ImageReadError(device, path, "it holds no pixels", is_tiff=True, no_pixels=True)
+        if reduced:
+            raise ImageReadError(
+                device,
+                path,
+                "it holds only a reduced-resolution image (a thumbnail, NewSubfileType 1), "
+                f"{image.shape[1]}x{image.shape[0]}, not the full-size image",
+                is_tiff=True,
+                thumbnail_only=True,
+            )
         if contradiction is not None:  # never taken as the other image it reads as
             raise ImageReadError(device, path, contradiction, is_tiff=True, contradicts=True)
         # a planar TIFF (Photoshop's "Per Channel") decodes samples first, (3, H, W): it had

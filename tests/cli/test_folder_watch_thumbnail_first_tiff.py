@@ -7,6 +7,7 @@ is (whole, one image per file wanted), not as a damaged or half-written file."""
 
 from __future__ import annotations
 
+import threading
 from io import BytesIO
 from pathlib import Path
 
@@ -68,5 +69,112 @@ def test_run_refuses_a_tiff_of_two_full_size_images_as_such(
     assert "save one image per TIFF" in said and "waiting will not help" in said, said
     assert "damaged" not in said and "complete TIFF" not in said, said
     assert f"left in {tether}" in said, said
+    assert not list((out / "linear").glob("image_*.tif")), said
+    assert lit_at_end == []
+
+
+def _thumbnail_written_alone(whole: bytes) -> bytes:
+    """What a libtiff writer has saved of a thumbnail-first TIFF when it pauses within the
+    full image: the thumbnail's IFD0 done, its next-IFD link still 0 (libtiff sets it only
+    when it writes the next IFD), and part of the full image's strips after it. As it stands
+    it is a valid TIFF of the thumbnail alone."""
+    with tifffile.TiffFile(BytesIO(whole)) as tif:
+        ifd0, ifd1 = tif.pages[0].offset, tif.pages[1].offset
+    entries = int.from_bytes(whole[ifd0 : ifd0 + 2], "little")
+    link = ifd0 + 2 + 12 * entries
+    assert int.from_bytes(whole[link : link + 4], "little") == ifd1
+    cut = ifd1 + (len(whole) - ifd1) // 2
+    return whole[:link] + bytes(4) + whole[link + 4 : cut]
+
+
+class PausedThumbnailFirst(threading.Thread):
+    """A tethering program on a slow share saving thumbnail-first TIFFs, fired by the board:
+    the first pulse's file comes as far as the thumbnail and part of the full image, and the
+    rest only once the camera has read that part and waits for more (until the run ends
+    otherwise); each later light's file comes whole."""
+
+    def __init__(self, firmware, folder: Path, files: list[bytes], tried: threading.Event) -> None:  # type: ignore[no-untyped-def]
+        super().__init__(daemon=True)
+        self.firmware, self.folder, self.files, self.tried = firmware, folder, files, tried
+        self.stop = threading.Event()
+
+    def run(self) -> None:
+        saved = 0
+        while not self.stop.is_set():
+            pulses = sum(e.what == "shutter" for e in list(self.firmware.history))
+            if pulses > saved and saved < len(self.files):
+                saved += 1
+                target = self.folder / f"IMG_{saved:04d}.tif"
+                if saved == 1:
+                    target.write_bytes(_thumbnail_written_alone(self.files[0]))
+                    while not self.tried.wait(0.05):
+                        if self.stop.is_set():
+                            return
+                target.write_bytes(self.files[saved - 1])
+            self.stop.wait(0.02)
+
+
+def test_run_waits_for_the_full_image_of_a_thumbnail_first_tiff_paused_after_its_thumbnail(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A file that holds only a reduced-resolution image is no shot yet: it had been read as
+    the thumbnail it is so far, and a 64x64 shot went into the session at 16x16 (its next
+    light's whole file then refused as another size)."""
+    from rti_rig.drivers.cameras import folder_watch
+
+    rng = np.random.default_rng(5)
+    shots = [rng.integers(1000, 60000, (64, 64, 3), dtype=np.uint16) for _ in range(2)]
+    files = [_thumbnail_first(p, "ifd") for p in shots]
+    with tifffile.TiffFile(BytesIO(_thumbnail_written_alone(files[0]))) as tif:
+        assert [p.shape for p in tif.pages] == [(16, 16, 3)]  # the thumbnail alone, so far
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=20.0, tiffs=True)
+    out = tmp_path / "s"
+    tried = threading.Event()
+    real = folder_watch.FolderWatchCamera._changed_and_settled
+
+    def waits(self, *args):  # type: ignore[no-untyped-def]
+        tried.set()  # the part read was refused and is waited for: the copy may go on
+        return real(self, *args)
+
+    monkeypatch.setattr(folder_watch.FolderWatchCamera, "_changed_and_settled", waits)
+    r, said, lit_at_end = tethered_run(
+        monkeypatch,
+        cfg,
+        tether,
+        [],
+        out,
+        camera=lambda firmware: PausedThumbnailFirst(firmware, tether, files, tried),
+    )
+    assert r.exit_code == 0, said
+    assert tried.is_set(), said
+    for n, shot in enumerate(shots, 1):
+        image = tifffile.imread(out / "linear" / f"image_{n:03d}.tif")
+        assert np.array_equal(image, shot), image.shape
+    assert lit_at_end == []
+
+
+def test_run_refuses_a_tiff_of_a_thumbnail_alone_once_it_stays_so(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A whole TIFF whose only image is marked reduced-resolution is no shot: waited for (a
+    writer may be on its way to the full image), then refused saying what it holds, never
+    recorded at thumbnail size nor called damaged."""
+    rng = np.random.default_rng(6)
+    alone = BytesIO()
+    tifffile.imwrite(
+        alone, rng.integers(0, 60000, (16, 16, 3), dtype=np.uint16), subfiletype=1, metadata=None
+    )
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=3.0, tiffs=True)
+    out = tmp_path / "s"
+    named = [(f"IMG_{n:04d}.tif", alone.getvalue()) for n in (1, 2)]
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, named, out)
+    assert r.exit_code != 0, said
+    assert "Traceback" not in said and "damaged" not in said, said
+    assert "IMG_0001.tif" in said and "only a reduced-resolution image" in said, said
+    assert "save the full-size image" in said and "did not change within 3 s" in said, said
     assert not list((out / "linear").glob("image_*.tif")), said
     assert lit_at_end == []
