@@ -66,3 +66,23 @@ def test_plan_refuses_a_tiff_of_two_full_size_images(tmp_path: Path) -> None:
     assert "two.tif" in said and "2 full-size images" in said, said
     assert "save it again as a TIFF of one image" in said, said
     assert not (tmp_path / "p.lp").exists()
+
+
+def test_plan_refuses_a_tiff_of_two_pages_of_one_size(tmp_path: Path) -> None:
+    """Two full-size pages of one size and type (a bracket, two frames) are one stack to
+    tifffile: the preview had been handed on as a (2, H, W, 3) array and refused by its shape
+    ("the preview must be an image (H, W) or (H, W, 3)"), the file and the fix unnamed."""
+    two = tmp_path / "two.tif"
+    with tifffile.TiffWriter(two) as tw:
+        tw.write(_relief(), photometric="rgb", metadata=None)
+        tw.write(_relief()[::-1], photometric="rgb", metadata=None)
+    with tifffile.TiffFile(two) as tif:  # the file is as described: one series of two pages
+        assert [s.shape for s in tif.series] == [(2, 96, 128, 3)]
+    r = runner.invoke(
+        app, ["plan", str(two), "--out", str(tmp_path / "p.lp"), "--preview-light", "90,40"]
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0 and "Traceback" not in said, said
+    assert "two.tif" in said and "2 full-size images" in said, said
+    assert "save it again as a TIFF of one image" in said, said
+    assert not (tmp_path / "p.lp").exists()
