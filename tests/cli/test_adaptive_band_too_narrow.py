@@ -213,3 +213,24 @@ def test_the_lights_asked_for_are_advised_as_a_session_can_take_them(
     r = runner.invoke(app, [*argv, "--no-verdict"])
     assert r.exit_code == 0, said(r)
     assert len(_elevations(tmp_path / "wide")) == lit
+
+
+def test_an_arm_asked_a_minimum_above_what_it_offers_too_is_advised_both_lowered(
+    tmp_path: Path,
+) -> None:
+    """`--until-error 5 --lights 130 --min-lights 125 --max-elevation-deg 30` on the virtual
+    arm (120 in reach): the command advised for --lights kept --min-lights 125, which that
+    command then refused as "above --lights 120, the session's maximum"."""
+    arm = CONFIGS / "virtual_arm.toml"
+    r = runner.invoke(
+        app,
+        ["run", str(arm), "--out", str(tmp_path / "s"), "--until-error", "5", "--lights", "130",
+         "--min-lights", "125", "--max-elevation-deg", "30"],
+    )  # fmt: skip
+    text = said(r)
+    assert r.exit_code == 2 and "--lights 130: this rig offers" in text, text
+    argv = _advised(text, "lighting rules): ", tmp_path, "advised")
+    most = int(argv[argv.index("--lights") + 1])
+    assert most < 125 and int(argv[argv.index("--min-lights") + 1]) == most, argv
+    assert argv[argv.index("--until-error") + 1] == "5", argv
+    assert not (tmp_path / "s").exists()

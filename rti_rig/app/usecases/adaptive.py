@@ -1557,7 +1557,12 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
                 lights,
                 in_reach,
                 band,
-                advice=widen(lights or 0, lambda n: options(n, min_lights)),
+                # a --min-lights above the count advised is lowered with it: the command
+                # given had kept it, and was refused in turn as a minimum above the maximum
+                advice=widen(
+                    lights or 0,
+                    lambda n: options(n, None if min_lights is None else min(min_lights, n)),
+                ),
             )
             if min_lights is not None:
                 _check_min_within(
