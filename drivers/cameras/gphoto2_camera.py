@@ -757,13 +757,20 @@ class Gphoto2Camera:
             code = getattr(exc, "code", None)
             why = f"gphoto2 error {code} ({exc})" if code is not None else str(exc)
             where = self._where(folder, name)
+            # a metering shot (no session bound) is no session's step: a resume had been
+            # advised beside the run's "nothing was captured or written"
+            then = (
+                "Its step is not recorded: free space on that disk (or fix it), then "
+                "'rti-rig run --resume SESSION' shoots it again"
+                if self.output_dir is not None
+                else "It was a test shot outside any session (metering): free space on that "
+                "disk (or fix it), then run the command again"
+            )
             raise CaptureError(
                 self.name,
                 f"{folder.rstrip('/')}/{name} came from the camera but could not be written "
                 f"into {target.parent} ({why}); that disk refused it (full, "
-                f"read-only or failing{free}). {where[0].upper()}{where[1:]}. Its step is not "
-                "recorded: free space on that disk (or fix it), then "
-                "'rti-rig run --resume SESSION' shoots it again",
+                f"read-only or failing{free}). {where[0].upper()}{where[1:]}. {then}",
                 "download",
             ) from exc
 

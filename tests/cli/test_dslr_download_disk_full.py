@@ -86,3 +86,26 @@ def test_a_disk_full_at_a_download_is_said_and_the_resume_shoots_the_light_again
         assert (out / f"raw/image_{k:03d}.cr2").is_file()
         record = json.loads((out / f"records/image_{k:03d}.json").read_text())
         assert record["image"] == f"image_{k:03d}.jpg"
+
+
+def test_a_disk_full_at_a_metering_download_advises_running_again_not_a_resume(
+    tmp_path, monkeypatch
+):
+    """`run --auto-exposure`'s metering downloads into a private temporary folder before any
+    session exists: its refusal advised "'rti-rig run --resume SESSION' shoots it again" beside
+    the run's "nothing was captured or written"."""
+    cfg = _config(tmp_path, "Internal RAM")
+    body = Body(render=_raw, disk_free_saves=0)  # the first metering shot finds it full
+    monkeypatch.setitem(sys.modules, "gphoto2", make_module(body))
+    out = tmp_path / "s"
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(
+            app, ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
+        )
+        lit_at_end = firmware.lit
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "IMG_0001.CR2 came from the camera but could not be written" in said, said
+    assert "nothing was captured or written" in said, said
+    assert "--resume" not in said and "run the command again" in said, said
+    assert not out.exists() or not any(out.iterdir()), said
