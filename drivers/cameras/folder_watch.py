@@ -675,7 +675,7 @@ class FolderWatchCamera:
                 reused = self._earlier_files_said()
                 if self._reused_names - self._at_connect:
                     names = ", ".join(sorted(self._reused_names - self._at_connect))
-                    reused = (
+                    reused += (  # after the earlier shoot's words, never in their place
                         f"; {names} appeared again as another file, but a name is used once "
                         "(an earlier shot had it): have the tethering program give every shot "
                         "its own file name"

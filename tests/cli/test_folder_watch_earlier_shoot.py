@@ -70,3 +70,56 @@ def test_an_earlier_shoots_file_saved_over_is_said_with_the_folder_to_empty(
     assert "give every shot its own file name" not in said, said
     assert f"move the files already in {tether} elsewhere" in said, said
     assert "IMG_9999 to IMG_0001" in said, said
+
+
+class GroupTether(Tether):
+    """A tethering program that saves ``files[n - 1]`` (a list of names and bytes, in order,
+    each renamed over its final name) for the board's n-th shutter pulse."""
+
+    def __init__(self, firmware, folder: Path, groups: list[list[tuple[str, bytes]]]) -> None:  # type: ignore[no-untyped-def]
+        super().__init__(firmware, folder, [])
+        self.groups = groups
+
+    def run(self) -> None:
+        saved = 0
+        while not self.stop.is_set() and saved < len(self.groups):
+            pulses = sum(e.what == "shutter" for e in list(self.firmware.history))
+            if pulses > saved:
+                for name, data in self.groups[saved]:
+                    temporary = self.folder / f".{name}.tmp"
+                    temporary.write_bytes(data)
+                    os.replace(temporary, self.folder / name)
+                saved += 1
+            self.stop.wait(0.02)
+
+
+def test_an_earlier_shoots_file_is_said_after_a_name_of_this_run_came_again(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A name of this run saved again (set aside, its light taken from the next file) and then
+    an earlier shoot's file saved over: the stop had kept only the words on the first ("an
+    earlier shot had it"), its own cause, the earlier shoot's file, unsaid."""
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    (tether / "IMG_0001.DNG").write_bytes(_shot(0.1) + b"earlier shoot")
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    groups = [
+        [("IMG_0010.DNG", _shot(0.3))],
+        [("IMG_0010.DNG", _shot(0.3) + b"again"), ("IMG_0011.DNG", _shot(0.3))],
+        [("IMG_0001.DNG", _shot(0.3))],
+    ]
+    run = tethered_run(
+        monkeypatch,
+        cfg,
+        tether,
+        [],
+        tmp_path / "s",
+        camera=lambda fw: GroupTether(fw, tether, groups),
+        lights=3,
+    )
+    said = run.said
+    assert run.result.exit_code == 2, said
+    assert "Traceback" not in said and not run.lit_at_end, said
+    assert "IMG_0010.DNG appeared again as another file" in said, said
+    assert "IMG_0001.DNG was in the folder before this run began" in said, said
+    assert f"move the files already in {tether} elsewhere" in said, said
