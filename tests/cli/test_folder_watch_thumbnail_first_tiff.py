@@ -54,14 +54,25 @@ def test_run_records_the_full_image_of_a_thumbnail_first_tiff(
     assert lit_at_end == []
 
 
+@pytest.mark.parametrize("pages", ["different", "of one size and type"])
 def test_run_refuses_a_tiff_of_two_full_size_images_as_such(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, pages: str
 ) -> None:
+    """Pages of one size and type are one stack to tifffile: such a file had gone on as a
+    (2, 64, 64, 3) array and stopped the run as "expected an H×W or H×W×3 image"."""
     rng = np.random.default_rng(4)
     two = BytesIO()
     with tifffile.TiffWriter(two) as tw:  # two photographs, neither a thumbnail
-        tw.write(rng.integers(0, 60000, (64, 64, 3), dtype=np.uint16), photometric="rgb")
-        tw.write(rng.integers(0, 60000, (64, 64), dtype=np.uint16), photometric="minisblack")
+        first = rng.integers(0, 60000, (64, 64, 3), dtype=np.uint16)
+        if pages == "different":
+            tw.write(first, photometric="rgb")
+            tw.write(rng.integers(0, 60000, (64, 64), dtype=np.uint16), photometric="minisblack")
+        else:  # as a program of its own writes them: no tifffile shape metadata
+            tw.write(first, photometric="rgb", metadata=None)
+            tw.write(first[::-1], photometric="rgb", metadata=None)
+    if pages != "different":
+        with tifffile.TiffFile(BytesIO(two.getvalue())) as tif:  # one series of two pages
+            assert [s.shape for s in tif.series] == [(2, 64, 64, 3)]
     r, said, tether, out, lit_at_end = _run(tmp_path, monkeypatch, [two.getvalue()] * 2)
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
