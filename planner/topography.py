@@ -41,7 +41,7 @@ from rti_rig.core.image_files import (
     colour_or_grey,
     jpeg_truncation,
     tiff_is_planar,
-    tiff_main_image,
+    tiff_one_image,
     tiff_samples_last,
 )
 
@@ -128,17 +128,7 @@ def _read_tiff_preview(p: Path) -> NDArray | None:
 
     try:
         with tifffile.TiffFile(p) as tif:
-            image = tiff_main_image(tif)
-            pages = len(image.pages)
-            if pages > 1:
-                # pages of one size tifffile reads as one stack: OpenCV had taken the first,
-                # this read had handed on an array of every page, refused by its shape alone
-                key = image.keyframe
-                raise SeveralFullSizeImages(
-                    f"it holds {pages} full-size images ({int(key.imagewidth)}x"
-                    f"{int(key.imagelength)} {image.dtype}, one per page) and which one is the "
-                    "photograph is not known; save it again as a TIFF of one image"
-                )
+            image = tiff_one_image(tif)  # not a thumbnail, nor one page of a stack
             pixels = tiff_samples_last(image.asarray(), tiff_is_planar(image.keyframe))
     except SeveralFullSizeImages as exc:
         raise ScheduleError(f"preview {p}: {exc}") from None

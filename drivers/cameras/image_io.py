@@ -20,7 +20,7 @@ from rti_rig.core.errors import CaptureError
 from rti_rig.core.image_files import (
     SeveralFullSizeImages,
     tiff_is_planar,
-    tiff_main_image,
+    tiff_one_image,
     tiff_samples_last,
 )
 from rti_rig.drivers.cameras.tiff_ifd import header_size
@@ -212,16 +212,7 @@ def read_image_file(path: Path, device: str) -> NDArray:
             with tifffile.TiffFile(path) as tif:
                 # the full-resolution image, not IFD0: a camera or tethering program may put
                 # a thumbnail first (it had been taken as the shot, at thumbnail size)
-                main = tiff_main_image(tif) if tif.series else None
-                if main is not None and len(main.pages) > 1:
-                    # pages of one size and type, one stack to tifffile: it had gone on as a
-                    # (2, H, W, 3) array, refused by its shape alone, not as two images
-                    key = main.keyframe
-                    raise SeveralFullSizeImages(
-                        f"it holds {len(main.pages)} full-size images ({int(key.imagewidth)}x"
-                        f"{int(key.imagelength)} {main.dtype}, one per page) and which one is "
-                        "the photograph is not known; save it again as a TIFF of one image"
-                    )
+                main = tiff_one_image(tif) if tif.series else None
                 image = main.asarray() if main is not None else tif.asarray()
                 page = main.keyframe if main is not None else None
                 if page is None and len(tif.pages):

@@ -319,6 +319,24 @@ def tiff_main_image(tif: Any) -> Any:
     return best
 
 
+def tiff_one_image(tif: Any) -> Any:
+    """:func:`tiff_main_image`, refused as :class:`SeveralFullSizeImages` also when it is a
+    stack: pages of one size and type, which tifffile reads as one series (2, H, W, …).
+
+    Why: a reader wanting one picture (the watched folder, the plan's preview) had handed
+    such a file on as one array and had it refused by its shape, the file and the fix
+    unnamed, where two images of different types were refused as what they are."""
+    main = tiff_main_image(tif)
+    if len(main.pages) > 1:
+        key = main.keyframe
+        raise SeveralFullSizeImages(
+            f"it holds {len(main.pages)} full-size images ({int(key.imagewidth)}x"
+            f"{int(key.imagelength)} {main.dtype}, one per page) and which one is the "
+            "photograph is not known; save it again as a TIFF of one image"
+        )
+    return main
+
+
 def tiff_several_images(path: Path) -> str | None:
     """Why the TIFF at ``path`` cannot give one image, when it holds two or more full-size
     images (:class:`SeveralFullSizeImages`: the file's name, then its words); None for any
