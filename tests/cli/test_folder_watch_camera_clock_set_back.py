@@ -86,7 +86,7 @@ def _run(monkeypatch, cfg, tether, args, set_back_after: int | None, offset_s: f
 def test_a_camera_clock_set_back_mid_session_is_said_with_the_way_out(tmp_path, monkeypatch):
     tether = tmp_path / "tether"
     tether.mkdir()
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     out = tmp_path / "s"
     r, said, lit = _run(
         monkeypatch, cfg, tether, ["run", str(cfg), "--out", str(out), "--lights", "4"], 2

@@ -58,7 +58,7 @@ def test_an_earlier_shoots_file_saved_over_is_said_with_the_folder_to_empty(
     tether.mkdir()
     for k in range(1, 4):  # the earlier shoot
         (tether / f"IMG_{k:04d}.DNG").write_bytes(_shot(0.1) + b"earlier shoot")
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     files = [(f"IMG_{k:04d}.DNG", _shot(0.3)) for k in range(1, 4)]
     camera = (lambda fw: RenamingTether(fw, tether, files)) if saving == "renamed over" else None
     run = tethered_run(monkeypatch, cfg, tether, files, tmp_path / "s", camera=camera)
@@ -102,7 +102,7 @@ def test_an_earlier_shoots_file_is_said_after_a_name_of_this_run_came_again(
     tether = tmp_path / "tether"
     tether.mkdir()
     (tether / "IMG_0001.DNG").write_bytes(_shot(0.1) + b"earlier shoot")
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     groups = [
         [("IMG_0010.DNG", _shot(0.3))],
         [("IMG_0010.DNG", _shot(0.3) + b"again"), ("IMG_0011.DNG", _shot(0.3))],
