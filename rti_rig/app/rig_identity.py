@@ -30,13 +30,16 @@ import dataclasses
 import hashlib
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rti_rig.app.config import LoadedRig, rig_geometry
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
+
+if TYPE_CHECKING:
+    from rti_rig.drivers.led_dome.protocol_spec import CommandSpec, ProtocolSpec
 
 #: How each identity key is named in a refusal.
 LABELS = {
@@ -124,17 +127,6 @@ def rig_identity(loaded: LoadedRig) -> dict[str, Any]:
     return ident
 
 
-#: The parts of a described protocol that say which LED a command lights and how it is
-#: addressed: its commands' bytes, its LED numbering and count, and its map. Timeouts,
-#: delays, the baud rate and the reply patterns are left out (they change how the board is
-#: talked to, not which light an LED index is), as a port's name and timing are.
-_ADDRESSING_KEYS = (
-    "name", "led_count", "encoding", "index_base", "columns", "mask_bit_order", "mask_bytes",
-    "stepping", "led_map",
-)  # fmt: skip
-_COMMAND_KEYS = ("handshake", "init", "light", "all_off", "shutter")
-
-
 def _dome_protocol_digest(serial: Any) -> str | None:
     """A digest of what defines the dome's protocol where the config describes it
     (``profile = "custom"``, or a ``[dome.serial.protocol]`` table or LED map laid over a
@@ -150,18 +142,37 @@ def _dome_protocol_digest(serial: Any) -> str | None:
         return None
     from rti_rig.drivers.led_dome.factory import protocol_for
 
-    return _protocol_digest(protocol_for(serial).model_dump(mode="json"))
+    return _protocol_digest(protocol_for(serial))
 
 
-def _protocol_digest(spec: dict[str, Any]) -> str:
-    """The digest of a protocol description's defining parts (``spec``: its JSON dump)."""
-    defining: dict[str, Any] = {k: spec.get(k) for k in _ADDRESSING_KEYS}
-    for key in _COMMAND_KEYS:
-        command = spec.get(key)
-        if isinstance(command, list):
-            defining[key] = [c.get("send") for c in command]
-        else:
-            defining[key] = None if command is None else command.get("send")
+def _protocol_digest(spec: ProtocolSpec) -> str:
+    """The digest of what ``spec`` sends to light each LED and to address the board: every
+    command's bytes, the light command's for each LED (its count, numbering, addressing and
+    map as the board receives them), and a stepping board's number for each LED.
+
+    Why the bytes, not the description's keys: a key that no template uses changes nothing
+    the board receives. A digest of keys had refused a resume as "its commands or LED
+    numbering differ" for a renamed protocol (``name`` is a label) or for ``columns`` set on
+    a mask-addressed board (no ``{row}``/``{col}`` in its commands: the mask alone says which
+    LED lights). Timeouts, delays, the baud rate, a timed LED's window and the reply patterns
+    are left out (they change how the board is talked to, not which light an LED index is),
+    as a port's name and timing are; a stepping board's numbering is kept (the number its
+    reply names an LED by is what says which LED a step lit)."""
+    # a timed LED's window ({secs}) is timing, not which light: rendered without it
+    bare = spec.model_copy(update={"light_on_s": None})
+    leds = range(spec.led_count)
+
+    def sent(command: CommandSpec | None, index: int | None, lit: frozenset[int]) -> str | None:
+        return None if command is None else bare.render(command.send, index, lit).hex()
+
+    defining: dict[str, Any] = {
+        "light": [sent(spec.light, i, frozenset({i})) for i in leds],
+        "all_off": sent(spec.all_off, None, frozenset()),
+        "handshake": sent(spec.handshake, None, frozenset()),
+        "init": [sent(c, None, frozenset()) for c in spec.init],
+        "shutter": [sent(spec.shutter, None, frozenset({i})) for i in leds],
+        "stepping": [i + spec.index_base for i in leds] if spec.stepping else None,
+    }
     return _digest(defining)
 
 
@@ -178,8 +189,7 @@ def _builtin_protocol_digest(profile: Any) -> str | None:
 
     if not isinstance(profile, str) or profile not in described_profiles():
         return None
-    spec = ProtocolSpec.model_validate(builtin_spec(profile))
-    return _protocol_digest(spec.model_dump(mode="json"))
+    return _protocol_digest(ProtocolSpec.model_validate(builtin_spec(profile)))
 
 
 def _recorded_images_digest(loaded: LoadedRig, geometry: DomeGeometry) -> str:

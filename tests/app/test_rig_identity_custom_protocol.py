@@ -26,9 +26,10 @@ profile = "custom"
 baudrate = 9600
 
 [dome.serial.protocol]
-name = "my-dome"
+name = "{protocol}"
 led_count = 12
 index_base = {base}
+columns = {columns}
 
 [dome.serial.protocol.light]
 send = "{light}"
@@ -51,6 +52,7 @@ folder = "{folder}"
 
 def _identity(tmp_path: Path, name: str, **keys: object) -> dict[str, object]:
     values = {"port": "/dev/ttyUSB0", "base": 0, "light": "L{index}\\n", "timeout": 1.0}
+    values.update(protocol="my-dome", columns=8)
     values["folder"] = str(tmp_path / "shots")
     values.update(keys)
     path = tmp_path / f"{name}.toml"
@@ -71,6 +73,19 @@ def test_what_does_not_address_the_leds_keeps_the_custom_rig(tmp_path: Path) -> 
     first = _identity(tmp_path, "a")
     again = _identity(tmp_path, "b", port="/dev/ttyUSB1", timeout=2.5)
     assert identity_differences(first, again) == []
+
+
+def test_a_label_or_a_key_no_command_uses_keeps_the_custom_rig(tmp_path: Path) -> None:
+    """The protocol's ``name`` is a label and ``columns`` only numbers ``{row}``/``{col}``:
+    with neither in the commands, both had been in the digest and refused the resume as "its
+    commands or LED numbering differ". Where a command does use them, columns is the rig."""
+    first = _identity(tmp_path, "a")
+    again = _identity(tmp_path, "b", protocol="renamed", columns=4)
+    assert identity_differences(first, again) == []
+    grid = _identity(tmp_path, "c", light="R{row}C{col}\\n")
+    regrid = _identity(tmp_path, "d", light="R{row}C{col}\\n", columns=4)
+    said = identity_differences(grid, regrid)
+    assert len(said) == 1 and said[0].startswith("dome protocol described in the config"), said
 
 
 def test_a_custom_session_recorded_before_the_protocol_digest_resumes(tmp_path: Path) -> None:
@@ -125,6 +140,10 @@ def test_a_table_restating_a_builtin_protocol_keeps_the_rig(tmp_path: Path) -> N
         assert restated["dome_protocol"] is not None
         assert identity_differences(bare, restated) == []
         assert identity_differences(restated, bare) == []
+    unused = _builtin_identity(
+        tmp_path, "cols", '[dome.serial.protocol]\nname = "ours"\ncolumns = 4\n'
+    )
+    assert identity_differences(bare, unused) == [] == identity_differences(unused, bare)
     other = _builtin_identity(
         tmp_path, "lsb", '[dome.serial.protocol]\nmask_bit_order = "lsb-first"\n'
     )

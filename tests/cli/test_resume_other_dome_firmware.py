@@ -86,11 +86,12 @@ def test_a_session_recorded_before_the_profile_was_in_the_identity_resumes(
     assert len(journal(out)) == 6
 
 
-def _nichlock_variant(tmp_path: Path, protocol_extra: str) -> Path:
-    """The shipped nichlock config with more keys in its [dome.serial.protocol] table."""
-    text = NICHLOCK.read_text()
+def _protocol_variant(tmp_path: Path, protocol_extra: str, config: Path = NICHLOCK) -> Path:
+    """The shipped nichlock config (or ``config``) with more keys in its
+    [dome.serial.protocol] table."""
+    text = config.read_text()
     assert "[dome.serial.protocol]\n" in text
-    cfg = tmp_path / "nichlock_variant.toml"
+    cfg = tmp_path / f"{config.stem}_variant.toml"
     cfg.write_text(
         text.replace("[dome.serial.protocol]\n", f"[dome.serial.protocol]\n{protocol_extra}")
     )
@@ -106,7 +107,7 @@ def test_a_resume_whose_config_describes_another_protocol_under_one_name_is_refu
     session recorded before the protocol was part of the identity resumes as it did."""
     out = tmp_path / "S"
     _cut(out)
-    r = _resume(out, _nichlock_variant(tmp_path, "index_base = 1\n"))
+    r = _resume(out, _protocol_variant(tmp_path, "index_base = 1\n"))
     text = said(r)
     assert r.exit_code == 2 and "Traceback" not in text, r.output
     assert "dome protocol described in the config: changed" in text, text
@@ -118,6 +119,22 @@ def test_a_resume_whose_config_describes_another_protocol_under_one_name_is_refu
     assert data["rig"]["identity"].pop("dome_protocol")
     manifest.write_text(json.dumps(data, indent=1), encoding="utf-8")
     r = _resume(out, NICHLOCK)
+    assert r.exit_code == 0 and "dome protocol" not in said(r), r.output
+    assert len(journal(out)) == 6
+
+
+@pytest.mark.e2e
+def test_a_protocol_renamed_or_given_unused_columns_resumes_as_the_same_rig(
+    tmp_path: Path,
+) -> None:
+    """A protocol's ``name`` is a label, and ``columns`` only numbers ``{row}``/``{col}``,
+    which the minirti board's commands do not use (0x42 + a 64-bit mask: the mask alone says
+    which LED lights). Both had been in the protocol's digest, so a resume with either was
+    refused as "its commands or LED numbering differ", which was untrue."""
+    out = tmp_path / "S"
+    _cut(out, MINIRTI)
+    variant = _protocol_variant(tmp_path, 'name = "our-minirti"\ncolumns = 4\n', MINIRTI)
+    r = _resume(out, variant)
     assert r.exit_code == 0 and "dome protocol" not in said(r), r.output
     assert len(journal(out)) == 6
 
