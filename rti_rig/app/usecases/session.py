@@ -1156,6 +1156,7 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     """
     from rti_rig.app.rig_identity import (
         IMAGE_KEYS,
+        LABELS,
         identity_differences,
         rig_identity,
         same_rig,
@@ -1190,6 +1191,12 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             f"files back to continue (rti-rig run --resume {shlex.quote(str(session_dir))}), "
             "or start a new session from the acquisition as it is now"
         )
+    if (
+        image_diffs
+        and recorded.get("backend") == identity.get("backend") == "replay"
+        and not any(d.startswith(LABELS["recorded_images"]) for d in image_diffs)
+    ):  # the same recorded files, read otherwise: nothing can be set back
+        raise RigChangedError(_replay_read_otherwise(config_path, image_diffs, session_dir))
     if recorded.get("kind") == identity.get("kind") and image_diffs:
         # accepted, a new exposure had gone into the fit as a brighter light: normals 5.5° off
         # on average, with a "good" verdict; nothing downstream corrects for it
@@ -1245,6 +1252,33 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     if not diffs:  # the same rig: its positions as the session recorded them (rounding aside)
         identity = same_rig(recorded, identity)
     return identity, diffs
+
+
+def _replay_read_otherwise(
+    config_path: Path, image_diffs: list[str], session_dir: Path | str
+) -> str:
+    """Why a replay session whose recorded images are unchanged cannot go on, and the command
+    that starts a new one (a sentence, no final stop).
+
+    Why: a replay rig's camera size (and exposure, gain, decoding) is its recorded images' own,
+    which no config sets. A session begun by an rti-rig that replayed a TIFF whose thumbnail
+    comes first at the thumbnail's size (before 2026-11-30) recorded 16×12 images of a 64×48
+    acquisition; its resume was told to "set it back to continue", which nothing can."""
+    root = Path(session_dir)
+    new = root.with_name(f"{root.name}-new")
+    n = 2
+    while new.exists():
+        new, n = root.with_name(f"{root.name}-new{n}"), n + 1
+    return (
+        f"{config_path} replays the same recorded images this session began with, but they "
+        "are now read as other images (" + "; ".join(image_diffs) + "): a replay's camera "
+        "takes its size and settings from the recorded images themselves, so nothing can be "
+        "set back, and images taken now would not match the ones already taken. (An rti-rig "
+        "before 2026-11-30 replayed a TIFF whose thumbnail comes first at the thumbnail's "
+        "size.) This session cannot be continued: start a new session from the acquisition "
+        f"(rti-rig run {shlex.quote(str(config_path))} --out {shlex.quote(str(new))}, with "
+        "the --lights and plan options this one began with)"
+    )
 
 
 def _read_file_changed(loaded, manifest: dict[str, Any]) -> str | None:  # type: ignore[no-untyped-def]
