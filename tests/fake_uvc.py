@@ -30,6 +30,11 @@ camera offers: another ``CAP_PROP_FOURCC`` is not taken) comes back as OpenCV's
 on (OpenCV's default) every format is converted to 8-bit BGR — Y16 by ``convertTo(CV_8U, 1/256)``,
 GREY by ``COLOR_GRAY2BGR``, YUYV by ``COLOR_YUV2BGR_YUYV``; with it off, the buffer as the
 camera sent it: Y16 as CV_16UC1, GREY as CV_8UC1, YUYV as CV_8UC2 (Y, then U or V).
+
+``opencv_4_11 = True`` models OpenCV 4.11.0 (opencv/opencv#27166, broken by #26224, fixed by
+#27193 in 4.12.0): with ``CAP_PROP_CONVERT_RGB`` off, ``retrieveFrame`` hands the buffer over
+as one row of its bytes (CV_8UC1, 1 × bytesused), whatever the format; converted frames are
+as in other releases.
 """
 
 from __future__ import annotations
@@ -91,9 +96,11 @@ class BufferedUvcStream:
         frame_rates: tuple[float, ...] | None = None,
         start_latency_s: float = 0.0,
         pixel_format: str = "Y16 ",
+        opencv_4_11: bool = False,
     ) -> None:
         self.light = light
         self.pixel_format = pixel_format
+        self.opencv_4_11 = opencv_4_11
         #: the first frame's readout begins this long after STREAMON (OpenCV #25688: "the
         #: first grab on a camera video stream is consistently several hundreds of ms long")
         self.start_latency_s = start_latency_s
@@ -236,7 +243,12 @@ class BufferedUvcStream:
         assert self.held is not None and self.held.frame is not None
         k = self.held.frame
         self.delivered.append((k, self._row_windows(k)))
-        return True, self._retrieve(self._pixels(k))
+        frame = self._retrieve(self._pixels(k))
+        if self.opencv_4_11 and self.props[cv2.CAP_PROP_CONVERT_RGB] == 0:
+            # the buffer's bytes (little-endian, as V4L2 Y16 is) as one row
+            frame = np.frombuffer(frame.astype(frame.dtype.newbyteorder("<")).tobytes(), np.uint8)
+            frame = frame.reshape(1, -1)
+        return True, frame
 
     def _retrieve(self, light16: np.ndarray) -> np.ndarray:
         """The frame as OpenCV hands it over for the camera's pixel format (module docstring):

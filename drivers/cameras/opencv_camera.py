@@ -232,10 +232,15 @@ class OpenCvCamera:
                 "together (`v4l2-ctl --list-formats-ext`)",
                 "verify fourcc",
             )
+        width, height = cap.get(cv2.CAP_PROP_FRAME_WIDTH), cap.get(cv2.CAP_PROP_FRAME_HEIGHT)
+        if width > 0 and height > 0:  # the size negotiated (VIDIOC_G_FMT), which frames have
+            info["frame_size"] = [int(width), int(height)]
+        self.connection_info = info
         if s.response is None and info.get("fourcc") not in RAW_GREY_FOURCCS:
             # an 8-bit stream is refused at connect, before a session lights anything
             ok, frame = cap.read()
             if ok and frame is not None:
+                self._refuse_misshapen(np.asarray(frame), "connect")
                 self._refuse_unset_response(np.asarray(frame))
         else:
             self._start_stream(cap)
@@ -473,6 +478,40 @@ class OpenCvCamera:
             "check exposure",
         )
 
+    def _refuse_misshapen(self, image: np.ndarray, operation: str) -> None:
+        """Refuse a frame whose shape is not the size the camera negotiated at connect.
+
+        Why: OpenCV 4.11.0's V4L2 backend hands every frame it does not convert to BGR (Y16,
+        GREY: ``CAP_PROP_CONVERT_RGB`` off) over as one flat row of the buffer's bytes
+        (opencv/opencv#27166, broken by #26224, fixed by #27193 in 4.12.0). Taken as an image,
+        a 64×48 Y16 frame was a 6144×1 8-bit one: recorded, and the run then advised setting
+        the camera's size to 6144×1. ``pyproject.toml`` excludes 4.11.0; another build of it
+        (a distribution's package) is refused here, naming the cause."""
+        size = self.connection_info.get("frame_size")
+        if size is None:
+            return
+        width, height = size
+        if image.shape[:2] == (height, width):
+            return
+        got = "×".join(str(n) for n in reversed(image.shape[:2]))
+        fourcc = self.connection_info.get("fourcc", "its")
+        if image.ndim <= 2 and min(image.shape, default=0) <= 1:
+            message = (
+                f"OpenCV {cv2.__version__} handed the camera's {fourcc!s} frame over as one "
+                f"flat row of {image.size} {image.dtype} values, not as its {width}×{height} "
+                "pixels: OpenCV 4.11.0's V4L2 backend does so with every frame it does not "
+                "convert to colour (opencv/opencv#27166, fixed in 4.12.0). Install another "
+                "OpenCV (pip install 'opencv-contrib-python-headless>=4.12') and run again"
+            )
+        else:
+            message = (
+                f"the camera delivered a {got} frame, not the {width}×{height} it negotiated "
+                "(CAP_PROP_FRAME_WIDTH, CAP_PROP_FRAME_HEIGHT): set width and height in "
+                f"[camera.device] to a size it offers (`v4l2-ctl -d {self.settings.device} "
+                "--list-formats-ext`)"
+            )
+        raise CaptureError(self.name, message, operation)
+
     def _refuse_unset_response(self, image: np.ndarray) -> None:
         """An 8-bit frame with no ``response`` configured is refused, not taken as linear: such
         frames are gamma-encoded on nearly every camera, and read as linear they bias every
@@ -589,6 +628,8 @@ class OpenCvCamera:
             )
         self._frames_read += 1
         image = np.asarray(image)
+        if s.backend == "v4l2":
+            self._refuse_misshapen(image, "read")
         self._refuse_unset_response(image)
         pixels, white = to_linear_uint16(
             image, s.response or "linear", s.black_level, s.white_level, order="bgr"

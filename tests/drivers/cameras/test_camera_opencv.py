@@ -134,16 +134,20 @@ class FakeV4l2:
             cv2.CAP_PROP_EXPOSURE: 156.0,
             cv2.CAP_PROP_GAIN: 32.0,
             cv2.CAP_PROP_AUTO_WB: 1.0 if has_awb else 0.0,
-            cv2.CAP_PROP_FRAME_WIDTH: 640.0,
-            cv2.CAP_PROP_FRAME_HEIGHT: 480.0,
+            # a small frame (the size its frames have: a camera's frames are the size it says)
+            cv2.CAP_PROP_FRAME_WIDTH: 6.0,
+            cv2.CAP_PROP_FRAME_HEIGHT: 4.0,
             # OpenCV's V4L2 backend reports its own buffer count, the request refused below
             cv2.CAP_PROP_BUFFERSIZE: float(buffers),
         }
         # buffers already filled at the old exposure
         self.queue = deque(self._frame() for _ in range(buffers))
 
+    def _size(self) -> tuple[int, int]:
+        return int(self.props[cv2.CAP_PROP_FRAME_HEIGHT]), int(self.props[cv2.CAP_PROP_FRAME_WIDTH])
+
     def _frame(self):
-        return np.full((4, 6), int(self.props[cv2.CAP_PROP_EXPOSURE]), np.uint16)
+        return np.full(self._size(), int(self.props[cv2.CAP_PROP_EXPOSURE]), np.uint16)
 
     def isOpened(self):
         return self.opened
@@ -316,7 +320,7 @@ class EightBitV4l2(FakeV4l2):
     """A UVC camera that offers only YUYV: OpenCV hands over 8-bit BGR frames."""
 
     def _frame(self):
-        return np.full((4, 6, 3), 128, np.uint8)
+        return np.full((*self._size(), 3), 128, np.uint8)
 
 
 def test_an_8bit_stream_without_a_response_is_refused_at_connect_not_taken_as_linear():

@@ -67,3 +67,56 @@ def test_a_yuyv_camera_is_written_as_colour_from_srgb(tmp_path, monkeypatch) -> 
     frames, _ = _run(tmp_path, monkeypatch, "YUYV", 'fourcc = "YUYV"\nresponse = "srgb"\n')
     for pixels in frames:
         assert pixels.ndim == 3 and pixels.shape[2] == 3, pixels.shape
+
+
+@pytest.mark.pty
+@pytest.mark.parametrize(
+    ("pixel_format", "device"),
+    [("Y16 ", 'fourcc = "Y16 "\n'), ("GREY", 'fourcc = "GREY"\nresponse = "srgb"\n')],
+)
+def test_opencv_4_11s_flat_row_is_refused_naming_the_release(
+    tmp_path, monkeypatch, pixel_format: str, device: str
+) -> None:
+    """OpenCV 4.11.0 hands an unconverted Y16 or GREY frame over as one row of its bytes
+    (opencv/opencv#27166): taken as an image, a 4×8 Y16 frame was a 64×1 8-bit one, written
+    into the session. Refused at the first frame, naming the bug and the release that fixes
+    it; nothing is written."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    text = cfg.read_text().replace('kind = "opencv"\n', f'kind = "opencv"\n{device}')
+    cfg.write_text(text)
+    stream = BufferedUvcStream(
+        LightHistory(SystemClock()),  # type: ignore[arg-type]  # the session's own clock
+        fps=20.0,
+        scale=6e5,
+        pixel_format=pixel_format,
+        opencv_4_11=True,
+    )
+    out = tmp_path / "s"
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        stream.light.set(1.0)
+        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "2"])
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0 and "Traceback" not in said, said
+    assert "as one flat row" in said and "not as its 4×8 pixels" in said, said
+    assert "opencv/opencv#27166, fixed in 4.12.0" in said, said
+    assert "opencv-contrib-python-headless>=4.12" in said, said
+    assert not list(out.glob("linear/*")), said  # no flat row kept as an image
+
+
+def test_the_dependency_excludes_opencv_4_11_0() -> None:
+    """The OpenCV release that flattens Y16 and GREY frames (opencv/opencv#27166: 4.11.0,
+    whose one wheel is 4.11.0.86) is not installable with rti-rig; the release that fixes it
+    (4.12.0, opencv/opencv#27193) and those before it are."""
+    import tomllib
+
+    from packaging.requirements import Requirement
+
+    project = Path(__file__).resolve().parents[3] / "pyproject.toml"
+    deps = tomllib.loads(project.read_text())["project"]["dependencies"]
+    (req,) = [
+        Requirement(d) for d in deps if Requirement(d).name == "opencv-contrib-python-headless"
+    ]
+    assert "4.11.0.86" not in req.specifier, req
+    for allowed in ("4.8.0.76", "4.10.0.84", "4.12.0.88", "5.0.0.93"):
+        assert allowed in req.specifier, (req, allowed)
