@@ -172,13 +172,7 @@ class OpenCvCamera:
             cap.set(cv2.CAP_PROP_FOURCC, cv2.VideoWriter_fourcc(*s.fourcc))
             got = fourcc_to_str(cap.get(cv2.CAP_PROP_FOURCC))
             if got != s.fourcc and s.require_fourcc:
-                raise DeviceError(
-                    self.name,
-                    f"camera refused pixel format {s.fourcc!r} (delivers {got!r}); it may not "
-                    "offer 16-bit frames: list formats with `v4l2-ctl --list-formats-ext`, or set "
-                    "fourcc = null and require_fourcc = false to accept 8-bit gamma-encoded frames",
-                    "set fourcc",
-                )
+                raise DeviceError(self.name, self._fourcc_refused(got), "set fourcc")
             info["fourcc"] = got
             if got in GREY_FOURCCS:
                 self._set_verified(cap, cv2.CAP_PROP_CONVERT_RGB, 0, "convert_rgb")
@@ -245,6 +239,31 @@ class OpenCvCamera:
         else:
             self._start_stream(cap)
         self.connection_info = info
+
+    def _fourcc_refused(self, got: str) -> str:
+        """Why the connect stops when the camera keeps another pixel format than ``fourcc``,
+        with settings the rig config can hold.
+
+        Why: it had said to "set fourcc = null", which TOML cannot write (it has no null): an
+        omitted ``fourcc`` is the default ``"Y16 "`` again, and ``""`` is refused as not four
+        characters. The format the camera delivers is named as the value to give instead, with
+        the ``response`` its 8-bit frames need (or ``require_fourcc = false`` where the camera
+        reports no readable format)."""
+        s = self.settings
+        readable = len(got) == 4 and got.isprintable() and got.strip()
+        accept = (
+            f'set fourcc = "{got}" (the format it delivers)'
+            if readable
+            else "set require_fourcc = false (to take the format it delivers)"
+        )
+        if got not in RAW_GREY_FOURCCS and s.response is None:
+            accept += ' and response = "srgb" (or "linear" if yours is linear)'
+        return (
+            f"camera refused pixel format {s.fourcc!r} (delivers {got!r}); it may not offer "
+            f"16-bit frames: list its formats with `v4l2-ctl -d {s.device} --list-formats-ext` "
+            f"and set fourcc to one it offers in [camera.device], or {accept} in "
+            "[camera.device] to accept its 8-bit gamma-encoded frames"
+        )
 
     def _start_stream(self, cap: VideoCaptureLike) -> None:
         """Start the stream at connect, with one frame read and discarded, in the dark.

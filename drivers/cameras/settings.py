@@ -101,8 +101,10 @@ class OpenCvCameraSettings(_Strict):
     height: int | None = Field(None, gt=0)
     fourcc: str | None = Field(
         "Y16 ",
-        description="pixel format to request; 'Y16 ' gives 16-bit grey frames; None keeps "
-        "the camera default (usually 8-bit YUYV/MJPEG, gamma-encoded)",
+        description="pixel format to request; 'Y16 ' gives 16-bit grey frames, one the camera "
+        "offers such as 'YUYV' or 'MJPG' 8-bit gamma-encoded ones (with response = 'srgb'); "
+        "None (Python only: TOML has no null, and an omitted key is 'Y16 ') keeps the camera "
+        "default",
     )
     require_fourcc: bool = Field(
         True, description="fail at connect if the camera refuses the requested fourcc"

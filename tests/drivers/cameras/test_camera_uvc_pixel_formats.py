@@ -120,3 +120,47 @@ def test_the_dependency_excludes_opencv_4_11_0() -> None:
     assert "4.11.0.86" not in req.specifier, req
     for allowed in ("4.8.0.76", "4.10.0.84", "4.12.0.88", "5.0.0.93"):
         assert allowed in req.specifier, (req, allowed)
+
+
+@pytest.mark.pty
+def test_a_refused_pixel_format_is_answered_with_settings_the_config_can_hold(
+    tmp_path, monkeypatch
+) -> None:
+    """A camera without Y16 (the default fourcc) is refused at connect with what to set. The
+    advice had been "set fourcc = null", which TOML cannot write: omitting the key is "Y16 "
+    again and "" is not four characters. The settings advised, written into [camera.device]
+    as said, load and run."""
+    import re
+    import tomllib
+
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)  # no fourcc: "Y16 " asked
+    out = tmp_path / "s"
+
+    def run():  # type: ignore[no-untyped-def]
+        stream = BufferedUvcStream(
+            LightHistory(SystemClock()),  # type: ignore[arg-type]  # the session's own clock
+            fps=20.0,
+            scale=6e5,
+            pixel_format="YUYV",
+        )
+        monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+        with shipped_dome_on_pty(monkeypatch, cfg):
+            stream.light.set(1.0)
+            r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "2"])
+        return r, " ".join(r.output.split())
+
+    r, said = run()
+    assert r.exit_code != 0 and "Traceback" not in said, said
+    assert "camera refused pixel format 'Y16 ' (delivers 'YUYV')" in said, said
+    assert "null" not in said, said
+    advice = said.split("and set fourcc to one it offers in [camera.device], or set ", 1)[1]
+    advice = advice.split(" in [camera.device] to accept", 1)[0]
+    keys = re.findall(r'(\w+) = ("[^"]*"|\w+)', advice)
+    assert keys == [("fourcc", '"YUYV"'), ("response", '"srgb"')], advice
+    table = "".join(f"{k} = {v}\n" for k, v in keys)  # [camera.device] edited as advised
+    cfg.write_text(cfg.read_text().replace('kind = "opencv"\n', f'kind = "opencv"\n{table}'))
+    device = tomllib.loads(cfg.read_text())["camera"]["device"]
+    assert device["fourcc"] == "YUYV" and device["response"] == "srgb", device
+    r, said = run()
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    assert len(list((out / "linear").glob("*.tif"))) == 2, said
