@@ -36,6 +36,7 @@ from rti_rig.core.geometry import (
 )
 from rti_rig.core.lp_format import LpEntry, image_path
 from rti_rig.runtime.session import (
+    JOURNAL,
     LINEAR_DIR,
     MANIFEST,
     RAW_DIR,
@@ -125,6 +126,31 @@ def _recorded_steps(
     )
 
 
+def _manifest_light(root: Path, step: dict[str, Any], image: Path) -> tuple[float, ...]:
+    """The direction the manifest's ``step`` records as fired, refused when it records none.
+
+    Why: the manifest's steps are not checked as the journal's records are, and a step
+    written without its light (a manifest damaged or edited, no journal beside it to stand in)
+    raised a KeyError traceback out of ``rti-rig plan PREVIEW``; the light the user can give is
+    what stands in for it."""
+    direction = step.get("actual_direction")
+    try:
+        light = tuple(float(v) for v in direction)  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        light = ()
+    if len(light) == 3 and all(np.isfinite(light)) and any(light):
+        return light
+    what = "no light" if direction is None else f"the light {direction!r}, not a direction"
+    index = step.get("index")
+    which = f"step {index + 1}" if isinstance(index, int) else "the step"
+    raise ScheduleError(
+        f"{root / MANIFEST}: {which} ({image.name}) records {what} ('actual_direction' is "
+        f"{'missing' if direction is None else 'unreadable'}), and no record in {JOURNAL} "
+        "stands in for it, so the light that lit the preview is not known: give it with "
+        "--preview-light AZ,EL"
+    )
+
+
 def _step_light(
     root: Path, step: dict[str, Any], journaled: dict[int, dict[str, Any]], image: Path
 ) -> Any:
@@ -136,7 +162,7 @@ def _step_light(
     known."""
     latest = journaled.get(step["index"])
     if latest is None:
-        return step["actual_direction"]
+        return _manifest_light(root, step, image)
     target = image.resolve()
     kind = next(
         (k for k in ("image", "linear_image") if (root / latest[k]).resolve() == target), None
@@ -144,7 +170,7 @@ def _step_light(
     if verified_steps(root, [latest], only=kind):
         return latest["actual_direction"]
     if step is not latest:  # the manifest lists the step
-        return step["actual_direction"]
+        return _manifest_light(root, step, image)
     raise ScheduleError(
         f"{image}: the image is not as the session {root} captured it (changed or replaced "
         "since; its checksum differs from its journal's), so the light recorded for it may not "
