@@ -5,13 +5,17 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out, print_notes
+from rti_rig.cli.app import app, err, fail, out, print_notes, stop_exit_code
+from rti_rig.cli.stopping import Terminated, sigterm_stops, stamp, stop_name, written_since
 from rti_rig.core.errors import RtiRigError
+
+if TYPE_CHECKING:
+    from rti_rig.app.usecases.calibrate import CalibrateRequest
 
 
 def _parse_normal(text: str) -> tuple[float, float, float]:
@@ -114,25 +118,60 @@ def calibrate_lights(
     # the backslash above keeps typer's rich help from reading "[dome.serial]" as markup and
     # dropping it (tests/cli/test_help_markup.py)
 
-    import numpy as np
-
-    from rti_rig.app.light_calibration import evened_sentence
-    from rti_rig.app.usecases.calibrate import CalibrateRequest, calibrate_lights
+    from rti_rig.app.usecases.calibrate import CalibrateRequest
 
     try:
-        done = calibrate_lights(
-            CalibrateRequest(
-                card_session,
-                rig_config,
-                out_file,
-                _parse_normal(card_normal),
-                _check_min_elevation(min_elevation_deg),
-                force,
-                not_flat_ok,
-            )
+        request = CalibrateRequest(
+            card_session,
+            rig_config,
+            out_file,
+            _parse_normal(card_normal),
+            _check_min_elevation(min_elevation_deg),
+            force,
+            not_flat_ok,
         )
     except RtiRigError as exc:
         raise fail(exc) from None
+    target = request.target
+    before = stamp(target)  # a file there already (--force) is not one this run wrote
+    reported: list[bool] = []  # set once the file is written and its report begun
+    try:
+        # SIGTERM as Ctrl-C: without a handler it ended the command mid-write, leaving a
+        # hidden .light_calibration.toml.tmp beside the file asked for, and said nothing
+        with sigterm_stops():
+            _calibrate_and_report(request, reported)
+    except (KeyboardInterrupt, Terminated) as exc:
+        why = stop_name(exc)
+        if reported or written_since(target, before):
+            rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
+            said = (
+                f"Stopped ({why}): the calibration {target} is written; to use it, set "
+                f'intensity_correction_file = "{rel}" under [dome.serial] in {rig_config}'
+            )
+        else:
+            kept = "" if before is None else " (the file already there is as it was)"
+            said = (
+                f"Stopped ({why}) before the calibration was written: nothing was written to "
+                f"{target}{kept}"
+            )
+        err.print(said, markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(code=stop_exit_code(why)) from None
+
+
+def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> None:
+    """Measure, write the calibration and report it: the body of :func:`calibrate_lights`, run
+    under its stop handling (``reported`` gets True once the file is written)."""
+    import numpy as np
+
+    from rti_rig.app.light_calibration import evened_sentence
+    from rti_rig.app.usecases.calibrate import calibrate_lights
+
+    card_session, rig_config = request.card_session, request.rig_config
+    try:
+        done = calibrate_lights(request)
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    reported.append(True)
     cal, card, loaded, geometry, target = (
         done.calibration,
         done.card,
@@ -141,7 +180,7 @@ def calibrate_lights(
         done.target,
     )
     print_notes(done.notes)
-    normal = np.asarray(_parse_normal(card_normal))
+    normal = np.asarray(request.card_normal)
     measured = np.flatnonzero(cal.measured)
     elevation = np.degrees(np.arcsin(np.clip(geometry.directions[measured] @ normal, -1, 1)))
     lowest = float(elevation.min())
@@ -193,8 +232,8 @@ def calibrate_lights(
         skipped = ", ".join(names[i] for i in np.flatnonzero(~cal.measured))
         err.print(
             f"[yellow]note:[/] not measured (not in the session, or lower than "
-            f"{min_elevation_deg:g}° above the card), assumed to give the median light under "
-            f"the correction in force: {escape(skipped)}"
+            f"{request.min_elevation_deg:g}° above the card), assumed to give the median light "
+            f"under the correction in force: {escape(skipped)}"
         )
     if cal.output[weak] < 0.5:
         err.print(

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_notes
+from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_notes, stop_exit_code
+from rti_rig.cli.stopping import Stamp, Terminated, sigterm_stops, stamp, stop_name, written_since
 from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free): a plan's minimum is the normal's (planner.make_plan)
@@ -17,6 +18,9 @@ from rti_rig.core.fit_minimums import (
     NORMAL_MIN_LIGHTS,
     NORMAL_NOISE,
 )
+
+if TYPE_CHECKING:
+    from rti_rig.app.usecases.plan import PlanLightsRequest
 
 
 @app.command()
@@ -166,7 +170,7 @@ def plan(
     """
     # the arm's order as rti_rig.app.compose.arm_order_for gives it (tests/cli/test_plan_help.py)
     from rti_rig.app.config import default_config_path
-    from rti_rig.app.usecases.plan import PlanLightsRequest, draw_plan_figure, plan_lights
+    from rti_rig.app.usecases.plan import PlanLightsRequest
 
     try:
         request = PlanLightsRequest(
@@ -189,48 +193,76 @@ def plan(
             force=force,
             allow_no_normals=allow_no_normals,
         )
-        planned = plan_lights(request)
     except RtiRigError as exc:
         raise fail(exc) from None
-    drawn = False
+    before = stamp(out_file)  # a file there already (--force) is not one this plan wrote
+    done: dict[str, Any] = {}
     try:
-        print_notes(planned.notes)
-        for line in planned.report.lines():
-            out.print(line, highlight=False, markup=False)
-        out.print(  # the path as it is: a folder named "coin [draft]" is no markup
-            f"Planned {len(planned.schedule)} lights ({planned.method}, {planned.objective}) → "
-            f"{out_file}",
-            markup=False,
-            highlight=False,
-        )
-        if figure is not None:
-            # after the report: a map that cannot be drawn must not hide a plan that was written
-            try:
-                draw_plan_figure(request, planned)
-            except RtiRigError as exc:
-                raise fail(exc) from None
-            drawn = True
-            out.print(f"Map of the plan → {figure}")
-    except KeyboardInterrupt:
-        # the plan is on disk by now: a Ctrl-C while the report or the map was printed or drawn
-        # had said only "rti-rig: stopped (Ctrl-C)", and the next run refused the --out
-        # a Ctrl-C as the map's line is printed finds the map written: it had been said "not
-        # drawn" beside the map on disk
-        map_said = (
-            ""
-            if figure is None
-            else f"; the map {figure} is written"
-            if drawn
-            else f"; the map {figure} was not drawn"
-        )
+        # SIGTERM as Ctrl-C: without a handler it ended the plan mid-write, leaving a hidden
+        # .map.partial.png (or .plan.lp.tmp) beside the file asked for, and said nothing
+        with sigterm_stops():
+            _plan_and_report(request, done)
+    except (KeyboardInterrupt, Terminated) as exc:
+        why = stop_name(exc)
         err.print(
-            f"Stopped (Ctrl-C): the plan {out_file} is written ({len(planned.schedule)} "
-            f"lights){map_said}",
+            _stopped(why, request, before, done),
             markup=False,
             highlight=False,
             soft_wrap=True,
         )
-        raise typer.Exit(code=130) from None
+        raise typer.Exit(code=stop_exit_code(why)) from None
+
+
+def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:
+    """Plan, write and report (and draw the map): the body of :func:`plan`, run under its stop
+    handling; ``done`` gets ``planned`` once the plan is written and ``drawn`` once the map is.
+    """
+    from rti_rig.app.usecases.plan import draw_plan_figure, plan_lights
+
+    try:
+        planned = done["planned"] = plan_lights(request)
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    print_notes(planned.notes)
+    for line in planned.report.lines():
+        out.print(line, highlight=False, markup=False)
+    out.print(  # the path as it is: a folder named "coin [draft]" is no markup
+        f"Planned {len(planned.schedule)} lights ({planned.method}, {planned.objective}) → "
+        f"{request.out_file}",
+        markup=False,
+        highlight=False,
+    )
+    if request.figure is not None:
+        # after the report: a map that cannot be drawn must not hide a plan that was written
+        try:
+            draw_plan_figure(request, planned)
+        except RtiRigError as exc:
+            raise fail(exc) from None
+        done["drawn"] = True
+        out.print(f"Map of the plan → {request.figure}")
+
+
+def _stopped(why: str, request: PlanLightsRequest, before: Stamp, done: dict[str, Any]) -> str:
+    """What a stop (Ctrl-C, SIGTERM) of ``plan`` left, said as it is on disk.
+
+    Why: a stop once the plan is on disk had said only "rti-rig: stopped (Ctrl-C)", and the
+    next run refused the --out; a stop as the map's line is printed finds the map written (it
+    had been said "not drawn" beside the map on disk); a stop before the plan is written says
+    so, and that a file already there (--force) is the earlier one."""
+    out_file, figure = request.out_file, request.figure
+    planned = done.get("planned")
+    if planned is None and not written_since(out_file, before):
+        kept = "" if before is None else " (the file already there is as it was)"
+        return f"Stopped ({why}) while planning: no plan was written to {out_file}{kept}"
+    count = "" if planned is None else f" ({len(planned.schedule)} lights)"
+    map_said = (
+        ""
+        if figure is None
+        else f"; the map {figure} is written"
+        if done.get("drawn")
+        else f"; the map {figure} was not drawn"
+    )
+    return f"Stopped ({why}): the plan {out_file} is written{count}{map_said}"
 
 
 def _given(ctx: typer.Context, name: str) -> bool:

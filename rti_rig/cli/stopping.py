@@ -1,0 +1,62 @@
+"""A SIGTERM that stops a file-writing command as Ctrl-C does, and what a stop left written.
+
+Why: ``plan`` and ``calibrate-lights`` had no SIGTERM handler (``run``, ``fit`` and ``check``
+have theirs): a SIGTERM (``timeout``, a scheduler, a service manager) mid-write ended the
+process at once, leaving a hidden ``.map.partial.png`` or ``.light_calibration.toml.tmp``
+beside the file asked for, and said nothing. Raised as a BaseException, as KeyboardInterrupt
+is, the stop runs the writers' own clean-up (each removes its temporary file on the way out)
+and is said by the command as its Ctrl-C is.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from rti_rig.runtime.deferred_signals import signal_handlers
+
+#: A file's identity and content stamp (inode, mtime in ns, size), or None where there is none.
+Stamp = tuple[int, int, int] | None
+
+
+class Terminated(BaseException):
+    """A SIGTERM during a command that uses :func:`sigterm_stops` (raised by its handler): a
+    BaseException so that no ``except Exception`` on the way swallows it and every ``finally``
+    (a temporary file removed) runs."""
+
+
+@contextmanager
+def sigterm_stops() -> Iterator[None]:
+    """For the block, a SIGTERM raises :class:`Terminated` (the handler before it is put back
+    however the block ends)."""
+
+    def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
+        raise Terminated()
+
+    with signal_handlers({signal.SIGTERM: terminated}):
+        yield
+
+
+def stamp(path: Path) -> Stamp:
+    """``path``'s stamp now: compared with one taken before the command wrote, it tells whether
+    the command wrote the file (its writers replace it by a rename, so a new inode), without
+    taking a file left there by an earlier run (``--force``) for one written now."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return (st.st_ino, st.st_mtime_ns, st.st_size)
+
+
+def written_since(path: Path, before: Stamp) -> bool:
+    """Whether ``path`` is there and is not the file (or the absence) :func:`stamp` saw."""
+    now = stamp(path)
+    return now is not None and now != before
+
+
+def stop_name(exc: BaseException) -> str:
+    """How a stop is named to the user: ``SIGTERM`` for :class:`Terminated`, else Ctrl-C."""
+    return "SIGTERM" if isinstance(exc, Terminated) else "Ctrl-C"
