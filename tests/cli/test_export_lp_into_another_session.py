@@ -48,3 +48,38 @@ def test_an_export_into_its_own_session_or_outside_any_is_written(tmp_path: Path
         r = runner.invoke(app, ["export-lp", str(a), "--out", str(out)])
         assert r.exit_code == 0, r.output
         assert out.is_file()
+
+
+def test_an_export_into_a_subfolder_of_another_session_is_refused_for_what_it_is(
+    tmp_path: Path,
+) -> None:
+    """B's images do not lie in B/exports (nor A's --linear names in B/linear): the refusal had
+    said they did; it says the .lp would sit inside B, where it could be taken for B's own."""
+    a, b = _session(tmp_path, "séance a", "6"), _session(tmp_path, "séance b", "8")
+    (b / "exports").mkdir()
+    before = sorted(p.name for p in b.iterdir())
+
+    for out, linear in ((b / "exports" / "a.lp", []), (b / "linear" / "a.lp", ["--linear"])):
+        r = runner.invoke(app, ["export-lp", str(a), "--out", str(out), *linear])
+
+        assert r.exit_code == 2, r.output
+        assert "Traceback" not in r.output
+        text = said(r)
+        assert f"--out {out} is in another session ({b})" in text, text
+        assert "own images of the same names lie" not in text, text
+        assert (
+            f"the .lp would sit inside the session {b.name}, where relight or RTIBuilder (or "
+            f"whoever opens {b.name}) could take it for that session's own; write it into {a} "
+            "or outside any session"
+        ) in text, text
+        assert not out.exists()
+    assert sorted(p.name for p in b.iterdir()) == before
+
+
+def test_an_export_beside_another_sessions_images_says_they_lie_there(tmp_path: Path) -> None:
+    a, b = _session(tmp_path, "a", "6"), _session(tmp_path, "b", "8")
+
+    r = runner.invoke(app, ["export-lp", str(a), "--out", str(b / "a.lp")])
+
+    assert r.exit_code == 2, r.output
+    assert "where b's own images of the same names lie" in said(r), r.output

@@ -122,7 +122,8 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
 
 
 def _refuse_another_session(out_file: Path, root: Path, first: str | None) -> None:
-    """Refuse an ``--out`` inside another session's folder than the one exported.
+    """Refuse an ``--out`` inside another session's folder than the one exported, saying
+    why as it is there: beside images of the same names, or inside that session.
 
     Why: every session names its images alike (image_001.jpg, ...), and relight, RTIBuilder
     and ``rti-rig fit`` read an ``.lp``'s names beside it. ``export-lp A --out B/a.lp`` was
@@ -135,11 +136,24 @@ def _refuse_another_session(out_file: Path, root: Path, first: str | None) -> No
         if f == own:  # its own session: names resolve there (the note says where they do)
             return
         if (f / MANIFEST).is_file():
+            name = first or "image_001.jpg"
+            if (folder / name).is_file():  # the names resolve there, to other images
+                where = f"{f.name}'s own images" if folder == f else f"images ({folder / name})"
+                why = (
+                    "relight, RTIBuilder and rti-rig fit read those names beside it, where "
+                    f"{where} of the same names lie"
+                )
+            else:
+                # a subfolder (B/exports/a.lp): B's images are not beside it, as had been said,
+                # but the .lp sits inside B, where it could be taken for B's own
+                why = (
+                    f"the .lp would sit inside the session {f.name}, where relight or "
+                    f"RTIBuilder (or whoever opens {f.name}) could take it for that session's "
+                    "own"
+                )
             raise RtiRigError(
                 f"--out {out_file} is in another session ({f}): this .lp names {root}'s "
-                f"images ({first or 'image_001.jpg'}, ...), and relight, RTIBuilder and rti-rig "
-                f"fit read those names beside it, where {f.name}'s own images of the same names "
-                f"lie; write it into {root} or outside any session"
+                f"images ({name}, ...), and {why}; write it into {root} or outside any session"
             )
 
 
