@@ -126,13 +126,15 @@ def _recorded_steps(
     )
 
 
-def _manifest_light(root: Path, step: dict[str, Any], image: Path) -> tuple[float, ...]:
+def _manifest_light(
+    root: Path, step: dict[str, Any], image: Path, journal: str
+) -> tuple[float, ...]:
     """The direction the manifest's ``step`` records as fired, refused when it records none.
 
     Why: the manifest's steps are not checked as the journal's records are, and a step
     written without its light (a manifest damaged or edited, no journal beside it to stand in)
     raised a KeyError traceback out of ``rti-rig plan PREVIEW``; the light the user can give is
-    what stands in for it."""
+    what stands in for it. ``journal``: why the journal's record does not (said after "and")."""
     direction = step.get("actual_direction")
     try:
         light = tuple(float(v) for v in direction)  # type: ignore[union-attr]
@@ -145,9 +147,8 @@ def _manifest_light(root: Path, step: dict[str, Any], image: Path) -> tuple[floa
     which = f"step {index + 1}" if isinstance(index, int) else "the step"
     raise ScheduleError(
         f"{root / MANIFEST}: {which} ({image.name}) records {what} ('actual_direction' is "
-        f"{'missing' if direction is None else 'unreadable'}), and no record in {JOURNAL} "
-        "stands in for it, so the light that lit the preview is not known: give it with "
-        "--preview-light AZ,EL"
+        f"{'missing' if direction is None else 'unreadable'}), and {journal}, so the light "
+        "that lit the preview is not known: give it with --preview-light AZ,EL"
     )
 
 
@@ -162,7 +163,7 @@ def _step_light(
     known."""
     latest = journaled.get(step["index"])
     if latest is None:
-        return _manifest_light(root, step, image)
+        return _manifest_light(root, step, image, f"{JOURNAL} holds no record of it")
     target = image.resolve()
     kind = next(
         (k for k in ("image", "linear_image") if (root / latest[k]).resolve() == target), None
@@ -170,11 +171,32 @@ def _step_light(
     if verified_steps(root, [latest], only=kind):
         return latest["actual_direction"]
     if step is not latest:  # the manifest lists the step
-        return _manifest_light(root, step, image)
+        journal = f"{JOURNAL}'s record of it does not match the image on disk"
+        return _manifest_light(root, step, image, journal)
     raise ScheduleError(
         f"{image}: the image is not as the session {root} captured it (changed or replaced "
         "since; its checksum differs from its journal's), so the light recorded for it may not "
         "be the one that lit it: give the light with --preview-light AZ,EL"
+    )
+
+
+def _linear_image(root: Path, step: dict[str, Any]) -> str:
+    """The linear image a one-image session's step records, refused when it records none.
+
+    Why: a manifest's step written without it (the manifest damaged or edited) raised a
+    KeyError traceback out of ``rti-rig plan PREVIEW_DIR``, with or without --preview-light."""
+    name = step.get("linear_image")
+    if isinstance(name, str) and name:
+        return name
+    jpeg = step.get("image")
+    instead = (
+        f"give the image itself as PREVIEW ({root / jpeg})"
+        if isinstance(jpeg, str) and jpeg
+        else "give the preview's image file itself as PREVIEW"
+    )
+    raise ScheduleError(
+        f"{root / MANIFEST}: its step records no linear image ('linear_image' is missing): "
+        f"{instead}"
     )
 
 
@@ -266,9 +288,9 @@ def resolve_preview(
         if len(steps) != 1:
             raise ScheduleError(
                 f"{path} is a session of {len(steps)} images: give the one to plan from, e.g. "
-                f"{path / steps[0]['linear_image']}"
+                f"{path / (steps[0].get('linear_image') or 'linear/image_001.tif')}"
             )
-        image = path / steps[0]["linear_image"]
+        image = path / _linear_image(path, steps[0])
         if light_given:  # the user's light stands: the session's record of it is not read
             return PreviewSource(image)
         where = f"the session {path.resolve().name}"

@@ -71,3 +71,31 @@ def test_a_step_recorded_with_a_light_that_is_no_direction_is_refused(tmp_path: 
     assert "records the light [0.0, 0.0], not a direction" in text, text
     assert "give it with --preview-light AZ,EL" in text, text
     assert not out.exists()
+
+
+@pytest.mark.parametrize("light", [[], ["--preview-light", "112.5,55"]])
+def test_a_step_recorded_without_its_linear_image_is_refused_naming_the_image_to_give(
+    tmp_path: Path, light: list[str]
+) -> None:
+    """The session folder's one step names its linear image; without it (a manifest damaged or
+    edited) plan raised a KeyError, with or without --preview-light."""
+    session = _preview_recording(tmp_path, [0.5, 0.2, 0.8])
+    manifest = json.loads((session / "manifest.json").read_text())
+    del manifest["steps"][0]["linear_image"]
+    (session / "manifest.json").write_text(json.dumps(manifest))
+    out = tmp_path / "plan.lp"
+
+    r = runner.invoke(app, ["plan", str(session), "--rig", str(RIG), "--out", str(out), *light])
+    text = said(r)
+
+    assert r.exit_code == 2, text
+    assert "Traceback" not in text and "KeyError" not in text, text
+    assert (
+        f"{session / 'manifest.json'}: its step records no linear image ('linear_image' is "
+        f"missing): give the image itself as PREVIEW ({session / 'image_001.jpg'})"
+    ) in text, text
+    assert not out.exists()
+    given = runner.invoke(
+        app, ["plan", str(session / "image_001.jpg"), "--rig", str(RIG), "--out", str(out)]
+    )
+    assert given.exit_code == 0, given.output
