@@ -561,6 +561,50 @@ class FolderWatchCamera:
             "[camera.device] at an empty folder"
         )
 
+    def _earlier_files_lead(self) -> str:
+        """The first words of a timeout that saw this run's shot saved over an earlier shoot's
+        file: what came, and that it was set aside (see :meth:`_earlier_files_said`)."""
+        names = sorted((self._reused_names | self._rewritten_names) & self._at_connect)
+        many = len(names) > 1
+        return (
+            f"{', '.join(names)} came but {'were' if many else 'was'} set aside, because "
+            f"{'their names were' if many else 'its name was'} an earlier shoot's file's "
+            "already in the folder"
+        )
+
+    def _set_aside_lead(self, pending: _Pending) -> str:
+        """The first words of a timeout after files came for ``pending``'s pulse and were set
+        aside: which, and why (shot before this run connected, before its first image, or out
+        of step with the pulse); empty when none came."""
+        if not pending.out_of_step:
+            return ""
+        parts = []
+        for why, names in (
+            (
+                "shot before this run connected",
+                [n for n in pending.out_of_step if n in pending.before_connect],
+            ),
+            (
+                "shot before this run's first image",
+                [n for n in pending.out_of_step if n in pending.before_first],
+            ),
+            (
+                "shot out of step with it",
+                [
+                    n
+                    for n in pending.out_of_step
+                    if n not in pending.before_connect and n not in pending.before_first
+                ],
+            ),
+        ):
+            if names:
+                many = len(names) > 1
+                parts.append(
+                    f"{', '.join(names)} came after the pulse but {'were' if many else 'was'} "
+                    f"set aside, {why}"
+                )
+        return "; ".join(parts)
+
     def _unmatched_said(self) -> str:
         """The files that came since connect but match no pattern, said with the fix.
 
@@ -638,11 +682,13 @@ class FolderWatchCamera:
             new.append((ident[3], p.name, p))
         return [p for _, _, p in sorted(new)]
 
-    def wait_for_file(self, *, came: bool = False) -> Path:
+    def wait_for_file(self, *, set_aside: str = "") -> Path:
         """Block (on the injected clock) until the next complete new file, or time out.
 
-        ``came``: files came after the pulse and were set aside (out of step), so the timeout
-        does not ask whether the camera is firing and saving there: it did both."""
+        ``set_aside``: what came after the pulse and was set aside (out of step), said first
+        in the timeout's message. Why: those stops began "no new file matching … within N s",
+        though a file had come, and asked whether the camera was firing and saving there: it
+        did both."""
         if self._seen is None:
             raise CaptureError(self.name, "not connected; call connect() first", "capture")
         s = self.settings
@@ -672,7 +718,9 @@ class FolderWatchCamera:
                         return path
             if self._clock.now() - start >= s.timeout_s:
                 growing = f"; {last[0]} appeared but was still being written" if last else ""
-                reused = self._earlier_files_said()
+                lead, reused = set_aside, self._earlier_files_said()
+                if reused and not lead:
+                    lead = self._earlier_files_lead()
                 if self._reused_names - self._at_connect:
                     names = ", ".join(sorted(self._reused_names - self._at_connect))
                     reused += (  # after the earlier shoot's words, never in their place
@@ -694,7 +742,7 @@ class FolderWatchCamera:
                 unmatched = self._unmatched_said()
                 ask = (
                     ""
-                    if unmatched or reused or came
+                    if unmatched or reused or lead
                     else ": is the camera firing and saving there?"
                 )
                 if not s.folder.is_dir():
@@ -705,9 +753,14 @@ class FolderWatchCamera:
                         "share disconnected or unmounted, a disk unplugged?): reconnect it, "
                         "then continue with 'rti-rig run --resume SESSION'"
                     )
+                none = (
+                    f"no other new file matching {list(s.patterns)} came to {s.folder} within "
+                    if lead
+                    else f"no new file matching {list(s.patterns)} in {s.folder} within "
+                )
                 raise CaptureError(
                     self.name,
-                    f"no new file matching {list(s.patterns)} in {s.folder} within "
+                    f"{lead}{'; ' if lead else ''}{none}"
                     f"{s.timeout_s:g} s{growing}{reused}{unmatched}{ask}",
                     "wait for file",
                 )
@@ -813,17 +866,16 @@ class FolderWatchCamera:
         recorded under a light it was not taken under."""
         while True:
             try:
-                path = self.wait_for_file(came=bool(pending.out_of_step))
+                path = self.wait_for_file(set_aside=self._set_aside_lead(pending))
             except CaptureError as exc:
                 said = exc.message
                 late = [n for n in pending.out_of_step if n not in pending.before_first]
                 if late:
                     pending.out_of_step = late  # those shot before the first are said below
                     said += (
-                        f"; {', '.join(pending.out_of_step)} came after the pulse but "
-                        f"{'were' if len(pending.out_of_step) > 1 else 'was'} shot out of step "
-                        "with it (a late file of an earlier pulse?), not used, and left in "
-                        f"{self.settings.folder}"
+                        f"; {', '.join(pending.out_of_step)} "
+                        f"{'were' if len(pending.out_of_step) > 1 else 'was'} not used and "
+                        f"left in {self.settings.folder} (a late file of an earlier pulse?)"
                     )
                     said += self._before_connect_said(pending)
                 said += self._before_first_said(pending)
@@ -982,9 +1034,9 @@ class FolderWatchCamera:
             else "run again"
         )
         return (
-            f"; {', '.join(pending.before_first)} came after the pulse but "
-            f"{'were' if many else 'was'} shot before this run's first image ({shown} before, "
-            "by the camera clock that image anchored), so no pulse of this run took "
+            f"; {'they were' if many else 'it was'} shot before this run's first image "
+            f"({shown} before, by the camera clock that image anchored), so no pulse of this "
+            "run took "
             f"{'them' if many else 'it'}: the camera's clock was set back since (a time-zone "
             "or daylight-saving change on the camera?) or an older picture was copied into the "
             f"folder. Not used, left in {self.settings.folder}. If the camera's clock was set "

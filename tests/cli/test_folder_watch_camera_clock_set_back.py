@@ -95,7 +95,12 @@ def test_a_camera_clock_set_back_mid_session_is_said_with_the_way_out(tmp_path, 
     assert "Traceback" not in said and not lit, said
     assert "is the camera firing" not in said, said
     assert "late file of an earlier pulse" not in said, said
-    assert "IMG_0003.DNG came after the pulse but was shot before this run's first image" in said
+    # the first words say what happened: the pulse's file came and was set aside, and why
+    assert said.split("error: ", 1)[1].startswith(
+        "folder-camera during 'wait for file': IMG_0003.DNG came after the pulse but was set "
+        "aside, shot before this run's first image; no other new file matching"
+    ), said
+    assert "it was shot before this run's first image (IMG_0003.DNG 3" in said, said
     clock_file = out / "raw" / ".folder_watch_clock.json"
     assert f"delete {clock_file} and resume" in said, said
     assert (tether / "IMG_0003.DNG").is_file()  # left where it was

@@ -65,6 +65,12 @@ def test_an_earlier_shoots_file_saved_over_is_said_with_the_folder_to_empty(
     said = run.said
     assert run.result.exit_code == 2, said
     assert "Traceback" not in said and not run.lit_at_end, said
+    # the first words say what happened: this run's shot came and was set aside, and why
+    assert said.split("error: ", 1)[1].startswith(
+        "folder-camera during 'wait for file': IMG_0001.DNG came but was set aside, because "
+        "its name was an earlier shoot's file's already in the folder; no other new file "
+        "matching"
+    ), said
     assert "IMG_0001.DNG was in the folder before this run began" in said, said
     assert "an earlier shot had it" not in said, said
     assert "give every shot its own file name" not in said, said
