@@ -53,6 +53,7 @@ Safe state: nothing to release (no device handle); ``close`` forgets the seen fi
 from __future__ import annotations
 
 import contextlib
+import errno
 import hashlib
 import json
 import os
@@ -1447,21 +1448,42 @@ class FolderWatchCamera:
             os.replace(tmp, dest)
         except OSError as exc:
             tmp.unlink(missing_ok=True)
-            gone = isinstance(exc, FileNotFoundError)
-            raise CaptureError(
-                self.name,
-                f"{path.name} came into {self.settings.folder} and was taken as this light's "
-                + (
-                    "image, but it was moved or deleted before rti-rig could copy it: another "
-                    "program takes files out of the folder (an auto import?); have it copy "
-                    "them, or point it at another folder"
-                    if gone
-                    else f"image, but it could not be copied into {self.output_dir} ({exc})"
-                )
-                + "; no image was recorded for this light",
-                "copy",
-            ) from exc
+            raise self._copy_failed(path, exc) from exc
         return dest
+
+    def _copy_failed(self, path: Path, exc: OSError) -> CaptureError:
+        """The stop for a taken file :meth:`_hold` could not copy into the session.
+
+        Why: a copy the session's disk refused (full) was said as "it could not be copied into
+        … ([Errno 28] …)": not where the shot is, nor what a resume does with it. The shot is
+        still in the watched folder, but a resume takes every file already there as seen (an
+        older file is never a light's image): it will not use it, and shoots the light again.
+        """
+        head = f"{path.name} came into {self.settings.folder} and was taken as this light's image"
+        if isinstance(exc, FileNotFoundError) and not path.exists():
+            return CaptureError(
+                self.name,
+                f"{head}, but it was moved or deleted before rti-rig could copy it: another "
+                "program takes files out of the folder (an auto import?); have it copy them, "
+                "or point it at another folder; no image was recorded for this light",
+                "copy",
+            )
+        if exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+            why = "full, or over a quota or file-size limit"
+            fix = "free space on that disk"
+        elif exc.errno == errno.EROFS:
+            why, fix = "read-only", "make that disk writable again"
+        else:
+            why, fix = exc.strerror or str(exc), "check that disk"
+        return CaptureError(
+            self.name,
+            f"{head}, but the disk refused the copy ({why}) into the session's "
+            f"{self.output_dir}; no image was recorded for this light. {path.name} is still in "
+            f"{self.settings.folder}, but a resume will not use it (a file already in the "
+            "folder when a run starts is never taken as a light's image): "
+            f"{fix}, then resume, which shoots this light again",
+            "copy",
+        )
 
     def _decode(
         self, path: Path, exposure_s: float, started: float, watched: Path | None = None

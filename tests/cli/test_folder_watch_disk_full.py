@@ -1,0 +1,96 @@
+"""A disk that fills while a watched folder's shot is copied into the session, through
+`rti-rig run` on the shipped folder-watch example (its dome firmware emulated on a pty, its
+camera a thread that saves a DNG into the folder for each shutter pulse the board saw), then
+the resume the stop gives.
+
+The folder belongs to the tethering program, so the shot is copied into the session's
+``raw/.incoming`` before it is decoded. When the disk refuses that copy, the shot is still in
+the watched folder under the camera's name; the stop said only "it could not be copied into …
+([Errno 28] …)": not where the shot is, nor what a resume does with it. A resume takes every
+file already in the folder as seen (an older file is never a light's image), so that shot is
+not used: the resume shoots the light again.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import shutil
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from conftest import Tether, folder_watch_config, shipped_dome_on_pty, tethered_run
+from dng_spec_writer import dng, mosaic_from_rgb
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+
+def _shot(level: float) -> bytes:
+    mosaic = mosaic_from_rgb(np.full((32, 48, 3), level), "RGGB", (0,) * 4, 4095)
+    return dng(mosaic, "RGGB", (0,) * 4, 4095)
+
+
+def _disk_full_after(monkeypatch: pytest.MonkeyPatch, copies: int) -> None:
+    """The session's disk fills after ``copies`` files copied into it: a later copy fails as
+    the system's does, with ENOSPC and part of the file written."""
+    real = shutil.copyfile
+    done = 0
+
+    def copyfile(src: Any, dst: Any, *args: Any, **kwargs: Any) -> Any:
+        nonlocal done
+        if ".incoming" not in str(dst):
+            return real(src, dst, *args, **kwargs)
+        done += 1
+        if done > copies:
+            Path(dst).write_bytes(Path(src).read_bytes()[:100])
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(dst))
+        return real(src, dst, *args, **kwargs)
+
+    monkeypatch.setattr(shutil, "copyfile", copyfile)
+
+
+def test_a_disk_full_copy_says_where_the_shot_is_and_what_the_resume_does(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    out = tmp_path / "s"
+    files = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(1, 4)]
+    with monkeypatch.context() as m:
+        _disk_full_after(m, 1)  # the 2nd shot's copy
+        run = tethered_run(monkeypatch, cfg, tether, files, out, lights=3)
+    said = run.said
+    assert run.result.exit_code != 0, said
+    assert "Traceback" not in said and not run.lit_at_end, said
+    assert (tether / "IMG_0002.DNG").is_file()  # where the camera saved it
+    assert not list((out / "raw" / ".incoming").glob(".*.partial"))  # no half copy left
+    assert "the disk refused the copy (full" in said, said
+    assert f"IMG_0002.DNG is still in {tether}, but a resume will not use it" in said, said
+    assert "shoots this light again" in said, said
+    assert f"rti-rig run --resume {out}" in said, said
+
+    # the resume, as said: the light is shot again and its new file taken, not IMG_0002.DNG
+    again = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(3, 5)]
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        camera = Tether(firmware, tether, again)
+        camera.start()
+        try:
+            r = CliRunner().invoke(
+                app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400
+            )
+        finally:
+            camera.stop.set()
+            camera.join(5.0)
+    assert r.exit_code == 0, r.output
+    assert (out / "raw" / "image_002.dng").read_bytes() == again[0][1]
+    assert (out / "lights.lp").read_text().split()[0] == "3"
