@@ -662,7 +662,7 @@ class Gphoto2Camera:
             camera_file = self._call(
                 "download", lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL)
             )
-            self._save(camera_file, target, folder, name)
+            self._save(camera_file, target, folder, name, shot=saved)
             stray_saved.append(
                 {
                     "path": str(target),
@@ -737,9 +737,22 @@ class Gphoto2Camera:
             metadata=metadata,
         )
 
-    def _save(self, camera_file: Any, target: Path, folder: str, name: str) -> None:
+    def _save(
+        self,
+        camera_file: Any,
+        target: Path,
+        folder: str,
+        name: str,
+        *,
+        shot: dict[str, Path] | None = None,
+    ) -> None:
         """Write a downloaded file to ``target``, or raise the error that says the computer's
         disk refused it, where the shot is now, and what to do.
+
+        ``shot``: the file is a stray (a picture the body took while answering busy), and
+        these are the light's own files, already downloaded (camera name -> where). Why: its
+        refusal had called the stray "the shot", said it was lost or on the card as if it were
+        the light's image, and said nothing of the light's own file, downloaded whole.
 
         Why: libgphoto2's ``gp_file_save`` answers a short write (a full disk) by unlinking
         the file and returning GP_ERROR (-1), which python-gphoto2 raises as ``GPhoto2Error``.
@@ -756,6 +769,19 @@ class Gphoto2Camera:
                 free = f": {shutil.disk_usage(target.parent).free / 1e6:.0f} MB free there now"
             code = getattr(exc, "code", None)
             why = f"gphoto2 error {code} ({exc})" if code is not None else str(exc)
+            if shot is not None:
+                raise CaptureError(
+                    self.name,
+                    f"{folder.rstrip('/')}/{name}, a stray (a picture the camera took while "
+                    "answering busy, at a moment rti-rig did not choose: never an image of the "
+                    f"session), came from the camera but could not be written into "
+                    f"{target.parent} ({why}); that disk refused it (full, read-only or "
+                    f"failing{free}). {self._stray_where(folder, name)}. "
+                    f"{self._shot_kept(folder, shot)}. The step is not recorded: free space on "
+                    "that disk (or fix it), then 'rti-rig run --resume SESSION' shoots this "
+                    "light again",
+                    "download",
+                ) from exc
             where = self._where(folder, name)
             # a metering shot (no session bound) is no session's step: a resume had been
             # advised beside the run's "nothing was captured or written"
@@ -773,6 +799,31 @@ class Gphoto2Camera:
                 f"read-only or failing{free}). {where[0].upper()}{where[1:]}. {then}",
                 "download",
             ) from exc
+
+    def _stray_where(self, folder: str, name: str) -> str:
+        """Where a stray whose file did not reach the computer is now (see :meth:`_where`)."""
+        on_camera = f"{folder.rstrip('/')}/{name}"
+        if self.settings.capture_target == "Internal RAM":
+            return (
+                f"The stray was in the camera's RAM, so it is lost: {on_camera} existed only there"
+            )
+        return f"The stray's copy stays on the camera's card at {on_camera}"
+
+    def _shot_kept(self, folder: str, shot: dict[str, Path]) -> str:
+        """Where the light's own files are when a stray's download failed after them: on the
+        computer, and (on a card) still on the card, deleted there only after every download."""
+        names = ", ".join(shot)
+        where = ", ".join(str(p) for p in shot.values())
+        kept = (
+            f"This light's own shot ({names}) was downloaded whole (into a temporary folder: "
+            "no session is bound, as for a metering shot)"
+            if self.output_dir is None
+            else f"This light's own shot ({names}) was downloaded whole to {where}, which a "
+            "resume moves to the session's recovered/ folder (never deleting it)"
+        )
+        if self.settings.capture_target != "Internal RAM":
+            kept += f"; its copy stays on the camera's card in {folder.rstrip('/')}/"
+        return kept
 
     def _where(self, folder: str, name: str) -> str:
         """Where a shot whose file did not reach the session is now: lost with the camera's

@@ -109,3 +109,44 @@ def test_a_disk_full_at_a_metering_download_advises_running_again_not_a_resume(
     assert "nothing was captured or written" in said, said
     assert "--resume" not in said and "run the command again" in said, said
     assert not out.exists() or not any(out.iterdir()), said
+
+
+@pytest.mark.parametrize("target", ["Internal RAM", "Memory card"])
+def test_a_disk_full_at_a_strays_download_is_said_as_the_stray_not_the_shot(
+    tmp_path, monkeypatch, target
+):
+    """The body answers busy once after the first shot yet takes the picture (IMG_0002, a
+    stray); the retry takes light 2's own IMG_0003, downloaded whole; the disk fills at the
+    stray's download. The stop had called the stray "the shot" ("the shot was taken into the
+    camera's RAM … so it is lost") and said nothing of light 2's own file, downloaded whole."""
+    cfg = _config(tmp_path, target)
+    body = Body(render=_raw, disk_free_saves=2, busy_after_shot=1, busy_yet_shot=1)
+    monkeypatch.setitem(sys.modules, "gphoto2", make_module(body))
+    out = tmp_path / "s"
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "3"])
+        lit_at_end = firmware.lit
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "Traceback" not in said and lit_at_end is None, said
+    assert body.stray_files == ["IMG_0002.CR2"], body.stray_files
+    assert "IMG_0002.CR2, a stray (a picture the camera took while answering busy" in said
+    assert "the shot was taken into" not in said and "the shot's copy" not in said, said
+    if target == "Internal RAM":
+        assert "The stray was in the camera's RAM, so it is lost" in said, said
+    else:
+        assert "The stray's copy stays on the camera's card at /store_00020001/" in said, said
+        assert "IMG_0002.CR2" in body.card and "IMG_0003.CR2" in body.card
+    # light 2's own shot: downloaded whole, and said so with where a resume puts it
+    (own,) = (out / "raw" / ".incoming").glob("*IMG_0003.CR2")
+    assert own.read_bytes() == _raw(body)
+    assert f"This light's own shot (IMG_0003.CR2) was downloaded whole to {own}" in said, said
+    assert "resume moves to the session's recovered/ folder" in said, said
+    assert (out / "lights.lp").read_text().split()[0] == "1"
+
+    body.disk_free_saves = None  # room again: the resume moves it aside as said
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, " ".join(r.output.split())
+    assert [p.name for p in (out / "recovered").rglob("*IMG_0003.CR2")], "not moved aside"
+    assert (out / "lights.lp").read_text().split()[0] == "3"
