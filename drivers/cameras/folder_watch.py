@@ -396,6 +396,10 @@ class _Pending:
     #: of ``out_of_step``, those shot before this run's first image, by the camera clock that
     #: image anchored: name -> how many seconds before
     before_first: dict[str, float] = field(default_factory=dict)
+    #: of ``out_of_step``, the others: name -> how many seconds its capture time is after
+    #: (negative: before) where this pulse's file would be, by the clock the last image
+    #: anchored
+    off_step: dict[str, float] = field(default_factory=dict)
     #: the capture time of the file taken, in step with the pulse (None: not checked)
     taken: float | None = None
 
@@ -458,6 +462,9 @@ class FolderWatchCamera:
         #: the first such anchor of this run: a file shot before it is no late file of a pulse
         #: of this run
         self._first_anchor: tuple[float, float, float] | None = None
+        #: the rig-clock times of this run's pulses, in order: an out-of-step file that fits
+        #: one may be its late file; one that fits none is not
+        self._pulse_times: list[float] = []
         #: (capture time, the pulse before) of the last file set aside as out of step: a late
         #: file of the previous pulse, if the next file fits it
         self._orphan: tuple[float, float, float] | None = None
@@ -484,6 +491,7 @@ class FolderWatchCamera:
         self._taken_stems = set()
         self._anchor = None
         self._first_anchor = None
+        self._pulse_times = []
         self._orphan = None
         self._learned = _LearnedClock.load(self._clock_file())
         self._connected_wall, self._wall_allowance_s = self._connect_on_learned_wall()
@@ -801,6 +809,7 @@ class FolderWatchCamera:
         except TriggerUnconfirmed as exc:
             pending.unconfirmed = str(exc)
         pending.pulsed_at, pending.pulsed_wall, pending.pulsed_mono = sent, wall, mono
+        self._pulse_times.append(sent)
         pending.pulse_window_s = self._clock.now() - sent
         self._pending = pending
         return self._clock.now() + self.settings.shutter_lag_s + exposure_s
@@ -841,8 +850,15 @@ class FolderWatchCamera:
                 said.append(
                     f"{len(pending.out_of_step)} file(s) came after this shot's trigger but "
                     f"were shot out of step with it and not used: "
-                    f"{', '.join(pending.out_of_step)} (their capture times fit no pulse of "
-                    "this run: a late file of an earlier pulse, or a shot no light asked for)"
+                    f"{', '.join(pending.out_of_step)}"
+                    + self._off_step_said(
+                        pending,
+                        [
+                            n
+                            for n in pending.out_of_step
+                            if n not in pending.before_connect and n not in pending.before_first
+                        ],
+                    )
                     + self._before_connect_said(pending)
                 )
             frame.metadata["notices"] = [
@@ -876,7 +892,7 @@ class FolderWatchCamera:
                     said += (
                         f"; {', '.join(pending.out_of_step)} "
                         f"{'were' if len(pending.out_of_step) > 1 else 'was'} not used and "
-                        f"left in {self.settings.folder} (a late file of an earlier pulse?)"
+                        f"left in {self.settings.folder}" + self._off_step_said(pending, late)
                     )
                     said += self._before_connect_said(pending)
                 said += self._before_first_said(pending)
@@ -905,6 +921,9 @@ class FolderWatchCamera:
                 pending.before_connect[path.name] = early
             elif (before := self._shot_before_first(taken, pending.pulse_window_s)) is not None:
                 pending.before_first[path.name] = before
+            elif self._anchor is not None:
+                anchor = self._anchor
+                pending.off_step[path.name] = (taken - anchor[0]) - (pending.pulsed_at - anchor[1])
             if len(pending.out_of_step) > MAX_OUT_OF_STEP:
                 raise CaptureError(
                     self.name,
@@ -1003,6 +1022,59 @@ class FolderWatchCamera:
         if self._first_anchor is None:
             self._first_anchor = self._anchor
         return notes
+
+    def _off_step_said(self, pending: _Pending, names: list[str]) -> str:
+        """What the capture times of ``names`` (out of step with ``pending``'s pulse) tell:
+        a late file of an earlier pulse, or the camera's clock changed, or both possible.
+
+        Why: every such file was called "a late file of an earlier pulse?", also one shot after
+        the pulse (no late file is) or between two pulses of the run (no pulse's file), where
+        the evidence says the camera's clock was changed mid-session (a time-zone or
+        daylight-saving change on the body). Where it fits an earlier pulse, both are said:
+        the capture times cannot tell them apart."""
+        said = []
+        way_out = ""
+        clock_file = self._clock_file()
+        if clock_file is not None:
+            way_out = f", delete {clock_file} and resume (its first image is then unchecked)"
+        base = CAPTURE_TIME_RESOLUTION_S + self.settings.shutter_lag_s + pending.pulse_window_s
+        pulses = self._pulse_times[:-1]  # those before this light's
+        for name in names:
+            off = pending.off_step.get(name)
+            if off is None:  # no clock to judge by: the old question, plainly
+                said.append(
+                    f"{name}: a late file of an earlier pulse, or a shot no light asked for"
+                )
+                continue
+            if off > 0:
+                said.append(
+                    f"{name} was shot {off:.0f} s after this pulse by the camera clock the last "
+                    "image anchored, so it is no late file of an earlier pulse: the camera's "
+                    f"clock was set forward by about {off:.0f} s (a time-zone or daylight-saving "
+                    "change on the camera?), or it is a shot no light asked for. If the clock "
+                    f"was set forward{way_out}"
+                )
+                continue
+            at = (pending.pulsed_at or 0.0) + off
+            fits = [k for k, t in enumerate(pulses, 1) if abs(at - t) <= base]
+            if fits:
+                which = " or ".join(f"this run's pulse {k}" for k in fits)
+                said.append(
+                    f"{name} was shot {-off:.0f} s before this pulse by the camera clock the "
+                    f"last image anchored, which fits {which}: either a late file of an earlier "
+                    f"pulse or the camera's clock set back by about {-off:.0f} s (a time-zone or "
+                    "daylight-saving change on the camera?); the capture times cannot tell "
+                    f"which. If the clock was set back{way_out}"
+                )
+            else:
+                said.append(
+                    f"{name} was shot {-off:.0f} s before this pulse by the camera clock the "
+                    "last image anchored, at no pulse of this run, so it is no late file of "
+                    f"one: the camera's clock was set back by about {-off:.0f} s (a time-zone or "
+                    "daylight-saving change on the camera?), or an older picture was copied "
+                    f"into the folder. If the clock was set back{way_out}"
+                )
+        return f" ({'; '.join(said)})" if said else ""
 
     def _shot_before_first(self, taken: float, window_s: float) -> float | None:
         """How many seconds before this run's first image a file was shot, by the camera clock

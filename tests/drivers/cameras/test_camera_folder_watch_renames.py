@@ -757,3 +757,28 @@ def test_a_tiff_that_can_never_be_read_is_not_waited_for_as_one_being_written(tm
     zeros.write_bytes(bytes(4096))  # a network share sets the size first, fills it later
     assert _read_capture_time(zeros) == (False, None)
     assert _read_capture_time(whole) == (True, None)  # whole, no EXIF DateTimeOriginal
+
+
+def test_a_clock_set_back_onto_no_pulse_of_the_run_is_said_as_such(tmp_path):
+    """Pulses 1 and 2 are 20 s apart; before pulse 3 the camera's clock is set back 12 s (less
+    than the time since the first image): pulse 3's file is shot, by the clock the last image
+    anchored, between pulses 1 and 2, at no pulse of the run. It is rightly not taken, but it
+    was called "a late file of an earlier pulse?": no pulse was shot then."""
+    body = _Body(tmp_path, [1.0, 1.0, 1.0])
+    settings = FolderWatchSettings(
+        folder=tmp_path, timeout_s=5.0, poll_interval_s=0.125, shutter_lag_s=0.25
+    )
+    cam = FolderWatchCamera(settings, clock=body.clock, trigger=body.pulse)
+    cam.connect()
+    cam.capture(0.5)
+    body.clock.sleep(20.0)
+    cam.capture(0.5)
+    body.offset_s -= 12.0
+    with pytest.raises(CaptureError) as stop:
+        cam.capture(0.5)
+    said = stop.value.message
+    assert said.startswith("IMG_0003.DNG came after the pulse but was set aside"), said
+    assert "late file of an earlier pulse" not in said, said
+    assert "IMG_0003.DNG was shot 12 s before this pulse" in said, said
+    assert "at no pulse of this run, so it is no late file of one" in said, said
+    assert "the camera's clock was set back by about 12 s" in said, said
