@@ -715,6 +715,15 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
     kept = opened.folder.images_kept
     if not isinstance(exc, SessionWriteError) or _cannot_resume(opened.rig) or not kept:
         return exc  # nothing kept: the folder may be used again, as said above
+    shot = ""
+    if exc.shot:
+        # the camera's file(s) of the step the disk refused: whatever of them reached the
+        # session is moved to recovered/ by the resume (never deleted), and the light reshot
+        shot = (
+            f"; this light's shot ({', '.join(exc.shot)}) is not recorded: the resume moves "
+            "whatever of it reached the session to its recovered/ folder and shoots this light "
+            "again"
+        )
     if exc.path.parent.name == RECORDS_DIR:
         what = (
             f"{exc.path.stem} is kept all the same (its journal line, which commits it in "
@@ -723,8 +732,8 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
     else:
         what = f"{kept} image(s) are kept"
     return RtiRigError(
-        f"{exc}: the session stopped there; {what}; {_disk_fix(exc.errno_name)}, then continue "
-        f"with {_continue_command(opened)}"
+        f"{exc}: the session stopped there; {what}{shot}; {_disk_fix(exc.errno_name)}, then "
+        f"continue with {_continue_command(opened)}"
     )
 
 

@@ -178,6 +178,9 @@ class SessionWriteError(SessionError):
         #: the step this write came after the commit of (its journal line or ``lights.lp``
         #: failed once its record file was on disk): kept, and to be counted as such
         self.committed: StepRecord | None = None
+        #: the camera's own names of the files of the step being written when this failed
+        #: before its commit (its shot): not recorded, reshot by a resume
+        self.shot: list[str] = []
         self.errno_name = _errno.errorcode.get(exc.errno or 0, "") if exc.errno else ""
         reason = exc.strerror or str(exc)
         code = f" ({self.errno_name})" if self.errno_name else ""
@@ -826,13 +829,32 @@ class SessionFolder:
         committed step. A write that fails (no space, read-only, I/O error) raises
         :class:`SessionWriteError` naming the file, with no temporary file left behind and the
         journal as it was; if the step was committed before the failure, the error's
-        ``committed`` holds its record, so that the run counts it as the folder does.
+        ``committed`` holds its record, so that the run counts it as the folder does; if not,
+        its ``shot`` names the step's camera files (the stop had not said which shot was lost
+        to the disk, nor that a resume shoots it again).
         """
         t0 = time.perf_counter()
         base = self.names[index]
+        listed = frame.metadata.get("originals") or []
+        try:
+            return self._write_step(index, frame, record_fields, t0, base, listed)
+        except SessionWriteError as exc:
+            if exc.committed is None:  # the step's shot is not recorded: say which it was
+                exc.shot = [str(item.get("name") or Path(item["path"]).name) for item in listed]
+            raise
+
+    def _write_step(
+        self,
+        index: int,
+        frame: Frame,
+        record_fields: dict[str, Any],
+        t0: float,
+        base: str,
+        listed: list[dict[str, Any]],
+    ) -> StepRecord:
+        """:meth:`write_step`'s writes, whose failure it completes with the step's shot."""
         jpg, tif = f"{base}.jpg", f"{LINEAR_DIR}/{base}.tif"
         decode = dict(frame.metadata.get("decode") or {})
-        listed = frame.metadata.get("originals") or []
         originals = self._keep_originals(base, listed)  # names the file if a write fails
         strays = self._keep_strays(base, frame.metadata.get("stray_originals") or [])
         current = self.root / tif

@@ -94,3 +94,40 @@ def test_a_disk_full_copy_says_where_the_shot_is_and_what_the_resume_does(
     assert r.exit_code == 0, r.output
     assert (out / "raw" / "image_002.dng").read_bytes() == again[0][1]
     assert (out / "lights.lp").read_text().split()[0] == "3"
+
+
+def test_a_disk_full_at_the_steps_images_says_which_shot_and_what_the_resume_does(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The copy came in, but the disk fills at the step's linear TIFF: the stop said "1
+    image(s) are kept" and to resume, not which shot was not recorded nor what becomes of it."""
+    from rti_rig.testing.disk_faults import failing_writes
+
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    out = tmp_path / "s"
+    files = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(1, 4)]
+    with failing_writes("tiff", after=1, errno_code=errno.ENOSPC):  # the 2nd shot's
+        run = tethered_run(monkeypatch, cfg, tether, files, out, lights=3)
+    said = run.said
+    assert run.result.exit_code != 0, said
+    assert "Traceback" not in said and not run.lit_at_end, said
+    assert "this light's shot (IMG_0002.DNG) is not recorded: the resume moves whatever" in said
+    assert "recovered/ folder and shoots this light again" in said, said
+
+    again = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(3, 5)]
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        camera = Tether(firmware, tether, again)
+        camera.start()
+        try:
+            r = CliRunner().invoke(
+                app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400
+            )
+        finally:
+            camera.stop.set()
+            camera.join(5.0)
+    assert r.exit_code == 0, r.output
+    assert (out / "raw" / "image_002.dng").read_bytes() == again[0][1]
+    moved = list((out / "recovered").rglob("*.dng"))
+    assert [p.read_bytes() for p in moved] == [files[1][1]], moved
