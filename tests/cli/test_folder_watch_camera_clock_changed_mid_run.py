@@ -69,7 +69,7 @@ class ClockChangingCamera(threading.Thread):
 def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, change: Any) -> tuple[Any, str, Any]:
     tether = tmp_path / "tether"
     tether.mkdir()
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     out = tmp_path / "s"
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
         camera = ClockChangingCamera(firmware, tether, change)

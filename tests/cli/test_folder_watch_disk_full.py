@@ -63,7 +63,7 @@ def test_a_disk_full_copy_says_where_the_shot_is_and_what_the_resume_does(
 ) -> None:
     tether = tmp_path / "tether"
     tether.mkdir()
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     out = tmp_path / "s"
     files = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(1, 4)]
     with monkeypatch.context() as m:
@@ -105,7 +105,7 @@ def test_a_disk_full_at_the_steps_images_says_which_shot_and_what_the_resume_doe
 
     tether = tmp_path / "tether"
     tether.mkdir()
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0)
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     out = tmp_path / "s"
     files = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(1, 4)]
     with failing_writes("tiff", after=1, errno_code=errno.ENOSPC):  # the 2nd shot's

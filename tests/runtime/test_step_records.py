@@ -456,7 +456,7 @@ def test_a_run_stopped_before_its_first_journal_line_tells_one_story(tmp_path: P
         "(its record file proves it)" in said(r)
     ), r.output
     r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
-    assert r.exit_code == 0 and "1 lights" in said(r), r.output
+    assert r.exit_code == 0 and "1 light" in said(r) and "1 lights" not in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert "the run stopped before its first journal line: journal.jsonl begun from " in said(r)
