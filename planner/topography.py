@@ -36,9 +36,9 @@ from numpy.typing import NDArray
 from rti_rig.core.errors import ConfigError, ScheduleError
 from rti_rig.core.geometry import direction_from_az_el, normalize
 from rti_rig.core.image_files import (
-    TIFF_MAGIC,
     SeveralFullSizeImages,
     colour_or_grey,
+    is_tiff_file,
     jpeg_truncation,
     tiff_is_planar,
     tiff_one_image,
@@ -121,9 +121,8 @@ def _read_tiff_preview(p: Path) -> NDArray | None:
     thumbnail there, the photograph in a later IFD or a SubIFD: the plan had been made from
     the thumbnail. :func:`~rti_rig.core.image_files.tiff_main_image` picks the image, as the
     replay rig and the watched folder do."""
-    with open(p, "rb") as fh:
-        if fh.read(4) not in TIFF_MAGIC:
-            return None
+    if not is_tiff_file(p):
+        return None
     import tifffile  # on a TIFF only: planning from a JPEG never needs it
 
     try:

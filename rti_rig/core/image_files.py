@@ -337,6 +337,27 @@ def tiff_one_image(tif: Any) -> Any:
     return main
 
 
+def is_tiff_file(path: Path) -> bool:
+    """Whether ``path`` starts as a TIFF does (classic or BigTIFF, either byte order).
+
+    Why by its bytes, not its suffix: a preview or shot saved as ``.TIF``, ``.tiff`` or with
+    no suffix at all is read the same way; the readers that pick a TIFF's full-resolution
+    image had each opened the file to check these four bytes themselves."""
+    with open(path, "rb") as fh:
+        return fh.read(4) in TIFF_MAGIC
+
+
+def tiff_main_pixels(tif: Any) -> NDArray[Any]:
+    """The pixels of an open TIFF's full-resolution image (:func:`tiff_main_image`), samples
+    last, (H, W) or (H, W, samples), whatever its planar configuration.
+
+    Why one function: the recorded-image reader, the planner's preview and the replay's row
+    view each picked the image and put its samples last in the same two lines; a reader that
+    forgot the second had refused a planar TIFF as an image 3 pixels high."""
+    image = tiff_main_image(tif)
+    return tiff_samples_last(image.asarray(), tiff_is_planar(image.keyframe))
+
+
 def tiff_several_images(path: Path) -> str | None:
     """Why the TIFF at ``path`` cannot give one image, when it holds two or more full-size
     images (:class:`SeveralFullSizeImages`: the file's name, then its words); None for any
@@ -346,9 +367,8 @@ def tiff_several_images(path: Path) -> str | None:
     listed it with them had advised copying it again from the camera or card, which gives
     the same two images back."""
     p = Path(path)
-    with open(p, "rb") as fh:
-        if fh.read(4) not in TIFF_MAGIC:
-            return None
+    if not is_tiff_file(p):
+        return None
     import tifffile
 
     try:
@@ -502,9 +522,8 @@ def tiff_sample_problem(path: Path) -> str | None:
     before a session had passed it ("undamaged and readable") and the session stopped at its
     image part-way, telling the user to resume into the same stop."""
     p = Path(path)
-    with open(p, "rb") as fh:
-        if fh.read(4) not in TIFF_MAGIC:
-            return None
+    if not is_tiff_file(p):
+        return None
     import tifffile
 
     try:
@@ -529,8 +548,7 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
 
         try:
             with tifffile.TiffFile(p) as tif:
-                image = tiff_main_image(tif)  # not a thumbnail in IFD0
-                img = tiff_samples_last(image.asarray(), tiff_is_planar(image.keyframe))
+                img = tiff_main_pixels(tif)  # not a thumbnail in IFD0
         except Exception as exc:  # tifffile raises many kinds; the user needs the file's name
             raise SessionError(f"cannot read image {p}: {exc}") from None
         if img.dtype not in (np.uint8, np.uint16) or img.ndim not in (2, 3):

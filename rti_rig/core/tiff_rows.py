@@ -29,7 +29,7 @@ from rti_rig.core.image_files import (
     pixels_hasher,
     tiff_is_planar,
     tiff_main_image,
-    tiff_samples_last,
+    tiff_main_pixels,
 )
 
 #: TIFF compression codes decoded strip by strip here: none, Adobe deflate, deflate.
@@ -161,8 +161,7 @@ class TiffRows:
             if self._full is None:
                 try:
                     with tifffile.TiffFile(self.path) as tf:
-                        pixels = tiff_main_image(tf).asarray()
-                    full = tiff_samples_last(pixels, self._planar)
+                        full = tiff_main_pixels(tf)
                     self._full = np.ascontiguousarray(colour_or_grey(full))
                 except MemoryError:
                     raise
