@@ -76,8 +76,8 @@ from rti_rig.app.usecases.scheduler_probe import (
     unreachable_scheduler,
 )
 from rti_rig.app.usecases.worker_code import (
-    OTHER_CODE,
     Unasked,
+    Untagged,
     WorkerCode,
     describe,
     local_identity,
@@ -247,14 +247,14 @@ def checked_gone(cluster: Cluster, kept: str) -> str:
         others: set[str] | None = workers_by_tag(cluster)[1]
     except Exception:  # the scheduler lost meanwhile: who is there is not known
         others = None
-    why: dict[str, str] = {}
+    why: dict[str, Untagged] = {}
     if others:
         try:
             why = plugin_outcomes(cluster.client, cluster.plugin, sorted(others))
         except Exception:  # the scheduler lost meanwhile: the workers are named alone
             why = {}
-    failed = sorted(w for w, o in why.items() if not o.startswith(OTHER_CODE))
-    named = ", ".join(f"{w} ({why[w]})" if w in why else w for w in sorted(others or ()))
+    failed = sorted(w for w, o in why.items() if not o.other_code)
+    named = ", ".join(f"{w} ({why[w].reason})" if w in why else w for w in sorted(others or ()))
     if others is None:  # not "no worker is there now": the scheduler did not say
         there = "which workers are there now is not known (the scheduler did not answer)"
     elif failed:
@@ -444,7 +444,7 @@ def _refuse_none_tagged(cluster: Cluster) -> None:
         why = plugin_outcomes(cluster.client, cluster.plugin, sorted(present))
     except Exception:  # the scheduler lost: said by the waiting code, in its words
         return
-    failed = {w: o for w, o in why.items() if not o.startswith(OTHER_CODE)}
+    failed = {w: o.reason for w, o in why.items() if not o.other_code}
     if not failed:  # replaced by workers of other code: _CheckedWatch's to say, as refused
         return
     named = "; ".join(f"{w} ({o})" for w, o in sorted(failed.items()))

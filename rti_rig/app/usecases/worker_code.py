@@ -26,7 +26,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
+from typing import Any, NamedTuple
 
 #: The packages rti-rig installs whose folders are not inside ``rti_rig/`` in a checkout
 #: (pyproject's ``[tool.setuptools.package-dir]``; a test holds the two equal). An editable
@@ -243,11 +243,24 @@ def tag_for(code: WorkerCode) -> str:
     return f"{TAG_PREFIX}{code.fingerprint}"
 
 
-#: What a worker's :func:`tagging_plugin` found there (its ``outcome``), read back by the client
-#: to say why a worker still in the cluster holds no tag.
+#: What a worker's :func:`tagging_plugin` found there (its ``outcome``, ``(kind, words)``), read
+#: back by the client to say why a worker still in the cluster holds no tag: the kinds.
 TAGGED = "tagged"
-#: ... or how it begins when the worker runs other code (then it is refused, not failed).
-OTHER_CODE = "it runs other code than this fit"
+#: ... the worker runs other code (then it is refused, not failed) ...
+OTHER_CODE = "other-code"
+#: ... or the check itself failed there (see that worker's log).
+CHECK_FAILED = "failed"
+
+
+class Untagged(NamedTuple):
+    """Why a worker still in the cluster holds no tag, as :func:`plugin_outcomes` read it.
+
+    Why a kind beside the words: the fit tells a worker refused for its code from one whose
+    check failed (restart it) by ``other_code``; it had told them apart by the words' first
+    characters, so rewording the sentence would have changed the verdict."""
+
+    other_code: bool
+    reason: str
 
 
 def tagging_plugin(code: WorkerCode) -> Any:
@@ -284,6 +297,8 @@ def tagging_plugin(code: WorkerCode) -> Any:
     expected = {"version": code.version, "fingerprint": code.fingerprint, "problem": None}
     resource = tag_for(code)
     identity = _identity_function()
+    # the kinds as closure values, sent with the class: never looked up in the worker's module
+    tagged, other_code, check_failed = TAGGED, OTHER_CODE, CHECK_FAILED
 
     class RtiRigCodeTag(WorkerPlugin):  # type: ignore[misc]  # untyped base
         """Tags a worker running this rti-rig (see :func:`tagging_plugin`)."""
@@ -293,7 +308,7 @@ def tagging_plugin(code: WorkerCode) -> Any:
             self.expected = expected
             self.resource = resource
             self.amount = TAG_AMOUNT
-            self.outcome: str | None = None
+            self.outcome: tuple[str, str] | None = None  # (kind, words): plain, as pickled
 
         async def setup(self, worker: Any) -> None:
             """Never raises: a worker whose check fails is left untagged, given no task (an
@@ -310,32 +325,41 @@ def tagging_plugin(code: WorkerCode) -> Any:
                     said = f"rti-rig {found.get('version')}, code {found.get('fingerprint')}"
                     if found.get("problem"):
                         said += f" ({found['problem']})"
-                    self.outcome = f"{OTHER_CODE}: {said}"
+                    self.outcome = (other_code, f"it runs other code than this fit: {said}")
                     return
                 if held != self.amount:
                     await worker.set_resources(**{self.resource: self.amount})
                     if worker.status == Status.running:  # see tagging_plugin: wakes tasks
                         worker.status = Status.paused
                         worker.status = Status.running
-                self.outcome = TAGGED
+                self.outcome = (tagged, "tagged")
             except Exception as exc:  # e.g. its scheduler lost meanwhile: untagged
-                self.outcome = f"{type(exc).__name__}: {exc}"
+                self.outcome = (check_failed, f"{type(exc).__name__}: {exc}")
 
     return RtiRigCodeTag()
 
 
-def plugin_outcomes(client: Any, name: str, workers: list[str]) -> dict[str, str]:
-    """What the plugin registered as ``name`` found on each of ``workers`` (its ``outcome``;
-    :data:`TAGGED`, or why the worker was not tagged), or why that could not be asked."""
+def plugin_outcomes(client: Any, name: str, workers: list[str]) -> dict[str, Untagged]:
+    """What the plugin registered as ``name`` found on each of ``workers`` (its ``outcome``:
+    tagged, other code, or why the check failed), or why that could not be asked (a failure,
+    not other code)."""
 
-    def outcome(dask_worker: Any) -> str:
+    failed = CHECK_FAILED  # a closure value, sent with the function
+
+    def outcome(dask_worker: Any) -> tuple[str, str]:
         plugin = dask_worker.plugins.get(name)
         if plugin is None:
-            return "the rti-rig check was never set up there"
-        return str(getattr(plugin, "outcome", None) or "the rti-rig check has not finished there")
+            return (failed, "the rti-rig check was never set up there")
+        found = getattr(plugin, "outcome", None)
+        return found or (failed, "the rti-rig check has not finished there")
 
     answers = client.run(outcome, workers=workers, on_error="return")
-    return {
-        w: a if isinstance(a, str) else f"it could not be asked ({type(a).__name__}: {a})"
-        for w, a in answers.items()
-    }
+    return {w: _untagged(a) for w, a in answers.items()}
+
+
+def _untagged(answer: Any) -> Untagged:
+    """One worker's answer to :func:`plugin_outcomes` (a ``(kind, words)`` pair, else the
+    error ``client.run`` returned in its place)."""
+    if isinstance(answer, tuple) and len(answer) == 2 and all(isinstance(a, str) for a in answer):
+        return Untagged(answer[0] == OTHER_CODE, answer[1])
+    return Untagged(False, f"it could not be asked ({type(answer).__name__}: {answer})")
