@@ -1351,13 +1351,12 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
     hold = min(need, len(el))
     wider = _band_holding(el, hold, band) if hold > START_LIGHTS else None
     if wider is not None:
-        asked = (
-            f"--until-error {until_error_deg:g}" if until_error_deg is not None else "--adaptive"
+        asked = _session_options(
+            until_error_deg,
+            # a --lights 4 kept as given was refused: "give at least 5"
+            None if lights is None else min(max(lights, START_LIGHTS + 1), hold),
+            None if min_lights is None else min(min_lights, hold),
         )
-        if lights is not None:  # a --lights 4 kept as given was refused: "give at least 5"
-            asked += f" --lights {min(max(lights, START_LIGHTS + 1), hold)}"
-        if min_lights is not None:
-            asked += f" --min-lights {min(min_lights, hold)}"
         lead = (
             f"Widen the band to hold {need}"
             if hold == need
@@ -1386,6 +1385,24 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
         )
         words.append(f"{shoot}: rti-rig run {config} --out DIR{in_band}{caveat}")
     raise RtiRigError(". ".join(words[:2]) + "".join(f"; or {w}" for w in words[2:]))
+
+
+def _session_options(
+    until_error_deg: float | None,
+    lights: int | None,
+    min_lights: int | None,
+    objective: str = "normals",
+) -> str:
+    """An adaptive session's own options, as a refusal's advised command repeats them
+    (``--adaptive --lights 6``, ``--until-error 2 --min-lights 8 --objective relight``), the
+    objective only where not the default.
+
+    Why one function: the dome's and the arm's band advice each spelled these options out,
+    and a working command must read the same whichever rig refused it."""
+    words = f"--until-error {until_error_deg:g}" if until_error_deg is not None else "--adaptive"
+    words += f" --lights {lights}" if lights is not None else ""
+    words += f" --min-lights {min_lights}" if min_lights is not None else ""
+    return words + (f" --objective {objective}" if objective != "normals" else "")
 
 
 def _band_options(band: tuple[float, float]) -> str:
@@ -1541,14 +1558,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
 
             def options(lights_now: int | None, min_now: int | None) -> str:
                 """The session's options as given, with these counts."""
-                words = (
-                    f"--until-error {until_error_deg:g}"
-                    if until_error_deg is not None
-                    else "--adaptive"
-                )
-                words += f" --lights {lights_now}" if lights_now is not None else ""
-                words += f" --min-lights {min_now}" if min_now is not None else ""
-                return words + (f" --objective {objective}" if objective != "normals" else "")
+                return _session_options(until_error_deg, lights_now, min_now, objective)
 
             def widen(need: int, asked: Callable[[int], str]) -> Callable[[], str]:
                 return lambda: _arm_widen_to_hold(rig, loaded, need, in_reach, band, asked)
