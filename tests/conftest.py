@@ -135,6 +135,31 @@ def tethered_run(
     return TetheredRun(r, " ".join(r.output.split()), lit_at_end)
 
 
+class TiffRun(NamedTuple):
+    """What :func:`tethered_tiffs` left: :class:`TetheredRun`'s facts, and the watched folder
+    and the session folder it used."""
+
+    result: Any
+    said: str
+    tether: Path
+    out: Path
+    lit_at_end: list[int]
+
+
+def tethered_tiffs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, files: list[bytes]) -> TiffRun:
+    """:func:`tethered_run` of the shipped folder-watch dome watching ``tmp_path/tether`` for
+    ``*.tif``, the n-th shutter pulse saving ``files[n - 1]`` as ``IMG_000n.tif``, into
+    ``tmp_path/s``. One spelling of the watched-TIFF tests' set-up (three files had each
+    written the folder, the config and the names out)."""
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=20.0, tiffs=True)
+    out = tmp_path / "s"
+    named = [(f"IMG_{n:04d}.tif", f) for n, f in enumerate(files, 1)]
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, named, out)
+    return TiffRun(r, said, tether, out, lit_at_end)
+
+
 #: The handlers a test must leave as it found them: a command run in the pytest process
 #: (CliRunner) that left SIGINT ignored made every later subprocess a test started inherit an
 #: ignored Ctrl-C (red in CI only, far from the test that leaked it).

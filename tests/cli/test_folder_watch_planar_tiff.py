@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from conftest import folder_watch_config, tethered_run
+from conftest import tethered_tiffs
 
 
 def _planar(pixels: np.ndarray) -> bytes:
@@ -30,12 +30,7 @@ def test_run_records_the_rgb_pixels_of_a_planar_tiff(
     files = [_planar(p) for p in shots]
     with tifffile.TiffFile(BytesIO(files[0])) as tif:  # the files are as described
         assert tif.pages[0].planarconfig == 2 and tif.pages[0].shape == (3, 40, 56)
-    tether = tmp_path / "tether"
-    tether.mkdir()
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=20.0, tiffs=True)
-    out = tmp_path / "s"
-    named = [(f"IMG_{n:04d}.tif", f) for n, f in enumerate(files, 1)]
-    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, named, out)
+    r, said, _tether, out, lit_at_end = tethered_tiffs(tmp_path, monkeypatch, files)
     assert r.exit_code == 0, said
     assert "Traceback" not in said, said
     for n, shot in enumerate(shots, 1):

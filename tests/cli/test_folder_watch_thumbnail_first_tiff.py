@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from conftest import folder_watch_config, tethered_run
+from conftest import folder_watch_config, tethered_run, tethered_tiffs
 
 
 def _thumbnail_first(pixels: np.ndarray, layout: str) -> bytes:
@@ -26,16 +26,6 @@ def _thumbnail_first(pixels: np.ndarray, layout: str) -> bytes:
     return out.getvalue()
 
 
-def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, files: list[bytes]):  # type: ignore[no-untyped-def]
-    tether = tmp_path / "tether"
-    tether.mkdir()
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=20.0, tiffs=True)
-    out = tmp_path / "s"
-    named = [(f"IMG_{n:04d}.tif", f) for n, f in enumerate(files, 1)]
-    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, named, out)
-    return r, said, tether, out, lit_at_end
-
-
 @pytest.mark.parametrize("layout", ["ifd", "subifd"])
 def test_run_records_the_full_image_of_a_thumbnail_first_tiff(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, layout: str
@@ -45,7 +35,7 @@ def test_run_records_the_full_image_of_a_thumbnail_first_tiff(
     files = [_thumbnail_first(p, layout) for p in shots]
     with tifffile.TiffFile(BytesIO(files[0])) as tif:  # the files are as described
         assert tif.pages[0].shape == (16, 16, 3)
-    r, said, _tether, out, lit_at_end = _run(tmp_path, monkeypatch, files)
+    r, said, _tether, out, lit_at_end = tethered_tiffs(tmp_path, monkeypatch, files)
     assert r.exit_code == 0, said
     for n, shot in enumerate(shots, 1):
         image = tifffile.imread(out / "linear" / f"image_{n:03d}.tif")
@@ -73,7 +63,7 @@ def test_run_refuses_a_tiff_of_two_full_size_images_as_such(
     if pages != "different":
         with tifffile.TiffFile(BytesIO(two.getvalue())) as tif:  # one series of two pages
             assert [s.shape for s in tif.series] == [(2, 64, 64, 3)]
-    r, said, tether, out, lit_at_end = _run(tmp_path, monkeypatch, [two.getvalue()] * 2)
+    r, said, tether, out, lit_at_end = tethered_tiffs(tmp_path, monkeypatch, [two.getvalue()] * 2)
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
     assert "IMG_0001.tif" in said and "2 full-size images" in said, said

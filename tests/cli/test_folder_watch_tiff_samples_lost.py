@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from conftest import folder_watch_config, tethered_run
+from conftest import tethered_tiffs
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -51,16 +51,6 @@ def _samples_lost(data: bytes) -> bytes:
     raise AssertionError("no SamplesPerPixel entry")
 
 
-def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, files: list[bytes]):  # type: ignore[no-untyped-def]
-    tether = tmp_path / "tether"
-    tether.mkdir()
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=20.0, tiffs=True)
-    out = tmp_path / "s"
-    named = [(f"IMG_{n:04d}.tif", f) for n, f in enumerate(files, 1)]
-    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, named, out)
-    return r, said, tether, out, lit_at_end
-
-
 def test_run_refuses_an_rgb_tiff_whose_samples_per_pixel_is_lost(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -68,7 +58,7 @@ def test_run_refuses_an_rgb_tiff_whose_samples_per_pixel_is_lost(
     rgb[..., 2] = 10000
     whole = _tiff(rgb, "rgb")
     damaged = _samples_lost(whole)
-    r, said, tether, out, lit_at_end = _run(tmp_path, monkeypatch, [damaged, whole])
+    r, said, tether, out, lit_at_end = tethered_tiffs(tmp_path, monkeypatch, [damaged, whole])
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
     assert "IMG_0001.tif is a damaged TIFF" in said and "waiting will not help" in said, said
@@ -87,7 +77,7 @@ def test_a_grey_cameras_tiffs_still_make_a_session(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     grey = [_tiff(np.full((64, 64), v, np.uint16), "minisblack") for v in (20000, 25000)]
-    r, said, _tether, out, lit_at_end = _run(tmp_path, monkeypatch, grey)
+    r, said, _tether, out, lit_at_end = tethered_tiffs(tmp_path, monkeypatch, grey)
     assert r.exit_code == 0, said
     assert "damaged" not in said, said
     for n in (1, 2):
