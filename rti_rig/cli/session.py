@@ -1352,13 +1352,15 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
 
 
 #: What a Ctrl-C once the capture has ended (returned, raised or been stopped) is told.
-_LATE_CTRL_C = (
+_LATE_CTRL_C_WORDS = (
     "Ctrl-C after the capture had ended: there was nothing left to stop, and the rig's "
-    "teardown has run (what it did is said below)."
+    "teardown has run (what it did is said {where})."
 )
+_LATE_CTRL_C = _LATE_CTRL_C_WORDS.format(where="below")
 #: The same once the stop has said what the teardown did: "said below" had pointed at the
-#: images kept and the resume, under the line of the lights.
-_LATE_CTRL_C_SAID_ABOVE = _LATE_CTRL_C.replace("said below", "said above")
+#: images kept and the resume, under the line of the lights. (Filled in, not a replace of the
+#: other's words: a rewording that dropped "said below" would have left both alike.)
+_LATE_CTRL_C_SAID_ABOVE = _LATE_CTRL_C_WORDS.format(where="above")
 #: What a Ctrl-C is told while a session stopped before its capture began closes its rig, a
 #: new one's and a resumed one's (which has images: "before its first image" had been said of
 #: it too, above "Stopped (Ctrl-C) before the session went on").
