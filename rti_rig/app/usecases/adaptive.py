@@ -1247,31 +1247,28 @@ def check_min_lights(
 def _check_min_within(
     min_lights: int,
     offered: int,
-    band: tuple[float, float] = _FULL_BAND,
-    el: NDArray[np.float64] | None = None,
-    advice: Callable[[], str] | None = None,
+    band: tuple[float, float],
+    advice: Callable[[int], str],
 ) -> None:
-    """``--min-lights M`` above what the rig offers (in the band) is refused; ``el``: a dome's
-    LED elevations (°), for the band that would hold M (:func:`_widen_to_hold`); ``advice``:
-    what follows "give at most …" instead (an arm's, :func:`_arm_widen_to_hold`), asked only
-    when the request is refused."""
+    """``--min-lights M`` above what the rig offers (in the band) is refused; ``advice(M)``:
+    what follows "give at most …", the band that would hold M (a dome's,
+    :func:`_widen_to_hold`; an arm's, :func:`_arm_widen_to_hold`), asked only when the request
+    is refused."""
     if min_lights > offered:
-        widen = advice() if advice is not None else _widen_to_hold(min_lights, band, el)
+        widen = advice(min_lights)
         raise RtiRigError(
             f"--min-lights {min_lights}: this rig offers {offered} lights{_band_words(band)} "
             f"an adaptive session can use; give at most {offered}{widen}"
         )
 
 
-def _widen_to_hold(need: int, band: tuple[float, float], el: NDArray[np.float64] | None) -> str:
+def _widen_to_hold(need: int, band: tuple[float, float], el: NDArray[np.float64]) -> str:
     """`` (or widen the band to hold N: --max-elevation-deg C)`` for a band asked for, where a
-    dome's elevations ``el`` say which would (a generic "widen" where they do not: an arm's
-    refusal words its own, :func:`_arm_widen_to_hold`);
-    nothing over every elevation. Why: "widen --min/--max-elevation-deg" gave no value."""
+    dome's LED elevations ``el`` (°) say which would (an arm's refusal words its own,
+    :func:`_arm_widen_to_hold`); nothing over every elevation. Why: "widen
+    --min/--max-elevation-deg" gave no value."""
     if tuple(band) == _FULL_BAND:
         return ""
-    if el is None:
-        return " (or widen --min/--max-elevation-deg)"
     wider = _band_holding(el, need, band)
     if wider is None:  # the dome has fewer LEDs in all: no band holds them
         return ""
@@ -1288,15 +1285,14 @@ def _band_words(band: tuple[float, float]) -> str:
 def _check_lights_within(
     lights: int | None,
     offered: int,
-    band: tuple[float, float] = _FULL_BAND,
-    el: NDArray[np.float64] | None = None,
-    advice: Callable[[], str] | None = None,
+    band: tuple[float, float],
+    advice: Callable[[int], str],
 ) -> None:
     """``--lights N`` above what the rig offers is refused, as a planned session's is (it was
-    capped without a word: 100 asked of a 48-LED dome ran 48); ``el`` and ``advice`` as
+    capped without a word: 100 asked of a 48-LED dome ran 48); ``advice`` as
     :func:`_check_min_within`'s."""
     if lights is not None and lights > offered:
-        widen = advice() if advice is not None else _widen_to_hold(lights, band, el)
+        widen = advice(lights)
         raise RtiRigError(
             f"--lights {lights}: this rig offers {offered} lights{_band_words(band)} an "
             f"adaptive session can use; give at most {offered}{widen}"
@@ -1536,10 +1532,15 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         )
     check_objective(objective, lights, until_error_deg)
     check_min_lights(min_lights, lights, until_error_deg)
-    if offered is not None:
-        _check_lights_within(lights, offered, band, elevations)
+    if offered is not None and elevations is not None:  # a dome's (an arm's are known later)
+        dome_el = elevations
+
+        def held_by(need: int) -> str:
+            return _widen_to_hold(need, band, dome_el)
+
+        _check_lights_within(lights, offered, band, held_by)
         if min_lights is not None:
-            _check_min_within(min_lights, offered, band, elevations)
+            _check_min_within(min_lights, offered, band, held_by)
     SessionFolder.check_new(out_dir)
     if check_room is not None:  # the disk, before the rig is built (as a planned run's)
         check_room(*images_before_rig(loaded, offered, lights, until_error_deg, min_lights, band))
@@ -1560,8 +1561,8 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
                 """The session's options as given, with these counts."""
                 return _session_options(until_error_deg, lights_now, min_now, objective)
 
-            def widen(need: int, asked: Callable[[int], str]) -> Callable[[], str]:
-                return lambda: _arm_widen_to_hold(rig, loaded, need, in_reach, band, asked)
+            def widen(asked: Callable[[int], str]) -> Callable[[int], str]:
+                return lambda need: _arm_widen_to_hold(rig, loaded, need, in_reach, band, asked)
 
             _check_lights_within(
                 lights,
@@ -1569,18 +1570,10 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
                 band,
                 # a --min-lights above the count advised is lowered with it: the command
                 # given had kept it, and was refused in turn as a minimum above the maximum
-                advice=widen(
-                    lights or 0,
-                    lambda n: options(n, None if min_lights is None else min(min_lights, n)),
-                ),
+                widen(lambda n: options(n, None if min_lights is None else min(min_lights, n))),
             )
             if min_lights is not None:
-                _check_min_within(
-                    min_lights,
-                    in_reach,
-                    band,
-                    advice=widen(min_lights, lambda n: options(lights, n)),
-                )
+                _check_min_within(min_lights, in_reach, band, widen(lambda n: options(lights, n)))
         source = AdaptiveSteps(rig, plan, until_error_deg, objective, min_lights=min_lights)
         schedule = source.start_schedule()
         validate_schedule(rig, schedule)  # the starting layout, before anything moves
