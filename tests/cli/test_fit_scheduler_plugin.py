@@ -121,36 +121,15 @@ def test_a_worker_whose_source_changed_after_it_imported_it_is_refused(tmp_path:
     mine = Path(rti_rig.__file__).parents[1]
     init = Path("rti_rig", "__init__.py")
     shutil.copyfile(mine / init, where / init)  # this version: only the fit differs
-    env = {**os.environ, "PYTHONPATH": str(where)}
     out = tmp_path / "FIT"
-    worker = None
-    try:
-        with _tcp_cluster(0) as cluster:
-            worker = subprocess.Popen(
-                [sys.executable, "-m", "distributed.cli.dask_worker", cluster.scheduler_address,
-                 "--nthreads", "1", "--no-nanny", "--no-dashboard"],
-                cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            )  # fmt: skip
-            _until(lambda: len(cluster.scheduler.workers) == 1, "the worker never joined")
-            from distributed import Client
 
-            with Client(cluster.scheduler_address, set_as_default=False) as client:
-                (loaded,) = client.run(exec, "import rti_rig.app.usecases.fit_batch").values()
-                assert loaded is None
-            shutil.copyfile(mine / fit_py, where / fit_py)  # the copy made this rti-rig again
-            r = runner.invoke(
-                app,
-                ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps",
-                 "--scheduler", cluster.scheduler_address],
-            )  # fmt: skip
-            (address,) = cluster.scheduler.workers
-    finally:
-        if worker is not None:  # killed: a SIGTERM'd dask worker may take minutes to close
-            worker.kill()
-            worker.wait(timeout=120)
+    def made_this_rti_rig_again() -> None:  # the copy, after the worker imported it
+        shutil.copyfile(mine / fit_py, where / fit_py)
+
+    r, address, scheduler = _fit_on_a_worker_of(where, session, out, made_this_rti_rig_again)
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
-    assert f"1 of the 1 workers of the Dask cluster at '{cluster.scheduler_address}'" in said
+    assert f"1 of the 1 workers of the Dask cluster at '{scheduler}'" in said
     assert address in said, said
     assert (
         f"(rti-rig {rti_rig.__version__}, code {local_identity().fingerprint}, but its rti-rig "

@@ -8,25 +8,19 @@ and the code the worker holds is its ``.py`` files alone."""
 
 from __future__ import annotations
 
-import os
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
-from test_fit_scheduler_late_worker import _until
-from test_fit_scheduler_plugin import _tcp_cluster
-from typer.testing import CliRunner
+from test_fit_scheduler_plugin import _fit, _one_worker_of
 
 import rti_rig
 from rti_rig import rig_configs
-from rti_rig.cli import app
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from fit_sessions import make_session
 
-runner = CliRunner()
 EDITED = "simulated_dome.toml"
 
 
@@ -56,34 +50,17 @@ def test_a_worker_whose_rig_config_was_edited_after_it_imported_rti_rig_still_fi
     session = make_session(tmp_path / "S", size=(24, 32))[0]
     where = _installed_copy(tmp_path / "installed")
     mine = Path(rig_configs.__file__).parent / EDITED
-    env = {**os.environ, "PYTHONPATH": str(where)}
     out = tmp_path / "FIT"
-    worker = None
-    try:
-        with _tcp_cluster(0) as cluster:
-            worker = subprocess.Popen(
-                [sys.executable, "-m", "distributed.cli.dask_worker", cluster.scheduler_address,
-                 "--nthreads", "1", "--no-nanny", "--no-dashboard"],
-                cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            )  # fmt: skip
-            _until(lambda: len(cluster.scheduler.workers) == 1, "the worker never joined")
-            from distributed import Client
+    from distributed import Client
 
-            with Client(cluster.scheduler_address, set_as_default=False) as client:
-                (loaded,) = client.run(exec, "import rti_rig.app.usecases.fit_batch").values()
-                assert loaded is None
-                (configs,) = client.run(eval, CONFIGS_FILE).values()
-            assert Path(configs).parent == where / "rti_rig" / "rig_configs"  # its own copy
-            shutil.copyfile(mine, where / "rti_rig" / "rig_configs" / EDITED)  # the edit
-            r = runner.invoke(
-                app,
-                ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps",
-                 "--scheduler", cluster.scheduler_address],
-            )  # fmt: skip
-    finally:
-        if worker is not None:  # killed: a SIGTERM'd dask worker may take minutes to close
-            worker.kill()
-            worker.wait(timeout=120)
+    with _one_worker_of(where) as cluster:
+        with Client(cluster.scheduler_address, set_as_default=False) as client:
+            (loaded,) = client.run(exec, "import rti_rig.app.usecases.fit_batch").values()
+            assert loaded is None
+            (configs,) = client.run(eval, CONFIGS_FILE).values()
+        assert Path(configs).parent == where / "rti_rig" / "rig_configs"  # its own copy
+        shutil.copyfile(mine, where / "rti_rig" / "rig_configs" / EDITED)  # the edit
+        r = _fit(session, out, cluster.scheduler_address)
     said = " ".join(r.output.split())
     assert r.exit_code == 0, said
     assert "source changed" not in said and "restart" not in said, said
