@@ -120,12 +120,10 @@ def test_two_ctrl_c_as_a_failed_capture_is_reported_leave_the_error_and_resume_s
     assert r.exit_code == 2, said
 
 
-def test_two_ctrl_c_as_a_session_stopped_before_its_capture_closes_are_answered(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """A Ctrl-C at the hand-over stops the session before its first image; two more as its
-    rig is closed had been told "Stopping after this image", then raised EmergencyStop out
-    of the except clause that closes it."""
+def _ctrl_c_at_hand_over_then_two_as_it_closes(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A Ctrl-C held by the hand-over (the capture never begins), then two more as the session
+    stopped before its capture closes its rig. (The new session's test and the resume's had
+    each written it out.)"""
     real_execute, real_stopped = cli_session._execute, cli_session._stopped_before_capture
 
     def execute(*args: Any, **kwargs: Any) -> Any:
@@ -139,6 +137,15 @@ def test_two_ctrl_c_as_a_session_stopped_before_its_capture_closes_are_answered(
 
     monkeypatch.setattr(cli_session, "_execute", execute)
     monkeypatch.setattr(cli_session, "_stopped_before_capture", stopped_before_capture)
+
+
+def test_two_ctrl_c_as_a_session_stopped_before_its_capture_closes_are_answered(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C at the hand-over stops the session before its first image; two more as its
+    rig is closed had been told "Stopping after this image", then raised EmergencyStop out
+    of the except clause that closes it."""
+    _ctrl_c_at_hand_over_then_two_as_it_closes(monkeypatch)
     r, said, out = _run(tmp_path)
     assert not (out / "lights.lp").exists(), said  # nothing was captured
     assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
@@ -172,19 +179,7 @@ def test_two_ctrl_c_as_a_resume_stopped_before_it_went_on_closes_are_not_told_fi
     r, said, out = _run(tmp_path)
     assert r.exit_code == 130 and "2 image(s) in the session" in said, said
     monkeypatch.undo()
-    real_execute, real_stopped = cli_session._execute, cli_session._stopped_before_capture
-
-    def execute(*args: Any, **kwargs: Any) -> Any:
-        signal.raise_signal(signal.SIGINT)  # held by the hand-over: the capture never begins
-        return real_execute(*args, **kwargs)
-
-    def stopped_before_capture(*args: Any, **kwargs: Any) -> Any:
-        signal.raise_signal(signal.SIGINT)
-        signal.raise_signal(signal.SIGINT)
-        return real_stopped(*args, **kwargs)
-
-    monkeypatch.setattr(cli_session, "_execute", execute)
-    monkeypatch.setattr(cli_session, "_stopped_before_capture", stopped_before_capture)
+    _ctrl_c_at_hand_over_then_two_as_it_closes(monkeypatch)
     argv = ["run", "--resume", str(out), "--no-verdict"]
     r = CliRunner().invoke(app, argv, terminal_width=400)
     said = " ".join(r.output.split())
