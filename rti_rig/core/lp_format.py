@@ -170,11 +170,18 @@ def _trailing_parts(name: str) -> list[str]:
     return parts
 
 
+def _under_lp_dir(lp_dir: Path, parts: list[str]) -> list[Path]:
+    """The files ``parts`` (:func:`_trailing_parts`) name under the `.lp`'s folder, longest
+    first (``sub/IMG.JPG``, then ``IMG.JPG``): one order for where a name is looked for and
+    for which of them make it ambiguous, so the two never judge different files."""
+    return [lp_dir.joinpath(*parts[k:]) for k in range(len(parts))]
+
+
 def _absolute_name_candidates(lp_dir: Path, name: str) -> list[Path]:
     """Where :func:`image_path` looks for an absolute name, in order (no duplicates)."""
     parts = _trailing_parts(name) or [image_file_name(name)]
     base = parts[-1]
-    tails = [lp_dir.joinpath(*parts[k:]) for k in range(len(parts))]
+    tails = _under_lp_dir(lp_dir, parts)
     found: list[Path] = []
     for c in [*tails, lp_dir / "jpeg-exports" / base, lp_dir.parent / "jpeg-exports" / base]:
         if c not in found:
@@ -191,9 +198,7 @@ def image_name_ambiguity(lp_dir: Path, name: str) -> str | None:
     if not is_absolute_name(name):
         return None
     lp_dir = Path(lp_dir)
-    parts = _trailing_parts(name)
-    existing = [lp_dir.joinpath(*parts[k:]) for k in range(len(parts))]
-    existing = [c for c in existing if c.is_file()]
+    existing = [c for c in _under_lp_dir(lp_dir, _trailing_parts(name)) if c.is_file()]
     if len(existing) < 2:
         return None
     chosen, others = existing[0], existing[1:]
