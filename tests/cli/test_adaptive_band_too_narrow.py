@@ -234,3 +234,17 @@ def test_an_arm_asked_a_minimum_above_what_it_offers_too_is_advised_both_lowered
     assert most < 125 and int(argv[argv.index("--min-lights") + 1]) == most, argv
     assert argv[argv.index("--until-error") + 1] == "5", argv
     assert not (tmp_path / "s").exists()
+
+
+def test_the_band_advised_to_a_dome_keeps_the_objective_asked(tmp_path: Path) -> None:
+    """``--objective relight`` is part of the session asked: the dome's widened-band command
+    had left it out (the arm's kept it), so the pasted command chose for normals."""
+    out = tmp_path / "s"
+    args = ["--adaptive", "--lights", "6", "--objective", "relight", "--max-elevation-deg", "20"]
+    r = runner.invoke(app, ["run", str(NAB), "--out", str(out), *args])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert not out.exists()
+    assert (
+        "--out DIR --adaptive --lights 6 --objective relight --max-elevation-deg 37 (6 lights"
+    ) in text, text

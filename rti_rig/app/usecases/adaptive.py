@@ -1306,6 +1306,7 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
     until_error_deg: float | None,
     band: tuple[float, float] = _FULL_BAND,
     min_lights: int | None = None,
+    objective: str = "normals",
 ) -> None:
     """Refuse ``--adaptive`` (or ``--lights N`` with it) on a rig offering no more lights than
     the starting layout: there is nothing left to choose. ``--lights 4`` was refused with "give
@@ -1352,6 +1353,7 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
             # a --lights 4 kept as given was refused: "give at least 5"
             None if lights is None else min(max(lights, START_LIGHTS + 1), hold),
             None if min_lights is None else min(min_lights, hold),
+            objective,  # kept, as an arm's advice keeps it ('relight' had become the default)
         )
         lead = (
             f"Widen the band to hold {need}"
@@ -1523,7 +1525,9 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         # --max-elevation-deg", with no value that would do)
         elevations = az_el_from_direction(geometry.directions)[1]
         offered = _held(elevations, band)
-        _refuse_nothing_to_choose(loaded, offered, lights, until_error_deg, band, min_lights)
+        _refuse_nothing_to_choose(
+            loaded, offered, lights, until_error_deg, band, min_lights, objective
+        )
     if lights is not None and lights < START_LIGHTS + 1:
         asked = "--until-error … " if until_error_deg is not None else "--adaptive "
         raise RtiRigError(
