@@ -3,9 +3,6 @@
 from __future__ import annotations
 
 import shlex
-import signal
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
@@ -13,8 +10,8 @@ import typer
 from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, print_notes
+from rti_rig.cli.stopping import Terminated, sigterm_stops
 from rti_rig.core.errors import RtiRigError
-from rti_rig.runtime.deferred_signals import signal_handlers
 
 #: The --model names, as --help offers them and an unknown name's refusal lists them: one
 #: list, as the refusal (the registry's) had left out ``auto`` and named robust PS
@@ -71,28 +68,6 @@ class VerdictTerminated(BaseException):
     phase): the session is complete, so it is said like a Ctrl-C there; it had ended the
     process silently (exit 143), which read like a failed session. A BaseException, as
     KeyboardInterrupt is, so that no ``except Exception`` on the way swallows it."""
-
-
-class FitStopped(BaseException):
-    """A SIGTERM during ``fit`` (raised by its handler): a BaseException, as KeyboardInterrupt
-    is, so that the fit's own clean-up (outputs written so far removed, a batch's partial
-    folder discarded) runs on the way out and no ``except Exception`` swallows it."""
-
-
-@contextmanager
-def _stoppable() -> Iterator[None]:
-    """SIGTERM stops a fit as Ctrl-C does: through its clean-up.
-
-    Why: without a handler a SIGTERM (``timeout``, a scheduler, a service manager) ended the
-    process at once, silently, exit 143, leaving half-written outputs (``fit.ptm.part``, a
-    normal map without its QA) in --out, and the same command run again was refused: "not
-    empty"."""
-
-    def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
-        raise FitStopped()
-
-    with signal_handlers({signal.SIGTERM: terminated}):
-        yield
 
 
 def _stopped(
@@ -217,7 +192,10 @@ def fit(
     written: list[bool] = []  # set once every output is written (what a stop then says)
     cluster = scheduler not in (None, "threads")  # the fit_dask.THREADS value, not imported
     try:
-        with _stoppable():
+        # a SIGTERM (timeout, a scheduler) stops a fit as Ctrl-C does, through its clean-up:
+        # without it the process ended at once, leaving half-written outputs (fit.ptm.part, a
+        # normal map without its QA) in --out, and the same command was refused: "not empty"
+        with sigterm_stops():
             _fit_command(
                 written,
                 sources,
@@ -233,7 +211,7 @@ def fit(
             )
     except KeyboardInterrupt:
         raise _stopped("Ctrl-C", out_dir, len(sources) > 1, bool(written), cluster) from None
-    except FitStopped:
+    except Terminated:
         raise _stopped("SIGTERM", out_dir, len(sources) > 1, bool(written), cluster) from None
 
 

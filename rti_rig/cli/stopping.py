@@ -1,11 +1,12 @@
 """A SIGTERM that stops a file-writing command as Ctrl-C does, and what a stop left written.
 
-Why: ``plan`` and ``calibrate-lights`` had no SIGTERM handler (``run``, ``fit`` and ``check``
-have theirs): a SIGTERM (``timeout``, a scheduler, a service manager) mid-write ended the
-process at once, leaving a hidden ``.map.partial.png`` or ``.light_calibration.toml.tmp``
-beside the file asked for, and said nothing. Raised as a BaseException, as KeyboardInterrupt
-is, the stop runs the writers' own clean-up (each removes its temporary file on the way out)
-and is said by the command as its Ctrl-C is.
+Why: ``plan`` and ``calibrate-lights`` had no SIGTERM handler (``run`` and ``check`` have
+theirs; ``fit`` had this one written out as its own and uses it now): a SIGTERM (``timeout``,
+a scheduler, a service manager) mid-write ended the process at once, leaving a hidden
+``.map.partial.png`` or ``.light_calibration.toml.tmp`` beside the file asked for, and said
+nothing. Raised as a BaseException, as KeyboardInterrupt is, the stop runs the writers' own
+clean-up (each removes its temporary file on the way out) and is said by the command as its
+Ctrl-C is.
 """
 
 from __future__ import annotations
