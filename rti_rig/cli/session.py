@@ -791,10 +791,17 @@ class _Stop:
 
     @property
     def kept(self) -> str:
+        """The images kept and where: every stop's wording begins with them, so the user
+        knows what is on disk before being told what to do with it."""
         return f"{self.ending.images_kept} image(s) kept in {self.out_dir}"
 
     @property
     def lp(self) -> str:
+        """The session's .lp file name, named where the stop says which lights the images
+        are labelled with."""
+        # imported here, not at the top: rti_rig.runtime.session loads numpy (through
+        # rti_rig.core.image_files), which `rti-rig --help` and the parsing stay free of; no
+        # import cycle
         from rti_rig.runtime.session import LP_NAME
 
         return LP_NAME
@@ -808,6 +815,8 @@ class _Stop:
 
     @property
     def fit_it(self) -> str:
+        """The command that fits the images as they are: offered where a resume is not
+        possible or not needed, so the user is not left without a next step."""
         return f"`rti-rig fit {_arg(self.out_dir)} --out FOLDER` fits the images as they are"
 
 
