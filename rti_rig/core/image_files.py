@@ -9,7 +9,6 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
-import itertools
 import os
 from pathlib import Path
 from typing import Any
@@ -381,12 +380,10 @@ def tiff_several_images(path: Path) -> str | None:
     return None
 
 
-def tiff_extent(
-    path: Path, pages: int | None = None, main_image: bool = False
-) -> tuple[int, int] | None:
+def tiff_extent(path: Path, main_image: bool = False) -> tuple[int, int] | None:
     """Where the TIFF ``path``'s own structure names last lies: (start, end) of the strip,
-    tile or IFD that ends furthest into the file, over its first ``pages`` pages (None: all),
-    or with ``main_image`` over the pages of the image a reader takes (:func:`tiff_main_image`:
+    tile or IFD that ends furthest into the file, over all its pages, or with ``main_image``
+    over the pages of the image a reader takes (:func:`tiff_main_image`:
     not a thumbnail before it, nor a SubIFD it would skip);
     None when tifffile cannot parse its IFDs at all, or one names no data (not all written
     yet, or damaged: not known which).
@@ -401,7 +398,7 @@ def tiff_extent(
         with tifffile.TiffFile(path) as tif:
             last = (0, 0)
             read = tiff_main_image(tif).pages if main_image else tif.pages
-            for page in itertools.islice(read, pages):
+            for page in read:
                 ifd = int(getattr(page, "offset", 0))
                 data = [
                     (int(o), int(o) + int(n))

@@ -34,11 +34,15 @@ def test_a_tiff_cut_short_is_said_to_be_by_how_much(tmp_path: Path) -> None:
     # tifffile writes the first IFD before its data: cutting the data's end keeps it whole
     cut = tmp_path / "cut.tif"
     cut.write_bytes(data[: offset + count - 100])
-    assert tiff_extent(cut, pages=1) == (offset, offset + count)
+    assert tiff_extent(cut, main_image=True) == (offset, offset + count)
     assert image_truncation(cut) == "its image data runs 100 bytes past its end (cut short)"
 
 
-def test_the_extent_reads_every_page_unless_told(tmp_path: Path) -> None:
-    path = _tiff(tmp_path / "a.tif", pages=2)
-    first, every = tiff_extent(path, pages=1), tiff_extent(path)
-    assert first is not None and every is not None and first[1] < every[1]
+def test_the_extent_reads_every_page_unless_told_the_main_image(tmp_path: Path) -> None:
+    # the image a reader takes, then a reduced-resolution thumbnail after it: the check before
+    # a session (main_image) reads the image, not the thumbnail's data further on
+    path = _tiff(tmp_path / "a.tif")
+    with tifffile.TiffWriter(path, append=True) as tw:
+        tw.write(np.full((8, 12), 7, np.uint16), photometric="minisblack", subfiletype=1)
+    main, every = tiff_extent(path, main_image=True), tiff_extent(path)
+    assert main is not None and every is not None and main[1] < every[1]
