@@ -10,7 +10,20 @@ from pathlib import Path
 from rti_rig.app.config import load_rig_config
 from rti_rig.app.rig_identity import identity_differences, rig_identity
 
-CUSTOM = """
+#: the camera both templates end with (a folder watch: nothing here opens a device)
+CAMERA = """
+[camera]
+width = 64
+height = 48
+exposure_s = 0.05
+
+[camera.device]
+kind = "folder_watch"
+folder = "{folder}"
+"""
+
+CUSTOM = (
+    """
 name = "my-dome"
 kind = "dome"
 backend = "hardware"
@@ -38,16 +51,9 @@ reply = {{ kind = "line", timeout_s = {timeout} }}
 [dome.serial.protocol.all_off]
 send = "X\\n"
 reply = {{ kind = "line" }}
-
-[camera]
-width = 64
-height = 48
-exposure_s = 0.05
-
-[camera.device]
-kind = "folder_watch"
-folder = "{folder}"
 """
+    + CAMERA
+)
 
 
 def _identity(tmp_path: Path, name: str, **keys: object) -> dict[str, object]:
@@ -94,7 +100,8 @@ def test_a_custom_session_recorded_before_the_protocol_digest_resumes(tmp_path: 
     assert identity_differences(before, _identity(tmp_path, "b", light="ON {index}\\n")) == []
 
 
-BUILTIN = """
+BUILTIN = (
+    """
 name = "minirti-64"
 kind = "dome"
 backend = "hardware"
@@ -108,15 +115,9 @@ min_elevation_deg = 15.0
 port = "/dev/ttyACM0"
 profile = "minirti"
 {table}
-[camera]
-width = 64
-height = 48
-exposure_s = 0.05
-
-[camera.device]
-kind = "folder_watch"
-folder = "{folder}"
 """
+    + CAMERA
+)
 
 
 def _builtin_identity(tmp_path: Path, name: str, table: str) -> dict[str, object]:
