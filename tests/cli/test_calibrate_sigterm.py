@@ -19,6 +19,7 @@ from typing import Any
 import pytest
 from card_support import card_rig, shoot
 from conftest import said
+from sigterm_support import Unhandled, sigterm_fails_the_test, terminated
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -29,25 +30,10 @@ pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="signals tested 
 runner = CliRunner()
 
 
-class Unhandled(Exception):
-    """Raised by this test's own SIGTERM handler: the command installed none (without one, the
-    signal would end the test process itself)."""
-
-
 @pytest.fixture(autouse=True)
 def _sigterm_fails_the_test_not_the_run() -> Iterator[None]:
-    def unhandled(signum: int, frame: Any) -> None:
-        raise Unhandled("SIGTERM reached the test's handler: calibrate-lights installed none")
-
-    previous = signal.signal(signal.SIGTERM, unhandled)
-    yield
-    signal.signal(signal.SIGTERM, previous)
-
-
-def _terminated() -> None:
-    """This process is sent SIGTERM, as `timeout` or a service manager sends it; its handler
-    runs at the next bytecode, so the statement after this one is not reached."""
-    os.kill(os.getpid(), signal.SIGTERM)
+    with sigterm_fails_the_test("calibrate-lights"):
+        yield
 
 
 @pytest.fixture(scope="module")
@@ -72,7 +58,7 @@ def test_a_sigterm_mid_write_leaves_no_temporary_file_and_calibrates_again(
         if self.name == ".light_calibration.toml.tmp":
             real(self, data[: len(data) // 2], *args, **kwargs)  # as far as it got
             cut.append(self)
-            _terminated()
+            terminated()
         return real(self, data, *args, **kwargs)
 
     argv = ["calibrate-lights", str(session), "--rig", str(rig)]
@@ -106,7 +92,7 @@ def test_a_sigterm_once_written_says_the_calibration_and_its_line(
 
     def interrupted(*args: Any, **kwargs: Any) -> None:
         if args and str(args[0]).startswith("Calibration →"):
-            _terminated()  # as the file's line is printed
+            terminated()  # as the file's line is printed
         printed(*args, **kwargs)
 
     monkeypatch.setattr(calibrate_cli.out, "print", interrupted)

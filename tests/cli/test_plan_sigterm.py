@@ -9,7 +9,6 @@ at the point under test (no sleeps).
 
 from __future__ import annotations
 
-import os
 import signal
 import sys
 from collections.abc import Iterator
@@ -19,6 +18,7 @@ from typing import Any
 import pytest
 from conftest import CONFIGS, said
 from matplotlib.figure import Figure
+from sigterm_support import Unhandled, sigterm_fails_the_test, terminated
 from typer.testing import CliRunner
 
 from rti_rig.app.usecases import plan as plan_usecase
@@ -31,25 +31,10 @@ runner = CliRunner()
 ARGV = ["plan", "--rig", str(CONFIGS / "virtual_arm.toml"), "--method", "optimal"]
 
 
-class Unhandled(Exception):
-    """Raised by this test's own SIGTERM handler: the command installed none (without one, the
-    signal would end the test process itself)."""
-
-
 @pytest.fixture(autouse=True)
 def _sigterm_fails_the_test_not_the_run() -> Iterator[None]:
-    def unhandled(signum: int, frame: Any) -> None:
-        raise Unhandled("SIGTERM reached the test's handler: plan installed none")
-
-    previous = signal.signal(signal.SIGTERM, unhandled)
-    yield
-    signal.signal(signal.SIGTERM, previous)
-
-
-def _terminated() -> None:
-    """This process is sent SIGTERM, as `timeout` or a service manager sends it; its handler
-    runs at the next bytecode, so the statement after this one is not reached."""
-    os.kill(os.getpid(), signal.SIGTERM)
+    with sigterm_fails_the_test("plan"):
+        yield
 
 
 def test_a_sigterm_while_the_map_is_written_leaves_no_partial_map(
@@ -60,7 +45,7 @@ def test_a_sigterm_while_the_map_is_written_leaves_no_partial_map(
     def savefig(self: Figure, fname: Any, *args: Any, **kwargs: Any) -> None:
         Path(fname).write_bytes(b"\x89PNG\r\n\x1a\n half a map")  # as far as it got
         written.append(Path(fname))
-        _terminated()
+        terminated()
 
     monkeypatch.setattr(Figure, "savefig", savefig)
     plan, figure = tmp_path / "plan é.lp", tmp_path / "map é.png"
@@ -86,7 +71,7 @@ def test_a_sigterm_while_planning_says_no_plan_was_written(
     real = plan_usecase.plan
 
     def stopped(*args: Any, **kwargs: Any) -> Any:
-        _terminated()
+        terminated()
         return real(*args, **kwargs)
 
     monkeypatch.setattr(plan_usecase, "plan", stopped)
