@@ -58,6 +58,25 @@ def _disk_full_after(monkeypatch: pytest.MonkeyPatch, copies: int) -> None:
     monkeypatch.setattr(shutil, "copyfile", copyfile)
 
 
+def _resumed(
+    monkeypatch: pytest.MonkeyPatch, cfg: Path, tether: Path, out: Path
+) -> tuple[Any, list[tuple[str, bytes]]]:
+    """``run --resume out`` on the dome, the camera saving two new shots (IMG_0003, IMG_0004)
+    into ``tether`` at the board's shutter pulses: the CLI's result and the shots given."""
+    again = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(3, 5)]
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        camera = Tether(firmware, tether, again)
+        camera.start()
+        try:
+            r = CliRunner().invoke(
+                app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400
+            )
+        finally:
+            camera.stop.set()
+            camera.join(5.0)
+    return r, again
+
+
 def test_a_disk_full_copy_says_where_the_shot_is_and_what_the_resume_does(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -80,17 +99,7 @@ def test_a_disk_full_copy_says_where_the_shot_is_and_what_the_resume_does(
     assert f"rti-rig run --resume {out}" in said, said
 
     # the resume, as said: the light is shot again and its new file taken, not IMG_0002.DNG
-    again = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(3, 5)]
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, again)
-        camera.start()
-        try:
-            r = CliRunner().invoke(
-                app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400
-            )
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
+    r, again = _resumed(monkeypatch, cfg, tether, out)
     assert r.exit_code == 0, r.output
     assert (out / "raw" / "image_002.dng").read_bytes() == again[0][1]
     assert (out / "lights.lp").read_text().split()[0] == "3"
@@ -116,17 +125,7 @@ def test_a_disk_full_at_the_steps_images_says_which_shot_and_what_the_resume_doe
     assert "this light's shot (IMG_0002.DNG) is not recorded: the resume moves whatever" in said
     assert "recovered/ folder and shoots this light again" in said, said
 
-    again = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(3, 5)]
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, again)
-        camera.start()
-        try:
-            r = CliRunner().invoke(
-                app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400
-            )
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
+    r, again = _resumed(monkeypatch, cfg, tether, out)
     assert r.exit_code == 0, r.output
     assert (out / "raw" / "image_002.dng").read_bytes() == again[0][1]
     moved = list((out / "recovered").rglob("*.dng"))
