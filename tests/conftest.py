@@ -160,6 +160,23 @@ def tethered_tiffs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, files: list[
     return TiffRun(r, said, tether, out, lit_at_end)
 
 
+def refused_and_waited(monkeypatch: pytest.MonkeyPatch) -> threading.Event:
+    """An event set once the folder-watch camera waits on a file it read and refused (its
+    ``_changed_and_settled``): a test's writer, paused part-way, may then finish the file.
+    Why an event: the writer waits on it, not on a sleep a loaded machine could outrun."""
+    from rti_rig.drivers.cameras import folder_watch
+
+    tried = threading.Event()
+    real = folder_watch.FolderWatchCamera._changed_and_settled
+
+    def waits(self: Any, *args: Any) -> Any:
+        tried.set()
+        return real(self, *args)
+
+    monkeypatch.setattr(folder_watch.FolderWatchCamera, "_changed_and_settled", waits)
+    return tried
+
+
 #: The handlers a test must leave as it found them: a command run in the pytest process
 #: (CliRunner) that left SIGINT ignored made every later subprocess a test started inherit an
 #: ignored Ctrl-C (red in CI only, far from the test that leaked it).

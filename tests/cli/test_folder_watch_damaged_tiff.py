@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from conftest import folder_watch_config, tethered_run
+from conftest import folder_watch_config, refused_and_waited, tethered_run
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -108,8 +108,6 @@ def test_run_waits_for_a_libtiff_tiff_whose_copy_paused_and_records_it_whole(
     records the shot."""
     import cv2
 
-    from rti_rig.drivers.cameras import folder_watch
-
     tether = tmp_path / "tether"
     tether.mkdir()
     out = tmp_path / "s"
@@ -119,14 +117,8 @@ def test_run_waits_for_a_libtiff_tiff_whose_copy_paused_and_records_it_whole(
     cfg.write_text(text.replace('trigger = "dome_shutter"', 'trigger = "none"'), encoding="utf-8")
     ok, encoded = cv2.imencode(".tif", np.full((64, 64, 3), 30000, np.uint16))
     assert ok
-    tried = threading.Event()
-    real = folder_watch.FolderWatchCamera._changed_and_settled
-
-    def waits(self, *args):  # type: ignore[no-untyped-def]
-        tried.set()  # the half file was read, refused and is waited for: the copy may go on
-        return real(self, *args)
-
-    monkeypatch.setattr(folder_watch.FolderWatchCamera, "_changed_and_settled", waits)
+    # set once the half file was read, refused and is waited for: the copy may go on
+    tried = refused_and_waited(monkeypatch)
     r, said, lit_at_end = tethered_run(
         monkeypatch,
         cfg,

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from conftest import folder_watch_config, tethered_run, tethered_tiffs
+from conftest import folder_watch_config, refused_and_waited, tethered_run, tethered_tiffs
 
 
 def _thumbnail_first(pixels: np.ndarray, layout: str) -> bytes:
@@ -121,8 +121,6 @@ def test_run_waits_for_the_full_image_of_a_thumbnail_first_tiff_paused_after_its
     """A file that holds only a reduced-resolution image is no shot yet: it had been read as
     the thumbnail it is so far, and a 64x64 shot went into the session at 16x16 (its next
     light's whole file then refused as another size)."""
-    from rti_rig.drivers.cameras import folder_watch
-
     rng = np.random.default_rng(5)
     shots = [rng.integers(1000, 60000, (64, 64, 3), dtype=np.uint16) for _ in range(2)]
     files = [_thumbnail_first(p, "ifd") for p in shots]
@@ -132,14 +130,8 @@ def test_run_waits_for_the_full_image_of_a_thumbnail_first_tiff_paused_after_its
     tether.mkdir()
     cfg = folder_watch_config(tmp_path, tether, timeout_s=20.0, tiffs=True)
     out = tmp_path / "s"
-    tried = threading.Event()
-    real = folder_watch.FolderWatchCamera._changed_and_settled
-
-    def waits(self, *args):  # type: ignore[no-untyped-def]
-        tried.set()  # the part read was refused and is waited for: the copy may go on
-        return real(self, *args)
-
-    monkeypatch.setattr(folder_watch.FolderWatchCamera, "_changed_and_settled", waits)
+    # set once the part read was refused and is waited for: the copy may go on
+    tried = refused_and_waited(monkeypatch)
     r, said, lit_at_end = tethered_run(
         monkeypatch,
         cfg,
