@@ -174,6 +174,17 @@ def test_a_check_that_fails_on_a_worker_still_there_names_it_and_the_error(
     assert not out.exists()
 
 
+def _this_rti_rig(where: Path) -> Path:
+    """``where``, holding a copy of this very rti-rig (no ``__pycache__``) as a worker's
+    PYTHONPATH: its files can be dated or written again without touching the tests' own."""
+    shutil.copytree(
+        Path(rti_rig.__file__).parent,
+        where / "rti_rig",
+        ignore=shutil.ignore_patterns("__pycache__"),
+    )
+    return where
+
+
 @contextmanager
 def _one_worker_of(where: Path) -> Iterator[Any]:
     """A scheduler (the ``LocalCluster``) of one ``dask worker`` process importing rti-rig from
@@ -263,12 +274,7 @@ def test_a_worker_whose_source_is_dated_after_the_clock_is_told_to_date_it_not_o
     worker imported it and to restart, and a restart was refused the same way until the clock
     passed that date. Whether it changed cannot be told; the file is named to be dated now."""
     session = make_session(tmp_path / "S", size=(24, 32))[0]
-    where = tmp_path / "same"
-    shutil.copytree(
-        Path(rti_rig.__file__).parent,
-        where / "rti_rig",
-        ignore=shutil.ignore_patterns("__pycache__"),
-    )
+    where = _this_rti_rig(tmp_path / "same")
     ahead = (where / "rti_rig" / "app" / "usecases" / "fit.py").resolve()
     day = 86_400 * 10**9
     os.utime(ahead, ns=(time.time_ns() + day, time.time_ns() + day))
@@ -296,12 +302,7 @@ def test_a_worker_checked_once_is_judged_by_its_files_contents_not_their_dates(
     again): it runs this code still, yet was called changed since its import and refused. A
     file edited, its date kept (`cp -a`, `rsync -a`), is still refused, and named."""
     session = make_session(tmp_path / "S", size=(24, 32))[0]
-    where = tmp_path / "same"
-    shutil.copytree(
-        Path(rti_rig.__file__).parent,
-        where / "rti_rig",
-        ignore=shutil.ignore_patterns("__pycache__"),
-    )
+    where = _this_rti_rig(tmp_path / "same")
     fit_py = where / "rti_rig" / "app" / "usecases" / "fit.py"
     with _one_worker_of(where) as cluster:
         first = _fit(session, tmp_path / "FIT1", cluster.scheduler_address)
