@@ -21,9 +21,16 @@ from rti_rig.cli import app
 from rti_rig.core.clock import SystemClock
 
 
-def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, pixel_format: str, device: str):
-    """Two lights shot with a UVC camera offering only ``pixel_format``; ``device`` is added
-    to its [camera.device] table. The session's linear TIFFs, and the output."""
+def _shot(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    pixel_format: str,
+    device: str,
+    opencv_4_11: bool = False,
+):
+    """``run --lights 2`` with a UVC camera offering only ``pixel_format`` (as OpenCV 4.11.0
+    hands it over, with ``opencv_4_11``); ``device`` is added to its [camera.device] table.
+    The CLI's result, its output on one line, the session folder and the stream."""
     cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
     text = cfg.read_text().replace('kind = "opencv"\n', f'kind = "opencv"\n{device}')
     cfg.write_text(text)
@@ -32,13 +39,20 @@ def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, pixel_format: str, dev
         fps=20.0,
         scale=6e5,  # 0.05 s under light 1: 30000 of 65535, well inside the range
         pixel_format=pixel_format,
+        opencv_4_11=opencv_4_11,
     )
     out = tmp_path / "s"
     monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
     with shipped_dome_on_pty(monkeypatch, cfg):
         stream.light.set(1.0)  # constant: the frames need a value to carry, not a light
         r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "2"])
-    said = " ".join(r.output.split())
+    return r, " ".join(r.output.split()), out, stream
+
+
+def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, pixel_format: str, device: str):
+    """Two lights shot with a UVC camera offering only ``pixel_format`` (:func:`_shot`): the
+    session's linear TIFFs, and the stream."""
+    r, said, out, stream = _shot(tmp_path, monkeypatch, pixel_format, device)
     assert r.exit_code == 0 and "Traceback" not in said, said
     frames = [tifffile.imread(p) for p in sorted((out / "linear").glob("*.tif"))]
     assert len(frames) == 2, said
@@ -81,22 +95,7 @@ def test_opencv_4_11s_flat_row_is_refused_naming_the_release(
     (opencv/opencv#27166): taken as an image, a 4×8 Y16 frame was a 64×1 8-bit one, written
     into the session. Refused at the first frame, naming the bug and the release that fixes
     it; nothing is written."""
-    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
-    text = cfg.read_text().replace('kind = "opencv"\n', f'kind = "opencv"\n{device}')
-    cfg.write_text(text)
-    stream = BufferedUvcStream(
-        LightHistory(SystemClock()),  # type: ignore[arg-type]  # the session's own clock
-        fps=20.0,
-        scale=6e5,
-        pixel_format=pixel_format,
-        opencv_4_11=True,
-    )
-    out = tmp_path / "s"
-    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
-    with shipped_dome_on_pty(monkeypatch, cfg):
-        stream.light.set(1.0)
-        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "2"])
-    said = " ".join(r.output.split())
+    r, said, out, _ = _shot(tmp_path, monkeypatch, pixel_format, device, opencv_4_11=True)
     assert r.exit_code != 0 and "Traceback" not in said, said
     assert "as one flat row" in said and "not as its 4×8 pixels" in said, said
     assert "opencv/opencv#27166, fixed in 4.12.0" in said, said
