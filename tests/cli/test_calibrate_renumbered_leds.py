@@ -23,17 +23,24 @@ from rti_rig.cli import app
 runner = CliRunner()
 
 
+def _rig_with_lights(rig: Path, name: str, lines: list[str]) -> Path:
+    """The card rig's config, beside it as other.toml, given ``lines`` as its .lp
+    (``name``.lp) in place of the shipped example_dome_48.lp the card was shot with."""
+    lp = rig.parent / f"{name}.lp"
+    lp.write_text("\n".join(lines) + "\n")
+    text = rig.read_text().replace(f"{CONFIGS}/example_dome_48.lp", str(lp))
+    assert str(lp) in text
+    other = rig.parent / "other.toml"
+    other.write_text(text)
+    return other
+
+
 def test_a_card_session_calibrated_against_reordered_leds_is_refused(tmp_path: Path) -> None:
     rig = card_rig(tmp_path)
     card = tmp_path / "card"
     shoot(rig, card)
     count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
-    reordered = tmp_path / "reordered.lp"
-    reordered.write_text("\n".join([count, *rows[24:], *rows[:24]]) + "\n")
-    text = rig.read_text().replace(f"{CONFIGS}/example_dome_48.lp", str(reordered))
-    assert str(reordered) in text
-    other = tmp_path / "other.toml"
-    other.write_text(text)
+    other = _rig_with_lights(rig, "reordered", [count, *rows[24:], *rows[:24]])
     out = tmp_path / "cal.toml"
 
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(other), "--out", str(out)])
@@ -73,12 +80,7 @@ def test_leds_re_measured_in_place_still_calibrate(tmp_path: Path) -> None:
         name, x, y, z = row.split()
         xf, yf = float(x), float(y)
         moved.append(f"{name} {c * xf - s * yf:.6f} {s * xf + c * yf:.6f} {z}")
-    remeasured = tmp_path / "remeasured.lp"
-    remeasured.write_text("\n".join([count, *moved]) + "\n")
-    text = rig.read_text().replace(f"{CONFIGS}/example_dome_48.lp", str(remeasured))
-    assert str(remeasured) in text
-    other = tmp_path / "other.toml"
-    other.write_text(text)
+    other = _rig_with_lights(rig, "remeasured", [count, *moved])
     out = tmp_path / "cal.toml"
 
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(other), "--out", str(out)])
