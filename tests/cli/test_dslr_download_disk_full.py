@@ -14,6 +14,7 @@ import json
 import shutil
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -48,18 +49,28 @@ def _raw(body: Body) -> bytes:
     return dng(mosaic_from_rgb(np.array(rgb), "RGGB", (0,) * 4, 4095), "RGGB", (0,) * 4, 4095)
 
 
+def _shot_with(
+    monkeypatch: pytest.MonkeyPatch, cfg: Path, body: Body, argv: list[str]
+) -> tuple[Any, str, Any]:
+    """``rti-rig ARGV`` on the shipped dome, the camera the gphoto2 ``body``: the CLI's
+    result, its output on one line, and the LEDs lit once it ended (None: all off)."""
+    monkeypatch.setitem(sys.modules, "gphoto2", make_module(body))
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, argv)
+        lit_at_end = firmware.lit
+    return r, " ".join(r.output.split()), lit_at_end
+
+
 @pytest.mark.parametrize("target", ["Internal RAM", "Memory card"])
 def test_a_disk_full_at_a_download_is_said_and_the_resume_shoots_the_light_again(
     tmp_path, monkeypatch, target
 ):
     cfg = _config(tmp_path, target)
     body = Body(render=_raw, disk_free_saves=2)  # the third RAW finds the disk full
-    monkeypatch.setitem(sys.modules, "gphoto2", make_module(body))
     out = tmp_path / "s"
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
-        lit_at_end = firmware.lit
-    said = " ".join(r.output.split())
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "4"]
+    )
     assert r.exit_code == 2, said
     assert "unexpected" not in said and "please report" not in said, said
     assert "Traceback" not in said and lit_at_end is None, said
@@ -96,14 +107,13 @@ def test_a_disk_full_at_a_metering_download_advises_running_again_not_a_resume(
     the run's "nothing was captured or written"."""
     cfg = _config(tmp_path, "Internal RAM")
     body = Body(render=_raw, disk_free_saves=0)  # the first metering shot finds it full
-    monkeypatch.setitem(sys.modules, "gphoto2", make_module(body))
     out = tmp_path / "s"
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        r = CliRunner().invoke(
-            app, ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
-        )
-        lit_at_end = firmware.lit
-    said = " ".join(r.output.split())
+    r, said, lit_at_end = _shot_with(
+        monkeypatch,
+        cfg,
+        body,
+        ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"],
+    )
     assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
     assert "IMG_0001.CR2 came from the camera but could not be written" in said, said
     assert "nothing was captured or written" in said, said
@@ -121,12 +131,10 @@ def test_a_disk_full_at_a_strays_download_is_said_as_the_stray_not_the_shot(
     camera's RAM … so it is lost") and said nothing of light 2's own file, downloaded whole."""
     cfg = _config(tmp_path, target)
     body = Body(render=_raw, disk_free_saves=2, busy_after_shot=1, busy_yet_shot=1)
-    monkeypatch.setitem(sys.modules, "gphoto2", make_module(body))
     out = tmp_path / "s"
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "3"])
-        lit_at_end = firmware.lit
-    said = " ".join(r.output.split())
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "3"]
+    )
     assert r.exit_code == 2, said
     assert "Traceback" not in said and lit_at_end is None, said
     assert body.stray_files == ["IMG_0002.CR2"], body.stray_files
