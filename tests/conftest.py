@@ -89,10 +89,14 @@ class Tether(threading.Thread):
         while not self.stop.is_set() and saved < len(self.files):
             pulses = sum(e.what == "shutter" for e in list(self.firmware.history))
             if pulses > saved:
-                name, data = self.files[saved]
-                (self.folder / name).write_bytes(data)
+                self.save(*self.files[saved])
                 saved += 1
             self.stop.wait(0.02)
+
+    def save(self, name: str, data: bytes) -> None:
+        """How the tethering program puts one shot into the folder: written in place here;
+        a subclass saves it another way (a temporary renamed over the name)."""
+        (self.folder / name).write_bytes(data)
 
 
 class TetheredRun(NamedTuple):

@@ -37,17 +37,10 @@ class RenamingTether(Tether):
     """A tethering program that saves each shot to a hidden temporary and renames it over
     the final name (a new file under the old name, as rsync and many programs save)."""
 
-    def run(self) -> None:
-        saved = 0
-        while not self.stop.is_set() and saved < len(self.files):
-            pulses = sum(e.what == "shutter" for e in list(self.firmware.history))
-            if pulses > saved:
-                name, data = self.files[saved]
-                temporary = self.folder / f".{name}.tmp"
-                temporary.write_bytes(data)
-                os.replace(temporary, self.folder / name)
-                saved += 1
-            self.stop.wait(0.02)
+    def save(self, name: str, data: bytes) -> None:
+        temporary = self.folder / f".{name}.tmp"
+        temporary.write_bytes(data)
+        os.replace(temporary, self.folder / name)
 
 
 @pytest.mark.parametrize("saving", ["in place", "renamed over"])
