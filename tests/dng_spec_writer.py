@@ -172,6 +172,13 @@ def dng(
     return tiff_bytes(entries, data, big_endian)
 
 
+def flat_dng(level: float) -> bytes:
+    """A 48x32 RGGB DNG of one flat ``level`` (0-1 of a 12-bit white, no black): the shot a
+    watched-folder test's camera saves, told apart from another by its level."""
+    mosaic = mosaic_from_rgb(np.full((32, 48, 3), level), "RGGB", (0,) * 4, 4095)
+    return dng(mosaic, "RGGB", (0,) * 4, 4095)
+
+
 def monochrome_dng(grey: np.ndarray) -> bytes:
     """An uncompressed 16-bit monochrome DNG of ``grey`` (raw codes, H×W): a LinearRaw image
     (PhotometricInterpretation 34892) of one sample per pixel and no CFA tags, as a camera

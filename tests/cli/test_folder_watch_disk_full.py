@@ -20,10 +20,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
 from conftest import Tether, folder_watch_config, shipped_dome_on_pty, tethered_run
-from dng_spec_writer import dng, mosaic_from_rgb
+from dng_spec_writer import flat_dng
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -32,11 +31,6 @@ pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
     pytest.mark.pty,
 ]
-
-
-def _shot(level: float) -> bytes:
-    mosaic = mosaic_from_rgb(np.full((32, 48, 3), level), "RGGB", (0,) * 4, 4095)
-    return dng(mosaic, "RGGB", (0,) * 4, 4095)
 
 
 def _disk_full_after(monkeypatch: pytest.MonkeyPatch, copies: int) -> None:
@@ -63,7 +57,7 @@ def _resumed(
 ) -> tuple[Any, list[tuple[str, bytes]]]:
     """``run --resume out`` on the dome, the camera saving two new shots (IMG_0003, IMG_0004)
     into ``tether`` at the board's shutter pulses: the CLI's result and the shots given."""
-    again = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(3, 5)]
+    again = [(f"IMG_{k:04d}.DNG", flat_dng(0.1 * k)) for k in range(3, 5)]
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
         camera = Tether(firmware, tether, again)
         camera.start()
@@ -84,7 +78,7 @@ def test_a_disk_full_copy_says_where_the_shot_is_and_what_the_resume_does(
     tether.mkdir()
     cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     out = tmp_path / "s"
-    files = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(1, 4)]
+    files = [(f"IMG_{k:04d}.DNG", flat_dng(0.1 * k)) for k in range(1, 4)]
     with monkeypatch.context() as m:
         _disk_full_after(m, 1)  # the 2nd shot's copy
         run = tethered_run(monkeypatch, cfg, tether, files, out, lights=3)
@@ -116,7 +110,7 @@ def test_a_disk_full_at_the_steps_images_says_which_shot_and_what_the_resume_doe
     tether.mkdir()
     cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     out = tmp_path / "s"
-    files = [(f"IMG_{k:04d}.DNG", _shot(0.1 * k)) for k in range(1, 4)]
+    files = [(f"IMG_{k:04d}.DNG", flat_dng(0.1 * k)) for k in range(1, 4)]
     with failing_writes("tiff", after=1, errno_code=errno.ENOSPC):  # the 2nd shot's
         run = tethered_run(monkeypatch, cfg, tether, files, out, lights=3)
     said = run.said

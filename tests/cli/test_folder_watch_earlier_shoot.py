@@ -17,20 +17,14 @@ import os
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 from conftest import Tether, folder_watch_config, tethered_run
-from dng_spec_writer import dng, mosaic_from_rgb
+from dng_spec_writer import flat_dng
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
     pytest.mark.pty,
 ]
-
-
-def _shot(level: float) -> bytes:
-    mosaic = mosaic_from_rgb(np.full((32, 48, 3), level), "RGGB", (0,) * 4, 4095)
-    return dng(mosaic, "RGGB", (0,) * 4, 4095)
 
 
 class RenamingTether(Tether):
@@ -50,9 +44,9 @@ def test_an_earlier_shoots_file_saved_over_is_said_with_the_folder_to_empty(
     tether = tmp_path / "tether"
     tether.mkdir()
     for k in range(1, 4):  # the earlier shoot
-        (tether / f"IMG_{k:04d}.DNG").write_bytes(_shot(0.1) + b"earlier shoot")
+        (tether / f"IMG_{k:04d}.DNG").write_bytes(flat_dng(0.1) + b"earlier shoot")
     cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
-    files = [(f"IMG_{k:04d}.DNG", _shot(0.3)) for k in range(1, 4)]
+    files = [(f"IMG_{k:04d}.DNG", flat_dng(0.3)) for k in range(1, 4)]
     camera = (lambda fw: RenamingTether(fw, tether, files)) if saving == "renamed over" else None
     run = tethered_run(monkeypatch, cfg, tether, files, tmp_path / "s", camera=camera)
     said = run.said
@@ -100,12 +94,12 @@ def test_an_earlier_shoots_file_is_said_after_a_name_of_this_run_came_again(
     earlier shot had it"), its own cause, the earlier shoot's file, unsaid."""
     tether = tmp_path / "tether"
     tether.mkdir()
-    (tether / "IMG_0001.DNG").write_bytes(_shot(0.1) + b"earlier shoot")
+    (tether / "IMG_0001.DNG").write_bytes(flat_dng(0.1) + b"earlier shoot")
     cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     groups = [
-        [("IMG_0010.DNG", _shot(0.3))],
-        [("IMG_0010.DNG", _shot(0.3) + b"again"), ("IMG_0011.DNG", _shot(0.3))],
-        [("IMG_0001.DNG", _shot(0.3))],
+        [("IMG_0010.DNG", flat_dng(0.3))],
+        [("IMG_0010.DNG", flat_dng(0.3) + b"again"), ("IMG_0011.DNG", flat_dng(0.3))],
+        [("IMG_0001.DNG", flat_dng(0.3))],
     ]
     run = tethered_run(
         monkeypatch,
