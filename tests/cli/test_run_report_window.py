@@ -26,6 +26,19 @@ from rti_rig.core.errors import CaptureError
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
 
 
+def _ctrl_c_as(monkeypatch: pytest.MonkeyPatch, owner: Any, name: str, times: int = 1) -> None:
+    """``owner.name`` begins with ``times`` Ctrl-C (SIGINT raised in this process, as the
+    terminal sends it), then runs as it would: a Ctrl-C at that moment of the run."""
+    real = getattr(owner, name)
+
+    def pressed(*args: Any, **kwargs: Any) -> Any:
+        for _ in range(times):
+            signal.raise_signal(signal.SIGINT)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(owner, name, pressed)
+
+
 def _first_ctrl_c_at_image(monkeypatch: pytest.MonkeyPatch, image: int) -> None:
     """A Ctrl-C as image ``image`` (1-based) is shot: the run stops after it."""
     real_shoot, shots = controller.shoot_step, []
@@ -102,15 +115,8 @@ def test_two_ctrl_c_as_a_failed_capture_is_reported_leave_the_error_and_resume_s
             raise CaptureError("camera", "no frame came (the cable was pulled)")
         return real_shoot(*args, **kwargs)
 
-    real_failures = cli_session._print_teardown_failures
-
-    def print_teardown_failures(*args: Any, **kwargs: Any) -> Any:
-        signal.raise_signal(signal.SIGINT)
-        signal.raise_signal(signal.SIGINT)
-        return real_failures(*args, **kwargs)
-
     monkeypatch.setattr(controller, "shoot_step", shoot_step)
-    monkeypatch.setattr(cli_session, "_print_teardown_failures", print_teardown_failures)
+    _ctrl_c_as(monkeypatch, cli_session, "_print_teardown_failures", times=2)
     r, said, out = _run(tmp_path)
     assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
     assert said.count("Ctrl-C after the capture had ended") == 1, said
@@ -124,19 +130,8 @@ def _ctrl_c_at_hand_over_then_two_as_it_closes(monkeypatch: pytest.MonkeyPatch) 
     """A Ctrl-C held by the hand-over (the capture never begins), then two more as the session
     stopped before its capture closes its rig. (The new session's test and the resume's had
     each written it out.)"""
-    real_execute, real_stopped = cli_session._execute, cli_session._stopped_before_capture
-
-    def execute(*args: Any, **kwargs: Any) -> Any:
-        signal.raise_signal(signal.SIGINT)  # held by the hand-over: the capture never begins
-        return real_execute(*args, **kwargs)
-
-    def stopped_before_capture(*args: Any, **kwargs: Any) -> Any:
-        signal.raise_signal(signal.SIGINT)
-        signal.raise_signal(signal.SIGINT)
-        return real_stopped(*args, **kwargs)
-
-    monkeypatch.setattr(cli_session, "_execute", execute)
-    monkeypatch.setattr(cli_session, "_stopped_before_capture", stopped_before_capture)
+    _ctrl_c_as(monkeypatch, cli_session, "_execute")  # held by the hand-over: no capture
+    _ctrl_c_as(monkeypatch, cli_session, "_stopped_before_capture", times=2)
 
 
 def test_two_ctrl_c_as_a_session_stopped_before_its_capture_closes_are_answered(
@@ -205,14 +200,8 @@ def test_a_ctrl_c_once_the_stop_said_the_lights_points_above(
             signal.raise_signal(signal.SIGINT)
         return real_shoot(*args, **kwargs)
 
-    real_after = cli_session._after_stop
-
-    def after_stop(*args: Any, **kwargs: Any) -> Any:
-        signal.raise_signal(signal.SIGINT)
-        return real_after(*args, **kwargs)
-
     monkeypatch.setattr(controller, "shoot_step", shoot_step)
-    monkeypatch.setattr(cli_session, "_after_stop", after_stop)
+    _ctrl_c_as(monkeypatch, cli_session, "_after_stop")
     r, said, out = _run(tmp_path)
     assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
     lights = said.index("Emergency stop (second Ctrl-C): lights were switched off.")
