@@ -2,7 +2,9 @@
 recorded the thumbnails (16×12 images of a 64×48 acquisition). Its resume now reads the same
 files at 64×48 and is refused, rightly: the images would not match. It had been told to "set
 it back to continue", which nothing can: a replay rig's camera size is its recorded images'
-own. It is told to start a new session, with the command, and that command runs.
+own. It is told to start a new session, with the command, and that command runs as printed,
+with the session's --lights (it had said "with the --lights and plan options this one began
+with", and pasted as printed shot every light).
 
 The old session is built with the old reader (IFD0, the thumbnail) standing in for
 :func:`rti_rig.core.image_files.tiff_main_image`, as the replay read them then."""
@@ -71,13 +73,13 @@ def test_a_replay_recorded_at_thumbnail_size_is_told_to_start_a_new_session(
     assert "This session cannot be continued: start a new session" in text, text
     assert len(journal(out)) == 3  # nothing captured, nothing overwritten
 
-    command = re.search(r"\(rti-rig run (.+?), with the --lights", text)
+    command = re.search(r"\(rti-rig run ([^()]+)\)$", text)
     assert command, text
     args = shlex.split(command.group(1))
     assert args[0] == str(acq / "dirs.lp") and args[1] == "--out", args
     new = Path(args[2])
     assert new.parent == out.parent and not new.exists(), args
-    r = runner.invoke(app, ["run", *args, "--lights", "6"])  # the advice runs as given
+    r = runner.invoke(app, ["run", *args])  # the advice runs as printed: its 6 lights too
     assert r.exit_code == 0, r.output
     frames = sorted((new / "linear").glob("*.tif"))
     assert len(frames) == 6

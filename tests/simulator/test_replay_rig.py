@@ -8,6 +8,8 @@ session encodes it, equals the decoded source JPEG).
 from __future__ import annotations
 
 import json
+import re
+import shlex
 import shutil
 from pathlib import Path
 
@@ -463,7 +465,8 @@ def test_an_acquisition_repeating_a_light_is_refused_in_a_replays_words(tmp_path
 def test_a_resume_on_an_acquisition_whose_images_changed_is_refused(tmp_path: Path) -> None:
     """An image of the replayed acquisition replaced between the interruption and the resume
     had been mixed in without a word: the resume's images came from another acquisition than
-    the first part's. Refused, nothing changed; with the original put back it continues."""
+    the first part's. Refused, nothing changed; the new session it offers runs as printed, with
+    the session's --lights; with the original put back it continues."""
     from rti_rig.app.usecases.session import (
         NewSessionRequest,
         open_new_session,
@@ -490,6 +493,16 @@ def test_a_resume_on_an_acquisition_whose_images_changed_is_refused(tmp_path: Pa
     said = " ".join(r.output.split())
     assert "are not the ones this session began with" in said and "Put the original" in said
     assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before
+    # the new session it offers runs as printed, with this one's 8 lights (it had no command)
+    command = re.search(r"as it is now \(rti-rig run ([^()]+)\)$", said)
+    assert command, said
+    args = shlex.split(command.group(1))
+    assert args[:2] == [str(acq / "dirs.lp"), "--out"] and "--lights" in args, args
+    new = Path(args[2])
+    assert new.parent == out.parent and not new.exists(), args
+    r = runner.invoke(app, ["run", *args, "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(new / "lights.lp")) == 8
     shutil.copy(ACQ / last, acq / last)  # put back
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output

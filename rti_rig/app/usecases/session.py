@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from rti_rig.app.usecases.replay_advice import new_session_command
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.runtime.controller import (
@@ -1189,14 +1190,18 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             "edited, replaced or re-exported since): the session's first images and the ones "
             "a resume would take would come from two different acquisitions. Put the original "
             f"files back to continue (rti-rig run --resume {shlex.quote(str(session_dir))}), "
-            "or start a new session from the acquisition as it is now"
+            "or start a new session from the acquisition as it is now ("
+            + new_session_command(config_path, manifest, session_dir)
+            + ")"
         )
     if (
         image_diffs
         and recorded.get("backend") == identity.get("backend") == "replay"
         and not any(d.startswith(LABELS["recorded_images"]) for d in image_diffs)
     ):  # the same recorded files, read otherwise: nothing can be set back
-        raise RigChangedError(_replay_read_otherwise(config_path, image_diffs, session_dir))
+        raise RigChangedError(
+            _replay_read_otherwise(config_path, image_diffs, manifest, session_dir)
+        )
     if recorded.get("kind") == identity.get("kind") and image_diffs:
         # accepted, a new exposure had gone into the fit as a brighter light: normals 5.5° off
         # on average, with a "good" verdict; nothing downstream corrects for it
@@ -1255,7 +1260,7 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
 
 
 def _replay_read_otherwise(
-    config_path: Path, image_diffs: list[str], session_dir: Path | str
+    config_path: Path, image_diffs: list[str], manifest: dict[str, Any], session_dir: Path | str
 ) -> str:
     """Why a replay session whose recorded images are unchanged cannot go on, and the command
     that starts a new one (a sentence, no final stop).
@@ -1264,11 +1269,6 @@ def _replay_read_otherwise(
     which no config sets. A session begun by an rti-rig that replayed a TIFF whose thumbnail
     comes first at the thumbnail's size (before 2026-11-30) recorded 16×12 images of a 64×48
     acquisition; its resume was told to "set it back to continue", which nothing can."""
-    root = Path(session_dir)
-    new = root.with_name(f"{root.name}-new")
-    n = 2
-    while new.exists():
-        new, n = root.with_name(f"{root.name}-new{n}"), n + 1
     return (
         f"{config_path} replays the same recorded images this session began with, but they "
         "are now read as other images (" + "; ".join(image_diffs) + "): a replay's camera "
@@ -1276,8 +1276,9 @@ def _replay_read_otherwise(
         "set back, and images taken now would not match the ones already taken. (An rti-rig "
         "before 2026-11-30 replayed a TIFF whose thumbnail comes first at the thumbnail's "
         "size.) This session cannot be continued: start a new session from the acquisition "
-        f"(rti-rig run {shlex.quote(str(config_path))} --out {shlex.quote(str(new))}, with "
-        "the --lights and plan options this one began with)"
+        "with the options it began with ("
+        + new_session_command(config_path, manifest, session_dir)
+        + ")"
     )
 
 

@@ -1,0 +1,69 @@
+"""The ``rti-rig run`` command that starts a new session in place of a replay session whose
+resume is refused, with the options that session began with.
+
+Why: a replay session (``rti-rig run ACQ/dirs.lp``) whose acquisition changed, or is read
+otherwise since, cannot be resumed, and its advice said to start a new session with
+``rti-rig run ACQ/dirs.lp --out NEW``, "with the --lights and plan options this one began
+with": a command that, pasted as printed, shot every light of the acquisition in place of the
+session's 8, or a homogeneous layout in place of its plan or adaptive choice. The manifest
+records what the session was asked for; the command repeats it.
+"""
+
+from __future__ import annotations
+
+import shlex
+from pathlib import Path
+from typing import Any
+
+
+def new_session_dir(session_dir: Path | str) -> Path:
+    """A folder beside ``session_dir`` that does not exist yet (``S-new``, ``S-new2``...), for
+    the new session a refused resume is told to start: never the session's own folder, whose
+    images nothing may overwrite."""
+    root = Path(session_dir)
+    new = root.with_name(f"{root.name}-new")
+    n = 2
+    while new.exists():
+        new, n = root.with_name(f"{root.name}-new{n}"), n + 1
+    return new
+
+
+def new_session_command(
+    config_path: Path | str, manifest: dict[str, Any], session_dir: Path | str
+) -> str:
+    """``rti-rig run CONFIG --out NEW`` with the session's layout options: its ``--plan``, its
+    adaptive options (``--adaptive``, ``--lights`` when it was given, ``--until-error``,
+    ``--min-lights``, ``--objective relight``) or its homogeneous ``--lights N``, and an
+    elevation band other than 0–90°, each as the manifest recorded it."""
+    words = [
+        "rti-rig run",
+        shlex.quote(str(config_path)),
+        "--out",
+        shlex.quote(str(new_session_dir(session_dir))),
+    ]
+    schedule = manifest.get("schedule") or {}
+    provenance = schedule.get("provenance") or {}
+    adaptive = manifest.get("adaptive")
+    band: tuple[Any, Any] = (None, None)
+    if isinstance(adaptive, dict):
+        words.append("--adaptive")
+        if adaptive.get("design_lights") is not None:  # --lights was given
+            words.append(f"--lights {int(adaptive['design_lights'])}")
+        if adaptive.get("until_error_deg") is not None:
+            words.append(f"--until-error {float(adaptive['until_error_deg']):g}")
+        if adaptive.get("min_lights") is not None:
+            words.append(f"--min-lights {int(adaptive['min_lights'])}")
+        if adaptive.get("objective") not in (None, "normals"):
+            words.append(f"--objective {shlex.quote(str(adaptive['objective']))}")
+        band = (adaptive.get("min_elevation_deg"), adaptive.get("max_elevation_deg"))
+    elif provenance.get("plan_file"):
+        words.append(f"--plan {shlex.quote(str(provenance['plan_file']))}")
+    elif provenance.get("n") is not None:
+        words.append(f"--lights {int(provenance['n'])}")
+        band = (provenance.get("min_elevation_deg"), provenance.get("max_elevation_deg"))
+    low, high = band
+    if low is not None and float(low) != 0.0:
+        words.append(f"--min-elevation-deg {float(low):g}")
+    if high is not None and float(high) != 90.0:
+        words.append(f"--max-elevation-deg {float(high):g}")
+    return " ".join(words)

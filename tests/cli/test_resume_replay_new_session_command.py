@@ -1,0 +1,102 @@
+"""A replay session whose acquisition changed since cannot be resumed, and is told to start a
+new session with a command. That command had left out the session's options ("rti-rig run
+ACQ/dirs.lp --out NEW, with the --lights and plan options this one began with", or no command
+at all): pasted as printed, it shot every light of the acquisition in place of the session's
+plan, adaptive choice or --lights N. It now repeats them, and runs as printed into a session
+asked for what the first one was."""
+
+from __future__ import annotations
+
+import json
+import re
+import shlex
+import shutil
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
+
+REPO = Path(__file__).resolve().parents[2]
+ACQ = REPO / "tests" / "data" / "neuralrti_replay"
+runner = CliRunner()
+
+
+def _asked(manifest: dict[str, Any]) -> dict[str, Any]:
+    """What a session's manifest records it was asked for (its layout options)."""
+    adaptive = manifest.get("adaptive") or {}
+    keys = ("max_lights", "design_lights", "until_error_deg", "min_lights", "objective")
+    return {
+        "method": manifest["schedule"]["method"],
+        "provenance": {
+            k: v for k, v in manifest["schedule"]["provenance"].items() if k != "plan_file"
+        },
+        "adaptive": {k: adaptive.get(k) for k in keys},
+        "elevation": (adaptive.get("min_elevation_deg"), adaptive.get("max_elevation_deg")),
+    }
+
+
+def _cut_session(acq: Path, out: Path, **options: Any) -> None:
+    """A replay of ``acq`` with ``options``, stopped after three images as Ctrl-C does."""
+    from rti_rig.app.usecases.session import (
+        NewSessionRequest,
+        open_new_session,
+        run_opened_session,
+    )
+    from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 2:
+            cancel.cancel()
+
+    opened = open_new_session(NewSessionRequest(acq / "dirs.lp", out, **options))
+    assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"lights": 7, "min_elevation_deg": 20.0, "max_elevation_deg": 80.0},
+        {"plan": "plan"},
+        {"adaptive": True, "lights": 7, "min_elevation_deg": 10.0},
+    ],
+    ids=["lights-band", "plan", "adaptive"],
+)
+def test_the_new_session_a_changed_replay_is_told_to_start_runs_as_printed_with_its_options(
+    tmp_path: Path, options: dict[str, Any], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)  # the plan is given by a relative path, as users type it
+    acq, out = tmp_path / "acq", tmp_path / "S"
+    shutil.copytree(ACQ, acq)
+    if "plan" in options:
+        r = runner.invoke(
+            app, ["plan", "--rig", str(acq / "dirs.lp"), "--lights", "6", "--out", "p.lp"]
+        )
+        assert r.exit_code == 0, r.output
+        options = {"plan": Path("p.lp")}
+    _cut_session(acq, out, **options)
+    first = json.loads((out / "manifest.json").read_text())
+    names = [e.name for e in read_lp(acq / "dirs.lp")]
+    shutil.copy(acq / names[0], acq / names[-1])  # an image replaced since
+
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    text = said(r)
+    assert r.exit_code == 2 and "Traceback" not in text, text
+    command = re.search(r"\(rti-rig run ([^()]+)\)$", text)
+    assert command, text
+    args = shlex.split(command.group(1))
+    assert args[:2] == [str(acq / "dirs.lp"), "--out"], args
+    new = Path(args[2])
+    assert new.parent == out.parent and not new.exists(), args
+
+    r = runner.invoke(app, ["run", *args, "--no-verdict"])  # as printed
+    assert r.exit_code == 0, r.output
+    again = json.loads((new / "manifest.json").read_text())
+    assert _asked(again) == _asked(first)
+    assert len((out / "journal.jsonl").read_text().splitlines()) == 3  # the first one kept
