@@ -1194,11 +1194,13 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             + new_session_command(config_path, manifest, session_dir)
             + ")"
         )
-    if (
-        image_diffs
-        and recorded.get("backend") == identity.get("backend") == "replay"
-        and not any(d.startswith(LABELS["recorded_images"]) for d in image_diffs)
-    ):  # the same recorded files, read otherwise: nothing can be set back
+    replay = recorded.get("backend") == identity.get("backend") == "replay"
+    if replay and any(d.startswith(LABELS["recorded_images"]) for d in image_diffs):
+        # other recorded files, and of another size or kind: no config to set back
+        raise RigChangedError(
+            _replay_images_changed(config_path, image_diffs, manifest, session_dir)
+        )
+    if image_diffs and replay:  # the same recorded files, read otherwise: nothing can be set back
         raise RigChangedError(
             _replay_read_otherwise(config_path, image_diffs, manifest, session_dir)
         )
@@ -1257,6 +1259,27 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     if not diffs:  # the same rig: its positions as the session recorded them (rounding aside)
         identity = same_rig(recorded, identity)
     return identity, diffs
+
+
+def _replay_images_changed(
+    config_path: Path, image_diffs: list[str], manifest: dict[str, Any], session_dir: Path | str
+) -> str:
+    """Why a replay session whose recorded images changed, and with them what they are (their
+    size, decoding), cannot go on, and the command that starts a new one (no final stop).
+
+    Why: such a resume (the acquisition re-exported at another size) was told that the .lp
+    "changes what this session's images are … set it back to continue (rti-rig run --resume
+    DIR with the session's own config)": the .lp is the session's own, untouched, and there is
+    no setting to set back; it is the images that changed."""
+    return (
+        f"the images of {config_path} are not the ones this session began with, and are other "
+        "images now (" + "; ".join(image_diffs) + "): replaced or re-exported since. A "
+        "replay's camera takes its size and settings from the recorded images themselves, "
+        "and a session's images are one set for fit, relight and RTIBuilder, so this session "
+        "cannot be continued on them (not even with --accept-rig-change; only the original "
+        "files, put back, would let it resume). Start a new session from the acquisition as "
+        "it is now (" + new_session_command(config_path, manifest, session_dir) + ")"
+    )
 
 
 def _replay_read_otherwise(
