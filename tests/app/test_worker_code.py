@@ -13,6 +13,8 @@ import sys
 import tomllib
 from pathlib import Path
 
+import pytest
+
 import rti_rig
 from rti_rig.app.usecases.worker_code import (
     MAPPED_PACKAGES,
@@ -89,3 +91,64 @@ def test_a_missing_version_is_none_not_a_sentinel_that_reads_as_unknown() -> Non
     assert found["b"] == Unasked("OSError: reset")
     assert describe(found["a"]) == "rti-rig (no version), code abc"
     assert describe(found["c"]) == "no rti-rig (ModuleNotFoundError: x)"  # type: ignore[arg-type]
+
+
+#: Deletes one file of the rti-rig it imports while the check reads it, as a `git checkout` or
+#: a reinstall on a worker does, then prints the check's answer. argv: the file, and whether
+#: it goes before it is read (listed, then gone) or just after (read, then gone before the
+#: dates of a process that imported rti-rig first are asked).
+_VANISHING = """
+import pathlib, sys
+from rti_rig.app.usecases.worker_code import _identity_function
+target, when = pathlib.Path(sys.argv[1]).resolve(), sys.argv[2]
+read_bytes = pathlib.Path.read_bytes
+def deleting(self):
+    if self.resolve() == target and when == "before":
+        self.unlink()
+    data = read_bytes(self)
+    if self.resolve() == target and when == "after":
+        self.unlink()
+    return data
+pathlib.Path.read_bytes = deleting
+print(repr(_identity_function()()))
+"""
+
+
+@pytest.mark.parametrize("when", ["before", "after"])
+def test_a_source_file_that_vanishes_while_it_is_checked_is_named_with_restart(
+    tmp_path: Path, when: str
+) -> None:
+    """A ``.py`` of a worker's rti-rig deleted between the listing of its folder and the read
+    of that file (or the read of its date) had failed the check there with a bare
+    ``FileNotFoundError``, which the fit said as a worker it "could not ask" (check that it
+    is running and reachable). The check says that file vanished and the worker must be
+    restarted; the fit names the worker with it."""
+    tree = _wheel_layout(tmp_path / "tree")
+    target = (
+        tree
+        / "rti_rig"
+        / "planner"
+        / sorted(p.name for p in (tree / "rti_rig" / "planner").glob("*.py"))[-1]
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", _VANISHING, str(target), when], capture_output=True, text=True,
+        env={"PYTHONPATH": str(tree), "PATH": ""}, cwd=tmp_path, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr  # no FileNotFoundError out of the check
+    assert not target.exists()
+    answer = ast.literal_eval(done.stdout.strip())
+    problem = answer["problem"]
+    assert problem and f"rti_rig/planner/{target.name} vanished while it was being checked" in (
+        problem
+    ), answer
+    assert "restart it" in problem, answer
+
+    class _Client:
+        def run(self, function, on_error):  # type: ignore[no-untyped-def]
+            return {"tcp://w:1": answer}
+
+    worker = worker_identities(_Client())["tcp://w:1"]
+    assert isinstance(worker, WorkerCode) and worker != local_identity()  # not this code
+    said = describe(worker)  # with its code when every file was read before one went
+    assert said.startswith(f"rti-rig {rti_rig.__version__}") and said.endswith(f", but {problem}")
+    assert "code None" not in said, said

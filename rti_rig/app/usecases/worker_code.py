@@ -91,6 +91,7 @@ def _identity_function(
         digest = hashlib.sha256()
         code: dict[str, str] = {}  # the .py files alone, by path: what a process imports
         everything: list[tuple[str, Path]] = []
+        vanished: list[str] = []  # listed, then gone before they were read
         for name in roots:
             folder = folders[name]
             digest.update(f"package {name}\0".encode())
@@ -108,7 +109,11 @@ def _identity_function(
                     files.append((path.relative_to(folder).as_posix(), path))
             where = name.replace(".", "/")
             for relative, path in sorted(files):
-                content = path.read_bytes()
+                try:
+                    content = path.read_bytes()
+                except FileNotFoundError:  # deleted or moved since it was listed
+                    vanished.append(f"{where}/{relative}")
+                    continue
                 digest.update(relative.encode() + b"\0" + content + b"\0")
                 if path.suffix == ".py":
                     code[f"{where}/{relative}"] = hashlib.sha256(content).hexdigest()
@@ -116,6 +121,8 @@ def _identity_function(
         fingerprint = digest.hexdigest()[:12]
         version = getattr(rti_rig, "__version__", None)
         said = None if version is None else str(version)
+        if vanished:  # an incomplete listing is no fingerprint, nor kept as the first check's
+            return {"version": said, "fingerprint": None, "problem": gone(vanished)}
         # The code this process runs is what it imported, not what its .py files say now (the
         # .toml and .lp are read when used). The .py files' contents at this process's first
         # check are kept in it, with what that check found; every later check compares
@@ -164,12 +171,19 @@ def _identity_function(
         now = time.time_ns()
         changed: list[str] = []
         ahead: list[str] = []  # dated after this clock: when they changed is not known
+        vanished: list[str] = []
         for relative, path in sorted(everything):
-            modified = path.stat().st_mtime_ns
+            try:
+                modified = path.stat().st_mtime_ns
+            except FileNotFoundError:  # read a moment ago, deleted or moved since
+                vanished.append(relative)
+                continue
             if modified > now:
                 ahead.append(str(path))
             elif modified > imported_at:
                 changed.append(relative)
+        if vanished:
+            return gone(vanished)
         if changed:
             named = ", ".join(changed[:3]) + (" …" if len(changed) > 3 else "")
             return (
@@ -188,6 +202,21 @@ def _identity_function(
                 "runs ahead), then restart it"
             )
         return None
+
+    def gone(vanished: list[str]) -> str:
+        """Why the code of a process one of whose rti-rig ``.py`` files vanished while it was
+        checked (listed, then deleted or moved before it was read) cannot be told.
+
+        Why: the check had failed there with a bare ``FileNotFoundError``, said as a worker
+        that "could not be asked" (check that it is running and reachable), or a check that
+        failed: its rti-rig is being changed under it (a ``git checkout``, a reinstall), and
+        what it runs is the code it imported, which no file there shows any more."""
+        named = ", ".join(vanished[:3]) + (" …" if len(vanished) > 3 else "")
+        return (
+            f"its rti-rig source file {named} vanished while it was being checked (deleted or "
+            "moved after its folder was listed): its rti-rig is being changed, so the code it "
+            "runs cannot be told; restart it once the change is done"
+        )
 
     return rti_rig_identity
 
@@ -226,7 +255,9 @@ def describe(code: WorkerCode) -> str:
     if code.problem is not None and code.version is None and code.fingerprint is None:
         return f"no rti-rig ({code.problem})"
     version = "(no version)" if code.version is None else code.version
-    said = f"rti-rig {version}, code {code.fingerprint}"
+    said = f"rti-rig {version}"
+    if code.fingerprint is not None:  # none when its files could not all be read
+        said += f", code {code.fingerprint}"
     return said if code.problem is None else f"{said}, but {code.problem}"
 
 
@@ -322,7 +353,9 @@ def tagging_plugin(code: WorkerCode) -> Any:
                 if found != self.expected:  # other code (or none, or changed): no task
                     if held:  # tagged earlier (this code then): taken back
                         await worker.set_resources(**{self.resource: 0})
-                    said = f"rti-rig {found.get('version')}, code {found.get('fingerprint')}"
+                    said = f"rti-rig {found.get('version')}"
+                    if found.get("fingerprint") is not None:
+                        said += f", code {found['fingerprint']}"
                     if found.get("problem"):
                         said += f" ({found['problem']})"
                     self.outcome = (other_code, f"it runs other code than this fit: {said}")
