@@ -14,7 +14,8 @@ Quirks of real bodies it reproduces (from gphoto/libgphoto2 issue threads, see
 or for a time as a body writing to a slow card is: it takes no picture meanwhile; or, pibooth
 #466, busy yet the picture taken, its file announced by event at once, at the next shot or
 never: ``folder_list_files`` then shows it on the card), a body switched off or unplugged
-(every call then fails with -7 and autodetect finds nothing), a card that fills up, a file
+(every call then fails with -7 and autodetect finds nothing), a card that fills up, the
+computer's disk filling at a download (:func:`save_as_libgphoto2`: libgphoto2's own source), a file
 counter that wraps (IMG_9999 → IMG_0001) or a RAM target that names every shot the same
 (Nikon's ``capt0000.nef``), RAW+JPEG delivered as two files, the second through a FILE_ADDED
 event (some bodies also announce the first one, and end with CAPTURE_COMPLETE), several bodies
@@ -23,6 +24,7 @@ on the bus, and a setting that does not latch (the mode dial not on M).
 
 from __future__ import annotations
 
+import os
 import types
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -136,10 +138,13 @@ class Body:
     chatter_s: float = 0.0
     chatter_clock: Any = None
     chatter_limit: int = 10_000
-    #: the computer's disk takes this many more downloads, then is full: libgphoto2's
-    #: ``gp_file_save`` then fails its ``fwrite``, unlinks the partial file and returns
-    #: GP_ERROR (-1, "Unspecified error"), which python-gphoto2 raises (None: never full)
+    #: the computer's disk takes this many more downloads whole, then only ``disk_free_bytes``
+    #: more bytes (None: never full). Where those run out decides what ``CameraFile.save``
+    #: does (see :func:`save_as_libgphoto2`): within what ``fwrite`` hands to the kernel, the
+    #: save raises -1 and the file is removed; within the last block stdio still buffers at
+    #: ``fclose``, it returns as if all went well and leaves a truncated file
     disk_free_saves: int | None = None
+    disk_free_bytes: int = 0
     powered: bool = True
     off_at_shot: int | None = None  # switched off when asked for this shot (1-based)
     shots: int = 0
@@ -198,6 +203,48 @@ class Body:
         return self.ram if self.config.get("capturetarget") == "Internal RAM" else self.card
 
 
+#: glibc's stdio buffer for a regular file: its ``st_blksize`` (4096 on ext4, xfs, btrfs)
+STDIO_BUFSIZ = 4096
+
+
+def save_as_libgphoto2(data: bytes, target: str, room: int | None) -> None:
+    """``gp_file_save`` of a memory CameraFile (what ``camera.file_get`` returns), on a disk
+    that takes ``room`` more bytes (None: all of them).
+
+    Source: libgphoto2's ``libgphoto2/gphoto2-file.c`` (gphoto/libgphoto2), ``gp_file_save``,
+    GP_FILE_ACCESSTYPE_MEMORY: ``fopen(filename, "wb")``, its failure GP_ERROR (-1) with no
+    file made; ``fwrite`` of the whole buffer, and if it writes short: "Not enough space on
+    device in order to save '%s'.", ``fclose``, ``unlink(filename)``, GP_ERROR (-1);
+    otherwise ``fclose(fp)`` *whose return value is not checked*, the mtime set with
+    ``utime`` if the CameraFile has one (not modelled), GP_OK.
+
+    What stdio does underneath (glibc, assumed, not read for this fake): ``fwrite`` of more
+    than its buffer writes the whole blocks through to the kernel and keeps the last partial
+    block (1 to ``STDIO_BUFSIZ`` bytes) buffered; ``fclose`` flushes that. So a disk that
+    fills within the bytes ``fwrite`` wrote through makes it write short (file removed, -1),
+    and one that fills within the last buffered block fails only the final flush, which
+    ``gp_file_save`` ignores: GP_OK, and a file of ``room`` bytes left behind. A file of no
+    more than one block (a small JPEG, a tiny RAW) is all buffered: a full disk can only give
+    the truncated file. python-gphoto2 raises a result below 0 as ``GPhoto2Error``."""
+    try:
+        fh = open(target, "wb")  # noqa: SIM115 - closed below on every path, as libgphoto2 does
+    except OSError as exc:  # fopen failed (permissions, no such folder): GP_ERROR, no file
+        raise GPhoto2Error(-1) from exc
+    size = len(data)
+    buffered = (size - 1) % STDIO_BUFSIZ + 1 if size else 0  # the last block, flushed at fclose
+    if room is None or room >= size:
+        fh.write(data)
+        fh.close()
+        return
+    if room < size - buffered:  # fwrite writes short
+        fh.write(data[:room])
+        fh.close()
+        os.unlink(target)
+        raise GPhoto2Error(-1)
+    fh.write(data[:room])  # fwrite "wrote" it all; fclose's flush fails, its result ignored
+    fh.close()
+
+
 def shutter_s(label: str) -> float:
     """Seconds of a shutter label of ``SHUTTERS`` ('1/125', '0.5', '30'; 'bulb': 0)."""
     if label == "bulb":
@@ -248,12 +295,16 @@ def make_module(body: Body) -> types.ModuleType:
             self._data = data
 
         def save(self, target: str) -> None:
+            room: int | None = None  # bytes the disk still takes (None: the whole file)
             if body.disk_free_saves is not None:
                 if body.disk_free_saves <= 0:
-                    raise GPhoto2Error(-1)
+                    room = body.disk_free_bytes
                 body.disk_free_saves -= 1
-            with open(target, "wb") as fh:
-                fh.write(self._data)
+            save_as_libgphoto2(self._data, target, room)
+
+        def get_data_and_size(self) -> bytes:
+            """python-gphoto2's ``gp_file_get_data_and_size``: the file's bytes in memory."""
+            return self._data
 
     def take_picture(announce_all: bool = False) -> CameraFilePath:
         """The shutter fires: the files are written and announced (``announce_all``: all

@@ -17,6 +17,7 @@ Safe state: no capture in progress, ``exit()`` called on the camera (``close``).
 from __future__ import annotations
 
 import contextlib
+import errno
 import math
 import re
 import shutil
@@ -758,9 +759,19 @@ class Gphoto2Camera:
         the file and returning GP_ERROR (-1), which python-gphoto2 raises as ``GPhoto2Error``.
         Uncaught, the session stopped with "unexpected GPhoto2Error: [-1] … please report it":
         the user was not told the disk was full, nor that a shot in the camera's RAM was
-        lost, nor that a resume reshoots it once there is room."""
+        lost, nor that a resume reshoots it once there is room.
+
+        Why the size is checked after a save that succeeded: ``gp_file_save`` ignores
+        ``fclose``'s result, so a disk that fills within the last block stdio still buffers
+        returns GP_OK and leaves a truncated file (libgphoto2's ``gphoto2-file.c``); it was
+        kept, said to be a RAW that "would not decode", and its card copy deleted.
+
+        Why a refused ``fopen`` is told apart: it is the same GP_ERROR (-1) with no file
+        left, but a folder the user cannot write into is not a full disk, and freeing space
+        does not fix it."""
         try:
             camera_file.save(str(target))
+            _check_saved_whole(camera_file, target)
         except (self._gp.GPhoto2Error, OSError) as exc:
             with contextlib.suppress(OSError):
                 target.unlink(missing_ok=True)  # never a partial file: ``_unused`` made it new
@@ -769,34 +780,43 @@ class Gphoto2Camera:
                 free = f": {shutil.disk_usage(target.parent).free / 1e6:.0f} MB free there now"
             code = getattr(exc, "code", None)
             why = f"gphoto2 error {code} ({exc})" if code is not None else str(exc)
+            refused = _create_refused(target) if code is not None else None
+            if refused is not None:  # fopen's -1: the file could not even be made
+                refusal = (
+                    f"no file can be created there ({refused.strerror or refused}): not a "
+                    "full disk, but the folder's permissions, a read-only mount or a folder "
+                    "gone"
+                )
+                fix = "make that folder writable"
+            else:
+                refusal = f"that disk refused it (full, read-only or failing{free})"
+                fix = "free space on that disk (or fix it)"
             if shot is not None:
                 raise CaptureError(
                     self.name,
                     f"{folder.rstrip('/')}/{name}, a stray (a picture the camera took while "
                     "answering busy, at a moment rti-rig did not choose: never an image of the "
                     f"session), came from the camera but could not be written into "
-                    f"{target.parent} ({why}); that disk refused it (full, read-only or "
-                    f"failing{free}). {self._stray_where(folder, name)}. "
-                    f"{self._shot_kept(folder, shot)}. The step is not recorded: free space on "
-                    "that disk (or fix it), then 'rti-rig run --resume SESSION' shoots this "
-                    "light again",
+                    f"{target.parent} ({why}); {refusal}. {self._stray_where(folder, name)}. "
+                    f"{self._shot_kept(folder, shot)}. The step is not recorded: {fix}, then "
+                    "'rti-rig run --resume SESSION' shoots this light again",
                     "download",
                 ) from exc
             where = self._where(folder, name)
             # a metering shot (no session bound) is no session's step: a resume had been
             # advised beside the run's "nothing was captured or written"
             then = (
-                "Its step is not recorded: free space on that disk (or fix it), then "
-                "'rti-rig run --resume SESSION' shoots it again"
+                f"Its step is not recorded: {fix}, then 'rti-rig run --resume SESSION' shoots "
+                "it again"
                 if self.output_dir is not None
-                else "It was a test shot outside any session (metering): free space on that "
-                "disk (or fix it), then run the command again"
+                else "It was a test shot outside any session (metering): "
+                f"{fix}, then run the command again"
             )
             raise CaptureError(
                 self.name,
                 f"{folder.rstrip('/')}/{name} came from the camera but could not be written "
-                f"into {target.parent} ({why}); that disk refused it (full, "
-                f"read-only or failing{free}). {where[0].upper()}{where[1:]}. {then}",
+                f"into {target.parent} ({why}); {refusal}. {where[0].upper()}{where[1:]}. "
+                f"{then}",
                 "download",
             ) from exc
 
@@ -1207,6 +1227,51 @@ class _BusySpell:
     waited_s: float = 0.0
     #: when its first try was made (on the camera's clock)
     first_try_at: float = 0.0
+
+
+class _SavedShort(OSError):
+    """A save gphoto2 reported done whose file on disk is shorter than the camera's."""
+
+    def __str__(self) -> str:
+        return str(self.strerror)
+
+
+def _check_saved_whole(camera_file: Any, target: Path) -> None:
+    """Raise :class:`_SavedShort` if ``target`` holds fewer bytes than ``camera_file``.
+
+    ``gp_file_save`` returns GP_OK even when its final ``fclose`` could not flush the last
+    buffered block to a full disk (it ignores ``fclose``'s result): only the size tells.
+    The camera file's size is its data in memory (python-gphoto2's
+    ``get_data_and_size``); a file whose data cannot be had is not checked."""
+    try:
+        expected = memoryview(camera_file.get_data_and_size()).nbytes
+    except Exception:  # an older binding, or a file not in memory: not checked
+        return
+    got = target.stat().st_size
+    if got < expected:
+        raise _SavedShort(
+            errno.ENOSPC,
+            f"only {got} of its {expected} bytes reached the disk, though gphoto2 reported "
+            "the save done",
+        )
+
+
+def _create_refused(target: Path) -> OSError | None:
+    """The error creating ``target`` gives now, or None if a file can be created there.
+
+    Why: ``gp_file_save`` answers both a refused ``fopen`` and a short write with GP_ERROR
+    (-1) and no file; trying the ``fopen`` again tells a folder that cannot be written into
+    (permissions, a read-only mount, a folder gone) from a full disk."""
+    try:
+        with open(target, "xb"):
+            pass
+    except FileExistsError:
+        return None
+    except OSError as exc:
+        return exc
+    with contextlib.suppress(OSError):
+        target.unlink()
+    return None
 
 
 def _unused(folder: Path, name: str) -> Path:

@@ -158,3 +158,70 @@ def test_a_disk_full_at_a_strays_download_is_said_as_the_stray_not_the_shot(
     assert r.exit_code == 0, " ".join(r.output.split())
     assert [p.name for p in (out / "recovered").rglob("*IMG_0003.CR2")], "not moved aside"
     assert (out / "lights.lp").read_text().split()[0] == "3"
+
+
+def _big_raw(body: Body) -> bytes:
+    """A RAW of some 12 kB: more than one stdio block (4096 bytes), so that where the disk
+    fills decides between a short ``fwrite`` and a failed final flush."""
+    rgb = np.broadcast_to(np.array([0.2, 0.5, 0.8]), (64, 96, 3))
+    return dng(mosaic_from_rgb(np.array(rgb), "RGGB", (0,) * 4, 4095), "RGGB", (0,) * 4, 4095)
+
+
+@pytest.mark.parametrize("where", ["fwrite", "fclose"])
+def test_a_disk_full_within_a_save_is_said_whether_gphoto2_failed_it_or_not(
+    tmp_path, monkeypatch, where
+):
+    """libgphoto2's ``gp_file_save`` fails a short ``fwrite`` (-1, the file removed) but
+    ignores a failed ``fclose``: a disk that fills within the last buffered block leaves a
+    truncated file and GP_OK. That file had been kept as the shot ("would not decode … is it
+    a complete RAW/DNG download?") and the card's copy, the only whole one, deleted."""
+    cfg = _config(tmp_path, "Memory card")
+    size = len(_big_raw(Body(render=_big_raw)))
+    whole_blocks = size - ((size - 1) % 4096 + 1)  # what fwrite writes through; the rest buffered
+    room = whole_blocks - 1000 if where == "fwrite" else whole_blocks + 10
+    body = Body(render=_big_raw, disk_free_saves=2, disk_free_bytes=room)
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "4"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "IMG_0003.CR2 came from the camera but could not be written" in said, said
+    assert "full, read-only or failing" in said and "rti-rig run --resume" in said, said
+    if where == "fclose":  # gphoto2 said nothing: the size did
+        assert f"only {room} of its {size} bytes reached the disk" in said, said
+    assert "would not decode" not in said, said
+    assert "stays on the camera's card at /store_00020001/DCIM/100CANON/IMG_0003" in said, said
+    assert "IMG_0003.CR2" in body.card and not any("IMG_0003" in d for d in body.deleted)
+    assert not list((out / "raw" / ".incoming").glob("*IMG_0003*")), "a truncated file kept"
+    assert (out / "lights.lp").read_text().split()[0] == "2"
+
+
+class _FolderGoneAtDownload:
+    """A download clock whose third download finds the session's staging folder gone (a
+    disk unmounted, a folder removed), so that libgphoto2's ``fopen`` fails: -1, no file."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder, self.downloads = folder, 0
+
+    def sleep(self, s: float) -> None:
+        self.downloads += 1
+        if self.downloads == 3:
+            shutil.rmtree(self.folder)
+
+
+def test_a_save_whose_file_cannot_be_created_is_not_called_a_full_disk(tmp_path, monkeypatch):
+    """``gp_file_save`` answers a refused ``fopen`` with the same -1 as a short write: the
+    stop said "that disk refused it (full, …)" and to free space, which fixes nothing."""
+    cfg = _config(tmp_path, "Memory card")
+    out = tmp_path / "s"
+    clock = _FolderGoneAtDownload(out / "raw" / ".incoming")
+    body = Body(render=_raw, download_s=0.001, download_clock=clock)
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "4"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "IMG_0003.CR2 came from the camera but could not be written" in said, said
+    assert "no file can be created there (No such file or directory): not a full disk" in said
+    assert "full, read-only or failing" not in said and "free space" not in said, said
+    assert "make that folder writable, then 'rti-rig run --resume SESSION'" in said, said
+    assert "IMG_0003.CR2" in body.card and not any("IMG_0003" in d for d in body.deleted)
