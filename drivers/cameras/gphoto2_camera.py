@@ -153,6 +153,10 @@ class Gphoto2Camera:
         self.settings = settings
         self.name = settings.name
         self.output_dir = output_dir
+        #: how the user shoots a lost step again, as a clause ("… then {again}"): a session's
+        #: resume, unless the session is one no resume continues (``rti-rig preview``'s one
+        #: image, whose use case sets it: a preview's full disk had advised a resume)
+        self.shoot_again = "'rti-rig run --resume SESSION' shoots it again"
         self._clock = clock or SystemClock()
         self._gp = gp_module
         self._cam: Any = None
@@ -806,8 +810,7 @@ class Gphoto2Camera:
             # a metering shot (no session bound) is no session's step: a resume had been
             # advised beside the run's "nothing was captured or written"
             then = (
-                f"Its step is not recorded: {fix}, then 'rti-rig run --resume SESSION' shoots "
-                "it again"
+                f"Its step is not recorded: {fix}, then {self.shoot_again}"
                 if self.output_dir is not None
                 else "It was a test shot outside any session (metering): "
                 f"{fix}, then run the command again"

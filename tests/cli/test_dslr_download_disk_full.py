@@ -225,3 +225,21 @@ def test_a_save_whose_file_cannot_be_created_is_not_called_a_full_disk(tmp_path,
     assert "full, read-only or failing" not in said and "free space" not in said, said
     assert "make that folder writable, then 'rti-rig run --resume SESSION'" in said, said
     assert "IMG_0003.CR2" in body.card and not any("IMG_0003" in d for d in body.deleted)
+
+
+def test_a_disk_full_at_a_preview_download_advises_the_preview_again_not_a_resume(
+    tmp_path, monkeypatch
+):
+    """`rti-rig preview` is a one-image session no `run --resume` continues: its refusal
+    advised "'rti-rig run --resume SESSION' shoots it again"."""
+    cfg = _config(tmp_path, "Internal RAM")
+    body = Body(render=_raw, disk_free_saves=0)  # the preview's one shot finds it full
+    out = tmp_path / "p"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["preview", str(cfg), "--out", str(out)]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "IMG_0001.CR2 came from the camera but could not be written" in said, said
+    assert "'rti-rig run --resume SESSION' shoots it again" not in said, said
+    assert "free space on that disk (or fix it), then run the same 'rti-rig preview' again" in said
+    assert "holds no image and may be used again" in said, said  # the same --out will do
