@@ -25,16 +25,40 @@ Each row's value is ``scale`` × the light integrated over that row's own exposu
 exposed partly under another light (or partly dark) shows it row by row.
 
 The pixel format (``pixel_format``: ``"Y16 "``, ``"GREY"`` or ``"YUYV"``, the only one the
-camera offers: another ``CAP_PROP_FOURCC`` is not taken) comes back as OpenCV's
-``retrieveFrame`` / ``convertToRgb`` in ``cap_v4l.cpp`` gives it: with ``CAP_PROP_CONVERT_RGB``
-on (OpenCV's default) every format is converted to 8-bit BGR — Y16 by ``convertTo(CV_8U, 1/256)``,
-GREY by ``COLOR_GRAY2BGR``, YUYV by ``COLOR_YUV2BGR_YUYV``; with it off, the buffer as the
-camera sent it: Y16 as CV_16UC1, GREY as CV_8UC1, YUYV as CV_8UC2 (Y, then U or V).
+camera offers) comes back as OpenCV's ``cap_v4l.cpp`` (repository opencv/opencv) gives it.
+What is verified, and from which source:
 
-``opencv_4_11 = True`` models OpenCV 4.11.0 (opencv/opencv#27166, broken by #26224, fixed by
-#27193 in 4.12.0): with ``CAP_PROP_CONVERT_RGB`` off, ``retrieveFrame`` hands the buffer over
-as one row of its bytes (CV_8UC1, 1 × bytesused), whatever the format; converted frames are
-as in other releases.
+* Read in two stored versions of ``modules/videoio/src/cap_v4l.cpp``: an IplImage-era one
+  (commit 02b49759, before #26224) and a 4.11-era one (commit dc2214ef, with #26224's
+  ``retrieveFrame`` that #27193 fixed in 4.12.0).
+* ``CAP_PROP_CONVERT_RGB`` on (``open`` sets ``convert_rgb = true``): ``convertToRgb`` makes
+  every frame 8-bit BGR, GREY by ``cvtColor(Mat(size, CV_8UC1), COLOR_GRAY2BGR)`` and YUYV
+  by ``cvtColor(Mat(size, CV_8UC2), COLOR_YUV2BGR_YUYV)`` (both versions). Y16: the 4.11-era
+  source takes each pixel's high byte (``extractChannel(Mat(size, CV_8UC2), temp, 1)``, the
+  little-endian sample's second byte: ``v >> 8``, truncated), then ``COLOR_GRAY2BGR``; this
+  fake does that. The IplImage-era source rounded instead (``convertTo(CV_8U, 1.0/256)``);
+  it had been modelled here, from memory, for every release. Which release switched is not
+  verified (likely with #18498, Y16_BE): the two differ by at most 1 in 8 bits.
+* ``CAP_PROP_CONVERT_RGB`` off, the IplImage-era source (``v4l2_create_frame``'s
+  ``!convert_rgb`` switch, then ``retrieveFrame`` copying the buffer into that header): Y16
+  as CV_16UC1 (rows × cols), GREY as CV_8UC1 (rows × cols), YUYV as CV_8UC2 (rows × cols × 2,
+  the bytes Y0 U Y1 V as sent, so channel 1 alternates U and V). This fake gives those.
+* ``opencv_4_11 = True``, the 4.11-era source: with ``CAP_PROP_CONVERT_RGB`` off,
+  ``retrieveFrame`` wraps the buffer as ``Mat(Size(min(length, bytesused), 1), CV_8U)``: one
+  row of its bytes, 1 × bytesused (numpy ``(1, bytesused)`` uint8), whatever the format
+  (opencv/opencv#27166: 16-bit frames "returned as a flattened array"; broken by #26224 in
+  4.11.0, fixed by #27193). Converted frames are as above.
+* ``set(CAP_PROP_FOURCC, other)`` (both versions): ``palette = value`` then ``v4l2_reset``,
+  whose ``autosetup_capture_mode_v4l2`` falls back through its ``try_order`` to a format the
+  camera takes: ``set`` answers True and the camera's own format stays. This fake does so.
+* ``set(CAP_PROP_CONVERT_RGB, 0)`` answers True; ``1`` answers ``convertableToRgb()`` (True
+  for these three formats).
+
+Assumed, not read: that 4.12's #27193 gives the unconverted shapes of the IplImage-era
+source again (its description: "Restored image initialization process for non-BGR data");
+OpenCV 5.x (this venv's cv2) is not verified at all. The pixel values are the model's own:
+the sensor's 16-bit light values for Y16, their high byte as the luma of GREY and YUYV, and
+no chroma (U = V = 128) in YUYV.
 """
 
 from __future__ import annotations
@@ -257,8 +281,8 @@ class BufferedUvcStream:
         if self.pixel_format == "Y16 ":
             if not convert:
                 return light16
-            # convertTo(CV_8U, 1.0 / 256): rounded to the nearest, then GRAY2BGR
-            high = np.clip(np.rint(light16 / 256.0), 0, 255).astype(np.uint8)
+            # extractChannel(…, 1): the high byte of each little-endian sample, then GRAY2BGR
+            high = (light16 >> 8).astype(np.uint8)
             return cv2.cvtColor(high, cv2.COLOR_GRAY2BGR)
         luma = (light16 >> 8).astype(np.uint8)
         if self.pixel_format == "GREY":

@@ -34,7 +34,7 @@ from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
 RAW_GREY_FOURCCS = {"Y16 ", "Y10 ", "Y12 "}
 #: Grey formats OpenCV hands over as they are (one channel) only with ``CAP_PROP_CONVERT_RGB``
 #: off: with it on (its default) ``convertToRgb`` in cap_v4l.cpp makes every frame 8-bit BGR
-#: (a Y16 frame by ``convertTo(CV_8U, 1/256)``, GREY by ``COLOR_GRAY2BGR``), so a grey camera's
+#: (a Y16 frame to its high byte, GREY by ``COLOR_GRAY2BGR``), so a grey camera's
 #: session had been written as three equal colour channels (an 8-bit GREY one) or lost its
 #: 16 bits (a Y16 one).
 GREY_FOURCCS = RAW_GREY_FOURCCS | {"GREY"}

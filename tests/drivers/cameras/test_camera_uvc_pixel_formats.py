@@ -163,3 +163,19 @@ def test_a_refused_pixel_format_is_answered_with_settings_the_config_can_hold(
     r, said = run()
     assert r.exit_code == 0 and "Traceback" not in said, said
     assert len(list((out / "linear").glob("*.tif"))) == 2, said
+
+
+def test_the_fake_converts_y16_to_bgr_by_its_high_byte_as_cap_v4l_does() -> None:
+    """OpenCV's ``convertToRgb`` (cap_v4l.cpp, 4.11-era source) makes a Y16 frame 8-bit by
+    ``extractChannel(Mat(size, CV_8UC2), temp, 1)``: each little-endian sample's high byte,
+    truncated. The fake had rounded (``convertTo(CV_8U, 1/256)``, an older source's), written
+    from memory: 0x01FF came back as 2, where OpenCV gives 1."""
+    stream = BufferedUvcStream(LightHistory(SystemClock()), pixel_format="Y16 ")  # type: ignore[arg-type]
+    assert stream.get(cv2.CAP_PROP_CONVERT_RGB) == 1  # OpenCV's default: converted
+    light16 = np.array([[0x01FF, 0x0280, 0xFFFF, 0x00FF]], np.uint16)
+    bgr = stream._retrieve(light16)
+    assert bgr.dtype == np.uint8 and bgr.shape == (1, 4, 3), bgr.shape
+    assert bgr[..., 0].tolist() == [[1, 2, 255, 0]], bgr[..., 0]
+    assert stream.set(cv2.CAP_PROP_CONVERT_RGB, 0)
+    raw = stream._retrieve(light16)  # unconverted: the samples as sent, rows × cols
+    assert raw.dtype == np.uint16 and raw.tolist() == light16.tolist()
