@@ -1270,8 +1270,8 @@ def _create_refused(target: Path) -> OSError | None:
             pass
     except FileExistsError:
         return None
-    except OSError as exc:
-        return exc
+    except OSError as exc:  # a disk out of inodes or quota refuses the file too: that is full
+        return None if exc.errno in (errno.ENOSPC, errno.EDQUOT) else exc
     with contextlib.suppress(OSError):
         target.unlink()
     return None
