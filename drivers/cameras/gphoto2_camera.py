@@ -1245,12 +1245,16 @@ def _check_saved_whole(camera_file: Any, target: Path) -> None:
     ``gp_file_save`` returns GP_OK even when its final ``fclose`` could not flush the last
     buffered block to a full disk (it ignores ``fclose``'s result): only the size tells.
     The camera file's size is its data in memory (python-gphoto2's
-    ``get_data_and_size``); a file whose data cannot be had is not checked."""
+    ``get_data_and_size``); a file whose data cannot be had is not checked, nor one another
+    program took away as it landed (the decode that follows says that, naming the folder)."""
     try:
         expected = memoryview(camera_file.get_data_and_size()).nbytes
     except Exception:  # an older binding, or a file not in memory: not checked
         return
-    got = target.stat().st_size
+    try:
+        got = target.stat().st_size
+    except FileNotFoundError:
+        return
     if got < expected:
         raise _SavedShort(
             errno.ENOSPC,
