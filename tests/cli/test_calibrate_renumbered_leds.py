@@ -53,6 +53,31 @@ def test_a_card_session_calibrated_against_reordered_leds_is_refused(tmp_path: P
     assert not out.exists()
 
 
+def test_a_card_of_other_leds_is_refused_for_them_before_any_image_is_read(
+    tmp_path: Path,
+) -> None:
+    """The LEDs a card was shot with are in its manifest: a card of others is refused for
+    that before its images are read. Every image was read (and checked against the journal)
+    first, so a card whose images were gone was refused for those, never for its LEDs."""
+    rig = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(rig, card)
+    count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
+    other = _rig_with_lights(rig, "reordered", [count, *rows[24:], *rows[:24]])
+    for image in [*card.glob("image_*"), *(card / "linear").glob("*.tif")]:
+        image.unlink()  # nothing left to read: a refusal that reads them says so instead
+    out = tmp_path / "cal.toml"
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(other), "--out", str(out)])
+
+    assert r.exit_code == 2, r.output
+    message = said(r)
+    assert "Traceback" not in r.output
+    assert "light positions: 48 of 48 LEDs moved" in message, message
+    assert "missing" not in message, message
+    assert not out.exists()
+
+
 def test_the_rig_config_the_card_was_shot_with_still_calibrates(tmp_path: Path) -> None:
     rig = card_rig(tmp_path)
     card = tmp_path / "card"

@@ -148,13 +148,18 @@ def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> str | None:
     or another controller board, which may number them otherwise) had its LED 18 (led_42.jpg)
     given the correction measured under the card session's LED 18 (led_18.jpg), with no word.
     A session recorded before identities were is not asked (as a resume does not ask it).
+    Decided from the manifest alone, before any card image is read: a card of other LEDs
+    had every image read first, and one with images missing was refused for those instead.
     LEDs that moved only as a re-measured ``.lp`` moves them (each still nearest its own
     recorded position) are the same LEDs: they had been refused as "others", though the
     correction by LED number holds for them (:func:`_same_leds_re_measured`)."""
     from rti_rig.app.rig_identity import identity_differences, rig_identity
     from rti_rig.runtime.session import read_manifest
 
-    recorded = (read_manifest(req.card_session).get("rig") or {}).get("identity")
+    rig = read_manifest(req.card_session).get("rig") or {}
+    if not isinstance(rig, dict) or rig.get("name") != loaded.config.name:
+        return None  # another rig's card: refused by name where the card session is read
+    recorded = rig.get("identity")
     if not isinstance(recorded, dict):
         return None
     now = rig_identity(loaded)
@@ -205,6 +210,9 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     loaded = load_rig_config(req.rig_config)
     _check_dome_can_dim(req, loaded)
     geometry = rig_geometry(loaded)
+    # from the manifest, before any image is read: a card of other LEDs had every image read
+    # (and a card with images missing was refused for them) before the refusal that mattered
+    same_leds = _refuse_other_leds(req, loaded)
     try:
         card = read_card_session(req.card_session, rig_name=loaded.config.name)
     except CardStoppedAtLedError as exc:
@@ -215,7 +223,6 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             else "that LED"
         )
         raise RtiRigError(f"{exc}. {_without_led(req, loaded, which)}") from None
-    same_leds = _refuse_other_leds(req, loaded)
     target = req.target
     if req.out_file is None and target.exists():
         raise RtiRigError(
