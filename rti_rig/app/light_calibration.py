@@ -38,6 +38,7 @@ from rti_rig.planner.topography import downsample
 from rti_rig.reconstruct import ReconstructionError, estimate_light_gains
 from rti_rig.runtime.session import (
     JOURNAL,
+    MANIFEST,
     image_names,
     read_manifest,
     scan_journal,
@@ -223,6 +224,7 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
             f"{root}: {len(steps)} image(s); shoot the card under every LED of the dome "
             "(rti-rig run RIG --out CARD_SESSION, with no --lights)"
         )
+    directions = _step_directions(root, steps)
     _refuse_unverified(root, steps, len(planned))
     correction = serial.get("intensity_correction")
     max_level = int(serial.get("max_level", 255))
@@ -259,12 +261,43 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
         root=root,
         rig_name=str(rig.get("name")),
         images=np.stack(images),
-        directions=np.array([s["actual_direction"] for s in steps], dtype=np.float64),
+        directions=directions,
         leds=np.array(leds, dtype=np.intp),
         drive=np.array(drive),
         correction=None if correction is None else tuple(float(v) for v in correction),
         image_of=image_of,
     )
+
+
+def _step_directions(root: Path, steps: list[dict[str, Any]]) -> NDArray[np.float64]:
+    """The direction each step of the card session records as lit, refused by step when one
+    records none, before any image is read.
+
+    Why: the card is read at the positions its steps recorded, and a step without one (a
+    manifest edited or damaged outside rti-rig) was refused as "does not describe a card
+    session (KeyError: 'actual_direction')", after every image had been read, naming neither
+    the step nor its image."""
+    out = []
+    for k, step in enumerate(steps):
+        direction = step.get("actual_direction")
+        try:
+            light = tuple(float(v) for v in direction)  # type: ignore[union-attr]
+        except (TypeError, ValueError):
+            light = ()
+        if len(light) != 3 or not all(np.isfinite(light)) or not any(light):
+            index = step.get("index")
+            which = f"step {index + 1}" if isinstance(index, int) else f"step {k + 1}"
+            image = step.get("image") or step.get("linear_image") or "its image"
+            what = "no light" if direction is None else f"the light {direction!r}, not a direction"
+            raise SessionError(
+                f"{root}/{MANIFEST}: {which} ({image}, LED {step.get('led')!r}) records {what} "
+                f"('actual_direction' is {'missing' if direction is None else 'unreadable'}), so "
+                f"the direction that lit it is not known and the card cannot be read at it: "
+                f"restore {MANIFEST} from a backup copy of the folder, or shoot the card again "
+                "with rti-rig run"
+            )
+        out.append(light)
+    return np.array(out, dtype=np.float64)
 
 
 def _refuse_saturated(

@@ -415,7 +415,7 @@ def test_resumed_unfinished_or_malformed_card_sessions_are_refused(tmp_path: Pat
 
     refused(resumed_with_another_calibration, "resumed with a changed rig config or light")
     refused(lambda m: m["steps"][3].update(led=-1), r"records LED -1")
-    refused(lambda m: m["steps"][3].pop("actual_direction"), "does not describe a card session")
+    refused(lambda m: m["steps"][3].pop("actual_direction"), r"step 4 \(image_004.jpg, LED 3\)")
     refused(lambda m: m.update(rig=[]), "does not describe a card session")
 
 
