@@ -90,6 +90,31 @@ def test_the_rig_config_the_card_was_shot_with_still_calibrates(tmp_path: Path) 
     assert out.is_file()
 
 
+def _re_measured(rig: Path) -> Path:
+    """The card rig with its .lp measured again: the whole dome 0.5° further round, every
+    LED moved and each still nearest its own old position."""
+    count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
+    turn = np.radians(0.5)
+    c, s = np.cos(turn), np.sin(turn)
+    moved = []
+    for row in rows:
+        name, x, y, z = row.split()
+        xf, yf = float(x), float(y)
+        moved.append(f"{name} {c * xf - s * yf:.6f} {s * xf + c * yf:.6f} {z}")
+    return _rig_with_lights(rig, "remeasured", [count, *moved])
+
+
+def _as_recorded_with_a_digest_alone(card: Path) -> None:
+    """The card session's manifest as versions before per-LED identity wrote it: its rig
+    identity holds the positions' digest (light_positions) and no light_directions,
+    dome_firmware or dome_protocol."""
+    manifest = json.loads((card / "manifest.json").read_text())
+    for key in ("light_directions", "dome_firmware", "dome_protocol"):
+        del manifest["rig"]["identity"][key]
+    assert "light_positions" in manifest["rig"]["identity"]
+    (card / "manifest.json").write_text(json.dumps(manifest))
+
+
 def test_leds_re_measured_in_place_still_calibrate(tmp_path: Path) -> None:
     """The same LEDs with re-measured positions (each still nearest its own recorded one, a
     finer .lp written after the card was shot) are not "other LEDs": the correction by LED
@@ -97,15 +122,7 @@ def test_leds_re_measured_in_place_still_calibrate(tmp_path: Path) -> None:
     rig = card_rig(tmp_path)
     card = tmp_path / "card"
     shoot(rig, card)
-    count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
-    turn = np.radians(0.5)  # the whole dome measured 0.5° further round: every LED moved
-    c, s = np.cos(turn), np.sin(turn)
-    moved = []
-    for row in rows:
-        name, x, y, z = row.split()
-        xf, yf = float(x), float(y)
-        moved.append(f"{name} {c * xf - s * yf:.6f} {s * xf + c * yf:.6f} {z}")
-    other = _rig_with_lights(rig, "remeasured", [count, *moved])
+    other = _re_measured(rig)
     out = tmp_path / "cal.toml"
 
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(other), "--out", str(out)])
@@ -116,6 +133,47 @@ def test_leds_re_measured_in_place_still_calibrate(tmp_path: Path) -> None:
     assert "48 of 48 LEDs moved" in message, message
     assert "each still nearest its own recorded position" in message, message
     assert out.is_file()
+
+
+def test_an_older_card_session_of_leds_re_measured_in_place_still_calibrates(
+    tmp_path: Path,
+) -> None:
+    """A card session recorded with a digest of the LEDs' positions alone, calibrated after
+    the .lp was measured again, is compared at the positions its steps record (where the
+    card is read): the same LEDs re-measured, with the note a newer session gets. It was
+    refused as "others" (its positions "not known"), though a session recorded before
+    identities at all is not asked."""
+    rig = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(rig, card)
+    _as_recorded_with_a_digest_alone(card)
+    out = tmp_path / "cal.toml"
+
+    r = runner.invoke(
+        app, ["calibrate-lights", str(card), "--rig", str(_re_measured(rig)), "--out", str(out)]
+    )
+
+    assert r.exit_code == 0, r.output
+    message = said(r)
+    assert "others than" not in message, message
+    assert "each still nearest its own recorded position (as its steps record them" in message
+    assert out.is_file()
+
+
+def test_an_older_card_session_of_reordered_leds_is_still_refused(tmp_path: Path) -> None:
+    rig = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(rig, card)
+    _as_recorded_with_a_digest_alone(card)
+    count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
+    other = _rig_with_lights(rig, "reordered", [count, *rows[24:], *rows[:24]])
+    out = tmp_path / "cal.toml"
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(other), "--out", str(out)])
+
+    assert r.exit_code == 2, r.output
+    assert "others than" in said(r), r.output
+    assert not out.exists()
 
 
 @pytest.mark.parametrize(

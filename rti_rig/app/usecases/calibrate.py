@@ -156,7 +156,8 @@ def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> str | None:
     from rti_rig.app.rig_identity import identity_differences, rig_identity
     from rti_rig.runtime.session import read_manifest
 
-    rig = read_manifest(req.card_session).get("rig") or {}
+    manifest = read_manifest(req.card_session)
+    rig = manifest.get("rig") or {}
     if not isinstance(rig, dict) or rig.get("name") != loaded.config.name:
         return None  # another rig's card: refused by name where the card session is read
     recorded = rig.get("identity")
@@ -169,12 +170,17 @@ def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> str | None:
     )
     if not diffs:
         return None
-    if _same_leds_re_measured(recorded, now):
+    if _same_leds_re_measured(recorded, now, manifest.get("steps")):
+        seen = (
+            ""
+            if isinstance(recorded.get("light_directions"), list)
+            else " (as its steps record them: its rig identity holds a digest of them alone)"
+        )
         return (
             f"{req.card_session} recorded the dome's LEDs elsewhere than {req.rig_config} "
             f"places them now ({'; '.join(diffs)}), each still nearest its own recorded "
-            "position: taken as the same LEDs re-measured (the correction is by LED number, "
-            "and the card is read at the positions it recorded)"
+            f"position{seen}: taken as the same LEDs re-measured (the correction is by LED "
+            "number, and the card is read at the positions it recorded)"
         )
     raise RtiRigError(
         f"{req.card_session} was shot when the dome's LEDs were others than "
@@ -185,20 +191,62 @@ def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> str | None:
     )
 
 
-def _same_leds_re_measured(recorded: dict[str, Any], now: dict[str, Any]) -> bool:
+def _same_leds_re_measured(recorded: dict[str, Any], now: dict[str, Any], steps: Any) -> bool:
     """True where only the LEDs' positions differ, and each LED's position now is nearer its
-    own recorded position than any other LED's: a finer ``.lp`` of the same LEDs, not LEDs
-    listed in another order (which puts an LED nearest another's recorded position)."""
+    own recorded position than any other LED's (and its recorded position nearer its own
+    position now than any other's): a finer ``.lp`` of the same LEDs, not LEDs listed in
+    another order (which puts an LED nearest another's recorded position).
+
+    A session recorded when the identity held a digest of the positions alone is compared at
+    the positions its steps record for the LEDs it lit: it had been refused as "others" for
+    any re-measure, though the card is read at those positions, and a session recorded before
+    identities at all is not asked."""
     from rti_rig.app.rig_identity import identity_differences
 
     others = [k for k in LED_KEYS if k in recorded and k not in _POSITION_KEYS]
     if identity_differences({k: recorded[k] for k in others}, {k: now.get(k) for k in others}):
         return False
-    before, after = recorded.get("light_directions"), now.get("light_directions")
-    if not isinstance(before, list) or not isinstance(after, list) or len(before) != len(after):
-        return False  # a session recorded with a digest alone: its positions are not known
-    nearest = np.argmax(np.asarray(after, float) @ np.asarray(before, float).T, axis=1)
-    return bool(np.array_equal(nearest, np.arange(len(after))))
+    before, after = _recorded_directions(recorded, steps), now.get("light_directions")
+    if before is None or not isinstance(after, list) or any(i >= len(after) for i in before):
+        return False
+    leds = sorted(before)
+    was = _unit([before[i] for i in leds])
+    is_now = _unit(after)
+    nearest_recorded = np.argmax(is_now[leds] @ was.T, axis=1)
+    nearest_now = np.argmax(was @ is_now.T, axis=1)
+    return bool(
+        np.array_equal(nearest_recorded, np.arange(len(leds)))
+        and np.array_equal(nearest_now, np.asarray(leds))
+    )
+
+
+def _recorded_directions(recorded: dict[str, Any], steps: Any) -> dict[int, Any] | None:
+    """Each LED's recorded position by LED number: the identity's ``light_directions``, or
+    for a session recorded with a digest of them alone, where its steps say each LED it lit
+    was; None where they cannot be told (a step without an LED or a direction)."""
+    listed = recorded.get("light_directions")
+    if "light_directions" in recorded:
+        return dict(enumerate(listed)) if isinstance(listed, list) and listed else None
+    if not isinstance(steps, list) or not steps:
+        return None
+    out: dict[int, Any] = {}
+    for step in steps:
+        led = step.get("led") if isinstance(step, dict) else None
+        if isinstance(led, bool) or not isinstance(led, int) or led < 0:
+            return None
+        try:
+            direction = np.asarray(step.get("actual_direction"), dtype=float)
+        except (TypeError, ValueError):
+            return None
+        if direction.shape != (3,) or not np.all(np.isfinite(direction)) or not direction.any():
+            return None
+        out[led] = direction
+    return out
+
+
+def _unit(directions: Any) -> np.ndarray:
+    vectors = np.asarray(directions, dtype=float)
+    return vectors / np.linalg.norm(vectors, axis=1, keepdims=True)
 
 
 #: The identity keys that hold the LEDs' positions (compared as positions when both are held).
