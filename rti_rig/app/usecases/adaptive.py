@@ -1299,67 +1299,112 @@ def _check_lights_within(
         )
 
 
-def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
-    loaded,
+@dataclass(frozen=True)
+class NothingToChoose:
+    """Why a dome offers an adaptive session nothing to choose, and what would hold it: the
+    facts :func:`_nothing_to_choose` decides and :func:`_nothing_to_choose_words` words.
+
+    Why apart: one function had both decided and worded the refusal and its two ways out
+    (the band that holds the session, the planned run of the band's lights), so what was
+    advised could be read only from the sentence it was in."""
+
+    #: The lights the band holds (no more than the starting layout's).
+    offered: int
+    band: tuple[float, float]
+    #: The dome's LED elevations (°).
+    elevations: NDArray[np.float64]
+    #: The lights this session needs, and the option that asked for them (None: an adaptive
+    #: session's own minimum, one more than its start).
+    need: int
+    need_from: str | None
+    #: What the advised band is to hold: ``need``, or the dome's every LED where it has fewer.
+    hold: int
+    #: The band nearest ``band`` that holds ``hold`` (None: none to advise).
+    wider: tuple[float, float] | None
+    #: The ``--lights``/``--min-lights`` the advised command keeps (what a session can take).
+    advised_lights: int | None
+    advised_min_lights: int | None
+
+
+def _nothing_to_choose(
+    elevations: NDArray[np.float64],
     offered: int,
     lights: int | None,
     until_error_deg: float | None,
     band: tuple[float, float] = _FULL_BAND,
     min_lights: int | None = None,
-    objective: str = "normals",
-) -> None:
-    """Refuse ``--adaptive`` (or ``--lights N`` with it) on a rig offering no more lights than
-    the starting layout: there is nothing left to choose. ``--lights 4`` was refused with "give
-    at least 5" and ``--lights 5`` with "give at most 4", sending the user round in a circle,
-    while ``--adaptive`` alone ran the lights as a planned run would, labelled adaptive.
+) -> NothingToChoose | None:
+    """What leaves an adaptive session nothing to choose on a dome whose LEDs are at
+    ``elevations`` (°), ``offered`` of them in ``band``; None where there is something.
+
     ``--until-error`` alone is kept where its estimate can say whether these lights reach the
     target (3 lights or more: photometric stereo's); with fewer it could judge nothing (a
-    1-light session ran, "the target is not claimed").
-
-    The advice is a band that holds the session (:func:`_band_holding`), as a command with
-    the user's own options, and the planned run of the band's lights as the other way: the
-    planned run alone had been advised, ``--lights 1`` on the Nab dome below 20°, a session
-    no fit can use. The advised ``--lights``/``--min-lights`` are what a session can take: at
-    least 5 (a ``--lights 4`` kept was refused "give at least 5") and at most the dome's LEDs
-    (``--lights 14`` of a 12-LED dome was left with no command)."""
+    1-light session ran, "the target is not claimed"). The advised ``--lights``/
+    ``--min-lights`` are what a session can take: at least 5 (a ``--lights 4`` kept was
+    refused "give at least 5") and at most the dome's LEDs (``--lights 14`` of a 12-LED dome
+    was left with no command)."""
     if offered > START_LIGHTS:
-        return
+        return None
     if lights is None and until_error_deg is not None and offered >= fit_minimums.NORMAL_MIN_LIGHTS:
-        return
-    from rti_rig.app.config import rig_geometry
-
-    noun = "light" if offered == 1 else "lights"
+        return None
     need = max(START_LIGHTS + 1, lights or 0, min_lights or 0)
-    _, el = az_el_from_direction(rig_geometry(loaded).directions)
-    config = shlex.quote(str(loaded.path))
+    # the option that asked for more than an adaptive session's own minimum, if one did
+    need_from = None if need == START_LIGHTS + 1 else "lights" if need == lights else "min-lights"
+    # what the advised band is to hold: no band holds more than the dome's LEDs (a --lights 14
+    # on a 12-LED dome had been left with no command, or only a test shot of the band's one)
+    hold = min(need, len(elevations))
+    wider = _band_holding(elevations, hold, band) if hold > START_LIGHTS else None
+    return NothingToChoose(
+        offered=offered,
+        band=band,
+        elevations=elevations,
+        need=need,
+        need_from=need_from,
+        hold=hold,
+        wider=wider,
+        # a --lights 4 kept as given was refused: "give at least 5"
+        advised_lights=None if lights is None else min(max(lights, START_LIGHTS + 1), hold),
+        advised_min_lights=None if min_lights is None else min(min_lights, hold),
+    )
+
+
+def _nothing_to_choose_words(
+    facts: NothingToChoose,
+    config: str,
+    until_error_deg: float | None,
+    objective: str = "normals",
+) -> str:
+    """The refusal of ``facts``, with its ways out as commands of the user's own options
+    (``config``: the rig config, quoted for a shell).
+
+    The advice is the band that holds the session (:func:`_band_holding`), and the planned
+    run of the band's lights as the other way: the planned run alone had been advised,
+    ``--lights 1`` on the Nab dome below 20°, a session no fit can use."""
+    offered, band, el, need = facts.offered, facts.band, facts.elevations, facts.need
+    noun = "light" if offered == 1 else "lights"
     session = (
         f"an adaptive session needs at least {need}"
-        if need == START_LIGHTS + 1
-        else f"this adaptive session (--{'lights' if need == lights else 'min-lights'} {need}) "
-        f"needs {need}"
+        if facts.need_from is None
+        else f"this adaptive session (--{facts.need_from} {need}) needs {need}"
     )
     words = [
         f"this rig offers {offered} {noun}{_band_words(band)} (its {len(el)} LEDs are at "
         f"{el.min():.1f}°–{el.max():.1f}° elevation), and {session}: it starts from "
         f"{START_LIGHTS} and chooses the next ones: there is none left to choose here"
     ]
-    # what the advised band is to hold: no band holds more than the dome's LEDs (a --lights 14
-    # on a 12-LED dome had been left with no command, or only a test shot of the band's one)
-    hold = min(need, len(el))
-    wider = _band_holding(el, hold, band) if hold > START_LIGHTS else None
+    wider = facts.wider
     if wider is not None:
         asked = _session_options(
             until_error_deg,
-            # a --lights 4 kept as given was refused: "give at least 5"
-            None if lights is None else min(max(lights, START_LIGHTS + 1), hold),
-            None if min_lights is None else min(min_lights, hold),
+            facts.advised_lights,
+            facts.advised_min_lights,
             objective,  # kept, as an arm's advice keeps it ('relight' had become the default)
         )
         lead = (
             f"Widen the band to hold {need}"
-            if hold == need
-            else f"No band holds {need} (the dome has {len(el)} LEDs): ask for {hold} in one "
-            "that holds them"
+            if facts.hold == need
+            else f"No band holds {need} (the dome has {len(el)} LEDs): ask for {facts.hold} in "
+            "one that holds them"
         )
         words.append(
             f"{lead}: rti-rig run {config} --out DIR {asked}"
@@ -1382,7 +1427,32 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
             else "Shoot them all with a planned run"
         )
         words.append(f"{shoot}: rti-rig run {config} --out DIR{in_band}{caveat}")
-    raise RtiRigError(". ".join(words[:2]) + "".join(f"; or {w}" for w in words[2:]))
+    return ". ".join(words[:2]) + "".join(f"; or {w}" for w in words[2:])
+
+
+def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
+    loaded,
+    offered: int,
+    lights: int | None,
+    until_error_deg: float | None,
+    band: tuple[float, float] = _FULL_BAND,
+    min_lights: int | None = None,
+    objective: str = "normals",
+) -> None:
+    """Refuse ``--adaptive`` (or ``--lights N`` with it) on a rig offering no more lights than
+    the starting layout: there is nothing left to choose. ``--lights 4`` was refused with "give
+    at least 5" and ``--lights 5`` with "give at most 4", sending the user round in a circle,
+    while ``--adaptive`` alone ran the lights as a planned run would, labelled adaptive.
+    Decided by :func:`_nothing_to_choose`, worded by :func:`_nothing_to_choose_words`."""
+    if offered > START_LIGHTS:
+        return  # before the rig's geometry is read: most rigs offer more
+    from rti_rig.app.config import rig_geometry
+
+    _, el = az_el_from_direction(rig_geometry(loaded).directions)
+    facts = _nothing_to_choose(el, offered, lights, until_error_deg, band, min_lights)
+    if facts is not None:
+        config = shlex.quote(str(loaded.path))
+        raise RtiRigError(_nothing_to_choose_words(facts, config, until_error_deg, objective))
 
 
 def _session_options(
