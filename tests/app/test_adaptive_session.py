@@ -291,7 +291,7 @@ def test_until_error_stops_when_the_estimate_is_reached(
         # capped without a word: 100 asked of a dome ran its every LED
         (["--adaptive", "--lights", "100"], "--lights 100: this rig offers"),
         # named by the options given: --adaptive had been named when only --until-error was
-        (["--until-error", "2", "--lights", "4"], "--until-error … --lights 4: an adaptive"),
+        (["--until-error", "2", "--lights", "4"], "--until-error 2 --lights 4: an adaptive"),
         (["--adaptive", "--lights", "4"], "--adaptive --lights 4: an adaptive"),
         # the reason and a way to meter it (it had said "chooses its own lights")
         (

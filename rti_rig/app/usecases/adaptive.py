@@ -1599,9 +1599,11 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
             loaded, offered, lights, until_error_deg, band, min_lights, objective
         )
     if lights is not None and lights < START_LIGHTS + 1:
-        asked = "--until-error … " if until_error_deg is not None else "--adaptive "
+        # the options as given, worded as every adaptive refusal words them (this one had
+        # built its own, "--until-error … --lights 4", without the target the user gave)
+        asked = _session_options(until_error_deg, lights, None)
         raise RtiRigError(
-            f"{asked}--lights {lights}: an adaptive session starts from {START_LIGHTS} lights "
+            f"{asked}: an adaptive session starts from {START_LIGHTS} lights "
             f"and chooses from there; give at least {START_LIGHTS + 1}"
         )
     check_objective(objective, lights, until_error_deg)
