@@ -629,7 +629,12 @@ class DynamixelArm:
         pose, reason = self.kin.solve(d, current_az)
         if pose is None:
             raise UnreachableError(self.name, np.round(d, 6).tolist(), reason or "unknown")
-        return self._move_ticks(self.kin.ticks_of_pose(*pose), f"move_to {np.round(d, 4)}")
+        # named by the pose a user reads in check's table and the .lp, not by the unit vector
+        # (its numpy repr, "move_to [0.9968 0.     0.0805]", had been said in every error)
+        az, el = pose
+        return self._move_ticks(
+            self.kin.ticks_of_pose(*pose), f"move to az {az:.1f}°, el {el:.1f}°"
+        )
 
     def park(self, cancelled: Callable[[], bool] | None = None) -> None:
         """Move to the park pose and wait until in position.
