@@ -1263,7 +1263,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     # "24 of 24 lights" for --lights 24 on a 48-LED dome read as if the dome had 24: a new
     # session says its count, a resumed one what is left of it
     todo, total = opened.steps_to_do, opened.total_steps
-    noun = "light" if todo == 1 else "lights"
+    # the noun agrees with the total it follows: "1 of 4 light left" had been said
+    noun = "light" if total == 1 else "lights"
     count = f"{todo} {noun}" if todo == total else f"{todo} of {total} {noun} left"
     out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {escape(str(out_dir))}")
 

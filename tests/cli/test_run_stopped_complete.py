@@ -166,3 +166,14 @@ def test_a_camera_triggered_run_stopped_before_its_proof_is_not_said_complete(
     assert "A camera-triggered dome cannot resume a session" in said, said
     code, fitted = _cli("fit", str(out), "--out", str(tmp_path / "fit"))  # what fit says of it
     assert code != 0 and "it is not used" in fitted, fitted
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
+def test_a_resume_with_one_image_left_says_it_of_all_the_lights(tmp_path: Path) -> None:
+    """Stopped with 5 of 6 images in, the resume says "1 of 6 lights left": the noun had
+    followed the images left, "1 of 6 light left"."""
+    code, said, out = _run_sigterm_at(tmp_path, 4)
+    assert code == 143 and "Traceback" not in said, said
+    code, said = _cli("run", "--resume", str(out), "--no-verdict")
+    assert code == 0 and "Traceback" not in said, said
+    assert "1 of 6 lights left" in said, said
