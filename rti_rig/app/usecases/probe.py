@@ -30,7 +30,11 @@ import time
 from dataclasses import dataclass, field
 from enum import Enum, auto
 
+from rti_rig.drivers.led_dome.codec_binary import BinaryCodec
+from rti_rig.drivers.led_dome.codec_default import DefaultCodec
+from rti_rig.drivers.led_dome.codec_framed import FramedCodec, FramedSpec
 from rti_rig.drivers.led_dome.dome_profiles import nab_rti_v1 as nab
+from rti_rig.drivers.led_dome.messages import Banner
 from rti_rig.drivers.led_dome.transport import SerialTransport, TransportError
 from rti_rig.runtime.controller import EmergencyStop
 
@@ -145,6 +149,9 @@ class ProbeResult:
     #: What the port's path is when it is no serial port ("is a regular file" …; None: it
     #: may be one), said in place of advice to check the dome's cable and power.
     not_serial: str | None = None
+    #: Config lines the firmware's answer showed beyond ``[dome.serial]`` (a default-profile
+    #: board without checksums).
+    extra_lines: list[str] = field(default_factory=list)
 
     def config_lines(self) -> list[str]:
         if self.profile is None:
@@ -153,7 +160,8 @@ class ProbeResult:
         # guide) keeps its "baudrate = 115200", which overrides the profile's own rate, and
         # a 9600-baud firmware then failed its check with no word of the rate that works
         rate = [f"baudrate = {self.baudrate}"] if self.baudrate is not None else []
-        return ["[dome.serial]", f'port = "{self.port}"', f'profile = "{self.profile}"', *rate]
+        lines = ["[dome.serial]", f'port = "{self.port}"', f'profile = "{self.profile}"', *rate]
+        return lines + self.extra_lines
 
     def heard_lines(self) -> list[str]:
         """What each probe heard, one line each (the end of a long text)."""
@@ -338,7 +346,7 @@ def _another_firmware_found(result: ProbeResult, text: str, baud: int) -> bool:
     if _ELEXOL_SAYS in text:
         result.profile, result.baudrate = "elexol-24r1", 38400
         return True
-    return False
+    return _own_protocol_found(result, text, baud)
 
 
 def _stopped_on_open_port(
@@ -663,6 +671,75 @@ def _nichlock_found(result: ProbeResult, text: str, baud: int) -> bool:
     return True
 
 
+#: The boot banners of rti-rig's own protocols (docs/protocols/led-dome.md), as each profile
+#: prints them with its options left at their defaults: ``READY <id> <version> <count>*HH``,
+#: ``<READY,<id>,<version>,<count>>`` and the binary ``0xFF R D Y``.
+_OWN_BANNERS = (
+    ("default", re.compile(r"READY [^\r\n]*\n")),
+    ("framed", re.compile(r"<READY(?:,[^<>\r\n]*)?>")),
+    ("binary", re.compile("\xffRDY")),
+)
+
+#: What the probe cannot hear of each own profile, said with its config lines.
+_OWN_UNHEARD = {
+    "framed": (
+        "a framed board's other options (index_base, line_ending, the command codes) are not "
+        "in its banner: set [dome.serial.framed] as its firmware's documentation says (the "
+        "defaults are 0-based and no line ending), then run rti-rig check"
+    ),
+    "binary": (
+        "a binary board's start_byte and index_base are not in its banner: set "
+        "[dome.serial.binary] as its firmware's documentation says if they are not 0xA5 and 0, "
+        "then run rti-rig check"
+    ),
+}
+
+
+def _own_protocol(text: str) -> str | None:
+    """The first boot banner of one of rti-rig's own protocols in ``text``, or None."""
+    found = [(m.start(), m.group()) for _, pattern in _OWN_BANNERS if (m := pattern.search(text))]
+    return min(found)[1] if found else None
+
+
+def _own_protocol_found(result: ProbeResult, text: str, baud: int) -> bool:
+    """Name rti-rig's own protocol (default, framed, binary) if ``text`` (heard at ``baud``
+    once the port opened, nothing sent) holds its boot banner, decoded by the profile's codec;
+    True if one was named.
+
+    The probe knew only the firmwares of other projects: a board speaking the project's own
+    protocol, which announces itself at every boot, had been told "No known dome firmware
+    answered" with its ``READY`` line among the lines heard, and sent on to set
+    ``profile = "rti-dome-m"``."""
+    for profile, pattern in _OWN_BANNERS:
+        match = pattern.search(text)
+        if match is None:
+            continue
+        raw = match.group().encode("latin-1")
+        codecs = {
+            "default": (DefaultCodec(), DefaultCodec(checksum=False)),
+            "framed": (FramedCodec(FramedSpec()),),
+            "binary": (BinaryCodec(),),
+        }[profile]
+        for codec in codecs:
+            reply, _ = codec.decode_reply(raw, None)
+            if not isinstance(reply, Banner):
+                continue
+            result.profile, result.baudrate = profile, baud
+            if isinstance(codec, DefaultCodec) and not codec.checksum:
+                result.extra_lines = ["[dome.serial.default]", "checksum = false"]
+            notes = []
+            if reply.identity is not None:
+                who = reply.identity
+                notes.append(
+                    f"it announced {who.firmware_id} {who.version} with {who.led_count} LEDs"
+                )
+            if profile in _OWN_UNHEARD:
+                notes.append(_OWN_UNHEARD[profile])
+            result.note = "; ".join(notes) or None
+            return True
+    return False
+
+
 def probe(request: ProbeRequest, result: ProbeResult | None = None) -> ProbeResult:
     """Try the known firmwares on ``request.port``; see the module docstring for the order.
 
@@ -730,15 +807,22 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
             return result
+        own_at_9600 = _own_protocol(text)
         text = _exchange(result, _LISTEN_SAID.format(baud=115200), 115200, wait, b"", 0)
         if _nichlock_found(result, text, 115200):
+            return result
+        # rti-rig's own protocols announce themselves at boot: heard at both rates, the link
+        # ignores the rate (a board's native USB, a pty), and 115200 is the profiles' own
+        if _own_protocol_found(result, text, 115200) or (
+            own_at_9600 is not None and _own_protocol_found(result, own_at_9600, 9600)
+        ):
             return result
         # nichlock's settings menu (``a``, ``2``) stores 19200 or 2400 too, taken at its next
         # boot: listened for before anything is sent, since bytes at another rate reach such a
         # board as keys of its menus (a board set so had been "No known dome firmware")
         for rate in NICHLOCK_OTHER_RATES:
             text = _exchange(result, _LISTEN_SAID.format(baud=rate), rate, wait, b"", 0)
-            if _nichlock_found(result, text, rate):
+            if _nichlock_found(result, text, rate) or _own_protocol_found(result, text, rate):
                 return result
         text = _exchange(result, "'?' at 38400 baud", 38400, 0.2, b"?", 0.5)
         if _ELEXOL_SAYS in text:

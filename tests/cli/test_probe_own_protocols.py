@@ -1,0 +1,58 @@
+"""``rti-rig probe`` names a board that speaks one of rti-rig's own protocols.
+
+The shipped hardware dome configs speak the project's own protocols (``default``, ``framed``),
+whose boards print a ``READY`` banner at every boot. The probe knew only other projects'
+firmwares: on such a board it said "No known dome firmware answered", the ``READY`` line among
+the lines heard, and advised ``profile = "rti-dome-m"`` (a dome that never answers).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, emulated_dome_as_hardware, said, shipped_dome_on_pty
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+runner = CliRunner()
+
+
+def test_probe_names_the_default_protocol_of_the_shipped_emulated_dome(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    port = "/dev/ttyACM7"
+    (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
+    config = emulated_dome_as_hardware(tmp_path, "emulated_dome.toml", port)
+    with shipped_dome_on_pty(monkeypatch, config) as firmware:
+        r = runner.invoke(app, ["probe", port], terminal_width=400)
+        words = said(r)
+        assert r.exit_code == 0, words
+        assert "No known dome firmware" not in words and "Traceback" not in words
+        assert f'Found: default. Rig-config lines to use: [dome.serial] port = "{port}" ' in words
+        assert 'profile = "default" baudrate = 115200' in words, words
+        assert "it announced RTIDOME-EMU 1.0.0 with 48 LEDs" in words
+        assert "Lights: nothing was lit by the probe" in words
+        assert firmware.commands_received == 0  # it only listened
+
+
+def test_probe_names_the_framed_protocol_of_the_shipped_hardware_dome(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    config = CONFIGS / "example_dome_48.toml"
+    port = "/dev/serial/by-id/usb-Arduino_Mega_2560-if00"
+    assert f'port = "{port}"' in config.read_text()
+    with shipped_dome_on_pty(monkeypatch, config):
+        r = runner.invoke(app, ["probe", port], terminal_width=400)
+        words = said(r)
+        assert r.exit_code == 0, words
+        assert "No known dome firmware" not in words and "Traceback" not in words
+        assert "Found: framed." in words and 'profile = "framed" baudrate = 115200' in words
+        # what its banner does not tell (the shipped config's index_base = 1) is named
+        assert "set [dome.serial.framed]" in words and "index_base" in words
