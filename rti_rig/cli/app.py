@@ -145,6 +145,28 @@ def quiet_library_logs() -> None:
         logging.getLogger(name).propagate = False
 
 
+def warnings_as_notes() -> None:
+    """Any Python warning that reaches the console is said as a note: its message alone, once.
+
+    Why: a warning no command turned into its own words (a library's, or a fit's trust
+    warning on a path not yet worded) printed Python's form, with a source file path and line
+    (``.../rti_rig/app/usecases/adaptive.py:176: IllConditionedFitWarning: ...``), which
+    tells a user nothing they can act on. Set for the console entry only: a caller of the
+    app from Python keeps its own warning handling."""
+    import warnings
+
+    said: set[str] = set()
+
+    def as_note(message, category, *_args, **_kwargs):  # type: ignore[no-untyped-def]
+        text = str(message)
+        if text not in said:
+            said.add(text)
+            err.print(f"[yellow]note:[/] {escape(text)}", soft_wrap=True, highlight=False)
+
+    warnings.showwarning = as_note
+
+
 def main() -> None:
     quiet_library_logs()
+    warnings_as_notes()
     app()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shlex
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -47,7 +48,11 @@ def print_verdict(session: Path | None) -> None:
     try:  # the import too: a SIGTERM while it loads (slow on a busy machine) is the verdict's
         from rti_rig.app.usecases.fit import verdict_for_session
 
-        out.print(f"QA verdict: {escape(verdict_for_session(session))}")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            verdict = verdict_for_session(session)
+        out.print(f"QA verdict: {escape(verdict)}")
+        _say_verdict_warnings(caught)
     except (RtiRigError, ValueError) as exc:
         err.print(f"[yellow]QA verdict unavailable:[/] {escape(str(exc))}")
     except KeyboardInterrupt:  # the session is complete: only the advice is cut short
@@ -61,6 +66,34 @@ def print_verdict(session: Path | None) -> None:
             f"rti-rig fit {escape(shlex.quote(str(session)))} --out FOLDER gives the verdict"
         )
         raise typer.Exit(code=143) from None
+
+
+def _say_verdict_warnings(caught: list[warnings.WarningMessage]) -> None:
+    """What the verdict's fits warned of, said once each as a note in the run's words.
+
+    Why: a session whose lights leave the normals poorly determined (``run --adaptive
+    --max-elevation-deg 10`` on the simulated arm: all lights within 10° of the horizon)
+    printed a raw ``IllConditionedFitWarning`` with the QA module's file path and line under
+    the verdict; the user was told neither what it meant for the session nor what to do."""
+    from rti_rig.reconstruct.errors import FitTrustWarning
+
+    said: set[str] = set()
+    for w in caught:
+        text = str(w.message)
+        if text in said:
+            continue
+        said.add(text)
+        if issubclass(w.category, FitTrustWarning):
+            err.print(
+                "[yellow]note:[/] this session's lights leave its surface normals poorly "
+                f"determined ({escape(text)}): its normal map, and relighting away from its "
+                "lights, are noisy whatever the verdict says of the images. To capture it "
+                "again with normals to trust, widen the elevation band "
+                "(--min-elevation-deg/--max-elevation-deg) or add lights at other elevations",
+                soft_wrap=True,
+            )
+        else:
+            err.print(f"[yellow]note:[/] {escape(text)}", soft_wrap=True)
 
 
 class VerdictTerminated(BaseException):

@@ -23,7 +23,8 @@ from __future__ import annotations
 import shlex
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
 from types import SimpleNamespace
@@ -137,6 +138,22 @@ def small_grey(pixels: NDArray, white_level: float = 65535.0) -> NDArray[np.floa
     return g / np.float32(white_level)
 
 
+@contextmanager
+def _decision_fit() -> Iterator[None]:
+    """The chooser's own fits on the images so far, their trust warnings silenced.
+
+    Why: each decision fits a small sample of the first few lights, which is ill-conditioned
+    by nature (4 lights of a narrow band always are): ``run --adaptive --max-elevation-deg
+    10`` on the simulated arm printed a raw ``IllConditionedFitWarning`` with this module's
+    path three times per image. Those fits only rank the next light; what the finished
+    light set is worth is judged by the QA verdict and by ``rti-rig fit``, which say it."""
+    from rti_rig.reconstruct.errors import FitTrustWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitTrustWarning)
+        yield
+
+
 def fit_state(images: NDArray[np.float32], lights: NDArray[np.float64]) -> SurfaceState | None:
     """What the images so far say of the surface, for the chooser (None: not yet solvable).
 
@@ -173,7 +190,8 @@ def relief_px(images: NDArray, lights: NDArray[np.float64]) -> NDArray[np.float6
 
     try:
         # least squares: the relief only places cast shadows, and it is 10× cheaper on every pixel
-        ps = fit_photometric_stereo(np.asarray(images, dtype=np.float32), lights, robust=False)
+        with _decision_fit():
+            ps = fit_photometric_stereo(np.asarray(images, dtype=np.float32), lights, robust=False)
     except ReconstructionError:
         return None
     n = np.where(ps.valid[..., None], ps.normals, np.float32([0.0, 0.0, 1.0])).astype(np.float64)
@@ -199,7 +217,8 @@ def fit_sample(
     if k < 3:
         return None
     try:
-        ps = fit_photometric_stereo(obs[:, None, :], lights, robust=True)
+        with _decision_fit():
+            ps = fit_photometric_stereo(obs[:, None, :], lights, robust=True)
     except ReconstructionError:
         return None
     seen = obs.max(axis=0) > ps.dark_threshold  # not dark under every light so far
@@ -256,7 +275,8 @@ def robust_fit(
     from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo
 
     try:
-        ps = fit_photometric_stereo(obs[:, None, :], lights, robust=True)
+        with _decision_fit():
+            ps = fit_photometric_stereo(obs[:, None, :], lights, robust=True)
     except ReconstructionError:
         return None
     return ps.normals.reshape(-1, 3), ps.valid.ravel()
