@@ -1089,17 +1089,48 @@ def _execute(opened, handover: HandOver | None = None) -> bool:  # type: ignore[
     try:
         return _run_and_report(opened, handover)
     finally:
-        put_back(previous)
+        try:
+            _print_failures(_close_left_open(opened))  # a stop the capture never answered
+        finally:
+            put_back(previous)
+
+
+def _close_left_open(opened) -> list[str]:  # type: ignore[no-untyped-def]
+    """Make safe and close a rig the capture's teardown never took (nothing if it did): the
+    lights' all-off where their link is open (a dome held open after metering), then the
+    close; what failed, said by the caller. Signals are held until both are through.
+
+    Why: ``run`` counted the capture as begun (``started = True``) before it called it, and
+    the controller's teardown takes the rig only once the capture runs: a stop in between
+    skipped both, and the emulated dome, held open after ``--auto-exposure``, was neither
+    switched off nor closed. Called from :func:`_execute`'s ``finally``, so it holds from the
+    moment the opened rig is handed over, whatever ends the command."""
+    from rti_rig.runtime.deferred_signals import signals_deferred
+    from rti_rig.runtime.lighting import attempt_all
+
+    if opened.closed:
+        return []
+    rig = opened.rig
+    failures: list[str] = []
+    with signals_deferred():
+        if getattr(rig.lighting, "link_open", False):
+            failures += rig.lighting.safe(emergency=True)
+        # the devices' own close, as the controller's teardown closes them, then the rig's
+        failures += attempt_all(
+            [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
+        )
+        try:
+            opened.close()
+        except Exception as exc:  # closing what the opening opened: said, never a traceback
+            failures.append(f"closing the rig failed: {exc}")
+    return failures
 
 
 def _stopped_before_capture(opened, why: str) -> typer.Exit:  # type: ignore[no-untyped-def]
     """Close a session stopped after it opened and before its capture began, say so as a stop
     while opening is said, and give the exit a stop by ``why`` asks (the capture's own
-    teardown never ran: the rig is closed here)."""
-    try:
-        opened.close()
-    except Exception as exc:  # closing what the opening opened: said, never a traceback
-        err.print(f"[yellow]Closing the rig failed:[/] {escape(str(exc))}")
+    teardown never ran: the rig is made safe and closed here)."""
+    _print_failures(_close_left_open(opened))
     if opened.resumed:
         said = (
             f"Stopped ({why}) before the session went on: no new image was captured; continue "
@@ -1318,19 +1349,20 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             started = True
             result = capture()
             over = True
-    except EmergencyStop as exc:
+    except (EmergencyStop, KeyboardInterrupt) as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
-        if not started:  # before the capture began: nothing was lit or written by it
-            raise _stopped_before_capture(opened, str(exc)) from None
+        why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
+        if not started or folder.run_end is None:
+            # before the capture began, or before the controller took the rig (its teardown
+            # records the run's end whatever happens): nothing was lit or written by it
+            raise _stopped_before_capture(opened, why) from None
 
         failed = _print_teardown_failures(folder)
-        err.print(
-            f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig, failed))}."
-        )
+        err.print(f"[red]Emergency stop ({escape(why)}):[/] {escape(lights_state(rig, failed))}.")
         teardown_said = True
         err.print(_after_stop(opened, resume_hint()), markup=False, soft_wrap=True)
-        raise typer.Exit(code=stop_exit_code(str(exc))) from None
+        raise typer.Exit(code=stop_exit_code(why)) from None
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 

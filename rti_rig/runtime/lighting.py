@@ -142,6 +142,13 @@ class DomeLighting:
     def safe(self, emergency: bool = False) -> list[str]:
         return attempt_all([("all LEDs off", self.source.all_off)])
 
+    @property
+    def link_open(self) -> bool:
+        """Whether the dome's port is open now (connected, or held open after metering): an
+        all-off can then be sent without opening it, which may reset a board that boots lit."""
+        link = getattr(self.source, "link", self.source)
+        return bool(getattr(link, "port_open", False))
+
 
 class ArmLighting:
     """An arm: move, then lamp on; the reached direction is the recorded one.

@@ -156,6 +156,9 @@ class OpenedSession:
     #: the request a resumed session was opened by (None: a new session): what the user gave
     #: (a rig config, --accept-rig-change …), which the command to continue with must repeat
     request: ResumeRequest | None = None
+    #: whether :meth:`close` has been called (the capture's ``with`` closes the rig; a stop
+    #: before it took the rig leaves the command to close it, once)
+    closed: bool = False
 
     @property
     def dry_run(self) -> bool:
@@ -178,6 +181,7 @@ class OpenedSession:
     def close(self) -> None:
         from rti_rig.runtime.session import unlock_session
 
+        self.closed = True
         try:
             self.rig.close()
         finally:

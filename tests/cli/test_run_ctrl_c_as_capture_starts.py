@@ -1,0 +1,56 @@
+"""A Ctrl-C landing as the capture starts (after ``run`` counted the capture as begun, before
+the controller's own teardown took charge of the rig) still sends the dome its all-off and
+closes the rig, and is said as a stop before the first image.
+
+``run`` marked the capture begun (``started = True``) and then called it: a stop in those
+few bytecodes, or before the session's ``with`` took the rig, was answered by neither the
+opening's clean-up nor the controller's teardown: the emulated dome, held open (lights off)
+after ``--auto-exposure``'s metering, was neither sent an all-off nor closed. The stop is
+injected exactly there: the step that follows (the use case's ``run_opened_session``)
+raises KeyboardInterrupt before it does anything."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+import rti_rig.app.usecases.session as session_usecase
+from rti_rig.cli import app
+from rti_rig.simulator.dome_firmware import DomeFirmware
+
+
+def test_a_ctrl_c_as_the_capture_starts_switches_the_emulated_dome_off_and_closes_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    received: list[str] = []
+    real_execute = DomeFirmware._execute
+
+    def execute(self, seq, cmd, now):  # type: ignore[no-untyped-def]
+        received.append(type(cmd).__name__)
+        return real_execute(self, seq, cmd, now)
+
+    monkeypatch.setattr(DomeFirmware, "_execute", execute)
+    seen: dict[str, Any] = {}
+
+    def interrupted(opened, *args: Any, **kwargs: Any) -> Any:
+        seen["opened"], seen["before"] = opened, len(received)
+        raise KeyboardInterrupt  # as a stop landing before the controller took the rig
+
+    monkeypatch.setattr(session_usecase, "run_opened_session", interrupted)
+    out = tmp_path / "s"
+    # metered first: its teardown keeps the dome's port open (lights off) for the capture
+    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
+    r = CliRunner().invoke(app, [*argv, "--auto-exposure", "--no-verdict"], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert "opened" in seen, said
+    assert seen["before"] > 0, said  # metering spoke to the dome (lit it, switched it off)
+    assert "AllOff" in received[seen["before"] :], (received, said)
+    assert not seen["opened"].rig.lighting.source.link.port_open, said  # the rig was closed
+    assert "Stopped (Ctrl-C) before the first image: nothing was captured" in said, said
+    assert "Traceback" not in said, said
+    assert r.exit_code == 130, said
+    assert not any(out.glob("image_*"))
