@@ -204,7 +204,8 @@ def run(
     switches the dome off, once its board has booted (a few seconds; a further Ctrl-C waits
     for it): opening its port may have reset a board that boots lit.
     SIGUSR1 pauses or resumes between images. An interrupted session can be continued with
-    --resume.
+    --resume. Exit 130 after a Ctrl-C stop, 143 after a SIGTERM, also one that comes while a
+    stop or an error is being reported (the report is finished first).
     """
     from rti_rig.app.usecases.session import (
         NewSessionRequest,
@@ -306,8 +307,9 @@ def run(
             not_opened=f"Nothing was captured or written to {out_dir}",
         )
     with _late_pause_ignored(), _late_term_held() as late_term:
-        opened, handover = _open_for_capture(opening)
-        unsafe = _execute(opened, handover)
+        with _sigterm_exit_wins(late_term):
+            opened, handover = _open_for_capture(opening)
+            unsafe = _execute(opened, handover)
         if late_term:  # the summary is out; the verdict, not computed, is fit's to give
             _refuse_unsafe_end(unsafe, exit_code=None)
             err.print(
@@ -608,6 +610,31 @@ def _late_term_held() -> Iterator[list[int]]:
 
     with signal_handlers({signal.SIGTERM: late}):
         yield held
+
+
+@contextmanager
+def _sigterm_exit_wins(late_term: list[int]) -> Iterator[None]:
+    """A run that ends with its own exit (a Ctrl-C stop's 130, an error's 2, an unsafe end's
+    1) after a SIGTERM was held while that end was said (``late_term``, from
+    :func:`_late_term_held`) exits 143 instead, once what it was saying is out, and says so.
+
+    Why: a SIGTERM in the window where the run reports how its capture ended (the ``except``
+    and ``finally`` clauses after a Ctrl-C, a failure's report) was recorded and then lost:
+    the run exited 130 or 2, and a service manager or ``timeout`` that sent the SIGTERM was
+    told the run had ended on a Ctrl-C or an error of its own. The SIGTERM is the last thing
+    asked of the run, so its exit is the one a SIGTERM has everywhere else (143); the stop's
+    or the error's words, printed above, still say what happened."""
+    try:
+        yield
+    except typer.Exit as exc:
+        if not late_term or exc.exit_code == 143:
+            raise
+        err.print(
+            "[yellow]SIGTERM while the run's end was being said: what is said above stands; "
+            f"exit 143 for the SIGTERM (not {exc.exit_code}).[/]",
+            soft_wrap=True,
+        )
+        raise typer.Exit(code=143) from None
 
 
 @contextmanager
@@ -1638,8 +1665,9 @@ def preview(
     )
     # a SIGTERM once the capture is over: the summary and the plan hint finish first
     with _late_term_held() as late_term:
-        opened, handover = _open_for_capture(opening)
-        unsafe = _execute(opened, handover)
+        with _sigterm_exit_wins(late_term):
+            opened, handover = _open_for_capture(opening)
+            unsafe = _execute(opened, handover)
         # the band given here is the one to plan in: said in the command to copy
         band = "".join(
             f" {flag} {value:g}"
