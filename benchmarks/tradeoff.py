@@ -388,6 +388,37 @@ def _series(rows: list[Row], scene: str) -> dict[str, list[Row]]:
     return out
 
 
+#: Tick values tried, coarsest first, in each decade of a log axis.
+_LOG_TICK_SUBS = ((1.0,), (1.0, 2.0, 5.0), (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0))
+
+
+def _plain_log_ticks(ax: Any) -> None:
+    """Label a log x axis with a few plain numbers (6, 8, 10), the coarsest set giving three.
+
+    Left to matplotlib, an axis spanning less than a decade (an acquisition of 16 lights:
+    N = 6…13) labels every minor tick in scientific notation, "6×10⁰ … 9×10⁰", which overlap
+    into an unreadable run at the figure's size.
+    """
+    import math
+
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    xs = [x for line in ax.get_lines() for x in line.get_xdata() if np.isfinite(x) and x > 0]
+    if not xs:
+        return
+    lo, hi = min(xs), max(xs)
+    decades = range(math.floor(math.log10(lo)), math.floor(math.log10(hi)) + 1)
+    ticks: list[float] = []
+    for subs in _LOG_TICK_SUBS:
+        ticks = [s * 10.0**k for k in decades for s in subs if lo <= s * 10.0**k <= hi]
+        if len(ticks) >= 3:
+            break
+    if ticks:
+        ax.set_xticks(ticks)
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:g}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
 def plot(rows: list[Row], out_dir: Path) -> list[Path]:
     """Error against N and against session time, one figure per metric."""
     import matplotlib
@@ -420,6 +451,7 @@ def plot(rows: list[Row], out_dir: Path) -> list[Path]:
                         label=series,
                     )
                 ax.set_xscale("log")
+                _plain_log_ticks(ax)
                 ax.set_title(scene)
                 ax.set_xlabel(x_label)
                 ax.grid(alpha=0.3)

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import csv
+import itertools
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -574,3 +576,52 @@ def test_a_folder_of_links_to_the_acquisitions_images_is_refused_as_out_even_wit
     assert links and all(p.is_symlink() for p in links)
     _refused_as_out(lp, project / "jpeg-exports")
     _refused_as_out(lp, shots)  # the links' targets: only the links, resolved, name it
+
+
+@pytest.mark.parametrize("ns", [(6, 9, 12, 13), (4, 6, 9, 12, 18, 24, 36, 48)])
+def test_the_plots_x_axes_read_as_plain_numbers_that_do_not_overlap(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, ns: tuple[int, ...]
+) -> None:
+    """An acquisition of 16 lights plots N = 6…13, less than a decade on a log axis: its ticks
+    were labelled "6×10⁰ 7×10⁰ 8×10⁰ 9×10⁰", run into one another. Every figure's x labels are
+    plain numbers, at least two of them, none overlapping another."""
+    from matplotlib.figure import Figure
+
+    from benchmarks.tradeoff import Row, plot
+
+    seen: list[tuple[list[str], list[Any]]] = []  # each figure's x labels and their boxes
+    savefig = Figure.savefig
+
+    def keep(fig: Figure, *args, **kwargs):  # type: ignore[no-untyped-def]
+        result = savefig(fig, *args, **kwargs)  # drawn: the labels and their extents are set
+        ax = fig.axes[0]
+        lo, hi = ax.get_xlim()
+        labels = [
+            t
+            for t in ax.get_xticklabels(which="both")
+            if t.get_visible() and t.get_text() and lo <= t.get_position()[0] <= hi
+        ]
+        renderer = fig.canvas.get_renderer()
+        seen.append(
+            ([t.get_text() for t in labels], [t.get_window_extent(renderer) for t in labels])
+        )
+        return result
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    nan = float("nan")
+
+    def row(method: str, n: int) -> Row:  # arm times differ by method, as in a simulated run
+        arm_s = 2.3 * n + (method == "optimal")
+        return Row("acq", method, "normals", n, 0.0, 1 / n, nan, 1.0, "ptm", 20.0 + n, nan,
+                   1.17 * n, arm_s, 0.0)  # fmt: skip
+
+    rows = [row(method, n) for method in ("uniform", "optimal") for n in ns]
+    paths = plot(rows, tmp_path)
+    assert len(seen) == len(paths) == 6
+    for (texts, boxes), path in zip(seen, paths, strict=True):
+        assert len(texts) >= 2, (path.name, texts)
+        for text in texts:
+            float(text)  # "8", "10", "15": not "$\\mathdefault{8\\times10^{0}}$"
+        boxes = sorted(boxes, key=lambda b: b.x0)
+        for a, b in itertools.pairwise(boxes):
+            assert a.x1 <= b.x0, (path.name, texts)
