@@ -13,7 +13,9 @@ from rti_rig.cli.app import app, err, fail, out, print_notes
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import ensure_writable_folder, refuse_a_file_in_the_way
 
-bench_app = typer.Typer(help="Benchmarks on the simulator: the speed/accuracy trade.")
+bench_app = typer.Typer(
+    help="Benchmarks: the speed/accuracy trade, on the simulator or on your own acquisition."
+)
 app.add_typer(bench_app, name="bench")
 
 
