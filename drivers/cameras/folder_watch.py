@@ -72,11 +72,18 @@ import numpy as np
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
-from rti_rig.core.image_files import CAMERA_RAW_SUFFIXES, TIFF_MAGIC, is_camera_raw, tiff_extent
+from rti_rig.core.image_files import (
+    CAMERA_RAW_SUFFIXES,
+    TIFF_MAGIC,
+    colour_or_grey,
+    is_camera_raw,
+    tiff_extent,
+)
 from rti_rig.drivers.cameras.dng_tags import IfdState, ifd_state
 from rti_rig.drivers.cameras.image_io import (
     ImageReadError,
     read_image_file,
+    tiff_extra_samples,
     to_linear_uint16,
 )
 from rti_rig.drivers.cameras.raw_decode import (
@@ -456,6 +463,9 @@ class FolderWatchCamera:
         #: pattern matches)
         self._at_connect: set[str] = set()
         self._pending: _Pending | None = None
+        #: the first file of this run whose alpha was dropped: the notice names it, one
+        #: wording for every image so the session says it once (with how many images)
+        self._alpha_first: str | None = None
         #: (capture time, pulse time) of the last image whose file had a capture time: the
         #: camera clock's anchor to the pulses
         self._anchor: tuple[float, float, float] | None = None
@@ -1557,6 +1567,40 @@ class FolderWatchCamera:
             "copy",
         )
 
+    def _without_alpha(
+        self, path: Path, watched: Path, image: np.ndarray
+    ) -> tuple[np.ndarray, str]:
+        """``image`` (read from ``path``, the copy of ``watched``) with a TIFF's extra samples
+        (alpha) dropped, and the notice saying so ("" when it had none); refused when the
+        alpha is premultiplied (associated).
+
+        Why: a tethering program may save grey + alpha (2 samples) or RGBA (4); grey + alpha
+        had stopped the run with "expected an H×W or H×W×3 image". Unassociated alpha carries
+        no light, so the grey or colour samples are the shot. Premultiplied alpha has scaled
+        every sample by it: dropped, the pixels would be darker wherever alpha is below full,
+        and nothing would say so."""
+        extra = tiff_extra_samples(path)
+        if not extra or image.ndim != 3 or image.shape[2] in (1, 3):
+            return image, ""
+        if "associated" in extra:
+            raise CaptureError(
+                self.name,
+                f"{watched.name} has premultiplied (associated) alpha: its grey or colour "
+                "samples were multiplied by the alpha, so they are not the light the camera "
+                "measured, and dropping the alpha would not give them back; save it without "
+                "alpha (turn the alpha channel or transparency off in the tethering program's "
+                "TIFF settings), then run again (a --resume of a session with images shoots "
+                "this light again)",
+                "decode",
+            )
+        self._alpha_first = self._alpha_first or watched.name
+        kind = "alpha channel" if "unassociated" in extra else "extra channel of no stated use"
+        note = (
+            f"the watched TIFFs (first {self._alpha_first}) have an {kind} (ExtraSamples), which "
+            "carries no light: it was dropped and the grey or colour samples recorded"
+        )
+        return np.ascontiguousarray(colour_or_grey(image)), note
+
     def _decode(
         self, path: Path, exposure_s: float, started: float, watched: Path | None = None
     ) -> Frame:
@@ -1591,6 +1635,7 @@ class FolderWatchCamera:
                     f"{watched.name} is 8-bit (gamma-encoded), not linear data: {fix}",
                     "decode",
                 )
+            image, alpha_note = self._without_alpha(path, watched, image)
             response = "linear" if s.eight_bit_response == "refuse" else s.eight_bit_response
             try:
                 pixels, white = to_linear_uint16(image, response, order="rgb")
@@ -1599,6 +1644,8 @@ class FolderWatchCamera:
             file_exposure, gain = None, s.gain
             metadata = {"source_file": str(path), "bit_depth": 8 * image.dtype.itemsize}
             metadata.update(exposure_stats(pixels, white, s.decode.underexposed_level))
+            if alpha_note:
+                metadata["notices"] = [alpha_note]
         if file_exposure is not None and s.exposure_tolerance is not None:
             rel = abs(file_exposure - exposure_s) / exposure_s
             if rel > s.exposure_tolerance:

@@ -20,6 +20,7 @@ from rti_rig.core.errors import CaptureError
 from rti_rig.core.image_files import (
     SeveralFullSizeImages,
     tiff_is_planar,
+    tiff_main_image,
     tiff_one_image,
     tiff_samples_last,
 )
@@ -192,6 +193,32 @@ def tiff_contradiction(page: Any) -> str | None:
             f"SamplesPerPixel {said}{' applies' if samples_tag is None else ''}"
         )
     return None
+
+
+#: TIFF ExtraSamples values (TIFF 6.0, section 18): what an extra sample per pixel is
+EXTRA_SAMPLE_KINDS = {0: "unspecified", 1: "associated", 2: "unassociated"}
+
+
+def tiff_extra_samples(path: Path) -> tuple[str, ...]:
+    """What the extra samples of a TIFF's full-resolution image are, by its ExtraSamples tag
+    (``"associated"`` alpha, i.e. premultiplied; ``"unassociated"`` alpha; ``"unspecified"``),
+    one word per extra sample; empty for no extra samples, another format, or a file that
+    will not parse (its reader says why).
+
+    Why: a tethering program may save grey + alpha or RGBA. Unassociated alpha carries no
+    light and can be dropped; premultiplied alpha has already scaled every colour sample by
+    it, so the pixels left once it is dropped are not what the camera measured."""
+    if path.suffix.lower() not in (".tif", ".tiff"):
+        return ()
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(path) as tif:
+            page = tiff_main_image(tif).keyframe
+            values = tuple(int(v) for v in (getattr(page, "extrasamples", ()) or ()))
+    except Exception:  # tifffile raises many kinds; read_image_file names the problem
+        return ()
+    return tuple(EXTRA_SAMPLE_KINDS.get(v, "unspecified") for v in values)
 
 
 def read_image_file(path: Path, device: str) -> NDArray:

@@ -1,0 +1,65 @@
+"""A tethering program that saves each shot as a TIFF with an alpha channel (grey + alpha,
+2 samples per pixel; or RGBA, 4), its ExtraSamples tag saying so, into the watched folder of
+the shipped folder-watch dome. Unassociated alpha carries no light: ``rti-rig run`` records
+the grey or colour pixels as shot and says once that the alpha was dropped. Associated
+(premultiplied) alpha has scaled the pixels by it: the run refuses the file, naming it and
+how to save it without alpha. Grey + alpha had stopped the run with "expected an H×W or
+H×W×3 image"; premultiplied RGBA had been recorded with its alpha silently cut off."""
+
+from __future__ import annotations
+
+from io import BytesIO
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tifffile
+from conftest import journal, tethered_tiffs
+
+
+def _with_alpha(pixels: np.ndarray, alpha: str) -> bytes:
+    out = BytesIO()
+    photometric = "rgb" if pixels.shape[2] == 4 else "minisblack"
+    tifffile.imwrite(out, pixels, photometric=photometric, extrasamples=[alpha], metadata=None)
+    return out.getvalue()
+
+
+@pytest.mark.parametrize("samples", [2, 4], ids=["grey+alpha", "rgba"])
+def test_run_records_the_pixels_of_a_tiff_with_alpha_and_says_alpha_was_dropped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, samples: int
+) -> None:
+    rng = np.random.default_rng(7)
+    shots = [rng.integers(1000, 60000, (40, 56, samples), dtype=np.uint16) for _ in range(2)]
+    files = [_with_alpha(p, "unassalpha") for p in shots]
+    with tifffile.TiffFile(BytesIO(files[0])) as tif:  # the files are as described
+        page = tif.pages[0]
+        assert page.samplesperpixel == samples and tuple(page.extrasamples) == (2,)
+    r, said, _tether, out, lit_at_end = tethered_tiffs(tmp_path, monkeypatch, files)
+    assert r.exit_code == 0, said
+    assert "Traceback" not in said, said
+    for n, shot in enumerate(shots, 1):
+        image = tifffile.imread(out / "linear" / f"image_{n:03d}.tif")
+        expected = shot[..., :3] if samples == 4 else shot[..., 0]
+        assert image.shape == expected.shape, image.shape
+        assert np.array_equal(image, expected)  # the shot's own pixels, the alpha left out
+    assert said.count("alpha channel") == 1, said  # said once, not once per image
+    assert "IMG_0001.tif" in said and "dropped" in said, said
+    assert all(any("alpha" in n for n in s.get("notices", [])) for s in journal(out)), out
+    assert lit_at_end == []
+
+
+def test_run_refuses_a_tiff_with_premultiplied_alpha_naming_it_and_the_fix(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rng = np.random.default_rng(8)
+    shot = rng.integers(1000, 60000, (40, 56, 4), dtype=np.uint16)
+    r, said, tether, out, lit_at_end = tethered_tiffs(
+        tmp_path, monkeypatch, [_with_alpha(shot, "assocalpha")]
+    )
+    assert r.exit_code != 0, said
+    assert "Traceback" not in said, said
+    assert "IMG_0001.tif" in said and "premultiplied" in said, said
+    assert "without alpha" in said, said
+    assert (tether / "IMG_0001.tif").exists()  # the shot is left where it was saved
+    assert not list(out.glob("linear/image_*.tif"))  # nothing recorded from it
+    assert lit_at_end == []
