@@ -740,8 +740,10 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
     from rti_rig.runtime.session import RECORDS_DIR, SessionWriteError
 
     kept = opened.folder.images_kept
-    if not isinstance(exc, SessionWriteError) or _cannot_resume(opened.rig) or not kept:
-        return exc  # nothing kept: the folder may be used again, as said above
+    if not isinstance(exc, SessionWriteError) or _cannot_resume(opened.rig):
+        return exc
+    if not kept:
+        return _first_write_failed_said(exc, opened)
     shot = ""
     if exc.shot:
         # the camera's file(s) of the step the disk refused: whatever of them reached the
@@ -761,6 +763,61 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
     return RtiRigError(
         f"{exc}: the session stopped there; {what}{shot}; {_disk_fix(exc.errno_name)}, then "
         f"continue with {_continue_command(opened)}"
+    )
+
+
+def _first_write_failed_said(exc: Any, opened) -> RtiRigError:  # type: ignore[no-untyped-def]
+    """A session write the disk refused before any image was kept (``exc`` a
+    :class:`SessionWriteError`), said with the disk, its free space, where this light's shot
+    is and what the resume does.
+
+    Why: at a later image this was said with what is kept and the shot reshot; at the first
+    it ended with a bare ``error: cannot write …/linear/image_001.tif: No space left on
+    device``: not on which disk, how much room it had, that the camera's file is still in
+    the watched folder, nor that the resume sets aside the copy that reached the session and
+    shoots this light again."""
+    import shutil
+
+    where = Path(exc.path).parent
+    while not where.exists() and where != where.parent:
+        where = where.parent
+    mount = where.resolve()
+    while not mount.is_mount() and mount != mount.parent:
+        mount = mount.parent
+    try:
+        room = shutil.disk_usage(where).free
+        size = f"{room / 1e9:.1f} GB" if room >= 1e9 else f"{room / 1e6:.0f} MB"
+        free = f"{size} free now"
+    except OSError:
+        free = "its free space could not be read"
+    disk = f"the disk of {_arg(opened.out_dir)} (mounted at {mount}; {free})"
+    shot = ""
+    if exc.shot:
+        names = ", ".join(exc.shot)
+        device = opened.rig.loaded.config.camera.device or {}
+        folder = device.get("folder") if device.get("kind") == "folder_watch" else None
+        watched = Path(str(folder)).expanduser() if folder else None
+        still = [n for n in exc.shot if watched is not None and (watched / n).is_file()]
+        held = (
+            f"; this light's shot ({names}) is not recorded"
+            if watched is None
+            else f"; this light's shot ({names}) is not recorded; "
+            + (
+                f"{', '.join(still)} {'is' if len(still) == 1 else 'are'} still in the watched "
+                f"folder {watched}, but the resume will not use "
+                f"{'it' if len(still) == 1 else 'them'} (a file already in the folder when a "
+                "run starts is never taken as a light's image)"
+                if still
+                else f"it is no longer in the watched folder {watched}"
+            )
+        )
+        shot = (
+            f"{held}: the resume moves whatever of it reached the session to its recovered/ "
+            "folder and shoots this light again"
+        )
+    return RtiRigError(
+        f"{exc}: the session stopped at its first image, on {disk}; no image is kept{shot}; "
+        f"{_disk_fix(exc.errno_name)}, then continue with {_continue_command(opened)}"
     )
 
 

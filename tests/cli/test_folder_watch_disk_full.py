@@ -53,11 +53,11 @@ def _disk_full_after(monkeypatch: pytest.MonkeyPatch, copies: int) -> None:
 
 
 def _resumed(
-    monkeypatch: pytest.MonkeyPatch, cfg: Path, tether: Path, out: Path
+    monkeypatch: pytest.MonkeyPatch, cfg: Path, tether: Path, out: Path, shots: int = 2
 ) -> tuple[Any, list[tuple[str, bytes]]]:
-    """``run --resume out`` on the dome, the camera saving two new shots (IMG_0003, IMG_0004)
+    """``run --resume out`` on the dome, the camera saving ``shots`` new shots (IMG_0004 on)
     into ``tether`` at the board's shutter pulses: the CLI's result and the shots given."""
-    again = [(f"IMG_{k:04d}.DNG", flat_dng(0.1 * k)) for k in range(3, 5)]
+    again = [(f"IMG_{k:04d}.DNG", flat_dng(0.1 * k)) for k in range(4, 4 + shots)]
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
         camera = Tether(firmware, tether, again)
         camera.start()
@@ -124,3 +124,39 @@ def test_a_disk_full_at_the_steps_images_says_which_shot_and_what_the_resume_doe
     assert (out / "raw" / "image_002.dng").read_bytes() == again[0][1]
     moved = list((out / "recovered").rglob("*.dng"))
     assert [p.read_bytes() for p in moved] == [files[1][1]], moved
+
+
+def test_a_disk_full_at_the_first_image_says_the_disk_the_shot_and_what_the_resume_does(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The disk fills at the first image's linear TIFF: nothing is kept yet, and the stop was a
+    bare "cannot write …/linear/image_001.tif: No space left on device", without the disk,
+    its free space, where the shot is or what the resume does with it."""
+    from rti_rig.testing.disk_faults import failing_writes
+
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
+    out = tmp_path / "s"
+    files = [(f"IMG_{k:04d}.DNG", flat_dng(0.1 * k)) for k in range(1, 4)]
+    with failing_writes("tiff", after=0, errno_code=errno.ENOSPC):  # the 1st shot's
+        run = tethered_run(monkeypatch, cfg, tether, files, out, lights=3)
+    said = run.said
+    assert run.result.exit_code != 0, said
+    assert "Traceback" not in said and not run.lit_at_end, said
+    assert f"cannot write {out}/linear/image_001.tif: No space left on device" in said, said
+    assert f"stopped at its first image, on the disk of {out} (mounted at /" in said, said
+    assert " free now); no image is kept" in said, said
+    assert f"IMG_0001.DNG is still in the watched folder {tether}, but the resume" in said
+    assert "recovered/ folder and shoots this light again" in said, said
+    assert (
+        f"free space on that disk (or lift the file-size limit or quota), then continue "
+        f"with rti-rig run --resume {out}" in said
+    ), said
+
+    # the resume, as said: the copy that reached the session is set aside, the light reshot
+    r, again = _resumed(monkeypatch, cfg, tether, out, shots=3)
+    assert r.exit_code == 0, r.output
+    assert (out / "raw" / "image_001.dng").read_bytes() == again[0][1]
+    moved = list((out / "recovered").rglob("*.dng"))
+    assert [p.read_bytes() for p in moved] == [files[0][1]], moved
