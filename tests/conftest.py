@@ -116,11 +116,13 @@ def tethered_run(
     out: Path,
     camera: Callable[[Any], Any] | None = None,
     lights: int = 2,
+    resume: bool = False,
 ) -> TetheredRun:
-    """``rti-rig run cfg --out out --lights <lights> --no-verdict`` on the shipped dome emulated
-    on a pty (:func:`shipped_dome_on_pty`), a :class:`Tether` saving ``files`` into ``tether``
-    (or the thread ``camera(firmware)`` builds: one with a ``stop`` event), stopped whatever
-    the command did. One spelling of the folder-watch CLI tests' set-up, which had each written
+    """``rti-rig run cfg --out out --lights <lights> --no-verdict`` (with ``resume``: ``rti-rig
+    run --resume out --no-verdict``) on the shipped dome emulated on a pty
+    (:func:`shipped_dome_on_pty`), a :class:`Tether` saving ``files`` into ``tether`` (or the
+    thread ``camera(firmware)`` builds: one with a ``stop`` event), stopped whatever the
+    command did. One spelling of the folder-watch CLI tests' set-up, which had each written
     it out."""
     from typer.testing import CliRunner
 
@@ -130,7 +132,11 @@ def tethered_run(
         thread = camera(firmware) if camera is not None else Tether(firmware, tether, files)
         thread.start()
         try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", str(lights), "--no-verdict"]
+            args = (
+                ["run", "--resume", str(out), "--no-verdict"]
+                if resume
+                else ["run", str(cfg), "--out", str(out), "--lights", str(lights), "--no-verdict"]
+            )
             r = CliRunner().invoke(app, args, terminal_width=400)
         finally:
             thread.stop.set()

@@ -21,11 +21,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import folder_watch_config, shipped_dome_on_pty
+from conftest import folder_watch_config, tethered_run
 from dng_spec_writer import dng, mosaic_from_rgb
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -70,17 +67,27 @@ class StampingCamera(threading.Thread):
             self.stop.wait(0.02)
 
 
-def _run(monkeypatch, cfg, tether, args, set_back_after: int | None, offset_s: float = 0.0):
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = StampingCamera(firmware, tether, set_back_after, offset_s)
-        camera.start()
-        try:
-            r = CliRunner().invoke(app, [*args, "--no-verdict"], terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-        lit = firmware.lit_indices()
-    return r, " ".join(r.output.split()), lit
+def _run(
+    monkeypatch: pytest.MonkeyPatch,
+    cfg: Path,
+    tether: Path,
+    out: Path,
+    set_back_after: int | None,
+    offset_s: float = 0.0,
+    resume: bool = False,
+) -> tuple[Any, str, list[int]]:
+    """:func:`conftest.tethered_run` of 4 lights into ``out`` (or its ``resume``) with a
+    :class:`StampingCamera`: the result, its words and the LEDs lit at the end."""
+    return tethered_run(
+        monkeypatch,
+        cfg,
+        tether,
+        [],
+        out,
+        camera=lambda firmware: StampingCamera(firmware, tether, set_back_after, offset_s),
+        lights=4,
+        resume=resume,
+    )
 
 
 def test_a_camera_clock_set_back_mid_session_is_said_with_the_way_out(tmp_path, monkeypatch):
@@ -88,9 +95,7 @@ def test_a_camera_clock_set_back_mid_session_is_said_with_the_way_out(tmp_path, 
     tether.mkdir()
     cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     out = tmp_path / "s"
-    r, said, lit = _run(
-        monkeypatch, cfg, tether, ["run", str(cfg), "--out", str(out), "--lights", "4"], 2
-    )
+    r, said, lit = _run(monkeypatch, cfg, tether, out, 2)
     assert r.exit_code == 2, said
     assert "Traceback" not in said and not lit, said
     assert "is the camera firing" not in said, said
@@ -107,6 +112,6 @@ def test_a_camera_clock_set_back_mid_session_is_said_with_the_way_out(tmp_path, 
 
     clock_file.unlink()  # the way out the stop gave
     # the camera's clock stays set back
-    r, said, lit = _run(monkeypatch, cfg, tether, ["run", "--resume", str(out)], None, -3600.0)
+    r, said, lit = _run(monkeypatch, cfg, tether, out, None, -3600.0, resume=True)
     assert r.exit_code == 0, said
     assert (out / "lights.lp").read_text().split()[0] == "4"
