@@ -8,6 +8,10 @@ The pulse's own file is then out of step and rightly not taken, but every such s
 late file is shot after its pulse), and one whose capture time lands on an earlier pulse of
 the run, where a late file and a clock set back are both possible and the capture times
 cannot tell which.
+
+Each stop's way out ("If the clock was set forward/back, delete <clock file> and resume") is
+followed as written, the camera's clock left as its owner set it: the resume takes the lights
+left (the advice had been reasoned, never run).
 """
 
 from __future__ import annotations
@@ -22,11 +26,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import folder_watch_config, shipped_dome_on_pty
+from conftest import folder_watch_config, journal, tethered_run
 from dng_spec_writer import dng, mosaic_from_rgb
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -39,14 +40,23 @@ CAMERA_EPOCH = datetime.datetime(2026, 11, 30, 9, 0, 0)
 
 class ClockChangingCamera(threading.Thread):
     """A camera fired by the board's shutter line: each pulse's DNG is saved into ``folder``,
-    stamped with the camera clock at the pulse (in whole seconds, as EXIF keeps them); before
-    its third shot its owner moves the clock by ``change(pulse times)`` seconds."""
+    stamped with the camera clock at the pulse (in whole seconds, as EXIF keeps them) plus
+    ``offset_s``; before its third shot its owner moves the clock by ``change(pulse times)``
+    seconds (None: the clock is left as it is). Its file counter goes on from the files
+    already in ``folder``."""
 
-    def __init__(self, firmware: Any, folder: Path, change: Callable[[list[float]], float]) -> None:
+    def __init__(
+        self,
+        firmware: Any,
+        folder: Path,
+        change: Callable[[list[float]], float] | None,
+        offset_s: float = 0.0,
+    ) -> None:
         super().__init__(daemon=True)
         self.firmware, self.folder, self.change = firmware, folder, change
-        self.offset_s = 0.0
+        self.offset_s = offset_s
         self.saved = 0
+        self.numbered = len(list(folder.iterdir()))
         self.stop = threading.Event()
 
     def run(self) -> None:
@@ -54,7 +64,7 @@ class ClockChangingCamera(threading.Thread):
         while not self.stop.is_set():
             pulses = [e.time_s for e in list(self.firmware.history) if e.what == "shutter"]
             while self.saved < len(pulses):
-                if self.saved == 2:
+                if self.saved == 2 and self.change is not None:
                     self.offset_s += self.change(pulses)
                 stamp = CAMERA_EPOCH + datetime.timedelta(
                     seconds=pulses[self.saved] + self.offset_s
@@ -63,11 +73,16 @@ class ClockChangingCamera(threading.Thread):
                 data = dng(
                     mosaic, "RGGB", (0,) * 4, 4095, date_time=stamp.strftime("%Y:%m:%d %H:%M:%S")
                 )
-                (self.folder / f"IMG_{self.saved:04d}.DNG").write_bytes(data)
+                name = f"IMG_{self.numbered + self.saved:04d}.DNG"
+                (self.folder / name).write_bytes(data)
             self.stop.wait(0.02)
 
 
-def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, change: Any) -> tuple[Any, str, Any]:
+def _run(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, change: Any
+) -> tuple[Any, ClockChangingCamera]:
+    """The run of 4 lights, its camera's clock moved by ``change`` before its third shot: what
+    it left (:class:`conftest.TetheredRun`) and the camera (its clock as moved)."""
     tether = tmp_path / "tether"
     tether.mkdir()
     cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
@@ -78,21 +93,41 @@ def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, change: Any) -> tuple[
     assert "settle_s = 0.2\n" in text
     cfg.write_text(text.replace("settle_s = 0.2\n", "settle_s = 1.5\n"), encoding="utf-8")
     out = tmp_path / "s"
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = ClockChangingCamera(firmware, tether, change)
-        camera.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-        lit = firmware.lit_indices()
-    return r, " ".join(r.output.split()), lit
+    cameras: list[ClockChangingCamera] = []
+
+    def camera(firmware: Any) -> ClockChangingCamera:
+        cameras.append(ClockChangingCamera(firmware, tether, change))
+        return cameras[-1]
+
+    return tethered_run(monkeypatch, cfg, tether, [], out, camera=camera, lights=4), cameras[0]
+
+
+def _follow_the_way_out(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, said: str, stopped: ClockChangingCamera
+) -> Any:
+    """Do what the stop said, as written ("If the clock was set forward/back, delete FILE and
+    resume"), the camera's clock left where its owner moved it (``stopped``'s offset: the
+    boards of both runs date their pulses by one monotonic clock): the resume's outcome."""
+    found = re.search(r"If the clock was set (?:forward|back), delete (\S+) and resume", said)
+    assert found, said
+    clock_file = Path(found.group(1))
+    assert clock_file == tmp_path / "s" / "raw" / ".folder_watch_clock.json", clock_file
+    clock_file.unlink()
+    tether = tmp_path / "tether"
+    cfg = tmp_path / "example_dome_48_folder_watch.toml"
+    return tethered_run(
+        monkeypatch,
+        cfg,
+        tether,
+        [],
+        tmp_path / "s",
+        camera=lambda firmware: ClockChangingCamera(firmware, tether, None, stopped.offset_s),
+        resume=True,
+    )
 
 
 def test_a_clock_set_forward_mid_run_is_said_as_such_not_as_a_late_file(tmp_path, monkeypatch):
-    r, said, lit = _run(tmp_path, monkeypatch, lambda pulses: 40.0)
+    (r, said, lit), stopped = _run(tmp_path, monkeypatch, lambda pulses: 40.0)
     assert r.exit_code == 2, said
     assert "Traceback" not in said and not lit, said
     assert "late file of an earlier pulse?" not in said, said
@@ -104,10 +139,18 @@ def test_a_clock_set_forward_mid_run_is_said_as_such_not_as_a_late_file(tmp_path
     clock_file = tmp_path / "s" / "raw" / ".folder_watch_clock.json"
     assert f"delete {clock_file} and resume" in said, said
 
+    resumed = _follow_the_way_out(tmp_path, monkeypatch, said, stopped)
+    assert resumed.result.exit_code == 0, resumed.said
+    assert not resumed.lit_at_end, resumed.said
+    assert (tmp_path / "s" / "lights.lp").read_text().split()[0] == "4"
+    # the resumed lights' own shots, not the set-aside IMG_0003.DNG
+    taken = [list(step["originals"].values()) for step in journal(tmp_path / "s")]
+    assert taken == [["IMG_0001.DNG"], ["IMG_0002.DNG"], ["IMG_0004.DNG"], ["IMG_0005.DNG"]]
+
 
 def test_a_clock_set_back_onto_an_earlier_pulse_is_said_as_either(tmp_path, monkeypatch):
     # set back by exactly the time since the first pulse: its capture time lands on pulse 1's
-    r, said, lit = _run(tmp_path, monkeypatch, lambda pulses: -(pulses[2] - pulses[0]))
+    (r, said, lit), stopped = _run(tmp_path, monkeypatch, lambda pulses: -(pulses[2] - pulses[0]))
     assert r.exit_code == 2, said
     assert "Traceback" not in said and not lit, said
     assert "which fits this run's pulse 1" in said, said
@@ -115,3 +158,11 @@ def test_a_clock_set_back_onto_an_earlier_pulse_is_said_as_either(tmp_path, monk
         said
     ), said
     assert "the capture times cannot tell which" in said, said
+
+    resumed = _follow_the_way_out(tmp_path, monkeypatch, said, stopped)
+    assert resumed.result.exit_code == 0, resumed.said
+    assert not resumed.lit_at_end, resumed.said
+    assert (tmp_path / "s" / "lights.lp").read_text().split()[0] == "4"
+    # the resumed lights' own shots, not the set-aside IMG_0003.DNG
+    taken = [list(step["originals"].values()) for step in journal(tmp_path / "s")]
+    assert taken == [["IMG_0001.DNG"], ["IMG_0002.DNG"], ["IMG_0004.DNG"], ["IMG_0005.DNG"]]
