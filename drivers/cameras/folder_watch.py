@@ -403,6 +403,8 @@ class _Pending:
     #: of ``out_of_step``, those shot before this run's first image, by the camera clock that
     #: image anchored: name -> how many seconds before
     before_first: dict[str, float] = field(default_factory=dict)
+    #: their capture times (camera clock), to set beside an earlier run's kept images
+    before_first_taken: dict[str, float] = field(default_factory=dict)
     #: of ``out_of_step``, the others: name -> how many seconds its capture time is after
     #: (negative: before) where this pulse's file would be, by the clock the last image
     #: anchored
@@ -445,6 +447,9 @@ class FolderWatchCamera:
         self._resume_said: str | None = None
         #: the camera clock as an earlier run of the session learned it, read at connect
         self._learned: _LearnedClock | None = None
+        #: a resume with no such clock: the earlier run's last kept camera file (its name in
+        #: the session) and its capture time (None: it holds none); None otherwise
+        self._earlier_last: tuple[str, float | None] | None = None
         self.name = settings.name
         self._trigger = trigger
         self._seen: set[str] | None = None
@@ -504,6 +509,7 @@ class FolderWatchCamera:
         self._pulse_times = []
         self._orphan = None
         self._learned = _LearnedClock.load(self._clock_file())
+        self._earlier_last = self._earlier_run_last_shot() if self._learned is None else None
         self._connected_wall, self._wall_allowance_s = self._connect_on_learned_wall()
         self._resume_said = RESUME_WALL_CHECKED if self._wall_allowance_s else None
 
@@ -931,6 +937,7 @@ class FolderWatchCamera:
                 pending.before_connect[path.name] = early
             elif (before := self._shot_before_first(taken, pending.pulse_window_s)) is not None:
                 pending.before_first[path.name] = before
+                pending.before_first_taken[path.name] = taken
             elif self._anchor is not None:
                 anchor = self._anchor
                 pending.off_step[path.name] = (taken - anchor[0]) - (pending.pulsed_at - anchor[1])
@@ -1110,6 +1117,7 @@ class FolderWatchCamera:
             return ""
         shown = ", ".join(f"{n} {s:.0f} s" for n, s in pending.before_first.items())
         many = len(pending.before_first) > 1
+        without_clock = self._without_clock_said(pending.before_first_taken)
         clock_file = self._clock_file()
         way_out = (
             f"delete {clock_file} and resume (its first image is then unchecked)"
@@ -1120,9 +1128,14 @@ class FolderWatchCamera:
             f"; {'they were' if many else 'it was'} shot before this run's first image "
             f"({shown} before, by the camera clock that image anchored), so no pulse of this "
             "run took "
-            f"{'them' if many else 'it'}: the camera's clock was set back since (a time-zone "
-            "or daylight-saving change on the camera?) or an older picture was copied into the "
-            f"folder. Not used, left in {self.settings.folder}. If the camera's clock was set "
+            f"{'them' if many else 'it'}"
+            + (
+                ":" + without_clock + " "
+                if without_clock
+                else ": the camera's clock was set back since (a time-zone or daylight-saving "
+                "change on the camera?) or an older picture was copied into the folder. "
+            )
+            + f"Not used, left in {self.settings.folder}. If the camera's clock was set "
             f"back, {way_out}"
         )
 
@@ -1141,6 +1154,71 @@ class FolderWatchCamera:
             "camera now saves there, delete "
             f"{self._clock_file()} and resume again (the first image is then unchecked)"
         )
+
+    def _earlier_run_last_shot(self) -> tuple[str, float | None] | None:
+        """The last camera file an earlier run of the session kept (``raw/image_NNN.*``, the
+        highest number) and its capture time; None when the session holds none (a new one).
+
+        Why: a resume of a session without a camera clock file (an older version's, or the
+        file deleted) has only this to date a file shot before its first image by: after the
+        earlier run's last kept shot, it fits the shot that run stopped waiting for."""
+        raw = None if self.output_dir is None else self.output_dir.parent
+        if raw is None or not raw.is_dir():
+            return None
+        kept = sorted(p for p in raw.glob("image_*.*") if p.is_file())
+        if not kept:
+            return None
+        last = kept[-1]
+        return f"{raw.name}/{last.name}", capture_time(last)
+
+    def _without_clock_said(self, shot: dict[str, float]) -> str:
+        """What is known, and what is not, of files shot before this run's first image
+        (``shot``: name → capture time) in a resume that found no camera clock of the
+        session's earlier run; "" when this run is no such resume.
+
+        Why: such a file was said to be "the camera's clock set back since … or an older
+        picture copied into the folder", though the likeliest, the shot the stopped run waited
+        for coming in late, fits too, and the earlier run's kept images tell which it can be;
+        what cannot be known without the clock file is whether the clock was changed."""
+        if self._earlier_last is None:
+            return ""
+        name, last = self._earlier_last
+        head = (
+            f" this run resumes a session that keeps no camera clock from its earlier run "
+            f"({CLOCK_FILE} was missing or unreadable when it started: a session of an older "
+            "version, or the file deleted), so whether the camera's clock was changed between "
+            "the runs is not known."
+        )
+        if last is None:
+            return (
+                f"{head} The earlier run's last kept image ({name}) holds no capture time, so "
+                "whether this is a late file of that run's last pulse (the shot it stopped "
+                "waiting for) is not known either: that, the camera's clock set back, or an "
+                "older picture copied into the folder."
+            )
+        # EXIF keeps whole seconds: within one of the last kept image, it may be after it
+        after = {n: t - last for n, t in shot.items() if t - last > -CAPTURE_TIME_RESOLUTION_S}
+        before = {n: last - t for n, t in shot.items() if n not in after}
+        said = []
+        if after:
+            shown = ", ".join(f"{n} {max(s, 0.0):.0f} s" for n, s in after.items())
+            said.append(
+                f" By the capture times {'they were' if len(after) > 1 else 'it was'} shot "
+                f"after the earlier run's last kept image ({name}; {shown} after): a late file "
+                "of the earlier run's last pulse (the shot it stopped waiting for) fits that, "
+                "if the camera's clock was not changed since; a clock set back or an older "
+                "picture copied in would look the same, and the capture times cannot tell "
+                "which."
+            )
+        if before:
+            shown = ", ".join(f"{n} {s:.0f} s" for n, s in before.items())
+            said.append(
+                f" By the capture times {'they were' if len(before) > 1 else 'it was'} shot "
+                f"before the earlier run's last kept image ({name}; {shown} before), so it is "
+                "no late file of the shot that run stopped waiting for, unless the camera's "
+                "clock was changed: the clock set back, or an older picture copied in."
+            )
+        return head + "".join(said)
 
     def _clock_file(self) -> Path | None:
         """Where the session keeps the camera clock learned: its ``raw/`` folder (the parent
