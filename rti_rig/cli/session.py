@@ -816,7 +816,7 @@ def _first_write_failed_said(exc: Any, opened) -> RtiRigError:  # type: ignore[n
             "folder and shoots this light again"
         )
     return RtiRigError(
-        f"{exc}: the session stopped at its first image, on {disk}; no image is kept{shot}; "
+        f"{exc}: the session stopped before any image was kept, on {disk}{shot}; "
         f"{_disk_fix(exc.errno_name)}, then continue with {_continue_command(opened)}"
     )
 

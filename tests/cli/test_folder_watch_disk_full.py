@@ -145,8 +145,8 @@ def test_a_disk_full_at_the_first_image_says_the_disk_the_shot_and_what_the_resu
     assert run.result.exit_code != 0, said
     assert "Traceback" not in said and not run.lit_at_end, said
     assert f"cannot write {out}/linear/image_001.tif: No space left on device" in said, said
-    assert f"stopped at its first image, on the disk of {out} (mounted at /" in said, said
-    assert " free now); no image is kept" in said, said
+    assert f"stopped before any image was kept, on the disk of {out} (mounted at /" in said
+    assert " free now); this light's shot (IMG_0001.DNG) is not recorded;" in said, said
     assert f"IMG_0001.DNG is still in the watched folder {tether}, but the resume" in said
     assert "recovered/ folder and shoots this light again" in said, said
     assert (
