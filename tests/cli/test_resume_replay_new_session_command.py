@@ -2,8 +2,9 @@
 new session with a command. That command had left out the session's options ("rti-rig run
 ACQ/dirs.lp --out NEW, with the --lights and plan options this one began with", or no command
 at all): pasted as printed, it shot every light of the acquisition in place of the session's
-plan, adaptive choice or --lights N. It now repeats them, and runs as printed into a session
-asked for what the first one was."""
+plan, adaptive choice or --lights N. It now repeats them, and runs as printed, from any
+folder (a relative --plan had been repeated as typed), into a session asked for what the first
+one was."""
 
 from __future__ import annotations
 
@@ -76,10 +77,10 @@ def test_the_new_session_a_changed_replay_is_told_to_start_runs_as_printed_with_
     shutil.copytree(ACQ, acq)
     if "plan" in options:
         r = runner.invoke(
-            app, ["plan", "--rig", str(acq / "dirs.lp"), "--lights", "6", "--out", "p.lp"]
+            app, ["plan", "--rig", str(acq / "dirs.lp"), "--lights", "6", "--out", "my plan.lp"]
         )
         assert r.exit_code == 0, r.output
-        options = {"plan": Path("p.lp")}
+        options = {"plan": Path("my plan.lp")}
     _cut_session(acq, out, **options)
     first = json.loads((out / "manifest.json").read_text())
     names = [e.name for e in read_lp(acq / "dirs.lp")]
@@ -94,7 +95,12 @@ def test_the_new_session_a_changed_replay_is_told_to_start_runs_as_printed_with_
     assert args[:2] == [str(acq / "dirs.lp"), "--out"], args
     new = Path(args[2])
     assert new.parent == out.parent and not new.exists(), args
+    if "--plan" in args:  # the plan as a path that holds from any folder
+        assert args[args.index("--plan") + 1] == str(tmp_path / "my plan.lp"), args
 
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)  # pasted in another folder than the session was started in
     r = runner.invoke(app, ["run", *args, "--no-verdict"])  # as printed
     assert r.exit_code == 0, r.output
     again = json.loads((new / "manifest.json").read_text())

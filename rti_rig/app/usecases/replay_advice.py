@@ -34,7 +34,9 @@ def new_session_command(
     """``rti-rig run CONFIG --out NEW`` with the session's layout options: its ``--plan``, its
     adaptive options (``--adaptive``, ``--lights`` when it was given, ``--until-error``,
     ``--min-lights``, ``--objective relight``) or its homogeneous ``--lights N``, and an
-    elevation band other than 0–90°, each as the manifest recorded it."""
+    elevation band other than 0–90°, each as the manifest recorded it. The plan is recorded as
+    an absolute path, so the command runs from any folder (a manifest from before that record
+    holds the path as it was typed, repeated as it is: where it was relative to is unknown)."""
     words = [
         "rti-rig run",
         shlex.quote(str(config_path)),

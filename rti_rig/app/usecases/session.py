@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import shlex
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -837,7 +837,8 @@ def refuse_unmeterable_camera(loaded) -> None:  # type: ignore[no-untyped-def]
 def new_session_schedule(  # type: ignore[no-untyped-def]
     req: NewSessionRequest, loaded, on_note: NoteSink = _ignore
 ) -> LightSchedule:
-    """The schedule a new session runs: the plan's, or a homogeneous layout."""
+    """The schedule a new session runs: the plan's, or a homogeneous layout, with what it was
+    asked for recorded in its provenance (:func:`_asked_for`)."""
     from rti_rig.app.compose import arm_order_for
     from rti_rig.app.config import rig_geometry
     from rti_rig.app.normals_determined import band_advice
@@ -864,7 +865,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
             "at several elevations and azimuths",
             on_note,
         )
-        return schedule
+        return _asked_for(schedule, req)
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     n = req.lights if req.lights is not None else default_lights(loaded, geometry)
     check_light_count(n)
@@ -899,7 +900,20 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         band_advice(req.min_elevation_deg, req.max_elevation_deg),
         on_note,
     )
-    return schedule
+    return _asked_for(schedule, req)
+
+
+def _asked_for(schedule: LightSchedule, req: NewSessionRequest) -> LightSchedule:
+    """``schedule`` whose provenance records ``--plan`` as an absolute path (``plan_file``).
+
+    Why: a refused replay resume prints the command that starts a new session with the
+    session's options (:func:`~rti_rig.app.usecases.replay_advice.new_session_command`). The
+    plan had been recorded as typed, so a relative ``--plan`` ran only from the folder the
+    session was started in."""
+    provenance = dict(schedule.provenance)
+    if req.plan is not None:
+        provenance["plan_file"] = str(Path(req.plan).resolve())
+    return replace(schedule, provenance=provenance)
 
 
 def _check_determined(
