@@ -3,8 +3,9 @@ new session with a command. That command had left out the session's options ("rt
 ACQ/dirs.lp --out NEW, with the --lights and plan options this one began with", or no command
 at all): pasted as printed, it shot every light of the acquisition in place of the session's
 plan, adaptive choice or --lights N. It now repeats them, and runs as printed, from any
-folder (a relative --plan had been repeated as typed), into a session asked for what the first
-one was."""
+folder (a relative --plan had been repeated as typed; --allow-no-normals was not recorded, and
+the command was refused the lights the session had been allowed), into a session asked for
+what the first one was."""
 
 from __future__ import annotations
 
@@ -25,6 +26,9 @@ from rti_rig.core.lp_format import read_lp
 REPO = Path(__file__).resolve().parents[2]
 ACQ = REPO / "tests" / "data" / "neuralrti_replay"
 runner = CliRunner()
+#: lights of the acquisition that cannot determine a normal (predicted error over 100°): a
+#: session of them is refused without --allow-no-normals
+RAKING = ("image01.jpg", "image09.jpg", "image13.jpg", "image69.jpg")
 
 
 def _asked(manifest: dict[str, Any]) -> dict[str, Any]:
@@ -65,9 +69,10 @@ def _cut_session(acq: Path, out: Path, **options: Any) -> None:
     [
         {"lights": 7, "min_elevation_deg": 20.0, "max_elevation_deg": 80.0},
         {"plan": "plan"},
+        {"plan": "raking", "allow_no_normals": True},
         {"adaptive": True, "lights": 7, "min_elevation_deg": 10.0},
     ],
-    ids=["lights-band", "plan", "adaptive"],
+    ids=["lights-band", "plan", "raking-plan-no-normals", "adaptive"],
 )
 def test_the_new_session_a_changed_replay_is_told_to_start_runs_as_printed_with_its_options(
     tmp_path: Path, options: dict[str, Any], monkeypatch: pytest.MonkeyPatch
@@ -75,7 +80,12 @@ def test_the_new_session_a_changed_replay_is_told_to_start_runs_as_printed_with_
     monkeypatch.chdir(tmp_path)  # the plan is given by a relative path, as users type it
     acq, out = tmp_path / "acq", tmp_path / "S"
     shutil.copytree(ACQ, acq)
-    if "plan" in options:
+    if options.get("plan") == "raking":  # 4 lights of the acquisition with no normal
+        lines = (ACQ / "dirs.lp").read_text().splitlines()[1:]
+        raking = [line for line in lines if line.split()[0] in RAKING]
+        Path("my plan.lp").write_text(f"{len(raking)}\n" + "\n".join(raking) + "\n")
+        options = {**options, "plan": Path("my plan.lp")}
+    elif "plan" in options:
         r = runner.invoke(
             app, ["plan", "--rig", str(acq / "dirs.lp"), "--lights", "6", "--out", "my plan.lp"]
         )

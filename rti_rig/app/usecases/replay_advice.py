@@ -33,8 +33,9 @@ def new_session_command(
 ) -> str:
     """``rti-rig run CONFIG --out NEW`` with the session's layout options: its ``--plan``, its
     adaptive options (``--adaptive``, ``--lights`` when it was given, ``--until-error``,
-    ``--min-lights``, ``--objective relight``) or its homogeneous ``--lights N``, and an
-    elevation band other than 0–90°, each as the manifest recorded it. The plan is recorded as
+    ``--min-lights``, ``--objective relight``) or its homogeneous ``--lights N``, an
+    elevation band other than 0–90°, and ``--allow-no-normals``, each as the manifest recorded
+    it. The plan is recorded as
     an absolute path, so the command runs from any folder (a manifest from before that record
     holds the path as it was typed, repeated as it is: where it was relative to is unknown)."""
     words = [
@@ -63,6 +64,9 @@ def new_session_command(
     elif provenance.get("n") is not None:
         words.append(f"--lights {int(provenance['n'])}")
         band = (provenance.get("min_elevation_deg"), provenance.get("max_elevation_deg"))
+    if provenance.get("allow_no_normals") is True and not isinstance(adaptive, dict):
+        # recorded since it was asked for; a manifest from before the record: not given
+        words.append("--allow-no-normals")
     low, high = band
     if low is not None and float(low) != 0.0:
         words.append(f"--min-elevation-deg {float(low):g}")

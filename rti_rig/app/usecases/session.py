@@ -904,13 +904,15 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
 
 
 def _asked_for(schedule: LightSchedule, req: NewSessionRequest) -> LightSchedule:
-    """``schedule`` whose provenance records ``--plan`` as an absolute path (``plan_file``).
+    """``schedule`` whose provenance records what the session was asked for beyond its
+    layout: ``--plan`` as an absolute path (``plan_file``) and ``--allow-no-normals``.
 
     Why: a refused replay resume prints the command that starts a new session with the
     session's options (:func:`~rti_rig.app.usecases.replay_advice.new_session_command`). The
     plan had been recorded as typed, so a relative ``--plan`` ran only from the folder the
-    session was started in."""
-    provenance = dict(schedule.provenance)
+    session was started in; ``--allow-no-normals`` was not recorded at all, so the command
+    was refused the very lights the session had been asked to capture."""
+    provenance = {**schedule.provenance, "allow_no_normals": req.allow_no_normals}
     if req.plan is not None:
         provenance["plan_file"] = str(Path(req.plan).resolve())
     return replace(schedule, provenance=provenance)
