@@ -71,8 +71,9 @@ def _cut_session(acq: Path, out: Path, **options: Any) -> None:
         {"plan": "plan"},
         {"plan": "raking", "allow_no_normals": True},
         {"adaptive": True, "lights": 7, "min_elevation_deg": 10.0},
+        {"until_error_deg": 4.0, "min_lights": 7},
     ],
-    ids=["lights-band", "plan", "raking-plan-no-normals", "adaptive"],
+    ids=["lights-band", "plan", "raking-plan-no-normals", "adaptive", "until-error"],
 )
 def test_the_new_session_a_changed_replay_is_told_to_start_runs_as_printed_with_its_options(
     tmp_path: Path, options: dict[str, Any], monkeypatch: pytest.MonkeyPatch
@@ -115,4 +116,9 @@ def test_the_new_session_a_changed_replay_is_told_to_start_runs_as_printed_with_
     assert r.exit_code == 0, r.output
     again = json.loads((new / "manifest.json").read_text())
     assert _asked(again) == _asked(first)
+    if "until_error_deg" in options:  # the stop and its floor, as the first session's
+        assert (again["adaptive"]["until_error_deg"], again["adaptive"]["min_lights"]) == (
+            options["until_error_deg"],
+            options["min_lights"],
+        ), again["adaptive"]
     assert len((out / "journal.jsonl").read_text().splitlines()) == 3  # the first one kept
