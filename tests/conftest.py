@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import contextlib
 import json
+import queue
 import re
 import signal
 import socket
+import subprocess
 import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, AnyStr, NamedTuple
 
 import numpy as np
 import pytest
@@ -453,6 +455,29 @@ def interrupted(  # type: ignore[no-untyped-def]
 
     with rig:
         return run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+
+
+def line_within(process: subprocess.Popen[AnyStr], seconds: float, what: str) -> AnyStr:
+    """The next line ``process`` prints on its stdout pipe, read on a thread and waited for at
+    most ``seconds``: past them the process is killed (by its own handle) and the test fails
+    naming ``what`` was awaited; a process that ends without a line fails it too, with its
+    exit status.
+
+    Why: a bare ``readline()`` on a child's pipe hung the run for ever, with no word, when the
+    child never printed (stuck importing or connecting on a loaded machine)."""
+    assert process.stdout is not None
+    stream = process.stdout
+    lines: queue.Queue[AnyStr] = queue.Queue()
+    threading.Thread(target=lambda: lines.put(stream.readline()), daemon=True).start()
+    try:
+        line = lines.get(timeout=seconds)
+    except queue.Empty:
+        process.kill()  # its finally need not wait on a child that is stuck
+        pytest.fail(f"{what}: no line from process {process.pid} in {seconds:.0f} s (killed)")
+    if not line:
+        status = process.wait(timeout=seconds)
+        pytest.fail(f"{what}: process {process.pid} ended (exit status {status}) without a line")
+    return line
 
 
 def said(result) -> str:  # type: ignore[no-untyped-def]

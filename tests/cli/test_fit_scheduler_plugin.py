@@ -15,13 +15,11 @@ rti-rig, met again and failing, on real Dask schedulers and workers started here
 from __future__ import annotations
 
 import os
-import queue
 import shutil
 import signal
 import subprocess
 import sys
 import textwrap
-import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -29,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from conftest import line_within
 from test_fit_scheduler_late_worker import _other_rti_rig, _until, quick_looks
 from typer.testing import CliRunner
 
@@ -55,23 +54,6 @@ def _tcp_cluster(n_workers: int) -> Any:
         host="127.0.0.1",
         dashboard_address=None,
     )
-
-
-def _line_within(process: subprocess.Popen[bytes], seconds: float, what: str) -> bytes:
-    """The next line ``process`` prints, read on a thread and waited for at most ``seconds``:
-    the test fails naming ``what`` was awaited, where a bare ``readline()`` on a loaded machine
-    (a child stuck connecting) hung the run with no word."""
-    assert process.stdout is not None
-    stream = process.stdout
-    lines: queue.Queue[bytes] = queue.Queue()
-    threading.Thread(target=lambda: lines.put(stream.readline()), daemon=True).start()
-    try:
-        return lines.get(timeout=seconds)
-    except queue.Empty:
-        pytest.fail(
-            f"{what}: no line from process {process.pid} in {seconds:.0f} s "
-            f"(exit status {process.poll()})"
-        )
 
 
 def _ours(scheduler: Any) -> list[str]:
@@ -106,7 +88,7 @@ def test_the_plugin_of_a_fit_whose_client_was_killed_is_removed_by_the_next_fit(
             env={**os.environ, "PYTHONPATH": str(Path.cwd())},
         )  # fmt: skip
         try:
-            line = _line_within(held, 300, "the holding client's 'registered'")
+            line = line_within(held, 300, "the holding client's 'registered'")
             assert line == b"registered\n"  # its plugin is registered
             (name,) = _ours(scheduler)
             (owner,) = set(scheduler.clients) - before

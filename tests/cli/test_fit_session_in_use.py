@@ -17,7 +17,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from conftest import REPO, SMALL_DOME, said, write_config
+from conftest import REPO, SMALL_DOME, line_within, said, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -49,7 +49,7 @@ def test_a_session_being_captured_is_not_fitted_or_exported(tmp_path: Path) -> N
         text=True,
     )
     try:
-        assert holder.stdout is not None and holder.stdout.readline().strip() == "locked"
+        assert line_within(holder, 120, "the lock holder's 'locked'").strip() == "locked"
         for args in (["fit", str(s)], ["fit", str(s / "lights.lp")]):
             r = runner.invoke(app, [*args, "--out", str(tmp_path / "fit")])
             assert r.exit_code == 2, r.output
@@ -100,7 +100,7 @@ def test_a_session_being_captured_is_not_planned_from(tmp_path: Path) -> None:
         text=True,
     )
     try:
-        assert holder.stdout is not None and holder.stdout.readline().strip() == "locked"
+        assert line_within(holder, 120, "the lock holder's 'locked'").strip() == "locked"
         for preview in (s, s / "image_002.jpg", s / "linear" / "image_002.tif"):
             r = runner.invoke(app, ["plan", str(preview), *args])
             assert r.exit_code == 2, r.output

@@ -15,7 +15,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from conftest import CONFIGS, said
+from conftest import CONFIGS, line_within, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -48,7 +48,7 @@ def _run_while_captured(tmp_path: Path, out: str) -> str:
         text=True,
     )
     try:
-        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        assert line_within(holder, 120, "the lock holder's 'held'").strip() == "held"
         r = runner.invoke(app, ["run", config, "--out", str(session / out), "--lights", "3"])
     finally:
         assert holder.stdin is not None

@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import SMALL_DOME, write_config
+from conftest import SMALL_DOME, line_within, write_config
 from typer.testing import CliRunner
 
 from rti_rig.app.compose import build_rig
@@ -205,7 +205,7 @@ def test_a_session_another_process_is_writing_is_not_resumed_under_it(tmp_path: 
         text=True,
     )
     try:
-        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        assert line_within(holder, 120, "the lock holder's 'held'").strip() == "held"
         r = runner.invoke(app, ["run", "--resume", str(out)])
         assert r.exit_code == 2, r.output
         assert "in use by another rti-rig process" in said(r), said(r)

@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, line_within
 from typer.testing import CliRunner
 
 from rti_rig.app.compose import build_rig
@@ -127,8 +127,7 @@ def test_a_firmware_served_in_another_process_can_be_probed() -> None:
         text=True,
     )
     try:
-        assert proc.stdout is not None
-        line = proc.stdout.readline()
+        line = line_within(proc, 120, "the served firmware's port")
         assert line.startswith("emulated nab-rti-v1 firmware (64 LEDs, 9600 baud) on "), line
         r = runner.invoke(app, ["probe", line.split()[-1]])
         assert r.exit_code == 0, r.output
@@ -873,8 +872,8 @@ def test_a_fault_asked_of_a_served_firmware_happens() -> None:
         text=True,
     )
     try:
-        assert proc.stdout is not None
-        port = serial.Serial(proc.stdout.readline().split()[-1], 115200, timeout=0.1)
+        line = line_within(proc, 120, "the served firmware's port")
+        port = serial.Serial(line.split()[-1], 115200, timeout=0.1)
         banner = b"For help, press 'h'\n>"
 
         def read_until(end: bytes) -> bytes:

@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import line_within
 
 from rti_rig.app.dome_factory import build_dome
 from rti_rig.core.clock import SystemClock, VirtualClock
@@ -236,7 +237,7 @@ def test_dry_run_against_the_emulator_in_another_process():
         cwd=Path(__file__).resolve().parents[3],
     )
     try:
-        line = proc.stdout.readline()
+        line = line_within(proc, 120, "the emulator's port")
         assert line.startswith("emulated default dome with 6 LEDs on "), line
         port = line.split()[-1]
         clock = VirtualClock()
