@@ -152,3 +152,45 @@ def test_a_source_file_that_vanishes_while_it_is_checked_is_named_with_restart(
     said = describe(worker)  # with its code when every file was read before one went
     assert said.startswith(f"rti-rig {rti_rig.__version__}") and said.endswith(f", but {problem}")
     assert "code None" not in said, said
+
+
+#: Removes one folder of the rti-rig it imports just as the check is about to list it (listed
+#: in its parent, then gone: a checkout that drops a subpackage), then prints the answer.
+_FOLDER_VANISHING = """
+import os, pathlib, shutil, sys
+from rti_rig.app.usecases.worker_code import _identity_function
+target = pathlib.Path(sys.argv[1]).resolve()
+scandir = os.scandir
+def vanishing(path="."):
+    if not isinstance(path, int) and pathlib.Path(path).resolve() == target and target.exists():
+        shutil.rmtree(target)
+    return scandir(path)
+os.scandir = vanishing
+print(repr(_identity_function()()))
+"""
+
+
+def test_a_source_folder_that_vanishes_while_it_is_listed_is_named_with_restart(
+    tmp_path: Path,
+) -> None:
+    """A subfolder of a worker's rti-rig removed between the listing of its parent and its own
+    listing (a ``git checkout`` of a branch without that subpackage) failed the check with a
+    bare ``FileNotFoundError`` from the folder walk, said as a worker that could not be asked,
+    though a vanished file was named. The folder is named, with the restart."""
+    tree = _wheel_layout(tmp_path / "tree")
+    target = tree / "rti_rig" / "extra_subpackage"
+    target.mkdir()
+    (target / "__init__.py").write_text('"""A subpackage a checkout drops."""\n')
+    done = subprocess.run(
+        [sys.executable, "-c", _FOLDER_VANISHING, str(target)], capture_output=True, text=True,
+        env={"PYTHONPATH": str(tree), "PATH": ""}, cwd=tmp_path, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr  # no FileNotFoundError out of the check
+    assert not target.exists()
+    answer = ast.literal_eval(done.stdout.strip())
+    problem = answer["problem"]
+    assert answer["fingerprint"] is None, answer
+    assert problem and "rti_rig/extra_subpackage/ vanished while it was being checked" in (
+        problem
+    ), answer
+    assert "restart it" in problem, answer

@@ -99,15 +99,21 @@ def _identity_function(
                 digest.update(b"missing\0")
                 continue
             files = []
-            for path in folder.rglob("*"):
-                if (
-                    path.is_file()
-                    and path.suffix in suffixes
-                    and "__pycache__" not in path.parts
-                    and not any(parent in nested for parent in path.parents if parent != folder)
-                ):
-                    files.append((path.relative_to(folder).as_posix(), path))
             where = name.replace(".", "/")
+            try:
+                for path in folder.rglob("*"):
+                    if (
+                        path.is_file()
+                        and path.suffix in suffixes
+                        and "__pycache__" not in path.parts
+                        and not any(parent in nested for parent in path.parents if parent != folder)
+                    ):
+                        files.append((path.relative_to(folder).as_posix(), path))
+            except FileNotFoundError as exc:  # a folder listed, then gone before its own listing
+                gone_folder = Path(str(exc.filename or folder))
+                inside = gone_folder.relative_to(folder) if folder in gone_folder.parents else None
+                vanished.append(f"{where}/{inside.as_posix()}/" if inside else f"{where}/")
+                continue
             for relative, path in sorted(files):
                 try:
                     content = path.read_bytes()
@@ -212,8 +218,10 @@ def _identity_function(
         failed: its rti-rig is being changed under it (a ``git checkout``, a reinstall), and
         what it runs is the code it imported, which no file there shows any more."""
         named = ", ".join(vanished[:3]) + (" …" if len(vanished) > 3 else "")
+        # a folder (named with its final /) can vanish as a whole: a subpackage a checkout drops
+        noun = "file" if not any(v.endswith("/") for v in vanished) else "file or folder"
         return (
-            f"its rti-rig source file {named} vanished while it was being checked (deleted or "
+            f"its rti-rig source {noun} {named} vanished while it was being checked (deleted or "
             "moved after its folder was listed): its rti-rig is being changed, so the code it "
             "runs cannot be told; restart it once the change is done"
         )
