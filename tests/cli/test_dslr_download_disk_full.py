@@ -243,3 +243,53 @@ def test_a_disk_full_at_a_preview_download_advises_the_preview_again_not_a_resum
     assert "'rti-rig run --resume SESSION' shoots it again" not in said, said
     assert "free space on that disk (or fix it), then run the same 'rti-rig preview' again" in said
     assert "holds no image and may be used again" in said, said  # the same --out will do
+
+
+class _OutOfInodesAtDownload:
+    """A download clock whose third download finds the session's disk out of inodes (or over
+    quota): from then on, creating a file in ``folder`` fails with ENOSPC, as ``creat`` does
+    on a filesystem with no free inode, so libgphoto2's ``fopen`` fails (-1, no file)."""
+
+    def __init__(self, folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        import builtins
+        import errno
+
+        self.downloads = 0
+        real_open = builtins.open
+
+        def creating(file: Any, mode: str = "r", *args: Any, **kwargs: Any) -> Any:
+            if (
+                self.downloads >= 3
+                and any(c in mode for c in "wxa")
+                and isinstance(file, str | Path)
+                and Path(file).parent == folder
+            ):
+                raise OSError(errno.ENOSPC, "No space left on device", str(file))
+            return real_open(file, mode, *args, **kwargs)
+
+        monkeypatch.setattr(builtins, "open", creating)
+
+    def sleep(self, s: float) -> None:
+        self.downloads += 1
+
+
+def test_a_folder_that_refuses_a_new_file_for_want_of_inodes_is_said_as_a_full_disk(
+    tmp_path, monkeypatch
+):
+    """A disk out of inodes (or a quota) refuses the new file itself with ENOSPC: the same -1
+    from ``fopen`` as a folder that cannot be written into. The probe that tells them apart
+    had called it "not a full disk, but the folder's permissions …" and advised making the
+    folder writable, which it is."""
+    cfg = _config(tmp_path, "Memory card")
+    out = tmp_path / "s"
+    clock = _OutOfInodesAtDownload(out / "raw" / ".incoming", monkeypatch)
+    body = Body(render=_raw, download_s=0.001, download_clock=clock)
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "4"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "IMG_0003.CR2 came from the camera but could not be written" in said, said
+    assert "not a full disk" not in said and "make that folder writable" not in said, said
+    assert "full, read-only or failing" in said, said
+    assert "free space on that disk (or fix it), then 'rti-rig run --resume SESSION'" in said
+    assert "IMG_0003.CR2" in body.card and not any("IMG_0003" in d for d in body.deleted)
