@@ -154,8 +154,8 @@ class Gphoto2Camera:
         self.name = settings.name
         self.output_dir = output_dir
         #: how the user shoots a lost step again, as a clause ("… then {again}"): a session's
-        #: resume, unless the session is one no resume continues (``rti-rig preview``'s one
-        #: image, whose use case sets it: a preview's full disk had advised a resume)
+        #: resume, or what the use case that opened the session sets (``rti-rig preview``
+        #: says to run the preview again, the command its user typed)
         self.shoot_again = "'rti-rig run --resume SESSION' shoots it again"
         self._clock = clock or SystemClock()
         self._gp = gp_module

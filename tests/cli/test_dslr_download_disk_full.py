@@ -293,3 +293,28 @@ def test_a_folder_that_refuses_a_new_file_for_want_of_inodes_is_said_as_a_full_d
     assert "full, read-only or failing" in said, said
     assert "free space on that disk (or fix it), then 'rti-rig run --resume SESSION'" in said
     assert "IMG_0003.CR2" in body.card and not any("IMG_0003" in d for d in body.deleted)
+
+
+def test_a_preview_whose_download_the_disk_refused_is_not_told_no_resume_continues_it(
+    tmp_path, monkeypatch
+):
+    """The preview's refusal said "(a preview is one image: no 'rti-rig run --resume'
+    continues it)": a preview is a one-image session, and `run --resume` on its folder, once
+    there is room, shoots its image. Its advice says to run the preview again, and nothing
+    false of the resume."""
+    cfg = _config(tmp_path, "Internal RAM")
+    body = Body(render=_raw, disk_free_saves=0)
+    out = tmp_path / "p"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["preview", str(cfg), "--out", str(out)]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "then run the same 'rti-rig preview' again" in said, said
+    assert "no 'rti-rig run --resume' continues it" not in said, said
+
+    body.disk_free_saves = None  # room again: the resume the advice had denied
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, " ".join(r.output.split())
+    assert (out / "lights.lp").read_text().split()[0] == "1"
+    assert (out / "raw" / "image_001.cr2").is_file()

@@ -1613,13 +1613,12 @@ def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> Op
         on_note(Note(note, "warning"))
     opened = _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
     opened.list_card = False
-    # a preview is no session a resume continues: a camera that advises how to shoot a lost
-    # image again (a DSLR whose download the disk refused) says to shoot the preview again
+    # a camera that advises how to shoot a lost image again (a DSLR whose download the disk
+    # refused) says to run the preview again, the command its user typed. Not that no resume
+    # continues a preview: 'rti-rig run --resume' does (a one-image session), and it had
+    # been said that none does
     if hasattr(opened.rig.camera, "shoot_again"):
-        opened.rig.camera.shoot_again = (
-            "run the same 'rti-rig preview' again (a preview is one image: no 'rti-rig run "
-            "--resume' continues it)"
-        )
+        opened.rig.camera.shoot_again = "run the same 'rti-rig preview' again"
     return opened
 
 
