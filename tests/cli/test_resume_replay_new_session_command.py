@@ -122,3 +122,40 @@ def test_the_new_session_a_changed_replay_is_told_to_start_runs_as_printed_with_
             options["min_lights"],
         ), again["adaptive"]
     assert len((out / "journal.jsonl").read_text().splitlines()) == 3  # the first one kept
+
+
+def test_the_new_session_command_names_the_plan_the_session_ran_from_any_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A session run with ``--plan plan.lp`` typed relative, resumed from another folder that
+    holds a plan.lp of its own: the command had repeated ``--plan plan.lp`` as typed, which
+    there names the other folder's plan (run as printed, it shot that plan's lights, not the
+    session's). It names the session's plan by its absolute path."""
+    acq, out = tmp_path / "acq", tmp_path / "S"
+    shutil.copytree(ACQ, acq)
+    first_dir, other_dir = tmp_path / "first", tmp_path / "other"
+    for folder, lights in ((first_dir, "6"), (other_dir, "9")):
+        folder.mkdir()
+        monkeypatch.chdir(folder)
+        r = runner.invoke(
+            app, ["plan", "--rig", str(acq / "dirs.lp"), "--lights", lights, "--out", "plan.lp"]
+        )
+        assert r.exit_code == 0, r.output
+    monkeypatch.chdir(first_dir)
+    _cut_session(acq, out, plan=Path("plan.lp"))
+    first = json.loads((out / "manifest.json").read_text())
+    names = [e.name for e in read_lp(acq / "dirs.lp")]
+    shutil.copy(acq / names[0], acq / names[-1])  # an image replaced since
+
+    monkeypatch.chdir(other_dir)  # the resume, typed in another folder
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    text = said(r)
+    assert r.exit_code == 2 and "Traceback" not in text, text
+    command = re.search(r"\(rti-rig run ([^()]+)\)$", text)
+    assert command, text
+    args = shlex.split(command.group(1))
+    assert args[args.index("--plan") + 1] == str(first_dir / "plan.lp"), args
+    r = runner.invoke(app, ["run", *args, "--no-verdict"])  # as printed, from there
+    assert r.exit_code == 0, r.output
+    again = json.loads((Path(args[2]) / "manifest.json").read_text())
+    assert again["schedule"]["steps"] == first["schedule"]["steps"]
