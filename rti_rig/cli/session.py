@@ -1180,33 +1180,25 @@ def _execute(opened, handover: HandOver | None = None) -> bool:  # type: ignore[
 
 
 def _close_left_open(opened) -> list[str]:  # type: ignore[no-untyped-def]
-    """Make safe and close a rig the capture's teardown never took (nothing if it did): the
-    lights' all-off where their link is open (a dome held open after metering), then the
-    close; what failed, said by the caller. Signals are held until both are through.
+    """Close the rig if the capture's ``with`` did not, and take what the close could not do
+    in making it safe (see :meth:`~rti_rig.app.usecases.session.OpenedSession.close`), for
+    the caller to say.
 
     Why: ``run`` counted the capture as begun (``started = True``) before it called it, and
     the controller's teardown takes the rig only once the capture runs: a stop in between
     skipped both, and the emulated dome, held open after ``--auto-exposure``, was neither
     switched off nor closed. Called from :func:`_execute`'s ``finally``, so it holds from the
-    moment the opened rig is handed over, whatever ends the command."""
-    from rti_rig.runtime.deferred_signals import signals_deferred
-    from rti_rig.runtime.lighting import attempt_all
-
-    if opened.closed:
-        return []
-    rig = opened.rig
+    moment the opened rig is handed over, whatever ends the command; the close's own failures
+    are taken here too when the capture's ``with`` closed the rig (a stop inside it, before
+    the controller's ``try``)."""
     failures: list[str] = []
-    with signals_deferred():
-        if getattr(rig.lighting, "link_open", False):
-            failures += rig.lighting.safe(emergency=True)
-        # the devices' own close, as the controller's teardown closes them, then the rig's
-        failures += attempt_all(
-            [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
-        )
+    if not opened.closed:
         try:
             opened.close()
         except Exception as exc:  # closing what the opening opened: said, never a traceback
             failures.append(f"closing the rig failed: {exc}")
+    failures = [*opened.close_failures, *failures]
+    opened.close_failures = []  # said once
     return failures
 
 
@@ -1450,7 +1442,12 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
-        state = lights_state(rig, _print_teardown_failures(folder, said_below=exc))
+        # the close's own failures (a failure before the controller's ``try``) above the lights
+        state = lights_state(
+            rig,
+            _print_teardown_failures(folder, said_below=exc)
+            | _print_failures(_close_left_open(opened), said_below=exc),
+        )
         hint = _dead_led_hint(opened, exc) or resume_hint()
         err.print(f"{_sentence(state)}. {_after_stop(opened, hint)}", markup=False)
         raise fail(_write_failed_said(exc, opened)) from None
@@ -1460,7 +1457,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         # with nothing said of the lights, of the images kept or of the resume
         from rti_rig.app.usecases.safe_state import lights_state
 
-        state = lights_state(rig, _print_teardown_failures(folder))
+        state = lights_state(
+            rig, _print_teardown_failures(folder) | _print_failures(_close_left_open(opened))
+        )
         err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint())}", markup=False)
         raise _unexpected(exc, f"{out_dir}/manifest.json") from None
     finally:

@@ -11,6 +11,8 @@ raises KeyboardInterrupt before it does anything."""
 
 from __future__ import annotations
 
+import signal
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +21,7 @@ from conftest import CONFIGS
 from typer.testing import CliRunner
 
 import rti_rig.app.usecases.session as session_usecase
+import rti_rig.runtime.controller as controller
 from rti_rig.cli import app
 from rti_rig.simulator.dome_firmware import DomeFirmware
 
@@ -54,3 +57,45 @@ def test_a_ctrl_c_as_the_capture_starts_switches_the_emulated_dome_off_and_close
     assert "Traceback" not in said, said
     assert r.exit_code == 130, said
     assert not any(out.glob("image_*"))
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_sigterm_as_the_controller_checks_the_disk_switches_the_held_dome_off_and_closes_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same stop one step later: inside the capture's ``with`` (the controller checking
+    the free space, before its ``try``). The ``with``'s close released the emulator alone
+    (the rig's close trusts the controller to have made the devices safe), and the command,
+    finding the session closed, did nothing: the held port stayed open, its all-off unsent.
+    A real SIGTERM, raised in the run's own process there (no timing)."""
+    received: list[str] = []
+    real_execute = DomeFirmware._execute
+
+    def execute(self, seq, cmd, now):  # type: ignore[no-untyped-def]
+        received.append(type(cmd).__name__)
+        return real_execute(self, seq, cmd, now)
+
+    monkeypatch.setattr(DomeFirmware, "_execute", execute)
+    seen: dict[str, Any] = {}
+    real_run = session_usecase.run_opened_session
+
+    def run_opened_session(opened, *args: Any, **kwargs: Any) -> Any:
+        seen["opened"], seen["before"] = opened, len(received)
+        return real_run(opened, *args, **kwargs)
+
+    def check_free_space(*args: Any, **kwargs: Any) -> None:
+        signal.raise_signal(signal.SIGTERM)
+
+    monkeypatch.setattr(session_usecase, "run_opened_session", run_opened_session)
+    monkeypatch.setattr(controller, "check_free_space", check_free_space)
+    out = tmp_path / "s"
+    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
+    r = CliRunner().invoke(app, [*argv, "--auto-exposure", "--no-verdict"], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert "opened" in seen, said
+    assert seen["before"] > 0, said  # metering spoke to the dome
+    assert "AllOff" in received[seen["before"] :], (received, said)
+    assert not seen["opened"].rig.lighting.source.link.port_open, said
+    assert "Stopped (SIGTERM) before the first image: nothing was captured" in said, said
+    assert "teardown problem" not in said and "Traceback" not in said, said
+    assert r.exit_code == 143, said

@@ -159,6 +159,9 @@ class OpenedSession:
     #: whether :meth:`close` has been called (the capture's ``with`` closes the rig; a stop
     #: before it took the rig leaves the command to close it, once)
     closed: bool = False
+    #: what :meth:`close` could not do in making safe a rig the controller's teardown never
+    #: took (for the command to say; it takes them)
+    close_failures: list[str] = field(default_factory=list)
 
     @property
     def dry_run(self) -> bool:
@@ -179,11 +182,34 @@ class OpenedSession:
         return self.total_steps - self.steps_done_before
 
     def close(self) -> None:
+        """Release the rig and the session's lock; once (a second call does nothing).
+
+        Where the controller's teardown never ran (a stop after the capture's ``with`` began,
+        before the controller's ``try``: :attr:`SessionFolder.run_end` unset), its device
+        part is done here first, before the rig's resources go: the lights' all-off where
+        their link is open (a dome held open after metering), then the camera's and the
+        lights' close, signals held; what failed is kept in :attr:`close_failures`.
+
+        Why: the rig's close releases only what ``build_rig`` opened (an emulator, its pty),
+        trusting the controller to have made the devices safe: a SIGTERM as the capture
+        checked the free space left the emulated dome's held port open, its all-off unsent."""
+        from rti_rig.runtime.deferred_signals import signals_deferred
+        from rti_rig.runtime.lighting import attempt_all
         from rti_rig.runtime.session import unlock_session
 
+        if self.closed:
+            return
         self.closed = True
+        rig = self.rig
         try:
-            self.rig.close()
+            with signals_deferred():
+                if self.folder.run_end is None:
+                    if getattr(rig.lighting, "link_open", False):
+                        self.close_failures += rig.lighting.safe(emergency=True)
+                    self.close_failures += attempt_all(
+                        [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
+                    )
+                rig.close()
         finally:
             unlock_session(self.folder.root)  # a resume's lock, also for a run never started
 
