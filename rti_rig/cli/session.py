@@ -1429,12 +1429,19 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         from rti_rig.app.usecases.safe_state import lights_state
 
         why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
-        if not started or folder.run_end is None:
-            # before the capture began, or before the controller took the rig (its teardown
-            # records the run's end whatever happens): nothing was lit or written by it
+        # before the capture began, or before the controller took the rig (its teardown
+        # records the run's end whatever happens): nothing was lit or written by it. Not a
+        # teardown that a stop cut before it could begin (run_end unset, the session's close
+        # made the rig safe) after this run committed images: "before the first image:
+        # nothing was captured" had been said of 6 images on disk, with no resume hint
+        if not started or (
+            folder.run_end is None and folder.images_kept == opened.steps_done_before
+        ):
             raise _stopped_before_capture(opened, why) from None
 
-        failed = _print_teardown_failures(folder)
+        # the session's close's failures too, where it made the rig safe in the teardown's
+        # place: above the lights' line that points at them
+        failed = _print_teardown_failures(folder) | _print_failures(_close_left_open(opened))
         err.print(f"[red]Emergency stop ({escape(why)}):[/] {escape(lights_state(rig, failed))}.")
         teardown_said = True
         err.print(_after_stop(opened, resume_hint()), markup=False, soft_wrap=True)

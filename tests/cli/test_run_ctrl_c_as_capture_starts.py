@@ -99,3 +99,42 @@ def test_a_sigterm_as_the_controller_checks_the_disk_switches_the_held_dome_off_
     assert "Stopped (SIGTERM) before the first image: nothing was captured" in said, said
     assert "teardown problem" not in said and "Traceback" not in said, said
     assert r.exit_code == 143, said
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_sigterm_as_the_teardown_begins_is_not_said_as_before_the_first_image(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A SIGTERM in the controller's ``finally`` before it holds signals (as it marks the
+    capture over) cuts its teardown before it records the run's end: the session's close
+    makes the dome safe in its place. Every image was in, and the run had said "Stopped
+    (SIGTERM) before the first image: nothing was captured", with no word of the images or
+    the resume. A real SIGTERM, raised in the run's own process there (no timing)."""
+    received: list[str] = []
+    real_execute = DomeFirmware._execute
+
+    def execute(self, seq, cmd, now):  # type: ignore[no-untyped-def]
+        received.append(type(cmd).__name__)
+        return real_execute(self, seq, cmd, now)
+
+    real_over = controller.CancelToken.capture_over
+
+    def capture_over(self) -> None:  # type: ignore[no-untyped-def]
+        received.append("capture over")
+        signal.raise_signal(signal.SIGTERM)
+        real_over(self)
+
+    monkeypatch.setattr(DomeFirmware, "_execute", execute)
+    monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
+    out = tmp_path / "s"
+    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
+    r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert len(list(out.glob("image_*"))) == 6, said
+    assert "before the first image" not in said and "nothing was captured" not in said, said
+    assert "Emergency stop (SIGTERM)" in said and "6 image(s) kept" in said, said
+    assert f"rti-rig run --resume {out}" in said, said
+    # the all-off the lights' line rests on came after the teardown was cut
+    assert "AllOff" in received[received.index("capture over") :], (received, said)
+    assert "Traceback" not in said, said
+    assert r.exit_code == 143, said
