@@ -75,7 +75,6 @@ from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.core.image_files import (
     CAMERA_RAW_SUFFIXES,
     TIFF_MAGIC,
-    colour_or_grey,
     is_camera_raw,
     tiff_extent,
 )
@@ -1656,10 +1655,22 @@ class FolderWatchCamera:
         had stopped the run with "expected an H×W or H×W×3 image". Unassociated alpha carries
         no light, so the grey or colour samples are the shot. Premultiplied alpha has scaled
         every sample by it: dropped, the pixels would be darker wherever alpha is below full,
-        and nothing would say so."""
+        and nothing would say so. Which samples are the grey or colour ones is the header's
+        count (SamplesPerPixel less ExtraSamples), never the array's: grey with two extra
+        samples has three per pixel and had been recorded as an RGB of grey and extras."""
         extra = tiff_extra_samples(path)
-        if not extra or image.ndim != 3 or image.shape[2] in (1, 3):
+        if not extra or image.ndim != 3:
             return image, ""
+        colour = image.shape[2] - len(extra)
+        if colour not in (1, 3):
+            raise CaptureError(
+                self.name,
+                f"{watched.name} has {image.shape[2]} samples per pixel, {len(extra)} of them "
+                f"extra (ExtraSamples), which leaves {colour} for the picture: neither grey (1) "
+                "nor RGB (3); save it as grey or RGB without extra channels, then run again "
+                "(a --resume of a session with images shoots this light again)",
+                "decode",
+            )
         if "associated" in extra:
             raise CaptureError(
                 self.name,
@@ -1672,12 +1683,20 @@ class FolderWatchCamera:
                 "decode",
             )
         self._alpha_first = self._alpha_first or watched.name
-        kind = "alpha channel" if "unassociated" in extra else "extra channel of no stated use"
-        note = (
-            f"the watched TIFFs (first {self._alpha_first}) have an {kind} (ExtraSamples), which "
-            "carries no light: it was dropped and the grey or colour samples recorded"
+        # unassociated alpha carries no light; an unspecified extra sample is, by the TIFF's
+        # own header, no part of its grey or colour picture: what it holds is not claimed
+        kind = (
+            "an alpha channel (ExtraSamples), which carries no light"
+            if set(extra) == {"unassociated"}
+            else "an extra channel of no stated use (ExtraSamples), which its header does not "
+            "count as part of the grey or colour picture"
         )
-        return np.ascontiguousarray(colour_or_grey(image)), note
+        note = (
+            f"the watched TIFFs (first {self._alpha_first}) have {kind}: it was dropped and the "
+            "grey or colour samples recorded"
+        )
+        kept = image[..., :3] if colour == 3 else image[..., 0]
+        return np.ascontiguousarray(kept), note
 
     def _decode(
         self, path: Path, exposure_s: float, started: float, watched: Path | None = None

@@ -63,3 +63,44 @@ def test_run_refuses_a_tiff_with_premultiplied_alpha_naming_it_and_the_fix(
     assert (tether / "IMG_0001.tif").exists()  # the shot is left where it was saved
     assert not list(out.glob("linear/image_*.tif"))  # nothing recorded from it
     assert lit_at_end == []
+
+
+def _grey_with_extras(pixels: np.ndarray, extras: list[str]) -> bytes:
+    out = BytesIO()
+    tifffile.imwrite(
+        out,
+        pixels,
+        photometric="minisblack",
+        planarconfig="contig",
+        extrasamples=extras,
+        metadata=None,
+    )
+    return out.getvalue()
+
+
+@pytest.mark.parametrize(
+    "extras", [["unassalpha", "unspecified"], ["unspecified"] * 3], ids=["grey+2", "grey+3"]
+)
+def test_run_records_the_grey_of_a_grey_tiff_with_several_extra_samples(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, extras: list[str]
+) -> None:
+    """Grey (MinIsBlack) with two or three extra samples has 3 or 4 per pixel: the grey is
+    the first, as its header counts them. It had been recorded as an RGB image of the grey
+    and its extra samples (their count, not the header, decided grey or colour)."""
+    rng = np.random.default_rng(9)
+    n = 1 + len(extras)
+    shot = rng.integers(1000, 60000, (40, 56, n), dtype=np.uint16)
+    data = _grey_with_extras(shot, extras)
+    with tifffile.TiffFile(BytesIO(data)) as tif:  # the file is as described
+        page = tif.pages[0]
+        assert page.photometric == 1 and page.samplesperpixel == n
+        assert len(page.extrasamples) == len(extras)
+    r, said, _tether, out, lit_at_end = tethered_tiffs(tmp_path, monkeypatch, [data, data])
+    assert r.exit_code == 0, said
+    assert "Traceback" not in said, said
+    image = tifffile.imread(out / "linear" / "image_001.tif")
+    assert image.shape == shot.shape[:2], image.shape  # grey, not colour
+    assert np.array_equal(image, shot[..., 0])
+    assert said.count("extra channel of no stated use") == 1, said
+    assert "carries no light" not in said, said  # an unspecified sample is not claimed alpha
+    assert lit_at_end == []
