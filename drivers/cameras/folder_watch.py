@@ -80,7 +80,9 @@ from rti_rig.core.image_files import (
 )
 from rti_rig.drivers.cameras.dng_tags import IfdState, ifd_state
 from rti_rig.drivers.cameras.image_io import (
+    PNG_ALPHA_TYPES,
     ImageReadError,
+    png_colour_type,
     read_image_file,
     tiff_extra_samples,
     to_linear_uint16,
@@ -1658,6 +1660,10 @@ class FolderWatchCamera:
         and nothing would say so. Which samples are the grey or colour ones is the header's
         count (SamplesPerPixel less ExtraSamples), never the array's: grey with two extra
         samples has three per pixel and had been recorded as an RGB of grey and extras."""
+        if png_colour_type(path) in PNG_ALPHA_TYPES:  # its reader dropped the alpha
+            return image, self._alpha_note(
+                "PNGs", watched, "an alpha channel, which carries no light"
+            )
         extra = tiff_extra_samples(path)
         if not extra or image.ndim != 3:
             return image, ""
@@ -1682,7 +1688,6 @@ class FolderWatchCamera:
                 "this light again)",
                 "decode",
             )
-        self._alpha_first = self._alpha_first or watched.name
         # unassociated alpha carries no light; an unspecified extra sample is, by the TIFF's
         # own header, no part of its grey or colour picture: what it holds is not claimed
         kind = (
@@ -1691,12 +1696,20 @@ class FolderWatchCamera:
             else "an extra channel of no stated use (ExtraSamples), which its header does not "
             "count as part of the grey or colour picture"
         )
-        note = (
-            f"the watched TIFFs (first {self._alpha_first}) have {kind}: it was dropped and the "
-            "grey or colour samples recorded"
-        )
         kept = image[..., :3] if colour == 3 else image[..., 0]
-        return np.ascontiguousarray(kept), note
+        return np.ascontiguousarray(kept), self._alpha_note("TIFFs", watched, kind)
+
+    def _alpha_note(self, files: str, watched: Path, kind: str) -> str:
+        """The notice that ``kind`` (an alpha channel, or an extra one) of the watched
+        ``files`` was dropped, naming the first file of this run that had one.
+
+        Why: one wording for every image, so the session says it once, with how many images
+        it concerns (a PNG's alpha had been dropped unsaid)."""
+        self._alpha_first = self._alpha_first or watched.name
+        return (
+            f"the watched {files} (first {self._alpha_first}) have {kind}: it was dropped and "
+            "the grey or colour samples recorded"
+        )
 
     def _decode(
         self, path: Path, exposure_s: float, started: float, watched: Path | None = None

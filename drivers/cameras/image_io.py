@@ -221,6 +221,29 @@ def tiff_extra_samples(path: Path) -> tuple[str, ...]:
     return tuple(EXTRA_SAMPLE_KINDS.get(v, "unspecified") for v in values)
 
 
+#: PNG colour types (PNG spec, IHDR) whose pixels carry an alpha sample: grey + alpha (4),
+#: RGBA (6). PNG alpha is never premultiplied (the PNG spec: unassociated alpha only).
+PNG_ALPHA_TYPES = {4: "grey + alpha", 6: "RGBA"}
+
+
+def png_colour_type(path: Path) -> int | None:
+    """A PNG's colour type from its IHDR (0 grey, 2 RGB, 3 palette, 4 grey + alpha, 6 RGBA);
+    None for another file (told by its signature, not its name) or one too short to say (its
+    reader says why).
+
+    Why: OpenCV reads grey + alpha as four samples, the grey copied to three colours, with no
+    way to tell it from RGBA: the watched folder had recorded a grey camera's PNGs as colour,
+    their alpha dropped unsaid."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(26)
+    except OSError:
+        return None
+    if len(head) < 26 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+        return None
+    return head[25]
+
+
 def read_image_file(path: Path, device: str) -> NDArray:
     """Read a non-RAW image file with its bit depth kept, colour in **RGB** order whatever the
     format (OpenCV decodes PNG/JPEG as BGR, tifffile TIFF as RGB: one order for callers), and
@@ -280,6 +303,8 @@ def read_image_file(path: Path, device: str) -> NDArray:
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise ImageReadError(device, path, "", is_tiff=False)
+    if img.ndim == 3 and img.shape[2] == 4 and png_colour_type(path) == 4:
+        return np.ascontiguousarray(img[..., 0])  # grey + alpha, read as B = G = R = grey
     if img.ndim == 3 and img.shape[2] in (3, 4):
         img = np.ascontiguousarray(img[..., 2::-1])  # BGR(A) -> RGB, alpha dropped
     return img
