@@ -469,9 +469,6 @@ class FolderWatchCamera:
         #: pattern matches)
         self._at_connect: set[str] = set()
         self._pending: _Pending | None = None
-        #: the first file of this run whose alpha was dropped: the notice names it, one
-        #: wording for every image so the session says it once (with how many images)
-        self._alpha_first: str | None = None
         #: (capture time, pulse time) of the last image whose file had a capture time: the
         #: camera clock's anchor to the pulses
         self._anchor: tuple[float, float, float] | None = None
@@ -1661,9 +1658,7 @@ class FolderWatchCamera:
         count (SamplesPerPixel less ExtraSamples), never the array's: grey with two extra
         samples has three per pixel and had been recorded as an RGB of grey and extras."""
         if png_colour_type(path) in PNG_ALPHA_TYPES:  # its reader dropped the alpha
-            return image, self._alpha_note(
-                "PNGs", watched, "an alpha channel, which carries no light"
-            )
+            return image, self._alpha_note("PNGs", "an alpha channel, which carries no light")
         extra = tiff_extra_samples(path)
         if not extra or image.ndim != 3:
             return image, ""
@@ -1697,18 +1692,20 @@ class FolderWatchCamera:
             "count as part of the grey or colour picture"
         )
         kept = image[..., :3] if colour == 3 else image[..., 0]
-        return np.ascontiguousarray(kept), self._alpha_note("TIFFs", watched, kind)
+        return np.ascontiguousarray(kept), self._alpha_note("TIFFs", kind)
 
-    def _alpha_note(self, files: str, watched: Path, kind: str) -> str:
+    @staticmethod
+    def _alpha_note(files: str, kind: str) -> str:
         """The notice that ``kind`` (an alpha channel, or an extra one) of the watched
-        ``files`` was dropped, naming the first file of this run that had one.
+        ``files`` was dropped; each step's journal names its own file.
 
-        Why: one wording for every image, so the session says it once, with how many images
-        it concerns (a PNG's alpha had been dropped unsaid)."""
-        self._alpha_first = self._alpha_first or watched.name
+        Why: one wording for every image of every run, so the session says it once, with how
+        many images it concerns (a PNG's alpha had been dropped unsaid; each run had named
+        its own first file, so a resumed session said it twice, calling two files the
+        first)."""
         return (
-            f"the watched {files} (first {self._alpha_first}) have {kind}: it was dropped and "
-            "the grey or colour samples recorded"
+            f"the watched {files} have {kind}: it was dropped and the grey or colour samples "
+            "recorded"
         )
 
     def _decode(

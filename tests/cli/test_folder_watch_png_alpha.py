@@ -60,6 +60,6 @@ def test_run_records_the_pixels_of_a_png_with_alpha_and_says_alpha_was_dropped(
         assert image.shape == expected.shape, image.shape  # grey + alpha is grey
         assert np.array_equal(image, expected)  # the shot's own pixels, the alpha left out
     assert said.count("alpha channel") == 1, said  # said once, not once per image
-    assert "PNGs (first IMG_0001.png)" in said and "dropped" in said, said
+    assert "the watched PNGs have an alpha channel" in said and "dropped" in said, said
     assert all(any("alpha" in n for n in s.get("notices", [])) for s in journal(out)), out
     assert lit_at_end == []

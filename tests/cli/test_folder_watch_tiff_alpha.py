@@ -43,7 +43,8 @@ def test_run_records_the_pixels_of_a_tiff_with_alpha_and_says_alpha_was_dropped(
         assert image.shape == expected.shape, image.shape
         assert np.array_equal(image, expected)  # the shot's own pixels, the alpha left out
     assert said.count("alpha channel") == 1, said  # said once, not once per image
-    assert "IMG_0001.tif" in said and "dropped" in said, said
+    assert "the watched TIFFs have an alpha channel" in said and "dropped" in said, said
+    assert "[2 of 2 images]" in said, said
     assert all(any("alpha" in n for n in s.get("notices", [])) for s in journal(out)), out
     assert lit_at_end == []
 
@@ -104,3 +105,29 @@ def test_run_records_the_grey_of_a_grey_tiff_with_several_extra_samples(
     assert said.count("extra channel of no stated use") == 1, said
     assert "carries no light" not in said, said  # an unspecified sample is not claimed alpha
     assert lit_at_end == []
+
+
+def test_a_resumed_session_of_tiffs_with_alpha_says_the_alpha_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A run stopped after its first image (the camera saved nothing more) and resumed: the
+    session's notices cover both runs' images. Each run named its own first file in the
+    notice, so the resumed session said it twice, each calling another file the first."""
+    from conftest import folder_watch_config, tethered_run
+
+    rng = np.random.default_rng(10)
+    shots = [rng.integers(1000, 60000, (40, 56, 4), dtype=np.uint16) for _ in range(2)]
+    files = [(f"IMG_{n:04d}.tif", _with_alpha(p, "unassalpha")) for n, p in enumerate(shots, 1)]
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0, tiffs=True)
+    out = tmp_path / "s"
+    first = tethered_run(monkeypatch, cfg, tether, files[:1], out)  # no file for light 2
+    assert first.result.exit_code != 0, first.said
+    assert (out / "linear" / "image_001.tif").is_file(), first.said
+    again = tethered_run(monkeypatch, cfg, tether, files[1:], out, resume=True)
+    assert again.result.exit_code == 0, again.said
+    assert "Traceback" not in again.said, again.said
+    assert again.said.count("alpha channel") == 1, again.said  # one notice, both runs
+    assert "[2 of 2 images]" in again.said, again.said
+    assert again.lit_at_end == []
