@@ -1210,11 +1210,13 @@ class FolderWatchCamera:
             )
         if before:
             shown = ", ".join(f"{n} {s:.0f} s" for n, s in before.items())
+            many = len(before) > 1
             said.append(
-                f" By the capture times {'they were' if len(before) > 1 else 'it was'} shot "
-                f"before the earlier run's last kept image ({name}; {shown} before), so it is "
-                "no late file of the shot that run stopped waiting for, unless the camera's "
-                "clock was changed: the clock set back, or an older picture copied in."
+                f" By the capture times {'they were' if many else 'it was'} shot before the "
+                f"earlier run's last kept image ({name}; {shown} before), so "
+                f"{'none of them is a' if many else 'it is no'} late file of the shot that run "
+                "stopped waiting for, unless the camera's clock was changed: the clock set "
+                "back, or an older picture copied in."
             )
         return head + "".join(said)
 

@@ -111,3 +111,29 @@ def test_a_late_file_of_the_earlier_run_in_a_resume_without_clock_file_says_what
     # not the words that left the late file out: "the camera's clock was set back since … or
     # an older picture was copied into the folder"
     assert "so no pulse of this run took it: the camera's clock was set back" not in said, said
+
+
+def test_files_shot_before_the_earlier_runs_last_kept_image_are_said_in_the_plural(
+    tmp_path: Path,
+) -> None:
+    """Two files of a resume without a clock file, both shot before the earlier run's last
+    kept image: the stop said "they were shot before … so it is no late file", one file's
+    words for two."""
+    from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
+    from rti_rig.drivers.cameras.settings import FolderWatchSettings
+
+    raw = tmp_path / "s" / "raw"
+    raw.mkdir(parents=True)
+    (raw / "image_001.dng").write_bytes(_dng(100.0))  # the earlier run's last kept shot
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    camera = FolderWatchCamera(FolderWatchSettings(folder=tether))
+    camera.output_dir = raw / ".incoming"  # as the session binds it
+    camera._earlier_last = camera._earlier_run_last_shot()
+    assert camera._earlier_last is not None and camera._earlier_last[1] is not None
+    taken = camera._earlier_last[1]
+    said = camera._without_clock_said({"IMG_0004.DNG": taken - 50, "IMG_0005.DNG": taken - 40})
+    assert "they were shot before the earlier run's last kept image" in said, said
+    assert "so none of them is a late file of the shot that run stopped waiting" in said, said
+    said = camera._without_clock_said({"IMG_0004.DNG": taken - 50})
+    assert "it was shot before" in said and "so it is no late file" in said, said
