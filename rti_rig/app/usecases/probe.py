@@ -673,9 +673,12 @@ def _nichlock_found(result: ProbeResult, text: str, baud: int) -> bool:
 
 #: The boot banners of rti-rig's own protocols (docs/protocols/led-dome.md), as each profile
 #: prints them with its options left at their defaults: ``READY <id> <version> <count>*HH``,
-#: ``<READY,<id>,<version>,<count>>`` and the binary ``0xFF R D Y``.
+#: ``<READY,<id>,<version>,<count>>`` and the binary ``0xFF R D Y``. A default line may end in
+#: CR LF (the protocol allows it; an Arduino sketch's ``Serial.println`` sends it): a pattern
+#: wanting a bare LF had left such a board "No known dome firmware answered". A bare ``READY``
+#: is taken only with its checksum (``READY*HH``): a sketch's "READY" alone names nothing.
 _OWN_BANNERS = (
-    ("default", re.compile(r"READY [^\r\n]*\n")),
+    ("default", re.compile(r"READY[ *][^\r\n]*\r?\n")),
     ("framed", re.compile(r"<READY(?:,[^<>\r\n]*)?>")),
     ("binary", re.compile("\xffRDY")),
 )
