@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.errors import MoveCancelled
+from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.bus import DxlBus
@@ -629,11 +630,15 @@ class DynamixelArm:
         pose, reason = self.kin.solve(d, current_az)
         if pose is None:
             raise UnreachableError(self.name, np.round(d, 6).tolist(), reason or "unknown")
-        # named by the pose a user reads in check's table and the .lp, not by the unit vector
-        # (its numpy repr, "move_to [0.9968 0.     0.0805]", had been said in every error)
-        az, el = pose
+        # named by the light's azimuth and elevation, as the .lp and rti-rig's other words give
+        # them (0-360°), not by the unit vector (its numpy repr, "move_to [0.9968 0.     0.0805]",
+        # had been said), nor by the joint's angle alone: a turn away on a joint limited to
+        # -170..170°, a light at az 200° had been said as "az -160.0°", named here as the joint
+        joint_az, el = pose
+        light_az = float(az_el_from_direction(d)[0])
+        joint = "" if abs(joint_az - light_az) < 0.05 else f" (azimuth joint at {joint_az:.1f}°)"
         return self._move_ticks(
-            self.kin.ticks_of_pose(*pose), f"move to az {az:.1f}°, el {el:.1f}°"
+            self.kin.ticks_of_pose(*pose), f"move to az {light_az:.1f}°, el {el:.1f}°{joint}"
         )
 
     def park(self, cancelled: Callable[[], bool] | None = None) -> None:
