@@ -182,7 +182,7 @@ class DomeSerialSettings(_Strict):
     #: Whether the board's firmware measures LED current and answers error 4 (LED fault) for a
     #: dead LED, as this project's protocols define. The protocol cannot tell: a board built
     #: without current sensing acknowledges a dead LED like a good one. ``false`` makes
-    #: ``rti-rig check`` say what it established ("acknowledged by the board … none seen lit")
+    #: ``rti-rig check`` say what it established ("acknowledged by the board; lit not verified")
     #: instead of "passed". This project's own profiles only (a described firmware senses none).
     senses_led_current: bool = Field(
         True,

@@ -37,7 +37,7 @@ def test_a_check_of_a_board_that_senses_no_current_claims_no_led_lit(tmp_path: P
     assert "whether each LED lights cannot be sensed by this firmware" in text, text
     assert "rti-rig fit S --out FOLDER --no-ptm --no-hsh --no-normals" in text, text
     assert r.output.rstrip().splitlines()[-1] == (
-        "RESULT: PASS (each LED acknowledged by the board, none seen lit)"
+        "RESULT: PASS (LEDs acknowledged; lit not verified: board cannot sense current)"
     )
 
 
@@ -89,7 +89,7 @@ def test_an_own_firmware_board_without_current_sensing_is_checked_for_what_it_es
     assert "LEDs stepped: 48, acknowledged by the board: 48, failed: 0" in text, text
     assert "passed: 48" not in text, text
     assert r.output.rstrip().splitlines()[-1] == (
-        "RESULT: PASS (each LED acknowledged by the board, none seen lit)"
+        "RESULT: PASS (LEDs acknowledged; lit not verified: board cannot sense current)"
     )
 
 
