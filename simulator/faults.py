@@ -13,6 +13,7 @@ import numpy as np
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.simulator.sim_lights import move_named
 
 
 @dataclass
@@ -81,7 +82,8 @@ class FaultyLightSource:
 
 
 class FaultyCarrier:
-    """An arm whose `move_to` fails once (a servo error surfacing mid-move)."""
+    """An arm whose `move_to` fails once (a servo error surfacing mid-move), named by the pose
+    it was moving to as the real arm's errors are."""
 
     def __init__(self, inner, plan: FaultPlan) -> None:  # type: ignore[no-untyped-def]
         self.inner, self.plan = inner, plan
@@ -92,7 +94,7 @@ class FaultyCarrier:
 
     def move_to(self, direction: np.ndarray) -> np.ndarray:
         if self.plan.due():
-            raise DeviceError(self.name, f"injected fault: {self.plan.kind}", "move_to")
+            raise DeviceError(self.name, f"injected fault: {self.plan.kind}", move_named(direction))
         return self.inner.move_to(direction)
 
 

@@ -76,6 +76,23 @@ class SimulatedDome:
         self.history.append((self._clock.now(), None))
 
 
+def arm_az_el(direction: NDArray[np.float64]) -> tuple[float, float]:
+    """The arm's azimuth (-180 to 180°) and elevation of a light direction, as its joints and
+    the real arm's errors take them."""
+    az, el = az_el_from_direction(direction)
+    az = float(az)
+    return (az - 360.0 if az >= 180.0 else az), float(el)
+
+
+def move_named(direction: NDArray[np.float64]) -> str:
+    """A move as an error names it: by the azimuth and elevation a user reads in the check's
+    table and the .lp, as the Dynamixel arm's errors do.
+
+    Why: the code name ``'move_to'`` had been said instead, which names no pose on the rig."""
+    az, el = arm_az_el(direction)
+    return f"move to az {az:.1f}°, el {el:.1f}°"
+
+
 class SimulatedArm:
     """A two-axis arm (azimuth, elevation) with quantised joints and trapezoidal moves.
 
@@ -133,14 +150,14 @@ class SimulatedArm:
 
     def move_to(self, direction: NDArray[np.float64]) -> NDArray[np.float64]:
         if not self._connected:
-            raise DeviceError(self.name, "not connected; call connect() first", "move_to")
+            raise DeviceError(
+                self.name, "not connected; call connect() first", move_named(direction)
+            )
         reason = self.unreachable_reason(direction)
         if reason:
-            raise DeviceError(self.name, f"refused: {reason}", "move_to")
-        az, el = az_el_from_direction(direction)
-        az = float(az)
-        az = az - 360.0 if az >= 180.0 else az
-        self._move_joints(az, float(el))
+            raise DeviceError(self.name, f"refused: {reason}", move_named(direction))
+        az, el = arm_az_el(direction)
+        self._move_joints(az, el)
         return self._direction()
 
     def lamp(self, on: bool) -> None:
