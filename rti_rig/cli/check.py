@@ -98,10 +98,13 @@ def check(
     if reboot_faulted:
         _reboot_faulted(rig_config)
         return
+
+    def announce() -> None:
+        out.print(f"Checking {escape(str(rig_config))} (Ctrl-C stops the check at once)…")
+
     try:
         with stop_on_signals():
-            out.print(f"Checking {escape(str(rig_config))} (Ctrl-C stops the check at once)…")
-            report = check_rig(CheckRequest(rig_config, intensity, auto_exposure))
+            report = check_rig(CheckRequest(rig_config, intensity, auto_exposure), announce)
     except CheckStopped as exc:
         for failure in exc.teardown_failures:
             err.print(f"[red]teardown problem:[/] {escape(failure)}")

@@ -53,8 +53,13 @@ class CheckRequest:
 DEFAULT_INTENSITY = 0.2
 
 
-def check_rig(req: CheckRequest) -> Any:
-    """The self-test report (``.lines()``, ``.ok``) of the rig ``req.rig_config`` describes."""
+def check_rig(req: CheckRequest, on_start: Callable[[], None] | None = None) -> Any:
+    """The self-test report (``.lines()``, ``.ok``) of the rig ``req.rig_config`` describes.
+
+    ``on_start`` is called once the config and the options are known to be usable, before
+    anything is opened. Why: the command said "Checking … (Ctrl-C stops the check at once)…"
+    and then refused ``--intensity 0.5`` on an on/off firmware's dome: validate, then
+    announce."""
     intensity = DEFAULT_INTENSITY if req.intensity is None else req.intensity
     if not 0.0 < intensity <= 1.0:
         raise RtiRigError(
@@ -71,6 +76,8 @@ def check_rig(req: CheckRequest) -> Any:
         if req.auto_exposure:  # refused on any replay: a usage error, said as before
             raise
         # what this check is for: the images of a recorded acquisition, each problem said
+        if on_start is not None:
+            on_start()
         return FailedReplayCheck(Path(exc.path).name, exc.problems)
     if req.intensity is not None:
         _refuse_undimmable(loaded, req.intensity)
@@ -81,6 +88,8 @@ def check_rig(req: CheckRequest) -> Any:
 
         refuse_unmeterable_rig(loaded)
         refuse_options(loaded, **{"--auto-exposure": True})
+    if on_start is not None:
+        on_start()
     if loaded.config.backend == "replay":
         return ReplayCheck.of(loaded)
     if loaded.config.dome is not None and loaded.config.dome.flash_sync is not None:
