@@ -128,8 +128,9 @@ def plan(
         Path,
         typer.Option(
             "--out",
-            help="Plan file to write (.lp; another name is written too, with a note: relight, "
-            "RTIBuilder and rti-rig fit find an .lp by its name).",
+            help="Plan file to write (.lp). A name that does not end in .lp is still written, "
+            "with a note to rename it: relight, RTIBuilder and rti-rig fit only read files "
+            "ending in .lp (rti-rig run --plan reads it as it is).",
         ),
     ] = Path("plan.lp"),
     figure: Annotated[

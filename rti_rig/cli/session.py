@@ -61,7 +61,9 @@ def run(
             help="Number of lights in a homogeneous layout (default: every LED of a dome, "
             "or the arm's default_lights). At least 1; below "
             f"{FIT_MINIMUMS.rti_file} a note says, before anything "
-            "lights, what `rti-rig fit` will not make of them (no fit.ptm, fit.rti or fit).",
+            "lights, what `rti-rig fit` will not make of them (no fit.ptm, fit.rti or fit). "
+            "A camera-triggered dome (\\[dome.flash_sync]) refuses any number but all of its "
+            "LEDs: its firmware lights them in its own order.",
         ),
     ] = None,
     plan: Annotated[
@@ -1796,8 +1798,9 @@ def export_lp(
         Path,
         typer.Option(
             "--out",
-            help="The .lp file to write (another name is written too, with a note: relight, "
-            "RTIBuilder and rti-rig fit find an .lp by its name).",
+            help="The .lp file to write. A name that does not end in .lp is still written, "
+            "with a note to rename it: relight, RTIBuilder and rti-rig fit only read files "
+            "ending in .lp.",
         ),
     ],
     linear: Annotated[
