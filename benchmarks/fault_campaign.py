@@ -237,6 +237,34 @@ def run_in_process(
         run_opened_session(opened, cancel, on_event)
 
 
+@contextlib.contextmanager
+def own_servo_state(tmpdir: Path) -> Iterator[None]:
+    """The emulated servos' latched errors (kept between commands) in the campaign's own
+    folder, never the user's: every session's servo config has one path."""
+    import os
+
+    from rti_rig.simulator.servo_latch import STATE_DIR_ENV
+
+    before = os.environ.get(STATE_DIR_ENV)
+    os.environ[STATE_DIR_ENV] = str(tmpdir / "servo-state")
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop(STATE_DIR_ENV, None)
+        else:
+            os.environ[STATE_DIR_ENV] = before
+
+
+def recover_servos(cfg: Path, tracebacks: Tracebacks) -> None:
+    """``rti-rig check CFG --reboot-faulted``, as a servo fault's error advises: an overload
+    or overheating stays latched until a Reboot, and every resume would meet it at connect."""
+    from rti_rig.app.usecases.check import reboot_faulted
+
+    with tracebacks.watch():
+        reboot_faulted(cfg)
+
+
 def run_killed_resume(out: Path, at_light: int, *flags: str) -> tuple[int, bytes]:
     """``rti-rig run --resume OUT`` (with ``flags``) in a child process, SIGKILLed before light
     ``at_light``."""
@@ -360,7 +388,7 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
     stats: Counter[str] = Counter()
     reshot: dict[str, Counter[str]] = {}  # per fault kind: what was set aside and shot again
     tracebacks = Tracebacks()
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp, own_servo_state(Path(tmp)):
         tmpdir = Path(tmp)
         for i in range(sessions):
             n = int(rng.integers(6, 17))
@@ -389,6 +417,9 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
                 faults.update(plan.fired)
                 first = first_finish_reason(out)
                 stats["servo_faults_stopped_with_error"] += int(first == "error")
+                # the servo keeps an overload's error while powered, as a real one (the
+                # emulated chain outlives the command): recovered as its error advises
+                recover_servos(cfg, tracebacks)
             elif fault_kind in SESSION:
                 cfg = session_fault(
                     fault_kind, tmpdir, out, n, k, seed_i, rng, stats, faults, tracebacks, seen
@@ -572,6 +603,9 @@ the simulated rigs the new capture has the same bytes), so it is counted here.
 - `servo-*`: the emulated Dynamixel servos (real SDK, in-process port) report overload or
   overheating in their Hardware Error Status, corrupt their status packets' CRC, or fall silent,
   just as a move is commanded (a read that meets one lost or corrupt reply is retried once).
+  An overload or overheating stays latched until a Reboot, also between commands (the emulated
+  servos stay powered), so the session is recovered with `rti-rig check CFG --reboot-faulted`
+  before it is resumed, as the error advises.
 - `rig-changed-at-resume`: the session is stopped, then resumed with another rig config (the
   other kind of rig, half the image width, or another exposure); the resume must be refused
   without touching the folder, and the session's own rig then finishes it.

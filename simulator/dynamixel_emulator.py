@@ -14,7 +14,9 @@ and fault injection: hardware errors (Alert in every status; torque off and moti
 for the errors the Shutdown register selects, as the e-manual says), corrupted CRC on replies,
 and silent (disconnected) servos; a servo at another baud rate, or switched to Protocol 1.0
 (Protocol Type 13 = 1), answers nothing. A Hardware Error Status bit stays set until a Reboot (not
-verified for a non-shutdown error whose cause has passed).
+verified for a non-shutdown error whose cause has passed), also between rti-rig commands: a
+rig's emulated chain is modelled as staying powered, its latched errors kept in a small state
+file (:mod:`rti_rig.simulator.servo_latch`; delete it to "power-cycle" the servos).
 
 Deliberate simplifications: a new goal during a move restarts the profile from the present
 position at zero velocity (the firmware blends); no load, current or temperature dynamics.
@@ -32,7 +34,7 @@ import contextlib
 import math
 import threading
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -536,6 +538,11 @@ class DynamixelBusEmulator:
         self.instructions: list[p2.Packet] = []
         self._parser = p2.PacketParser()
         self._lock = threading.RLock()
+        #: Called with every servo's Hardware Error Status (id -> bits) whenever one changes:
+        #: how a command's latched errors outlive it (:mod:`rti_rig.simulator.servo_latch`,
+        #: the chain kept powered between commands). None: nothing outlives the emulator.
+        self.on_errors_changed: Callable[[dict[int, int]], None] | None = None
+        self._errors_seen = self.hardware_errors()
 
     # -- accessors for the simulated rig ----------------------------------------------------
     def joint_positions(self) -> dict[int, float]:
@@ -543,14 +550,29 @@ class DynamixelBusEmulator:
         with self._lock:
             return {i: s.position() for i, s in self.servos.items()}
 
+    def hardware_errors(self) -> dict[int, int]:
+        """Every servo's Hardware Error Status (70) bits, by id."""
+        with self._lock:
+            return {i: s.hardware_error for i, s in self.servos.items()}
+
+    def _errors_changed(self) -> None:
+        """Tell :attr:`on_errors_changed` of a change in any servo's Hardware Error Status."""
+        now = self.hardware_errors()
+        if now != self._errors_seen:
+            self._errors_seen = now
+            if self.on_errors_changed is not None:
+                self.on_errors_changed(now)
+
     def inject_hardware_error(self, dxl_id: int, fault: int) -> None:
         with self._lock:
             self.servos[dxl_id].inject_hardware_error(int(fault))
+            self._errors_changed()
 
     def set_input_voltage(self, dxl_id: int, decivolts: int) -> None:
         """The supply servo ``dxl_id`` sees (0.1 V); outside its limits: Input Voltage Error."""
         with self._lock:
             self.servos[dxl_id].set_input_voltage(int(decivolts))
+            self._errors_changed()
 
     # -- bytes ------------------------------------------------------------------------------
     def receive(self, data: bytes) -> bytes:
@@ -593,6 +615,7 @@ class DynamixelBusEmulator:
                 elif reply and fault == "garble_reply":
                     reply = reply[:-1] + bytes([reply[-1] ^ 0xFF])
                 out += reply
+            self._errors_changed()  # a fault raised or a Reboot among these packets
             return bytes(out)
 
     def add_fault(self, at: int, kind: str, servo_id: int | None = None) -> None:

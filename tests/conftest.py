@@ -196,6 +196,18 @@ _WATCHED_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 @pytest.fixture(autouse=True)
+def _emulated_servos_power_cycled(
+    tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each test's emulated servo chains start powered up fresh: their latched hardware
+    errors (kept between commands, :mod:`rti_rig.simulator.servo_latch`) go to the test's
+    own folder, never the user's, nor another test's (child processes inherit it)."""
+    from rti_rig.simulator.servo_latch import STATE_DIR_ENV
+
+    monkeypatch.setenv(STATE_DIR_ENV, str(tmp_path_factory.mktemp("servo-state")))
+
+
+@pytest.fixture(autouse=True)
 def _signal_handlers_left_as_found() -> Iterator[None]:
     """Fail the test that changes a SIGINT/SIGTERM handler and does not put it back.
 

@@ -8,12 +8,16 @@ from __future__ import annotations
 
 import contextlib
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rti_rig.app.config import LoadedRig, rig_geometry
 from rti_rig.core.clock import Clock, SystemClock, VirtualClock
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.runtime.lighting import ArmLighting, DomeLighting
 from rti_rig.runtime.rig import Rig
+
+if TYPE_CHECKING:
+    from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
 
 
 def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
@@ -285,6 +289,10 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     # servo's hardware error (overload …) raised as that packet arrives
     for f in loaded.config.emulator.faults:
         emulator.add_fault(f.at_command, f.kind, f.servo_id)
+    # the chain stays powered between commands: an error latched by an earlier command on
+    # this rig is still set until a Reboot (the recovery, check --reboot-faulted, had found
+    # a fresh servo with nothing to reboot)
+    _keep_latched_errors(loaded, emulator)
     try:
         arm = DynamixelArm(settings, port, clock, config_path=loaded.path)
         camera = _simulated_camera(loaded, _ArmLamp(arm, emulator, settings), clock)
@@ -294,6 +302,18 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     rig = Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock, stack)
     rig.emulator = emulator  # type: ignore[attr-defined]  # for tests and the fault campaign
     return rig
+
+
+def _keep_latched_errors(loaded: LoadedRig, emulator: DynamixelBusEmulator) -> None:
+    """Give the emulated servos the Hardware Error Status an earlier command on this rig left
+    them (a real servo keeps it while powered), and record each change from here on."""
+    from rti_rig.simulator.servo_latch import LatchedErrors
+
+    latch = LatchedErrors(loaded.path, loaded.config.emulator.model_dump(mode="json"))
+    for dxl_id, bits in latch.load().items():
+        if dxl_id in emulator.servos:
+            emulator.inject_hardware_error(dxl_id, bits)
+    emulator.on_errors_changed = latch.save
 
 
 def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:

@@ -1,0 +1,99 @@
+"""The emulated servos' latched hardware errors, kept between rti-rig commands.
+
+A real X-series servo keeps its Hardware Error Status (70) while it stays powered: after a
+shutdown "REBOOT is the only method to reset Torque Enable(64) to '1'" (ROBOTIS e-manual,
+Shutdown (63); Hardware Error Status (70)). Each rti-rig command
+builds a fresh emulator, so an overload met by ``rti-rig run`` was gone by the next command and
+the documented recovery, ``rti-rig check ARM.toml --reboot-faulted``, found "no hardware
+fault: not rebooted": it could not be rehearsed.
+
+This models the emulated chain staying powered between commands: the errors latched by a
+command are written to a small state file, read back by the next command on the same rig, and
+cleared by a Reboot instruction (the file is removed once no servo has an error). Only the
+error bits are kept (and, through them, a shutdown's torque off); positions, RAM settings and
+the like start from power-on, a simplification.
+
+The file is keyed by the rig config's absolute path and its ``[emulator]`` section, so a test
+or a user with another config (or another rehearsal of faults) meets a fresh chain. It lives
+in a per-user folder: ``$RTI_RIG_EMULATOR_STATE_DIR`` if set, else
+``$XDG_RUNTIME_DIR/rti-rig/emulated-servos``, else ``<temp>/rti-rig-<uid>/emulated-servos``.
+To "power-cycle" the emulated servos, delete that file (or the folder).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+#: Overrides where the state files are kept (a test's own folder, say).
+STATE_DIR_ENV = "RTI_RIG_EMULATOR_STATE_DIR"
+
+
+def state_dir() -> Path:
+    """The per-user folder of the emulated servos' state files (see the module docstring)."""
+    given = os.environ.get(STATE_DIR_ENV)
+    if given:
+        return Path(given)
+    runtime = os.environ.get("XDG_RUNTIME_DIR")
+    if runtime and Path(runtime).is_dir():
+        return Path(runtime) / "rti-rig" / "emulated-servos"
+    uid = os.getuid() if hasattr(os, "getuid") else "user"
+    return Path(tempfile.gettempdir()) / f"rti-rig-{uid}" / "emulated-servos"
+
+
+class LatchedErrors:
+    """The state file of one emulated chain: servo id -> latched Hardware Error Status bits."""
+
+    def __init__(self, config_path: Path, emulator_section: Any) -> None:
+        self.config_path = Path(config_path).resolve()
+        key = json.dumps(
+            {"config": str(self.config_path), "emulator": emulator_section},
+            sort_keys=True,
+            default=str,
+        )
+        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+        self.path = state_dir() / f"{self.config_path.stem}-{digest}.json"
+
+    def load(self) -> dict[int, int]:
+        """The errors the chain still has from an earlier command; {} if none or unreadable.
+
+        Why unreadable is {}: the file is the emulator's own scratch state, not the user's
+        data; a damaged one is a chain that was power-cycled, not an error to stop a run on."""
+        try:
+            raw = json.loads(self.path.read_text(encoding="utf-8"))
+            errors = raw["hardware_error_status"]
+            return {int(k): int(v) & 0xFF for k, v in errors.items() if int(v) & 0xFF}
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            return {}
+
+    def save(self, errors: dict[int, int]) -> None:
+        """Record the chain's errors now (atomically); no error left removes the file."""
+        latched = {str(k): v for k, v in sorted(errors.items()) if v}
+        if not latched:
+            with contextlib.suppress(FileNotFoundError):
+                self.path.unlink()
+            return
+        self.path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+        body = json.dumps(
+            {
+                "config": str(self.config_path),
+                "hardware_error_status": latched,
+                "note": "emulated servos kept powered between rti-rig commands; "
+                "delete this file to power-cycle them",
+            },
+            indent=1,
+        )
+        fd, tmp = tempfile.mkstemp(dir=self.path.parent, prefix=".", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                f.write(body)
+            os.replace(tmp, self.path)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+            raise

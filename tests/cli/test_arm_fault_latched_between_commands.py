@@ -1,0 +1,82 @@
+"""A servo's hardware error outlives the command that met it, as on a powered servo.
+
+A real X-series servo keeps its Hardware Error Status (70) until a Reboot or a power-off
+(ROBOTIS e-manual, Shutdown (63): after a shutdown only a Reboot re-enables torque). Each
+rti-rig command built a fresh emulator, so after a run stopped by an overload on the shipped
+emulated arm the documented recovery, ``rti-rig check ARM.toml --reboot-faulted``, said
+"no hardware fault: not rebooted": the recovery could not be rehearsed. The emulated chain is
+now kept powered between commands (its latched errors in a small state file per config).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from conftest import inprocess_arm_config, journal, said, servo_fault
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+# the elevation servo overloads part-way through the run, once some images are kept
+FAULT = servo_fault(200, 2)
+
+
+def test_a_faulted_run_is_recovered_by_reboot_faulted_then_resumed(tmp_path: Path) -> None:
+    cfg = inprocess_arm_config(tmp_path, FAULT)
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(cfg), "--lights", "6", "--out", str(out)], terminal_width=400
+    )
+    words = said(r)
+    assert r.exit_code == 2 and "Traceback" not in words, words
+    assert "servo 2: hardware fault overload" in words, words
+    kept = len(journal(out))
+    assert 0 < kept < 6, words
+
+    # the servo is still faulted for the next command: the resume meets it as the port opens
+    r = runner.invoke(app, ["run", "--resume", str(out)], terminal_width=400)
+    words = said(r)
+    assert r.exit_code != 0 and "Traceback" not in words, words
+    assert "arm during 'connect': servo 2: hardware fault overload" in words, words
+    assert "Nothing was commanded: the arm could not be connected" in words, words
+    assert len(journal(out)) == kept
+
+    # the documented recovery reboots the faulted servo, and it is cleared for good
+    r = runner.invoke(app, ["check", str(cfg), "--reboot-faulted"], terminal_width=400)
+    words = said(r)
+    assert r.exit_code == 0 and "Traceback" not in words, words
+    assert "servo 1 (azimuth): no hardware fault (Hardware Error Status 0x00): not rebooted" in (
+        words
+    )
+    assert (
+        "servo 2 (elevation): hardware fault overload (0x20); rebooted, Hardware Error Status "
+        "read back 0x00" in words
+    ), words
+    assert words.endswith("RESULT: PASS"), words
+    r = runner.invoke(app, ["check", str(cfg), "--reboot-faulted"], terminal_width=400)
+    assert "nothing rebooted" in said(r) and r.exit_code == 0, said(r)
+
+    # the obstruction cleared (the rehearsed fault taken out of the config): the resume ends
+    cfg.write_text(cfg.read_text().replace(FAULT, ""))
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400)
+    words = said(r)
+    assert r.exit_code == 0 and "Traceback" not in words, words
+    assert len(journal(out)) == 6, words
+
+
+def test_each_config_has_its_own_chain(tmp_path: Path) -> None:
+    """Another config (another path) is another rig: its servos meet no other's error."""
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    faulted = inprocess_arm_config(tmp_path / "a", FAULT)
+    r = runner.invoke(
+        app,
+        ["run", str(faulted), "--lights", "6", "--out", str(tmp_path / "s")],
+        terminal_width=400,
+    )
+    assert "servo 2: hardware fault overload" in said(r), said(r)
+    other = inprocess_arm_config(tmp_path / "b")
+    r = runner.invoke(app, ["check", str(other), "--reboot-faulted"], terminal_width=400)
+    assert "nothing rebooted" in said(r) and r.exit_code == 0, said(r)
