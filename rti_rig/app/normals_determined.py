@@ -24,6 +24,11 @@ FIT_WITHOUT_NORMALS = (
     "lights do not span, their relighting is a guess)"
 )
 
+#: What the note of lights captured with ``--allow-no-normals`` says (kept in the manifest's
+#: ``input_notes``): a manifest from before the flag was recorded shows it was given by this
+#: note alone (:func:`~rti_rig.app.usecases.replay_advice.new_session_command` reads it).
+CAPTURED_WITHOUT_NORMALS = "captured as asked (--allow-no-normals)"
+
 
 def _layout(lights: np.ndarray) -> str:
     """How ``lights`` (N×3, judged ill-conditioned) fail to span the three directions.

@@ -159,3 +159,59 @@ def test_the_new_session_command_names_the_plan_the_session_ran_from_any_folder(
     assert r.exit_code == 0, r.output
     again = json.loads((Path(args[2]) / "manifest.json").read_text())
     assert again["schedule"]["steps"] == first["schedule"]["steps"]
+
+
+def test_a_session_from_before_the_flag_was_recorded_is_told_allow_no_normals_by_its_note(
+    tmp_path: Path,
+) -> None:
+    """A raking-light session begun before ``--allow-no-normals`` was recorded in the
+    provenance (its manifest holds only the note its lights were captured with, as
+    e71079f2's do): the command had left the flag out, and pasted as printed it was refused
+    the very lights the session had been allowed. The note says the flag was given."""
+    acq, out = tmp_path / "acq", tmp_path / "S"
+    shutil.copytree(ACQ, acq)
+    lines = (ACQ / "dirs.lp").read_text().splitlines()[1:]
+    raking = [line for line in lines if line.split()[0] in RAKING]
+    plan = tmp_path / "raking.lp"
+    plan.write_text(f"{len(raking)}\n" + "\n".join(raking) + "\n")
+    _cut_session(acq, out, plan=plan, allow_no_normals=True)
+    manifest_path = out / "manifest.json"
+    manifest = json.loads(manifest_path.read_text())
+    del manifest["schedule"]["provenance"]["allow_no_normals"]  # as an older manifest
+    assert any("--allow-no-normals" in n for n in manifest["input_notes"]), manifest
+    manifest_path.write_text(json.dumps(manifest))
+    names = [e.name for e in read_lp(acq / "dirs.lp")]
+    shutil.copy(acq / names[0], acq / names[-1])  # an image replaced since
+
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    text = said(r)
+    assert r.exit_code == 2 and "Traceback" not in text, text
+    command = re.search(r"\(rti-rig run ([^()]+)\)$", text)
+    assert command, text
+    args = shlex.split(command.group(1))
+    assert "--allow-no-normals" in args, args
+    r = runner.invoke(app, ["run", *args, "--no-verdict"])  # as printed
+    assert r.exit_code == 0, r.output
+    again = json.loads((Path(args[2]) / "manifest.json").read_text())
+    assert again["schedule"]["steps"] == manifest["schedule"]["steps"]
+    assert again["schedule"]["provenance"]["allow_no_normals"] is True
+
+
+def test_a_session_from_before_the_record_whose_lights_needed_no_flag_is_not_given_it(
+    tmp_path: Path,
+) -> None:
+    """The other side: an older manifest with no such note (its lights determine normals)
+    is not told a flag nothing shows it was given."""
+    acq, out = tmp_path / "acq", tmp_path / "S"
+    shutil.copytree(ACQ, acq)
+    _cut_session(acq, out, lights=7)
+    manifest_path = out / "manifest.json"
+    manifest = json.loads(manifest_path.read_text())
+    del manifest["schedule"]["provenance"]["allow_no_normals"]
+    manifest_path.write_text(json.dumps(manifest))
+    names = [e.name for e in read_lp(acq / "dirs.lp")]
+    shutil.copy(acq / names[0], acq / names[-1])
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    text = said(r)
+    assert r.exit_code == 2 and "--lights 7" in text, text
+    assert "--allow-no-normals" not in text, text

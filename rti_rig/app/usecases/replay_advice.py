@@ -28,14 +28,31 @@ def new_session_dir(session_dir: Path | str) -> Path:
     return new
 
 
+def _allowed_no_normals(manifest: dict[str, Any], provenance: dict[str, Any]) -> bool:
+    """Whether the session was run with ``--allow-no-normals``: as its provenance records it,
+    or, in a manifest from before that record, as the note the flag's lights were captured
+    with says (kept in its ``input_notes``).
+
+    Why: every session begun before the record was told to start a new one without the flag,
+    and that command, pasted as printed, was refused the very lights the session had been
+    allowed. The note is written exactly when the flag let undetermined lights through, the
+    one case the new session needs it; a session whose lights needed no flag needs none."""
+    from rti_rig.app.normals_determined import CAPTURED_WITHOUT_NORMALS
+
+    if "allow_no_normals" in provenance:
+        return provenance["allow_no_normals"] is True
+    notes = manifest.get("input_notes") or []
+    return any(CAPTURED_WITHOUT_NORMALS in str(note) for note in notes)
+
+
 def new_session_command(
     config_path: Path | str, manifest: dict[str, Any], session_dir: Path | str
 ) -> str:
     """``rti-rig run CONFIG --out NEW`` with the session's layout options: its ``--plan``, its
     adaptive options (``--adaptive``, ``--lights`` when it was given, ``--until-error``,
     ``--min-lights``, ``--objective relight``) or its homogeneous ``--lights N``, an
-    elevation band other than 0–90°, and ``--allow-no-normals``, each as the manifest recorded
-    it. The plan is recorded as
+    elevation band other than 0–90°, and ``--allow-no-normals`` (see
+    :func:`_allowed_no_normals`), each as the manifest recorded it. The plan is recorded as
     an absolute path, so the command runs from any folder (a manifest from before that record
     holds the path as it was typed, repeated as it is: where it was relative to is unknown)."""
     words = [
@@ -64,8 +81,7 @@ def new_session_command(
     elif provenance.get("n") is not None:
         words.append(f"--lights {int(provenance['n'])}")
         band = (provenance.get("min_elevation_deg"), provenance.get("max_elevation_deg"))
-    if provenance.get("allow_no_normals") is True and not isinstance(adaptive, dict):
-        # recorded since it was asked for; a manifest from before the record: not given
+    if _allowed_no_normals(manifest, provenance) and not isinstance(adaptive, dict):
         words.append("--allow-no-normals")
     low, high = band
     if low is not None and float(low) != 0.0:

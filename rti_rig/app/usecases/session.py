@@ -958,6 +958,7 @@ def _check_determined(
     import numpy as np
 
     from rti_rig.app.normals_determined import (
+        CAPTURED_WITHOUT_NORMALS,
         FIT_WITHOUT_NORMALS,
         refuse_undetermined,
         undetermined_normals,
@@ -977,7 +978,7 @@ def _check_determined(
     if reason is not None:
         on_note(
             Note(
-                f"{reason}; captured as asked (--allow-no-normals): {FIT_WITHOUT_NORMALS}",
+                f"{reason}; {CAPTURED_WITHOUT_NORMALS}: {FIT_WITHOUT_NORMALS}",
                 "warning",
             )
         )
