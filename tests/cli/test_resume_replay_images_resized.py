@@ -89,6 +89,8 @@ def test_an_older_replay_session_re_exported_since_is_not_told_its_images_are_th
     assert r.exit_code == 2 and "Traceback" not in text, text
     assert "camera size: 402×395 → 200×196" in text, text
     assert "the same recorded images" not in text, text
+    # nor that they are other images: the same files read otherwise are not
+    assert "now read otherwise than this session's (camera size" in text, text
     assert "re-exported since, or the same files read otherwise" in text, text
     assert "so which cannot be told" in text, text
     assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before

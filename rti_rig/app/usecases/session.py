@@ -1353,7 +1353,7 @@ def _replay_read_otherwise(
     established."""
     if not digest_recorded:
         return (
-            f"the images of {config_path} are now other images than this session's ("
+            f"the images of {config_path} now read otherwise than this session's ("
             + "; ".join(image_diffs)
             + "): re-exported since, or the same files read otherwise (an rti-rig before "
             "2026-11-30 replayed a TIFF whose thumbnail comes first at the thumbnail's size); "
