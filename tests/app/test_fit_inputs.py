@@ -366,3 +366,43 @@ def test_an_acquisition_mixing_8_and_16_bit_images_is_fitted_with_a_note(tmp_pat
     assert len(mixed) == 1, notes
     assert "17 8-bit image(s), decoded as sRGB, with 1 16-bit one(s), taken as linear" in mixed[0]
     assert "image01.tif" in mixed[0] and "export every image of the acquisition alike" in mixed[0]
+
+
+def _srgb8_to_linear16(srgb: np.ndarray) -> np.ndarray:
+    """IEC 61966-2-1's sRGB decoding of 8-bit codes, at 16 bits (what a linear export holds)."""
+    c = srgb.astype(np.float64) / 255.0
+    linear = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return np.round(linear * 65535.0).astype(np.uint16)
+
+
+def test_jpegs_beside_compressed_16_bit_exports_are_fitted_with_the_note(tmp_path: Path) -> None:
+    """16-bit PNGs (compressed: decoded, not read in place) among JPEGs, the first of them
+    listed first: the fit had refused the acquisition as "images of … differ: image05.png is
+    (40, 48, 3) uint16, image01.png is (40, 48, 3) uint8" (one store of the first image's
+    type), where an uncompressed 16-bit TIFF among them is fitted with a note. Both are
+    fitted and said; each PNG holds its JPEG's pixels as linear data, so the normals are the
+    all-JPEG fit's."""
+    src = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay"
+    acq = tmp_path / "acq"
+    shutil.copytree(src, acq)
+    lp = acq / "dirs.lp"
+    reference = tmp_path / "jpeg"
+    _fit(lp, reference)
+    text = lp.read_text()
+    for name in ("image01.jpg", "image25.jpg"):  # the first listed, and one among the others
+        srgb = cv2.imread(str(acq / name))
+        png = name.replace(".jpg", ".png")
+        assert cv2.imwrite(str(acq / png), _srgb8_to_linear16(srgb))
+        text = text.replace(name, png)
+    lp.write_text(text)
+    out = tmp_path / "mixed"
+    r = runner.invoke(app, ["fit", str(lp), "--out", str(out), *FIT])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "uint" not in said and "(395" not in said
+    assert "mixes 16 8-bit image(s), decoded as sRGB, with 2 16-bit one(s)" in said
+    assert "image01.png, image25.png" in said
+    normals, jpeg_normals = np.load(out / "normals.npy"), np.load(reference / "normals.npy")
+    lit = np.isfinite(jpeg_normals).all(axis=-1) & np.isfinite(normals).all(axis=-1)
+    assert lit.mean() > 0.9
+    assert np.percentile(_angles(normals[lit], jpeg_normals[lit]), 99) < 0.5

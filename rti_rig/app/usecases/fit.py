@@ -293,10 +293,20 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
         return frames
     first = _decode(paths[pending[0]])
     shape, stored = first.shape, first.dtype
-    size = first.nbytes
-    # unlinked at once: gone when the last frame reading it is released
-    store = DecodedStore()
-    lut = _SRGB_TO_LINEAR16 if stored == np.uint8 else None
+    # one store per pixel type: an acquisition may mix 8-bit images (kept 8-bit, linearised
+    # on read) with compressed 16-bit ones (a PNG or zlib TIFF export beside JPEGs), fitted
+    # with a note (:func:`_mixed_depth_note`) as an uncompressed 16-bit TIFF beside them is;
+    # one store of the first image's type had refused them as "(395, 402, 3) uint16"
+    stores: dict[np.dtype[Any], tuple[DecodedStore, list[int]]] = {}
+    claim = threading.Lock()
+
+    def place(img: np.ndarray) -> tuple[DecodedStore, int]:
+        """The store of ``img``'s type and the offset reserved there for it."""
+        with claim:
+            store, end = stores.setdefault(img.dtype, (DecodedStore(), [0]))
+            offset = end[0]
+            end[0] += img.nbytes
+        return store, offset
 
     buffers = threading.local()  # one decode buffer per thread, reused image after image
 
@@ -307,13 +317,16 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
             if buffer is None:
                 buffer = buffers.image = np.empty(shape, stored)
             img = _decode(paths[i], buffer)
-        if img.shape != shape or img.dtype != stored:
+        if img.shape != shape:
             raise FitInputError(
-                f"images of {label} differ: {paths[i].name} is {img.shape} {img.dtype}, "
-                f"{paths[pending[0]].name} is {shape} {stored}"
+                f"images of {label} differ: {paths[pending[0]].name} is {_layout_words(shape)} "
+                f"but {paths[i].name} is {_layout_words(img.shape)}; an acquisition has one "
+                "image size and kind (replace those images, or list only the others)"
             )
-        os.pwrite(store.fileno(), memoryview(img.reshape(-1).view(np.uint8)), k * size)
-        frames[i] = RawRows(store, k * size, shape, stored, lut, name=str(paths[i]))
+        store, offset = place(img)
+        os.pwrite(store.fileno(), memoryview(img.reshape(-1).view(np.uint8)), offset)
+        lut = _SRGB_TO_LINEAR16 if img.dtype == np.uint8 else None
+        frames[i] = RawRows(store, offset, img.shape, img.dtype, lut, name=str(paths[i]))
 
     put(0, first)
     del first
@@ -327,6 +340,11 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     finally:
         cv2.setNumThreads(cv_threads)
     return frames
+
+
+def _layout_words(shape: tuple[int, ...]) -> str:
+    """An image's size and kind as a user reads them (``402x395 colour``), not a numpy shape."""
+    return f"{shape[1]}x{shape[0]} {'colour' if len(shape) == 3 else 'greyscale'}"
 
 
 def acquisition_files(
