@@ -2692,12 +2692,29 @@ _JSON_KIND = {
 }
 
 
+def _acquisition_lp_use(lp: Path) -> str:
+    """What to do with an `.lp` outside any session (a recorded acquisition's, its images
+    beside it): it is fitted and replayed as it is, with no session to export or resume."""
+    q = shlex.quote(str(lp))
+    return (
+        "if that is a recorded acquisition's .lp (its images beside it), use it as it is: "
+        f"rti-rig fit {q} --out DIR, or replay it as a rig: rti-rig run {q} --out DIR"
+    )
+
+
 def read_manifest(root: Path) -> dict[str, Any]:
     """The manifest of a session folder, with a clear error if it is not one."""
     path = Path(root) / MANIFEST
     if not Path(root).exists():
         raise SessionError(f"{root} does not exist: give a session folder written by 'rti-rig run'")
     if not Path(root).is_dir():
+        if Path(root).suffix.lower() == ".lp" and not (Path(root).parent / MANIFEST).is_file():
+            # a recorded acquisition's .lp had been told to give "the session folder that
+            # holds it", which was then refused as "not an rti-rig session folder"
+            raise SessionError(
+                f"{root} is an .lp, not a session folder, and its folder is no session either "
+                f"(no {MANIFEST}): {_acquisition_lp_use(Path(root))}"
+            )
         raise SessionError(
             f"{root} is a file: give the session folder that holds it (the one with {MANIFEST})"
         )
@@ -2724,8 +2741,15 @@ def read_manifest(root: Path) -> dict[str, Any]:
                 f"restore {MANIFEST} from a backup copy of the folder; without it the session "
                 f"cannot be resumed (its schedule and rig are recorded there){fit}"
             ) from None
+        lps = sorted(Path(root).glob("*.lp"))
+        held = (
+            f"; it holds {lps[0].name}{' and more .lp files' if len(lps) > 1 else ''}: "
+            + _acquisition_lp_use(lps[0])
+            if lps
+            else ""
+        )
         raise SessionError(
-            f"{root} has no {MANIFEST}: it is not an rti-rig session folder"
+            f"{root} has no {MANIFEST}: it is not an rti-rig session folder{held}"
         ) from None
     except IsADirectoryError:
         raise SessionError(f"{path} is a folder, not the session's manifest{damaged}") from None
