@@ -336,7 +336,41 @@ def missing_images_advice(
         )
     others = f", or remove their lines from the .lp to {use} the others"
     return ("; " + where if absolute else "") + (
-        case_hint(paths) or f"; {copy}{others if len(names) < total else ''}"
+        case_hint(paths)
+        or quote_hint(names, lp_dir)
+        or f"; {copy}{others if len(names) < total else ''}"
+    )
+
+
+def quote_hint(names: Sequence[str], lp_dir: Path) -> str:
+    """What to say of images not found whose names are in quotes (``"my image 01.jpg"``, as a
+    script's CSV writer quotes a field with spaces) when the file without them is there: ""
+    when none is.
+
+    Why: an `.lp` does not quote its names (relight, like this reader, takes the quotes as
+    part of the name), so such images had been told to be copied "where their names point",
+    beside files the user sees are there. Named, not read in their place: the fix is one
+    edit of the `.lp`, and then every reader finds them."""
+    quoted = [
+        n
+        for n in names
+        if len(n) > 2
+        and n[0] == n[-1]
+        and n[0] in "\"'"
+        and image_path(Path(lp_dir), n[1:-1]).is_file()
+    ]
+    if not quoted:
+        return ""
+    more = f" and {len(quoted) - 3} more" if len(quoted) > 3 else ""
+    which = (
+        "its name is in quotes and the file without them is there"
+        if len(names) == 1
+        else f"{len(quoted)} of them are named in quotes ({', '.join(quoted[:3])}{more}) "
+        "and their files without the quotes are there"
+    )
+    return (
+        f"; {which}: an .lp does not quote its names (a name may hold spaces: the last three "
+        "fields are the light), so remove the quotes from the .lp"
     )
 
 
