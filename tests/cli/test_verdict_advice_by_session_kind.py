@@ -7,13 +7,16 @@ cannot reshoot one image (the lights after it were chosen from it).
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import CONFIGS, coin_dome
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
 
 REPO = Path(__file__).resolve().parents[2]
 ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
@@ -30,9 +33,30 @@ def test_a_replayed_acquisition_is_not_told_to_reshoot_with_less_exposure(tmp_pa
     text = said(r)
     assert "saturated" in text, text  # the recording's own clipped images
     assert "reshoot with less exposure" not in text
-    assert "clipped in the recording (a replayed acquisition cannot be reshot)" in text
+    assert "(a replayed acquisition cannot be reshot)" in text
     assert "this session replays a recorded acquisition" in text
     assert "QA verdict: flawed: image_" in text and "QA verdict: reshoot" not in text
+
+
+def test_a_replay_verdict_names_the_recorded_file_of_each_clipped_image(tmp_path: Path) -> None:
+    """The verdict had named the session's images only ("image_006 … clipped in the
+    recording"): which of the user's own photographs was clipped was theirs to work out. Each
+    clipped image is named with the recorded file it replays, found here by its light."""
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(ACQ), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    recorded = {e.direction: e.name for e in read_lp(ACQ)}
+    clipped = re.findall(r"(image_\d{3}) \(saturated: [^;]*; clipped in the recording", text)
+    assert clipped, text
+    session = {Path(e.name).stem: e.direction for e in read_lp(out / "lights.lp")}
+    for image in clipped:
+        light = np.asarray(session[image])
+        source = min(recorded, key=lambda d: float(np.sum((np.asarray(d) - light) ** 2)))
+        assert (
+            f"clipped in the recording, {recorded[source]} (a replayed acquisition cannot be "
+            "reshot)" in text
+        ), (image, text)
 
 
 @pytest.mark.pty

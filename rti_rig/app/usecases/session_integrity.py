@@ -253,9 +253,11 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
     be reshot, and an adaptive one cannot reshoot one image ("reshoot with less exposure" had
     been the advice to both, which neither could follow)."""
     word = "reshoot"
+    recorded: dict[str, str] = {}
     if (manifest.get("rig") or {}).get("backend") == "replay":
         word = "flawed"  # "reshoot: …" headed advice that said it could not be
         advice = "clipped in the recording (a replayed acquisition cannot be reshot)"
+        recorded = _replayed_names(manifest)
         note = (
             "this session replays a recorded acquisition: the problems named are the "
             "recording's, and cannot be reshot here"
@@ -268,11 +270,43 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
         )
     else:
         return qa
+
+    def said(name: str) -> str:
+        if name not in recorded:
+            return advice
+        return advice.replace("the recording", f"the recording, {recorded[name]}", 1)
+
     images = tuple(
-        replace(c, problems=tuple(p.replace(LESS_EXPOSURE, advice) for p in c.problems))
+        replace(c, problems=tuple(p.replace(LESS_EXPOSURE, said(c.name)) for p in c.problems))
         for c in qa.images
     )
     return replace(qa, images=images, session_note=note if qa.reshoot else "", verdict_word=word)
+
+
+def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
+    """The recorded file each image of a replay session is (``image_064`` → ``image10.jpg``),
+    from the LED its step fired and the replayed acquisition's `.lp`; {} when that `.lp` can
+    no longer be read (moved since).
+
+    Why: the verdict named the session's images only, "clipped in the recording", so a user
+    replaying their own acquisition could not tell which of its photographs was clipped."""
+    rig = manifest.get("rig") or {}
+    lp_file = ((rig.get("config") or {}).get("dome") or {}).get("lp_file")
+    steps = manifest.get("steps")
+    if not isinstance(lp_file, str) or not isinstance(steps, list):
+        return {}
+    try:
+        entries = read_lp(Path(lp_file))
+    except (RtiRigError, OSError):
+        return {}
+    names: dict[str, str] = {}
+    for step in steps:
+        if not isinstance(step, dict):
+            continue
+        led, image = step.get("led"), step.get("image")
+        if isinstance(led, int) and 0 <= led < len(entries) and isinstance(image, str):
+            names[Path(image).stem] = entries[led].name
+    return names
 
 
 #: How a session that did not finish ended, as the manifest's finish_reason records it.
