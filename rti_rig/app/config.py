@@ -1379,7 +1379,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     default dome's (about 1 s a light), so a replayed session reports what a real dome would
     take.
     """
-    from rti_rig.core.acquisition_images import check_acquisition_images
+    from rti_rig.core.acquisition_images import check_acquisition_images, mixed_depth_note
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -1410,6 +1410,9 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
         lead="as a rig, an .lp is a recorded acquisition whose images lie beside it: ",
     )
     width, height = found.width, found.height
+    mixed = mixed_depth_note(lp_path, [e.name for e in entries], found.paths, "replayed")
+    if mixed:
+        notes.append(mixed)
     data: dict[str, Any] = {
         "name": f"replay of {lp_path.parent.name}/{lp_path.name}",
         "kind": "dome",

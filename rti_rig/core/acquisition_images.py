@@ -15,6 +15,7 @@ from pathlib import Path
 
 from rti_rig.core.errors import ConfigError, SessionError
 from rti_rig.core.image_files import (
+    header_bit_depth,
     header_layout,
     image_truncation,
     is_camera_raw,
@@ -221,3 +222,25 @@ def check_image_files(
     if problems:
         raise AcquisitionImagesError(lp_path, problems)
     return AcquisitionImages([paths[n] for n in names], height, width, colour)
+
+
+def mixed_depth_note(lp_path: Path, names: Sequence[str], paths: Sequence[Path], use: str) -> str:
+    """A note when the images ``lp_path`` lists (``names``, read from ``paths``) mix 8-bit
+    files, read as sRGB, with 16-bit ones, read as linear (their headers say which); "" when
+    they do not. ``use`` is what is done with them ("replayed").
+
+    Why: ``fit`` of such an `.lp` says so (a gamma-encoded 16-bit export beside JPEGs is
+    wrong in its mid-tones), but its replay, whose session holds them all as linear TIFFs,
+    and the check before it had said nothing."""
+    depths = [header_bit_depth(p) for p in paths]
+    eight = [n for n, d in zip(names, depths, strict=True) if d == 8]
+    sixteen = [n for n, d in zip(names, depths, strict=True) if d == 16]
+    if not eight or not sixteen:
+        return ""
+    shown = ", ".join(sixteen[:3]) + (" ..." if len(sixteen) > 3 else "")
+    return (
+        f"{lp_path} mixes {len(eight)} 8-bit image(s), decoded as sRGB, with {len(sixteen)} "
+        f"16-bit one(s), taken as linear ({shown}): if the 16-bit files are gamma-encoded "
+        f"exports, not linear data, they are {use} wrongly; export every image of the "
+        "acquisition alike"
+    )

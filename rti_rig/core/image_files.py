@@ -421,20 +421,37 @@ def header_layout(path: Path) -> tuple[int, int, bool] | None:
     TIFF full-resolution image's IFD), without decoding the pixels; ``colour`` as
     :func:`read_image_any` would return it (3 channels, not grey). None when the header does
     not say (another format, or a damaged or empty file: the decoder will say why)."""
+    info = _header_info(path)
+    return None if info is None else info[:3]
+
+
+def header_bit_depth(path: Path) -> int | None:
+    """Bits per sample from the file's header alone (8 for a JPEG or an 8-bit PNG/TIFF, 16 for
+    a 16-bit one), None when the header does not say. Why: 8-bit images are read as sRGB and
+    16-bit ones as linear, so an acquisition mixing them is said before it is used."""
+    info = _header_info(path)
+    return None if info is None else info[3]
+
+
+def _header_info(path: Path) -> tuple[int, int, bool, int] | None:
+    """(height, width, colour, bits per sample) from the header (see :func:`header_layout`)."""
     p = Path(path)
     with open(p, "rb") as fh:
         head = fh.read(64 * 1024)
     if head.startswith(PNG_MAGIC) and head[12:16] == b"IHDR" and len(head) >= 26:
         # colour type 0 grey, 4 grey + alpha; 2 RGB, 3 palette (decoded to RGB), 6 RGBA
         colour = head[25] not in (0, 4)
-        return int.from_bytes(head[20:24], "big"), int.from_bytes(head[16:20], "big"), colour
+        bits = 8 if head[25] == 3 else int(head[24])  # a palette's entries are 8-bit samples
+        return int.from_bytes(head[20:24], "big"), int.from_bytes(head[16:20], "big"), colour, bits
     if head[:4] in TIFF_MAGIC:
         import tifffile
 
         try:
             with tifffile.TiffFile(p) as tif:
                 page = tiff_main_image(tif).keyframe  # not a thumbnail in IFD0
-                return int(page.imagelength), int(page.imagewidth), page.samplesperpixel >= 3
+                colour = page.samplesperpixel >= 3
+                bits = int(page.bitspersample)
+                return int(page.imagelength), int(page.imagewidth), colour, bits
         except Exception:  # tifffile raises many kinds; the decoder names the problem later
             return None
     if not head.startswith(JPEG_MAGIC):
@@ -450,7 +467,8 @@ def header_layout(path: Path) -> tuple[int, int, bool] | None:
         if 0xC0 <= marker <= 0xCF and marker not in (0xC4, 0xC8, 0xCC):  # start of frame
             height = int.from_bytes(data[pos + 5 : pos + 7], "big")
             width = int.from_bytes(data[pos + 7 : pos + 9], "big")
-            return height, width, data[pos + 9] != 1  # components: 1 grey, 3 YCbCr, 4 CMYK
+            # components: 1 grey, 3 YCbCr, 4 CMYK; sample precision 8 (12 in rare files)
+            return height, width, data[pos + 9] != 1, int(data[pos + 4])
         if marker == 0xDA:
             return None
         pos += 2 + length
