@@ -2036,12 +2036,15 @@ def _evidence(
             f"light directions not checked: {undimmed} image(s) with light, too few to tell a "
             f"wrong light from the others (at least {MIN_DIRECTION_IMAGES} are needed)"
         )
-    elif cand.sum() < max(MIN_DIRECTION_IMAGES, (undimmed + 1) // 2):
+    elif cand.sum() < (needed := max(MIN_DIRECTION_IMAGES, (undimmed + 1) // 2)):
         spread = float(np.median(misfit[~dead & np.isfinite(misfit)])) if undimmed else np.nan
+        # how many are needed is said: "median misfit 9%, limit 10%" alone had read as a
+        # check passed (6 images need 5 close; a median under the limit says 3 or 4 are)
         note = (
             f"light directions not checked: only {int(cand.sum())} of {undimmed} images are "
-            f"close to any Lambertian rendering of the fit (median misfit {spread:.0%}, limit "
-            f"{MISFIT_LIMIT:.0%}): a glossy, saturated or non-Lambertian surface"
+            f"close to any Lambertian rendering of the fit (misfit within {MISFIT_LIMIT:.0%}; "
+            f"{needed} are needed to judge the lights; median misfit {spread:.0%}): a glossy, "
+            "saturated or non-Lambertian surface"
         )
     else:
         judged = cand.copy()
