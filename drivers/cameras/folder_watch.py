@@ -75,6 +75,7 @@ from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.core.image_files import (
     CAMERA_RAW_SUFFIXES,
     TIFF_MAGIC,
+    image_number,
     is_camera_raw,
     tiff_extent,
 )
@@ -1155,7 +1156,8 @@ class FolderWatchCamera:
 
     def _earlier_run_last_shot(self) -> tuple[str, float | None] | None:
         """The last camera file an earlier run of the session kept (``raw/image_NNN.*``, the
-        highest number) and its capture time; None when the session holds none (a new one).
+        highest number, by number: ``image_1000`` after ``image_999``) and its capture time;
+        None when the session holds none (a new one).
 
         Why: a resume of a session without a camera clock file (an older version's, or the
         file deleted) has only this to date a file shot before its first image by: after the
@@ -1163,7 +1165,7 @@ class FolderWatchCamera:
         raw = None if self.output_dir is None else self.output_dir.parent
         if raw is None or not raw.is_dir():
             return None
-        kept = sorted(p for p in raw.glob("image_*.*") if p.is_file())
+        kept = sorted((p for p in raw.glob("image_*.*") if p.is_file()), key=image_number)
         if not kept:
             return None
         last = kept[-1]

@@ -44,6 +44,17 @@ def is_camera_raw(path: Path) -> bool:
     return Path(path).suffix.lower() in CAMERA_RAW_SUFFIXES
 
 
+def image_number(path: Path) -> tuple[int, str]:
+    """The sort key of a session's numbered file (``image_NNN.*``): its number, then its name
+    (a name without one sorts first).
+
+    Why: by name, ``image_1000`` sorts before ``image_999``; the last image kept is the one
+    with the highest number, not the last name."""
+    stem = Path(path).name.split(".", 1)[0]
+    digits = stem.rpartition("_")[2]
+    return (int(digits) if digits.isdigit() else -1, Path(path).name)
+
+
 def looks_like_image(raw: bytes) -> bool:
     """Whether ``raw`` starts as a JPEG, PNG or TIFF file does (an .lp or a rig config given
     an image is refused as one, not as text with NUL bytes)."""

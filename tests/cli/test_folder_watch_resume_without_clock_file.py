@@ -137,3 +137,29 @@ def test_files_shot_before_the_earlier_runs_last_kept_image_are_said_in_the_plur
     assert "so none of them is a late file of the shot that run stopped waiting" in said, said
     said = camera._without_clock_said({"IMG_0004.DNG": taken - 50})
     assert "it was shot before" in said and "so it is no late file" in said, said
+
+
+def test_the_earlier_runs_last_kept_image_is_the_highest_number_not_the_last_name(
+    tmp_path: Path,
+) -> None:
+    """``raw/image_1000`` is kept after ``raw/image_999``: by name it sorted first, and the
+    resume dated its files by image 999's capture time."""
+    from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
+    from rti_rig.drivers.cameras.settings import FolderWatchSettings
+
+    raw = tmp_path / "s" / "raw"
+    raw.mkdir(parents=True)
+    (raw / "image_999.dng").write_bytes(_dng(100.0))
+    (raw / "image_1000.dng").write_bytes(_dng(160.0))  # the earlier run's last kept shot
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    camera = FolderWatchCamera(FolderWatchSettings(folder=tether))
+    camera.output_dir = raw / ".incoming"  # as the session binds it
+    last = camera._earlier_run_last_shot()
+    assert last is not None and last[0] == "raw/image_1000.dng", last
+    earlier = FolderWatchCamera(FolderWatchSettings(folder=tether))
+    earlier.output_dir = raw / ".incoming"
+    (raw / "image_1000.dng").unlink()
+    only = earlier._earlier_run_last_shot()
+    assert only is not None and last[1] is not None and only[1] is not None
+    assert last[1] - only[1] == pytest.approx(60.0)  # its own capture time, not image 999's
