@@ -1457,9 +1457,12 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             _print_teardown_failures(folder, said_below=exc)
             | _print_failures(_close_left_open(opened), said_below=exc),
         )
-        hint = _dead_led_hint(opened, exc) or resume_hint()
-        err.print(f"{_sentence(state)}. {_after_stop(opened, hint)}", markup=False)
-        raise fail(_write_failed_said(exc, opened)) from None
+        said = _write_failed_said(exc, opened)
+        # a write the disk refused ends with the resume command, after the fix it needs: said
+        # there once (this line had said "Continue with: …" too, just above it)
+        hint = _dead_led_hint(opened, exc) or ("" if said is not exc else resume_hint())
+        err.print(f"{_sentence(state)}. {_after_stop(opened, hint)}".rstrip(), markup=False)
+        raise fail(said) from None
     except Exception as exc:
         # a fault no driver named (an OSError, a library's own exception): the controller has
         # torn down and kept the images all the same, but this had been a Python traceback,

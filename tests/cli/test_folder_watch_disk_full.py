@@ -118,6 +118,10 @@ def test_a_disk_full_at_the_steps_images_says_which_shot_and_what_the_resume_doe
     assert "Traceback" not in said and not run.lit_at_end, said
     assert "this light's shot (IMG_0002.DNG) is not recorded: the resume moves whatever" in said
     assert "recovered/ folder and shoots this light again" in said, said
+    # the resume command once, at the end of the error (the teardown's line had said it too)
+    assert said.lower().count("rti-rig run --resume") == 1, said
+    assert said.rstrip().endswith(f"continue with rti-rig run --resume {out}"), said
+    assert f"1 image(s) kept in {out}, listed in lights.lp." in said, said
 
     r, again = _resumed(monkeypatch, cfg, tether, out)
     assert r.exit_code == 0, r.output
@@ -153,6 +157,9 @@ def test_a_disk_full_at_the_first_image_says_the_disk_the_shot_and_what_the_resu
         f"free space on that disk (or lift the file-size limit or quota), then continue "
         f"with rti-rig run --resume {out}" in said
     ), said
+    # said once, after the fix it needs (the teardown's line had said "Continue with:" too)
+    assert said.lower().count("rti-rig run --resume") == 1, said
+    assert f"No image was completed, but {out} holds files of the camera." in said, said
 
     # the resume, as said: the copy that reached the session is set aside, the light reshot
     r, again = _resumed(monkeypatch, cfg, tether, out, shots=3)
