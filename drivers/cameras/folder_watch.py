@@ -74,16 +74,16 @@ from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.core.image_files import (
     CAMERA_RAW_SUFFIXES,
+    PNG_ALPHA_TYPES,
     TIFF_MAGIC,
     image_number,
     is_camera_raw,
+    png_colour_type,
     tiff_extent,
 )
 from rti_rig.drivers.cameras.dng_tags import IfdState, ifd_state
 from rti_rig.drivers.cameras.image_io import (
-    PNG_ALPHA_TYPES,
     ImageReadError,
-    png_colour_type,
     read_image_file,
     tiff_extra_samples,
     to_linear_uint16,

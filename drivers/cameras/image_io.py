@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from rti_rig.core.errors import CaptureError
 from rti_rig.core.image_files import (
     SeveralFullSizeImages,
+    png_colour_type,
     tiff_is_planar,
     tiff_main_image,
     tiff_one_image,
@@ -219,29 +220,6 @@ def tiff_extra_samples(path: Path) -> tuple[str, ...]:
     except Exception:  # tifffile raises many kinds; read_image_file names the problem
         return ()
     return tuple(EXTRA_SAMPLE_KINDS.get(v, "unspecified") for v in values)
-
-
-#: PNG colour types (PNG spec, IHDR) whose pixels carry an alpha sample: grey + alpha (4),
-#: RGBA (6). PNG alpha is never premultiplied (the PNG spec: unassociated alpha only).
-PNG_ALPHA_TYPES = {4: "grey + alpha", 6: "RGBA"}
-
-
-def png_colour_type(path: Path) -> int | None:
-    """A PNG's colour type from its IHDR (0 grey, 2 RGB, 3 palette, 4 grey + alpha, 6 RGBA);
-    None for another file (told by its signature, not its name) or one too short to say (its
-    reader says why).
-
-    Why: OpenCV reads grey + alpha as four samples, the grey copied to three colours, with no
-    way to tell it from RGBA: the watched folder had recorded a grey camera's PNGs as colour,
-    their alpha dropped unsaid."""
-    try:
-        with path.open("rb") as f:
-            head = f.read(26)
-    except OSError:
-        return None
-    if len(head) < 26 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
-        return None
-    return head[25]
 
 
 def read_image_file(path: Path, device: str) -> NDArray:

@@ -1380,6 +1380,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     take.
     """
     from rti_rig.core.acquisition_images import check_acquisition_images, mixed_depth_note
+    from rti_rig.core.image_files import png_alpha_note
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -1409,6 +1410,8 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
         entries,
         lead="as a rig, an .lp is a recorded acquisition whose images lie beside it: ",
     )
+    # their readers drop a PNG's alpha: said once, among the rig's notes (run, check)
+    notes.extend(png_alpha_note([e.name for e in entries], found.paths))
     width, height = found.width, found.height
     mixed = mixed_depth_note(lp_path, [e.name for e in entries], found.paths, "replayed")
     if mixed:

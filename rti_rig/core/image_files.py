@@ -10,6 +10,7 @@ import contextlib
 import functools
 import hashlib
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +43,47 @@ CAMERA_RAW_SUFFIXES = frozenset(
 def is_camera_raw(path: Path) -> bool:
     """Whether ``path`` is named as a camera RAW file (see :data:`CAMERA_RAW_SUFFIXES`)."""
     return Path(path).suffix.lower() in CAMERA_RAW_SUFFIXES
+
+
+#: PNG colour types (PNG spec, IHDR) whose pixels carry an alpha sample: grey + alpha (4),
+#: RGBA (6). PNG alpha is never premultiplied (the PNG spec: unassociated alpha only).
+PNG_ALPHA_TYPES = {4: "grey + alpha", 6: "RGBA"}
+
+
+def png_colour_type(path: Path) -> int | None:
+    """A PNG's colour type from its IHDR (0 grey, 2 RGB, 3 palette, 4 grey + alpha, 6 RGBA);
+    None for another file (told by its signature, not its name) or one too short to say (its
+    reader says why).
+
+    Why: OpenCV reads grey + alpha as four samples, the grey copied to three colours, with no
+    way to tell it from RGBA: the watched folder, the replay rig and the fit had read a grey
+    camera's PNGs as colour, their alpha dropped unsaid. One reading for the core and the
+    drivers (a driver may import the core, not the other way)."""
+    try:
+        with Path(path).open("rb") as f:
+            head = f.read(26)
+    except OSError:
+        return None
+    if len(head) < 26 or head[:8] != PNG_MAGIC or head[12:16] != b"IHDR":
+        return None
+    return head[25]
+
+
+def png_alpha_note(names: Sequence[str], paths: Sequence[Path]) -> list[str]:
+    """The one note of an acquisition (``paths[i]`` read for ``names[i]``) whose PNGs carry
+    an alpha channel, which their readers drop; none when no PNG does.
+
+    Why once for the acquisition: the alpha carries no light, so the grey or colour samples
+    are the picture, but the user should know it is left out (the replay rig and the fit had
+    dropped it unsaid), in one line, not one per image."""
+    alpha = [n for n, p in zip(names, paths, strict=True) if png_colour_type(p) in PNG_ALPHA_TYPES]
+    if not alpha:
+        return []
+    shown = ", ".join(alpha[:3]) + (" ..." if len(alpha) > 3 else "")
+    return [
+        f"{len(alpha)} of {len(names)} image(s) are PNGs with an alpha channel ({shown}), "
+        "which carries no light: it was dropped and their grey or colour samples used"
+    ]
 
 
 def image_number(path: Path) -> tuple[int, str]:
@@ -566,8 +608,9 @@ def tiff_sample_problem(path: Path) -> str | None:
 
 def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
     """A recorded image as stored: 8-bit (JPEG, 8-bit PNG/TIFF) or 16-bit (TIFF, PNG), RGB
-    order, shape (H, W) or (H, W, 3) (a TIFF's full-resolution image, :func:`tiff_main_image`);
-    refused with the file's name if it cannot be read."""
+    order, shape (H, W) or (H, W, 3) (a TIFF's full-resolution image, :func:`tiff_main_image`;
+    a grey + alpha PNG is grey, :func:`png_colour_type`), an alpha channel dropped; refused
+    with the file's name if it cannot be read."""
     p = Path(path)
     if p.suffix.lower() in (".tif", ".tiff"):
         import tifffile
@@ -590,6 +633,8 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
         raise SessionError(f"cannot read image {p} (missing, or not an image OpenCV decodes)")
     if img.dtype not in (np.uint8, np.uint16):
         raise SessionError(f"image {p}: {img.dtype} is not 8- or 16-bit")
-    if img.ndim == 3:
+    if img.ndim == 3 and img.shape[2] == 4 and png_colour_type(p) == 4:
+        img = img[..., 0]  # grey + alpha, read as B = G = R = grey: grey, as its header says
+    elif img.ndim == 3:
         img = img[..., 2::-1] if img.shape[2] >= 3 else img[..., 0]
     return np.ascontiguousarray(img)

@@ -45,7 +45,7 @@ from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core.acquisition_images import check_image_files
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.fit_minimums import FIT_MINIMUMS
-from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation
+from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation, png_alpha_note
 from rti_rig.core.json_values import strict_dumps
 from rti_rig.core.lp_format import (
     LpEntry,
@@ -613,6 +613,9 @@ def load_acquisition(
     if notes is not None and not any(p.parent.name == "linear" for p in paths):
         # (a session's linear/ with stand-ins is said by acquisition_files)
         notes.extend(_mixed_depth_note(lp, frames, paths))
+    if notes is not None:
+        # dropped by the reader: said once, by the files' names (``names`` are stems)
+        notes.extend(png_alpha_note([p.name for p in paths], paths))
     return frames, lights, names, f"{len(frames)} images from {lp}"
 
 

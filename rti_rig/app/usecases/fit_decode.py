@@ -23,22 +23,28 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from rti_rig.core.image_files import png_colour_type
+
 
 def imread_rgb(path: Path, into: np.ndarray | None = None) -> np.ndarray | None:
     """The image at ``path`` as OpenCV reads it unchanged (8- or 16-bit, grey or colour), with
-    colour images in RGB order and an alpha channel dropped; None when it cannot be decoded.
-    Decoded into ``into`` when that buffer has the image's shape and type (else into a new
-    array)."""
+    colour images in RGB order, a grey + alpha PNG as grey, and an alpha channel dropped; None
+    when it cannot be decoded. Decoded into ``into`` when that buffer has the image's shape and
+    type (else into a new array)."""
     img = imread_into(path, into) if into is not None else _imread(path)
     if img is None:
         return None
     if img.ndim == 3 and img.shape[2] == 3 and img.dtype in (np.uint8, np.uint16):
         # BGR to RGB in place: a reversed copy would hold each image twice while it is written
         return cv2.cvtColor(img, cv2.COLOR_BGR2RGB, dst=img)
+    if img.ndim == 3 and img.shape[2] == 4 and png_colour_type(path) == 4:
+        # grey + alpha, which OpenCV reads as B = G = R = grey and alpha: grey, as its header
+        # says (it had been fitted as colour); the alpha carries no light
+        return np.ascontiguousarray(img[..., 0])
     if img.ndim == 3:
-        # BGRA (or grey + alpha): the alpha sample carries no light and is dropped, as the
-        # replay rig reads such images (reversed whole, RGBA had become ARGB, four channels
-        # the fit only refused at its export)
+        # BGRA: the alpha sample carries no light and is dropped, as the replay rig reads such
+        # images (reversed whole, RGBA had become ARGB, four channels the fit only refused at
+        # its export)
         return np.ascontiguousarray(img[..., 2::-1] if img.shape[2] >= 3 else img[..., 0])
     return img
 

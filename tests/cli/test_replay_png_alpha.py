@@ -1,0 +1,104 @@
+"""A recorded acquisition of PNGs with an alpha channel (a grey camera's grey + alpha, PNG
+colour type 4; or RGBA, type 6), through `rti-rig check`, `run` and `fit` of its `.lp`.
+
+OpenCV reads grey + alpha as four samples, the grey copied to three colours: the replay rig
+recorded a grey acquisition as colour (its check had said, from the header, "of one kind"
+grey) and the fit fitted it as colour; any PNG's alpha was dropped unsaid. The folder watch
+reads such PNGs as grey and says the alpha once: so do these, from the same header reading.
+A plain 16-bit grey PNG is read as it is, with nothing said."""
+
+from __future__ import annotations
+
+import math
+import struct
+import subprocess
+import sys
+import zlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tifffile
+
+RTI_RIG = [sys.executable, "-c", "from rti_rig.cli import main; main()"]
+KINDS = {"grey+alpha-16": (4, 16), "grey+alpha-8": (4, 8), "rgba-16": (6, 16), "grey-16": (0, 16)}
+
+
+def _png(pixels: np.ndarray, colour_type: int, depth: int) -> bytes:
+    """A PNG of ``pixels`` (H, W, samples), written to the PNG spec by hand: OpenCV writes no
+    grey + alpha PNG."""
+    h, w = pixels.shape[:2]
+    rows = b"".join(
+        b"\x00" + pixels[y].astype(">u2" if depth == 16 else "u1").tobytes() for y in range(h)
+    )
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (
+            struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+        )
+
+    head = struct.pack(">IIBBBBB", w, h, depth, colour_type, 0, 0, 0)
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", head)
+        + chunk(b"IDAT", zlib.compress(rows))
+        + chunk(b"IEND", b"")
+    )
+
+
+def _acquisition(folder: Path, colour_type: int, depth: int) -> tuple[Path, list[np.ndarray]]:
+    """12 PNGs lit from a ring at 40°: the .lp and each image's pixels (alpha included)."""
+    samples = {0: 1, 4: 2, 6: 4}[colour_type]
+    top = 65535 if depth == 16 else 255
+    rng = np.random.default_rng(5)
+    lines, shots = ["12"], []
+    for i in range(12):
+        az, el = 2 * math.pi * i / 12, math.radians(40)
+        x, y, z = math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)
+        pixels = rng.integers(top // 10, top // 2, (24, 32, samples)).astype(np.uint32)
+        if samples in (2, 4):
+            pixels[..., -1] = rng.integers(0, top, (24, 32))  # an alpha that varies
+        (folder / f"im{i:02d}.png").write_bytes(_png(pixels, colour_type, depth))
+        lines.append(f"im{i:02d}.png {x:.6f} {y:.6f} {z:.6f}")
+        shots.append(pixels)
+    (folder / "dirs.lp").write_text("\n".join(lines) + "\n")
+    return folder / "dirs.lp", shots
+
+
+def _cli(*args: str) -> tuple[int, str]:
+    r = subprocess.run([*RTI_RIG, *args], capture_output=True, text=True, timeout=600)
+    return r.returncode, r.stdout + r.stderr
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_a_replayed_png_acquisition_keeps_its_grey_or_colour_and_says_the_alpha_once(
+    tmp_path: Path, kind: str
+) -> None:
+    colour_type, depth = KINDS[kind]
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lp, shots = _acquisition(acq, colour_type, depth)
+    alpha = colour_type in (4, 6)
+    note = "12 of 12 image(s) are PNGs with an alpha channel (im00.png, im01.png, im02.png ...)"
+
+    code, said = _cli("check", str(lp))
+    assert code == 0 and "RESULT: PASS" in said, said
+    assert said.count("alpha channel") == (1 if alpha else 0), said
+    assert (note in " ".join(said.split())) == alpha, said
+
+    out = tmp_path / "s"
+    code, said = _cli("run", str(lp), "--out", str(out), "--lights", "12", "--no-verdict")
+    assert code == 0 and "Traceback" not in said, said
+    assert said.count("alpha channel") == (1 if alpha else 0), said  # once, not per image
+    for n, shot in enumerate(shots, 1):
+        image = tifffile.imread(out / "linear" / f"image_{n:03d}.tif")
+        expected = shot[..., :3] if colour_type == 6 else shot[..., 0]
+        assert image.shape == expected.shape, (kind, image.shape)  # grey + alpha is grey
+        if depth == 16:  # the recorded pixels themselves, the alpha left out
+            assert np.array_equal(image, expected)
+
+    code, said = _cli("fit", str(lp), "--out", str(tmp_path / "f"))
+    assert code == 0 and "Traceback" not in said, said
+    assert said.count("alpha channel") == (1 if alpha else 0), said
+    albedo = np.load(tmp_path / "f" / "albedo.npy")
+    assert albedo.shape == ((24, 32, 3) if colour_type == 6 else (24, 32)), albedo.shape
