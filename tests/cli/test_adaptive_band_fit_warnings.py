@@ -7,6 +7,7 @@ pytest's own warning capture would hide a raw warning from an in-process run."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import subprocess
@@ -49,6 +50,7 @@ def test_a_band_too_low_for_normals_is_said_in_words_not_as_python_warnings(
     assert not re.search(r"\.py:\d+", text), text
     # once, with what it means and what to do
     assert text.count("leave its surface normals poorly determined") == 1, text
+    assert text.count("photometric stereo fit ill-conditioned") == 1, text  # the run's verdict
     assert "widen the elevation band" in text, text
     # the chooser's own decision fits (4 lights of a narrow band) are not said at all
     assert "for these 4 lights" not in text, text
@@ -58,3 +60,11 @@ def test_a_band_too_low_for_normals_is_said_in_words_not_as_python_warnings(
     words = " ".join((fitted.stdout + fitted.stderr).split())
     assert "Warning:" not in words and not re.search(r"\.py:\d+", words), words
     assert "photometric stereo fit ill-conditioned" in words, words  # said, not dropped
+    # a warning about the user's result, as the PTM's and HSH's are (it had been a "note:",
+    # the console's safety net catching the QA's warning outside the fit's own capture), once,
+    # and recorded with them in fit.json
+    assert "warning: photometric stereo fit ill-conditioned" in words, words
+    assert words.count("photometric stereo fit ill-conditioned") == 1, words
+    assert "warning: ptm fit" in words or "warning: hsh" in words, words
+    recorded = json.loads((tmp_path / "fit" / "fit.json").read_text())["warnings"]
+    assert any("photometric stereo fit ill-conditioned" in w for w in recorded), recorded

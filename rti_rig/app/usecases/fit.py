@@ -808,7 +808,10 @@ def _fit_into(  # type: ignore[no-untyped-def]
             with contextlib.suppress(Exception):  # the QA's own check says what went wrong
                 checksums.result()
         try:
-            qa = assess(frames, lights, names)  # every row of every frame: checksummed too
+            with warnings.catch_warnings(record=True) as qa_caught:
+                warnings.simplefilter("always")
+                qa = assess(frames, lights, names)  # every row of every frame: checksummed too
+            _say_qa_trust_warnings(qa_caught, result.warnings)
             _remember_pixels(frames)
             result.qa = with_lost_files(qa, req.source)
         except ReconstructionError as exc:  # e.g. coplanar lights for PS, 1-px images
@@ -837,6 +840,22 @@ def _fit_into(  # type: ignore[no-untyped-def]
     (out / "fit.json").write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
     result.files.append(out / "fit.json")
     return result
+
+
+def _say_qa_trust_warnings(caught: list[warnings.WarningMessage], said: list[str]) -> None:
+    """The QA's trust warnings (its photometric-stereo fit's) added to the fit's ``said``
+    warnings, each once; any other warning is issued again to the caller's filters.
+
+    Why: the QA runs after the fit's own warning capture, so its photometric-stereo warning
+    reached the console's safety net and was printed as a "note:" (and left out of
+    ``fit.json``), where the PTM and HSH trust warnings about the same result are warnings."""
+    from rti_rig.reconstruct.errors import FitTrustWarning
+
+    for w in fit_warnings(caught):
+        if not issubclass(w.category, FitTrustWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        elif str(w.message) not in said:
+            said.append(str(w.message))
 
 
 #: The fewest lights whose 5-fold cross-validation leaves a PTM its 6 fitting lights in every
