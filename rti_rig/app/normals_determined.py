@@ -16,10 +16,16 @@ from rti_rig.core.errors import RtiRigError
 # that the command line's help states them without loading numpy
 from rti_rig.core.fit_minimums import NORMAL_ERROR_LIMIT_DEG, NORMAL_MIN_LIGHTS, NORMAL_NOISE
 
-#: What ``rti-rig fit`` does with lights that give no normals, as a CLI user can act on it.
-FIT_WITHOUT_NORMALS = (
+#: What ``rti-rig fit`` refuses of lights that give no normals, whatever their count (the start
+#: of :data:`FIT_WITHOUT_NORMALS`; ``fit_outlook.fit_without_normals`` goes on from it).
+NO_NORMAL_MAPS = (
     "rti-rig fit would write no normal maps from them (--model ps, lambert and robust-ps refuse "
-    "them; --model auto, which then chooses among the PTM and HSH, hsh2 and ptm write the "
+    "them"
+)
+
+#: What ``rti-rig fit`` does with lights that give no normals, as a CLI user can act on it.
+FIT_WITHOUT_NORMALS = NO_NORMAL_MAPS + (
+    "; --model auto, which then chooses among the PTM and HSH, hsh2 and ptm write the "
     "relighting files fit.ptm and fit.rti only, ridge-regularised: along the direction the "
     "lights do not span, their relighting is a guess)"
 )

@@ -71,3 +71,59 @@ FIT_MINIMUMS = FitMinimums(
     ptm=N_COEFFICIENTS["ptm"],
     rti=fewest_held_out(("hsh1",)),
 )
+
+#: The models whose fit is the normal map (photometric stereo): on lights that cannot determine
+#: a normal there is nothing to write, and ``--model auto`` leaves them out of its choice.
+PHOTOMETRIC_STEREO = ("ps", "lambert", "ps-robust")
+
+
+def auto_models(normals_determined: bool) -> tuple[str, ...]:
+    """The models ``rti-rig fit --model auto`` chooses among: every relighting model, less
+    photometric stereo (Lambert) on lights that cannot determine a normal. The fit's choice
+    (``app.usecases.fit.auto_candidates``) and the outlook before a session both read this."""
+    return tuple(m for m in N_COEFFICIENTS if normals_determined or m not in PHOTOMETRIC_STEREO)
+
+
+@dataclass(frozen=True)
+class AutoFit:
+    """What ``rti-rig fit`` with its default ``--model auto`` makes of ``n`` lights.
+
+    Why one object: the run's note before a session and the fit's own refusal had each worked
+    it out, and disagreed: on 4 raking lights (one azimuth) the note promised a normal map while
+    the fit, with photometric stereo left out, needed 5 lights for its simplest model and made
+    nothing. Every figure is derived from :func:`auto_models` and :data:`FIT_MINIMUMS`.
+    """
+
+    n: int
+    normals_determined: bool
+
+    @property
+    def least(self) -> int:
+        """The fewest lights auto fits from on such lights (its simplest model, checked on one
+        left out)."""
+        return fewest_held_out(auto_models(self.normals_determined))
+
+    @property
+    def simplest(self) -> str:
+        """Auto's simplest candidate model on such lights."""
+        return min(auto_models(self.normals_determined), key=N_COEFFICIENTS.__getitem__)
+
+    @property
+    def fits(self) -> bool:
+        """Whether auto fits anything at all (else it refuses the session)."""
+        return self.n >= self.least
+
+    @property
+    def normal_map(self) -> bool:
+        """Whether normal maps are written."""
+        return self.fits and self.normals_determined
+
+    @property
+    def ptm(self) -> bool:
+        """Whether fit.ptm is written."""
+        return self.fits and self.n >= FIT_MINIMUMS.ptm
+
+    @property
+    def rti(self) -> bool:
+        """Whether fit.rti is written (an HSH order chosen on held-out lights)."""
+        return self.fits and self.n >= FIT_MINIMUMS.rti

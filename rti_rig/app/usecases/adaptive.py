@@ -1182,15 +1182,22 @@ def few_lights_note(result: dict[str, Any]) -> str | None:
     used = int(result.get("lights_used") or 0)
     if not result.get("target_claimed"):
         return None
-    short = [(name, what, n) for name, what, n in RTI_FILE_LIGHTS if used < n]
+    # what the fit makes of them, from the rules the fit applies (the lights an adaptive
+    # session chooses determine a normal: it refuses --allow-no-normals)
+    auto = fit_minimums.AutoFit(used, normals_determined=True)
+    made = {"fit.ptm": auto.ptm, "fit.rti": auto.rti}
+    short = [(name, what, n) for name, what, n in RTI_FILE_LIGHTS if not made[name]]
     if not short:
         return None
     needs = " and ".join(f"{what} needs {n}" for _, what, n in short)
     files = " and ".join(name for name, _, _ in short)
-    text = (
-        f"{used} lights reached the normal-error target, but {needs}: `rti-rig fit` will "
-        f"write the normal map without {files}."
+    makes = (
+        f"will write the normal map without {files}"
+        if auto.normal_map
+        else f"with its default --model auto will write nothing ({auto.least} lights are its "
+        "fewest); `rti-rig fit --model ps` writes the normal map"
     )
+    text = f"{used} lights reached the normal-error target, but {needs}: `rti-rig fit` {makes}."
     cap = int(result.get("max_lights") or 0)
     reachable = [(name, n) for name, _, n in short if n <= cap]
     if reachable:

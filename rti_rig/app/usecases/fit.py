@@ -39,12 +39,13 @@ from rti_rig.app.usecases.fit_inputs import (
 )
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
+from rti_rig.app.usecases.fit_outlook import auto_way_out
 from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.app.usecases.fit_signal import no_signal_warning
 from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core.acquisition_images import check_image_files
 from rti_rig.core.errors import ConfigError, RtiRigError
-from rti_rig.core.fit_minimums import FIT_MINIMUMS
+from rti_rig.core.fit_minimums import FIT_MINIMUMS, PHOTOMETRIC_STEREO, AutoFit, auto_models
 from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation, png_alpha_note
 from rti_rig.core.json_values import strict_dumps
 from rti_rig.core.lp_format import (
@@ -941,8 +942,8 @@ def _fit_all(
             raise FitInputError(
                 f"--model auto: {exc}. "
                 + (
-                    f"Nor can photometric stereo be fitted: {undetermined}; capture again "
-                    "with more lights at several elevations and azimuths"
+                    f"Nor can photometric stereo be fitted: {undetermined}; "
+                    + auto_way_out(AutoFit(n, normals_determined=False))
                     if undetermined
                     else "Photometric stereo alone (normals and albedo, no relighting model) "
                     "may still be fitted: --model ps"
@@ -1174,11 +1175,6 @@ def _normal_source(model_name: str) -> str:
     return NORMALS_BY_MODEL.get(model_name, "ps-robust")
 
 
-#: The models whose fit is the normal map: on lights that cannot determine a normal there is
-#: nothing to write, and ``auto`` does not choose them.
-PHOTOMETRIC_STEREO = ("ps", "lambert", "ps-robust")
-
-
 def auto_candidates(lights: np.ndarray) -> tuple[tuple[str, ...], str]:
     """The models ``--model auto`` chooses among on ``lights``, and why Lambert is not among
     them ("" where it is).
@@ -1194,9 +1190,9 @@ def auto_candidates(lights: np.ndarray) -> tuple[tuple[str, ...], str]:
     from rti_rig.reconstruct.registry import RELIGHT_MODELS
 
     undetermined = undetermined_normals(lights, "lights of this session")
-    if undetermined is None:
-        return RELIGHT_MODELS, ""
-    return tuple(m for m in RELIGHT_MODELS if m not in PHOTOMETRIC_STEREO), undetermined
+    # the same choice of models the outlook before a session reads (core.fit_minimums)
+    chosen = auto_models(undetermined is None)
+    return tuple(m for m in RELIGHT_MODELS if m in chosen), undetermined or ""
 
 
 def _refuse_undetermined_normals(req: FitRequest, model_name: str, lights: np.ndarray) -> None:

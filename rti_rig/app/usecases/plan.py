@@ -18,7 +18,6 @@ import numpy as np
 from rti_rig.app.compose import arm_order_for, read_preview_image
 from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
 from rti_rig.app.normals_determined import (
-    FIT_WITHOUT_NORMALS,
     band_advice,
     refuse_undetermined,
     undetermined_normals,
@@ -30,7 +29,7 @@ from rti_rig.app.output_files import (
     rig_inputs,
 )
 from rti_rig.app.preview_source import given_light_differs, resolve_preview
-from rti_rig.app.usecases.fit_outlook import fit_needs, fit_outlook
+from rti_rig.app.usecases.fit_outlook import fit_needs, fit_outlook, fit_without_normals
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
@@ -253,7 +252,9 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)],
     )
     # what the session it plans gives `rti-rig fit` (run says it again before it shoots)
-    if (outlook := fit_outlook(len(schedule))) is not None:
+    # (lights planned with --allow-no-normals: their own note has said it, from the same rules)
+    determined = undetermined_normals(np.array([s.direction for s in schedule.steps])) is None
+    if determined and (outlook := fit_outlook(len(schedule))) is not None:
         notes.append(outlook)
     if (misnamed := lp_name_note(Path(req.out_file), run_reads_it=True)) is not None:
         notes.append(misnamed)
@@ -340,8 +341,9 @@ def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: li
     reason = undetermined_normals(lights, "planned lights")
     if reason is not None:
         notes.append(
-            f"{reason}; planned as asked (--allow-no-normals): {FIT_WITHOUT_NORMALS}; run it "
-            f"with {run_plan_command(req.rig, req.out_file)}"
+            f"{reason}; planned as asked (--allow-no-normals): "
+            f"{fit_without_normals(len(lights))}; run it with "
+            f"{run_plan_command(req.rig, req.out_file)}"
         )
 
 

@@ -263,13 +263,25 @@ def check_light_count(n: int) -> None:
         )
 
 
-def too_few_to_fit(n: int) -> Note | None:
+def too_few_to_fit(n: int, schedule: LightSchedule | None = None) -> Note | None:
     """What `rti-rig fit` will not make of a session of ``n`` lights (:func:`fit_outlook`):
     accepted (a test shot of one or two lights is a use), but said before the rig moves, not
     only by the QA or the fit afterwards (``--lights 3`` had been silent, its verdict "good",
-    and plain ``fit`` then failed)."""
+    and plain ``fit`` then failed).
+
+    ``schedule``: the session's lights, where known. Lights that cannot determine a normal
+    (captured with ``--allow-no-normals``) get no note here: their own note has said what the
+    fit makes of them, from the same rules (a second note had promised them a normal map)."""
     from rti_rig.app.usecases.fit_outlook import fit_outlook
 
+    if schedule is not None:
+        import numpy as np
+
+        from rti_rig.app.normals_determined import undetermined_normals
+
+        lights = np.array([s.direction for s in schedule.steps], dtype=np.float64)
+        if undetermined_normals(lights) is not None:
+            return None
     said = fit_outlook(n)
     return None if said is None else Note(said, "warning")
 
@@ -959,10 +971,10 @@ def _check_determined(
 
     from rti_rig.app.normals_determined import (
         CAPTURED_WITHOUT_NORMALS,
-        FIT_WITHOUT_NORMALS,
         refuse_undetermined,
         undetermined_normals,
     )
+    from rti_rig.app.usecases.fit_outlook import fit_without_normals
 
     lights = np.array([s.direction for s in schedule.steps], dtype=np.float64)
     if not req.allow_no_normals:
@@ -978,7 +990,7 @@ def _check_determined(
     if reason is not None:
         on_note(
             Note(
-                f"{reason}; {CAPTURED_WITHOUT_NORMALS}: {FIT_WITHOUT_NORMALS}",
+                f"{reason}; {CAPTURED_WITHOUT_NORMALS}: {fit_without_normals(len(lights))}",
                 "warning",
             )
         )
@@ -1129,7 +1141,7 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
 
     schedule = new_session_schedule(req, loaded, keep_note)
     # said before the rig opens, not recorded among the inputs' notes: not about the inputs
-    if (few := too_few_to_fit(len(schedule))) is not None:
+    if (few := too_few_to_fit(len(schedule), schedule)) is not None:
         on_note(few)
     opened = _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
     opened.folder.input_notes = [*loaded.notes, *(n.text for n in plan_notes)]
