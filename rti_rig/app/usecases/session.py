@@ -181,14 +181,25 @@ class OpenedSession:
     def steps_to_do(self) -> int:
         return self.total_steps - self.steps_done_before
 
+    @property
+    def teardown_ran(self) -> bool:
+        """Whether the controller's teardown took the rig in this run (it hands the run's end
+        to :meth:`SessionFolder.finish` whatever happens, so :attr:`SessionFolder.run_end` is
+        set).
+
+        Why one place: :meth:`close` makes the devices safe in the teardown's stead when it
+        did not run, and ``run`` tells such a stop from a stop during the capture by the same
+        fact; each had read ``run_end`` on its own."""
+        return self.folder.run_end is not None
+
     def close(self) -> None:
         """Release the rig and the session's lock; once (a second call does nothing).
 
         Where the controller's teardown never ran (a stop after the capture's ``with`` began,
-        before the controller's ``try``: :attr:`SessionFolder.run_end` unset), its device
-        part is done here first, before the rig's resources go: the lights' all-off where
-        their link is open (a dome held open after metering), then the camera's and the
-        lights' close, signals held; what failed is kept in :attr:`close_failures`.
+        before the controller's ``try``: :attr:`teardown_ran` False), its device part is done
+        here first, before the rig's resources go: the lights' all-off where their link is
+        open (a dome held open after metering), then the camera's and the lights' close,
+        signals held; what failed is kept in :attr:`close_failures`.
 
         Why: the rig's close releases only what ``build_rig`` opened (an emulator, its pty),
         trusting the controller to have made the devices safe: a SIGTERM as the capture
@@ -203,7 +214,7 @@ class OpenedSession:
         rig = self.rig
         try:
             with signals_deferred():
-                if self.folder.run_end is None:
+                if not self.teardown_ran:
                     if getattr(rig.lighting, "link_open", False):
                         self.close_failures += rig.lighting.safe(emergency=True)
                     self.close_failures += attempt_all(
@@ -1216,7 +1227,6 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     """
     from rti_rig.app.rig_identity import (
         IMAGE_KEYS,
-        LABELS,
         identity_differences,
         rig_identity,
         same_rig,
@@ -1254,7 +1264,12 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             + ")"
         )
     replay = recorded.get("backend") == identity.get("backend") == "replay"
-    if replay and any(d.startswith(LABELS["recorded_images"]) for d in image_diffs):
+    # decided on the digests themselves, not on how identity_differences words them
+    images_other = recorded.get("recorded_images") not in (
+        None,  # a session begun before the images' digest was recorded: not known
+        identity.get("recorded_images"),
+    )
+    if replay and images_other:
         # other recorded files, and of another size or kind: no config to set back
         raise RigChangedError(
             _replay_images_changed(config_path, image_diffs, manifest, session_dir)
