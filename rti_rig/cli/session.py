@@ -1076,6 +1076,21 @@ def _print_teardown_failures(  # type: ignore[no-untyped-def]
     return _print_failures(failures, said_below)
 
 
+def _print_stop_failures(  # type: ignore[no-untyped-def]
+    opened, said_below: BaseException | None = None
+) -> bool:
+    """What could not be made safe when this run stopped early, from whichever took the rig
+    down: the controller's teardown (:func:`_print_teardown_failures`), or the session's close
+    where it made the rig safe in the teardown's place (a stop or a failure before the
+    controller's ``try``, :func:`_close_left_open`); True if any. Printed above the lights'
+    line that points at them; ``said_below`` as for :func:`_print_failures`.
+
+    Why one helper: every way a capture ends (a stop, a session error, an unexpected fault)
+    must say both, in this order; each ``except`` clause had joined them on its own."""
+    teardown = _print_teardown_failures(opened.folder, said_below)
+    return _print_failures(_close_left_open(opened), said_below) or teardown
+
+
 def _print_failures(  # type: ignore[no-untyped-def]
     failures, said_below: BaseException | None = None
 ) -> bool:
@@ -1437,13 +1452,11 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         # made the rig safe) after this run committed images: "before the first image:
         # nothing was captured" had been said of 6 images on disk, with no resume hint
         if not started or (
-            folder.run_end is None and folder.images_kept == opened.steps_done_before
+            not opened.teardown_ran and folder.images_kept == opened.steps_done_before
         ):
             raise _stopped_before_capture(opened, why) from None
 
-        # the session's close's failures too, where it made the rig safe in the teardown's
-        # place: above the lights' line that points at them
-        failed = _print_teardown_failures(folder) | _print_failures(_close_left_open(opened))
+        failed = _print_stop_failures(opened)
         err.print(f"[red]Emergency stop ({escape(why)}):[/] {escape(lights_state(rig, failed))}.")
         teardown_said = True
         err.print(_after_stop(opened, resume_hint()), markup=False, soft_wrap=True)
@@ -1451,12 +1464,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
-        # the close's own failures (a failure before the controller's ``try``) above the lights
-        state = lights_state(
-            rig,
-            _print_teardown_failures(folder, said_below=exc)
-            | _print_failures(_close_left_open(opened), said_below=exc),
-        )
+        state = lights_state(rig, _print_stop_failures(opened, said_below=exc))
         said = _write_failed_said(exc, opened)
         # a write the disk refused ends with the resume command, after the fix it needs: said
         # there once (this line had said "Continue with: …" too, just above it)
@@ -1469,9 +1477,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         # with nothing said of the lights, of the images kept or of the resume
         from rti_rig.app.usecases.safe_state import lights_state
 
-        state = lights_state(
-            rig, _print_teardown_failures(folder) | _print_failures(_close_left_open(opened))
-        )
+        state = lights_state(rig, _print_stop_failures(opened))
         err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint())}", markup=False)
         raise _unexpected(exc, f"{out_dir}/manifest.json") from None
     finally:
