@@ -40,6 +40,7 @@ from rti_rig.app.usecases.adaptive_constants import (
     decision_constants,
     describe_differences,
 )
+from rti_rig.app.usecases.run_options import adaptive_options, band_options
 from rti_rig.core import fit_minimums
 from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.devices import Frame
@@ -1299,7 +1300,7 @@ def _widen_to_hold(need: int, band: tuple[float, float], el: NDArray[np.float64]
     wider = _band_holding(el, need, band)
     if wider is None:  # the dome has fewer LEDs in all: no band holds them
         return ""
-    return f" (or widen the band to hold {need}:{_band_options(wider)})"
+    return f" (or widen the band to hold {need}:{band_options(wider)})"
 
 
 def _band_words(band: tuple[float, float]) -> str:
@@ -1421,7 +1422,7 @@ def _nothing_to_choose_words(
     ]
     wider = facts.wider
     if wider is not None:
-        asked = _session_options(
+        asked = adaptive_options(
             until_error_deg,
             facts.advised_lights,
             facts.advised_min_lights,
@@ -1435,7 +1436,7 @@ def _nothing_to_choose_words(
         )
         words.append(
             f"{lead}: rti-rig run {config} --out DIR {asked}"
-            f"{_band_options(wider)} ({_held(el, wider)} lights"
+            f"{band_options(wider)} ({_held(el, wider)} lights"
             f"{_band_words(wider) or ' at every elevation'})"
         )
     if offered:
@@ -1480,33 +1481,6 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
     if facts is not None:
         config = shlex.quote(str(loaded.path))
         raise RtiRigError(_nothing_to_choose_words(facts, config, until_error_deg, objective))
-
-
-def _session_options(
-    until_error_deg: float | None,
-    lights: int | None,
-    min_lights: int | None,
-    objective: str = "normals",
-) -> str:
-    """An adaptive session's own options, as a refusal's advised command repeats them
-    (``--adaptive --lights 6``, ``--until-error 2 --min-lights 8 --objective relight``), the
-    objective only where not the default.
-
-    Why one function: the dome's and the arm's band advice each spelled these options out,
-    and a working command must read the same whichever rig refused it."""
-    words = f"--until-error {until_error_deg:g}" if until_error_deg is not None else "--adaptive"
-    words += f" --lights {lights}" if lights is not None else ""
-    words += f" --min-lights {min_lights}" if min_lights is not None else ""
-    return words + (f" --objective {objective}" if objective != "normals" else "")
-
-
-def _band_options(band: tuple[float, float]) -> str:
-    """`` --min-elevation-deg A --max-elevation-deg B`` for those of ``band`` not at their
-    defaults (nothing for every elevation)."""
-    lo, hi = band
-    return (f" --min-elevation-deg {lo:g}" if lo != 0.0 else "") + (
-        f" --max-elevation-deg {hi:g}" if hi != 90.0 else ""
-    )
 
 
 def _held(el: NDArray[np.float64], band: tuple[float, float]) -> int:
@@ -1575,13 +1549,13 @@ def _arm_widen_to_hold(  # type: ignore[no-untyped-def]
         except RtiRigError:  # a band the arm cannot light at all
             continue
         if held >= need:
-            return f" (or widen the band to hold {need}:{_band_options(wider)})"
+            return f" (or widen the band to hold {need}:{band_options(wider)})"
     config = shlex.quote(str(loaded.path))
     widening = "; a wider band holds no more on this arm" if tuple(band) != _FULL_BAND else ""
     return (
         f"{widening} (an arm's lights are its {ARM_CANDIDATES} candidate directions spread over "
         f"the band asked, {offered} of them within its reach and lighting rules): rti-rig run "
-        f"{config} --out DIR {asked(offered)}{_band_options(band)}"
+        f"{config} --out DIR {asked(offered)}{band_options(band)}"
     )
 
 
@@ -1628,7 +1602,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     if lights is not None and lights < START_LIGHTS + 1:
         # the options as given, worded as every adaptive refusal words them (this one had
         # built its own, "--until-error … --lights 4", without the target the user gave)
-        asked = _session_options(until_error_deg, lights, None)
+        asked = adaptive_options(until_error_deg, lights, None)
         raise RtiRigError(
             f"{asked}: an adaptive session starts from {START_LIGHTS} lights "
             f"and chooses from there; give at least {START_LIGHTS + 1}"
@@ -1662,7 +1636,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
 
             def options(lights_now: int | None, min_now: int | None) -> str:
                 """The session's options as given, with these counts."""
-                return _session_options(until_error_deg, lights_now, min_now, objective)
+                return adaptive_options(until_error_deg, lights_now, min_now, objective)
 
             def widen(asked: Callable[[int], str]) -> Callable[[int], str]:
                 return lambda need: _arm_widen_to_hold(rig, loaded, need, in_reach, band, asked)

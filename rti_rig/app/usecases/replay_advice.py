@@ -15,6 +15,8 @@ import shlex
 from pathlib import Path
 from typing import Any
 
+from rti_rig.app.usecases.run_options import adaptive_options, band_options
+
 
 def new_session_dir(session_dir: Path | str) -> Path:
     """A folder beside ``session_dir`` that does not exist yet (``S-new``, ``S-new2``...), for
@@ -49,12 +51,12 @@ def new_session_command(
     config_path: Path | str, manifest: dict[str, Any], session_dir: Path | str
 ) -> str:
     """``rti-rig run CONFIG --out NEW`` with the session's layout options: its ``--plan``, its
-    adaptive options (``--adaptive``, ``--lights`` when it was given, ``--until-error``,
-    ``--min-lights``, ``--objective relight``) or its homogeneous ``--lights N``, an
-    elevation band other than 0–90°, and ``--allow-no-normals`` (see
-    :func:`_allowed_no_normals`), each as the manifest recorded it. The plan is recorded as
-    an absolute path, so the command runs from any folder (a manifest from before that record
-    holds the path as it was typed, repeated as it is: where it was relative to is unknown)."""
+    adaptive options (:func:`~rti_rig.app.usecases.run_options.adaptive_options`, ``--lights``
+    only where it was given) or its homogeneous ``--lights N``, an elevation band other than
+    0–90°, and ``--allow-no-normals`` (see :func:`_allowed_no_normals`), each as the manifest
+    recorded it. The plan is recorded as an absolute path, so the command runs from any folder
+    (a manifest from before that record holds the path as it was typed, repeated as it is:
+    where it was relative to is unknown)."""
     words = [
         "rti-rig run",
         shlex.quote(str(config_path)),
@@ -64,28 +66,27 @@ def new_session_command(
     schedule = manifest.get("schedule") or {}
     provenance = schedule.get("provenance") or {}
     adaptive = manifest.get("adaptive")
-    band: tuple[Any, Any] = (None, None)
+    band: dict[str, Any] = {}  # the record that holds the elevation band, if any
     if isinstance(adaptive, dict):
-        words.append("--adaptive")
-        if adaptive.get("design_lights") is not None:  # --lights was given
-            words.append(f"--lights {int(adaptive['design_lights'])}")
-        if adaptive.get("until_error_deg") is not None:
-            words.append(f"--until-error {float(adaptive['until_error_deg']):g}")
-        if adaptive.get("min_lights") is not None:
-            words.append(f"--min-lights {int(adaptive['min_lights'])}")
-        if adaptive.get("objective") not in (None, "normals"):
-            words.append(f"--objective {shlex.quote(str(adaptive['objective']))}")
-        band = (adaptive.get("min_elevation_deg"), adaptive.get("max_elevation_deg"))
+        until = adaptive.get("until_error_deg")
+        lights, floor = adaptive.get("design_lights"), adaptive.get("min_lights")
+        words.append(
+            adaptive_options(
+                float(until) if until is not None else None,
+                int(lights) if lights is not None else None,  # --lights was given
+                int(floor) if floor is not None else None,
+                shlex.quote(str(adaptive.get("objective") or "normals")),
+            )
+        )
+        band = adaptive
     elif provenance.get("plan_file"):
         words.append(f"--plan {shlex.quote(str(provenance['plan_file']))}")
     elif provenance.get("n") is not None:
         words.append(f"--lights {int(provenance['n'])}")
-        band = (provenance.get("min_elevation_deg"), provenance.get("max_elevation_deg"))
+        band = provenance
     if _allowed_no_normals(manifest, provenance) and not isinstance(adaptive, dict):
         words.append("--allow-no-normals")
-    low, high = band
-    if low is not None and float(low) != 0.0:
-        words.append(f"--min-elevation-deg {float(low):g}")
-    if high is not None and float(high) != 90.0:
-        words.append(f"--max-elevation-deg {float(high):g}")
-    return " ".join(words)
+    low, high = band.get("min_elevation_deg"), band.get("max_elevation_deg")
+    return " ".join(words) + band_options(
+        (float(low) if low is not None else 0.0, float(high) if high is not None else 90.0)
+    )
