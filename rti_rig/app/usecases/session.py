@@ -1274,11 +1274,14 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         raise RigChangedError(
             _replay_images_changed(config_path, image_diffs, manifest, session_dir)
         )
-    if image_diffs and replay:  # the same recorded files (or unknown), read otherwise
+    if image_diffs and replay and "recorded_images" not in recorded:
+        # a session begun before the images' digest was recorded: same files or not, unknown
         raise RigChangedError(
-            _replay_read_otherwise(
-                config_path, image_diffs, manifest, session_dir, "recorded_images" in recorded
-            )
+            _replay_images_unknown(config_path, image_diffs, manifest, session_dir)
+        )
+    if image_diffs and replay:  # the same recorded files, read otherwise
+        raise RigChangedError(
+            _replay_read_otherwise(config_path, image_diffs, manifest, session_dir)
         )
     if recorded.get("kind") == identity.get("kind") and image_diffs:
         # accepted, a new exposure had gone into the fit as a brighter light: normals 5.5° off
@@ -1358,40 +1361,40 @@ def _replay_images_changed(
     )
 
 
-def _replay_read_otherwise(
-    config_path: Path,
-    image_diffs: list[str],
-    manifest: dict[str, Any],
-    session_dir: Path | str,
-    digest_recorded: bool = True,
+def _replay_images_unknown(
+    config_path: Path, image_diffs: list[str], manifest: dict[str, Any], session_dir: Path | str
 ) -> str:
-    """Why a replay session whose recorded images are unchanged (or, ``digest_recorded``
-    False, not known to be) cannot go on, and the command that starts a new one (a sentence,
-    no final stop).
+    """Why a replay session begun before its images' digest was recorded, whose images now
+    read otherwise, cannot go on, and the command that starts a new one (no final stop).
+
+    Why: such a session (before 2026-11-29) cannot tell the same files read otherwise from
+    files re-exported at another size since; it had been told they were "the same recorded
+    images" (:func:`_replay_read_otherwise`), which nothing established."""
+    return (
+        f"the images of {config_path} now read otherwise than this session's ("
+        + "; ".join(image_diffs)
+        + "): re-exported since, or the same files read otherwise (an rti-rig before "
+        "2026-11-30 replayed a TIFF whose thumbnail comes first at the thumbnail's size); "
+        "this session began before rti-rig recorded its acquisition's images, so which "
+        "cannot be told. A replay's camera takes its size and settings from the recorded "
+        "images themselves, so nothing can be set back, and images taken now would not "
+        "match the ones already taken. This session cannot be continued: start a new "
+        "session from the acquisition as it is now, with the options it began with ("
+        + new_session_command(config_path, manifest, session_dir)
+        + ")"
+    )
+
+
+def _replay_read_otherwise(
+    config_path: Path, image_diffs: list[str], manifest: dict[str, Any], session_dir: Path | str
+) -> str:
+    """Why a replay session whose recorded images are unchanged cannot go on, and the command
+    that starts a new one (a sentence, no final stop).
 
     Why: a replay rig's camera size (and exposure, gain, decoding) is its recorded images' own,
     which no config sets. A session begun by an rti-rig that replayed a TIFF whose thumbnail
     comes first at the thumbnail's size (before 2026-11-30) recorded 16×12 images of a 64×48
-    acquisition; its resume was told to "set it back to continue", which nothing can.
-
-    Why ``digest_recorded``: a session begun before the images' digest was recorded
-    (2026-11-29) cannot tell the same files read otherwise from files re-exported at another
-    size since; it had been told they were "the same recorded images", which nothing
-    established."""
-    if not digest_recorded:
-        return (
-            f"the images of {config_path} now read otherwise than this session's ("
-            + "; ".join(image_diffs)
-            + "): re-exported since, or the same files read otherwise (an rti-rig before "
-            "2026-11-30 replayed a TIFF whose thumbnail comes first at the thumbnail's size); "
-            "this session began before rti-rig recorded its acquisition's images, so which "
-            "cannot be told. A replay's camera takes its size and settings from the recorded "
-            "images themselves, so nothing can be set back, and images taken now would not "
-            "match the ones already taken. This session cannot be continued: start a new "
-            "session from the acquisition as it is now, with the options it began with ("
-            + new_session_command(config_path, manifest, session_dir)
-            + ")"
-        )
+    acquisition; its resume was told to "set it back to continue", which nothing can."""
     return (
         f"{config_path} replays the same recorded images this session began with, but they "
         "are now read as other images (" + "; ".join(image_diffs) + "): a replay's camera "
