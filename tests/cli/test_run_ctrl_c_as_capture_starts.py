@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 from conftest import CONFIGS
+from conftest import said as unwrapped
 from typer.testing import CliRunner
 
 import rti_rig.app.usecases.session as session_usecase
@@ -26,9 +27,9 @@ from rti_rig.cli import app
 from rti_rig.simulator.dome_firmware import DomeFirmware
 
 
-def test_a_ctrl_c_as_the_capture_starts_switches_the_emulated_dome_off_and_closes_it(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def _dome_commands(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """The names of the commands the emulated dome's firmware executes from now on, in order
+    (the firmware's own record: what reached the board, not what the driver meant to send)."""
     received: list[str] = []
     real_execute = DomeFirmware._execute
 
@@ -37,6 +38,21 @@ def test_a_ctrl_c_as_the_capture_starts_switches_the_emulated_dome_off_and_close
         return real_execute(self, seq, cmd, now)
 
     monkeypatch.setattr(DomeFirmware, "_execute", execute)
+    return received
+
+
+def _run_six(out: Path, *options: str) -> tuple[Any, str]:
+    """``rti-rig run`` of 6 lights on the shipped emulated dome into ``out``; the result and
+    what it said, unwrapped."""
+    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
+    r = CliRunner().invoke(app, [*argv, *options, "--no-verdict"], terminal_width=400)
+    return r, unwrapped(r)
+
+
+def test_a_ctrl_c_as_the_capture_starts_switches_the_emulated_dome_off_and_closes_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    received = _dome_commands(monkeypatch)
     seen: dict[str, Any] = {}
 
     def interrupted(opened, *args: Any, **kwargs: Any) -> Any:
@@ -46,9 +62,7 @@ def test_a_ctrl_c_as_the_capture_starts_switches_the_emulated_dome_off_and_close
     monkeypatch.setattr(session_usecase, "run_opened_session", interrupted)
     out = tmp_path / "s"
     # metered first: its teardown keeps the dome's port open (lights off) for the capture
-    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
-    r = CliRunner().invoke(app, [*argv, "--auto-exposure", "--no-verdict"], terminal_width=400)
-    said = " ".join(r.output.split())
+    r, said = _run_six(out, "--auto-exposure")
     assert "opened" in seen, said
     assert seen["before"] > 0, said  # metering spoke to the dome (lit it, switched it off)
     assert "AllOff" in received[seen["before"] :], (received, said)
@@ -68,14 +82,7 @@ def test_a_sigterm_as_the_controller_checks_the_disk_switches_the_held_dome_off_
     (the rig's close trusts the controller to have made the devices safe), and the command,
     finding the session closed, did nothing: the held port stayed open, its all-off unsent.
     A real SIGTERM, raised in the run's own process there (no timing)."""
-    received: list[str] = []
-    real_execute = DomeFirmware._execute
-
-    def execute(self, seq, cmd, now):  # type: ignore[no-untyped-def]
-        received.append(type(cmd).__name__)
-        return real_execute(self, seq, cmd, now)
-
-    monkeypatch.setattr(DomeFirmware, "_execute", execute)
+    received = _dome_commands(monkeypatch)
     seen: dict[str, Any] = {}
     real_run = session_usecase.run_opened_session
 
@@ -89,9 +96,7 @@ def test_a_sigterm_as_the_controller_checks_the_disk_switches_the_held_dome_off_
     monkeypatch.setattr(session_usecase, "run_opened_session", run_opened_session)
     monkeypatch.setattr(controller, "check_free_space", check_free_space)
     out = tmp_path / "s"
-    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
-    r = CliRunner().invoke(app, [*argv, "--auto-exposure", "--no-verdict"], terminal_width=400)
-    said = " ".join(r.output.split())
+    r, said = _run_six(out, "--auto-exposure")
     assert "opened" in seen, said
     assert seen["before"] > 0, said  # metering spoke to the dome
     assert "AllOff" in received[seen["before"] :], (received, said)
@@ -110,13 +115,7 @@ def test_a_sigterm_as_the_teardown_begins_is_not_said_as_before_the_first_image(
     makes the dome safe in its place. Every image was in, and the run had said "Stopped
     (SIGTERM) before the first image: nothing was captured", with no word of the images or
     the resume. A real SIGTERM, raised in the run's own process there (no timing)."""
-    received: list[str] = []
-    real_execute = DomeFirmware._execute
-
-    def execute(self, seq, cmd, now):  # type: ignore[no-untyped-def]
-        received.append(type(cmd).__name__)
-        return real_execute(self, seq, cmd, now)
-
+    received = _dome_commands(monkeypatch)
     real_over = controller.CancelToken.capture_over
 
     def capture_over(self) -> None:  # type: ignore[no-untyped-def]
@@ -124,12 +123,9 @@ def test_a_sigterm_as_the_teardown_begins_is_not_said_as_before_the_first_image(
         signal.raise_signal(signal.SIGTERM)
         real_over(self)
 
-    monkeypatch.setattr(DomeFirmware, "_execute", execute)
     monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
     out = tmp_path / "s"
-    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
-    r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
-    said = " ".join(r.output.split())
+    r, said = _run_six(out)
     assert len(list(out.glob("image_*"))) == 6, said
     assert "before the first image" not in said and "nothing was captured" not in said, said
     assert "Emergency stop (SIGTERM)" in said and "6 image(s) kept" in said, said
