@@ -53,12 +53,18 @@ def shipped_dome_on_pty(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterat
 
 
 def folder_watch_config(
-    tmp_path: Path, tether: Path, *, timeout_s: float | None = None, tiffs: bool = False
+    tmp_path: Path,
+    tether: Path,
+    *,
+    timeout_s: float | None = None,
+    tiffs: bool = False,
+    settle_s: float | None = None,
 ) -> Path:
     """The shipped folder-watch dome config watching ``tether``, its LED .lp named where it
-    ships; ``timeout_s`` replaces its wait for a file, ``tiffs`` watches for ``*.tif`` only.
-    (One rewrite for the folder-watch CLI tests, which had each kept, or imported from another
-    test module, a copy.)"""
+    ships; ``timeout_s`` replaces its wait for a file, ``tiffs`` watches for ``*.tif`` only,
+    ``settle_s`` replaces the dome's settle before each shot (1.5 s puts the shutter pulses
+    whole EXIF seconds apart, for the camera-clock tests). (One rewrite for the folder-watch
+    CLI tests, which had each kept, or imported from another test module, a copy.)"""
     text = (CONFIGS / "example_dome_48_folder_watch.toml").read_text(encoding="utf-8")
     changes = [
         ('lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS / "example_dome_48.lp"}"'),
@@ -66,6 +72,8 @@ def folder_watch_config(
     ]
     if timeout_s is not None:
         changes.append(("timeout_s = 15.0", f"timeout_s = {timeout_s}"))
+    if settle_s is not None:
+        changes.append(("settle_s = 0.2\n", f"settle_s = {settle_s}\n"))
     for old, new in changes:
         assert old in text, old
         text = text.replace(old, new)

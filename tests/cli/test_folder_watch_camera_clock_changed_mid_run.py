@@ -85,13 +85,10 @@ def _run(
     it left (:class:`conftest.TetheredRun`) and the camera (its clock as moved)."""
     tether = tmp_path / "tether"
     tether.mkdir()
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0)
     # pulses at least 1.5 s apart, so that a capture time on pulse 1's whole second cannot
     # also fit pulse 3's (EXIF keeps whole seconds; at the shipped 0.2 s settle the pulses
     # of a fast run came under a second apart, and the set-back file was taken as pulse 3's)
-    text = cfg.read_text(encoding="utf-8")
-    assert "settle_s = 0.2\n" in text
-    cfg.write_text(text.replace("settle_s = 0.2\n", "settle_s = 1.5\n"), encoding="utf-8")
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=10.0, settle_s=1.5)
     out = tmp_path / "s"
     cameras: list[ClockChangingCamera] = []
 

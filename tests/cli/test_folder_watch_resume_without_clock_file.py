@@ -70,12 +70,9 @@ def test_a_late_file_of_the_earlier_run_in_a_resume_without_clock_file_says_what
 ) -> None:
     tether = tmp_path / "tether"
     tether.mkdir()
-    cfg = folder_watch_config(tmp_path, tether, timeout_s=8.0)
     # pulses at least 1.5 s apart: EXIF keeps whole seconds, and at the shipped 0.2 s settle
     # the late shot and the last kept one could carry the same second
-    text = cfg.read_text(encoding="utf-8")
-    assert "settle_s = 0.2\n" in text
-    cfg.write_text(text.replace("settle_s = 0.2\n", "settle_s = 1.5\n"), encoding="utf-8")
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=8.0, settle_s=1.5)
     out = tmp_path / "s"
     cameras: list[Camera] = []
 
