@@ -12,6 +12,7 @@ import subprocess
 import sys
 import tomllib
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -114,6 +115,19 @@ print(repr(_identity_function()()))
 """
 
 
+def _checked_as_it_vanishes(script: str, tree: Path, target: Path, *args: str) -> Any:
+    """The worker check's answer from ``script`` run on the rti-rig at ``tree`` (a fresh
+    interpreter, nothing else on its path), which removes ``target`` during the check; the
+    script must end without an exception and ``target`` be gone."""
+    done = subprocess.run(
+        [sys.executable, "-c", script, str(target), *args], capture_output=True, text=True,
+        env={"PYTHONPATH": str(tree), "PATH": ""}, cwd=tree.parent, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr  # no FileNotFoundError out of the check
+    assert not target.exists()
+    return ast.literal_eval(done.stdout.strip())
+
+
 @pytest.mark.parametrize("when", ["before", "after"])
 def test_a_source_file_that_vanishes_while_it_is_checked_is_named_with_restart(
     tmp_path: Path, when: str
@@ -130,13 +144,7 @@ def test_a_source_file_that_vanishes_while_it_is_checked_is_named_with_restart(
         / "planner"
         / sorted(p.name for p in (tree / "rti_rig" / "planner").glob("*.py"))[-1]
     )
-    done = subprocess.run(
-        [sys.executable, "-c", _VANISHING, str(target), when], capture_output=True, text=True,
-        env={"PYTHONPATH": str(tree), "PATH": ""}, cwd=tmp_path, timeout=300,
-    )  # fmt: skip
-    assert done.returncode == 0, done.stderr  # no FileNotFoundError out of the check
-    assert not target.exists()
-    answer = ast.literal_eval(done.stdout.strip())
+    answer = _checked_as_it_vanishes(_VANISHING, tree, target, when)
     problem = answer["problem"]
     assert problem and f"rti_rig/planner/{target.name} vanished while it was being checked" in (
         problem
@@ -181,13 +189,7 @@ def test_a_source_folder_that_vanishes_while_it_is_listed_is_named_with_restart(
     target = tree / "rti_rig" / "extra_subpackage"
     target.mkdir()
     (target / "__init__.py").write_text('"""A subpackage a checkout drops."""\n')
-    done = subprocess.run(
-        [sys.executable, "-c", _FOLDER_VANISHING, str(target)], capture_output=True, text=True,
-        env={"PYTHONPATH": str(tree), "PATH": ""}, cwd=tmp_path, timeout=300,
-    )  # fmt: skip
-    assert done.returncode == 0, done.stderr  # no FileNotFoundError out of the check
-    assert not target.exists()
-    answer = ast.literal_eval(done.stdout.strip())
+    answer = _checked_as_it_vanishes(_FOLDER_VANISHING, tree, target)
     problem = answer["problem"]
     assert answer["fingerprint"] is None, answer
     assert problem and "rti_rig/extra_subpackage/ vanished while it was being checked" in (
