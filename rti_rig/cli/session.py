@@ -1214,9 +1214,7 @@ def _close_left_open(opened) -> list[str]:  # type: ignore[no-untyped-def]
             opened.close()
         except Exception as exc:  # closing what the opening opened: said, never a traceback
             failures.append(f"closing the rig failed: {exc}")
-    failures = [*opened.close_failures, *failures]
-    opened.close_failures = []  # said once
-    return failures
+    return [*opened.take_close_failures(), *failures]
 
 
 def _stopped_before_capture(opened, why: str) -> typer.Exit:  # type: ignore[no-untyped-def]

@@ -160,7 +160,7 @@ class OpenedSession:
     #: before it took the rig leaves the command to close it, once)
     closed: bool = False
     #: what :meth:`close` could not do in making safe a rig the controller's teardown never
-    #: took (for the command to say; it takes them)
+    #: took (for the command to say, through :meth:`take_close_failures`)
     close_failures: list[str] = field(default_factory=list)
 
     @property
@@ -191,6 +191,15 @@ class OpenedSession:
         did not run, and ``run`` tells such a stop from a stop during the capture by the same
         fact; each had read ``run_end`` on its own."""
         return self.folder.run_end is not None
+
+    def take_close_failures(self) -> list[str]:
+        """What :meth:`close` could not make safe, handed over once (emptied as it is taken).
+
+        Why: the command says them beside the stop that led to the close; the ``finally``
+        that closes the rig a second time round must not say them again (the command had
+        emptied this list itself)."""
+        failures, self.close_failures = self.close_failures, []
+        return failures
 
     def close(self) -> None:
         """Release the rig and the session's lock; once (a second call does nothing).
