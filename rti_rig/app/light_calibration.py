@@ -269,6 +269,22 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
     )
 
 
+def step_direction(step: Any) -> NDArray[np.float64] | None:
+    """The direction a card session's step records as lit (its ``actual_direction``), or None
+    where it records none that is a direction (missing, not three finite numbers, or zero).
+
+    Why one reader: the card is read at these directions (:func:`_step_directions`), and
+    calibrate-lights compares an older session's LEDs at them
+    (:mod:`rti_rig.app.usecases.calibrate`); each had its own test of what counts as one."""
+    try:
+        direction = np.asarray(step.get("actual_direction"), dtype=np.float64)
+    except (AttributeError, TypeError, ValueError):
+        return None
+    if direction.shape != (3,) or not np.all(np.isfinite(direction)) or not direction.any():
+        return None
+    return direction
+
+
 def _step_directions(root: Path, steps: list[dict[str, Any]]) -> NDArray[np.float64]:
     """The direction each step of the card session records as lit, refused by step when one
     records none, before any image is read.
@@ -280,11 +296,8 @@ def _step_directions(root: Path, steps: list[dict[str, Any]]) -> NDArray[np.floa
     out = []
     for k, step in enumerate(steps):
         direction = step.get("actual_direction")
-        try:
-            light = tuple(float(v) for v in direction)  # type: ignore[union-attr]
-        except (TypeError, ValueError):
-            light = ()
-        if len(light) != 3 or not all(np.isfinite(light)) or not any(light):
+        light = step_direction(step)
+        if light is None:
             index = step.get("index")
             which = f"step {index + 1}" if isinstance(index, int) else f"step {k + 1}"
             image = step.get("image") or step.get("linear_image") or "its image"

@@ -27,6 +27,7 @@ from rti_rig.app.light_calibration import (
     calibration_toml,
     card_spread_deg,
     read_card_session,
+    step_direction,
 )
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.core.errors import RtiRigError
@@ -234,11 +235,8 @@ def _recorded_directions(recorded: dict[str, Any], steps: Any) -> dict[int, Any]
         led = step.get("led") if isinstance(step, dict) else None
         if isinstance(led, bool) or not isinstance(led, int) or led < 0:
             return None
-        try:
-            direction = np.asarray(step.get("actual_direction"), dtype=float)
-        except (TypeError, ValueError):
-            return None
-        if direction.shape != (3,) or not np.all(np.isfinite(direction)) or not direction.any():
+        direction = step_direction(step)
+        if direction is None:
             return None
         out[led] = direction
     return out
