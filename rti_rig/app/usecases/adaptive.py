@@ -1359,8 +1359,8 @@ def _nothing_to_choose(
     offered: int,
     lights: int | None,
     until_error_deg: float | None,
-    band: tuple[float, float] = _FULL_BAND,
-    min_lights: int | None = None,
+    band: tuple[float, float],
+    min_lights: int | None,
 ) -> NothingToChoose | None:
     """What leaves an adaptive session nothing to choose on a dome whose LEDs are at
     ``elevations`` (°), ``offered`` of them in ``band``; None where there is something.
@@ -1400,7 +1400,7 @@ def _nothing_to_choose_words(
     facts: NothingToChoose,
     config: str,
     until_error_deg: float | None,
-    objective: str = "normals",
+    objective: str,
 ) -> str:
     """The refusal of ``facts``, with its ways out as commands of the user's own options
     (``config``: the rig config, quoted for a shell).
