@@ -64,6 +64,19 @@ def _cut_session(acq: Path, out: Path, **options: Any) -> None:
     assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
 
 
+def _refused_resume_command(acq: Path, out: Path) -> list[str]:
+    """The words of the new-session command a resume of ``out`` is refused with once an image
+    of ``acq`` is replaced (as the shell splits it, after ``rti-rig run``)."""
+    names = [e.name for e in read_lp(acq / "dirs.lp")]
+    shutil.copy(acq / names[0], acq / names[-1])  # an image replaced since
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    text = said(r)
+    assert r.exit_code == 2 and "Traceback" not in text, text
+    command = re.search(r"\(rti-rig run ([^()]+)\)$", text)
+    assert command, text
+    return shlex.split(command.group(1))
+
+
 @pytest.mark.parametrize(
     "options",
     [
@@ -94,15 +107,7 @@ def test_the_new_session_a_changed_replay_is_told_to_start_runs_as_printed_with_
         options = {"plan": Path("my plan.lp")}
     _cut_session(acq, out, **options)
     first = json.loads((out / "manifest.json").read_text())
-    names = [e.name for e in read_lp(acq / "dirs.lp")]
-    shutil.copy(acq / names[0], acq / names[-1])  # an image replaced since
-
-    r = runner.invoke(app, ["run", "--resume", str(out)])
-    text = said(r)
-    assert r.exit_code == 2 and "Traceback" not in text, text
-    command = re.search(r"\(rti-rig run ([^()]+)\)$", text)
-    assert command, text
-    args = shlex.split(command.group(1))
+    args = _refused_resume_command(acq, out)
     assert args[:2] == [str(acq / "dirs.lp"), "--out"], args
     new = Path(args[2])
     assert new.parent == out.parent and not new.exists(), args
@@ -144,16 +149,8 @@ def test_the_new_session_command_names_the_plan_the_session_ran_from_any_folder(
     monkeypatch.chdir(first_dir)
     _cut_session(acq, out, plan=Path("plan.lp"))
     first = json.loads((out / "manifest.json").read_text())
-    names = [e.name for e in read_lp(acq / "dirs.lp")]
-    shutil.copy(acq / names[0], acq / names[-1])  # an image replaced since
-
     monkeypatch.chdir(other_dir)  # the resume, typed in another folder
-    r = runner.invoke(app, ["run", "--resume", str(out)])
-    text = said(r)
-    assert r.exit_code == 2 and "Traceback" not in text, text
-    command = re.search(r"\(rti-rig run ([^()]+)\)$", text)
-    assert command, text
-    args = shlex.split(command.group(1))
+    args = _refused_resume_command(acq, out)
     assert args[args.index("--plan") + 1] == str(first_dir / "plan.lp"), args
     r = runner.invoke(app, ["run", *args, "--no-verdict"])  # as printed, from there
     assert r.exit_code == 0, r.output
