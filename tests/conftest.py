@@ -477,6 +477,22 @@ def interrupted(  # type: ignore[no-untyped-def]
         return run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
 
 
+def cut_new_session(request: Any, after_step: int) -> Any:
+    """The run of a new session opened by ``request`` (a ``NewSessionRequest``), cancelled once
+    step ``after_step`` (0-based) is committed, as Ctrl-C does: a session for a resume to
+    continue. (The resume tests had each kept a copy of this.)"""
+    from rti_rig.app.usecases.session import open_new_session, run_opened_session
+    from rti_rig.runtime.controller import CancelToken, StepCompleted
+
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == after_step:
+            cancel.cancel()
+
+    return run_opened_session(open_new_session(request), cancel, on_event)
+
+
 def line_within(process: subprocess.Popen[AnyStr], seconds: float, what: str) -> AnyStr:
     """The next line ``process`` prints on its stdout pipe, read on a thread and waited for at
     most ``seconds``: past them the process is killed (by its own handle) and the test fails

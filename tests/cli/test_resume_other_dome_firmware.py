@@ -16,7 +16,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, journal, said
+from conftest import CONFIGS, cut_new_session, journal, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -29,20 +29,9 @@ MINIRTI = CONFIGS / "emulated_minirti.toml"
 def _cut(out: Path, config: Path = NICHLOCK) -> None:
     """A 6-light session on ``config`` (the nichlock dome), cancelled after three images as
     Ctrl-C does."""
-    from rti_rig.app.usecases.session import (
-        NewSessionRequest,
-        open_new_session,
-        run_opened_session,
-    )
-    from rti_rig.runtime.controller import CancelToken, StepCompleted
+    from rti_rig.app.usecases.session import NewSessionRequest
 
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 2:
-            cancel.cancel()
-
-    run_opened_session(open_new_session(NewSessionRequest(config, out, 6)), cancel, on_event)
+    cut_new_session(NewSessionRequest(config, out, 6), after_step=2)
     assert len(journal(out)) == 3
 
 

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import said
+from conftest import cut_new_session, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -47,21 +47,11 @@ def _asked(manifest: dict[str, Any]) -> dict[str, Any]:
 
 def _cut_session(acq: Path, out: Path, **options: Any) -> None:
     """A replay of ``acq`` with ``options``, stopped after three images as Ctrl-C does."""
-    from rti_rig.app.usecases.session import (
-        NewSessionRequest,
-        open_new_session,
-        run_opened_session,
-    )
-    from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+    from rti_rig.app.usecases.session import NewSessionRequest
+    from rti_rig.runtime.controller import FinishReason
 
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 2:
-            cancel.cancel()
-
-    opened = open_new_session(NewSessionRequest(acq / "dirs.lp", out, **options))
-    assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+    result = cut_new_session(NewSessionRequest(acq / "dirs.lp", out, **options), after_step=2)
+    assert result.finish_reason is FinishReason.CANCELLED
 
 
 def _refused_resume_command(acq: Path, out: Path) -> list[str]:
