@@ -123,6 +123,19 @@ def _follow_the_way_out(
     )
 
 
+def _resumes_without_the_stopped_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, said: str, stopped: ClockChangingCamera
+) -> None:
+    """The way out followed (:func:`_follow_the_way_out`) completes the session, lights off,
+    its 4 lights shot by the resumed lights' own files, never the set-aside IMG_0003.DNG."""
+    resumed = _follow_the_way_out(tmp_path, monkeypatch, said, stopped)
+    assert resumed.result.exit_code == 0, resumed.said
+    assert not resumed.lit_at_end, resumed.said
+    assert (tmp_path / "s" / "lights.lp").read_text().split()[0] == "4"
+    taken = [list(step["originals"].values()) for step in journal(tmp_path / "s")]
+    assert taken == [["IMG_0001.DNG"], ["IMG_0002.DNG"], ["IMG_0004.DNG"], ["IMG_0005.DNG"]]
+
+
 def test_a_clock_set_forward_mid_run_is_said_as_such_not_as_a_late_file(tmp_path, monkeypatch):
     (r, said, lit), stopped = _run(tmp_path, monkeypatch, lambda pulses: 40.0)
     assert r.exit_code == 2, said
@@ -136,13 +149,7 @@ def test_a_clock_set_forward_mid_run_is_said_as_such_not_as_a_late_file(tmp_path
     clock_file = tmp_path / "s" / "raw" / ".folder_watch_clock.json"
     assert f"delete {clock_file} and resume" in said, said
 
-    resumed = _follow_the_way_out(tmp_path, monkeypatch, said, stopped)
-    assert resumed.result.exit_code == 0, resumed.said
-    assert not resumed.lit_at_end, resumed.said
-    assert (tmp_path / "s" / "lights.lp").read_text().split()[0] == "4"
-    # the resumed lights' own shots, not the set-aside IMG_0003.DNG
-    taken = [list(step["originals"].values()) for step in journal(tmp_path / "s")]
-    assert taken == [["IMG_0001.DNG"], ["IMG_0002.DNG"], ["IMG_0004.DNG"], ["IMG_0005.DNG"]]
+    _resumes_without_the_stopped_file(tmp_path, monkeypatch, said, stopped)
 
 
 def test_a_clock_set_back_onto_an_earlier_pulse_is_said_as_either(tmp_path, monkeypatch):
@@ -156,10 +163,4 @@ def test_a_clock_set_back_onto_an_earlier_pulse_is_said_as_either(tmp_path, monk
     ), said
     assert "the capture times cannot tell which" in said, said
 
-    resumed = _follow_the_way_out(tmp_path, monkeypatch, said, stopped)
-    assert resumed.result.exit_code == 0, resumed.said
-    assert not resumed.lit_at_end, resumed.said
-    assert (tmp_path / "s" / "lights.lp").read_text().split()[0] == "4"
-    # the resumed lights' own shots, not the set-aside IMG_0003.DNG
-    taken = [list(step["originals"].values()) for step in journal(tmp_path / "s")]
-    assert taken == [["IMG_0001.DNG"], ["IMG_0002.DNG"], ["IMG_0004.DNG"], ["IMG_0005.DNG"]]
+    _resumes_without_the_stopped_file(tmp_path, monkeypatch, said, stopped)
