@@ -335,11 +335,14 @@ def missing_images_advice(
             f"into {lp_dir}"
         )
     others = f", or remove their lines from the .lp to {use} the others"
-    return ("; " + where if absolute else "") + (
-        case_hint(paths)
-        or quote_hint(names, lp_dir)
-        or f"; {copy}{others if len(names) < total else ''}"
-    )
+    plain = f"; {copy}{others if len(names) < total else ''}"
+    quoted = quote_hint(names, lp_dir)
+    if quoted and (rest := len(names) - len(_quoted_names(names, lp_dir))):
+        # the images not quoted are missing all the same: their way out is said too (it had
+        # been left out, the quotes' edit alone offered for every image)
+        tail = others if len(names) < total else ""
+        quoted += f"; for the other {rest} not found, {copy}{tail}"
+    return ("; " + where if absolute else "") + (case_hint(paths) or quoted or plain)
 
 
 def quote_hint(names: Sequence[str], lp_dir: Path) -> str:
@@ -351,7 +354,29 @@ def quote_hint(names: Sequence[str], lp_dir: Path) -> str:
     part of the name), so such images had been told to be copied "where their names point",
     beside files the user sees are there. Named, not read in their place: the fix is one
     edit of the `.lp`, and then every reader finds them."""
-    quoted = [
+    quoted = _quoted_names(names, lp_dir)
+    if not quoted:
+        return ""
+    more = f" and {len(quoted) - 3} more" if len(quoted) > 3 else ""
+    if len(names) == 1:
+        which = "its name is in quotes and the file without them is there"
+    elif len(quoted) == 1:
+        which = f"1 of them is named in quotes ({quoted[0]}) and its file without them is there"
+    else:
+        which = (
+            f"{len(quoted)} of them are named in quotes ({', '.join(quoted[:3])}{more}) and "
+            "their files without the quotes are there"
+        )
+    return (
+        f"; {which}: an .lp does not quote its names (a name may hold spaces: the last three "
+        "fields are the light), so remove the quotes from the .lp"
+    )
+
+
+def _quoted_names(names: Sequence[str], lp_dir: Path) -> list[str]:
+    """The ``names`` in quotes whose file without the quotes is in ``lp_dir`` (see
+    :func:`quote_hint`)."""
+    return [
         n
         for n in names
         if len(n) > 2
@@ -359,19 +384,6 @@ def quote_hint(names: Sequence[str], lp_dir: Path) -> str:
         and n[0] in "\"'"
         and image_path(Path(lp_dir), n[1:-1]).is_file()
     ]
-    if not quoted:
-        return ""
-    more = f" and {len(quoted) - 3} more" if len(quoted) > 3 else ""
-    which = (
-        "its name is in quotes and the file without them is there"
-        if len(names) == 1
-        else f"{len(quoted)} of them are named in quotes ({', '.join(quoted[:3])}{more}) "
-        "and their files without the quotes are there"
-    )
-    return (
-        f"; {which}: an .lp does not quote its names (a name may hold spaces: the last three "
-        "fields are the light), so remove the quotes from the .lp"
-    )
 
 
 def _is_file_at(name: str) -> bool:
