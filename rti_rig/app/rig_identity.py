@@ -29,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -198,11 +199,16 @@ def _recorded_images_digest(loaded: LoadedRig, geometry: DomeGeometry) -> str:
     been mixed into the session without a word (the resume's images then came from another
     acquisition than the first part's). Hashed in full: a fraction of a second for a
     72-image acquisition of 5 MB JPEGs."""
+    return recorded_images_digest(Path(loaded.path).parent, geometry.names)
+
+
+def recorded_images_digest(folder: Path, names: Sequence[str]) -> str:
+    """:func:`_recorded_images_digest` of the images ``names`` (an `.lp`'s, in its order) in
+    ``folder``: also what a replay's verdict checks before it names the recorded files."""
     from rti_rig.core.lp_format import image_path
 
-    folder = Path(loaded.path).parent
     total = hashlib.sha256()
-    for name in geometry.names:
+    for name in names:
         digest = hashlib.sha256()
         try:
             with open(image_path(folder, name), "rb") as f:

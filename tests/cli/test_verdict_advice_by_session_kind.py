@@ -8,6 +8,7 @@ cannot reshoot one image (the lights after it were chosen from it).
 from __future__ import annotations
 
 import re
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -98,3 +99,25 @@ def test_a_test_shot_of_too_few_lights_is_told_what_run_can_do(tmp_path: Path, l
         f"session has {lights}; run with --lights 3 or more" in text
     )
     assert len(list(out.glob("image_*.jpg"))) == lights
+
+
+def test_a_replay_verdict_names_no_recorded_file_once_the_lp_is_edited(tmp_path: Path) -> None:
+    """The recorded files are named from the replayed `.lp` as it is when the verdict is made:
+    one edited since the session (here its lines' names reversed) had the verdict name other
+    photographs as clipped. The files are named only while the `.lp` and its images are the
+    ones the session began with (their recorded digest)."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ.parent, acq)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(acq / ACQ.name), "--out", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    lines = (acq / ACQ.name).read_text().splitlines()
+    names = [line.split()[0] for line in lines[1:]][::-1]
+    edited = [f"{n} {' '.join(line.split()[1:])}" for n, line in zip(names, lines[1:], strict=True)]
+    (acq / ACQ.name).write_text("\n".join([lines[0], *edited]) + "\n")
+
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    text = said(r)
+    assert r.exit_code == 0, text
+    assert "clipped in the recording (a replayed acquisition cannot be reshot)" in text, text
+    assert not re.search(r"clipped in the recording, \S+", text), text

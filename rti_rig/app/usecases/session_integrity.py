@@ -286,7 +286,7 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
 def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
     """The recorded file each image of a replay session is (``image_064`` → ``image10.jpg``),
     from the LED its step fired and the replayed acquisition's `.lp`; {} when that `.lp` can
-    no longer be read (moved since).
+    no longer be read (moved since) or it, or its images, are no longer the ones replayed.
 
     Why: the verdict named the session's images only, "clipped in the recording", so a user
     replaying their own acquisition could not tell which of its photographs was clipped."""
@@ -298,6 +298,17 @@ def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
     try:
         entries = read_lp(Path(lp_file))
     except (RtiRigError, OSError):
+        return {}
+    # named only where the `.lp` and its images are still the ones the session replayed (their
+    # digest, recorded when it began): an `.lp` edited since (lines reordered or removed) or
+    # images re-exported had the verdict name other photographs, and a session from before
+    # the digest was recorded cannot tell
+    from rti_rig.app.rig_identity import recorded_images_digest
+
+    began = ((manifest.get("rig") or {}).get("identity") or {}).get("recorded_images")
+    if began is None or began != recorded_images_digest(
+        Path(lp_file).parent, [e.name for e in entries]
+    ):
         return {}
     names: dict[str, str] = {}
     for step in steps:
