@@ -27,6 +27,7 @@ import hashlib
 import json
 import os
 import tempfile
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -72,7 +73,27 @@ class LatchedErrors:
             return {}
 
     def save(self, errors: dict[int, int]) -> None:
-        """Record the chain's errors now (atomically); no error left removes the file."""
+        """Record the chain's errors now (atomically); no error left removes the file.
+
+        Why a file that cannot be written is a warning, not an error: this is called from
+        inside the emulated bus as a status packet goes out, so an OSError here (a full disk,
+        a state folder another user made in the shared temp folder) reached the driver as its
+        serial port failing, "check that the arm's USB adapter is still plugged in", and the
+        servo's own fault went unsaid. Unkept, the chain is met by the next command as if
+        power-cycled, which the warning says (the console prints it as a note)."""
+        try:
+            self._write(errors)
+        except OSError as exc:
+            warnings.warn(
+                f"the emulated servos' hardware error state could not be kept in {self.path} "
+                f"({exc}): the next command on this rig meets them as if power-cycled; set "
+                f"{STATE_DIR_ENV} to a writable folder to keep it",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+
+    def _write(self, errors: dict[int, int]) -> None:
+        """:meth:`save`'s file work, which may raise OSError."""
         latched = {str(k): v for k, v in sorted(errors.items()) if v}
         if not latched:
             with contextlib.suppress(FileNotFoundError):

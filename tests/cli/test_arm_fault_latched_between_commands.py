@@ -12,10 +12,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from conftest import inprocess_arm_config, journal, said, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.simulator.servo_latch import STATE_DIR_ENV
 
 runner = CliRunner()
 
@@ -80,3 +82,29 @@ def test_each_config_has_its_own_chain(tmp_path: Path) -> None:
     other = inprocess_arm_config(tmp_path / "b")
     r = runner.invoke(app, ["check", str(other), "--reboot-faulted"], terminal_width=400)
     assert "nothing rebooted" in said(r) and r.exit_code == 0, said(r)
+
+
+def test_a_state_file_that_cannot_be_written_leaves_the_servo_fault_said(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A state folder that cannot be made (a full disk, another user's folder in the shared
+    temp folder) is a warning: the run still ends on the servo's own fault, not on its port.
+
+    The state is written from inside the emulated bus as a status goes out, so the OSError had
+    reached the driver as "the port 'inprocess' failed …: check that the arm's USB adapter
+    (e.g. a U2D2) is still plugged in", the overload said only among the teardown problems."""
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    monkeypatch.setenv(STATE_DIR_ENV, str(blocker / "servo-state"))
+    cfg = inprocess_arm_config(tmp_path, FAULT)
+    with pytest.warns(RuntimeWarning, match="could not be kept in .*as if power-cycled"):
+        r = runner.invoke(
+            app,
+            ["run", str(cfg), "--lights", "6", "--out", str(tmp_path / "s")],
+            terminal_width=400,
+        )
+    words = said(r)
+    assert r.exit_code == 2 and "Traceback" not in words, words
+    assert "USB adapter" not in words, words
+    assert "error: arm during 'move to az" in words, words
+    assert "servo 2: hardware fault overload" in words.split("error: ")[-1], words
