@@ -85,12 +85,18 @@ def arm_az_el(direction: NDArray[np.float64]) -> tuple[float, float]:
 
 
 def move_named(direction: NDArray[np.float64]) -> str:
-    """A move as an error names it: by the azimuth and elevation a user reads in the check's
-    table and the .lp, as the Dynamixel arm's errors do.
+    """A move as an error names it: by the light's own azimuth (0-360°) and elevation, as a
+    user reads them in the check's table and the .lp, with the azimuth joint's angle beside
+    it when that is a turn away, as the Dynamixel arm's errors do.
 
-    Why: the code name ``'move_to'`` had been said instead, which names no pose on the rig."""
-    az, el = arm_az_el(direction)
-    return f"move to az {az:.1f}°, el {el:.1f}°"
+    Why: the code name ``'move_to'`` had been said instead, which names no pose on the rig;
+    then the joint's angle alone, so a light at az 200° was said as "az -160.0°", an azimuth
+    no light of the plan has (the Dynamixel arm had been corrected for that, not this one)."""
+    light_az, el = az_el_from_direction(direction)
+    joint_az, _ = arm_az_el(direction)
+    light_az = float(light_az)
+    joint = "" if abs(joint_az - light_az) < 0.05 else f" (azimuth joint at {joint_az:.1f}°)"
+    return f"move to az {light_az:.1f}°, el {float(el):.1f}°{joint}"
 
 
 class SimulatedArm:

@@ -45,9 +45,56 @@ def test_a_failed_virtual_arm_move_is_named_by_its_pose(
     words = said(r)
     assert r.exit_code == 2 and "Traceback" not in words, words
     assert "move_to" not in words, words
-    move = re.search(r"during 'move to az (-?\d+\.\d)°, el (-?\d+\.\d)°': injected fault", words)
+    move = re.search(
+        r"during 'move to az (\d+\.\d)°, el (\d+\.\d)°(?: \(azimuth joint at -?\d+\.\d°\))?': "
+        "injected fault",
+        words,
+    )
     assert move is not None, words
-    assert -180 <= float(move.group(1)) <= 180 and 5 <= float(move.group(2)) <= 80
+    assert 0 <= float(move.group(1)) < 360 and 5 <= float(move.group(2)) <= 80
+
+
+def test_a_light_a_turn_from_the_virtual_joint_is_named_by_its_own_azimuth(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The virtual arm's azimuth joint turns -180..180°, so a light at az 200° (as the .lp
+    and rti-rig's other words give it, 0-360°) is reached at the joint's -160°: its failed
+    move had been named "az -160.0°", an azimuth no light of the plan has, after the
+    Dynamixel arm's errors had been corrected to say the light's own azimuth."""
+    real_arm = sim_lights.SimulatedArm
+
+    def failing_arm(*args, **kwargs):  # type: ignore[no-untyped-def]
+        return FaultyCarrier(real_arm(*args, **kwargs), FaultPlan("arm-jam", at=0))
+
+    monkeypatch.setattr(sim_lights, "SimulatedArm", failing_arm)
+    rows = []
+    for k, az in enumerate((200.0, 215.0, 230.0, 245.0, 260.0, 275.0)):
+        d = direction_from_az_el(az, 30.0 + 5 * k)
+        rows.append(f"light_{k} {d[0]:.6f} {d[1]:.6f} {d[2]:.6f}")
+    plan = tmp_path / "plan.lp"
+    plan.write_text(f"{len(rows)}\n" + "\n".join(rows) + "\n")
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(CONFIGS / "virtual_arm.toml"),
+            "--plan",
+            str(plan),
+            "--out",
+            str(tmp_path / "s"),
+        ],
+        terminal_width=400,
+    )
+    words = said(r)
+    assert r.exit_code == 2 and "Traceback" not in words, words
+    move = re.search(
+        r"during 'move to az (\d+\.\d)°, el (\d+\.\d)° \(azimuth joint at (-\d+\.\d)°\)': "
+        "injected fault",
+        words,
+    )
+    assert move is not None, words
+    az, joint = float(move.group(1)), float(move.group(3))
+    assert 200.0 <= az <= 275.0 and abs(joint - (az - 360.0)) < 0.1, words
 
 
 def test_a_refused_virtual_arm_move_is_named_by_its_pose() -> None:
