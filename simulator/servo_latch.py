@@ -13,8 +13,9 @@ cleared by a Reboot instruction (the file is removed once no servo has an error)
 error bits are kept (and, through them, a shutdown's torque off); positions, RAM settings and
 the like start from power-on, a simplification.
 
-The file is keyed by the rig config's absolute path and its ``[emulator]`` section, so a test
-or a user with another config (or another rehearsal of faults) meets a fresh chain. It lives
+The file is keyed by the rig config's absolute path, so another config meets a fresh chain;
+the same config with its ``[[emulator.faults]]`` edited (the obstruction cleared, as the
+error advises before the reboot) is the same chain, its error still latched. It lives
 in a per-user folder: ``$RTI_RIG_EMULATOR_STATE_DIR`` if set, else
 ``$XDG_RUNTIME_DIR/rti-rig/emulated-servos``, else ``<temp>/rti-rig-<uid>/emulated-servos``.
 To "power-cycle" the emulated servos, delete that file (or the folder).
@@ -29,7 +30,6 @@ import os
 import tempfile
 import warnings
 from pathlib import Path
-from typing import Any
 
 #: Overrides where the state files are kept (a test's own folder, say).
 STATE_DIR_ENV = "RTI_RIG_EMULATOR_STATE_DIR"
@@ -50,14 +50,13 @@ def state_dir() -> Path:
 class LatchedErrors:
     """The state file of one emulated chain: servo id -> latched Hardware Error Status bits."""
 
-    def __init__(self, config_path: Path, emulator_section: Any) -> None:
+    def __init__(self, config_path: Path) -> None:
         self.config_path = Path(config_path).resolve()
-        key = json.dumps(
-            {"config": str(self.config_path), "emulator": emulator_section},
-            sort_keys=True,
-            default=str,
-        )
-        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+        # keyed by the config's path alone, not its [emulator] section too: the error's advice
+        # is "clear the obstruction; then run rti-rig check … --reboot-faulted", and on an
+        # emulated arm the obstruction is cleared by taking its [[emulator.faults]] out; a key
+        # that changed with them met a fresh chain, "no hardware fault: not rebooted"
+        digest = hashlib.sha256(str(self.config_path).encode()).hexdigest()[:16]
         self.path = state_dir() / f"{self.config_path.stem}-{digest}.json"
 
     def load(self) -> dict[int, int]:

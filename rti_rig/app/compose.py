@@ -309,7 +309,7 @@ def _keep_latched_errors(loaded: LoadedRig, emulator: DynamixelBusEmulator) -> N
     them (a real servo keeps it while powered), and record each change from here on."""
     from rti_rig.simulator.servo_latch import LatchedErrors
 
-    latch = LatchedErrors(loaded.path, loaded.config.emulator.model_dump(mode="json"))
+    latch = LatchedErrors(Path(loaded.path))
     for dxl_id, bits in latch.load().items():
         if dxl_id in emulator.servos:
             emulator.inject_hardware_error(dxl_id, bits)

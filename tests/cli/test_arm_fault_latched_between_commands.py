@@ -108,3 +108,27 @@ def test_a_state_file_that_cannot_be_written_leaves_the_servo_fault_said(
     assert "USB adapter" not in words, words
     assert "error: arm during 'move to az" in words, words
     assert "servo 2: hardware fault overload" in words.split("error: ")[-1], words
+
+
+def test_the_obstruction_cleared_first_leaves_the_fault_for_the_reboot(tmp_path: Path) -> None:
+    """The error's advice in its own order: "clear the obstruction; then run rti-rig check …
+    --reboot-faulted". On the emulated arm the obstruction is cleared by taking the rehearsed
+    fault out of the config; the servo's latched error is still there for the reboot, as on a
+    real servo (the chain had been keyed by the config's [emulator] section too, so the edit
+    met a fresh chain: "no hardware fault: not rebooted", the recovery not rehearsed)."""
+    cfg = inprocess_arm_config(tmp_path, FAULT)
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(cfg), "--lights", "6", "--out", str(out)], terminal_width=400
+    )
+    assert "servo 2: hardware fault overload" in said(r), said(r)
+    cfg.write_text(cfg.read_text().replace(FAULT, ""))
+    r = runner.invoke(app, ["check", str(cfg), "--reboot-faulted"], terminal_width=400)
+    words = said(r)
+    assert r.exit_code == 0 and "Traceback" not in words, words
+    assert (
+        "servo 2 (elevation): hardware fault overload (0x20); rebooted, Hardware Error Status "
+        "read back 0x00" in words
+    ), words
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400)
+    assert r.exit_code == 0 and len(journal(out)) == 6, said(r)
