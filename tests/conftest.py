@@ -203,6 +203,31 @@ def refused_and_waited(monkeypatch: pytest.MonkeyPatch) -> threading.Event:
 _WATCHED_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    """Point the emulated servos' latched-error folder at a temporary one for the whole run,
+    before any fixture: session-scoped fixtures run before the per-test
+    :func:`_emulated_servos_power_cycled`, and one driving an emulated arm would otherwise
+    write the user's own folder (and find a fault a developer's rehearsal left there)."""
+    import os
+    import shutil
+    import tempfile
+
+    from rti_rig.simulator.servo_latch import STATE_DIR_ENV
+
+    folder = tempfile.mkdtemp(prefix="rti-rig-test-servo-state-")
+    before = os.environ.get(STATE_DIR_ENV)
+    os.environ[STATE_DIR_ENV] = folder
+
+    def restore() -> None:
+        if before is None:
+            os.environ.pop(STATE_DIR_ENV, None)
+        else:
+            os.environ[STATE_DIR_ENV] = before
+        shutil.rmtree(folder, ignore_errors=True)
+
+    config.add_cleanup(restore)
+
+
 @pytest.fixture(autouse=True)
 def _emulated_servos_power_cycled(
     tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
