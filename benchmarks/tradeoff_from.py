@@ -116,7 +116,31 @@ def check_acquisition(lp: Path, notes: list[str] | None = None) -> list[Path]:
     too_few = _too_few_lights(lp, len(entries))
     if too_few is not None:
         raise RtiRigError(too_few)
+    no_normals = _no_reference_normals(lp, np.array([e.direction for e in entries]))
+    if no_normals is not None:
+        raise RtiRigError(no_normals)
     return files
+
+
+def _no_reference_normals(lp: Path, dirs: np.ndarray) -> str | None:
+    """What is said of an acquisition whose lights cannot determine a surface normal, or None.
+
+    Why: the trade is scored against normals fitted on every light (:func:`reference`); lights
+    in one plane (one azimuth, the horizon) or one direction repeated give none, and the
+    solver's refusal reached the user as "light set is ill-conditioned ... (from Python,
+    ill_conditioned='regularise' fits it regularised)", naming no file and advising what a
+    command-line user cannot do. Judged as ``plan``, ``run`` and ``fit`` judge it
+    (:func:`~rti_rig.app.normals_determined.undetermined_normals`), before any pixel is read.
+    """
+    from rti_rig.app.normals_determined import undetermined_normals
+
+    reason = undetermined_normals(dirs, "lights")
+    if reason is None:
+        return None
+    return (
+        f"{lp}: {reason}; a trade-off is scored against the normals fitted on every light, so "
+        "it needs an acquisition whose lights span several elevations and azimuths"
+    )
 
 
 def _image_files(lp: Path, entries: list[Any]) -> list[Path]:

@@ -625,3 +625,42 @@ def test_the_plots_x_axes_read_as_plain_numbers_that_do_not_overlap(
         boxes = sorted(boxes, key=lambda b: b.x0)
         for a, b in itertools.pairwise(boxes):
             assert a.x1 <= b.x0, (path.name, texts)
+
+
+@pytest.mark.parametrize(
+    ("layout", "said"),
+    [
+        ("azimuth", "lights at one azimuth"),  # every light in one upright plane
+        ("horizon", "the horizon"),  # every light at z = 0.0005
+    ],
+)
+def test_lights_that_cannot_give_reference_normals_are_refused_by_name(
+    tmp_path: Path, layout: str, said: str
+) -> None:
+    """The trade is scored against normals fitted on every light; lights that give none had
+    reached the user as the solver's "ill-conditioned ... (from Python,
+    ill_conditioned='regularise' fits it regularised)", naming no file, after --out was made."""
+    lp = _acquisition(tmp_path / "acq")
+    names = [line.split()[0] for line in lp.read_text().splitlines()[1:]]
+    if layout == "azimuth":
+        el = np.radians(np.linspace(10.0, 80.0, len(names)))
+        dirs = np.stack([np.cos(el), np.zeros_like(el), np.sin(el)], axis=1)
+    else:
+        az = np.linspace(0.0, 2.0 * np.pi, len(names), endpoint=False)
+        dirs = np.stack([np.cos(az), np.sin(az), np.full_like(az, 0.0005)], axis=1)
+        dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    dirs = np.clip(dirs, -0.999999, 0.999999)
+    lp.write_text(
+        f"{len(names)}\n"
+        + "".join(
+            f"{n} {x:.6f} {y:.6f} {z:.6f}\n" for n, (x, y, z) in zip(names, dirs, strict=True)
+        )
+    )
+    out = tmp_path / "o"
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out)])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert f"{lp}: the 12 lights cannot determine a surface normal" in text
+    assert said in text and "several elevations and azimuths" in text
+    assert "from Python" not in text and "Traceback" not in text
+    assert not out.exists()  # refused before --out is made
