@@ -84,6 +84,7 @@ from rti_rig.reconstruct.qa_exposure import (
     exposure_scatter,
 )
 from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
+from rti_rig.reconstruct.qa_unchanging import UNCHANGING, unchanging_problem, unchanging_spread
 from rti_rig.reconstruct.signal_check import SAMPLE_PIXELS, every_image_black, sample_grid
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
@@ -525,11 +526,12 @@ class QAReport:
         # A move part-way through is one fault of every image from it on: said once, as a
         # range, whatever else some of those images have. Each image's other problems are
         # said on their own (a saturated image in the range had been given the move's whole
-        # advice again, and a run of 48 cut into pieces around it).
+        # advice again, and a run of 48 cut into pieces around it). So are images that do not
+        # change with their light (:mod:`qa_unchanging`): one fault of the whole session.
         carriers: dict[str, list[ImageCheck]] = {}
         for c in self.reshoot:
             for p in c.problems:
-                if p.startswith(MOVED_FROM):
+                if p.startswith((MOVED_FROM, UNCHANGING)):
                     carriers.setdefault(p, []).append(c)
         ranged = {p: run for p, run in carriers.items() if len(run) >= 3}
         parts = []
@@ -1267,6 +1269,8 @@ def assess(
     dark = DARK_FRACTION * ref
     dark_frac = (small < dark).mean(axis=(1, 2))
     coverage = ((small > dark) & ~small_sat).sum(axis=0).astype(np.int16)
+    # every image the same picture: said once, for every image, as no per-image check sees it
+    unchanged = None if all_black else unchanging_spread(small, small_sat, dark, lt)
 
     # per-image evidence on a full-resolution crop where the object has lit structure (a
     # second pass reads only its rows)
@@ -1624,6 +1628,8 @@ def assess(
                 "as every image's do (a lens cap, lights that never fired, or an exposure far "
                 "too short)"
             )
+        if unchanged is not None:
+            problems.append(unchanging_problem(unchanged))
         if step is not None and _in_open_range(step, i):
             problems.append(_may_have_moved(step, names))
         elif step_moved[i] and step is not None:

@@ -1,0 +1,83 @@
+"""Whether an acquisition's images change with their light at all, judged on the QA's reduced
+images.
+
+Why: a session whose every image is the same picture (the dome's LEDs never fired while the
+room light was on, or one frame saved under every light's name) was fitted and told
+``QA verdict: good``. A PTM explains a constant image exactly (its constant term), so the
+per-image checks, which compare each image with the fit, found nothing; the normal map was a
+least-squares answer to lights that made no difference (24 identical frames at 46 % of full
+scale read as a level surface of albedo 0.46).
+
+A Lambertian surface under lights that do not all lie on one plane cannot look the same under
+every one of them: its ``rho n . l`` changes from light to light. Only lights on one plane
+(a ring at one elevation over a level object, where ``n . l`` is the same for every light) can
+give identical images of a real object, so those are never judged here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: The images do not change with their light when their median pixel (lit in some image,
+#: clipped in none) spreads less than this fraction of its brightest value between its brightest and
+#: darkest image. Why 2 %: the reduced images are area averages, whose camera noise is well
+#: below 1 % of a lit pixel; lights whose ``n . l`` for a single normal already differs by
+#: :data:`MIN_LAMBERT_CHANGE` change a lit matte pixel by at least that fraction, and a real
+#: session's median pixel (shadows, highlights) by tens of per cent.
+UNCHANGING_SPREAD = 0.02
+#: The judgement is made only when no surface normal can look the same under every light:
+#: the relative RMS misfit of the best ``L x = 1`` (a constant rendering ``n . l``) is at least
+#: this. Lights on one plane (a ring at one elevation) read 0; 4 to 1000 lights spread over 10-90°
+#: elevation read 0.33-0.38.
+MIN_LAMBERT_CHANGE = 0.1
+#: The words of the problem, said once for the run of images (``QAReport.verdict``).
+UNCHANGING = "the images do not change with their light"
+
+
+def lambert_change(lights: NDArray[np.floating]) -> float:
+    """How far the best constant Lambertian rendering falls from constant over ``lights``
+    (N×3): the relative RMS residual of ``L x = 1`` in least squares (0: lights on one plane,
+    where some normal sees every light alike)."""
+    lt = np.asarray(lights, dtype=np.float64).reshape(-1, 3)
+    ones = np.ones(len(lt))
+    x, *_ = np.linalg.lstsq(lt, ones, rcond=None)
+    return float(np.sqrt(np.mean((lt @ x - ones) ** 2)))
+
+
+def unchanging_spread(
+    small: NDArray[np.floating],
+    small_sat: NDArray[np.bool_],
+    dark: float,
+    lights: NDArray[np.floating],
+) -> float | None:
+    """The median relative spread of ``small``'s (N, h, w) lit pixels clipped in no image when
+    it is below :data:`UNCHANGING_SPREAD` on lights that cannot give identical images (the
+    images do not change with their light), else None.
+
+    ``small_sat`` marks clipped reduced pixels and ``dark`` is the QA's dark level, in the
+    units of ``small``. Fewer than 3 images, lights on one plane, or no lit unclipped pixel:
+    None (nothing to judge)."""
+    n = small.shape[0]
+    if n < 3 or lambert_change(lights) < MIN_LAMBERT_CHANGE:
+        return None
+    stack = small.reshape(n, -1).astype(np.float64)
+    hi = stack.max(axis=0)
+    # lit in some image (a pixel shadowed in others spreads fully: it changed) and clipped in
+    # none (a clipped pixel reads full scale whatever its light)
+    usable = (hi > dark) & ~small_sat.reshape(n, -1).any(axis=0)
+    if not usable.any():
+        return None
+    spread = float(np.median((hi[usable] - stack.min(axis=0)[usable]) / hi[usable]))
+    return spread if spread < UNCHANGING_SPREAD else None
+
+
+def unchanging_problem(spread: float) -> str:
+    """What the verdict says of every image of an acquisition that does not change with its
+    light, and what to do."""
+    return (
+        f"{UNCHANGING} (their median pixel varies {spread:.1%} from image to image, where "
+        "these lights would change any surface's shading): the lights never changed (the "
+        "dome's LEDs did not fire while another light was on, or one frame was saved under "
+        "every name); check that each light fires, then reshoot"
+    )
