@@ -42,12 +42,17 @@ def _layout(lights: np.ndarray) -> str:
     Read off the singular vectors of the Lambert matrix (the lights themselves: the
     hemisphere scaling of :func:`~rti_rig.reconstruct.solve.solve_matrix` is the same for its
     3 columns, so these are the vectors it judges): lights closer to one line than to one plane
-    (``s2² < s1·s3``) are bunched about the strongest direction; else they lie in the plane
+    (``s2² <= s1·s3``) are bunched about the strongest direction; else they lie in the plane
     whose normal is the weakest. Why: every refusal had said "one plane through the object, or
-    bunched at the zenith", leaving the user to guess which of the two to mend.
+    bunched at the zenith", leaving the user to guess which of the two to mend. Why ``<=``:
+    lights all at one direction (four straight overhead) have ``s2 = s3 = 0`` exactly, and with
+    ``<`` were said to "lie in one upright plane … at one azimuth (90° or 270°)", a plane
+    picked at random among those through the one direction; singular values at rounding level
+    (below ``1e-9 s1``: one direction read from an ``.lp``'s 6 decimals) count as 0 for it.
     """
     _, s, vt = np.linalg.svd(lights, full_matrices=False)
-    if s[1] ** 2 < s[0] * s[2]:
+    s = np.where(s < s[0] * 1e-9, 0.0, s)
+    if s[1] ** 2 <= s[0] * s[2]:
         strong = vt[0] * np.sign(vt[0][2] or 1.0)
         el = float(np.degrees(np.arcsin(np.clip(strong[2], -1.0, 1.0))))
         if el >= 80.0:
