@@ -1161,6 +1161,29 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
     )
 
 
+def _duty_clause(rig) -> str:  # type: ignore[no-untyped-def]
+    """For a dome whose thermal guard made an LED wait before lighting again (its duty limit,
+    ``[dome.serial.thermal] max_duty``), the time this run's LEDs waited dark to cool, and
+    why; "" when none did. Why: the guard waited (up to a minute a light) and said it only in
+    a debug log: a metered run on a duty-limited dome spent 180 s of its 256 s cooling LEDs,
+    the rig sat still with no word, and the time line read as slow metering."""
+    from rti_rig.runtime.lighting import DomeLighting
+
+    if not isinstance(rig.lighting, DomeLighting):
+        return ""
+    source = rig.lighting.source
+    stats, settings = getattr(source, "stats", None), getattr(source, "settings", None)
+    waited = float(getattr(stats, "thermal_wait_s", 0.0) or 0.0)
+    if settings is None or waited < 0.05:
+        return ""
+    thermal = settings.thermal
+    return (
+        f"; of which LEDs waited dark {waited:.1f} s to cool, as the dome's duty limit asks "
+        f"([dome.serial.thermal] max_duty = {thermal.max_duty:g} over "
+        f"duty_window_s = {thermal.duty_window_s:g} s): no LED was driven past it"
+    )
+
+
 def _moving_clause(rig, folder) -> str:  # type: ignore[no-untyped-def]
     """For an arm, the part of the session's time spent moving it: the sum of its images'
     ``light_s`` (from a step's start until its lamp is on, i.e. the move and the lamp-on; all
@@ -1581,6 +1604,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         f"{folder.images_kept} image(s) in the session; {labels}\n"
         + _time_line(folder, result, dry)
         + _moving_clause(rig, folder)
+        + escape(_duty_clause(rig))
     )
     for note in folder.manifest.get("notices") or []:
         err.print(f"[yellow]note:[/] {escape(str(note))}")
