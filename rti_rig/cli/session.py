@@ -333,7 +333,12 @@ def run(
             from rti_rig.cli.fit import print_verdict
 
             with _verdict_terminable():
-                print_verdict(opened.out_dir)
+                try:
+                    print_verdict(opened.out_dir)
+                except typer.Exit:
+                    raise  # a SIGTERM said by the verdict: exit 143
+                except Exception as exc:
+                    _verdict_failed(exc, opened.out_dir)
         _refuse_unsafe_end(unsafe)
 
 
@@ -656,6 +661,23 @@ def _late_pause_ignored() -> Iterator[None]:
 
     with signal_handlers({usr1: nothing_to_pause}):
         yield
+
+
+def _verdict_failed(exc: Exception, session: Path) -> None:
+    """A QA verdict that failed in a way the fit did not name (a MemoryError loading a large
+    session's images, an OSError from a disk that went away, a fault in the QA), said in one
+    line after a session that is complete; the run's exit is left to its end (the verdict is
+    advice). Why: such an error escaped ``run`` as a traceback and exit 1 after "6 image(s) in
+    the session … lights are off", read as a failed capture of a complete session."""
+    what = type(exc).__name__ + (f": {exc}" if str(exc) else "")
+    err.print(
+        f"[yellow]QA verdict unavailable:[/] unexpected {escape(what)} (a fault that rti-rig "
+        "should have named: please report it); the "
+        f"session is complete: rti-rig fit {escape(_arg(session))} --out FOLDER gives the "
+        "verdict",
+        highlight=False,
+        soft_wrap=True,
+    )
 
 
 def _unexpected(exc: Exception, report: str) -> typer.Exit:
