@@ -511,7 +511,10 @@ def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
     except Exception as exc:  # no part of rti-rig named it: said, not a traceback
         _print_failures(getattr(exc, "teardown_failures", None))
         said = opening.not_opened
-        if opening.auto_exposure:
+        state = getattr(exc, "lights_state", None)
+        if state is not None:  # metering failed: what its teardown established
+            said += f"; metering failed, and then: {state}"
+        elif opening.auto_exposure:
             said += (
                 "; metering, if it had begun, attempted an all-off on its way out: check the "
                 "rig's lights"

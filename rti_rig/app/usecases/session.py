@@ -7,6 +7,7 @@ CLI only parses its options into a request, calls these functions and prints wha
 
 from __future__ import annotations
 
+import contextlib
 import math
 import shlex
 from collections.abc import Callable
@@ -537,6 +538,16 @@ def fix_exposure(
 
         failures = getattr(exc, "teardown_failures", None)
         exc.lights_state = lights_state(rig, bool(failures))  # type: ignore[attr-defined]
+        raise
+    except Exception as exc:
+        # a fault no part of rti-rig named, likewise (a camera driver's TypeError had the run
+        # say "check the rig's lights" of a dome whose all-off metering had sent and seen
+        # acknowledged); a state that cannot be told leaves the fault to be said as it is
+        from rti_rig.app.usecases.safe_state import lights_state
+
+        failures = getattr(exc, "teardown_failures", None)
+        with contextlib.suppress(Exception):  # never said in place of the fault raised
+            exc.lights_state = lights_state(rig, bool(failures))  # type: ignore[attr-defined]
         raise
     chosen = fixed.provenance["exposure"]
     where = ""
