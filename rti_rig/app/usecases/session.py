@@ -1233,6 +1233,16 @@ def _first_image_size(root: Path) -> list[int] | None:
     return None if layout is None else [layout[1], layout[0]]
 
 
+def _recorded_images_other(recorded: dict[str, Any], identity: dict[str, Any]) -> bool:
+    """Whether the recorded images' digest says other files than the session began with
+    (False where the session began before that digest was recorded: not known).
+
+    Why on the digests: a resume had decided by matching :func:`~rti_rig.app.rig_identity.
+    identity_differences`' printed label ("recorded images: changed"), which a rewording
+    would have silently turned off."""
+    return recorded.get("recorded_images") not in (None, identity.get("recorded_images"))
+
+
 def check_resume_rig(  # type: ignore[no-untyped-def]
     manifest: dict[str, Any],
     loaded,
@@ -1272,7 +1282,17 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         {k: recorded[k] for k in IMAGE_KEYS if k in recorded},
         {k: identity.get(k) for k in IMAGE_KEYS if k in recorded},
     )
-    if image_diffs == ["recorded images: changed"]:
+    images_other = _recorded_images_other(recorded, identity)
+    only_images_other = (
+        images_other
+        and identity.get("recorded_images") is not None
+        and all(
+            recorded[k] == identity.get(k)
+            for k in IMAGE_KEYS
+            if k in recorded and k != "recorded_images"
+        )
+    )
+    if only_images_other:
         # a replayed acquisition is a rig whose camera returns its files: they are its images
         raise RigChangedError(
             f"the images of {config_path} are not the ones this session began with (one was "
@@ -1284,11 +1304,6 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             + ")"
         )
     replay = recorded.get("backend") == identity.get("backend") == "replay"
-    # decided on the digests themselves, not on how identity_differences words them
-    images_other = recorded.get("recorded_images") not in (
-        None,  # a session begun before the images' digest was recorded: not known
-        identity.get("recorded_images"),
-    )
     if replay and images_other:
         # other recorded files, and of another size or kind: no config to set back
         raise RigChangedError(
