@@ -83,6 +83,12 @@ class CameraTriggeredLighting:
     def safe(self, emergency: bool = False) -> list[str]:
         return []  # nothing can be sent: lights_state says what the firmware does by itself
 
+    @property
+    def link_open(self) -> bool:
+        """Always False: this dome has no link to the host (the camera's flash signal steps
+        it), so there is no all-off to send."""
+        return False
+
     #: What the CLI says instead of "continue with --resume": the dome's count went on.
     resume_hint = (
         "A camera-triggered dome cannot resume a session (its own count went on): long-press "

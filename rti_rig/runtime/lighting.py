@@ -49,6 +49,15 @@ class Lighting(Protocol):
 
     def safe(self, emergency: bool = False) -> list[str]: ...
 
+    @property
+    def link_open(self) -> bool:
+        """Whether the lights' link to the host is open now, so that :meth:`safe` can be sent
+        on it without opening it (a session closed before the controller's teardown ran makes
+        the lights safe only then). Each implementation answers it: the caller had guessed
+        with ``getattr(lighting, "link_open", False)``, which a renamed or mistyped attribute
+        would have silently answered False."""
+        ...
+
 
 class DomeLighting:
     """A dome: each step names an LED whose calibrated direction is the recorded one."""
@@ -250,6 +259,13 @@ class ArmLighting:
         except Exception as exc:  # the arm's own failure: no park after it
             self.arm_failure = exc
             raise
+
+    @property
+    def link_open(self) -> bool:
+        """Always False: an arm's safe state (lamp off, stop, the park its policy asks for) is
+        the controller's teardown's and the carrier's close's, never sent from a session's
+        close on its own (a park is a move): the getattr this replaced answered False too."""
+        return False
 
     def safe(self, emergency: bool = False) -> list[str]:
         """Lamp off, stop, then park as the policy says; :attr:`end` records where the arm

@@ -225,7 +225,7 @@ class OpenedSession:
         try:
             with signals_deferred():
                 if not self.teardown_ran:
-                    if getattr(rig.lighting, "link_open", False):
+                    if rig.lighting.link_open:
                         self.close_failures += rig.lighting.safe(emergency=True)
                     self.close_failures += attempt_all(
                         [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
