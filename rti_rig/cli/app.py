@@ -7,6 +7,7 @@ message (file, line or key, and what to do) with exit status 2, never a tracebac
 from __future__ import annotations
 
 import math
+import signal
 
 import typer
 from rich.console import Console
@@ -110,10 +111,11 @@ def parse_az_el(text: str | None, option: str = "--preview-light") -> tuple[floa
     return az, el
 
 
-def stop_exit_code(why: str) -> int:
-    """The exit code of a command stopped by a signal: 128 + its number, as a shell reports
-    a process the signal ended (SIGTERM 143, Ctrl-C 130)."""
-    return 143 if why == "SIGTERM" else 130
+def stop_exit_code(signum: signal.Signals) -> int:
+    """The exit code of a command stopped by the signal ``signum``: 128 + its number, as a
+    shell reports a process the signal ended (SIGTERM 143, Ctrl-C 130). Decided on the signal
+    itself, not on the words that name it to the user."""
+    return 128 + int(signum)
 
 
 #: Libraries whose log records are not for the user's terminal: a command says in words what

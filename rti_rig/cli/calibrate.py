@@ -11,8 +11,9 @@ import typer
 from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, print_notes, stop_exit_code
-from rti_rig.cli.stopping import Terminated, sigterm_stops, stamp, stop_name, written_since
+from rti_rig.cli.stopping import Terminated, sigterm_stops, stamp, stop_signal, written_since
 from rti_rig.core.errors import RtiRigError
+from rti_rig.runtime.deferred_signals import stop_words
 
 if TYPE_CHECKING:
     from rti_rig.app.usecases.calibrate import CalibrateRequest
@@ -141,7 +142,8 @@ def calibrate_lights(
         with sigterm_stops():
             _calibrate_and_report(request, reported)
     except (KeyboardInterrupt, Terminated) as exc:
-        why = stop_name(exc)
+        signum = stop_signal(exc)
+        why = stop_words(signum)
         if reported or written_since(target, before):
             rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
             said = (
@@ -155,7 +157,7 @@ def calibrate_lights(
                 f"{target}{kept}"
             )
         err.print(said, markup=False, highlight=False, soft_wrap=True)
-        raise typer.Exit(code=stop_exit_code(why)) from None
+        raise typer.Exit(code=stop_exit_code(signum)) from None
 
 
 def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> None:

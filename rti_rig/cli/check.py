@@ -37,7 +37,7 @@ def stop_on_signals() -> Iterator[None]:
         if phase != "checking":
             return  # never raised mid-teardown, nor mid-restore
         phase = "stopping"
-        raise EmergencyStop("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
+        raise EmergencyStop(signal.Signals(signum))
 
     with signal_handlers({signal.SIGINT: on_signal, signal.SIGTERM: on_signal}):
         try:
@@ -109,10 +109,10 @@ def check(
         for failure in exc.teardown_failures:
             err.print(f"[red]teardown problem:[/] {escape(failure)}")
         err.print(f"[red]Check stopped ({escape(exc.why)}):[/] {escape(exc.lights)}.")
-        raise typer.Exit(code=stop_exit_code(exc.why)) from None
+        raise typer.Exit(code=stop_exit_code(exc.signum)) from None
     except EmergencyStop as exc:  # stopped outside a self-test (loading, a camera's check)
         err.print(f"[red]Check stopped ({escape(str(exc))}):[/] check the rig's lights.")
-        raise typer.Exit(code=stop_exit_code(str(exc))) from None
+        raise typer.Exit(code=stop_exit_code(exc.signum)) from None
     except RtiRigError as exc:
         raise fail(exc) from None
     for line in report.lines():
@@ -139,9 +139,9 @@ def _reboot_faulted(rig_config: Path) -> None:
         raise typer.Exit(code=1)
 
 
-def _probe_stopped(why: str, result: ProbeResult) -> NoReturn:
-    """Say what a stopped probe heard and found and what is known of the lights; exit as a
-    stop does."""
+def _probe_stopped(why: str, signum: signal.Signals, result: ProbeResult) -> NoReturn:
+    """Say what a stopped probe heard and found and what is known of the lights (the stop
+    named by ``why``); exit as a stop by ``signum`` does."""
     for line in result.heard_lines():
         out.print(line, highlight=False, markup=False)
     if result.profile is not None:
@@ -149,7 +149,7 @@ def _probe_stopped(why: str, result: ProbeResult) -> NoReturn:
         for line in result.config_lines():
             out.print("  " + line, highlight=False, markup=False)
     err.print(f"[red]Probe stopped ({escape(why)}):[/] {escape(result.lights)}.", highlight=False)
-    raise typer.Exit(code=stop_exit_code(why)) from None
+    raise typer.Exit(code=stop_exit_code(signum)) from None
 
 
 @app.command()
@@ -169,12 +169,12 @@ def probe(
         with stop_on_signals():
             run_probe(ProbeRequest(port), result=result)
     except ProbeStopped as exc:
-        _probe_stopped(exc.why, exc.result)
+        _probe_stopped(exc.why, exc.signum, exc.result)
     except EmergencyStop as exc:
         # after the probe returned (its teardown done, its lights said in the result), or
         # before it began (nothing opened): it had said "look at the dome's lights" even after
         # an all-off the board acknowledged
-        _probe_stopped(str(exc), result)
+        _probe_stopped(str(exc), exc.signum, result)
     for line in result.heard_lines():
         out.print(line, highlight=False, markup=False)
     if result.error is not None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shlex
+import signal
 import warnings
 from pathlib import Path
 from typing import Annotated
@@ -11,8 +12,9 @@ import typer
 from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, print_notes
-from rti_rig.cli.stopping import Terminated, sigterm_stops
+from rti_rig.cli.stopping import Terminated, sigterm_stops, stop_signal
 from rti_rig.core.errors import RtiRigError
+from rti_rig.runtime.deferred_signals import stop_words
 
 #: The --model names, as --help offers them and an unknown name's refusal lists them: one
 #: list, as the refusal (the registry's) had left out ``auto`` and named robust PS
@@ -104,13 +106,14 @@ class VerdictTerminated(BaseException):
 
 
 def _stopped(
-    why: str, out_dir: Path, batch: bool, written: bool, cluster: bool = False
+    signum: signal.Signals, out_dir: Path, batch: bool, written: bool, cluster: bool = False
 ) -> typer.Exit:
     """Say what a stopped fit left (``written``: the stop came after every output was
     written, while they were being reported; ``cluster``: a batch whose sessions are tasks on
     Dask workers), and the exit a shell expects for that signal."""
     from rti_rig.cli.app import stop_exit_code
 
+    why = stop_words(signum)
     if written:
         said = f"Stopped ({why}) after the fit had written its outputs to {out_dir}"
     elif batch and cluster:
@@ -136,7 +139,7 @@ def _stopped(
             "run the same command again"
         )
     err.print(f"[yellow]{escape(said)}.[/]")
-    return typer.Exit(code=stop_exit_code(why))
+    return typer.Exit(code=stop_exit_code(signum))
 
 
 @app.command()
@@ -242,10 +245,9 @@ def fit(
                 hsh_order,
                 scheduler,
             )
-    except KeyboardInterrupt:
-        raise _stopped("Ctrl-C", out_dir, len(sources) > 1, bool(written), cluster) from None
-    except Terminated:
-        raise _stopped("SIGTERM", out_dir, len(sources) > 1, bool(written), cluster) from None
+    except (KeyboardInterrupt, Terminated) as exc:
+        signum = stop_signal(exc)
+        raise _stopped(signum, out_dir, len(sources) > 1, bool(written), cluster) from None
 
 
 def _fit_command(  # type: ignore[no-untyped-def]

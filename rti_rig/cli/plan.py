@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_notes, stop_exit_code
-from rti_rig.cli.stopping import Stamp, Terminated, sigterm_stops, stamp, stop_name, written_since
+from rti_rig.cli.stopping import Stamp, Terminated, sigterm_stops, stamp, stop_signal, written_since
 from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free): a plan's minimum is the normal's (planner.make_plan)
@@ -18,6 +18,7 @@ from rti_rig.core.fit_minimums import (
     NORMAL_MIN_LIGHTS,
     NORMAL_NOISE,
 )
+from rti_rig.runtime.deferred_signals import stop_words
 
 if TYPE_CHECKING:
     from rti_rig.app.usecases.plan import PlanLightsRequest
@@ -204,14 +205,15 @@ def plan(
         with sigterm_stops():
             _plan_and_report(request, done)
     except (KeyboardInterrupt, Terminated) as exc:
-        why = stop_name(exc)
+        signum = stop_signal(exc)
+        why = stop_words(signum)
         err.print(
             _stopped(why, request, before, done),
             markup=False,
             highlight=False,
             soft_wrap=True,
         )
-        raise typer.Exit(code=stop_exit_code(why)) from None
+        raise typer.Exit(code=stop_exit_code(signum)) from None
 
 
 def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:

@@ -19,6 +19,7 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_note, stop_exit_code
+from rti_rig.cli.stopping import stop_signal
 from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free)
@@ -465,7 +466,7 @@ def _stopped_while_opening(
             "lights"
         )
     err.print(f"[yellow]{escape(said)}.[/]")
-    return typer.Exit(code=stop_exit_code(why))
+    return typer.Exit(code=stop_exit_code(stop_signal(exc)))
 
 
 @dataclass(frozen=True)
@@ -541,7 +542,7 @@ def _terminable_while_opening() -> Iterator[None]:
         return
 
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
-        raise EmergencyStop("SIGTERM")
+        raise EmergencyStop(signal.SIGTERM)
 
     previous = signal.signal(signal.SIGTERM, terminated)
     handover = HandOver({signal.SIGTERM: previous})
@@ -578,11 +579,9 @@ class HandOver:
             self.originals.setdefault(sig, before)
         self.holding = True
 
-    def why(self) -> str:
-        """How the held stop is named ("" when none came)."""
-        if signal.SIGTERM in self.held:
-            return "SIGTERM"
-        return "Ctrl-C" if self.held else ""
+    def stop(self) -> signal.Signals:
+        """The held stop's signal: SIGTERM if one came, else SIGINT (called once one came)."""
+        return signal.SIGTERM if signal.SIGTERM in self.held else signal.SIGINT
 
 
 @contextmanager
@@ -1265,10 +1264,12 @@ def _close_left_open(opened) -> list[str]:  # type: ignore[no-untyped-def]
     return [*opened.take_close_failures(), *failures]
 
 
-def _stopped_before_capture(opened, why: str) -> typer.Exit:  # type: ignore[no-untyped-def]
-    """Close a session stopped after it opened and before its capture began, say so as a stop
-    while opening is said, and give the exit a stop by ``why`` asks (the capture's own
-    teardown never ran: the rig is made safe and closed here)."""
+def _stopped_before_capture(  # type: ignore[no-untyped-def]
+    opened, why: str, signum: signal.Signals
+) -> typer.Exit:
+    """Close a session stopped after it opened and before its capture began, say so (the stop
+    named by ``why``) as a stop while opening is said, and give the exit a stop by ``signum``
+    asks (the capture's own teardown never ran: the rig is made safe and closed here)."""
     _print_failures(_close_left_open(opened))
     if opened.resumed:
         said = (
@@ -1280,7 +1281,7 @@ def _stopped_before_capture(opened, why: str) -> typer.Exit:  # type: ignore[no-
         if not opened.folder.begun:
             said += f" or written to {opened.out_dir}"
     err.print(f"[yellow]{escape(said)}.[/]")
-    return typer.Exit(code=stop_exit_code(why))
+    return typer.Exit(code=stop_exit_code(signum))
 
 
 def _refuse_unsafe_end(unsafe: bool, exit_code: int | None = 1) -> None:
@@ -1378,7 +1379,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             return
         if cancel.cancelled:
             ended = not started  # stopped before the capture began: it never will
-            raise EmergencyStop("second Ctrl-C")
+            raise EmergencyStop(signal.SIGINT, "second Ctrl-C")
         cancel.cancel()
         if _park_stopped_by(opened.rig) is not None:  # delivered after the teardown it stopped:
             return  # no image is left to stop after; the arm's line and the summary say it
@@ -1400,7 +1401,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         if ended:  # as for Ctrl-C: nothing left to stop; the handler from before answers it
             _as_before(previous.get(signal.SIGTERM), signum, frame)
             return
-        raise EmergencyStop("SIGTERM")
+        raise EmergencyStop(signal.SIGTERM)
 
     def on_sigusr1(signum, frame):  # type: ignore[no-untyped-def]
         if ended:  # as the session's end is reported: "Pausing after this image" had been said
@@ -1446,7 +1447,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             signal.signal(signal.SIGTERM, on_sigterm)
         if handover.held:  # a SIGTERM or Ctrl-C while the capture took over from the opening
             ended = True  # the capture will not begin: a Ctrl-C as the rig closes stops nothing
-            raise EmergencyStop(handover.why())
+            raise EmergencyStop(handover.stop())
         with Progress(
             TextColumn("[progress.description]{task.description}"),
             BarColumn(),
@@ -1500,13 +1501,13 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         if not started or (
             not opened.teardown_ran and folder.images_kept == opened.steps_done_before
         ):
-            raise _stopped_before_capture(opened, why) from None
+            raise _stopped_before_capture(opened, why, stop_signal(exc)) from None
 
         failed = _print_stop_failures(opened)
         err.print(f"[red]Emergency stop ({escape(why)}):[/] {escape(lights_state(rig, failed))}.")
         teardown_said = True
         err.print(_after_stop(opened, resume_hint()), markup=False, soft_wrap=True)
-        raise typer.Exit(code=stop_exit_code(why)) from None
+        raise typer.Exit(code=stop_exit_code(stop_signal(exc))) from None
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 

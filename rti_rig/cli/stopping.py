@@ -58,6 +58,13 @@ def written_since(path: Path, before: Stamp) -> bool:
     return now is not None and now != before
 
 
-def stop_name(exc: BaseException) -> str:
-    """How a stop is named to the user: ``SIGTERM`` for :class:`Terminated`, else Ctrl-C."""
-    return "SIGTERM" if isinstance(exc, Terminated) else "Ctrl-C"
+def stop_signal(exc: BaseException) -> signal.Signals:
+    """The signal a caught stop came from: an
+    :class:`~rti_rig.runtime.controller.EmergencyStop`'s own, SIGTERM for :class:`Terminated`,
+    else SIGINT (KeyboardInterrupt). The exit code is decided on it (the words said derive
+    from it too): it had been decided by comparing the words with "SIGTERM"."""
+    from rti_rig.runtime.controller import EmergencyStop
+
+    if isinstance(exc, EmergencyStop):
+        return exc.signum
+    return signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT

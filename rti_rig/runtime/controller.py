@@ -8,6 +8,7 @@ and writes the session's `.lp` and manifest from the images already on disk.
 
 from __future__ import annotations
 
+import signal
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
@@ -19,7 +20,7 @@ from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.runtime.deferred_signals import signals_deferred
+from rti_rig.runtime.deferred_signals import signals_deferred, stop_words
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
     FRAME_SIZE_KEY,
@@ -51,7 +52,16 @@ class EmergencyStop(BaseException):
 
     A BaseException so that no ``except Exception`` in a driver swallows it; the controller's
     ``finally`` still puts every device in its safe state.
+
+    :attr:`signum` is the signal that stopped, as the handler received it: a command's exit
+    code is decided on it (128 + its number); ``str()`` is the words said to the user
+    (:func:`stop_words`, or ``words`` where the handler names it otherwise: "second Ctrl-C").
+    Why typed: the exit code had been decided by comparing those words with "SIGTERM".
     """
+
+    def __init__(self, signum: signal.Signals, words: str | None = None) -> None:
+        self.signum = signal.Signals(signum)
+        super().__init__(words or stop_words(self.signum))
 
 
 class CancelToken:

@@ -18,6 +18,12 @@ from collections.abc import Callable, Iterator, Mapping
 from typing import Any
 
 
+def stop_words(signum: signal.Signals) -> str:
+    """How a stop by ``signum`` is named to the user: ``Ctrl-C`` for SIGINT, else the
+    signal's name (``SIGTERM``)."""
+    return "Ctrl-C" if signum == signal.SIGINT else signum.name
+
+
 @contextlib.contextmanager
 def signals_deferred(on_held: Callable[[int], None] | None = None) -> Iterator[None]:
     """Hold SIGINT/SIGTERM while devices are put in their safe state, or while a captured

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -436,7 +437,7 @@ def test_a_stop_while_the_outcome_is_concluded_leaves_a_session_the_resume_finis
     rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 6, None)
 
     def signalled() -> dict:  # the SIGTERM arrives while the final estimate is computed
-        raise EmergencyStop("SIGTERM")
+        raise EmergencyStop(signal.SIGTERM)
 
     source.chooser.conclude = signalled
     with rig, pytest.raises(EmergencyStop):

@@ -86,7 +86,7 @@ def test_a_stopped_arm_check_says_what_its_teardown_could_not_do(
     def move_to(self, direction):  # type: ignore[no-untyped-def]
         moves.append(1)
         if len(moves) == 2:
-            raise EmergencyStop("SIGTERM")
+            raise EmergencyStop(signal.SIGTERM)
         return real_move(self, direction)
 
     def lamp(self, on):  # type: ignore[no-untyped-def]

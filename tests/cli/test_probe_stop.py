@@ -160,7 +160,7 @@ def test_a_stop_inside_the_opening_at_9600_reopens_the_port_and_switches_the_nab
         if not stops:  # the first opening: the system opened it (the board reset), then
             stops.append(self.port)  # the signal, and pyserial closes the port
             self.close()
-            raise EmergencyStop("Ctrl-C")
+            raise EmergencyStop(signal.SIGINT)
 
     monkeypatch.setattr(SerialTransport, "open", open_cut_short)
     board = board_for("nab-rti-v1")
@@ -187,7 +187,7 @@ def test_a_stop_once_the_nab_banner_was_heard_but_not_yet_named_switches_the_dom
     def stopped_first(result: probe_usecase.ProbeResult, wait: float) -> Any:
         calls.append(result.profile)
         if len(calls) == 1:
-            raise EmergencyStop("Ctrl-C")
+            raise EmergencyStop(signal.SIGINT)
         return real_found(result, wait)
 
     monkeypatch.setattr(probe_usecase, "_nab_found", stopped_first)
@@ -215,7 +215,7 @@ def test_a_stop_as_the_port_closes_after_an_acknowledged_all_off_does_not_reopen
         real_close(self)
         if not stops and board.commands >= 1:  # the board was sent its all-off
             stops.append(self.port)
-            raise EmergencyStop("Ctrl-C")
+            raise EmergencyStop(signal.SIGINT)
 
     monkeypatch.setattr(SerialTransport, "close", close_then_stopped)
     with serve_on_pty(board, "nab-rti-v1") as link:
@@ -250,7 +250,7 @@ def test_a_stop_inside_an_opening_at_another_rate_reopens_at_9600_and_switches_t
         if not stops and self.baudrate == 115200:  # the system opened it (the board reset),
             stops.append(self.baudrate)  # then the signal, and pyserial closes the port
             self.close()
-            raise EmergencyStop("Ctrl-C")
+            raise EmergencyStop(signal.SIGINT)
 
     monkeypatch.setattr(SerialTransport, "open", open_cut_short)
     board = board_for("nab-rti-v1")
@@ -292,7 +292,7 @@ def test_a_stop_after_the_probe_returned_says_the_acknowledged_all_off(
 
     def then_stopped(request: probe_usecase.ProbeRequest, **kwargs: Any) -> Any:
         real_probe(request, **kwargs)
-        raise EmergencyStop("Ctrl-C")
+        raise EmergencyStop(signal.SIGINT)
 
     monkeypatch.setattr(probe_usecase, "probe", then_stopped)
     board = board_for("nab-rti-v1")
@@ -317,7 +317,7 @@ def test_a_stop_as_the_probe_returns_keeps_what_it_found_of_another_firmware(
 
     def then_stopped(result: probe_usecase.ProbeResult, wait: float) -> Any:
         real_sequence(result, wait)
-        raise EmergencyStop("Ctrl-C")
+        raise EmergencyStop(signal.SIGINT)
 
     monkeypatch.setattr(probe_usecase, "_probe", then_stopped)
     board = board_for("nichlock")

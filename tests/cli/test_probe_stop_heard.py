@@ -11,6 +11,7 @@ ports), which no timing could aim a real signal at.
 
 from __future__ import annotations
 
+import signal
 from typing import Any
 
 import pytest
@@ -46,7 +47,7 @@ def _probe(board: Any, name: str) -> tuple[int, str]:
 
 
 def _stopped_in_a_read_once_heard(
-    monkeypatch: pytest.MonkeyPatch, baud: int, words: str, why: str = "SIGTERM"
+    monkeypatch: pytest.MonkeyPatch, baud: int, words: str, why: signal.Signals = signal.SIGTERM
 ) -> list[str]:
     """Raise the stop from the read that follows the one completing ``words`` on a port open at
     ``baud``: the signal landing in a listen that has already heard them."""
@@ -97,7 +98,7 @@ def test_a_stop_as_the_first_port_closes_keeps_the_nab_banner_it_heard(
         real_close(self)
         if not stops:
             stops.append(self.port)
-            raise EmergencyStop("Ctrl-C")
+            raise EmergencyStop(signal.SIGINT)
 
     monkeypatch.setattr(SerialTransport, "close", close_then_stopped)
     board = board_for("nab-rti-v1")
@@ -130,7 +131,7 @@ def test_a_slow_nab_board_stopped_before_it_is_named_is_switched_off(
     def stopped_first(result: probe_usecase.ProbeResult, wait: float) -> Any:
         calls.append(result.profile)
         if len(calls) == 1:
-            raise EmergencyStop("Ctrl-C")
+            raise EmergencyStop(signal.SIGINT)
         return real_found(result, wait)
 
     monkeypatch.setattr(probe_usecase, "_nab_found", stopped_first)
@@ -168,7 +169,7 @@ def test_a_stop_between_two_ports_reopens_at_9600_and_switches_the_nab_off(
         text = real_exchange(result, what, *args)
         if not stops:
             stops.append(what)
-            raise EmergencyStop("Ctrl-C")
+            raise EmergencyStop(signal.SIGINT)
         return text
 
     monkeypatch.setattr(probe_usecase, "_exchange", then_stopped)
@@ -189,7 +190,7 @@ def test_a_stop_after_nichlocks_banner_at_115200_names_it_and_does_not_reset_it(
     opened a third time at 9600 (a reset) to look for a Nab board, and the stop said "stopped
     before a firmware answered"."""
     stops = _stopped_in_a_read_once_heard(
-        monkeypatch, 115200, "Reflectance Transformation Imager Serial Interface", "Ctrl-C"
+        monkeypatch, 115200, "Reflectance Transformation Imager Serial Interface", signal.SIGINT
     )
     board = board_for("nichlock")
     code, said = _probe(board, "nichlock")
@@ -226,7 +227,7 @@ def test_a_stop_between_two_ports_after_nichlocks_banner_names_it_and_does_not_r
         text = real_exchange(result, what, *args)
         if not stops and what == "listen at 115200 baud":
             stops.append(what)
-            raise EmergencyStop("Ctrl-C")
+            raise EmergencyStop(signal.SIGINT)
         return text
 
     monkeypatch.setattr(probe_usecase, "_exchange", then_stopped)
@@ -258,7 +259,7 @@ def test_a_listen_label_without_its_rate_still_names_nichlock_at_its_rate(
         text = real_exchange(result, what, baud, *args)
         if not stops and baud == 115200:
             stops.append(what)
-            raise EmergencyStop("Ctrl-C")
+            raise EmergencyStop(signal.SIGINT)
         return text
 
     monkeypatch.setattr(probe_usecase, "_exchange", then_stopped)

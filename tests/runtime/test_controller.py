@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -303,7 +304,7 @@ def test_arm_emergency_stop_follows_parking_policy(
         f"default_lights = 24\npark_on_emergency_stop = {str(park_on_emergency).lower()}",
     )
     rig = build_rig(load_rig_config(write_config(tmp_path, text)))
-    rig.camera = FailingCamera(rig.camera, 3, EmergencyStop("SIGTERM"))
+    rig.camera = FailingCamera(rig.camera, 3, EmergencyStop(signal.SIGTERM))
     out = tmp_path / "s"
     with pytest.raises(EmergencyStop):
         run_session(rig, plan_uniform(rig.geometry, 8), SessionFolder.create(out, 8))
@@ -331,7 +332,7 @@ def test_emulated_dynamixel_arm_stays_put_after_an_emergency_stop_unless_told(
         f"default_lights = 24\npark_on_emergency_stop = {str(park_on_emergency).lower()}",
     )
     rig = build_rig(load_rig_config(write_config(tmp_path, text)))
-    rig.camera = FailingCamera(rig.camera, 3, EmergencyStop("SIGTERM"))
+    rig.camera = FailingCamera(rig.camera, 3, EmergencyStop(signal.SIGTERM))
     with rig, pytest.raises(EmergencyStop):
         run_session(rig, plan_uniform(rig.geometry, 8), SessionFolder.create(tmp_path / "s", 8))
     arm = rig.lighting.carrier  # type: ignore[attr-defined]
@@ -391,7 +392,7 @@ def test_an_emergency_stop_during_an_image_s_commit_leaves_it_listed(
         return real_write(path, pixels)
 
     def on_sigterm(signum, frame):  # type: ignore[no-untyped-def]
-        raise EmergencyStop("SIGTERM")
+        raise EmergencyStop(signal.SIGTERM)
 
     monkeypatch.setattr(session_module, "write_srgb_jpeg", write_and_get_killed)
     previous = signal.signal(signal.SIGTERM, on_sigterm)

@@ -30,9 +30,12 @@ from rti_rig.runtime.session import refuse_if_in_use
 class CheckStopped(Exception):
     """The check was stopped (SIGTERM, Ctrl-C) part-way; the rig was torn down first."""
 
-    def __init__(self, why: str, lights: str, teardown_failures: tuple[str, ...] = ()) -> None:
-        super().__init__(f"check stopped ({why}): {lights}")
-        self.why = why
+    def __init__(
+        self, stop: EmergencyStop, lights: str, teardown_failures: tuple[str, ...] = ()
+    ) -> None:
+        super().__init__(f"check stopped ({stop}): {lights}")
+        #: the words said of the stop, and the signal it came from (the exit code's)
+        self.why, self.signum = str(stop), stop.signum
         #: what is known about the lights after the teardown (never "off" unless established)
         self.lights = lights
         #: what the teardown could not do (an arm's lamp off, stop), to be said first
@@ -118,7 +121,7 @@ def check_rig(req: CheckRequest, on_start: Callable[[], None] | None = None) -> 
             # where the self-test's teardown left the arm, as read back (a stopped check
             # had said "lamp off and stop were requested" and nothing of the arm)
             lights = lights_state(rig, bool(failures), end=getattr(report, "end", None))
-            raise CheckStopped(str(exc), lights, failures) from None
+            raise CheckStopped(exc, lights, failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
 
 

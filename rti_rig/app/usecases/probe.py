@@ -233,9 +233,11 @@ class ProbeStopped(Exception):
     """The probe was stopped (Ctrl-C, SIGTERM) and its teardown done: ``result`` holds what was
     heard, the firmware if one was found, and in ``lights`` what is known of the lights."""
 
-    def __init__(self, why: str, result: ProbeResult) -> None:
-        super().__init__(why)
-        self.why, self.result = why, result
+    def __init__(self, stop: EmergencyStop, result: ProbeResult) -> None:
+        super().__init__(str(stop))
+        self.why, self.result = str(stop), result
+        #: the signal the stop came from: the exit code is decided on it
+        self.signum = stop.signum
 
 
 # What the probe knows of the Nab sketch is read from its profile (``nab_rti_v1``), so that
@@ -296,7 +298,7 @@ def _exchange(
         # inside pyserial's open, which closes the port as the stop goes through: the opening
         # may have reset the board all the same (the Nab sketch then boots with every LED on)
         _stopped_inside_opening(result, t, wait_s)
-        raise ProbeStopped(str(exc), result) from None
+        raise ProbeStopped(exc, result) from None
     opened = time.monotonic()
     # the bytes are collected here as they come, not when a listen returns: a stop inside a
     # listen had lost all it heard (a Nab banner already in, then "stopped before a firmware
@@ -320,7 +322,7 @@ def _exchange(
         except TransportError as failed:
             result.error = ProbeError(ProbeFailure.PORT_FAILED, str(failed))
             _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
-        raise ProbeStopped(str(exc), result) from None
+        raise ProbeStopped(exc, result) from None
     except BaseException:
         t.close()
         raise
@@ -509,11 +511,11 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
             raise  # the probe's own handler says it (the dome may be lit; exit 1)
         result.error = ProbeError(ProbeFailure.PORT_FAILED, str(exc))
         _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(exc))
-        raise ProbeStopped(str(stop), result) from None
+        raise ProbeStopped(stop, result) from None
     finally:
         t.close()
     if stop is not None:
-        raise ProbeStopped(str(stop), result) from None
+        raise ProbeStopped(stop, result) from None
     return result
 
 
@@ -757,7 +759,7 @@ def probe(request: ProbeRequest, result: ProbeResult | None = None) -> ProbeResu
         return _probe(result, request.listen_s)
     except EmergencyStop as exc:  # stopped with no port open: a port's own is raised there
         _stopped_between_ports(result, request.listen_s)
-        raise ProbeStopped(str(exc), result) from None
+        raise ProbeStopped(exc, result) from None
 
 
 def _stopped_between_ports(result: ProbeResult, wait: float) -> None:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import re
+import signal
 import sys
 import time
 from pathlib import Path
@@ -552,7 +553,7 @@ def test_a_stop_during_the_handshake_of_the_lit_nab_sketch_sends_all_off() -> No
 
         def stopped_here():  # type: ignore[no-untyped-def]
             assert eventually(lambda: len(board.lit) > 1)  # booted, every LED on
-            raise EmergencyStop("SIGTERM")
+            raise EmergencyStop(signal.SIGTERM)
 
         dome.link.hello = stopped_here
         with pytest.raises(EmergencyStop):
@@ -580,7 +581,7 @@ def test_a_stop_while_the_board_is_still_in_its_bootloader_leaves_it_dark() -> N
         def stopped_at_once():  # type: ignore[no-untyped-def]
             if not stops:  # one signal, as the port has just opened: the board is booting
                 stops.append("SIGTERM")
-                raise EmergencyStop("SIGTERM")
+                raise EmergencyStop(signal.SIGTERM)
             wait_boot()
 
         dome.link._wait_boot = stopped_at_once
@@ -610,7 +611,7 @@ def test_a_stop_late_in_the_boot_wait_finishes_that_wait_not_a_new_one() -> None
 
         def stopped_late():  # type: ignore[no-untyped-def]
             time.sleep(late)  # most of the boot wait has passed
-            raise EmergencyStop("SIGTERM")
+            raise EmergencyStop(signal.SIGTERM)
 
         dome.link._wait_boot = stopped_late
         waits = []  # the deadlines the waits for the ready banner were given
@@ -644,7 +645,7 @@ def test_a_second_stop_during_that_all_off_says_it_was_not_sent_and_closes() -> 
         dome = build_dome(DomeSerialSettings(port=link.port, profile="nab-rti-v1"), VirtualClock())
 
         def stopped(*args):  # type: ignore[no-untyped-def]
-            raise EmergencyStop("SIGTERM")
+            raise EmergencyStop(signal.SIGTERM)
 
         dome.link.hello = stopped
         dome.link.all_off = stopped
@@ -1180,7 +1181,7 @@ def test_a_stop_inside_the_opening_whose_port_will_not_reopen_says_the_board_is_
                 raise TransportError(f"cannot open serial port {link.port}: No such device")
             real_open()
             transport.close()  # as pyserial closes the port when a stop goes through its open
-            raise EmergencyStop("SIGTERM")
+            raise EmergencyStop(signal.SIGTERM)
 
         transport.open = open_port
         with pytest.raises(EmergencyStop):
