@@ -147,6 +147,12 @@ def quiet_library_logs() -> None:
         logging.getLogger(name).propagate = False
 
 
+def warning_note(text: str) -> None:
+    """Say a warning's message as a note on stderr (the one form both :func:`warnings_as_notes`
+    and the run's verdict use for a warning no command words otherwise)."""
+    err.print(f"[yellow]note:[/] {escape(text)}", soft_wrap=True, highlight=False)
+
+
 def warnings_as_notes() -> None:
     """Any Python warning that reaches the console is said as a note: its message alone, once.
 
@@ -154,7 +160,13 @@ def warnings_as_notes() -> None:
     warning on a path not yet worded) printed Python's form, with a source file path and line
     (``.../rti_rig/app/usecases/adaptive.py:176: IllConditionedFitWarning: ...``), which
     tells a user nothing they can act on. Set for the console entry only: a caller of the
-    app from Python keeps its own warning handling."""
+    app from Python keeps its own warning handling.
+
+    Why this and ``run``'s verdict warnings (``cli.fit._say_verdict_warnings``) both exist:
+    this one is the fallback for any warning, said as it is raised, in its own words; the
+    verdict catches its fits' warnings to say them after the verdict line, a fit-trust warning
+    worded as what it means for the session and what to do (its other warnings go through
+    :func:`warning_note`, as here)."""
     import warnings
 
     said: set[str] = set()
@@ -163,7 +175,7 @@ def warnings_as_notes() -> None:
         text = str(message)
         if text not in said:
             said.add(text)
-            err.print(f"[yellow]note:[/] {escape(text)}", soft_wrap=True, highlight=False)
+            warning_note(text)
 
     warnings.showwarning = as_note
 

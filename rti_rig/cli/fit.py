@@ -76,7 +76,14 @@ def _say_verdict_warnings(caught: list[warnings.WarningMessage]) -> None:
     Why: a session whose lights leave the normals poorly determined (``run --adaptive
     --max-elevation-deg 10`` on the simulated arm: all lights within 10° of the horizon)
     printed a raw ``IllConditionedFitWarning`` with the QA module's file path and line under
-    the verdict; the user was told neither what it meant for the session nor what to do."""
+    the verdict; the user was told neither what it meant for the session nor what to do.
+
+    Why not left to :func:`~rti_rig.cli.app.warnings_as_notes` (which says any warning, as it
+    is raised, in its own words): these are caught so as to be said after the verdict line
+    they qualify, and a fit-trust warning needs the run's advice (the elevation band), which
+    the generic note cannot give; the others are said as it says them (:func:`warning_note`).
+    """
+    from rti_rig.cli.app import warning_note
     from rti_rig.reconstruct.errors import FitTrustWarning
 
     said: set[str] = set()
@@ -95,7 +102,7 @@ def _say_verdict_warnings(caught: list[warnings.WarningMessage]) -> None:
                 soft_wrap=True,
             )
         else:
-            err.print(f"[yellow]note:[/] {escape(text)}", soft_wrap=True)
+            warning_note(text)
 
 
 class VerdictTerminated(BaseException):
