@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import journal, said, write_config
+from conftest import cut_new_session, journal, said, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -53,23 +53,12 @@ def _write_lp(path: Path, names: list[str], dirs: np.ndarray, decimals: int, eol
 
 def _cut(tmp_path: Path) -> tuple[Path, Path]:
     """A session on the shipped 48-LED `.lp`, cancelled after three images as Ctrl-C does."""
-    from rti_rig.app.usecases.session import (
-        NewSessionRequest,
-        open_new_session,
-        run_opened_session,
-    )
-    from rti_rig.runtime.controller import CancelToken, StepCompleted
+    from rti_rig.app.usecases.session import NewSessionRequest
 
     shutil.copy(SHIPPED_LP, tmp_path / "dome.lp")
     cfg = write_config(tmp_path, DOME_LP)
     out = tmp_path / "out"
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 2:
-            cancel.cancel()
-
-    run_opened_session(open_new_session(NewSessionRequest(cfg, out)), cancel, on_event)
+    cut_new_session(NewSessionRequest(cfg, out), after_step=2)
     assert len(journal(out)) == 3
     return cfg, out
 

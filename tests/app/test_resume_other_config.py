@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from conftest import SMALL_DOME, write_config
+from conftest import SMALL_DOME, cut_new_session, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -26,21 +26,13 @@ def said(result) -> str:  # type: ignore[no-untyped-def]
 def _interrupted(tmp_path: Path) -> tuple[Path, Path]:
     """(config, session): a session of 6 lights on the small simulated dome, cancelled after
     its third image (as a Ctrl-C leaves it), to be resumed."""
-    from rti_rig.app.usecases.session import NewSessionRequest, open_new_session, run_opened_session
-    from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+    from rti_rig.app.usecases.session import NewSessionRequest
+    from rti_rig.runtime.controller import FinishReason
 
     cfg = write_config(tmp_path, SMALL_DOME)
     out = tmp_path / "s"
-    cancel = CancelToken()
-
-    def stop_after_three(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 2:
-            cancel.cancel()
-
-    opened = open_new_session(NewSessionRequest(cfg, out, lights=6))
-    assert run_opened_session(opened, cancel, stop_after_three).finish_reason is (
-        FinishReason.CANCELLED
-    )
+    run = cut_new_session(NewSessionRequest(cfg, out, lights=6), after_step=2)
+    assert run.finish_reason is FinishReason.CANCELLED
     return cfg, out
 
 

@@ -15,13 +15,13 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, said, write_config
+from conftest import CONFIGS, cut_new_session, said, write_config
 from typer.testing import CliRunner
 
 import rti_rig.app.compose as compose
-from rti_rig.app.usecases.session import NewSessionRequest, open_new_session, run_opened_session
+from rti_rig.app.usecases.session import NewSessionRequest
 from rti_rig.cli import app
-from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+from rti_rig.runtime.controller import FinishReason
 
 pytestmark = pytest.mark.pty
 
@@ -40,14 +40,8 @@ def metered_and_stopped(tmp_path: Path) -> tuple[Path, Path, float]:
     """A 6-light session metered with --auto-exposure and stopped after 2 images."""
     cfg = emulated_dome(tmp_path, 8.0)
     out = tmp_path / "s"
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 1:
-            cancel.cancel()
-
-    opened = open_new_session(NewSessionRequest(cfg, out, lights=6, auto_exposure=True))
-    assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+    request = NewSessionRequest(cfg, out, lights=6, auto_exposure=True)
+    assert cut_new_session(request, after_step=1).finish_reason is FinishReason.CANCELLED
     steps = json.loads((out / "manifest.json").read_text())["schedule"]["steps"]
     (exposure,) = {s["exposure_s"] for s in steps}
     return cfg, out, exposure

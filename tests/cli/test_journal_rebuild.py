@@ -17,12 +17,12 @@ import shutil
 from pathlib import Path
 
 import pytest
-from conftest import SMALL_DOME, interrupted, said, write_config
+from conftest import SMALL_DOME, cut_new_session, interrupted, said, write_config
 from typer.testing import CliRunner
 
-from rti_rig.app.usecases.session import NewSessionRequest, open_new_session, run_opened_session
+from rti_rig.app.usecases.session import NewSessionRequest
 from rti_rig.cli import app
-from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+from rti_rig.runtime.controller import FinishReason
 from rti_rig.testing.kill_hooks import popen_argv
 
 runner = CliRunner()
@@ -56,14 +56,8 @@ def made(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, Path]:
     r = runner.invoke(app, ["run", str(cfg), "--out", str(ref), "--lights", str(LIGHTS)])
     assert r.exit_code == 0, r.output
     stopped = base / "stopped"
-    cancel = CancelToken()
-
-    def on_event(e) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(e, StepCompleted) and e.index == 3:
-            cancel.cancel()
-
-    opened = open_new_session(NewSessionRequest(cfg, stopped, lights=LIGHTS))
-    assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+    run = cut_new_session(NewSessionRequest(cfg, stopped, lights=LIGHTS), after_step=3)
+    assert run.finish_reason is FinishReason.CANCELLED
     for session in (ref, stopped):
         shutil.rmtree(session / "records")
     return cfg, ref, stopped

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from conftest import CONFIGS, write_config
+from conftest import CONFIGS, cut_new_session, write_config
 from typer.testing import CliRunner
 
-from rti_rig.app.usecases.session import NewSessionRequest, open_new_session, run_opened_session
+from rti_rig.app.usecases.session import NewSessionRequest
 from rti_rig.cli import app
-from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+from rti_rig.runtime.controller import FinishReason
 
 runner = CliRunner()
 
@@ -33,14 +33,8 @@ def small_arm(tmp_path: Path, name: str, cone: str = "10.0") -> Path:
 
 
 def stopped_after(cfg: Path, out: Path, n: int) -> None:
-    cancel = CancelToken()
-
-    def on_event(e) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(e, StepCompleted) and e.index == n - 1:
-            cancel.cancel()
-
-    opened = open_new_session(NewSessionRequest(cfg, out, lights=8))
-    assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+    run = cut_new_session(NewSessionRequest(cfg, out, lights=8), after_step=n - 1)
+    assert run.finish_reason is FinishReason.CANCELLED
 
 
 def test_an_own_config_edited_in_place_is_to_be_set_back(tmp_path: Path) -> None:

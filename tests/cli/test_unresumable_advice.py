@@ -13,12 +13,12 @@ import shutil
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, said
+from conftest import CONFIGS, cut_new_session, said
 from typer.testing import CliRunner
 
-from rti_rig.app.usecases.session import NewSessionRequest, open_new_session, run_opened_session
+from rti_rig.app.usecases.session import NewSessionRequest
 from rti_rig.cli import app
-from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+from rti_rig.runtime.controller import FinishReason
 
 runner = CliRunner()
 SHIPPED = CONFIGS / "emulated_cceh_rti.toml"
@@ -32,14 +32,8 @@ def shot(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     r = runner.invoke(app, ["run", str(SHIPPED), "--out", str(done), "--no-verdict"])
     assert r.exit_code == 0, r.output
     stopped = base / "stopped"
-    cancel = CancelToken()
-
-    def on_event(e) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(e, StepCompleted) and e.index == 4:
-            cancel.cancel()
-
-    opened = open_new_session(NewSessionRequest(SHIPPED, stopped))
-    assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+    run = cut_new_session(NewSessionRequest(SHIPPED, stopped), after_step=4)
+    assert run.finish_reason is FinishReason.CANCELLED
     # the labels checked by hand, as the marker allows: the session is then used
     (stopped / "LABELS_NOT_VERIFIED.txt").unlink()
     return done, stopped

@@ -20,13 +20,13 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, SMALL_DOME, write_config
+from conftest import CONFIGS, SMALL_DOME, cut_new_session, write_config
 from typer.testing import CliRunner
 
-from rti_rig.app.usecases.session import NewSessionRequest, open_new_session, run_opened_session
+from rti_rig.app.usecases.session import NewSessionRequest
 from rti_rig.cli import app
 from rti_rig.core.lp_format import read_lp
-from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+from rti_rig.runtime.controller import FinishReason
 from rti_rig.testing.disk_faults import WRITE_POINTS, failing_writes
 
 runner = CliRunner()
@@ -74,14 +74,7 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 
 def cancelled_after(cfg: Path, out: Path, n: int) -> None:
     """A session stopped after ``n`` images, through the use-case API (no typer)."""
-    cancel = CancelToken()
-
-    def on_event(e) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(e, StepCompleted) and e.index == n - 1:
-            cancel.cancel()
-
-    opened = open_new_session(NewSessionRequest(cfg, out, lights=LIGHTS))
-    result = run_opened_session(opened, cancel, on_event)
+    result = cut_new_session(NewSessionRequest(cfg, out, lights=LIGHTS), after_step=n - 1)
     assert result.finish_reason is FinishReason.CANCELLED
 
 

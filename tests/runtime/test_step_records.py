@@ -14,7 +14,7 @@ import signal
 from pathlib import Path
 
 import pytest
-from conftest import SMALL_DOME, write_config
+from conftest import SMALL_DOME, cut_new_session, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -388,26 +388,13 @@ def _stopped_before_line(tmp_path: Path, n: int) -> Path:
     """A session as a kill between image ``n``'s record file and its journal line leaves it:
     that image's files and record file on disk, no journal line or lights.lp line of it, a
     manifest as begun. Made from a run cancelled after ``n`` images (no child to kill: fast)."""
-    from rti_rig.app.usecases.session import (
-        NewSessionRequest,
-        open_new_session,
-        run_opened_session,
-    )
+    from rti_rig.app.usecases.session import NewSessionRequest
     from rti_rig.core.lp_format import read_lp
-    from rti_rig.runtime.controller import CancelToken, StepCompleted
     from rti_rig.runtime.session import write_lp_atomic
 
     cfg = write_config(tmp_path, SMALL_DOME)
     out = tmp_path / "s"
-    cancel = CancelToken()
-
-    def on_event(e) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(e, StepCompleted) and e.index == n - 1:
-            cancel.cancel()
-
-    run_opened_session(
-        open_new_session(NewSessionRequest(cfg, out, lights=LIGHTS)), cancel, on_event
-    )
+    cut_new_session(NewSessionRequest(cfg, out, lights=LIGHTS), after_step=n - 1)
     journal = out / "journal.jsonl"
     lines = journal.read_bytes().splitlines(keepends=True)
     assert len(lines) == n and (out / "records" / f"image_{n:03d}.json").is_file()

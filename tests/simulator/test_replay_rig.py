@@ -25,7 +25,7 @@ from rti_rig.core.image_files import (
 )
 from rti_rig.core.lp_format import read_lp
 from rti_rig.simulator.replay import SRGB8_TO_LINEAR16
-from tests.conftest import SMALL_DOME, write_config
+from tests.conftest import SMALL_DOME, cut_new_session, write_config
 
 REPO = Path(__file__).resolve().parents[2]
 ACQ = REPO / "tests" / "data" / "neuralrti_replay"
@@ -148,23 +148,11 @@ def test_the_readers_notes_are_recorded_in_the_manifest(tmp_path: Path) -> None:
 
 
 def test_a_resumed_run_records_the_notes_of_the_rig_it_read_again(tmp_path: Path) -> None:
-    from rti_rig.app.usecases.session import (
-        NewSessionRequest,
-        open_new_session,
-        run_opened_session,
-    )
-    from rti_rig.runtime.controller import CancelToken, StepCompleted
+    from rti_rig.app.usecases.session import NewSessionRequest
 
     lp = _flawed_acquisition(tmp_path, "17", "-0.0012")
     out = tmp_path / "cut"
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 1:
-            cancel.cancel()
-
-    opened = open_new_session(NewSessionRequest(lp, out, lights=5))
-    run_opened_session(opened, cancel=cancel, on_event=on_event)
+    cut_new_session(NewSessionRequest(lp, out, lights=5), after_step=1)
     assert len(_journal(out)) == 2
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output
@@ -467,24 +455,14 @@ def test_a_resume_on_an_acquisition_whose_images_changed_is_refused(tmp_path: Pa
     had been mixed in without a word: the resume's images came from another acquisition than
     the first part's. Refused, nothing changed; the new session it offers runs as printed, with
     the session's --lights; with the original put back it continues."""
-    from rti_rig.app.usecases.session import (
-        NewSessionRequest,
-        open_new_session,
-        run_opened_session,
-    )
-    from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+    from rti_rig.app.usecases.session import NewSessionRequest
+    from rti_rig.runtime.controller import FinishReason
 
     acq = tmp_path / "acq"
     shutil.copytree(ACQ, acq)
     out = tmp_path / "s"
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 2:
-            cancel.cancel()
-
-    opened = open_new_session(NewSessionRequest(acq / "dirs.lp", out, lights=8))
-    assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+    run = cut_new_session(NewSessionRequest(acq / "dirs.lp", out, lights=8), after_step=2)
+    assert run.finish_reason is FinishReason.CANCELLED
     before = sorted(p.relative_to(out).as_posix() for p in out.rglob("*"))
     last = read_lp(acq / "dirs.lp")[-1].name
     shutil.copy(acq / read_lp(acq / "dirs.lp")[0].name, acq / last)  # an image replaced
