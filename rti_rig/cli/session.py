@@ -841,9 +841,20 @@ def _first_write_failed_said(exc: Any, opened) -> RtiRigError:  # type: ignore[n
             f"{held}: the resume moves whatever of it reached the session to its recovered/ "
             "folder and shoots this light again"
         )
+    from rti_rig.runtime.session import holds_no_image
+
+    # a folder left holding no image (no camera file reached it) is used again by the same
+    # command, as the stop's own line says of it; a camera file that reached it is the
+    # resume's to set aside in recovered/
+    reused = f"{_arg(opened.out_dir)} holds no image and may be used again"
+    then = (
+        f"run the same command again ({reused})"
+        if not exc.shot and holds_no_image(Path(opened.out_dir))
+        else f"continue with {_continue_command(opened)}"
+    )
     return RtiRigError(
         f"{exc}: the session stopped before any image was kept, on {disk}{shot}; "
-        f"{_disk_fix(exc.errno_name)}, then continue with {_continue_command(opened)}"
+        f"{_disk_fix(exc.errno_name)}, then {then}"
     )
 
 
