@@ -86,6 +86,10 @@ SESSION = (
 )
 JUNK_LINES = ("42", "[]", "null", '"text"', "{}", '{"index": 1}', "not json", '{"index": 0, ')
 SIZE = 48
+#: Runs again into a folder its runs left without a manifest before the session is given up and
+#: counted as not finished: a fault present at every connect (a rig that never answers) had
+#: the campaign run the same command again for ever.
+MAX_RUNS_FROM_NOTHING = 10
 
 
 def make_config(folder: Path, kind: str, seed: int, fault: tuple[int, str] | None = None) -> Path:
@@ -437,10 +441,15 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
                     stats["kills_that_did_not_kill"] += int(not killed)
             snapshots: dict[str, str] = {}
             resumes = 0
+            from_nothing = 0
             while True:
                 if not (out / "manifest.json").exists():
                     # stopped before anything was written: the folder (if any) holds no
-                    # image, and the same command is simply run again
+                    # image, and the same command is simply run again, a bounded number of
+                    # times (a fault at every connect would have it run for ever)
+                    if from_nothing >= MAX_RUNS_FROM_NOTHING:
+                        break
+                    from_nothing += 1
                     stats["sessions_restarted_from_nothing"] += 1
                     run_in_process(cfg, out, n, None, False, tracebacks)
                     continue
@@ -461,6 +470,13 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
                     faults.update(again.fired)
             stats["sessions"] += 1
             stats["resumes"] += resumes
+            if not (out / "manifest.json").exists():
+                # never begun: not finished, with no image to check
+                stats["sessions_never_begun"] += 1
+                stats["sessions_not_finished"] += 1
+                if (i + 1) % 20 == 0:
+                    print(f"{i + 1}/{sessions} sessions", flush=True)
+                continue
             m = read_manifest(out)
             complete = m["runner"].get("finish_reason") == "completed" and len(m["steps"]) == n
             lp_lines = (out / "lights.lp").read_text().splitlines()
@@ -527,6 +543,11 @@ def report(
             "servo_faults_stopped_with_error",
         ),
         ("sessions abandoned after 10 resumes", "sessions_abandoned"),
+        (
+            f"sessions given up after {MAX_RUNS_FROM_NOTHING} runs again that wrote nothing "
+            "(a fault at every connect; counted as not finished)",
+            "sessions_never_begun",
+        ),
         ("**sessions that could not be finished**", "sessions_not_finished"),
         ("**tracebacks** (an exception that was not a named error)", "tracebacks"),
         ("resumes on a changed rig refused (folder untouched)", "rig_changes_refused"),
