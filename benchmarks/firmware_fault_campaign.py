@@ -55,6 +55,8 @@ SECTION = "firmware_faults"
 #: Commands the fault is drawn from: after the connect, or at it (``--at-connect``).
 AFTER_CONNECT = (4, 4 + 2 * LIGHTS)
 AT_CONNECT = (1, 4)
+#: Runs after the first before a session is given up (counted as abandoned, not completed).
+MAX_RESUMES = 5
 
 
 def make_config(folder: Path, profile: str, fault: tuple[int, str] | None) -> Path:
@@ -115,7 +117,7 @@ def campaign(sessions: int, seed: int, at_connect: bool = False) -> dict:
             clean = make_config(tmpdir, profile, None)
             resumes = 0
             while first_finish_reason(out) != "completed":
-                if resumes >= 5:
+                if resumes >= MAX_RESUMES:
                     stats["abandoned"] += 1
                     break
                 resumes += 1
@@ -125,9 +127,15 @@ def campaign(sessions: int, seed: int, at_connect: bool = False) -> dict:
                     continue
                 snapshots.update(committed_files(out))
                 stats["dark_at_end"] += int(run_once(clean, out, resume=True))
+            stats["sessions"] += 1
+            if not (out / "manifest.json").exists():
+                # every run failed at connect: never begun, no image to check (reading its
+                # manifest stopped the campaign with a traceback)
+                stats["never_begun"] += 1
+                print(f"{i + 1}/{sessions} {profile} {kind}@{at}: never begun", flush=True)
+                continue
             m = read_manifest(out)
             complete = m["runner"].get("finish_reason") == "completed" and len(m["steps"]) == LIGHTS
-            stats["sessions"] += 1
             stats["sessions_completed"] += int(complete)
             stats["images_lost"] += sum(
                 1
@@ -157,6 +165,14 @@ def report(result: dict, sessions: int, seed: int, seconds: float, at_connect: b
             s.get("stopped_at_connect", 0),
         ),
         ("sessions completed", s.get("sessions_completed", 0)),
+        (
+            f"sessions abandoned after {MAX_RESUMES} runs again (not completed)",
+            s.get("abandoned", 0),
+        ),
+        (
+            "of which never begun (every run stopped at connect, nothing written)",
+            s.get("never_begun", 0),
+        ),
         ("images checked", s.get("images_checked", 0)),
         ("images lost or changed", s.get("images_lost", 0)),
         ("images under a wrong light", s.get("wrong_light_images", 0)),
