@@ -417,8 +417,12 @@ class DomePolicy:
         was there and then was not. It is reopened only if the board spoke the profile before
         the drop (its banner, ready text or a well-formed reply): then the port is the dome's
         and a reconnection is what the session would do a minute later. A board heard from
-        nothing before its port vanished (one that browns out its USB port as it boots lit
-        drops off at every opening) is not reopened: connect says the port was lost at once.
+        nothing before its port vanished is reopened too unless its firmware boots lit (the
+        Nab sketch): one that browns out its USB port as it boots lit drops off at every
+        opening, and each reopening would light it again, so connect says the port was lost
+        at once. A board that boots dark and has no banner to be heard (the Elexol board, whose
+        first byte from it is the answer to the handshake ``?``) had failed at once where
+        every other firmware reconnected.
 
         Up to ``reconnect_attempts`` reopenings (none if it is 0), with the back-off doubling
         from ``reconnect_backoff_s`` on the link's clock; one whose port came back but whose
@@ -430,7 +434,7 @@ class DomePolicy:
         except DomeLinkError as exc:
             if not (
                 _lost_after_opening(exc)
-                and self.link.profile_heard
+                and (self.link.profile_heard or self.link.boots_lit_firmware is None)
                 and self.settings.reconnect_attempts > 0
             ):
                 raise
@@ -441,7 +445,7 @@ class DomePolicy:
     def _reopen_after_drop(self, drop: DomeLinkError, recovered: list[str]) -> DomeInfo:
         """Reopen the port a connect lost after the board had spoken the profile on it (see
         :meth:`_connect_link`); the info of the handshake that got through."""
-        self._spoke_before_drop = True
+        self._spoke_before_drop = self.link.profile_heard
         self.stats.retries += 1  # the handshake is sent again, on the reopened port
         recovered.append(f"{drop.command}: {drop.fault}")
         log.warning(

@@ -661,18 +661,16 @@ def test_a_usb_drop_during_the_handshake_that_does_not_come_back_names_the_usb_l
     assert not dome.off_report.lights_known_off  # honest: the all-off could not be sent
 
 
-def test_a_usb_drop_before_the_board_spoke_is_named_but_not_reconnected():
-    """A board without auto-reset has said nothing before its handshake: its port vanishing
-    then is still a USB drop, not a wrong port, baud rate or profile, and the message says so.
-    It is not reopened (a board that browns out its USB port as it boots would drop again)."""
-    dome, _fw, _clock = make("default", [Fault(1, FaultKind.DISCONNECT, delay_s=0.5)], banner=False)
-    with pytest.raises(DeviceError) as caught:
-        dome.connect()
-    msg = str(caught.value)
-    assert "port was lost during the handshake" in msg and "check the USB cable" in msg
-    assert "check the port, the baud rate" not in msg
-    assert dome.stats.reconnects == 0 and dome.stats.recovered == []
-    assert dome.link.transport.opens == 1
+def test_a_usb_drop_before_a_board_that_boots_dark_spoke_is_reconnected():
+    """A board without auto-reset or banner has said nothing before its handshake: its port
+    vanishing then is a USB drop, and a board that boots dark cannot have browned its port out
+    by lighting at the opening, so it is reopened as a drop mid-session is (the Elexol board,
+    whose first byte is the answer to its handshake, had failed at once)."""
+    dome, fw, _clock = make("default", [Fault(1, FaultKind.DISCONNECT, delay_s=0.5)], banner=False)
+    dome.connect()
+    assert dome.stats.reconnects >= 1 and dome.stats.recovered
+    assert dome.link.transport.opens >= 2
+    assert dome.info is not None and fw.lit is None  # connected, and no LED lit (None: all off)
 
 
 def test_a_board_that_comes_back_silent_after_a_drop_at_connect_keeps_the_usb_advice():
