@@ -277,6 +277,10 @@ class OffReport:
     #: all-off again, after the one at the configured rate went unanswered on a firmware that
     #: boots lit; ``outcome`` is then what that second all-off established. None: no reopening.
     reopened_at: int | None = None
+    #: SELF_TIMED: how long the firmware keeps an LED lit before it goes dark by itself (the
+    #: rig config's ``light_on_s``): an LED lit just before the stop stays lit up to that long,
+    #: which "it switches each LED off by itself" alone left unsaid. None: not known.
+    on_time_s: float | None = None
 
     @property
     def lights_known_off(self) -> bool:
@@ -327,6 +331,12 @@ class OffReport:
             OffOutcome.SELF_TIMED: (
                 f"this firmware has no all-off command{why}: it switches each LED off by itself "
                 "at the end of its on-time"
+                + (
+                    ""
+                    if self.on_time_s is None
+                    else f", so the last LED lit may stay lit for up to {self.on_time_s:g} s "
+                    "(its light_on_s)"
+                )
             ),
             OffOutcome.NOT_SENT: (
                 f"all-off could NOT be sent{why}: lights may still be on; switch the dome off at "

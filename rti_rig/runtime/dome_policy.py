@@ -255,7 +255,9 @@ class DomePolicy:
                 # the all-off; the all-off (recovered as any command's) confirms the board
                 # is still there and off
                 self._run(self.link.all_off, "all off")
-                self.off_report = OffReport(self.link.off_outcome)
+                self.off_report = OffReport(
+                    self.link.off_outcome, on_time_s=self.link.light_window_s
+                )
                 return
         self._spoke_before_drop = False
         self.reached = "not opened"
@@ -657,7 +659,7 @@ class DomePolicy:
             else:
                 self.off_report = _failed_off(exc)
             raise
-        self.off_report = OffReport(self.link.off_outcome)
+        self.off_report = OffReport(self.link.off_outcome, on_time_s=self.link.light_window_s)
         self._check_on_time("all off")
         if self._lit is not None:
             self.guard.record(self._lit.index, self._lit.since, self.clock.now())
@@ -1173,7 +1175,9 @@ class DomePolicy:
                 OffOutcome.SENT_UNCONFIRMED, str(exc), boots_lit=lit_at_boot
             )
         else:
-            self.off_report = OffReport(self.link.off_outcome, when)
+            self.off_report = OffReport(
+                self.link.off_outcome, when, on_time_s=self.link.light_window_s
+            )
 
     def _all_off_after_reboot(self, reset: DomeLinkError, when: str) -> None:
         """The all-off once more after the one that met a reboot banner (found before it was
