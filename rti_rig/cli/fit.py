@@ -44,7 +44,9 @@ NORMALS_SHOWN = {
 
 
 def print_verdict(session: Path | None) -> None:
-    """Last line of ``run``: the QA verdict (never fails the run: it is advice)."""
+    """Last line of ``run``: the QA verdict (never fails the run: it is advice). A Ctrl-C or
+    SIGTERM while it is computed is said (the session is complete, and which command gives the
+    verdict) and exits as a stop does, 130 or 143 (:class:`typer.Exit`)."""
     if session is None:
         return
     try:  # the import too: a SIGTERM while it loads (slow on a busy machine) is the verdict's
@@ -58,10 +60,14 @@ def print_verdict(session: Path | None) -> None:
     except (RtiRigError, ValueError) as exc:
         err.print(f"[yellow]QA verdict unavailable:[/] {escape(str(exc))}")
     except KeyboardInterrupt:  # the session is complete: only the advice is cut short
+        # said, then the exit a Ctrl-C has everywhere else (130), as a SIGTERM here exits 143:
+        # it had exited 0, so ``run && fit`` went on to fit after the user asked to stop, and
+        # the two stops of the same moment disagreed
         err.print(
             "[yellow]QA verdict skipped (Ctrl-C):[/] the session is complete; "
             f"rti-rig fit {escape(shlex.quote(str(session)))} --out FOLDER gives the verdict"
         )
+        raise typer.Exit(code=130) from None
     except VerdictTerminated:  # SIGTERM: said as Ctrl-C is, then the exit a SIGTERM asks for
         err.print(
             "[yellow]QA verdict skipped (SIGTERM):[/] the session is complete; "

@@ -208,7 +208,8 @@ def run(
     for it): opening its port may have reset a board that boots lit.
     SIGUSR1 pauses or resumes between images. An interrupted session can be continued with
     --resume. Exit 130 after a Ctrl-C stop, 143 after a SIGTERM, also one that comes while a
-    stop or an error is being reported (the report is finished first).
+    stop or an error is being reported (the report is finished first) or while the QA verdict
+    of a complete session is computed (the session stays complete; rti-rig fit gives it).
     """
     from rti_rig.app.usecases.session import (
         NewSessionRequest,
@@ -337,7 +338,10 @@ def run(
                 try:
                     print_verdict(opened.out_dir)
                 except typer.Exit:
-                    raise  # a SIGTERM said by the verdict: exit 143
+                    # a Ctrl-C or SIGTERM said by the verdict: its exit (130 or 143), after
+                    # the unsafe end's words, which that exit had skipped
+                    _refuse_unsafe_end(unsafe, exit_code=None)
+                    raise
                 except Exception as exc:
                     _verdict_failed(exc, opened.out_dir)
         _refuse_unsafe_end(unsafe)

@@ -77,7 +77,9 @@ def test_ctrl_c_during_the_verdict_of_a_complete_session_says_it_is_complete(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Ctrl-C while the QA verdict is computed (seconds, after the last image) had ended the
-    command with exit code 130 and no word: a complete session read as an interrupted one."""
+    command with exit code 130 and no word: a complete session read as an interrupted one. It
+    is said; the exit is a Ctrl-C's (130), as a SIGTERM there exits 143 (it had exited 0, so
+    ``run && fit`` fitted after the user asked to stop)."""
     import rti_rig.app.usecases.fit as fit_usecase
 
     def interrupted(session: Path) -> str:
@@ -85,7 +87,8 @@ def test_ctrl_c_during_the_verdict_of_a_complete_session_says_it_is_complete(
 
     monkeypatch.setattr(fit_usecase, "verdict_for_session", interrupted)
     code, said, out = _small_run(tmp_path)
-    assert code == 0, said
+    assert code == 130, said
+    assert "6 image(s) in the session" in said and "Traceback" not in said
     assert "QA verdict skipped (Ctrl-C): the session is complete" in said
     assert f"rti-rig fit {out} --out FOLDER" in said
 
