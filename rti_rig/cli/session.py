@@ -1498,6 +1498,13 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
                 nonlocal ended
                 try:
                     return run_opened_session(opened, cancel, on_event)
+                except BaseException:
+                    # a run that ends before its first image (a dome that could not be
+                    # connected) leaves no bar: an empty "capturing 0/6" had stood above
+                    # "Nothing was captured"
+                    if progress.tasks[0].completed == len(folder.done) == 0:
+                        progress.update(task, visible=False)
+                    raise
                 finally:
                     ended = True
 

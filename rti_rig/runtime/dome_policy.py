@@ -398,6 +398,15 @@ class DomePolicy:
             # firmware's own all-off is not (a Nab board boots with every LED on)
             self._port_was_open = True
             self._switch_off_foreign("after the board was refused")
+        elif _lost_after_opening(exc) and not self.link.port_open:
+            # The port vanished and did not come back: no all-off can be written. Said as
+            # that, once, in the lights line; a warning had reached the user besides it, with
+            # the link's "port not open (connect first)" as the reason (Elexol's drop at '?')
+            self._port_was_open = True
+            log.debug("%s: no all-off after the failed connection: the port is gone", self.name)
+            self.off_report = OffReport(
+                OffOutcome.NOT_SENT, "the dome's port was lost and had not come back"
+            )
         else:
             if exc.command != "open port":
                 self._port_was_open = True
