@@ -35,12 +35,18 @@ def _rig_with_lights(rig: Path, name: str, lines: list[str]) -> Path:
     return other
 
 
-def test_a_card_session_calibrated_against_reordered_leds_is_refused(tmp_path: Path) -> None:
+def _card_and_reordered_rig(tmp_path: Path) -> tuple[Path, Path, Path]:
+    """A card session shot on the card rig, and that rig with its LEDs listed in another
+    order (the second half first): the rig config, the card folder and the reordered config."""
     rig = card_rig(tmp_path)
     card = tmp_path / "card"
     shoot(rig, card)
     count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
-    other = _rig_with_lights(rig, "reordered", [count, *rows[24:], *rows[:24]])
+    return rig, card, _rig_with_lights(rig, "reordered", [count, *rows[24:], *rows[:24]])
+
+
+def test_a_card_session_calibrated_against_reordered_leds_is_refused(tmp_path: Path) -> None:
+    _, card, other = _card_and_reordered_rig(tmp_path)
     out = tmp_path / "cal.toml"
 
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(other), "--out", str(out)])
@@ -59,11 +65,7 @@ def test_a_card_of_other_leds_is_refused_for_them_before_any_image_is_read(
     """The LEDs a card was shot with are in its manifest: a card of others is refused for
     that before its images are read. Every image was read (and checked against the journal)
     first, so a card whose images were gone was refused for those, never for its LEDs."""
-    rig = card_rig(tmp_path)
-    card = tmp_path / "card"
-    shoot(rig, card)
-    count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
-    other = _rig_with_lights(rig, "reordered", [count, *rows[24:], *rows[:24]])
+    _, card, other = _card_and_reordered_rig(tmp_path)
     for image in [*card.glob("image_*"), *(card / "linear").glob("*.tif")]:
         image.unlink()  # nothing left to read: a refusal that reads them says so instead
     out = tmp_path / "cal.toml"
@@ -161,12 +163,8 @@ def test_an_older_card_session_of_leds_re_measured_in_place_still_calibrates(
 
 
 def test_an_older_card_session_of_reordered_leds_is_still_refused(tmp_path: Path) -> None:
-    rig = card_rig(tmp_path)
-    card = tmp_path / "card"
-    shoot(rig, card)
+    _, card, other = _card_and_reordered_rig(tmp_path)
     _as_recorded_with_a_digest_alone(card)
-    count, *rows = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
-    other = _rig_with_lights(rig, "reordered", [count, *rows[24:], *rows[:24]])
     out = tmp_path / "cal.toml"
 
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(other), "--out", str(out)])

@@ -167,15 +167,8 @@ def test_a_session_from_before_the_flag_was_recorded_is_told_allow_no_normals_by
     del manifest["schedule"]["provenance"]["allow_no_normals"]  # as an older manifest
     assert any("--allow-no-normals" in n for n in manifest["input_notes"]), manifest
     manifest_path.write_text(json.dumps(manifest))
-    names = [e.name for e in read_lp(acq / "dirs.lp")]
-    shutil.copy(acq / names[0], acq / names[-1])  # an image replaced since
 
-    r = runner.invoke(app, ["run", "--resume", str(out)])
-    text = said(r)
-    assert r.exit_code == 2 and "Traceback" not in text, text
-    command = re.search(r"\(rti-rig run ([^()]+)\)$", text)
-    assert command, text
-    args = shlex.split(command.group(1))
+    args = _refused_resume_command(acq, out)
     assert "--allow-no-normals" in args, args
     r = runner.invoke(app, ["run", *args, "--no-verdict"])  # as printed
     assert r.exit_code == 0, r.output
