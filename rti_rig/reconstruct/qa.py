@@ -85,7 +85,7 @@ from rti_rig.reconstruct.qa_exposure import (
 )
 from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
 from rti_rig.reconstruct.qa_unchanging import UNCHANGING, unchanging_problem, unchanging_spread
-from rti_rig.reconstruct.signal_check import SAMPLE_PIXELS, every_image_black, sample_grid
+from rti_rig.reconstruct.signal_check import every_image_black, sample_grid, sample_pixels
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
 #: Side of the central crop the per-image checks fit on (full resolution).
@@ -1239,7 +1239,9 @@ def assess(
     small_shape = (max(1, w // factor), max(1, h // factor))
     sat_frac = np.zeros(n)
     small_list, small_sat_list, sample_list = [], [], []
-    rows, cols = sample_grid(h, w, SAMPLE_PIXELS)  # the pixels fit --no-qa's check samples
+    channels = int(np.prod(first.shape[2:], dtype=int))
+    # the pixels fit --no-qa's check samples (fewer at many lights: the sample's memory)
+    rows, cols = sample_grid(h, w, sample_pixels(n, channels))
     for f in frames:  # one frame in memory at a time
         a = np.asarray(f[0:h])
         sample_list.append(a[rows[:, None], cols[None, :]].reshape(rows.size * cols.size, -1))

@@ -28,6 +28,23 @@ SIGNAL_MIN_VALUES = 8
 #: The pixels sampled from each image: the fit's sample (model choice, quantisation ranges,
 #: this check) and the QA's "black throughout", so that both judge the same pixels.
 SAMPLE_PIXELS = 30_000
+#: Values (pixels × images × channels) the sample holds at most: 30 000 pixels of 100 RGB
+#: images (36 MB as float32). The sample is held whole (model choice, quantisation ranges, and
+#: the QA's copy of it), so at 30 000 pixels it grew with the lights — 360 MB at 1000 RGB
+#: lights, several times that with the copies made from it — while the bands stay within
+#: their budget. Up to 100 RGB images the sample is 30 000 pixels, as before.
+SAMPLE_VALUES = SAMPLE_PIXELS * 100 * 3
+#: The fewest pixels sampled, however many lights (model choice and quantisation ranges are
+#: judged on these pixels' observations under every light).
+MIN_SAMPLE_PIXELS = 1_000
+
+
+def sample_pixels(images: int, channels: int) -> int:
+    """Pixels the sample of ``images`` images of ``channels`` channels takes: ``SAMPLE_PIXELS``,
+    fewer when that many would hold more than ``SAMPLE_VALUES`` values (many lights), so that
+    the sample's memory is bounded like a band's rather than growing with the lights."""
+    per_pixel = max(1, images * channels)
+    return max(MIN_SAMPLE_PIXELS, min(SAMPLE_PIXELS, SAMPLE_VALUES // per_pixel))
 
 
 def sample_grid(height: int, width: int, max_pixels: int) -> tuple[np.ndarray, np.ndarray]:

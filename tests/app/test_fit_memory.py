@@ -205,3 +205,57 @@ def test_only_the_command_caps_the_heap(
     assert calls == []
     _fit(inputs["tiff"], tmp_path / "cli", *NORMALS)
     assert calls == ["cap"]
+
+
+def test_the_sample_keeps_its_size_up_to_100_rgb_lights_and_shrinks_beyond() -> None:
+    """The fit's pixel sample is held whole (model choice, quantisation ranges, the QA's copy):
+    at 30 000 pixels it grew with the lights (360 MB of float32 at 1000 RGB lights, peak RSS
+    1.4 GB for a 128 × 128 fit). Up to 100 RGB images it is unchanged (the outputs too); beyond,
+    it holds at most ``SAMPLE_VALUES`` values."""
+    from rti_rig.reconstruct import signal_check as sc
+
+    assert sc.sample_pixels(72, 3) == sc.sample_pixels(100, 3) == sc.SAMPLE_PIXELS
+    assert sc.sample_pixels(300, 1) == sc.SAMPLE_PIXELS
+    for n, c in ((301, 3), (1000, 3), (1000, 1), (2500, 3)):
+        assert sc.sample_pixels(n, c) < sc.SAMPLE_PIXELS
+        assert sc.sample_pixels(n, c) * n * c <= sc.SAMPLE_VALUES
+    assert sc.sample_pixels(100_000, 3) == sc.MIN_SAMPLE_PIXELS
+
+
+def test_the_fit_and_its_qa_hold_a_sample_within_the_budget(
+    inputs: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Through the CLI, with the sample's budget lowered so that this small session's lights
+    exceed it: every pixel sample the fit holds (model choice, quantisation ranges, HSH order)
+    and the QA's grid stay within ``SAMPLE_VALUES`` values, and the QA samples the pixels the
+    fit's signal check does (one grid for both)."""
+    from rti_rig.reconstruct import qa, signal_check
+    from rti_rig.reconstruct.stack import ImageStack
+
+    n = len(read_lp(inputs["tiff"] / "lights.lp"))
+    budget = n * 3 * 1500  # 1500 RGB pixels of this session's lights, of its 5120
+    monkeypatch.setattr(signal_check, "SAMPLE_VALUES", budget, raising=False)
+    held: list[int] = []
+    grids: list[int] = []
+    sample = ImageStack.pixel_sample
+
+    def recording_sample(self: ImageStack, max_pixels: int) -> tuple[np.ndarray, np.ndarray]:
+        values, flat = sample(self, max_pixels)
+        if self.channels == 3:  # the fit's stack (the QA's crop fit is grey: its own sample)
+            held.append(values.size)
+        return values, flat
+
+    grid = qa.sample_grid
+
+    def recording_grid(height: int, width: int, max_pixels: int) -> tuple[np.ndarray, np.ndarray]:
+        rows, cols = grid(height, width, max_pixels)
+        grids.append(rows.size * cols.size)
+        return rows, cols
+
+    monkeypatch.setattr(ImageStack, "pixel_sample", recording_sample)
+    monkeypatch.setattr(qa, "sample_grid", recording_grid)
+    _fit(inputs["tiff"], tmp_path / "out")  # auto model, normals, .ptm, .rti, QA
+    assert held and grids, (held, grids)
+    assert max(held) <= budget, held
+    assert all(g * n * 3 <= budget for g in grids), grids
+    assert {h // (n * 3) for h in held} >= set(grids)

@@ -875,6 +875,15 @@ RELIGHT_HSH_ORDER = 2
 #: decode pass of the files for all three, and the no-signal check's, which the QA's "black
 #: throughout" shares.
 SAMPLE_PIXELS = signal_check.SAMPLE_PIXELS
+
+
+def sample_size(stack: ImageStack) -> int:
+    """Pixels of the fit's shared sample for this stack: ``SAMPLE_PIXELS``, fewer at many
+    lights, so that the sample (held whole) stays within a fixed number of values
+    (:func:`rti_rig.reconstruct.signal_check.sample_pixels`)."""
+    return signal_check.sample_pixels(stack.n, stack.channels)
+
+
 #: Working-set budget of one band of the stack in the streamed fit (float32 bytes): small, so
 #: that the fit's temporaries (robust PS keeps ~15 arrays of the band's pixels) stay bounded.
 #: Measured at 72 images × 2.5 MP (3 rows a band): 8 MB put the band phase of a normals fit at
@@ -935,7 +944,9 @@ def _fit_all(
                 "ridge-regularised, are written"
             )
         try:
-            choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS, candidates=candidates)
+            choice = select_model(
+                stack, lights, max_pixels=sample_size(stack), candidates=candidates
+            )
         except ReconstructionError as exc:
             if n < FIT_MINIMUMS.normal:  # no normal either: the choice's refusal stands
                 raise
@@ -1048,10 +1059,10 @@ def _fit_all(
             # that determine a normal)
             written = {("fit.ptm" if k == "ptm" else "fit.rti"): k for k in exported}
             skipped += no_signal_warning(
-                stack, lights, names, SAMPLE_PIXELS, written, normals=write_normals
+                stack, lights, names, sample_size(stack), written, normals=write_normals
             )
         # the last use of the sample: when nothing above read it, it is streamed, never held
-        ref = stack.reference_level(SAMPLE_PIXELS, keep_sample=False)
+        ref = stack.reference_level(sample_size(stack), keep_sample=False)
         del obs
         stack.forget_samples()  # planned: the sample is not needed while the bands are fitted
         release_free_memory()
@@ -1134,7 +1145,7 @@ def rti_order(
     clipped, share = None, 0.0
     if evidence is not None and not named_hsh and stack.saturation_level is not None:
         # the model choice's sample (cached: no second read), and how much of it clips
-        values, _ = stack.pixel_sample(SAMPLE_PIXELS)
+        values, _ = stack.pixel_sample(sample_size(stack))
         share = float(np.any(values >= stack.saturation_level, axis=(0, 2)).mean())
         if share > 0.0:  # the choice left those values out: judge the orders with them kept
             clipped = hsh_evidence(ImageStack(stack, saturation_level=math.inf), lights)
@@ -1148,7 +1159,7 @@ def hsh_evidence(stack: ImageStack, lights: np.ndarray) -> Any:
 
     try:
         return select_model(
-            stack, lights, max_pixels=SAMPLE_PIXELS, candidates=("hsh1", "hsh2", "hsh3")
+            stack, lights, max_pixels=sample_size(stack), candidates=("hsh1", "hsh2", "hsh3")
         )
     except ReconstructionError:
         return None
@@ -1267,7 +1278,7 @@ def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str
 def _usable_sample(stack: ImageStack) -> np.ndarray:
     """The pixel sample's observations (N, P·C) of the pixels with no missing or saturated
     value in any image (all of them, NaN taken as 0, when no pixel is clean)."""
-    sample, _ = stack.pixel_sample(SAMPLE_PIXELS)  # the sample model choice read (cached)
+    sample, _ = stack.pixel_sample(sample_size(stack))  # the sample model choice read (cached)
     obs = sample.reshape(stack.n, -1)
     keep = np.all(np.isfinite(obs), axis=0)
     if stack.saturation_level is not None:
