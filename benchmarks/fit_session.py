@@ -12,7 +12,8 @@ peak resident memory (``ru_maxrss`` of the child) and its CPU time (user + syste
 the figure to compare when the shared machine is loaded.
 
 Run: ``python -m benchmarks.fit_session [--width 1936 --height 1296 --lights 72]``;
-``--write`` puts the table into docs/benchmarks.md.
+``--write`` puts the table into docs/benchmarks.md. ``--many-lights 100,300,1000 [--width 128]``
+prints the peak memory as the lights grow (square images of ``--width``).
 """
 
 from __future__ import annotations
@@ -229,6 +230,53 @@ def memory_at(width: int, height: int, lights: int, write: bool) -> None:
         print(f"written to {write_section('fit_memory', table)}")
 
 
+#: (label, arguments) of the many-lights memory cases
+MANY_LIGHTS_CASES = [
+    ("PTM only", ["--model", "ptm", "--no-qa"]),
+    ("HSH2 only", ["--model", "hsh2", "--no-qa"]),
+    ("everything (auto, normals, .ptm, .rti, QA)", []),
+]
+
+
+def many_lights(side: int, counts: list[int]) -> None:
+    """Peak RSS of `rti-rig fit` as the lights grow, at one small image size (printed only).
+
+    The fit's memory should be bounded by its budgets (a band's, the pixel sample's), not grow
+    with lights × pixels: at 1000 RGB lights of 128 × 128 a PTM fit peaked at 1.4 GB while the
+    sample was 30 000 pixels at any light count. The QA works on a crop and a coverage grid of
+    every image, so its memory does grow with the lights (see the docs)."""
+    work = Path(tempfile.mkdtemp(prefix="fit_many_"))
+    rows = []
+    try:
+        for n in counts:
+            session = make_session(work / f"s{n}", side, side, n)
+            pixel_mb = n * side * side * 3 * 2 / 1e6
+            for label, extra in MANY_LIGHTS_CASES:
+                wall, peak, cpu = time_fit(session, extra)
+                rows.append((n, pixel_mb, label, wall, cpu, peak))
+                print(f"{n} lights, {label}: {wall:.1f} s, peak RSS {peak:.0f} MB", flush=True)
+            shutil.rmtree(session, ignore_errors=True)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    print(
+        "\n".join(
+            [
+                f"## `rti-rig fit` memory at many lights ({side} × {side} RGB 16-bit TIFFs)",
+                "",
+                f"{machine_line()} Command: `python -m benchmarks.fit_session --many-lights "
+                f"{','.join(str(n) for n in counts)} --width {side}`.",
+                "",
+                "| lights | pixels (MB, 16-bit) | case | wall (s) | CPU (s) | peak RSS (MB) |",
+                "|---|---|---|---|---|---|",
+                *[
+                    f"| {n} | {mb:.1f} | {label} | {w:.1f} | {c:.1f} | {p:.0f} |"
+                    for n, mb, label, w, c, p in rows
+                ],
+            ]
+        )
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--width", type=int, default=1936)
@@ -240,7 +288,17 @@ def main() -> None:
     )
     parser.add_argument("--memory-scaling", action="store_true", help="see memory_scaling()")
     parser.add_argument("--memory-at", default="", help="WIDTHxHEIGHT: see memory_at()")
+    parser.add_argument(
+        "--many-lights",
+        default="",
+        help="comma-separated light counts: peak RSS as the lights grow at --width px square "
+        "(see many_lights(); printed, never written)",
+    )
     args = parser.parse_args()
+    if args.many_lights:
+        side = args.width if args.width != 1936 else 128
+        many_lights(side, [int(x) for x in args.many_lights.split(",")])
+        return
     if args.memory_at:
         w, h = (int(x) for x in args.memory_at.lower().split("x"))
         memory_at(w, h, args.lights if args.lights != 72 else 100, args.write)
