@@ -95,6 +95,8 @@ class SerialTransport:
         self.clock: Clock = SystemClock()
         self._ser: serial.SerialBase | None = None
         self._timeout: float | None = None
+        #: the open port's file (device, inode), to tell it from a descriptor number reused
+        self._opened_as: tuple[int, int] | None = None
 
     @property
     def resets_on_open(self) -> bool:
@@ -136,12 +138,28 @@ class SerialTransport:
                 f"cannot open serial port {self.port}: {why}", errno=_system_errno(exc)
             ) from exc
         self._timeout = 0
+        self._opened_as = _identity(self._ser)
 
     def close(self) -> None:
-        ser, self._ser = self._ser, None
-        if ser is not None:
+        """Release the port (its descriptor, and with it the lock ``open`` took); safe twice.
+
+        A stop raised inside pyserial's close (the CLI's emergency stop is raised wherever its
+        signal lands, here as the close begins) had left the descriptor open, its lock held by
+        the port object that the stop's traceback keeps alive: the stop's teardown then failed
+        to reopen the port to switch a Nab dome off ("another program holds it (it could not
+        be locked)"), and the dome stayed lit. The close is finished before the stop goes on
+        (the CLI raises only the first signal, so the second close runs through)."""
+        ser = self._ser
+        if ser is None:
+            return
+        try:
             with contextlib.suppress(*_PORT_ERRORS):  # already gone: closing is best effort
                 ser.close()
+        except BaseException:
+            _finish_close(ser, self._opened_as)
+            raise
+        finally:
+            self._ser, self._opened_as = None, None
 
     def write(self, data: bytes) -> None:
         ser = self._require()
@@ -174,6 +192,35 @@ class SerialTransport:
         if self._ser is None:
             raise TransportError(f"serial port {self.port} is not open")
         return self._ser
+
+
+def _identity(ser: serial.SerialBase) -> tuple[int, int] | None:
+    """The (device, inode) of the file ``ser``'s descriptor refers to; None for a port with no
+    descriptor of its own (``loop://``, a socket URL whose number is no device)."""
+    fd = getattr(ser, "fd", None)
+    if not isinstance(fd, int):
+        return None
+    try:
+        st = os.fstat(fd)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino
+
+
+def _finish_close(ser: serial.SerialBase, opened_as: tuple[int, int] | None) -> None:
+    """Close ``ser`` again after a stop cut its close short: its descriptor (and lock) is
+    released now, not when the stop's traceback lets the object go. Closed only if the
+    descriptor still refers to the port opened (a stop landing just after pyserial's
+    ``os.close``, before it forgot the number, must not close a file another thread has since
+    been given under that number); pyserial's own close is otherwise used, suppressed errors
+    and all."""
+    fd = getattr(ser, "fd", None)
+    if opened_as is not None and isinstance(fd, int) and _identity(ser) != opened_as:
+        ser.fd = None  # already closed by the close that was cut short
+        ser.is_open = False
+        return
+    with contextlib.suppress(*_PORT_ERRORS):
+        ser.close()
 
 
 def _system_errno(exc: BaseException) -> int | None:

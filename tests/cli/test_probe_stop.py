@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import serial
 from typer.testing import CliRunner
 
 from rti_rig.app.usecases import probe as probe_usecase
@@ -328,4 +329,34 @@ def test_a_stop_as_the_probe_returns_keeps_what_it_found_of_another_firmware(
     assert "Probe stopped (Ctrl-C): the firmware boots with every LED off; nothing that " in said
     assert "before a firmware answered" not in said, said
     assert 'profile = "nichlock"' in said and "Traceback" not in said, said
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_as_the_first_port_closes_leaves_it_unlocked_for_the_all_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C as pyserial begins closing the 9600-baud port on which the Nab banner was
+    heard: the close was cut short, the port's descriptor (and its lock) kept by the port
+    object that the stop's traceback holds, so the teardown's reopening to send the all-off
+    failed with "another program holds it (it could not be locked)" and left the dome lit (a
+    flake of this file on a loaded machine). The stop is raised where the signal lands, as the
+    close begins, before pyserial's own ``os.close`` (too short a window to aim a signal)."""
+    real_close = serial.Serial.close
+    stops: list[str] = []
+
+    def stopped_as_it_closes(self: serial.Serial) -> None:
+        if not stops and self.is_open and _boots(board) >= 1:
+            stops.append(str(self.port))  # the handler raises only the first signal
+            raise EmergencyStop(signal.SIGINT)
+        real_close(self)
+
+    board = board_for("nab-rti-v1")
+    monkeypatch.setattr(serial.Serial, "close", stopped_as_it_closes)
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130 and stops, said
+    assert "could not be locked" not in said, said
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
+    assert "Traceback" not in said, said
     assert board.lit_once_booted() == frozenset()
