@@ -11,7 +11,7 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out, print_notes
+from rti_rig.cli.app import app, err, fail, out, print_notes, stop_exit_code
 from rti_rig.cli.stopping import Terminated, sigterm_stops, stop_signal
 from rti_rig.core.errors import RtiRigError
 from rti_rig.runtime.deferred_signals import stop_words
@@ -59,21 +59,16 @@ def print_verdict(session: Path | None) -> None:
         _say_verdict_warnings(caught)
     except (RtiRigError, ValueError) as exc:
         err.print(f"[yellow]QA verdict unavailable:[/] {escape(str(exc))}")
-    except KeyboardInterrupt:  # the session is complete: only the advice is cut short
-        # said, then the exit a Ctrl-C has everywhere else (130), as a SIGTERM here exits 143:
-        # it had exited 0, so ``run && fit`` went on to fit after the user asked to stop, and
-        # the two stops of the same moment disagreed
+    except (KeyboardInterrupt, VerdictTerminated) as exc:  # only the advice is cut short
+        # said, then the exit the stop has everywhere else (Ctrl-C 130, SIGTERM 143): a
+        # Ctrl-C here had exited 0, so ``run && fit`` went on to fit after the user asked to
+        # stop, and the two stops of the same moment disagreed
+        signum = signal.SIGTERM if isinstance(exc, VerdictTerminated) else signal.SIGINT
         err.print(
-            "[yellow]QA verdict skipped (Ctrl-C):[/] the session is complete; "
+            f"[yellow]QA verdict skipped ({stop_words(signum)}):[/] the session is complete; "
             f"rti-rig fit {escape(shlex.quote(str(session)))} --out FOLDER gives the verdict"
         )
-        raise typer.Exit(code=130) from None
-    except VerdictTerminated:  # SIGTERM: said as Ctrl-C is, then the exit a SIGTERM asks for
-        err.print(
-            "[yellow]QA verdict skipped (SIGTERM):[/] the session is complete; "
-            f"rti-rig fit {escape(shlex.quote(str(session)))} --out FOLDER gives the verdict"
-        )
-        raise typer.Exit(code=143) from None
+        raise typer.Exit(code=stop_exit_code(signum)) from None
 
 
 def _say_verdict_warnings(caught: list[warnings.WarningMessage]) -> None:

@@ -322,7 +322,7 @@ def run(
                 f"{escape(_arg(opened.out_dir))} --out FOLDER gives it",
                 soft_wrap=True,
             )
-            raise typer.Exit(code=143)
+            raise typer.Exit(code=stop_exit_code(signal.SIGTERM))
         # the verdict is not computed: the stop asked for no more
         _exit_if_park_stopped(
             opened,
@@ -640,14 +640,14 @@ def _sigterm_exit_wins(late_term: list[int]) -> Iterator[None]:
     try:
         yield
     except typer.Exit as exc:
-        if not late_term or exc.exit_code == 143:
+        if not late_term or exc.exit_code == stop_exit_code(signal.SIGTERM):
             raise
         err.print(
             "[yellow]SIGTERM while the run's end was being said: what is said above stands; "
-            f"exit 143 for the SIGTERM (not {exc.exit_code}).[/]",
+            f"exit {stop_exit_code(signal.SIGTERM)} for the SIGTERM (not {exc.exit_code}).[/]",
             soft_wrap=True,
         )
-        raise typer.Exit(code=143) from None
+        raise typer.Exit(code=stop_exit_code(signal.SIGTERM)) from None
 
 
 @contextmanager
@@ -1640,7 +1640,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
             f"[yellow]Session cancelled.[/] {escape(lights)} "
             f"{escape(_after_stop(opened, resume_hint))}"
         )
-        raise typer.Exit(code=130)
+        raise typer.Exit(code=stop_exit_code(signal.SIGINT))
     marker = folder.root / MARKER
     labels = (
         f"{LP_NAME} lists the lights that fired."
@@ -1693,7 +1693,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
             f"[yellow]Session cancelled; the images captured so far are kept.[/] "
             f"{escape(lights)} {resume_hint}"
         )
-        raise typer.Exit(code=130)
+        raise typer.Exit(code=stop_exit_code(signal.SIGINT))
     from rti_rig.app.usecases.safe_state import safe_state_unsure
 
     return bool(result.teardown_failures) or safe_state_unsure(rig)
@@ -1722,7 +1722,7 @@ def _exit_if_park_stopped(  # type: ignore[no-untyped-def]
         f"complete{head}[/]{tail}",
         soft_wrap=True,
     )
-    raise typer.Exit(code=130)
+    raise typer.Exit(code=stop_exit_code(signal.SIGINT))
 
 
 @app.command()
@@ -1845,7 +1845,7 @@ def preview(
                 f"{escape(_arg(out_dir))}[/] (plan from it as above)",
                 soft_wrap=True,
             )
-            raise typer.Exit(code=143)
+            raise typer.Exit(code=stop_exit_code(signal.SIGTERM))
         _exit_if_park_stopped(
             opened,
             unsafe,
