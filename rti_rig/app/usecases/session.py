@@ -530,19 +530,12 @@ def fix_exposure(
             shot_per_lighting=limit is not None,
             within=within,
         )
-    except (RtiRigError, KeyboardInterrupt, EmergencyStop) as exc:
-        # what metering's teardown established about the lights travels with the error, or
-        # with the stop (Ctrl-C, SIGTERM) (the user had been told only the error: no word of
-        # the lights metering had switched on)
-        from rti_rig.app.usecases.safe_state import lights_state
-
-        failures = getattr(exc, "teardown_failures", None)
-        exc.lights_state = lights_state(rig, bool(failures))  # type: ignore[attr-defined]
-        raise
-    except Exception as exc:
-        # a fault no part of rti-rig named, likewise (a camera driver's TypeError had the run
-        # say "check the rig's lights" of a dome whose all-off metering had sent and seen
-        # acknowledged); a state that cannot be told leaves the fault to be said as it is
+    except (Exception, KeyboardInterrupt, EmergencyStop) as exc:
+        # what metering's teardown established about the lights travels with the error, the
+        # stop (Ctrl-C, SIGTERM) or a fault no part of rti-rig named (the user had been told
+        # only the error, and of a camera driver's TypeError "check the rig's lights" of a
+        # dome whose all-off metering had sent and seen acknowledged); a state that cannot be
+        # told leaves the fault to be said as it is
         from rti_rig.app.usecases.safe_state import lights_state
 
         failures = getattr(exc, "teardown_failures", None)
