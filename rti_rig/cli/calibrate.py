@@ -12,8 +12,8 @@ from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, print_notes, stop_exit_code
 from rti_rig.cli.stopping import Terminated, sigterm_stops, stamp, stop_signal, written_since
+from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
-from rti_rig.runtime.deferred_signals import stop_words
 
 if TYPE_CHECKING:
     from rti_rig.app.usecases.calibrate import CalibrateRequest

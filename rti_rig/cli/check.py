@@ -13,8 +13,8 @@ import typer
 from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, stop_exit_code
+from rti_rig.core.deferred_signals import signal_handlers
 from rti_rig.core.errors import RtiRigError
-from rti_rig.runtime.deferred_signals import signal_handlers
 
 if TYPE_CHECKING:
     from rti_rig.app.usecases.probe import ProbeResult

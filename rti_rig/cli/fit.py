@@ -13,8 +13,8 @@ from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, print_notes, stop_exit_code
 from rti_rig.cli.stopping import Terminated, sigterm_stops, stop_signal
+from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
-from rti_rig.runtime.deferred_signals import stop_words
 
 #: The --model names, as --help offers them and an unknown name's refusal lists them: one
 #: list, as the refusal (the registry's) had left out ``auto`` and named robust PS

@@ -9,6 +9,7 @@ import typer
 
 from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_notes, stop_exit_code
 from rti_rig.cli.stopping import Stamp, Terminated, sigterm_stops, stamp, stop_signal, written_since
+from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free): a plan's minimum is the normal's (planner.make_plan)
@@ -18,7 +19,6 @@ from rti_rig.core.fit_minimums import (
     NORMAL_MIN_LIGHTS,
     NORMAL_NOISE,
 )
-from rti_rig.runtime.deferred_signals import stop_words
 
 if TYPE_CHECKING:
     from rti_rig.app.usecases.plan import PlanLightsRequest

@@ -20,11 +20,11 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_note, stop_exit_code
 from rti_rig.cli.stopping import stop_signal
+from rti_rig.core.deferred_signals import handlers_settable, put_back, signal_handlers
 from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free)
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, NORMAL_ERROR_LIMIT_DEG, NORMAL_NOISE
-from rti_rig.runtime.deferred_signals import handlers_settable, put_back, signal_handlers
 
 if TYPE_CHECKING:
     from rti_rig.runtime.run_ending import RunEnding

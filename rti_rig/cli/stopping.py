@@ -17,7 +17,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from rti_rig.runtime.deferred_signals import signal_handlers
+from rti_rig.core.deferred_signals import signal_handlers
 
 #: A file's identity and content stamp (inode, mtime in ns, size), or None where there is none.
 Stamp = tuple[int, int, int] | None

@@ -15,12 +15,12 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any, Protocol
 
+from rti_rig.core.deferred_signals import signals_deferred, stop_words
 from rti_rig.core.devices import BusyAwareCamera, ExposingCamera, Frame, FramePacedCamera
 from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.runtime.deferred_signals import signals_deferred, stop_words
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
     FRAME_SIZE_KEY,

@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.clock import Clock, VirtualClock
+from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.core.devices import DiscreteLightSource
 from rti_rig.core.dome_link import (
     DomeInfo,
@@ -46,7 +47,6 @@ from rti_rig.core.dome_link import (
     OffReport,
 )
 from rti_rig.core.errors import DeviceError
-from rti_rig.runtime.deferred_signals import signals_deferred
 
 log = logging.getLogger("rti_rig.dome")
 

@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.core.devices import ExposingCamera, Frame
 from rti_rig.core.errors import DeviceError
 from rti_rig.core.exposure_range import Bound, longer_than, shared_range
@@ -45,7 +46,6 @@ from rti_rig.runtime.controller import (
     shoot_step,
     validate_schedule,
 )
-from rti_rig.runtime.deferred_signals import signals_deferred
 from rti_rig.runtime.lighting import attempt_all
 from rti_rig.runtime.rig import Rig
 

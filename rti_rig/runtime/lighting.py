@@ -14,13 +14,13 @@ from typing import Protocol
 
 import numpy as np
 
+from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.core.devices import DiscreteLightSource, LightCarrier
 from rti_rig.core.errors import DeviceError, MoveCancelled
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.schedule import LightStep
 from rti_rig.runtime.arm_end import ArmEnd, left_end, park_end
-from rti_rig.runtime.deferred_signals import signals_deferred
 
 #: A dome step's direction must match its LED's calibrated direction this closely (degrees).
 LED_MATCH_TOLERANCE_DEG = 0.5

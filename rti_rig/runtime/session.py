@@ -55,6 +55,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import (
@@ -67,7 +68,6 @@ from rti_rig.core.image_files import (
 )
 from rti_rig.core.lp_format import LpEntry, format_lp
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
-from rti_rig.runtime.deferred_signals import signals_deferred
 from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
 
 MANIFEST = "manifest.json"

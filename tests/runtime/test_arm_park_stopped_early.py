@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 import pytest
 
+from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.core.geometry import direction_from_az_el
-from rti_rig.runtime.deferred_signals import signals_deferred
 from rti_rig.runtime.lighting import ArmLighting
 
 

@@ -13,7 +13,7 @@ from typing import Any
 
 import pytest
 
-from rti_rig.runtime.deferred_signals import put_back, signal_handlers
+from rti_rig.core.deferred_signals import put_back, signal_handlers
 
 
 def _mark(signum: int, frame: Any) -> None:
@@ -101,7 +101,7 @@ def test_a_signal_whose_handler_was_set_outside_python_is_left_to_it(
 ) -> None:
     """A host's C handler (``getsignal`` None) stays in charge: ours could not be put back and
     stayed installed after the block."""
-    import rti_rig.runtime.deferred_signals as deferred
+    import rti_rig.core.deferred_signals as deferred
 
     real_getsignal, real_signal = signal.getsignal, signal.signal
     installed: list[int] = []

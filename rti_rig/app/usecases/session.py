@@ -214,7 +214,7 @@ class OpenedSession:
         Why: the rig's close releases only what ``build_rig`` opened (an emulator, its pty),
         trusting the controller to have made the devices safe: a SIGTERM as the capture
         checked the free space left the emulated dome's held port open, its all-off unsent."""
-        from rti_rig.runtime.deferred_signals import signals_deferred
+        from rti_rig.core.deferred_signals import signals_deferred
         from rti_rig.runtime.lighting import attempt_all
         from rti_rig.runtime.session import unlock_session
 

@@ -2,7 +2,10 @@
 
 Why a module of its own: the controller holds them while devices go safe and while an image is
 committed, metering while its lights go off, and a resume while it sets unverified images aside
-and relists ``lights.lp`` (a stop in between had left the `.lp` listing a moved image).
+and relists ``lights.lp`` (a stop in between had left the `.lp` listing a moved image). In the
+core, not the runtime, because the drivers hold them too, over a serial port's opening (a stop
+landing just after the system's open, before pyserial keeps the descriptor, leaked it), and the
+drivers may stand on the core alone.
 
 It also holds :func:`signal_handlers`, the one way the CLI sets handlers for a block: the
 save, install, restore and main-thread check had been written out by hand seven times, and
