@@ -589,3 +589,59 @@ def dead_pid() -> int:
     proc = subprocess.Popen([sys.executable, "-c", "pass"])
     proc.wait()
     return proc.pid
+
+
+class InjectedStop(BaseException):
+    """Stands for the CLI's emergency stop: a BaseException its handler raises wherever the
+    signal lands."""
+
+
+def descriptors_on(path: str) -> set[int]:
+    """This process's open descriptors that refer to the file at ``path`` (Linux's
+    ``/proc/self/fd``): what a stop must not leave behind of a port."""
+    import os
+
+    st = os.stat(path)
+    found = set()
+    for name in os.listdir("/proc/self/fd"):
+        try:
+            other = os.fstat(int(name))
+        except OSError:  # the listing's own descriptor, closed since
+            continue
+        if (other.st_dev, other.st_ino) == (st.st_dev, st.st_ino):
+            found.add(int(name))
+    return found
+
+
+@contextlib.contextmanager
+def sigint_as_the_system_opens(path: str) -> Iterator[list[int]]:
+    """A SIGINT sent to this process the first time the system's ``os.open`` of ``path``
+    returns, handled by raising :class:`InjectedStop`; yields the descriptors so opened.
+
+    The instant a stop leaked a port's descriptor: pyserial keeps the number only once
+    ``os.open`` has returned, and Python runs a signal's handler as soon as the call returns.
+    ``signal.raise_signal`` runs the handler before it returns, so the stop lands there, every
+    time, unless the caller holds the signal (``signals_deferred``)."""
+    import os
+
+    from rti_rig.core.deferred_signals import signal_handlers
+
+    opened: list[int] = []
+    real_open = os.open
+
+    def open_then_stopped(file: Any, flags: int, *args: Any, **kwargs: Any) -> int:
+        fd = real_open(file, flags, *args, **kwargs)
+        if not opened and os.fspath(file) == path:
+            opened.append(fd)
+            signal.raise_signal(signal.SIGINT)
+        return fd
+
+    def stop(signum: int, frame: Any) -> None:
+        raise InjectedStop
+
+    os.open = open_then_stopped
+    try:
+        with signal_handlers({signal.SIGINT: stop}):
+            yield opened
+    finally:
+        os.open = real_open

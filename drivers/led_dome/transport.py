@@ -18,19 +18,8 @@ from typing import Protocol
 import serial
 
 from rti_rig.core.clock import Clock, SystemClock
-
-try:  # pyserial lets termios.error (not an OSError) escape from tcdrain/tcsetattr on POSIX
-    import termios
-
-    _PORT_ERRORS: tuple[type[BaseException], ...] = (
-        serial.SerialException,
-        OSError,
-        termios.error,
-    )
-    _TERMIOS_ERROR: type[BaseException] | None = termios.error
-except ImportError:  # pragma: no cover - Windows
-    _PORT_ERRORS = (serial.SerialException, OSError)
-    _TERMIOS_ERROR = None
+from rti_rig.core.deferred_signals import signals_deferred
+from rti_rig.drivers.serial_ports import PORT_ERRORS, TERMIOS_ERROR, finish_close, identity
 
 
 class TransportError(Exception):
@@ -110,20 +99,33 @@ class SerialTransport:
         return "://" not in self.port
 
     def open(self) -> None:
+        """Open (and lock) the port; nothing to do if it is open.
+
+        A device path is opened with SIGINT/SIGTERM held (:func:`signals_deferred`), the stop
+        acted on once the port is this transport's: pyserial keeps the system's descriptor
+        only once ``os.open`` has returned, so a stop landing in between (the CLI's emergency
+        stop is raised wherever its signal lands) left a descriptor no object knew, open until
+        the process ended (and the board's line held up, so the teardown's reopening for the
+        all-off did not reset it). A device's opening does not wait on anything (non-blocking
+        open, termios calls); a URL port's connect may (a socket's, seconds), and its socket
+        object closes as the stop drops it, so a URL is opened as before, unheld."""
         if self._ser is not None:
             return
         # A second program on the same port would interleave its bytes with ours: lock it
         # (POSIX device paths only; URL handlers such as loop:// have nothing to lock).
         lock = {"exclusive": True} if "://" not in self.port and os.name == "posix" else {}
+        held = signals_deferred() if self.resets_on_open else contextlib.nullcontext()
         try:
-            self._ser = serial.serial_for_url(
-                self.port,
-                baudrate=self.baudrate,
-                timeout=0,
-                write_timeout=self.write_timeout_s,
-                **lock,
-            )
-        except (*_PORT_ERRORS, ValueError) as exc:
+            with held:
+                ser = serial.serial_for_url(
+                    self.port,
+                    baudrate=self.baudrate,
+                    timeout=0,
+                    write_timeout=self.write_timeout_s,
+                    **lock,
+                )
+                self._ser, self._opened_as, self._timeout = ser, identity(ser), 0
+        except (*PORT_ERRORS, ValueError) as exc:
             # pyserial's text repeats the port twice ("could not open port P: [Errno 2] No such
             # file or directory: 'P'"): the system's reason alone, where it gives one
             errno = getattr(exc, "errno", None)
@@ -137,8 +139,6 @@ class SerialTransport:
             raise error(
                 f"cannot open serial port {self.port}: {why}", errno=_system_errno(exc)
             ) from exc
-        self._timeout = 0
-        self._opened_as = _identity(self._ser)
 
     def close(self) -> None:
         """Release the port (its descriptor, and with it the lock ``open`` took); safe twice.
@@ -153,10 +153,10 @@ class SerialTransport:
         if ser is None:
             return
         try:
-            with contextlib.suppress(*_PORT_ERRORS):  # already gone: closing is best effort
+            with contextlib.suppress(*PORT_ERRORS):  # already gone: closing is best effort
                 ser.close()
         except BaseException:
-            _finish_close(ser, self._opened_as)
+            finish_close(ser, self._opened_as)
             raise
         finally:
             self._ser, self._opened_as = None, None
@@ -166,7 +166,7 @@ class SerialTransport:
         try:
             ser.write(data)
             ser.flush()
-        except _PORT_ERRORS as exc:
+        except PORT_ERRORS as exc:
             raise TransportError(
                 f"write to {self.port} failed: {exc}", errno=_system_errno(exc)
             ) from exc
@@ -183,7 +183,7 @@ class SerialTransport:
                 return b""
             waiting = ser.in_waiting
             return first + (ser.read(waiting) if waiting else b"")
-        except _PORT_ERRORS as exc:
+        except PORT_ERRORS as exc:
             raise TransportError(
                 f"read from {self.port} failed: {exc}", errno=_system_errno(exc)
             ) from exc
@@ -192,35 +192,6 @@ class SerialTransport:
         if self._ser is None:
             raise TransportError(f"serial port {self.port} is not open")
         return self._ser
-
-
-def _identity(ser: serial.SerialBase) -> tuple[int, int] | None:
-    """The (device, inode) of the file ``ser``'s descriptor refers to; None for a port with no
-    descriptor of its own (``loop://``, a socket URL whose number is no device)."""
-    fd = getattr(ser, "fd", None)
-    if not isinstance(fd, int):
-        return None
-    try:
-        st = os.fstat(fd)
-    except OSError:
-        return None
-    return st.st_dev, st.st_ino
-
-
-def _finish_close(ser: serial.SerialBase, opened_as: tuple[int, int] | None) -> None:
-    """Close ``ser`` again after a stop cut its close short: its descriptor (and lock) is
-    released now, not when the stop's traceback lets the object go. Closed only if the
-    descriptor still refers to the port opened (a stop landing just after pyserial's
-    ``os.close``, before it forgot the number, must not close a file another thread has since
-    been given under that number); pyserial's own close is otherwise used, suppressed errors
-    and all."""
-    fd = getattr(ser, "fd", None)
-    if opened_as is not None and isinstance(fd, int) and _identity(ser) != opened_as:
-        ser.fd = None  # already closed by the close that was cut short
-        ser.is_open = False
-        return
-    with contextlib.suppress(*_PORT_ERRORS):
-        ser.close()
 
 
 def _system_errno(exc: BaseException) -> int | None:
@@ -233,7 +204,7 @@ def _system_errno(exc: BaseException) -> int | None:
     while cause is not None and id(cause) not in seen:
         seen.add(id(cause))
         number = getattr(cause, "errno", None)
-        if number is None and _TERMIOS_ERROR is not None and isinstance(cause, _TERMIOS_ERROR):
+        if number is None and TERMIOS_ERROR is not None and isinstance(cause, TERMIOS_ERROR):
             number = cause.args[0] if cause.args else None  # termios.error(errno, text)
         if isinstance(number, int) and number > 0:
             return number
