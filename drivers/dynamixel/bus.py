@@ -23,7 +23,9 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 import dynamixel_sdk as sdk
+import serial
 
+from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.faults import (
@@ -32,6 +34,7 @@ from rti_rig.drivers.dynamixel.faults import (
     HardwareFaultError,
     ServoStatusError,
 )
+from rti_rig.drivers.serial_ports import finish_close, identity
 
 log = logging.getLogger("rti_rig.dynamixel.traffic")
 
@@ -133,28 +136,41 @@ class DxlBus:
         #: ids that have answered on this port since it opened: one of them silent later was
         #: reached at this id and baud rate, so its silence is its cable or power, not those
         self.answered: set[int] = set()
+        #: the open port's file (device, inode), to tell it from a descriptor number reused
+        self._opened_as: tuple[int, int] | None = None
 
     # -- port -------------------------------------------------------------------------------
     def open(self, baudrate: int) -> None:
+        """Open the port at ``baudrate`` and lock it, with SIGINT/SIGTERM held until both are
+        done (:func:`signals_deferred`; the stop is acted on as soon as they are).
+
+        Why held: the SDK keeps pyserial's port only once it is open, and pyserial keeps the
+        system's descriptor only once ``os.open`` has returned; a stop landing in between (the
+        CLI's emergency stop is raised wherever its signal lands) left a descriptor no object
+        knew, open until the process ended, and one landing before the lock a port this bus
+        had not locked. Opening a serial device waits on nothing (non-blocking open, termios
+        calls), so the stop is held for no time a user would notice."""
         log.debug("%s: open %s at %d baud", self.device, self.port.getPortName(), baudrate)
-        try:
-            ok = self.port.openPort() and self.port.setBaudRate(baudrate)
-        except Exception as exc:  # pyserial raises SerialException/OSError
-            raise CommunicationError(
-                self.device,
-                f"cannot open port {self.port.getPortName()!r}: {exc}; check that the arm's USB "
-                "adapter (e.g. a U2D2) is plugged in and that the rig config's [arm.dynamixel] "
-                "port names it",
-                "open",
-            ) from exc
-        if not ok:
-            raise CommunicationError(
-                self.device,
-                f"port {self.port.getPortName()!r} refused baud rate {baudrate}",
-                "open",
-            )
-        self._lock_exclusively()
-        self.baudrate = baudrate
+        with signals_deferred():
+            try:
+                ok = self.port.openPort() and self.port.setBaudRate(baudrate)
+            except Exception as exc:  # pyserial raises SerialException/OSError
+                raise CommunicationError(
+                    self.device,
+                    f"cannot open port {self.port.getPortName()!r}: {exc}; check that the "
+                    "arm's USB adapter (e.g. a U2D2) is plugged in and that the rig config's "
+                    "[arm.dynamixel] port names it",
+                    "open",
+                ) from exc
+            if not ok:
+                raise CommunicationError(
+                    self.device,
+                    f"port {self.port.getPortName()!r} refused baud rate {baudrate}",
+                    "open",
+                )
+            self._lock_exclusively()
+            self._opened_as = identity(getattr(self.port, "ser", None))
+            self.baudrate = baudrate
 
     def _lock_exclusively(self) -> None:
         """Hold the port's lock (``flock``, as pyserial's ``exclusive=True`` and the dome's
@@ -188,9 +204,25 @@ class DxlBus:
             return  # a device that cannot be locked (flock unsupported): as before
 
     def close(self) -> None:
+        """Release the port (its descriptor, and with it the lock); safe twice.
+
+        A stop raised inside the SDK's close (pyserial's, underneath) had left the descriptor
+        open and locked, the SDK still counting the port open: a second ``rti-rig`` was told
+        the port "is locked by another program" until this process ended, and a later close
+        landing after pyserial's own ``os.close`` closed whatever file had since been given
+        that number. The close is finished before the stop goes on, as the dome's transport
+        finishes its own (:func:`finish_close`)."""
         self.answered.clear()
-        if getattr(self.port, "is_open", False):
+        if not getattr(self.port, "is_open", False):
+            return
+        ser = getattr(self.port, "ser", None)
+        try:
             self.port.closePort()
+        except BaseException:
+            if isinstance(ser, serial.SerialBase):
+                finish_close(ser, self._opened_as)
+            self.port.is_open = False
+            raise
 
     # -- checks -----------------------------------------------------------------------------
     def _check(self, result: int, error: int, dxl_id: int, command: str, alert: bool = True):
@@ -330,8 +362,9 @@ class DxlBus:
                 if rate == configured:
                     continue
                 try:
-                    if not self.port.setBaudRate(rate):
-                        continue
+                    with signals_deferred():  # the SDK reopens the port (see open)
+                        if not self.port.setBaudRate(rate):
+                            continue
                 except Exception:  # an adapter (or pty) that cannot run at this rate
                     continue
                 if tried is not None:
@@ -342,8 +375,9 @@ class DxlBus:
             return None
         finally:
             try:
-                self.port.setBaudRate(configured)  # the SDK reopens the port: lock it again
-                self._lock_exclusively()
+                with signals_deferred():  # the SDK reopens the port (see open): lock it again
+                    self.port.setBaudRate(configured)
+                    self._lock_exclusively()
             except Exception as exc:  # the caller's error says what the bus gave
                 log.warning(
                     "%s: could not set the port back to %d baud: %s", self.device, configured, exc
