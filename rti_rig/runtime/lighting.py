@@ -14,7 +14,7 @@ from typing import Protocol
 
 import numpy as np
 
-from rti_rig.core.deferred_signals import signals_deferred
+from rti_rig.core.deferred_signals import signals_deferred, stop_words
 from rti_rig.core.devices import DiscreteLightSource, LightCarrier
 from rti_rig.core.errors import DeviceError, MoveCancelled
 from rti_rig.core.geometry import angle_between_deg
@@ -291,7 +291,7 @@ class ArmLighting:
     def _stopped_why(self, released: bool = False) -> str:
         """Why the arm is where the stop left it; ``released``: the close then found it at the
         park pose and released its torque (said after this, from the carrier's own note)."""
-        who = "Ctrl-C" if self.stopped_by == signal.SIGINT else "SIGTERM"
+        who = stop_words(signal.Signals(self.stopped_by or signal.SIGTERM))
         if released:
             return (
                 f"the park was stopped by {who}: held where it stopped, close enough to the park "
