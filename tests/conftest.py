@@ -212,20 +212,27 @@ def pytest_configure(config: pytest.Config) -> None:
     import shutil
     import tempfile
 
+    from rti_rig.runtime.duty_ledger import LEDGER_DIR_ENV
     from rti_rig.simulator.servo_latch import STATE_DIR_ENV
 
-    folder = tempfile.mkdtemp(prefix="rti-rig-test-servo-state-")
-    before = os.environ.get(STATE_DIR_ENV)
-    os.environ[STATE_DIR_ENV] = folder
+    for env, prefix in (
+        (STATE_DIR_ENV, "rti-rig-test-servo-state-"),
+        # the dome duty ledgers too: a session-scoped fixture's run on a shipped dome would
+        # otherwise write the user's own ledger (and wait for LEDs a rehearsal left hot)
+        (LEDGER_DIR_ENV, "rti-rig-test-dome-duty-"),
+    ):
+        folder = tempfile.mkdtemp(prefix=prefix)
+        before = os.environ.get(env)
+        os.environ[env] = folder
 
-    def restore() -> None:
-        if before is None:
-            os.environ.pop(STATE_DIR_ENV, None)
-        else:
-            os.environ[STATE_DIR_ENV] = before
-        shutil.rmtree(folder, ignore_errors=True)
+        def restore(env: str = env, before: str | None = before, folder: str = folder) -> None:
+            if before is None:
+                os.environ.pop(env, None)
+            else:
+                os.environ[env] = before
+            shutil.rmtree(folder, ignore_errors=True)
 
-    config.add_cleanup(restore)
+        config.add_cleanup(restore)
 
 
 @pytest.fixture(autouse=True)
@@ -238,6 +245,18 @@ def _emulated_servos_power_cycled(
     from rti_rig.simulator.servo_latch import STATE_DIR_ENV
 
     monkeypatch.setenv(STATE_DIR_ENV, str(tmp_path_factory.mktemp("servo-state")))
+
+
+@pytest.fixture(autouse=True)
+def _dome_leds_cold(
+    tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each test's domes start with cold LEDs: a duty ledger of their own, so an earlier
+    test's run on the same shipped config does not make this test's LEDs wait (a test that
+    means to, runs both commands itself)."""
+    from rti_rig.runtime.duty_ledger import LEDGER_DIR_ENV
+
+    monkeypatch.setenv(LEDGER_DIR_ENV, str(tmp_path_factory.mktemp("dome-duty")))
 
 
 @pytest.fixture(autouse=True)

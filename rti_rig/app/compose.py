@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from rti_rig.app.config import LoadedRig, rig_geometry
 from rti_rig.core.clock import Clock, SystemClock, VirtualClock
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.runtime.duty_ledger import DutyLedger
 from rti_rig.runtime.lighting import ArmLighting, DomeLighting
 from rti_rig.runtime.rig import Rig
 
@@ -136,6 +137,7 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
             clock,
             directions=geometry.directions,
             name=f"dome on {link.port} (emulated)",
+            ledger=DutyLedger.for_emulated(Path(loaded.path)),
         )
         camera = _simulated_camera(
             loaded,
@@ -232,6 +234,7 @@ def _build_emulated_firmware_dome(
             clock,
             directions=geometry.directions,
             name=f"dome on {link.port} (emulated {serial.profile})",
+            ledger=DutyLedger.for_emulated(Path(loaded.path)),
         )
         power = cfg.emulator.led_powers(geometry.count, cfg.scene.seed)
         light = _BoardLight(board, geometry, link, power, cfg.emulator.dead_leds)
@@ -344,6 +347,7 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
             clock,
             directions=geometry.directions,
             name=f"dome on {cfg.dome.serial.port}",
+            ledger=DutyLedger.for_port(cfg.dome.serial.port),
         )
         camera = build_camera(
             camera_settings, clock=clock, trigger=_camera_trigger(camera_settings, dome)

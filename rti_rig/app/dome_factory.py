@@ -14,6 +14,7 @@ from rti_rig.drivers.led_dome.factory import build_driver
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.drivers.led_dome.transport import Transport
 from rti_rig.runtime.dome_policy import DomePolicy, DomePolicySettings, ThermalLimits
+from rti_rig.runtime.duty_ledger import DutyLedger
 
 
 def policy_settings(settings: DomeSerialSettings) -> DomePolicySettings:
@@ -70,12 +71,18 @@ def build_dome(
     transport: Transport | None = None,
     directions: NDArray[np.float64] | None = None,
     name: str = "dome",
+    ledger: DutyLedger | None = None,
 ) -> DomePolicy:
-    """A ready-to-connect dome light source (a ``DiscreteLightSource``); nothing is opened yet."""
+    """A ready-to-connect dome light source (a ``DiscreteLightSource``); nothing is opened yet.
+
+    ``ledger``: the duty ledger its thermal guard shares with earlier and later commands on
+    the same physical dome (:mod:`rti_rig.runtime.duty_ledger`); None counts this process's
+    lightings alone (a test's own dome)."""
     return DomePolicy(
         build_driver(settings, transport, name=name),
         clock,
         policy_settings(settings),
         directions=directions,
         name=name,
+        ledger=ledger,
     )

@@ -26,6 +26,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from functools import partial
@@ -47,6 +48,7 @@ from rti_rig.core.dome_link import (
     OffReport,
 )
 from rti_rig.core.errors import DeviceError
+from rti_rig.runtime.duty_ledger import SAVE_EVERY_S, DutyLedger
 
 log = logging.getLogger("rti_rig.dome")
 
@@ -86,6 +88,9 @@ class ThermalGuard:
     def __init__(self, limits: ThermalLimits) -> None:
         self.limits = limits
         self._intervals: dict[int, list[tuple[float, float]]] = {}
+        #: Lightings by an earlier command (from the duty ledger), kept apart so that a wait
+        #: they cause can be said as theirs.
+        self._earlier: dict[int, list[tuple[float, float]]] = {}
 
     def record(self, index: int, start: float, end: float) -> None:
         if end < start:
@@ -96,19 +101,43 @@ class ThermalGuard:
         while spans and spans[0][1] < horizon:
             spans.pop(0)
 
-    def on_time(self, index: int, window_start: float, window_end: float) -> float:
+    def remember(self, index: int, start: float, end: float) -> None:
+        """Count a lighting an earlier command made (times on this guard's clock)."""
+        if end < start:
+            raise ValueError(f"LED {index}: interval ends ({end}) before it starts ({start})")
+        self._earlier.setdefault(index, []).append((start, end))
+
+    def earlier(self, index: int) -> list[tuple[float, float]]:
+        """The lightings of ``index`` an earlier command made, as :meth:`remember` got them."""
+        return list(self._earlier.get(index, ()))
+
+    def spans(self) -> dict[int, list[tuple[float, float]]]:
+        """Every known lighting, this command's and earlier ones', per LED (for the ledger)."""
+        out: dict[int, list[tuple[float, float]]] = {}
+        for table in (self._earlier, self._intervals):
+            for index, spans in table.items():
+                out.setdefault(index, []).extend(spans)
+        return {i: sorted(v) for i, v in out.items()}
+
+    def on_time(
+        self, index: int, window_start: float, window_end: float, *, earlier: bool = True
+    ) -> float:
         total = 0.0
-        for s, e in self._intervals.get(index, ()):
-            total += max(0.0, min(e, window_end) - max(s, window_start))
+        tables = (self._intervals, self._earlier) if earlier else (self._intervals,)
+        for table in tables:
+            for s, e in table.get(index, ()):
+                total += max(0.0, min(e, window_end) - max(s, window_start))
         return total
 
-    def earliest_start(self, index: int, now: float) -> float:
-        """Earliest time ≥ ``now`` at which ``index`` may be lit for up to ``max_on_s``."""
+    def earliest_start(self, index: int, now: float, *, earlier: bool = True) -> float:
+        """Earliest time ≥ ``now`` at which ``index`` may be lit for up to ``max_on_s``
+        (``earlier=False``: as if no earlier command had lit it)."""
         lim = self.limits
         budget = lim.max_duty * lim.duty_window_s - lim.max_on_s
 
         def fits(t: float) -> bool:
-            return self.on_time(index, t - lim.duty_window_s, t) <= budget + 1e-9
+            on = self.on_time(index, t - lim.duty_window_s, t, earlier=earlier)
+            return on <= budget + 1e-9
 
         if fits(now):
             return now
@@ -160,6 +189,16 @@ class DomePolicySettings:
 
 
 @dataclass(frozen=True)
+class DutyWait:
+    """How long this command's LEDs waited dark for the duty limit, and how much of it was for
+    lightings an earlier command made (the duty ledger), under which limits."""
+
+    waited_s: float
+    for_earlier_s: float
+    limits: ThermalLimits
+
+
+@dataclass(frozen=True)
 class _Lit:
     index: int
     level: int
@@ -182,6 +221,7 @@ class DomePolicy:
         *,
         directions: NDArray[np.float64] | None = None,
         name: str = "dome",
+        ledger: DutyLedger | None = None,
     ) -> None:
         self.name = name
         self.link = link
@@ -190,6 +230,18 @@ class DomePolicy:
         self.directions = None if directions is None else np.asarray(directions, dtype=float)
         self.guard = ThermalGuard(self.settings.thermal)
         self.stats = DomeStats()
+        #: The duty ledger shared with earlier and later commands on this dome (None: this
+        #: process alone counts its lightings). Read at the first :meth:`connect`.
+        self.ledger = ledger
+        self._ledger_read = False
+        #: Wall-clock seconds (``time.time()``) at this clock's reading 0: the guard's times
+        #: and the ledger's are one shift apart, fixed once (a wall clock set mid-command
+        #: moves nothing).
+        self._wall_offset = 0.0
+        self._saved_at: float | None = None
+        #: Seconds of :attr:`DomeStats.thermal_wait_s` due to an earlier command's lightings.
+        self._earlier_wait_s = 0.0
+        self._earlier_said = False
         self.info: DomeInfo | None = None
         self._lit: _Lit | None = None
         #: What the last all-off attempt established (None: none attempted yet).
@@ -238,6 +290,7 @@ class DomePolicy:
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> None:
+        self._read_ledger()
         if self.settings.intensity_correction is not None and not self.link.can_dim:
             # before the port opens (the Nab sketch boots lit): every corrected level of an
             # on/off link had been lit at full light, as if no correction were given
@@ -577,6 +630,7 @@ class DomePolicy:
             raise
         if self.info is not None and self.link.port_open:
             self._held = True
+            self._keep_ledger()
         else:
             self.close()
 
@@ -588,9 +642,66 @@ class DomePolicy:
                 self.all_off()
             except DeviceError as exc:
                 log.warning("%s: could not switch all off while closing: %s", self.name, exc)
+        if self._lit is not None:
+            # not known off: its lighting counts up to now at least (the next command's guard
+            # then errs towards waiting)
+            lit, now = self._lit, self.clock.now()
+            self.guard.record(lit.index, lit.since, max(now, lit.since))
         self.info = None
         self._lit = None
         self._quiet_close()
+        self._keep_ledger()
+
+    # ------------------------------------------------------------------ duty ledger
+
+    def _read_ledger(self) -> None:
+        """Count the lightings an earlier command made on this dome (once per policy)."""
+        if self.ledger is None or self._ledger_read:
+            return
+        self._ledger_read = True
+        window = self.settings.thermal.duty_window_s
+        now = self.clock.now()
+        self._wall_offset = self.ledger.wall() - now
+        read = self.ledger.load(window)
+        for index, spans in read.spans.items():
+            for start, end in spans:
+                self.guard.remember(index, start - self._wall_offset, end - self._wall_offset)
+        self._saved_at = now
+
+    def _keep_ledger(self, *, throttled: bool = False) -> None:
+        """Write this dome's lightings of the last duty window to the ledger; ``throttled``:
+        only if :data:`SAVE_EVERY_S` of the rig's clock passed since the last write (an
+        all-off's, so that a session is not slowed by a write per image)."""
+        if self.ledger is None or not self._ledger_read:
+            return
+        now = self.clock.now()
+        if throttled and self._saved_at is not None and now - self._saved_at < SAVE_EVERY_S:
+            return
+        self._saved_at = now
+        offset = self._wall_offset
+        spans = {i: [(s + offset, e + offset) for s, e in v] for i, v in self.guard.spans().items()}
+        self.ledger.save(spans, now + offset, self.settings.thermal.duty_window_s)
+
+    def duty_wait(self) -> DutyWait:
+        """How long this command's LEDs waited dark for the duty limit (see :class:`DutyWait`)."""
+        return DutyWait(self.stats.thermal_wait_s, self._earlier_wait_s, self.settings.thermal)
+
+    def _say_earlier_wait(self, index: int, now: float, wait_s: float) -> None:
+        """Say once per command that an LED waits for what an earlier command lit."""
+        if self._earlier_said:
+            return
+        self._earlier_said = True
+        spans = self.guard.earlier(index)
+        window = self.settings.thermal.duty_window_s
+        lit = sum(max(0.0, e - max(s, now - window)) for s, e in spans)
+        ago = max(0.0, now - max(e for _, e in spans)) if spans else 0.0
+        warnings.warn(
+            f"LED {index} was lit {lit:.1f} s by an earlier command {ago:.0f} s ago: waiting "
+            f"{wait_s:.1f} s for its duty limit ([dome.serial.thermal] max_duty = "
+            f"{self.settings.thermal.max_duty:g} over duty_window_s = {window:g} s)",
+            RuntimeWarning,
+            stacklevel=3,
+        )
 
     def light_count(self) -> int:
         if self.info is not None:
@@ -619,6 +730,10 @@ class DomePolicy:
         start = self.guard.earliest_start(index, now)
         if start > now:
             log.info("%s: LED %d cools for %.3f s (duty limit)", self.name, index, start - now)
+            alone = self.guard.earliest_start(index, now, earlier=False)
+            if start > alone + 1e-6:  # an earlier command's lightings hold it back
+                self._earlier_wait_s += start - alone
+                self._say_earlier_wait(index, now, start - now)
             self.clock.sleep(start - now)
             self.stats.thermal_wait_s += start - now
         max_on_ms = math.ceil(self.settings.thermal.max_on_s * 1000)
@@ -662,6 +777,8 @@ class DomePolicy:
         try:
             self._run(self.link.all_off, "all off")
         except DomeLinkError as exc:
+            if self._lit is not None:  # its lighting counts, up to now at least
+                self.guard.record(self._lit.index, self._lit.since, self.clock.now())
             self._lit = None
             if exc.fault is LinkFault.FOREIGN:
                 self._switch_off_foreign("in place of this profile's all-off")
@@ -673,6 +790,7 @@ class DomePolicy:
         if self._lit is not None:
             self.guard.record(self._lit.index, self._lit.since, self.clock.now())
         self._lit = None
+        self._keep_ledger(throttled=True)
 
     def shutter(self, pulse_ms: int | None = None) -> None:
         """Pulse the camera release line. Never resent: a resend could take a second picture."""
