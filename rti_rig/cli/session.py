@@ -1210,15 +1210,18 @@ def _duty_clause(rig) -> str:  # type: ignore[no-untyped-def]
 
     if not isinstance(rig.lighting, DomeLighting):
         return ""
-    source = rig.lighting.source
-    stats, settings = getattr(source, "stats", None), getattr(source, "settings", None)
-    waited = float(getattr(stats, "thermal_wait_s", 0.0) or 0.0)
-    if settings is None or waited < 0.05:
+    wait = rig.lighting.duty_wait()
+    if wait is None or wait.waited_s < 0.05:
         return ""
-    thermal = settings.thermal
+    thermal = wait.limits
+    earlier = ""
+    if wait.for_earlier_s >= 0.05:
+        # the guard counts an earlier command's lightings (the duty ledger): a wait at the
+        # start of a run right after another is theirs, not this run's
+        earlier = f", {wait.for_earlier_s:.1f} s of it for LEDs an earlier command left hot"
     return (
-        f"; of which LEDs waited dark {waited:.1f} s to cool, as the dome's duty limit asks "
-        f"([dome.serial.thermal] max_duty = {thermal.max_duty:g} over "
+        f"; of which LEDs waited dark {wait.waited_s:.1f} s to cool{earlier}, as the dome's "
+        f"duty limit asks ([dome.serial.thermal] max_duty = {thermal.max_duty:g} over "
         f"duty_window_s = {thermal.duty_window_s:g} s): no LED was driven past it"
     )
 

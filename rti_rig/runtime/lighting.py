@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import signal
 from dataclasses import dataclass, replace
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -21,6 +21,9 @@ from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.schedule import LightStep
 from rti_rig.runtime.arm_end import ArmEnd, left_end, park_end
+
+if TYPE_CHECKING:
+    from rti_rig.runtime.dome_policy import DutyWait
 
 #: A dome step's direction must match its LED's calibrated direction this closely (degrees).
 LED_MATCH_TOLERANCE_DEG = 0.5
@@ -79,6 +82,15 @@ class DomeLighting:
 
     def close(self) -> None:
         self.source.close()
+
+    def duty_wait(self) -> DutyWait | None:
+        """How long the dome's LEDs waited dark for its duty limit; None for a source with no
+        thermal guard (a simulated dome). Why typed: the run's time line had guessed at the
+        source's ``stats`` and ``settings`` with ``getattr``, which a rename would have
+        silently turned into "never waited"."""
+        from rti_rig.runtime.dome_policy import DomePolicy
+
+        return self.source.duty_wait() if isinstance(self.source, DomePolicy) else None
 
     def hold(self) -> None:
         """Lights off, the dome's port kept open for the next :meth:`connect` where its driver
