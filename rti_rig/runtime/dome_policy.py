@@ -13,7 +13,10 @@ means for an acquisition, and implements :class:`rti_rig.core.devices.DiscreteLi
 * per-LED intensity correction maps a requested intensity to a PWM level;
 * a thermal guard bounds each LED's continuous on-time (also sent to the firmware's watchdog when
   the profile can carry it) and its duty cycle over a sliding window, waiting on the injected
-  clock for an LED to cool rather than overdriving it;
+  clock for an LED to cool rather than overdriving it; its lightings outlive the command in the
+  dome's duty ledger (:mod:`rti_rig.runtime.duty_ledger`: read at the first connect, written at
+  close, hold and, at most every ``SAVE_EVERY_S`` of rig time, an all-off), so the next command
+  on the same dome waits for the LEDs this one left hot, and says so once (a warning);
 * LED index ↔ direction comes from the dome's calibrated ``.lp`` (passed in as directions).
 
 The runtime never imports ``drivers``: the driver is reached through the core's
