@@ -166,3 +166,26 @@ def test_a_ledger_from_the_future_is_taken_as_just_ended(tmp_path: Path) -> None
     assert code == 0, text
     waited, earlier = _waited(text)
     assert 500.0 < earlier <= waited <= 600.0 + 60.0, text
+
+
+@pytest.mark.pty
+def test_a_hardware_dome_keeps_its_ledger_under_its_port(tmp_path: Path) -> None:
+    """A hardware config's dome is keyed by its port, not its config file: the check's LEDs
+    are in the port's ledger, where another config naming the same port will find them."""
+    from conftest import emulated_dome_as_hardware
+
+    from rti_rig.simulator.domes import board_for
+    from rti_rig.simulator.pty_link import serve_on_pty
+
+    board = board_for("elexol-24r1")
+    with serve_on_pty(board, "elexol-24r1") as link:
+        cfg = emulated_dome_as_hardware(tmp_path, "emulated_elexol.toml", link.port)
+        r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+        # the port is a link to the pty: keyed by what it points to, as a by-id link is
+        ledger = DutyLedger.for_port(link.port).path
+        assert ledger == DutyLedger.for_port(os.path.realpath(link.port)).path
+    text = said(r)
+    assert r.exit_code == 0, text
+    assert not DutyLedger.for_emulated(cfg).path.exists()
+    lit = json.loads(ledger.read_text())["lit"]
+    assert sorted(map(int, lit)) == list(range(12)), lit  # the check lit each LED once
