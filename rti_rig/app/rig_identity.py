@@ -124,7 +124,9 @@ def rig_identity(loaded: LoadedRig) -> dict[str, Any]:
         ident["scene"] = _digest(cfg.scene.model_dump())
     if cfg.backend == "replay":
         assert isinstance(geometry, DomeGeometry)
-        ident["recorded_images"] = _recorded_images_digest(loaded, geometry)
+        ident["recorded_images"], ident["recorded_files"] = _recorded_images_digest(
+            loaded, geometry
+        )
     return ident
 
 
@@ -193,31 +195,78 @@ def _builtin_protocol_digest(profile: Any) -> str | None:
     return _protocol_digest(ProtocolSpec.model_validate(builtin_spec(profile)))
 
 
-def _recorded_images_digest(loaded: LoadedRig, geometry: DomeGeometry) -> str:
+def _recorded_images_digest(loaded: LoadedRig, geometry: DomeGeometry) -> tuple[str, dict]:  # type: ignore[type-arg]
     """The content of a replayed acquisition's images, in light order: they are what its
     camera returns. An image edited or replaced between an interruption and the resume had
     been mixed into the session without a word (the resume's images then came from another
-    acquisition than the first part's). Hashed in full: a fraction of a second for a
-    72-image acquisition of 5 MB JPEGs."""
-    return recorded_images_digest(Path(loaded.path).parent, geometry.names)
+    acquisition than the first part's). Hashed in full (a fraction of a second for a 72-image
+    acquisition of 5 MB JPEGs; seconds for one of 16-bit TIFFs not in the page cache), with
+    each file's stamp (:func:`recorded_images_stamped`), recorded beside the digest so that a
+    verdict need not hash them again."""
+    return recorded_images_stamped(Path(loaded.path).parent, geometry.names)
 
 
-def recorded_images_digest(folder: Path, names: Sequence[str]) -> str:
+def recorded_images_digest(
+    folder: Path,
+    names: Sequence[str],
+    stamps: Any = None,
+) -> str:
     """:func:`_recorded_images_digest` of the images ``names`` (an `.lp`'s, in its order) in
-    ``folder``: also what a replay's verdict checks before it names the recorded files."""
+    ``folder``: also what a replay's verdict checks before it names the recorded files, with
+    the ``stamps`` its session recorded (:func:`recorded_images_stamped`)."""
+    return recorded_images_stamped(folder, names, stamps)[0]
+
+
+def recorded_images_stamped(
+    folder: Path,
+    names: Sequence[str],
+    stamps: Any = None,
+) -> tuple[str, dict[str, list[Any]]]:
+    """:func:`recorded_images_digest` of ``names`` in ``folder``, and each file's stamp
+    ``{name: [size, mtime_ns, ctime_ns, sha256]}`` (a missing file has none). A file whose
+    size, mtime and ctime are those ``stamps`` (a session's ``recorded_files``) holds for it is
+    not read again: its recorded SHA-256 stands.
+
+    Why: a replayed session's verdict (on every ``run`` and ``fit`` of it) checks that the
+    acquisition is still the one replayed before naming its files, and had hashed every image
+    of it each time: seconds for 72 16-bit TIFFs. Why that is safe enough: any write to a file
+    sets its mtime and ctime to the clock, and a file replaced (an editor's save, a re-export,
+    a copy over it) changes them too; ``touch -r``/``os.utime`` can set the mtime back, but the
+    ctime only the kernel sets, to now. An edit that kept size, mtime *and* ctime (a write to
+    the disk beneath the filesystem, or the system clock set back to the instant of the stamp)
+    would go unseen here: the verdict would then name the recorded file a clipped image replays
+    from its light, as for an unchanged acquisition; a resume hashes every file in full, and
+    refuses such an acquisition. A folder copied elsewhere (a new ctime) is hashed in full on
+    each verdict: its stamps are not written back (a verdict writes nothing to the session)."""
     from rti_rig.core.lp_format import image_path
 
+    known = stamps if isinstance(stamps, dict) else {}
     total = hashlib.sha256()
+    stamped: dict[str, list[Any]] = {}
     for name in names:
-        digest = hashlib.sha256()
+        path = image_path(folder, name)
         try:
-            with open(image_path(folder, name), "rb") as f:
-                for block in iter(lambda f=f: f.read(1 << 20), b""):
-                    digest.update(block)
+            st = path.stat()
+            stamp = [st.st_size, st.st_mtime_ns, st.st_ctime_ns]
+            was = known.get(name)
+            if isinstance(was, list) and len(was) == 4 and was[:3] == stamp:
+                hexdigest = str(was[3])
+            else:
+                hexdigest = _file_digest(path)
+            stamped[name] = [*stamp, hexdigest]
         except OSError:
-            digest.update(b"missing")  # refused by name where the images are read
-        total.update(f"{name}\0{digest.hexdigest()}\n".encode())
-    return total.hexdigest()[:16]
+            hexdigest = hashlib.sha256(b"missing").hexdigest()  # refused where images are read
+        total.update(f"{name}\0{hexdigest}\n".encode())
+    return total.hexdigest()[:16], stamped
+
+
+def _file_digest(path: Path) -> str:
+    """The SHA-256 of the file at ``path``, read in blocks (OSError when it cannot be)."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda f=f: f.read(1 << 20), b""):  # type: ignore[misc]
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[str]:
@@ -248,6 +297,8 @@ def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[st
                 continue  # a built-in's own protocol, with or without a table restating it
         if key == "light_directions":
             continue  # said under "light positions"
+        if key == "recorded_files":
+            continue  # the files' stamps and checksums: "recorded images" says a change
         if key == "light_positions":
             moved = _moved_lights(before.get("light_directions"), now.get("light_directions"))
             if moved is not None:  # both sides hold the positions: compared, not digested

@@ -257,7 +257,8 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
     if (manifest.get("rig") or {}).get("backend") == "replay":
         word = "flawed"  # "reshoot: …" headed advice that said it could not be
         advice = "clipped in the recording (a replayed acquisition cannot be reshot)"
-        recorded = _replayed_names(manifest)
+        if any(LESS_EXPOSURE in p for c in qa.images for p in c.problems):
+            recorded = _replayed_names(manifest)  # checks the acquisition: only when named
         note = (
             "this session replays a recorded acquisition: the problems named are the "
             "recording's, and cannot be reshot here"
@@ -302,12 +303,15 @@ def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
     # named only where the `.lp` and its images are still the ones the session replayed (their
     # digest, recorded when it began): an `.lp` edited since (lines reordered or removed) or
     # images re-exported had the verdict name other photographs, and a session from before
-    # the digest was recorded cannot tell
+    # the digest was recorded cannot tell. Files whose stamps are the ones recorded with it
+    # are not hashed again (:func:`~rti_rig.app.rig_identity.recorded_images_stamped` says why
+    # that is safe enough): every verdict had hashed every image of the acquisition
     from rti_rig.app.rig_identity import recorded_images_digest
 
-    began = ((manifest.get("rig") or {}).get("identity") or {}).get("recorded_images")
+    identity = (manifest.get("rig") or {}).get("identity") or {}
+    began = identity.get("recorded_images")
     if began is None or began != recorded_images_digest(
-        Path(lp_file).parent, [e.name for e in entries]
+        Path(lp_file).parent, [e.name for e in entries], identity.get("recorded_files")
     ):
         return {}
     names: dict[str, str] = {}
