@@ -106,13 +106,23 @@ def check_acquisition(lp: Path, notes: list[str] | None = None) -> list[Path]:
     What the tolerant reader kept of a flawed file (a count line that disagrees, a light a hair
     below the horizon clamped to it) is appended to ``notes`` for the command to say, as
     ``run``, ``check``, ``plan`` and ``fit`` say it: such a file had been measured in silence.
+    So are the notes ``run`` and ``fit`` give of its images (PNGs whose alpha or transparency
+    key is dropped, 8-bit files mixed with 16-bit ones): they had gone unsaid here.
 
     Returns the image files, for the command to keep ``--out`` out of their folders."""
+    from rti_rig.core.acquisition_images import mixed_depth_note
     from rti_rig.core.errors import RtiRigError
+    from rti_rig.core.image_files import png_alpha_note
     from rti_rig.core.lp_format import read_lp
 
     entries = read_lp(lp, upper_hemisphere=True, notes=notes)
     files = _image_files(lp, entries)
+    if notes is not None:  # what run and fit of it say of its images, said alike here
+        names = [e.name for e in entries]
+        notes.extend(png_alpha_note(names, files))
+        mixed = mixed_depth_note(lp, names, files, "measured")
+        if mixed:
+            notes.append(mixed)
     too_few = _too_few_lights(lp, len(entries))
     if too_few is not None:
         raise RtiRigError(too_few)

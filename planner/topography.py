@@ -40,6 +40,7 @@ from rti_rig.core.image_files import (
     colour_or_grey,
     is_tiff_file,
     jpeg_truncation,
+    opencv_as_stored,
     tiff_is_planar,
     tiff_one_image,
     tiff_samples_last,
@@ -108,9 +109,9 @@ def read_preview(path: Path) -> NDArray:
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise ScheduleError(f"{p}: cannot read this file as an image (JPEG, PNG or TIFF)")
-    if img.ndim == 3 and img.shape[2] >= 3:
-        img = cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2RGB)
-    return img
+    # grey + alpha is grey, an alpha dropped, as the replay rig and the fit read it: a grey
+    # camera's grey + alpha PNG had been read as colour
+    return opencv_as_stored(img, p)
 
 
 def _read_tiff_preview(p: Path) -> NDArray | None:

@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from rti_rig.core.errors import CaptureError
 from rti_rig.core.image_files import (
     SeveralFullSizeImages,
-    png_colour_type,
+    opencv_as_stored,
     tiff_is_planar,
     tiff_main_image,
     tiff_one_image,
@@ -281,8 +281,4 @@ def read_image_file(path: Path, device: str) -> NDArray:
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise ImageReadError(device, path, "", is_tiff=False)
-    if img.ndim == 3 and img.shape[2] == 4 and png_colour_type(path) == 4:
-        return np.ascontiguousarray(img[..., 0])  # grey + alpha, read as B = G = R = grey
-    if img.ndim == 3 and img.shape[2] in (3, 4):
-        img = np.ascontiguousarray(img[..., 2::-1])  # BGR(A) -> RGB, alpha dropped
-    return img
+    return opencv_as_stored(img, path)  # grey + alpha as grey, BGR(A) -> RGB, alpha dropped

@@ -69,21 +69,75 @@ def png_colour_type(path: Path) -> int | None:
     return head[25]
 
 
+def png_transparency(path: Path) -> str | None:
+    """What of a PNG says transparency, which its readers drop: its colour type's alpha
+    (``"grey + alpha"``, ``"RGBA"``) or a transparency key (``"tRNS"``: one grey or colour
+    value, or palette entries, marked transparent); None for a PNG without, or another file.
+
+    Why the key too: OpenCV drops it from a grey PNG and turns it into an alpha sample of a
+    colour or palette one, which the readers then drop: either way it had gone unsaid, where
+    an alpha channel was said. Read from the chunks before the pixels (the PNG spec puts tRNS
+    before the first IDAT)."""
+    kind = png_colour_type(path)
+    if kind is None:
+        return None
+    if kind in PNG_ALPHA_TYPES:
+        return PNG_ALPHA_TYPES[kind]
+    try:
+        with Path(path).open("rb") as f:
+            f.seek(8)
+            while True:
+                head = f.read(8)
+                if len(head) < 8 or head[4:] in (b"IDAT", b"IEND"):
+                    return None
+                if head[4:] == b"tRNS":
+                    return "tRNS"
+                f.seek(int.from_bytes(head[:4], "big") + 4, 1)  # its data and CRC
+    except OSError:
+        return None
+
+
 def png_alpha_note(names: Sequence[str], paths: Sequence[Path]) -> list[str]:
     """The one note of an acquisition (``paths[i]`` read for ``names[i]``) whose PNGs carry
-    an alpha channel, which their readers drop; none when no PNG does.
+    an alpha channel or a transparency key (:func:`png_transparency`), which their readers
+    drop; none when no PNG does.
 
     Why once for the acquisition: the alpha carries no light, so the grey or colour samples
     are the picture, but the user should know it is left out (the replay rig and the fit had
-    dropped it unsaid), in one line, not one per image."""
-    alpha = [n for n, p in zip(names, paths, strict=True) if png_colour_type(p) in PNG_ALPHA_TYPES]
-    if not alpha:
-        return []
-    shown = ", ".join(alpha[:3]) + (" ..." if len(alpha) > 3 else "")
-    return [
-        f"{len(alpha)} of {len(names)} image(s) are PNGs with an alpha channel ({shown}), "
-        "which carries no light: it was dropped and their grey or colour samples used"
-    ]
+    dropped it unsaid), in one line, not one per image. A transparency key is dropped alike:
+    it marks a value as see-through, and that value is still what the camera measured."""
+    kinds = {n: png_transparency(p) for n, p in zip(names, paths, strict=True)}
+    alpha = [n for n, k in kinds.items() if k is not None and k != "tRNS"]
+    keyed = [n for n, k in kinds.items() if k == "tRNS"]
+    notes = []
+    if alpha:
+        shown = ", ".join(alpha[:3]) + (" ..." if len(alpha) > 3 else "")
+        notes.append(
+            f"{len(alpha)} of {len(names)} image(s) are PNGs with an alpha channel ({shown}), "
+            "which carries no light: it was dropped and their grey or colour samples used"
+        )
+    if keyed:
+        shown = ", ".join(keyed[:3]) + (" ..." if len(keyed) > 3 else "")
+        notes.append(
+            f"{len(keyed)} of {len(names)} image(s) are PNGs with a transparency key (tRNS: "
+            f"{shown}), which marks a value see-through but carries no light: it was dropped "
+            "and every pixel used as measured"
+        )
+    return notes
+
+
+def opencv_as_stored(img: NDArray[Any], path: Path) -> NDArray[Any]:
+    """``cv2.imread(path, IMREAD_UNCHANGED)``'s ``img`` as the file stores it: colour in RGB
+    order, a grey + alpha PNG as grey (OpenCV gives B = G = R = grey and alpha,
+    :func:`png_colour_type` tells it from RGBA), an alpha sample dropped (it carries no light).
+
+    Why one function: the recorded-image reader and the planner's preview each converted
+    OpenCV's channels themselves, and the preview had read a grey + alpha PNG as colour."""
+    if img.ndim == 3 and img.shape[2] == 4 and png_colour_type(path) == 4:
+        return np.ascontiguousarray(img[..., 0])
+    if img.ndim == 3:
+        return np.ascontiguousarray(img[..., 2::-1] if img.shape[2] >= 3 else img[..., 0])
+    return img
 
 
 def image_number(path: Path) -> tuple[int, str]:
@@ -633,8 +687,4 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
         raise SessionError(f"cannot read image {p} (missing, or not an image OpenCV decodes)")
     if img.dtype not in (np.uint8, np.uint16):
         raise SessionError(f"image {p}: {img.dtype} is not 8- or 16-bit")
-    if img.ndim == 3 and img.shape[2] == 4 and png_colour_type(p) == 4:
-        img = img[..., 0]  # grey + alpha, read as B = G = R = grey: grey, as its header says
-    elif img.ndim == 3:
-        img = img[..., 2::-1] if img.shape[2] >= 3 else img[..., 0]
-    return np.ascontiguousarray(img)
+    return np.ascontiguousarray(opencv_as_stored(img, p))

@@ -32,6 +32,7 @@ from rti_rig.app.preview_source import given_light_differs, resolve_preview
 from rti_rig.app.usecases.fit_outlook import fit_needs, fit_outlook, fit_without_normals
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import direction_from_az_el
+from rti_rig.core.image_files import png_alpha_note
 from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 from rti_rig.core.schedule import LightSchedule
@@ -209,6 +210,8 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             if differs is not None:
                 notes.append(differs)
         image = read_preview_image(source.image)
+        # its alpha or transparency key dropped, said as run and fit say it of an acquisition
+        notes.extend(png_alpha_note([source.image.name], [source.image]))
     schedule, report = plan(
         PlanRequest(
             image,
