@@ -738,17 +738,77 @@ def _with_led_map_path(data: dict[str, Any], folder: Path) -> dict[str, Any]:
     return {**data, "dome": {**dome, "serial": resolved}}  # type: ignore[dict-item]
 
 
-def _not_toml_hint(raw: bytes) -> str:
-    """What a file that is no TOML was given as a rig instead, where that can be told: an image
-    of an acquisition (``run ACQ/image01.jpg``), or an acquisition's light list saved under
-    another suffix (``lights.txt``), which a rig is read as only when it ends in ``.lp``.
-    Both had been told only the TOML parser's complaint ("codec can't decode byte 0xff",
-    "Expected '=' after a key")."""
+#: What to give instead of a file that is no rig config (said after what the file is).
+_GIVE_RIG = (
+    "give the rig config (.toml), or the .lp of a recorded acquisition that lists its images"
+)
+
+
+def _config_text(path: Path, raw: bytes) -> str:
+    """The text of rig config ``path`` (its bytes ``raw``): UTF-8, with or without a BOM, or
+    UTF-16 with one (Notepad's "Unicode"); else a :class:`ConfigError` saying what the file is
+    and what to give.
+
+    Why: an image given as the rig (``run ACQ/image01.jpg``), any other binary file, or a
+    config saved in a Windows ANSI encoding had been told Python's decoder's words, "not valid
+    TOML: 'utf-8' codec can't decode byte 0xff in position 0", which say neither what the file
+    is nor what to do (``run``, ``check`` and ``plan --rig`` read a rig here)."""
+    import codecs
+
     if looks_like_image(raw):
-        return (
-            "; this is an image: give the rig config (.toml) or the recorded acquisition's .lp "
-            "that lists the images"
+        kind = _image_kind(path, raw)
+        lps = _lps_beside(path)
+        beside = f" ({path.parent} holds {', '.join(lps)}: give that)" if lps else ""
+        raise ConfigError(
+            path, None, f"this is {kind}, not a rig config or an .lp: {_GIVE_RIG}{beside}"
         )
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        with contextlib.suppress(UnicodeDecodeError):
+            return raw.decode("utf-16")
+    head = raw[:4096]
+    controls = sum(1 for b in head if b < 0x20 and b not in b"\t\n\r\f")
+    if b"\x00" in head or controls > len(head) // 20:
+        raise ConfigError(
+            path,
+            None,
+            f"this is a binary file (not text), so not a rig config or an .lp: {_GIVE_RIG}",
+        )
+    try:
+        return raw.decode("utf-8-sig")  # a BOM (Notepad) is no error
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise ConfigError(
+            path,
+            None,
+            f"line {line}: byte 0x{raw[exc.start]:02x} is not UTF-8 text (the file was saved in "
+            "another encoding, such as a Windows ANSI one): save it again as UTF-8 (in Notepad: "
+            "Save As, Encoding UTF-8)",
+        ) from None
+
+
+def _image_kind(path: Path, raw: bytes) -> str:
+    """What kind of image ``raw`` (the start of ``path``) is, for a refusal: "an image (JPEG)"."""
+    from rti_rig.core.image_files import JPEG_MAGIC, PNG_MAGIC, is_camera_raw
+
+    if is_camera_raw(path):
+        return "a camera RAW image"
+    kind = "JPEG" if raw.startswith(JPEG_MAGIC) else "PNG" if raw.startswith(PNG_MAGIC) else "TIFF"
+    return f"an image ({kind})"
+
+
+def _lps_beside(path: Path) -> list[str]:
+    """The ``.lp`` files beside ``path`` (at most three), by their path as given."""
+    try:
+        return [str(path.parent / p.name) for p in sorted(path.parent.glob("*.lp"))][:3]
+    except OSError:
+        return []
+
+
+def _not_toml_hint(raw: bytes) -> str:
+    """What a text file that is no TOML was given as a rig instead, where that can be told: an
+    acquisition's light list saved under another suffix (``lights.txt``), which a rig is read
+    as only when it ends in ``.lp``. It had been told only the TOML parser's complaint
+    ("Expected '=' after a key")."""
     with contextlib.suppress(LpFormatError):
         from rti_rig.core.lp_format import parse_lp
 
@@ -783,8 +843,8 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     except OSError as exc:
         raise ConfigError(path, None, f"cannot read the file: {exc.strerror or exc}") from None
     try:
-        data = tomllib.loads(raw_bytes.decode("utf-8-sig"))  # a BOM (Notepad) is no error
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        data = tomllib.loads(_config_text(path, raw_bytes))
+    except tomllib.TOMLDecodeError as exc:
         raise ConfigError(path, None, f"not valid TOML: {exc}{_not_toml_hint(raw_bytes)}") from None
     data, settings, correction_bytes = _with_correction_file(data, path)
     settings = _with_led_map_path(settings, path.parent)

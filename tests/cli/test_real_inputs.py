@@ -558,7 +558,8 @@ def test_an_image_or_a_light_list_named_txt_given_as_the_rig_says_what_it_is(
     0xff", and an acquisition's light list saved as lights.txt "Expected '=' after a key"."""
     r = runner.invoke(app, ["run", str(ACQ / "image01.jpg"), "--out", str(tmp_path / "s")])
     said = " ".join(r.output.split())
-    assert r.exit_code == 2 and "this is an image: give the rig config (.toml) or" in said, said
+    assert r.exit_code == 2 and "this is an image (JPEG), not a rig config or an .lp" in said, said
+    assert f"({ACQ} holds {ACQ / 'dirs.lp'}: give that)" in said and "codec" not in said, said
     txt = tmp_path / "lights.txt"
     shutil.copy(ACQ / "dirs.lp", txt)
     r = runner.invoke(app, ["run", str(txt), "--out", str(tmp_path / "s")])
