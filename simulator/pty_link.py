@@ -25,6 +25,7 @@ import ctypes
 import fcntl
 import os
 import select
+import shutil
 import signal
 import struct
 import sys
@@ -338,10 +339,81 @@ def host_baud(master: int) -> int | None:
         return None
 
 
+#: The temporary folders the emulated ports live in: ``<tempdir>/rti-rig-pty-XXXX``.
+PTY_FOLDER_PREFIX = "rti-rig-pty-"
+#: The file in such a folder naming the process that serves it: ``<pid> <start time>``.
+PTY_OWNER_FILE = "owner"
+
+
+def _start_time(pid: int) -> str:
+    """The process's start time (clock ticks since boot, ``/proc/<pid>/stat``'s field 22), or
+    "" where it cannot be read: with the pid it names one process, not a later one given the
+    same number."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return ""
+    # the command name (field 2) is in parentheses and may hold spaces: count after it
+    return stat.rpartition(")")[2].split()[19]
+
+
+def _owner_alive(owner: str) -> bool:
+    """Whether the process an owner file names (``<pid> <start time>``) is still running."""
+    pid_text, _, started = owner.strip().partition(" ")
+    try:
+        pid = int(pid_text)
+    except ValueError:
+        return True  # unreadable: never taken for dead
+    if pid <= 0:
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True  # another user's live process
+    return not started or _start_time(pid) in ("", started)
+
+
+def remove_stale_pty_folders(root: Path | None = None) -> list[Path]:
+    """Remove the emulated-port folders (``rti-rig-pty-*`` under ``root``, the temporary
+    directory by default) whose serving process is gone; the folders removed.
+
+    Why: an emulator ends by removing its folder, but one killed outright (SIGKILL, an
+    out-of-memory kill, a test's timeout) cannot, and its folder stayed in /tmp for ever,
+    one more for each. Only a folder of this user's with an owner file naming a process that
+    no longer runs (its pid gone, or reused by a process started later) is removed: a live
+    emulator's never, nor a folder whose owner cannot be told (one made before owner files)."""
+    base = Path(tempfile.gettempdir()) if root is None else root
+    removed: list[Path] = []
+    try:
+        candidates = list(base.glob(f"{PTY_FOLDER_PREFIX}*"))
+    except OSError:
+        return removed
+    for folder in candidates:
+        try:
+            if folder.is_symlink() or not folder.is_dir() or folder.stat().st_uid != os.getuid():
+                continue
+            owner = (folder / PTY_OWNER_FILE).read_text()
+        except OSError:
+            continue  # no owner file (or unreadable): its owner cannot be told
+        if _owner_alive(owner):
+            continue
+        shutil.rmtree(folder, ignore_errors=True)  # symlinks inside are removed, not followed
+        if not folder.exists():
+            removed.append(folder)
+    return removed
+
+
 @contextlib.contextmanager
 def serve_on_pty(device: PtyDevice, name: str = "dome") -> Iterator[PtyLink]:
-    """Serve ``device`` on a pty; yields a :class:`PtyLink` whose ``port`` pyserial can open."""
-    folder = Path(tempfile.mkdtemp(prefix="rti-rig-pty-"))
+    """Serve ``device`` on a pty; yields a :class:`PtyLink` whose ``port`` pyserial can open.
+
+    The folder of its port names this process as its owner, and folders that emulators killed
+    outright left behind are removed first (:func:`remove_stale_pty_folders`)."""
+    remove_stale_pty_folders()
+    folder = Path(tempfile.mkdtemp(prefix=PTY_FOLDER_PREFIX))
+    (folder / PTY_OWNER_FILE).write_text(f"{os.getpid()} {_start_time(os.getpid())}\n")
     link_path = folder / f"tty-{name}"
     stop = threading.Event()
     server = _Server(device, link_path, stop)
@@ -354,7 +426,7 @@ def serve_on_pty(device: PtyDevice, name: str = "dome") -> Iterator[PtyLink]:
     finally:
         stop.set()
         thread.join(2.0)
-        for p in (link_path, link_path.with_suffix(".new")):
+        for p in (link_path, link_path.with_suffix(".new"), folder / PTY_OWNER_FILE):
             with contextlib.suppress(FileNotFoundError):
                 p.unlink()
         with contextlib.suppress(OSError):
