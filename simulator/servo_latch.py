@@ -27,6 +27,7 @@ import contextlib
 import hashlib
 import json
 import os
+import shlex
 import tempfile
 import warnings
 from pathlib import Path
@@ -58,6 +59,18 @@ class LatchedErrors:
         # that changed with them met a fresh chain, "no hardware fault: not rebooted"
         digest = hashlib.sha256(str(self.config_path).encode()).hexdigest()[:16]
         self.path = state_dir() / f"{self.config_path.stem}-{digest}.json"
+
+    def power_cycle_said(self) -> str:
+        """How a fault's advice tells the user to power-cycle this emulated chain: delete its
+        state file (path shell-quoted, to be pasted).
+
+        Why: the advice said "switch the servos' power off and on", which an emulated chain
+        has no switch for; its errors outlive the command in this file, and deleting it is
+        what clears them (as ``rti-rig check RIG.toml --reboot-faulted`` does)."""
+        return (
+            f"delete {shlex.quote(str(self.path))} (where the emulated servos' latched errors "
+            "are kept: their power off and on)"
+        )
 
     def load(self) -> dict[int, int]:
         """The errors the chain still has from an earlier command; {} if none or unreadable.

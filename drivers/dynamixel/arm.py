@@ -69,6 +69,8 @@ class RebootOutcome:
     status_after: int | None = None
     #: Torque Enable as read (after the reboot; before it for one left alone)
     torque_on: bool = False
+    #: how this rig's servos are power-cycled (an emulated chain's way is its own)
+    power_cycle: str = ct.POWER_CYCLE
 
     @property
     def cleared(self) -> bool:
@@ -93,8 +95,8 @@ class RebootOutcome:
             return (
                 f"{who}: hardware fault{faults} (0x{self.status_before:02X}) but its torque "
                 "is on (it still holds its joint): NOT rebooted, as a reboot switches torque "
-                f"off and the joint would drop; {cause}, then support the arm and switch the "
-                "servos' power off and on (that clears the fault, and the joint goes limp), "
+                f"off and the joint would drop; {cause}, then support the arm and "
+                f"{self.power_cycle} (that clears the fault, and the joint goes limp), "
                 "then run rti-rig check"
             )
         assert self.status_after is not None
@@ -130,13 +132,17 @@ class DynamixelArm:
         packet_handler: Any | None = None,
         *,
         config_path: str | None = None,
+        power_cycle: str = ct.POWER_CYCLE,
     ) -> None:
         self.settings = settings
         self.name = settings.name
         self.clock = clock
         self.kin = ArmKinematics(settings)
         # the rig config's path: a servo fault's advice names it in the command to paste
-        self._bus = DxlBus(port, settings.name, packet_handler, config=config_path)
+        # and how its servos are power-cycled (an emulated chain has no power switch)
+        self._bus = DxlBus(
+            port, settings.name, packet_handler, config=config_path, power_cycle=power_cycle
+        )
         self._connected = False
         #: whether a connect ever completed (what a stop may say of an arm it never reached)
         self.ever_connected = False
@@ -855,7 +861,16 @@ class DynamixelArm:
                     out.append(RebootOutcome(role, sid, 0, rebooted=False))
                     continue
                 if self._bus.read(sid, ct.TORQUE_ENABLE, check_alert=False):
-                    out.append(RebootOutcome(role, sid, status, rebooted=False, torque_on=True))
+                    out.append(
+                        RebootOutcome(
+                            role,
+                            sid,
+                            status,
+                            rebooted=False,
+                            torque_on=True,
+                            power_cycle=self._bus.power_cycle,
+                        )
+                    )
                     continue
                 self._bus.reboot(sid)
                 self._wait_restarted(joint)

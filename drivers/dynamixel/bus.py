@@ -118,11 +118,14 @@ class DxlBus:
         packet_handler: Any | None = None,
         *,
         config: str | None = None,
+        power_cycle: str = ct.POWER_CYCLE,
     ) -> None:
         self.port = port
         self.device = device
         #: the rig config the arm was opened from (named in a hardware fault's advice)
         self.config = config
+        #: how this chain's servos are power-cycled (the advice's other way to clear a fault)
+        self.power_cycle = power_cycle
         self.ph = _ReleasingHandler(packet_handler or sdk.PacketHandler(2.0), port, device)
         #: the line speed the port was opened at (named when a servo does not answer)
         self.baudrate: int | None = None
@@ -283,7 +286,14 @@ class DxlBus:
             except DynamixelError:
                 voltage = None
         return HardwareFaultError(
-            self.device, dxl_id, status, command, torque_on, voltage, config=self.config
+            self.device,
+            dxl_id,
+            status,
+            command,
+            torque_on,
+            voltage,
+            config=self.config,
+            power_cycle=self.power_cycle,
         )
 
     #: Results that mean the status packet was lost or damaged (not that the servo refused).

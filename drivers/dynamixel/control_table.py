@@ -149,7 +149,12 @@ FAULT_ADVICE = {
 }
 
 
-def reboot_how(config: str | None = None) -> str:
+#: How a real chain's servos are power-cycled, as the advice says it (an emulated chain's way
+#: differs: :meth:`rti_rig.simulator.servo_latch.LatchedErrors.power_cycle_said`).
+POWER_CYCLE = "switch the servos' power off and on"
+
+
+def reboot_how(config: str | None = None, power_cycle: str = POWER_CYCLE) -> str:
     """The advice's last clause: how to clear a latched fault, ``config`` (the rig config's
     path, shell-quoted) named in the command when known, so that it can be pasted; the
     placeholder ``RIG.toml`` only for a bus opened without a rig config (the manual tools).
@@ -160,11 +165,13 @@ def reboot_how(config: str | None = None) -> str:
     some faults and nothing for others (an overheated servo, told only to cool down, was
     refused again once cool, its fault still latched); and "then run rti-rig check RIG.toml
     --reboot-faulted" was said by ``run`` and ``check`` of a config they had just opened,
-    which the user had to put in by hand."""
+    which the user had to put in by hand. ``power_cycle``: how this rig's servos are power-
+    cycled (an emulated chain has no power switch: "switch the servos' power off and on" was
+    advice no one could follow on it)."""
     rig = shlex.quote(config) if config else "RIG.toml"
     return (
         f"then run rti-rig check {rig} --reboot-faulted (it reboots the faulted servos whose "
-        "torque is off, and nothing moves), or switch the servos' power off and on, to clear it"
+        f"torque is off, and nothing moves), or {power_cycle}, to clear it"
     )
 
 

@@ -41,7 +41,8 @@ class HardwareFaultError(DynamixelError):
     so the message never claims a limp joint that is still driven, or a held one that is limp.
     ``voltage`` is (Present Input Voltage, Min, Max Voltage Limit) in 0.1 V as read for an
     input-voltage error (``None``: not read). ``config``: the rig config's path, named in the
-    ``--reboot-faulted`` command the message gives (:func:`~control_table.reboot_how`)."""
+    ``--reboot-faulted`` command the message gives (:func:`~control_table.reboot_how`), and
+    ``power_cycle`` how this rig's servos are power-cycled (the other way it gives)."""
 
     def __init__(
         self,
@@ -53,6 +54,7 @@ class HardwareFaultError(DynamixelError):
         voltage: tuple[int, int, int] | None = None,
         *,
         config: str | None = None,
+        power_cycle: str = ct.POWER_CYCLE,
     ) -> None:
         self.status = status
         self.torque_on = torque_on
@@ -72,7 +74,7 @@ class HardwareFaultError(DynamixelError):
         super().__init__(
             device,
             f"hardware fault {names} (Hardware Error Status 0x{status:02X}); {advice}; "
-            f"{ct.reboot_how(config)}. " + torque_statement(torque_on),
+            f"{ct.reboot_how(config, power_cycle)}. " + torque_statement(torque_on),
             command,
             servo_id,
         )

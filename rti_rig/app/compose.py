@@ -19,6 +19,7 @@ from rti_rig.runtime.rig import Rig
 
 if TYPE_CHECKING:
     from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
+    from rti_rig.simulator.servo_latch import LatchedErrors
 
 
 def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
@@ -295,9 +296,12 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     # the chain stays powered between commands: an error latched by an earlier command on
     # this rig is still set until a Reboot (the recovery, check --reboot-faulted, had found
     # a fresh servo with nothing to reboot)
-    _keep_latched_errors(loaded, emulator)
+    latch = _keep_latched_errors(loaded, emulator)
     try:
-        arm = DynamixelArm(settings, port, clock, config_path=loaded.path)
+        # the advice's power cycle is what clears the emulated chain's kept errors
+        arm = DynamixelArm(
+            settings, port, clock, config_path=loaded.path, power_cycle=latch.power_cycle_said()
+        )
         camera = _simulated_camera(loaded, _ArmLamp(arm, emulator, settings), clock)
     except BaseException:
         stack.close()
@@ -307,9 +311,10 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     return rig
 
 
-def _keep_latched_errors(loaded: LoadedRig, emulator: DynamixelBusEmulator) -> None:
+def _keep_latched_errors(loaded: LoadedRig, emulator: DynamixelBusEmulator) -> LatchedErrors:
     """Give the emulated servos the Hardware Error Status an earlier command on this rig left
-    them (a real servo keeps it while powered), and record each change from here on."""
+    them (a real servo keeps it while powered), and record each change from here on; the
+    state file they are kept in."""
     from rti_rig.simulator.servo_latch import LatchedErrors
 
     latch = LatchedErrors(Path(loaded.path))
@@ -317,6 +322,7 @@ def _keep_latched_errors(loaded: LoadedRig, emulator: DynamixelBusEmulator) -> N
         if dxl_id in emulator.servos:
             emulator.inject_hardware_error(dxl_id, bits)
     emulator.on_errors_changed = latch.save
+    return latch
 
 
 def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:

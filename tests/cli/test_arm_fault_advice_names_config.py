@@ -54,3 +54,28 @@ def test_the_advised_reboot_command_names_the_config_and_clears_the_fault(
     assert "servo 2 (elevation): hardware fault overload (0x20); rebooted" in again, again
     (emu,) = emulators
     assert emu.servos[2].get(ct.HARDWARE_ERROR_STATUS) == 0
+
+
+def test_an_emulated_arms_power_cycle_is_advised_as_what_clears_it(tmp_path: Path) -> None:
+    """An emulated chain has no power switch: its latched errors outlive a command in a state
+    file (:mod:`rti_rig.simulator.servo_latch`), and the advice's power cycle is deleting that
+    file, named so that it can be pasted. "switch the servos' power off and on" had been said
+    of it, which no one could do."""
+    cfg = inprocess_arm_config(tmp_path, FAULT)
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "servo 2: hardware fault overload" in said, said
+    assert "switch the servos' power" not in said, said
+    found = re.search(r"--reboot-faulted \(it reboots .+?\), or delete (.+?) \(where the", said)
+    assert found, said
+    (state,) = shlex.split(found.group(1))
+    assert Path(state).is_file()
+
+    cfg.write_text(cfg.read_text().replace(FAULT, ""))  # the obstruction cleared
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 1 and "hardware fault overload" in " ".join(r.output.split())  # kept
+
+    Path(state).unlink()  # as advised
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    again = " ".join(r.output.split())
+    assert r.exit_code == 0 and "RESULT: PASS" in again, again

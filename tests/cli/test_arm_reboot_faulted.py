@@ -107,8 +107,11 @@ def test_a_faulted_servo_whose_torque_is_on_is_left_alone_and_the_user_told_what
         "servo 2 (elevation): hardware fault input voltage (0x01) but its torque is on (it "
         "still holds its joint): NOT rebooted, as a reboot switches torque off and the joint "
         "would drop; check the power supply voltage against the servo's limits, then support "
-        "the arm and switch the servos' power off and on" in said
+        "the arm and delete " in said
     ), said
+    # an emulated chain has no power switch: its power cycle is deleting its kept state
+    assert "(where the emulated servos' latched errors are kept: their power off and on)" in said
+    assert "switch the servos' power" not in said, said
     assert "nothing rebooted; no torque was switched on or off" in said
     assert "RESULT: FAIL" in said
     (emu,) = emulators  # the truth: no Reboot sent, the joint still held
