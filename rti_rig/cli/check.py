@@ -104,7 +104,12 @@ def check(
 
     try:
         with stop_on_signals():
-            report = check_rig(CheckRequest(rig_config, intensity, auto_exposure), announce)
+            report = check_rig(
+                CheckRequest(rig_config, intensity, auto_exposure),
+                announce,
+                # a dome's lost port, reopened during the walk: said as it happens
+                lambda text: err.print(text, markup=False, highlight=False),
+            )
     except CheckStopped as exc:
         for failure in exc.teardown_failures:
             err.print(f"[red]teardown problem:[/] {escape(failure)}")

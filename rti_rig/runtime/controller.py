@@ -193,8 +193,9 @@ class LightOffForCamera:
 
 @dataclass(frozen=True)
 class DeviceSays:
-    """A device's word on what it is doing before the first step, said as it happens (a
-    DSLR listing its card, which may take minutes on a full card, had been silent)."""
+    """A device's word on what it is doing, said as it happens: a DSLR listing its card before
+    the first step (which may take minutes on a full card, had been silent), a dome reopening
+    its lost port and the outcome (printed raw as log records before)."""
 
     device: str
     text: str
@@ -611,6 +612,15 @@ def _arm_end(lighting: object) -> dict[str, Any]:
     return {} if to_dict is None else {"arm_end": to_dict()}
 
 
+def _dome_reconnections(lighting: object) -> dict[str, Any]:
+    """The manifest's ``dome_reconnections``: each reopening of a dome's lost port in this run
+    (during which command, what was lost, the attempts, the outcome), the detail of what the
+    user was told in a line as it happened; nothing when none was reopened."""
+    said = getattr(lighting, "reconnections", None)
+    found = [] if said is None else said()
+    return {"dome_reconnections": found} if found else {}
+
+
 def _teardown_failure(label: str, exc: Exception, earlier: list[str]) -> str:
     """``label: what failed``, or a pointer to the earlier failure it repeats word for word.
 
@@ -685,6 +695,10 @@ def run_session(
     rig_t0, wall_t0 = clock.now(), time.perf_counter()
     try:
         rig.bind_session(folder.root)
+        # a lost port's reopening is said as the product speaks, between the bar's redraws
+        listen = getattr(rig.lighting, "listen", None)
+        if listen is not None:
+            listen(lambda text: emit(DeviceSays(rig.lighting.name, text)))
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.off()
@@ -847,6 +861,7 @@ def run_session(
                         "steps_done_this_run": len(records),
                         **({"end_check": end_notes} if rig.end_check is not None else {}),
                         **_arm_end(rig.lighting),
+                        **_dome_reconnections(rig.lighting),
                         **({"led_error": led_error} if led_error is not None else {}),
                     },
                     timing={"rig_time_s": rig_time, "wall_time_s": wall_time},

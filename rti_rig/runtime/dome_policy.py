@@ -170,6 +170,10 @@ class DomeStats:
     #: included) that then got through; a command that failed in the end adds none (its resends
     #: still count in ``retries``).
     recovered: list[str] = field(default_factory=list)
+    #: One record per reopening of a lost port (during which command, what was lost, how many
+    #: attempts, the outcome, the last attempt's error): the detail the session's manifest
+    #: keeps, while the user is told of it in one line and of its outcome in another.
+    reconnections: list[dict[str, object]] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -289,6 +293,27 @@ class DomePolicy:
         #: The port was kept open, switched off, by :meth:`hold` for the next :meth:`connect`
         #: (metering, then the session), which then reuses it instead of reopening it.
         self._held = False
+        #: Where a reopening of a lost port is said as it happens (the command line's console,
+        #: set by :meth:`listen`); None: said nowhere but in the stats and the log.
+        self._say: Callable[[str], None] | None = None
+
+    def listen(self, say: Callable[[str], None] | None) -> None:
+        """Have each reopening of a lost port said through ``say`` as it happens: one line
+        when it begins (what happened, and what follows once the dome is back), one with its
+        outcome. ``None`` stops it.
+
+        Why: the reopening had been told only as Python log records, which the command line
+        (which configures no logging) printed raw on stderr in the middle of the progress
+        bar, once per failed attempt, with the port's path three times over."""
+        self._say = say
+
+    def _tell(self, text: str) -> None:
+        if self._say is not None:
+            self._say(text)
+
+    def _goes_on(self) -> str:
+        what = "session" if self.lights_images else "check"
+        return f"the {what} goes on once it is back"
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -515,13 +540,19 @@ class DomePolicy:
         self._spoke_before_drop = self.link.profile_heard
         self.stats.retries += 1  # the handshake is sent again, on the reopened port
         recovered.append(f"{drop.command}: {drop.fault}")
-        log.warning(
+        log.info(
             "%s: the port was lost during the %s (%s); reopening it",
             self.name,
             drop.command,
             drop.message,
         )
-        info, last, came_back = self._reopen(recovered, end_when_back=True)
+        info, last, came_back = self._reopen(
+            recovered,
+            end_when_back=True,
+            drop=drop,
+            during=f"the {drop.command}",
+            goes_on=self._goes_on(),
+        )
         if info is not None:
             return info
         if came_back and last is not None:
@@ -872,7 +903,10 @@ class DomePolicy:
                 result = self._counted(op)
             except DomeLinkError as exc:
                 fault = exc.fault
-                log.warning(
+                # a lost port is said in words as it is reopened (:meth:`_reopen`), not as a
+                # log record that the command line would print raw beside its progress bar
+                log.log(
+                    logging.INFO if fault is LinkFault.DISCONNECTED else logging.WARNING,
                     "%s: %s failed (%s, attempt %d): %s",
                     self.name,
                     command,
@@ -884,7 +918,12 @@ class DomePolicy:
                     lost = self._lit
                     self._lit = None
                     self.guard.record(lost.index, lost.since, self.clock.now())
-                    back = self._recover(exc, command)
+                    stops = (
+                        f"LED {lost.index} went dark with it, so the session stops at its image"
+                        if self.lights_images
+                        else f"LED {lost.index} went dark with it, so the check fails there"
+                    )
+                    back = self._recover(exc, command, goes_on=stops)
                     what = "rebooted" if fault is LinkFault.RESET else "dropped off the USB bus"
                     # "off again" only once the handshake after the reboot went through: a
                     # board that rebooted again there (the Nab sketch boots lit) had been said
@@ -960,19 +999,20 @@ class DomePolicy:
                 self.stats.recovered += resent
                 return result
 
-    def _recover(self, exc: DomeLinkError, command: str) -> bool:
+    def _recover(self, exc: DomeLinkError, command: str, goes_on: str | None = None) -> bool:
         """Bring the link back after ``exc`` so that the command can be sent again. False when
         the handshake after a reboot failed (what the board then has lit is unknown), True
-        otherwise (a failed reconnection raises)."""
+        otherwise (a failed reconnection raises). ``goes_on``: what follows once the dome is
+        back, as the user is told when a lost port is reopened (default: the run goes on)."""
         if exc.fault is LinkFault.DISCONNECTED:
-            self._reconnect(command)
+            self._reconnect(command, exc, goes_on)
         elif exc.fault is LinkFault.RESET:
             self.stats.rehandshakes += 1
             try:
                 info = self._counted(self.link.hello)
             except DomeLinkError as again:
                 if again.fault is LinkFault.DISCONNECTED:
-                    self._reconnect(command)
+                    self._reconnect(command, again, goes_on)
                     return True
                 # the resend that follows is bounded by the retry count anyway
                 log.warning("%s: handshake after a reset failed: %s", self.name, again)
@@ -999,10 +1039,17 @@ class DomePolicy:
         else:
             self._counted(lambda: link_clock.sleep(seconds))
 
-    def _reconnect(self, command: str) -> None:
-        """Reopen the port a session lost (a USB drop) and check it is the same dome."""
+    def _reconnect(self, command: str, drop: DomeLinkError, goes_on: str | None = None) -> None:
+        """Reopen the port a session lost (``drop``, a USB drop during ``command``) and check
+        it is the same dome."""
         recovered: list[str] = []
-        info, last, came_back = self._reopen(recovered, end_when_back=False)
+        info, last, came_back = self._reopen(
+            recovered,
+            end_when_back=False,
+            drop=drop,
+            during=f"'{command}'",
+            goes_on=goes_on or self._goes_on(),
+        )
         if info is not None:
             problem = self._check_identity(info)
             if problem:
@@ -1051,7 +1098,13 @@ class DomePolicy:
         )
 
     def _reopen(
-        self, recovered: list[str], *, end_when_back: bool
+        self,
+        recovered: list[str],
+        *,
+        end_when_back: bool,
+        drop: DomeLinkError,
+        during: str,
+        goes_on: str,
     ) -> tuple[DomeInfo | None, DomeLinkError | None, bool]:
         """Close the port and open it again by path, up to ``reconnect_attempts`` times, the
         back-off doubling from ``reconnect_backoff_s`` on the link's clock; each opening
@@ -1064,10 +1117,24 @@ class DomePolicy:
         through (``stats.reconnects`` counted), else None, the last failure and whether its port
         had come back. ``end_when_back``: stop at the first port that came back but whose
         handshake failed otherwise (a connect: that board's answer is then what is in
-        question), rather than trying again (mid-session: a board may still be booting)."""
+        question), rather than trying again (mid-session: a board may still be booting).
+
+        ``drop`` (the loss that led here, ``during`` a command) is said through
+        :meth:`listen`'s ``say`` as the reopening begins, with ``goes_on`` (what follows once
+        the dome is back), and the outcome once it is known; each reopening is recorded in
+        ``stats.reconnections``."""
+        n = self.settings.reconnect_attempts
+        self._tell(
+            f"The dome dropped off the USB bus during {during}: reopening its port (up to {n} "
+            f"attempt{'s' if n != 1 else ''} over {self.reconnect_window_s():.1f} s); "
+            f"{goes_on}."
+        )
         last: DomeLinkError | None = None
         came_back = False
-        for attempt in range(self.settings.reconnect_attempts):
+        tries = 0
+        info: DomeInfo | None = None
+        for attempt in range(n):
+            tries = attempt + 1
             self._quiet_close()
             self._back_off(self.settings.reconnect_backoff_s * (2**attempt))
             try:
@@ -1075,13 +1142,38 @@ class DomePolicy:
             except DomeLinkError as exc:
                 last = exc
                 came_back = not (exc.command == "open port" or _lost_after_opening(exc))
-                log.warning("%s: reconnection %d failed: %s", self.name, attempt + 1, exc)
+                log.info("%s: reconnection %d failed: %s", self.name, attempt + 1, exc)
                 if came_back and end_when_back:
-                    return None, exc, True
+                    break
                 continue
             self.stats.reconnects += 1
+            break
+        if info is None and not (came_back and end_when_back):
+            self._quiet_close()
+        attempts = f"{tries} attempt{'s' if tries != 1 else ''}"
+        if info is not None:
+            outcome = "reconnected"
+            self._tell(f"The dome is back: its port reopened and it answered, after {attempts}.")
+        elif came_back:
+            outcome = "port back, no handshake"
+            self._tell(
+                "The dome's port came back but the board did not answer its handshake, after "
+                f"{attempts} (said below)."
+            )
+        else:
+            outcome = "did not come back"
+            self._tell(f"The dome's port did not come back, after {attempts} (said below).")
+        self.stats.reconnections.append(
+            {
+                "during": during.strip("'"),
+                "lost": drop.message,
+                "attempts": tries,
+                "outcome": outcome,
+                "last_error": None if info is not None or last is None else last.message,
+            }
+        )
+        if info is not None:
             return info, None, False
-        self._quiet_close()
         return None, last, came_back
 
     def _check_identity(self, info: DomeInfo) -> str | None:

@@ -9,6 +9,7 @@ arm reached, which is what the session's `.lp` records.
 from __future__ import annotations
 
 import signal
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Protocol
 
@@ -162,6 +163,19 @@ class DomeLighting:
 
     def safe(self, emergency: bool = False) -> list[str]:
         return attempt_all([("all LEDs off", self.source.all_off)])
+
+    def listen(self, say: Callable[[str], None] | None) -> None:
+        """Have the dome say through ``say`` each reopening of its lost port and its outcome,
+        as it happens (a source that never reopens a port says nothing)."""
+        listen = getattr(self.source, "listen", None)
+        if listen is not None:
+            listen(say)
+
+    def reconnections(self) -> list[dict[str, object]]:
+        """Each reopening of the dome's lost port so far (what was lost, the outcome), for the
+        session's manifest: the user is told of it in a line, the detail is kept there."""
+        stats = getattr(self.source, "stats", None)
+        return list(getattr(stats, "reconnections", None) or [])
 
     @property
     def link_open(self) -> bool:

@@ -56,8 +56,15 @@ class CheckRequest:
 DEFAULT_INTENSITY = 0.2
 
 
-def check_rig(req: CheckRequest, on_start: Callable[[], None] | None = None) -> Any:
+def check_rig(
+    req: CheckRequest,
+    on_start: Callable[[], None] | None = None,
+    on_note: Callable[[str], None] | None = None,
+) -> Any:
     """The self-test report (``.lines()``, ``.ok``) of the rig ``req.rig_config`` describes.
+
+    ``on_note`` is told, as it happens, what the user should know while the walk goes on (a
+    dome's lost port being reopened, and the outcome), which the report then sums up.
 
     ``on_start`` is called once the config and the options are known to be usable, before
     anything is opened. Why: the command said "Checking … (Ctrl-C stops the check at once)…"
@@ -102,6 +109,7 @@ def check_rig(req: CheckRequest, on_start: Callable[[], None] | None = None) -> 
     with build_rig(loaded) as rig:
         try:
             if isinstance(rig.lighting, DomeLighting):
+                rig.lighting.listen(on_note)
                 lights = self_test(rig.lighting.source, rig.clock, intensity=intensity)
                 camera = camera_line(rig, auto_exposure=req.auto_exposure)
                 return WithCamera(lights, camera, config_note_lines(loaded))
