@@ -1173,7 +1173,11 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
         total = float(timing["rig_time_s"])
         beside.insert(0, f"this run {result.rig_time_s:.1f} s")
         # a run killed outright (kill -9, power) recorded no time: the sum leaves it out
-        untimed = sum(1 for r in folder.manifest.get("runs") or [] if r.get("rig_time_s") is None)
+        untimed_runs = [r for r in folder.manifest.get("runs") or [] if r.get("rig_time_s") is None]
+        untimed = len(untimed_runs)
+        # a run a stop cut before it recorded its end says so on disk (its ``end_cut``): only
+        # the others were killed (SIGKILL, a power cut); all had been said "killed"
+        cut = sum(1 for r in untimed_runs if r.get("end_cut"))
         if untimed:
             # the journal still times every image the killed run committed ("at least 0.0 s"
             # had been said for 15 images shot in 17.5 s)
@@ -1181,8 +1185,12 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
 
             at_least = "at least "
             total = max(total, journal_rig_time(folder.root))
+            ended = [
+                *([f"{cut} run(s) stopped"] if cut else []),
+                *([f"{untimed - cut} run(s) killed"] if untimed - cut else []),
+            ]
             beside.append(
-                f"{untimed} run(s) killed before recording their time, counted from their "
+                f"{' and '.join(ended)} before recording their time, counted from their "
                 "images' times"
             )
     over = f" over {runs} runs" if runs > 1 else ""

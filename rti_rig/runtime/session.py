@@ -819,6 +819,30 @@ class SessionFolder:
         _write_json_atomic(self.root / MANIFEST, self.manifest)
         self.begun = True
 
+    def record_cut_end(self, reason: str) -> None:
+        """Record in the manifest that this run was stopped (``reason``: a finish reason such
+        as ``"emergency-stop"``) where the stop cut the run's end before :meth:`finish` could
+        record it; nothing for a session never begun, or a run whose end is recorded.
+
+        Why: the run's entry was left as a killed run leaves it (no end, no time), so a later
+        ``--resume`` said "1 run(s) killed" of a run a Ctrl-C or SIGTERM had stopped. Only the
+        manifest is written, atomically, from what it held at the run's start: the images,
+        their records, the journal and ``lights.lp`` are left as they are (the resume reads
+        them as after a kill); the run's time is not known here and stays unrecorded. A write
+        that fails changes nothing on disk (the run then reads as killed, as before)."""
+        if not self.begun or self.run_end is not None or not self.manifest.get("runs"):
+            return
+        run = self.manifest["runs"][-1]
+        run.update({"finished_at": _now_iso(), "finish_reason": reason, "end_cut": True})
+        self.manifest["runner"] = {
+            **(self.manifest.get("runner") or {}),
+            "state": "stopped",
+            "finish_reason": reason,
+            "end_cut": True,
+        }
+        with contextlib.suppress(OSError, SessionWriteError):
+            _write_json_atomic(self.root / MANIFEST, self.manifest)
+
     def write_step(self, index: int, frame: Frame, record_fields: dict[str, Any]) -> StepRecord:
         """Write one captured frame (linear TIFF, then sRGB JPEG), then journal it.
 

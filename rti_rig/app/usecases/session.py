@@ -163,6 +163,9 @@ class OpenedSession:
     #: what :meth:`close` could not do in making safe a rig the controller's teardown never
     #: took (for the command to say, through :meth:`take_close_failures`)
     close_failures: list[str] = field(default_factory=list)
+    #: the finish reason of the stop that left the capture's ``with`` (an emergency stop, a
+    #: Ctrl-C), for :meth:`close` to record where it cut the run's end; None: no stop
+    cut_by: str | None = None
 
     @property
     def dry_run(self) -> bool:
@@ -224,6 +227,10 @@ class OpenedSession:
         rig = self.rig
         try:
             with signals_deferred():
+                if not self.teardown_ran and self.cut_by is not None:
+                    # a stop cut the run's end before the controller recorded it: said on
+                    # disk as a stop, not left as a kill leaves it (first: the images are in)
+                    self.folder.record_cut_end(self.cut_by)
                 if not self.teardown_ran:
                     if rig.lighting.link_open:
                         self.close_failures += rig.lighting.safe(emergency=True)
@@ -237,7 +244,13 @@ class OpenedSession:
     def __enter__(self) -> OpenedSession:
         return self
 
-    def __exit__(self, *exc: object) -> None:
+    def __exit__(self, exc_type: object, exc: object, tb: object) -> None:
+        from rti_rig.runtime.controller import EmergencyStop, FinishReason
+
+        if isinstance(exc, EmergencyStop):
+            self.cut_by = str(FinishReason.EMERGENCY_STOP)
+        elif isinstance(exc, KeyboardInterrupt):
+            self.cut_by = str(FinishReason.INTERRUPTED)
         self.close()
 
 

@@ -1,0 +1,113 @@
+"""A run whose end a stop cut (a SIGTERM as the controller's teardown begins, before it records
+the run's end) is recorded on disk as stopped, so that a later ``--resume`` says "stopped",
+and "killed" only of a run killed outright.
+
+The teardown's end record (:meth:`SessionFolder.finish`) is written only by the controller:
+where a stop cut it, the session's close made the devices safe in its place and wrote nothing,
+and the run's manifest entry was left as a SIGKILL leaves it. The resume then said "1 run(s)
+killed before recording their time" of a run the user had stopped with a SIGTERM.
+
+An arm's run cut at the same moment: the session's close switches its lamp off (the carrier's
+close sends the lamp-off and the stop while it is connected), checked on the emulated servo.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import CONFIGS, inprocess_arm_config
+from conftest import said as unwrapped
+from typer.testing import CliRunner
+
+import rti_rig.app.usecases.session as session_usecase
+import rti_rig.runtime.controller as controller
+from rti_rig.cli import app
+from rti_rig.drivers.dynamixel import control_table as ct
+
+pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+
+
+def _sigterm_as_the_teardown_begins(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A real SIGTERM, raised in the run's own process in the controller's ``finally``
+    before it holds signals (as it marks the capture over): no timing."""
+    real_over = controller.CancelToken.capture_over
+
+    def capture_over(self) -> None:  # type: ignore[no-untyped-def]
+        signal.raise_signal(signal.SIGTERM)
+        real_over(self)
+
+    monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
+
+
+def _run(config: Path, out: Path, *more: str) -> tuple[Any, str]:
+    argv = ["run", str(config), "--lights", "6", "--out", str(out), "--no-verdict", *more]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    return r, unwrapped(r)
+
+
+def test_a_run_whose_end_a_stop_cut_is_resumed_as_stopped_not_killed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    out = tmp_path / "s"
+    with monkeypatch.context() as patched:
+        _sigterm_as_the_teardown_begins(patched)
+        r, said = _run(CONFIGS / "emulated_dome.toml", out)
+    assert r.exit_code == 143, said
+    assert "Emergency stop (SIGTERM)" in said and "6 image(s) kept" in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    (run,) = manifest["runs"]
+    assert run["finish_reason"] == "emergency-stop" and run["end_cut"] is True, run
+    assert "rig_time_s" not in run  # not known where the stop cut the end: not made up
+    assert manifest["runner"]["finish_reason"] == "emergency-stop", manifest["runner"]
+    assert manifest["runner"].get("steps_done") is None  # the steps stay for the resume
+
+    r = CliRunner().invoke(app, ["run", "--resume", str(out)], terminal_width=400)
+    said = unwrapped(r)
+    assert r.exit_code == 0, said
+    assert "6 image(s) in the session" in said, said
+    assert "1 run(s) stopped before recording their time" in said, said
+    assert "killed" not in said, said
+
+
+def test_an_arm_run_whose_end_a_stop_cut_has_its_lamp_switched_off(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The lamp on the elevation servo's LED, lit for each image: the stop lands as the
+    teardown begins, and the session's close (not the teardown) switches it off."""
+    cfg = inprocess_arm_config(tmp_path)
+    text = cfg.read_text()
+    assert 'lamp = "software"' in text
+    cfg.write_text(text.replace('lamp = "software"', 'lamp = "servo_led"\nlamp_servo_id = 2'))
+    seen: dict[str, Any] = {}
+    real_run = session_usecase.run_opened_session
+
+    def run_opened_session(opened, *args: Any, **kwargs: Any) -> Any:
+        seen["opened"] = opened
+        return real_run(opened, *args, **kwargs)
+
+    monkeypatch.setattr(session_usecase, "run_opened_session", run_opened_session)
+    lit: list[int] = []
+    real_lamp = controller.CancelToken.capture_over
+
+    def capture_over(self) -> None:  # type: ignore[no-untyped-def]
+        # the lamp as the stop lands: lit again here, as a stop during an image leaves it
+        emulator = seen["opened"].rig.emulator
+        emulator.servos[2]._set(ct.LED, 1)
+        lit.append(emulator.servos[2].get(ct.LED))
+        signal.raise_signal(signal.SIGTERM)
+        real_lamp(self)
+
+    monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
+    r, said = _run(cfg, tmp_path / "s")
+    assert r.exit_code == 143, said
+    assert lit == [1], said
+    assert seen["opened"].rig.emulator.servos[2].get(ct.LED) == 0, said  # switched off
+    assert "Emergency stop (SIGTERM): lamp off and stop were requested" in said, said
+    assert "teardown problem" not in said and "Traceback" not in said, said
+    manifest = json.loads((tmp_path / "s" / "manifest.json").read_text())
+    assert manifest["runs"][-1]["finish_reason"] == "emergency-stop", manifest["runs"]
