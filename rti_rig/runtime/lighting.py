@@ -290,7 +290,12 @@ class ArmLighting:
     def link_open(self) -> bool:
         """Always False: an arm's safe state (lamp off, stop, the park its policy asks for) is
         the controller's teardown's and the carrier's close's, never sent from a session's
-        close on its own (a park is a move): the getattr this replaced answered False too."""
+        close on its own (a park is a move): the getattr this replaced answered False too.
+
+        A session closed before its teardown ran still switches the lamp off: its close calls
+        :meth:`close`, and the carrier's close sends the lamp-off and the stop while it is
+        connected (an arm stopped as the teardown began had its lit lamp switched off there:
+        tests/cli/test_run_cut_end_recorded.py)."""
         return False
 
     def safe(self, emergency: bool = False) -> list[str]:
