@@ -5,6 +5,7 @@ for a batch (sessions as tasks, resumable); an address nobody answers is a clear
 from __future__ import annotations
 
 import json
+import logging
 import os
 import shutil
 import subprocess
@@ -123,6 +124,53 @@ def test_a_lost_scheduler_mid_fit_is_said_so(tmp_path: Path, monkeypatch) -> Non
     assert f"lost the Dask scheduler at '{address}' while fitting" in said, said
     assert "memory limit" not in said and "run the same command" in said
     assert not (tmp_path / "o").exists()
+
+
+class _Kept(logging.Handler):
+    """The log records that reach a logger's handlers (past its filters)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage())
+
+
+def test_a_scheduler_lost_before_the_bands_are_sent_is_said_so(tmp_path: Path, monkeypatch) -> None:
+    """The scheduler really stopped while this process reads the sample and chooses the model,
+    before any band is sent: Dask's client retries for its timeout, then a client call raises
+    ``CommClosedError``. It had reached the user as a 120-line traceback (exit 1), after Dask's
+    own timestamped "Failed to reconnect to scheduler" ERROR line."""
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+
+    monkeypatch.setattr(fit_dask, "CONNECT_TIMEOUT_S", 5.0)  # Dask's reconnection window
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        address = cluster.scheduler_address
+        files_of = fit_dask.acquisition_files
+
+        def scheduler_stops_first(source):  # type: ignore[no-untyped-def]
+            cluster.close()  # the scheduler process stops (killed, its machine rebooted)
+            return files_of(source)
+
+        monkeypatch.setattr(fit_dask, "acquisition_files", scheduler_stops_first)
+        out = tmp_path / "o"
+        kept, log = _Kept(), logging.getLogger("distributed.client")
+        log.addHandler(kept)
+        try:
+            r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--scheduler", address])
+        finally:
+            log.removeHandler(kept)
+    assert r.exit_code == 2, (r.output, r.exception)
+    said = " ".join(r.output.split())
+    assert f"lost the Dask scheduler at '{address}' while fitting" in said, said
+    assert "run the same command" in said and not out.exists()
+    assert not [m for m in kept.messages if "Failed to reconnect" in m], kept.messages
 
 
 def test_a_lost_scheduler_mid_batch_keeps_and_names_the_finished_sessions(

@@ -360,6 +360,35 @@ def scheduler_client(address: str) -> Iterator[Cluster | None]:
         client = Client(target, timeout=CONNECT_TIMEOUT_S, set_as_default=False, security=security)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:
         raise unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
+    with _reconnect_failure_unlogged(), _cluster_of(client, address) as cluster:
+        yield cluster
+
+
+@contextmanager
+def _reconnect_failure_unlogged() -> Iterator[None]:
+    """Dask's "Failed to reconnect to scheduler" log line kept off the user's terminal.
+
+    Why: a scheduler lost mid-fit is said by this command in its own words ("lost the Dask
+    scheduler at …"); Dask's client first logged it as a timestamped ERROR line on stderr, a
+    second account of the same event in another voice."""
+    log = logging.getLogger("distributed.client")
+    dropped = _DropReconnectFailure()
+    log.addFilter(dropped)
+    try:
+        yield
+    finally:
+        log.removeFilter(dropped)
+
+
+class _DropReconnectFailure(logging.Filter):
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not str(record.msg).startswith("Failed to reconnect to scheduler")
+
+
+@contextmanager
+def _cluster_of(client: Any, address: str) -> Iterator[Cluster]:
+    """The :class:`Cluster` of a connected ``client``: workers waited for and checked, the
+    tagging plugin registered (removed afterwards); the client closed at the end."""
     try:
         try:
             client.wait_for_workers(1, timeout=WORKERS_TIMEOUT_S)
@@ -629,11 +658,7 @@ def _band_failed(cluster: Cluster, exc: BaseException) -> SchedulerError:
         kept = "nothing of this fit was kept in --out"
         return SchedulerError(_unreachable(address, "a band of the fit", kept))
     if scheduler_lost(client, exc):
-        return SchedulerError(
-            f"lost the Dask scheduler at {address!r} while fitting (it stopped or the network "
-            "to it failed); nothing of this fit was kept in --out: start the scheduler again "
-            f"(`dask scheduler`, workers with `dask worker {address}`) and run the same command"
-        )
+        return _fit_lost(address)
     return SchedulerError(
         f"a band of the fit failed on the Dask cluster at {address!r}: "
         f"{type(exc).__name__}: {exc}. Check the workers' logs (memory limit?) and run again; "
@@ -641,11 +666,43 @@ def _band_failed(cluster: Cluster, exc: BaseException) -> SchedulerError:
     )
 
 
+def _fit_lost(address: str) -> SchedulerError:
+    """The error of a single-session fit whose scheduler went away."""
+    return SchedulerError(
+        f"lost the Dask scheduler at {address!r} while fitting (it stopped or the network "
+        "to it failed); nothing of this fit was kept in --out: start the scheduler again "
+        f"(`dask scheduler`, workers with `dask worker {address}`) and run the same command"
+    )
+
+
 def run_fit_dask(req: FitRequest, scheduler: str = THREADS) -> FitResult:
     """:func:`run_fit` with its bands computed by Dask (``scheduler``: :data:`THREADS` or a
-    scheduler address)."""
+    scheduler address).
+
+    A scheduler lost before the first band is sent (while this process reads the sample and
+    chooses the model) surfaces from a client call, not from a band's result: Dask's client
+    retries for its timeout, then raises ``CommClosedError`` (an ``OSError``). Until
+    2026-12-01 that reached the user as a 120-line traceback (exit 1)."""
     with scheduler_client(scheduler) as cluster:
-        return run_fit(req, bands=dask_bands(cluster, req.source))
+        try:
+            return run_fit(req, bands=dask_bands(cluster, req.source))
+        except OSError as exc:  # output write failures are named by run_fit, not OSError
+            if cluster is None or not _comm_lost(cluster.client, exc):
+                raise
+            raise _fit_lost(cluster.address) from None
+
+
+def _comm_lost(client: Any, exc: OSError) -> bool:
+    """Whether ``exc``, raised by a call on ``client``, is its connection to the scheduler
+    gone (stricter than :func:`scheduler_lost`, which takes any ``OSError`` of a band's
+    result as one: here a local file error must stay itself)."""
+    from distributed.comm.core import CommClosedError
+
+    return isinstance(exc, CommClosedError) or str(getattr(client, "status", "running")) in (
+        "connecting",
+        "closing",
+        "closed",
+    )
 
 
 _SESSION_LOCK = threading.Lock()
