@@ -70,6 +70,39 @@ def test_a_scheduler_without_workers_is_a_clear_error(tmp_path: Path, monkeypatc
     assert "Traceback" not in r.output
 
 
+def test_a_scheduler_of_another_dask_version_is_refused_naming_both(tmp_path: Path) -> None:
+    """The scheduler answers Dask's ``versions`` request as distributed 2025.1.0 does (a
+    scheduler of 2025.1.0 against this client: Dask's ``Client`` failed as it connected with
+    "TypeError: Scheduler.identity() got an unexpected keyword argument 'n_workers'", said as
+    "cannot reach the Dask scheduler … Start one with `dask scheduler`", then hung 40 s in its
+    ``__del__`` and printed a traceback). Refused before any Client, one session or a batch."""
+    import distributed
+    from distributed import LocalCluster
+    from distributed.versions import get_versions
+
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    theirs = get_versions()
+    theirs["packages"] = {**theirs["packages"], "dask": "2025.1.0", "distributed": "2025.1.0"}
+    with LocalCluster(  # tcp://: an inproc:// address is not probed (only this process's)
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", dashboard_address=None
+    ) as cluster:
+        cluster.scheduler.handlers["versions"] = lambda packages=None: theirs
+        address = cluster.scheduler_address
+        for extra in ([], [str(session)]):  # one session, and a batch
+            out = tmp_path / "o"
+            r = runner.invoke(
+                app, ["fit", str(session), *extra, "--out", str(out), "--scheduler", address]
+            )
+            assert r.exit_code == 2, (r.output, r.exception)
+            said = " ".join(r.output.split())
+            mine = distributed.__version__
+            assert (
+                f"the Dask scheduler at '{address}' runs distributed 2025.1.0, and this machine "
+                f"distributed {mine}" in said
+            ), said
+            assert "cannot reach" not in said and not out.exists()
+
+
 def _unreadable(path: Path):
     """An image opener standing for a worker that does not see the session's files."""
     raise FileNotFoundError(2, "No such file or directory", str(path))

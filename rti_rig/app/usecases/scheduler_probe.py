@@ -292,16 +292,51 @@ async def _connect(
 
 async def _identity(
     address: str, timeout: float, connection_args: dict[str, Any], ips: Sequence[str] = ()
-) -> tuple[Any, Reached]:
+) -> tuple[Any, Reached, Any]:
     """The scheduler's answer to Dask's ``identity`` request (a connection, its handshake, one
-    request and its reply), and where it came from; ``ips``: its host's addresses
+    request and its reply), where it came from, and, from a scheduler, its answer to Dask's
+    ``versions`` request (None from anything else); ``ips``: its host's addresses
     (:func:`_connect`)."""
     comm, reached = await _connect(address, timeout, connection_args, ips)
     try:
         await comm.write({"op": "identity", "reply": True})
-        return await comm.read(), reached
+        identity = await comm.read()
+        versions = None
+        if _is_scheduler(identity):
+            await comm.write({"op": "versions", "reply": True})
+            versions = await comm.read()
+        return identity, reached, versions
     finally:
         comm.abort()
+
+
+def _is_scheduler(identity: Any) -> bool:
+    return isinstance(identity, dict) and "workers" in identity
+
+
+def _other_dask(address: str, versions: Any) -> SchedulerError | None:
+    """The refusal of a scheduler that runs another version of Dask's ``distributed`` than
+    this machine (None when it runs this one, or does not say).
+
+    Why: Dask's messages change between versions; a ``Client`` of one built on the scheduler
+    of another failed as it connected ("TypeError: Scheduler.identity() got an unexpected
+    keyword argument 'n_workers'"), which was told as a scheduler that "cannot be reached",
+    with advice to start one, then hung 40 s in the Client's ``__del__`` and printed a
+    traceback. Refused before any Client is built, naming both versions."""
+    import distributed
+
+    packages = versions.get("packages") if isinstance(versions, dict) else None
+    theirs = packages.get("distributed") if isinstance(packages, dict) else None
+    if not isinstance(theirs, str) or theirs == distributed.__version__:
+        return None
+    mine = distributed.__version__
+    return SchedulerError(
+        f"the Dask scheduler at {address!r} runs distributed {theirs}, and this machine "
+        f"distributed {mine}: Dask's client, scheduler and workers must run the same version "
+        f"(their messages differ between versions). Start the scheduler and its workers "
+        f"from an environment with distributed {mine}, as this one (pip install "
+        f"'distributed=={mine}'), and run the same command"
+    )
 
 
 def _run_quietly(main: Any) -> Any:
@@ -538,7 +573,7 @@ def probe(address: str, timeout: float) -> Reached:
         return await asyncio.wait_for(_identity(address, timeout, args, ips), left)
 
     try:
-        identity, reached = _run_quietly(bounded())
+        identity, reached, versions = _run_quietly(bounded())
     except TimeoutError:  # asyncio's is the builtin's since 3.11; Dask's own names the address
         raise unreachable_scheduler(
             address,
@@ -565,7 +600,7 @@ def probe(address: str, timeout: float) -> Reached:
         ) from None
     except Exception as exc:  # reset, a TLS failure, a reply that is not Dask's
         raise unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
-    if not (isinstance(identity, dict) and "workers" in identity):
+    if not _is_scheduler(identity):
         # e.g. a worker's or nanny's address: it answers, then the Client built on it failed
         # with a TypeError and hung 40 s in its __del__, printing a traceback
         what = identity.get("type", "server") if isinstance(identity, dict) else "server"
@@ -574,4 +609,7 @@ def probe(address: str, timeout: float) -> Reached:
             "address `dask scheduler` prints (the one its workers were started with), such as "
             "tcp://HOST:8786"
         )
+    other = _other_dask(address, versions)
+    if other is not None:
+        raise other
     return replace(reached, base_security=security)
