@@ -238,6 +238,12 @@ def test_a_lost_scheduler_mid_batch_keeps_and_names_the_finished_sessions(
     assert f"lost the Dask scheduler at '{address}' during the batch" in said, said
     assert f"1 of 2 sessions are finished in {out.resolve()} ({tmp_path / 's1'})" in said
     assert "run the same command" in said and "s1: failed" not in said
+    # a worker goes on with the task it runs: a real scheduler killed mid-batch had been said
+    # as "no session is finished yet", and the session being fitted appeared in ROOT after
+    assert (
+        f"a session a worker had already begun may still finish there and appear in {out.resolve()}"
+        in said
+    )
     assert (out / "s1" / "fit.json").exists() and not (out / "s2").exists()
 
 

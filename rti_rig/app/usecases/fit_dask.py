@@ -768,11 +768,17 @@ def _batch_lost(
     scheduler: str, sources: list[Path], given: list[tuple[Path, Path]], root: Path
 ) -> SchedulerError:
     """The error of a batch whose scheduler went away: which sessions are finished in
-    ``root`` (:func:`_finished_kept`)."""
+    ``root`` (:func:`_finished_kept`), and that those a worker had begun may still finish.
+
+    Why the latter: a worker goes on with its running task after the scheduler is lost, until
+    it shuts down. Killed mid-batch, the scheduler's loss was said as "no session is finished
+    in ROOT yet", and 13 s later the session its worker was fitting stood finished in ROOT."""
     kept = _finished_kept(sources, given, root)
     return SchedulerError(
         f"lost the Dask scheduler at {scheduler!r} during the batch (it stopped or the network "
-        f"to it failed): {kept}. Start the scheduler again (`dask scheduler`, workers with "
+        f"to it failed): {kept}; a session a worker had already begun may still finish there "
+        f"and appear in {root} (a worker goes on with its task until it shuts down). Start "
+        "the scheduler again (`dask scheduler`, workers with "
         f"`dask worker {scheduler}`) and run the same command to fit the rest: finished "
         "sessions are skipped, partial ones redone"
     )
