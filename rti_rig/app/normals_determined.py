@@ -17,18 +17,43 @@ from rti_rig.core.errors import RtiRigError
 from rti_rig.core.fit_minimums import NORMAL_ERROR_LIMIT_DEG, NORMAL_MIN_LIGHTS, NORMAL_NOISE
 
 #: What ``rti-rig fit`` refuses of lights that give no normals, whatever their count (the start
-#: of :data:`FIT_WITHOUT_NORMALS`; ``fit_outlook.fit_without_normals`` goes on from it).
+#: of :func:`fit_without_normals_words`; ``fit_outlook.fit_without_normals`` goes on from it).
 NO_NORMAL_MAPS = (
     "rti-rig fit would write no normal maps from them (--model ps, lambert and robust-ps refuse "
     "them"
 )
 
-#: What ``rti-rig fit`` does with lights that give no normals, as a CLI user can act on it.
-FIT_WITHOUT_NORMALS = NO_NORMAL_MAPS + (
-    "; --model auto, which then chooses among the PTM and HSH, hsh2 and ptm write the "
-    "relighting files fit.ptm and fit.rti only, ridge-regularised: along the direction the "
-    "lights do not span, their relighting is a guess)"
-)
+#: The named models that write the relighting files of lights giving no normals, as they are
+#: offered to a user (``--model auto`` besides them).
+_RELIGHTING_BY_NAME = ("hsh2", "ptm")
+
+
+def relighting_models(n: int) -> str:
+    """The ``--model`` options that write fit.ptm and fit.rti of ``n`` lights that give no
+    normals, those ``n`` is too few for named with what they need (``core.fit_minimums``).
+
+    Why: 6-8 lights at one azimuth were told "hsh2 and ptm write the relighting files", and
+    ``--model hsh2`` then refused them: it needs 9.
+    """
+    from rti_rig.core.fit_minimums import N_COEFFICIENTS
+
+    fits = [f"--model {m}" for m in _RELIGHTING_BY_NAME if n >= N_COEFFICIENTS[m]]
+    short = [m for m in _RELIGHTING_BY_NAME if n < N_COEFFICIENTS[m]]
+    named = ", ".join(["--model auto", *fits[:-1]]) + f" or {fits[-1]}" if fits else ""
+    named = named or "--model auto"
+    needs = "; ".join(f"--model {m} needs {N_COEFFICIENTS[m]} lights" for m in short)
+    return named + (f" ({needs}, these are {n})" if needs else "")
+
+
+def fit_without_normals_words(n: int) -> str:
+    """What ``rti-rig fit`` does with ``n`` lights that give no normals, as a CLI user can act
+    on it: no normal maps, and the models that write the relighting files of ``n`` lights."""
+    return NO_NORMAL_MAPS + (
+        f"; {relighting_models(n)} write the relighting files fit.ptm and fit.rti only, "
+        "ridge-regularised: along the direction the lights do not span, their relighting is a "
+        "guess)"
+    )
+
 
 #: What the note of lights captured with ``--allow-no-normals`` says (kept in the manifest's
 #: ``input_notes``): a manifest from before the flag was recorded shows it was given by this
@@ -120,21 +145,24 @@ def undetermined_normals(lights: np.ndarray, what: str = "lights") -> str | None
     ``what`` names them in the text ("planned lights", "lights of this session").
     """
     from rti_rig.core.rti_bases import design_matrix
-    from rti_rig.reconstruct.solve import solve_matrix
+    from rti_rig.reconstruct.solve import condition_words, solve_matrix
 
     lights = np.asarray(lights, dtype=np.float64).reshape(-1, 3)
     if len(lights) < NORMAL_MIN_LIGHTS:  # too few is refused elsewhere, by count
         return None
     _, report = solve_matrix(design_matrix("lambert", lights), "lambert", warn=False)
     error = predicted_normal_error_deg(lights)
+    conditioned = condition_words(
+        report.condition_number, report.cond_limit, "the three components of a normal"
+    )
     if not report.regularised and error <= NORMAL_ERROR_LIMIT_DEG:
         return None
     shown = f"{error:.3g}°" if np.isfinite(error) else "unbounded"
     return (
         f"the {len(lights)} {what}{_listed(lights)} cannot determine a surface normal: "
         f"{_layout(lights)} (predicted normal error {shown} at {NORMAL_NOISE:.0%} image "
-        f"noise, limit {NORMAL_ERROR_LIMIT_DEG:g}°; condition number "
-        f"{report.condition_number:.3g} over the hemisphere, limit {report.cond_limit:g})"
+        f"noise, limit {NORMAL_ERROR_LIMIT_DEG:g}°; "
+        f"{conditioned})"
     )
 
 
@@ -164,5 +192,6 @@ def refuse_undetermined(lights: np.ndarray, what: str, advice: str, nothing_done
     reason = undetermined_normals(lights, what)
     if reason is not None:
         raise RtiRigError(
-            f"{reason}; {FIT_WITHOUT_NORMALS}. {advice[0].upper()}{advice[1:]}; {nothing_done}"
+            f"{reason}; {fit_without_normals_words(len(lights))}. "
+            f"{advice[0].upper()}{advice[1:]}; {nothing_done}"
         )

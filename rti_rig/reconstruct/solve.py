@@ -112,8 +112,8 @@ class FitReport:
         """One line for logs and reports."""
         text = (
             f"{self.model}: {self.n_coefficients} coefficients from {self.n_lights} lights, "
-            f"condition number {self.condition_number:.3g} over the hemisphere "
-            f"(limit {self.cond_limit:g}), noise gain {self.noise_gain:.3g}, {self.action}"
+            f"{condition_words(self.condition_number, self.cond_limit)}, "
+            f"noise gain {self.noise_gain:.3g}, {self.action}"
         )
         if self.regularised:
             text += f" with lambda {self.ridge_lambda:.3g} on hemisphere-scaled columns"
@@ -188,6 +188,15 @@ _SOLVED_MAX = 32
 _SOLVED_LOCK = threading.Lock()
 
 
+def condition_words(cond: float, limit: float, what: str = "its terms") -> str:
+    """A condition number as a user reads it: the figure and its limit, or, where it is
+    infinite, what that means for the lights. Why: "condition number inf" reached users, who
+    were left to guess that no fit can tell ``what`` apart from these lights at all."""
+    if np.isfinite(cond):
+        return f"condition number {cond:.3g} over the hemisphere, limit {limit:g}"
+    return f"these lights cannot separate {what} (the fit's system is singular)"
+
+
 def _solve(
     design: NDArray[np.float64],
     model: str,
@@ -225,8 +234,9 @@ def _solve(
     if regularised:
         if ill_conditioned == "refuse":
             raise ReconstructionError(
-                f"light set is ill-conditioned for {model}: condition number {cond:.3g} over the "
-                f"hemisphere exceeds {cond_limit:g} (lights nearly coplanar or bunched near the "
+                f"light set is ill-conditioned for {model}: "
+                f"{condition_words(cond, cond_limit, f'its {p} terms')} (lights nearly "
+                "coplanar or bunched near the "
                 "zenith for Lambert, on a single ring or a small cap for PTM/HSH); add lights "
                 "at other elevations (from Python, ill_conditioned='regularise' fits it "
                 "regularised)"
@@ -242,8 +252,9 @@ def _solve(
         texts.append(
             (
                 RegularisedFitWarning,
-                f"{model} fit ridge-regularised: condition number {cond:.3g} over the hemisphere "
-                f"exceeds {cond_limit:g} for these {n} lights; its coefficients are biased and "
+                f"{model} fit ridge-regularised: "
+                f"{condition_words(cond, cond_limit, f'its {p} terms')}, for these {n} lights; "
+                "its coefficients are biased and "
                 f"relighting away from the lights is not trustworthy (noise gain {gain:.3g})",
             )
         )

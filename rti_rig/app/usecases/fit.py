@@ -809,6 +809,9 @@ def _fit_into(  # type: ignore[no-untyped-def]
             with contextlib.suppress(Exception):  # the QA's own check says what went wrong
                 checksums.result()
         try:
+            no_qa = qa_without_normals(lights)
+            if no_qa is not None:
+                raise ReconstructionError(no_qa)
             with warnings.catch_warnings(record=True) as qa_caught:
                 warnings.simplefilter("always")
                 qa = assess(frames, lights, names)  # every row of every frame: checksummed too
@@ -1214,7 +1217,7 @@ def _refuse_undetermined_normals(req: FitRequest, model_name: str, lights: np.nd
     regularised)", which a CLI user cannot act on. ``auto`` never gets here: on such lights it
     leaves Lambert out of its choice (:func:`auto_candidates`).
     """
-    from rti_rig.app.normals_determined import undetermined_normals
+    from rti_rig.app.normals_determined import relighting_models, undetermined_normals
 
     reason = undetermined_normals(lights, "lights of this session")
     if reason is None:
@@ -1222,7 +1225,7 @@ def _refuse_undetermined_normals(req: FitRequest, model_name: str, lights: np.nd
     asked = f"--model auto chose {model_name}" if req.model == AUTO else f"--model {req.model}"
     raise FitInputError(
         f"{asked}, photometric stereo, but {reason}: ill-conditioned for photometric stereo. "
-        "--model auto, --model hsh2 or --model ptm write the relighting files (fit.rti, fit.ptm), "
+        f"{relighting_models(len(lights))} write the relighting files (fit.rti, fit.ptm), "
         "ridge-regularised, without normal maps; for normals, capture again with lights at "
         "several elevations and azimuths"
     )
@@ -1249,16 +1252,18 @@ def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str
     """
     from rti_rig.app.normals_determined import undetermined_normals
     from rti_rig.core.rti_bases import design_matrix
-    from rti_rig.reconstruct.solve import NOISE_GAIN_LIMIT, solve_matrix
+    from rti_rig.reconstruct.solve import NOISE_GAIN_LIMIT, condition_words, solve_matrix
 
     undetermined = undetermined_normals(lights, "lights of this session")
     if source == "ptm":
         _, ptm = solve_matrix(design_matrix("ptm", lights), "ptm", warn=False)
         if ptm.trusted:  # neither regularised nor over the noise-gain limit
             return "ptm", ""
+        terms = f"its {ptm.n_coefficients} terms"
         why = (
-            f"ridge-regularised on these lights (condition number {ptm.condition_number:.3g} "
-            "over the hemisphere), and its normals would be biased"
+            "ridge-regularised on these lights ("
+            f"{condition_words(ptm.condition_number, ptm.cond_limit, terms)}), and its "
+            "normals would be biased"
             if ptm.regularised
             else f"ill-conditioned on these lights (noise gain {ptm.noise_gain:.3g}, limit "
             f"{NOISE_GAIN_LIMIT:g}), and its normals would be far off"
@@ -1393,9 +1398,40 @@ def verdict_for_session(session: Path) -> str:
             f"session has {len(lights)}; run with --lights {VERDICT_MIN_LIGHTS} or more for "
             "an RTI the verdict can judge (the images taken are kept)"
         )
+    no_qa = qa_without_normals(lights, session)
+    if no_qa is not None:
+        raise RtiRigError(no_qa)
     qa = assess(frames, lights, names)
     _remember_pixels(frames)
     return with_lost_files(qa, session).verdict
+
+
+def qa_without_normals(lights: np.ndarray, session: Path | None = None) -> str | None:
+    """Why the QA cannot judge a session's images, where its lights give no normals, in words
+    a command-line user can act on; None where they give normals. ``session``: the folder
+    whose fit is still to be made (the run's verdict), named in the command that makes it.
+
+    Why: the QA judges each image against a photometric-stereo fit, and the solver's refusal
+    reached the verdict of a ``run --allow-no-normals`` as "(from Python,
+    ill_conditioned='regularise' fits it regularised)": no option of ``rti-rig fit`` does that,
+    and a QA of a regularised normal map would judge images against a guess.
+    """
+    from rti_rig.app.normals_determined import undetermined_normals
+
+    reason = undetermined_normals(lights, "lights of this session")
+    if reason is None:
+        return None
+    fit = (
+        ""
+        if session is None
+        else f"; `rti-rig fit {shlex.quote(str(session))} --out FOLDER` still writes the "
+        "relighting files"
+    )
+    return (
+        f"the QA judges every image against a normal map, and {reason}. No option of "
+        f"`rti-rig fit` gives a verdict on such lights{fit}. For a verdict, capture again with "
+        "lights at several elevations and azimuths"
+    )
 
 
 def _read_pixels(frame: Any) -> str | None:

@@ -105,13 +105,13 @@ _FILES = (("fit.ptm", "a PTM", "ptm"), ("fit.rti", "an HSH fit", "rti"))
 
 def fit_without_normals(n: int) -> str:
     """What ``rti-rig fit`` makes of ``n`` lights that give no normals: the general words
-    (``normals_determined.FIT_WITHOUT_NORMALS``) where ``--model auto`` writes both relighting
+    (``normals_determined.fit_without_normals_words``) where ``--model auto`` writes both relighting
     files of them, else what it does write of ``n`` and what to do (:func:`fit_outlook`).
 
     Why: a run of 4 raking lights said both "fit.ptm and fit.rti only" and, in the next note,
     "will make a normal map"; `rti-rig fit` then made neither (without photometric stereo its
     simplest model needs 5 lights)."""
-    from rti_rig.app.normals_determined import FIT_WITHOUT_NORMALS, NO_NORMAL_MAPS
+    from rti_rig.app.normals_determined import NO_NORMAL_MAPS, fit_without_normals_words
 
     outlook = fit_outlook(n, normals_determined=False)
-    return FIT_WITHOUT_NORMALS if outlook is None else f"{NO_NORMAL_MAPS}): {outlook}"
+    return fit_without_normals_words(n) if outlook is None else f"{NO_NORMAL_MAPS}): {outlook}"

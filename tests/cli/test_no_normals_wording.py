@@ -1,0 +1,86 @@
+"""What a run of lights that give no normals is told, in words a command-line user can act on.
+
+Three wordings of 7 lights at one azimuth captured with ``--allow-no-normals`` had misled: the
+run's note said "hsh2 and ptm write the relighting files" (``--model hsh2`` needs 9 lights
+and refused them), the verdict advised "from Python, ill_conditioned='regularise'", and both
+said "condition number inf".
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import CONFIGS, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.fit_minimums import N_COEFFICIENTS
+from rti_rig.core.lp_format import LpEntry, write_lp
+
+
+def _one_azimuth(path: Path, n: int) -> Path:
+    """``n`` lights at azimuth 0°, elevations 15-80°: in one plane through the object."""
+    el = np.radians(np.linspace(15, 80, n))
+    write_lp(path, [LpEntry(f"i{k}.jpg", (np.cos(e), 0.0, np.sin(e))) for k, e in enumerate(el)])
+    return path
+
+
+@pytest.fixture(scope="module")
+def seven(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """A session of 7 lights at one azimuth, run with its verdict: the folder and its words."""
+    tmp = tmp_path_factory.mktemp("seven")
+    plan = _one_azimuth(tmp / "one_az.lp", 7)
+    out = tmp / "s"
+    args = [str(CONFIGS / "virtual_arm.toml"), "--plan", str(plan), "--out", str(out)]
+    r = CliRunner().invoke(app, ["run", *args, "--allow-no-normals"])
+    assert r.exit_code == 0, r.output
+    return out, said(r)
+
+
+def test_the_note_does_not_offer_a_model_the_lights_are_too_few_for(seven) -> None:
+    _, text = seven
+    assert "hsh2 and ptm write" not in text
+    assert "--model auto or --model ptm" in text
+    assert f"--model hsh2 needs {N_COEFFICIENTS['hsh2']} lights, these are 7" in text
+
+
+def test_the_verdict_gives_a_command_line_answer(seven) -> None:
+    session, text = seven
+    assert "QA verdict unavailable" in text
+    assert "from Python" not in text and "ill_conditioned" not in text
+    assert "No option of `rti-rig fit` gives a verdict on such lights" in text
+    assert f"rti-rig fit {session} --out FOLDER` still writes the relighting files" in text
+
+
+def test_an_infinite_condition_number_is_said_as_what_it_means(seven, tmp_path: Path) -> None:
+    session, text = seven
+    r = CliRunner().invoke(app, ["fit", str(session), "--out", str(tmp_path / "f")])
+    fitted = said(r)
+    assert r.exit_code == 0, fitted
+    for words in (text, fitted):
+        assert "condition number inf" not in words
+        assert "these lights cannot separate the three components of a normal" in words
+    assert "these lights cannot separate its 4 terms (the fit's system is singular)" in fitted
+    assert "from Python" not in fitted
+    assert (tmp_path / "f" / "fit.rti").exists()
+
+
+def test_nine_lights_are_offered_hsh2(tmp_path: Path) -> None:
+    plan = _one_azimuth(tmp_path / "one_az.lp", 9)
+    r = CliRunner().invoke(
+        app,
+        [
+            "run",
+            str(CONFIGS / "virtual_arm.toml"),
+            "--plan",
+            str(plan),
+            "--out",
+            str(tmp_path / "s"),
+            "--no-verdict",
+            "--allow-no-normals",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    assert "--model auto, --model hsh2 or --model ptm write the relighting files" in said(r)
