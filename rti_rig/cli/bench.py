@@ -95,11 +95,18 @@ def bench_tradeoff(
             )
         ) from None
     # the fits' trust warnings (a layout too sparse for HSH3 ...) are information about a cell
-    # of the table: shown as notes, not as Python warnings with a source line and file path
+    # of the table: shown as notes, not as Python warnings with a source line and file path,
+    # each said once, and as the sentence it is (they had led with the warning's class name,
+    # "RegularisedFitWarning: hsh1 fit ridge-regularised ...", the same note twice in a row)
     import warnings
 
+    said: set[str] = set()
+
     def _as_note(message, category, *_args, **_kwargs):  # type: ignore[no-untyped-def]
-        err.print(f"[yellow]note:[/] {escape(f'{category.__name__}: {message}')}", soft_wrap=True)
+        text = str(message)
+        if text not in said:
+            said.add(text)
+            err.print(f"[yellow]note:[/] {escape(text)}", soft_wrap=True)
 
     with warnings.catch_warnings():  # restored after: the CLI may run inside a test process
         warnings.showwarning = _as_note

@@ -664,3 +664,25 @@ def test_lights_that_cannot_give_reference_normals_are_refused_by_name(
     assert said in text and "several elevations and azimuths" in text
     assert "from Python" not in text and "Traceback" not in text
     assert not out.exists()  # refused before --out is made
+
+
+def test_the_fits_trust_notes_are_sentences_said_once(tmp_path: Path) -> None:
+    """Lights low on the horizon regularise the richer bases: their notes had led with the
+    warning's Python class name ("RegularisedFitWarning: hsh1 fit ...") and come twice."""
+    lp = _acquisition(tmp_path / "acq", 18)
+    names = [line.split()[0] for line in lp.read_text().splitlines()[1:]]
+    az = np.linspace(0.0, 2.0 * np.pi, len(names), endpoint=False)
+    el = np.radians(np.where(np.arange(len(names)) % 2, 8.0, 22.0))
+    dirs = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
+    lp.write_text(
+        f"{len(names)}\n"
+        + "".join(
+            f"{n} {x:.6f} {y:.6f} {z:.6f}\n" for n, (x, y, z) in zip(names, dirs, strict=True)
+        )
+    )
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp)])
+    assert r.exit_code == 0, r.output
+    notes = [line for line in r.output.splitlines() if line.startswith("note:")]
+    assert any("fit ridge-regularised" in n for n in notes), r.output  # the premise
+    assert not [n for n in notes if "Warning" in n], notes
+    assert len(notes) == len(set(notes)), notes
