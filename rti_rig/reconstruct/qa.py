@@ -179,10 +179,13 @@ GRAZING_DEG = 5.0
 GRAZING_TRUSTED_BRIGHT_END = 0.85
 GRAZING_DIM_MIN_DEG = 1.5
 #: The percentile of an image's reduced pixels that is its brightest: the level a black
-#: acquisition's "misfired, no light" names. Whether it is black throughout is judged by
+#: acquisition's :data:`BLACK_THROUGHOUT` names. Whether it is black throughout is judged by
 #: :func:`~rti_rig.reconstruct.signal_check.every_image_black` (the rule ``fit --no-qa``
 #: warns by), not by this level: the two rules had been written twice and could disagree.
 PEAK_PERCENTILE = 99.9
+#: The words of an acquisition black throughout, said once for the run of images
+#: (:attr:`QAReport.verdict`).
+BLACK_THROUGHOUT = "no light in any image"
 #: A light is dim too when its image's median gain is at most this fraction of the median
 #: gain of its :data:`NEIGHBOUR_COUNT` nearest lights' images: the Lambertian prediction
 #: misjudges a glossy object's brightness light by light (bright-end gains of 0.8-5.4 on the
@@ -527,11 +530,12 @@ class QAReport:
         # range, whatever else some of those images have. Each image's other problems are
         # said on their own (a saturated image in the range had been given the move's whole
         # advice again, and a run of 48 cut into pieces around it). So are images that do not
-        # change with their light (:mod:`qa_unchanging`): one fault of the whole session.
+        # change with their light (:mod:`qa_unchanging`) and images all black: one fault of
+        # the whole session (a black one had said "misfired, no light ..." once per image).
         carriers: dict[str, list[ImageCheck]] = {}
         for c in self.reshoot:
             for p in c.problems:
-                if p.startswith((MOVED_FROM, UNCHANGING)):
+                if p.startswith((MOVED_FROM, UNCHANGING, BLACK_THROUGHOUT)):
                     carriers.setdefault(p, []).append(c)
         ranged = {p: run for p, run in carriers.items() if len(run) >= 3}
         parts = []
@@ -1559,6 +1563,14 @@ def assess(
     # an uneven dome's LEDs scatter a correct image's level against its mates' (qa_exposure)
     limit = np.array([exposure_limit(s) for s in exposure_scatter(level, lt, exposure_usable)])
     checks: list[ImageCheck] = []
+    # one text for every image, so that the verdict says it once for the run of them
+    black_throughout = (
+        f"{BLACK_THROUGHOUT}: the brightest pixels of every image reach at most "
+        f"{float(np.max(peak)):.2%} of full scale (a lens cap left on, lights that never fired, "
+        "or an exposure far too short); mend that, then reshoot"
+        if all_black  # judged with a full scale: ``peak`` is finite
+        else ""
+    )
     for i in range(n):
         problems = []
         bright_claim: str | None = None  # the one problem that says "brighter", if any
@@ -1625,11 +1637,7 @@ def assess(
             if bright_claim is not None:  # brighter than predicted, of nothing
                 problems.remove(bright_claim)
                 bright_claim = None
-            problems.append(
-                f"misfired, no light: its brightest pixels reach {peak[i]:.2%} of full scale, "
-                "as every image's do (a lens cap, lights that never fired, or an exposure far "
-                "too short)"
-            )
+            problems.append(black_throughout)
         if unchanged is not None:
             problems.append(unchanging_problem(unchanged))
         if step is not None and _in_open_range(step, i):
