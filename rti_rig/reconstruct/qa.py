@@ -84,7 +84,13 @@ from rti_rig.reconstruct.qa_exposure import (
     exposure_scatter,
 )
 from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
-from rti_rig.reconstruct.qa_unchanging import UNCHANGING, unchanging_problem, unchanging_spread
+from rti_rig.reconstruct.qa_unchanging import (
+    UNCHANGING,
+    flat_images,
+    flat_problem,
+    unchanging_problem,
+    unchanging_spread,
+)
 from rti_rig.reconstruct.signal_check import every_image_black, sample_grid, sample_pixels
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
@@ -1277,6 +1283,9 @@ def assess(
     coverage = ((small > dark) & ~small_sat).sum(axis=0).astype(np.int16)
     # every image the same picture: said once, for every image, as no per-image check sees it
     unchanged = None if all_black else unchanging_spread(small, small_sat, dark, lt)
+    # one image of one level among images that shade with their light: named, in place of
+    # the dim or bright claims its level against the fit would give it
+    flat = {} if all_black or unchanged is not None else flat_images(small, small_sat, dark)
 
     # per-image evidence on a full-resolution crop where the object has lit structure (a
     # second pass reads only its rows)
@@ -1640,6 +1649,12 @@ def assess(
             problems.append(black_throughout)
         if unchanged is not None:
             problems.append(unchanging_problem(unchanged))
+        if i in flat:
+            # its level against the fit (dim, too bright, exposure off) says nothing of a
+            # frame with no picture of the object in it
+            problems = [p for p in problems if p.startswith("saturated")]
+            problems.append(flat_problem(*flat[i]))
+            bright_claim = None
         if step is not None and _in_open_range(step, i):
             problems.append(_may_have_moved(step, names))
         elif step_moved[i] and step is not None:

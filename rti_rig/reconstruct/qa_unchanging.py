@@ -81,3 +81,58 @@ def unchanging_problem(spread: float) -> str:
         "dome's LEDs did not fire while another light was on, or one frame was saved under "
         "every name); check that each light fires, then reshoot"
     )
+
+
+#: The words of one image that shows no picture of the object (:func:`flat_images`).
+FLAT_FRAME = "a flat frame: no picture of the object"
+#: An image is judged flat against the others only where their median spread is at least this
+#: many times :data:`UNCHANGING_SPREAD`: an object whose every image is nearly flat (a
+#: featureless card under distant lights) gives no image that differs from the rest.
+FLAT_AGAINST = 5.0
+#: The fewest lit, unclipped reduced pixels a flat image is judged on.
+FLAT_MIN_PIXELS = 16
+
+
+def flat_images(
+    small: NDArray[np.floating],
+    small_sat: NDArray[np.bool_],
+    dark: float,
+) -> dict[int, tuple[float, float]]:
+    """The images of ``small`` (N, h, w; ``small_sat`` and ``dark`` as in
+    :func:`unchanging_spread`) that are one level across the frame while the others are not:
+    each with its spread and the other images' median spread.
+
+    Why: one flat grey frame among lit ones (a frame from another source, a lens covered, a
+    camera that sent a blank buffer) was judged "good" at a level near its mates', and "too
+    bright for its light" above it: the per-image checks compare it with a fit that, at its
+    level, it matches on average. An image of the object under a light shades and shadows it;
+    a frame of one level has nothing of the object in it. The spread is the 10th to 90th
+    percentile of the pixels lit in some image and clipped in none, over the 90th; an image
+    whose 90th percentile is dark is a misfire, judged elsewhere.
+    """
+    n = small.shape[0]
+    if n < 3:
+        return {}
+    stack = small.reshape(n, -1).astype(np.float64)
+    usable = (stack.max(axis=0) > dark) & ~small_sat.reshape(n, -1).any(axis=0)
+    if int(usable.sum()) < FLAT_MIN_PIXELS:
+        return {}
+    lo, hi = np.percentile(stack[:, usable], [10.0, 90.0], axis=1)
+    spread = np.where(hi > dark, (hi - lo) / np.where(hi > 0.0, hi, 1.0), np.nan)
+    found: dict[int, tuple[float, float]] = {}
+    for i in np.flatnonzero(spread < UNCHANGING_SPREAD):
+        others = np.delete(spread, i)
+        others = others[np.isfinite(others)]
+        typical = float(np.median(others)) if others.size >= 2 else 0.0
+        if typical >= FLAT_AGAINST * UNCHANGING_SPREAD:
+            found[int(i)] = (float(spread[i]), typical)
+    return found
+
+
+def flat_problem(spread: float, typical: float) -> str:
+    """What the verdict says of a flat image (:func:`flat_images`), and what to do."""
+    return (
+        f"{FLAT_FRAME} (one level across the frame: it varies {spread:.1%} across it, where "
+        f"the other images vary a median {typical:.0%} under their lights); a frame from "
+        "another source, a covered lens or a camera fault; reshoot it"
+    )
