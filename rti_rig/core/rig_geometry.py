@@ -40,6 +40,27 @@ def coincident_leds(directions: ArrayLike) -> tuple[int, int] | None:
     return None if pairs.size == 0 else (int(pairs[0][0]), int(pairs[0][1]))
 
 
+def repeated_directions(directions: ArrayLike) -> list[list[int]]:
+    """The groups (each in order, of two or more) of lights sharing a direction within
+    :data:`COINCIDENT_LED_DEG`, as :func:`coincident_leds` judges a pair: an acquisition may
+    repeat a light, and a fit has one direction the fewer for each repeat."""
+    d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    if len(d) < 2:
+        return []
+    d = d / np.linalg.norm(d, axis=1, keepdims=True)
+    close = d @ d.T >= np.cos(np.radians(COINCIDENT_LED_DEG))
+    seen: set[int] = set()
+    groups = []
+    for i in range(len(d)):
+        if i in seen:
+            continue
+        group = [int(j) for j in np.flatnonzero(close[i]) if j >= i and j not in seen]
+        seen.update(group)
+        if len(group) > 1:
+            groups.append(group)
+    return groups
+
+
 @dataclass(frozen=True, eq=False)
 class DomeGeometry:
     """A dome: LED ``i`` lights from ``directions[i]`` and is called ``names[i]``."""

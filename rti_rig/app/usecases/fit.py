@@ -738,6 +738,9 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     notes: list[str] = []
     inputs = acquisition_inputs(req.source)  # before reading: a later change is a change
     frames, lights, names, what = load_acquisition(req.source, notes)
+    repeated = repeated_lights_note(lights, names)
+    if repeated is not None:
+        notes.append(repeated)
     release_free_memory()  # the decode buffers
     out = req.out_dir
     created = not out.exists()
@@ -766,6 +769,40 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
         pool.shutdown(wait=False, cancel_futures=True)
     result.seconds = time.perf_counter() - t0
     return result
+
+
+def repeated_lights_note(lights: np.ndarray, names: Sequence[str]) -> str | None:
+    """What a fit says of lights that repeat a direction, whatever its model, or None.
+
+    Why: a plan or a dome's calibration that repeats a light is refused, saying so, but a fit
+    of 7 images of which 3 share one direction said nothing of it with ``--model ptm``: only
+    "these lights cannot separate its 6 terms", leaving the user to find that 7 images gave
+    5 directions. The models the distinct lights are too few for are named (the coefficient
+    counts of ``core.fit_minimums``)."""
+    from rti_rig.core.fit_minimums import N_COEFFICIENTS
+    from rti_rig.core.rig_geometry import COINCIDENT_LED_DEG, repeated_directions
+
+    groups = repeated_directions(lights)
+    if not groups:
+        return None
+    n = len(lights)
+    distinct = n - sum(len(g) - 1 for g in groups)
+    shown = [", ".join(str(names[i]) for i in g[:-1]) + f" and {names[g[-1]]}" for g in groups[:4]]
+    more = f" and {len(groups) - 4} more groups" if len(groups) > 4 else ""
+    share = "share one direction" if len(groups) == 1 else "each share a direction"
+    short = [m for m in ("ptm", "hsh2", "hsh3") if distinct < N_COEFFICIENTS[m] <= n]
+    tail = (
+        "; too few distinct for "
+        + ", ".join(f"--model {m} ({N_COEFFICIENTS[m]} terms)" for m in short)
+        + ", fitted ridge-regularised and not to be trusted: add lights at other directions"
+        if short
+        else ""
+    )
+    return (
+        f"lights repeated: {'; '.join(shown)}{more} {share} (within "
+        f"{COINCIDENT_LED_DEG:g}°): the {n} images give {distinct} distinct lights, and a "
+        f"repeat adds no direction to the fit{tail}"
+    )
 
 
 def _fit_into(  # type: ignore[no-untyped-def]
