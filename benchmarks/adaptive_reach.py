@@ -247,7 +247,86 @@ def pinned_optimal(
     return np.array([s.led for s in sched.steps], dtype=np.intp)
 
 
-def start_functions() -> dict:  # type: ignore[type-arg]
+@dataclass(frozen=True)
+class FloorCosts:
+    """A planning method that only scores: the expected error, under the objective
+    ``optimal`` builds from the preview, of the homogeneous layout at every floor the plan
+    starts from (``report.expected`` by label, "uniform ≥F°"); it keeps the user's floor's
+    layout (benchmark only: what :class:`PreviewFloorStart` reads)."""
+
+    name: str = "floor-costs"
+    summary: str = "the homogeneous layouts scored by optimal's objective (benchmark only)"
+    surface: str = "flat"
+    needs_preview_reason: str = ""
+    optimises_objective: bool = False
+
+    def prepare(self, ctx):  # type: ignore[no-untyped-def]
+        return ctx.starts[0][1]
+
+    def decide(self, ctx, objective, chosen):  # type: ignore[no-untyped-def]
+        for label, idx in ctx.starts:
+            ctx.report.expected[label] = objective.cost(idx)
+        return chosen
+
+
+_FLOOR_COSTS = FloorCosts()
+
+
+def floor_costs(
+    preview: NDArray | None,
+    geometry: DomeGeometry,
+    n: int,
+    light: tuple[float, float] | None,
+    objective: str = "normals",
+) -> dict[float, float]:
+    """The expected error of the homogeneous layout of ``n`` above each of ``FLOORS`` under
+    the objective `rti-rig plan --method optimal PREVIEW` builds (the same surface, sample and
+    objective; every light of the dome a candidate): {floor: cost}."""
+    from rti_rig.planner.make_plan import plan_with_report
+    from rti_rig.planner.methods import _METHODS, register_method
+
+    if _FLOOR_COSTS.name not in _METHODS:
+        register_method(_FLOOR_COSTS)  # type: ignore[arg-type]
+    _, report = plan_with_report(preview, geometry, n, _FLOOR_COSTS.name, objective, light)
+    return {f: float(report.expected[f"uniform ≥{f:g}°"]) for f in FLOORS}
+
+
+def preview_floor(costs: dict[float, float], default: float) -> float:
+    """The floor of least expected error; an exact tie goes to ``default`` (then the lower)."""
+    return min(costs, key=lambda f: (costs[f], f != default, f))
+
+
+@dataclass
+class PreviewFloorStart:
+    """The ``preview-floor`` start: 4 lights of the homogeneous layout of N above the floor
+    :func:`preview_floor` picks from the preview (the layout of least expected error under
+    ``optimal``'s objective, :func:`floor_costs`), chosen among that layout's lights as the
+    shipped start chooses them among the default floor's (``start_subset``) — so that the
+    design the preview favours is exactly reachable, the completion to that floor being its
+    layout. The rule was fixed before it was measured and has no tuned constant
+    (docs/adaptive.md, "The start chosen from the preview"). ``chosen`` logs (N, floor) per
+    call. Without a preview (None) the objective is `optimal`'s flat-surface one."""
+
+    preview: NDArray | None = None
+    light: tuple[float, float] | None = None
+    chosen: list[tuple[int, float]] = field(default_factory=list)
+
+    def __call__(
+        self, geometry: DomeGeometry, k: int, n_total: int | None, objective: str = "normals"
+    ) -> list[int]:
+        if n_total is None or n_total <= k:
+            return dome_start(geometry, k, n_total, objective)
+        costs = floor_costs(self.preview, geometry, n_total, self.light, objective)
+        floor = preview_floor(costs, adaptive.default_floor_for(objective))
+        self.chosen.append((n_total, floor))
+        full = select_uniform_leds(geometry, n_total, floor)
+        pick = adaptive.start_subset(geometry.directions[full], k, objective=objective)
+        return sorted(int(full[i]) for i in pick)
+
+
+def start_functions(
+    preview: NDArray | None = None, light: tuple[float, float] | None = None
+) -> dict:  # type: ignore[type-arg]
     others = tuple(f for f in FLOORS if f != adaptive.DESIGN_DEFAULT_FLOOR)
     return {
         "default": dome_start,
@@ -259,7 +338,14 @@ def start_functions() -> dict:  # type: ignore[type-arg]
         "shared-3": shared_three_start,
         "above-floor": above_floor_start,
         "all-lights": all_lights_start,
+        # the preview's (None: optimal's flat surface), as `rti-rig plan` takes it
+        "preview-floor": PreviewFloorStart(preview, light),
     }
+
+
+def _plain_starts() -> dict:  # type: ignore[type-arg]
+    """The starts of the main table: those that need no preview."""
+    return {k: v for k, v in start_functions().items() if k != "preview-floor"}
 
 
 #: What ``reach`` scores a layout by: the true mean normal error (°, lower is better), or the
@@ -336,7 +422,7 @@ def reach(
 ) -> list[str]:
     """Table rows: per scene and N, the tuned bar and, per start, each floor's completion (mean
     over draws) and the oracle (``measure``: one of :data:`MEASURES`)."""
-    starts = start_functions()
+    starts = _plain_starts()
     objective = "relight" if measure == "relight" else "normals"
     rows = []
     for _, scene, data, rng in _scenes(scenes, seed):
@@ -361,6 +447,53 @@ def reach(
                     res.setdefault((n, k), []).append(v)
 
         rows += scene_rows(scene, res, list(starts), measure)
+        print(f"{scene} done", flush=True)
+    return rows
+
+
+def preview_start(draws: int, scenes: tuple[str, ...] = (), seed: int = 0) -> list[str]:
+    """Table rows: per scene and N, the tuned bar, the oracle (best floor's completion per draw,
+    decided at the first decision, true mean normal error) from the shipped start and from
+    the ``preview-floor`` start (:class:`PreviewFloorStart`, on the benchmark's preview, the
+    light `--families` plans `optimal` with), the completion to the floor the preview chose
+    (a session that kept it), and the floor chosen per draw."""
+    from benchmarks.tradeoff import TradeoffSettings
+
+    light = TradeoffSettings(held_out_lights=1, ground_truth_lights=50).preview_light_az_el_deg
+    rows = []
+    for _, scene, data, rng in _scenes(scenes, seed):
+        cand = data.candidate_dirs
+        err = _layout_error(data)
+        starts = {"default": dome_start, "preview": PreviewFloorStart(data.preview, light)}
+        res: dict[tuple[int, str], list[float]] = {}
+        picked: dict[int, list[float]] = {n: [] for n in NS}
+        for _ in range(draws):
+            keep, sub = _draw_lights(rng, len(cand), cand)
+            for n in NS:
+                _score_floors(res, n, keep, sub, err)
+                for name, fn in starts.items():
+                    st = fn(sub, adaptive.START_LIGHTS, n)
+                    _, comps = _floor_completions(cand[keep], st, n)
+                    for f, comp in zip(FLOORS, comps, strict=True):
+                        assert comp is not None
+                        res.setdefault((n, f"{name} {f:g}"), []).append(err(keep[np.r_[st, comp]]))
+                got = starts["preview"].chosen[-1]
+                assert got[0] == n
+                picked[n].append(got[1])
+                res.setdefault((n, "kept"), []).append(res[(n, f"preview {got[1]:g}")][-1])
+        tuned = adaptive_tuned(res, 1.0)
+        for n in NS:
+            bar = float(np.mean(res[(n, f"hom {tuned:g}")]))
+            cells = []
+            for name in starts:
+                per = np.array([res[(n, f"{name} {f:g}")] for f in FLOORS])
+                cells.append(float(per.min(axis=0).mean()))
+            cells.append(float(np.mean(res[(n, "kept")])))
+            txt = [f"{c:.4g}" + (" **above**" if c > bar * (1 + 1e-9) else "") for c in cells]
+            floors = ",".join(f"{f:g}" for f in picked[n])
+            rows.append(
+                f"| {scene} | {n} | {tuned:g}°: {bar:.4g} | " + " | ".join(txt) + f" | {floors} |"
+            )
         print(f"{scene} done", flush=True)
     return rows
 
@@ -803,6 +936,12 @@ def main(argv: list[str] | None = None) -> str:
         "shipped designs (their reach and the session's simulated choice)",
     )
     ap.add_argument(
+        "--preview-start",
+        action="store_true",
+        help="instead: the oracle from the start chosen from the preview (preview-floor) "
+        "beside the shipped start's, and the floor chosen per draw",
+    )
+    ap.add_argument(
         "--true-normal",
         action="store_true",
         help="with --object-frame: the layouts about the scene's true mean normal",
@@ -811,7 +950,8 @@ def main(argv: list[str] | None = None) -> str:
         "--seed",
         type=int,
         default=0,
-        help="with --object-frame: the draws (0: those of the tables; another: fresh draws)",
+        help="with --object-frame or --preview-start: the draws (0: those of the tables; "
+        "another: fresh draws)",
     )
     ap.add_argument(
         "--measure",
@@ -828,9 +968,11 @@ def main(argv: list[str] | None = None) -> str:
         return _truth_main(args, t0)
     if args.object_frame:
         return _object_frame_main(args, t0)
+    if args.preview_start:
+        return _preview_start_main(args, t0)
     rows = reach(args.draws, tuple(x for x in args.scenes.split(",") if x), measure=args.measure)
     floors = "/".join(f"{f:g}°" for f in FLOORS)
-    starts = list(start_functions())
+    starts = list(_plain_starts())
     what = (
         "the true mean normal error (°)"
         if args.measure == "normals"
@@ -961,6 +1103,40 @@ def _truth_main(args: argparse.Namespace, t0: float) -> str:
     print(md)
     if args.write:
         write_section("adaptive_reach_truth", md, DOC)
+    return md
+
+
+def _preview_start_main(args: argparse.Namespace, t0: float) -> str:
+    scenes = tuple(x for x in args.scenes.split(",") if x)
+    rows = preview_start(args.draws, scenes, seed=args.seed)
+    md = "\n".join(
+        [
+            _command_line(
+                "--preview-start" + (f" --seed {args.seed}" if args.seed else ""), args, (), t0
+            ),
+            "",
+            f"Simulator, {args.draws} paired draws (those of `benchmarks.adaptive`"
+            + (f", seed {args.seed}" if args.seed else "")
+            + "), designs decided at the first decision; true mean normal error (°). Oracle: "
+            f"the best of the completions above {'/'.join(f'{f:g}°' for f in FLOORS)} per "
+            "draw, from the shipped start (4 lights of the 10° layout) and from `preview-floor` "
+            "(4 lights of the layout of the floor whose homogeneous layout of N has the least "
+            "expected error under `optimal`'s normals objective from the benchmark's preview); "
+            "`kept`: the completion to the floor the preview chose (its layout exactly); the "
+            "floors chosen per draw. **above**: above the bar (the hindsight-tuned "
+            "homogeneous layout).",
+            "",
+            "| scene | N | bar | oracle, shipped start | oracle, `preview-floor` | `kept` | "
+            "floor chosen per draw |",
+            "|---|---|---|---|---|---|---|",
+            *rows,
+        ]
+    )
+    print(md)
+    if args.write:
+        write_section(
+            "adaptive_reach_preview_start" + (f"_seed{args.seed}" if args.seed else ""), md, DOC
+        )
     return md
 
 

@@ -250,3 +250,66 @@ def test_the_simulated_search_never_leaves_a_worse_simulated_design() -> None:
     out = _simulated_search(model, dirs, shot, start, before, sweeps=1)
     assert len(out) == 2 and not set(out.tolist()) & set(shot.tolist())
     assert simulate_designs(model, [full(out)], robust_fit)[0] <= before + 1e-12
+
+
+def _relief_preview(light: tuple[float, float]) -> np.ndarray:
+    from rti_rig.core.geometry import direction_from_az_el
+    from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
+
+    scene = relief_scene(48, 64, seed=0)
+    return lambert_radiance(scene, direction_from_az_el(*light)).astype(np.float32)
+
+
+def test_the_floor_costs_are_optimal_s_own_scores_of_its_homogeneous_starts() -> None:
+    from benchmarks.adaptive_reach import FLOORS, floor_costs
+    from rti_rig.planner.make_plan import plan_with_report
+
+    dome, light = _dome(0), (30.0, 50.0)
+    preview = _relief_preview(light)
+    costs = floor_costs(preview, dome, 9, light)
+    _, report = plan_with_report(preview, dome, 9, "optimal", "normals", light)
+    assert set(costs) == set(FLOORS)
+    for f in FLOORS:
+        assert costs[f] == pytest.approx(report.expected[f"uniform ≥{f:g}°"])
+
+
+def test_the_preview_floor_is_the_least_expected_error_and_a_tie_keeps_the_default() -> None:
+    from benchmarks.adaptive_reach import preview_floor
+
+    assert preview_floor({0.0: 0.3, 10.0: 0.2, 20.0: 0.1, 30.0: 0.4}, 10.0) == 20.0
+    assert preview_floor({0.0: 0.1, 10.0: 0.1, 20.0: 0.1, 30.0: 0.4}, 10.0) == 10.0
+    assert preview_floor({0.0: 0.1, 10.0: 0.2, 20.0: 0.1, 30.0: 0.4}, 10.0) == 0.0
+
+
+@pytest.mark.parametrize("n", [6, 9, 12, 18])
+def test_the_preview_floor_start_belongs_to_the_chosen_layout_which_stays_reachable(
+    n: int,
+) -> None:
+    from benchmarks.adaptive_reach import floor_costs, preview_floor
+    from rti_rig.planner import adaptive
+
+    dome, light = _dome(1), (30.0, 50.0)
+    preview = _relief_preview(light)
+    start_fn = start_functions(preview, light)["preview-floor"]
+    start = start_fn(dome, 4, n)
+    assert start_fn.chosen == [(n, preview_floor(floor_costs(preview, dome, n, light), 10.0))]
+    floor = start_fn.chosen[0][1]
+    layout = {int(i) for i in select_uniform_leds(dome, n, floor)}
+    assert len(set(start)) == 4 and set(start) <= layout
+    avail = np.ones(dome.count, dtype=bool)
+    avail[start] = False
+    comp = adaptive.homogeneous_completion(dome.directions, avail, dome.directions[start], n, floor)
+    assert comp is not None
+    assert set(start) | {int(i) for i in comp} == layout
+    # with its floor the shipped one the start is the shipped start
+    if floor == DESIGN_DEFAULT_FLOOR:
+        assert sorted(start) == sorted(dome_start(dome, 4, n))
+
+
+def test_the_preview_floor_start_without_a_preview_scores_a_level_surface() -> None:
+    start_fn = start_functions()["preview-floor"]
+    start = start_fn(_dome(0), 4, 9)
+    assert len(start) == 4 and len(start_fn.chosen) == 1
+    # N unknown or not above the start: the shipped start, nothing chosen
+    assert start_fn(_dome(0), 4, None) == dome_start(_dome(0), 4, None)
+    assert len(start_fn.chosen) == 1
