@@ -292,7 +292,9 @@ def test_the_preview_floor_start_belongs_to_the_chosen_layout_which_stays_reacha
     preview = _relief_preview(light)
     start_fn = start_functions(preview, light)["preview-floor"]
     start = start_fn(dome, 4, n)
-    assert start_fn.chosen == [(n, preview_floor(floor_costs(preview, dome, n, light), 10.0))]
+    costs = floor_costs(preview, dome, n, light)
+    assert start_fn.costs == [costs]
+    assert start_fn.chosen == [(n, preview_floor(costs, DESIGN_DEFAULT_FLOOR))]
     floor = start_fn.chosen[0][1]
     layout = {int(i) for i in select_uniform_leds(dome, n, floor)}
     assert len(set(start)) == 4 and set(start) <= layout
