@@ -151,10 +151,11 @@ class DxlBus:
         system's descriptor only once ``os.open`` has returned; a stop landing in between (the
         CLI's emergency stop is raised wherever its signal lands) left a descriptor no object
         knew, open until the process ended, and one landing before the lock a port this bus
-        had not locked. Opening a serial device waits on nothing (non-blocking open, termios
-        calls), so the stop is held for no time a user would notice."""
+        had not locked. Opening a serial device is short (non-blocking open, termios calls) but
+        can hang (a wedged USB adapter): a second stop ends the hold at once
+        (``second_stops``), so Ctrl-C twice or SIGTERM after Ctrl-C still stops it."""
         log.debug("%s: open %s at %d baud", self.device, self.port.getPortName(), baudrate)
-        with signals_deferred():
+        with signals_deferred(second_stops=True):
             try:
                 ok = self.port.openPort() and self.port.setBaudRate(baudrate)
             except Exception as exc:  # pyserial raises SerialException/OSError
@@ -372,7 +373,8 @@ class DxlBus:
                 if rate == configured:
                     continue
                 try:
-                    with signals_deferred():  # the SDK reopens the port (see open)
+                    # the SDK reopens the port (see open)
+                    with signals_deferred(second_stops=True):
                         if not self.port.setBaudRate(rate):
                             continue
                 except Exception:  # an adapter (or pty) that cannot run at this rate
@@ -385,7 +387,8 @@ class DxlBus:
             return None
         finally:
             try:
-                with signals_deferred():  # the SDK reopens the port (see open): lock it again
+                # the SDK reopens the port (see open): lock it again
+                with signals_deferred(second_stops=True):
                     self.port.setBaudRate(configured)
                     self._lock_exclusively()
             except Exception as exc:  # the caller's error says what the bus gave

@@ -106,15 +106,19 @@ class SerialTransport:
         only once ``os.open`` has returned, so a stop landing in between (the CLI's emergency
         stop is raised wherever its signal lands) left a descriptor no object knew, open until
         the process ended (and the board's line held up, so the teardown's reopening for the
-        all-off did not reset it). A device's opening does not wait on anything (non-blocking
-        open, termios calls); a URL port's connect may (a socket's, seconds), and its socket
-        object closes as the stop drops it, so a URL is opened as before, unheld."""
+        all-off did not reset it). A device's opening is short (non-blocking open, termios
+        calls) but can hang (a wedged USB adapter): a second stop ends the hold at once
+        (``second_stops``), so Ctrl-C twice or SIGTERM after Ctrl-C still stops it. A URL
+        port's connect may wait (a socket's, seconds), and its socket object closes as the
+        stop drops it, so a URL is opened as before, unheld."""
         if self._ser is not None:
             return
         # A second program on the same port would interleave its bytes with ours: lock it
         # (POSIX device paths only; URL handlers such as loop:// have nothing to lock).
         lock = {"exclusive": True} if "://" not in self.port and os.name == "posix" else {}
-        held = signals_deferred() if self.resets_on_open else contextlib.nullcontext()
+        held = (
+            signals_deferred(second_stops=True) if self.resets_on_open else contextlib.nullcontext()
+        )
         try:
             with held:
                 ser = serial.serial_for_url(

@@ -28,7 +28,9 @@ def stop_words(signum: signal.Signals) -> str:
 
 
 @contextlib.contextmanager
-def signals_deferred(on_held: Callable[[int], None] | None = None) -> Iterator[None]:
+def signals_deferred(
+    on_held: Callable[[int], None] | None = None, *, second_stops: bool = False
+) -> Iterator[None]:
     """Hold SIGINT/SIGTERM while devices are put in their safe state, or while a captured
     image is committed (its files and journal line).
 
@@ -43,6 +45,14 @@ def signals_deferred(on_held: Callable[[int], None] | None = None) -> Iterator[N
     the thread's signal mask: a signal sent to the process is delivered to any thread that does
     not block it (BLAS, the progress bar, an emulator's), and Python then runs the handler in
     the main thread all the same — a mask in the main thread alone had held nothing.
+
+    ``second_stops``: a second signal while one is held ends the hold at once, both delivered
+    in their order where the block is (the drivers' hold over a serial port's opening). Why:
+    the block is meant to be short, but an opening can hang (a wedged USB adapter, a tty whose
+    last close still drains); every Ctrl-C and SIGTERM had been held until it returned, so the
+    user's only way out was SIGKILL, which skips the teardown's all-off. A second stop is the
+    user insisting: the descriptor the hold guards may leak then, the stop is not lost. Inside
+    another hold (the teardown's), the signals go to that hold, which keeps them.
     """
     if threading.current_thread() is not threading.main_thread():
         yield  # handlers can only be set from the main thread, where they run
@@ -50,22 +60,17 @@ def signals_deferred(on_held: Callable[[int], None] | None = None) -> Iterator[N
     pending: list[tuple[int, Any]] = []
     raised: list[BaseException] = []  # by a pending signal's handler as a handler was swapped
 
-    def hold(signum: int, frame: Any) -> None:
-        pending.append((signum, frame))
-        if on_held is not None:
-            on_held(signum)
+    released = False  # the hold was ended early by a second stop (``second_stops``)
 
-    installed: dict[int, Any] = {}
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        if signal.getsignal(sig) is None:  # set outside Python: it could not be put back
-            continue
-        installed[sig] = _swap_handler(sig, hold, raised)
-    try:  # a stop that came as the hold was set (in ``raised``) acts after the block too
-        yield
-    finally:
+    def release() -> None:
+        """Put the handlers back and deliver what was held, in order, as they would have
+        been (a handler's exception is kept in ``raised``)."""
+        nonlocal released
+        released = True
         for sig, handler in installed.items():
             _swap_handler(sig, handler, raised)
-        for signum, frame in pending:  # delivered now, as they would have been
+        held, pending[:] = list(pending), []
+        for signum, frame in held:
             handler = installed.get(signum)
             if handler is None:
                 continue
@@ -76,6 +81,32 @@ def signals_deferred(on_held: Callable[[int], None] | None = None) -> Iterator[N
                     raised.append(exc)
             elif handler != signal.SIG_IGN:  # the default action: raised again, now unheld
                 signal.raise_signal(signum)
+
+    def hold(signum: int, frame: Any) -> None:
+        pending.append((signum, frame))
+        if on_held is not None:
+            on_held(signum)
+        if second_stops and len(pending) > 1 and not released:
+            release()  # the user insists: acted on here, in the block, as if never held
+            if raised:
+                first = raised[0]
+                raised.clear()
+                raise first
+
+    installed: dict[int, Any] = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        if signal.getsignal(sig) is None:  # set outside Python: it could not be put back
+            continue
+        installed[sig] = _swap_handler(sig, hold, raised)
+    try:  # a stop that came as the hold was set (in ``raised``) acts after the block too
+        yield
+    finally:
+        if not released:
+            release()  # delivered now, as they would have been
+        else:  # a hold the loop above set after a second stop had ended it: put back too
+            for sig, handler in installed.items():
+                if signal.getsignal(sig) is hold:
+                    _swap_handler(sig, handler, raised)
         if raised:
             raise raised[0]
 

@@ -64,3 +64,36 @@ def test_a_url_port_is_opened_unheld(monkeypatch: pytest.MonkeyPatch) -> None:
     transport = SerialTransport("loop://")
     transport.open()
     transport.close()
+
+
+def test_a_second_stop_during_a_hung_opening_ends_it_there(
+    port: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An opening that hangs (a wedged USB adapter) had held every Ctrl-C and SIGTERM until it
+    returned: the user's only way out was SIGKILL, which skips the teardown's all-off."""
+    import signal
+
+    from rti_rig.core.deferred_signals import signal_handlers
+
+    real_open = os.open
+    reached: list[str] = []
+
+    def hung_open(file, flags, *args, **kwargs):  # type: ignore[no-untyped-def]
+        if os.fspath(file) == port:  # the system's open waits; the user presses Ctrl-C twice
+            signal.raise_signal(signal.SIGINT)
+            signal.raise_signal(signal.SIGINT)
+            reached.append("the open returned")
+        return real_open(file, flags, *args, **kwargs)
+
+    def stop(signum: int, frame: object) -> None:
+        raise InjectedStop
+
+    before = descriptors_on(port)
+    transport = SerialTransport(port)
+    monkeypatch.setattr(os, "open", hung_open)
+    with signal_handlers({signal.SIGINT: stop}), pytest.raises(InjectedStop):
+        transport.open()
+    monkeypatch.setattr(os, "open", real_open)
+    assert reached == []  # held until the open returned: the second Ctrl-C did nothing
+    transport.close()
+    assert descriptors_on(port) == before
