@@ -15,11 +15,16 @@ Where it lives: ``$RTI_RIG_DUTY_LEDGER_DIR`` if set (the tests' own folder), els
 worth backing up), not the runtime folder the emulated servos use, since LEDs stay warm across
 a log-out but a stale ledger costs at most one duty window of waiting.
 
-What is "the same dome": a hardware dome is keyed by its serial port's real path (symlinks such
-as ``/dev/serial/by-id/...`` resolved), not by the config file nor the protocol profile: two
-configs for one dome (a copy with another camera, a profile tried) drive the same LEDs, and a
-key that told them apart would protect nothing. A different board later plugged into the same
-port meets the first one's ledger: the cost is at most one duty window of waiting, the safe side.
+What is "the same dome": a hardware dome is keyed by its USB adapter's ``/dev/serial/by-id/``
+name, whichever path the config gives (the by-id link, a ``by-path`` link, the ``/dev/ttyACM0``
+they point to), else by its port's real path; not by the config file nor the protocol profile:
+two configs for one dome (a copy with another camera, a profile tried) drive the same LEDs, and
+a key that told them apart would protect nothing. Why not the real path alone: ``ttyACM0`` is
+the kernel's enumeration order, not the dome; a dome that drops off USB while a command still
+holds its old node comes back as ``ttyACM1``, and the next command, keyed ``ttyACM1``, had found
+no ledger and lit the LEDs the last one left hot at once. A different board later plugged into
+the same port (no by-id name) meets the first one's ledger: at most one duty window of waiting,
+the safe side.
 An emulated dome has a new pseudo-terminal each command, so it is keyed by its config's real
 path (as the emulated servos' latched errors are): a rehearsal of "check right after run".
 
@@ -51,6 +56,9 @@ LEDGER_DIR_ENV = "RTI_RIG_DUTY_LEDGER_DIR"
 
 #: At most this often (rig-clock seconds) an all-off writes the ledger mid-command.
 SAVE_EVERY_S = 10.0
+
+#: The system's stable names of USB serial adapters (udev), one link per adapter.
+BY_ID_DIR = Path("/dev/serial/by-id")
 
 #: Ledger times ahead of the wall clock by up to this are clock noise, not a clock set back.
 _FUTURE_SLACK_S = 1.0
@@ -95,9 +103,9 @@ class DutyLedger:
 
     @classmethod
     def for_port(cls, port: str) -> DutyLedger:
-        """A hardware dome's ledger: its port's real path (by-id symlinks resolved); a port
-        that is no file path (``COM3``, ``socket://host:port``) as given."""
-        return cls("port:" + (os.path.realpath(port) if os.path.isabs(port) else port))
+        """A hardware dome's ledger: its adapter's by-id name (:func:`stable_port_name`); a
+        port that is no file path (``COM3``, ``socket://host:port``) as given."""
+        return cls("port:" + (stable_port_name(port) if os.path.isabs(port) else port))
 
     @classmethod
     def for_emulated(cls, config_path: Path) -> DutyLedger:
@@ -193,6 +201,24 @@ class DutyLedger:
         warnings.warn(
             f"the dome's duty ledger {self.path} {what}{advice}", RuntimeWarning, stacklevel=3
         )
+
+
+def stable_port_name(port: str) -> str:
+    """The ``/dev/serial/by-id/`` link that points where ``port`` does (the first by name if
+    several do), else ``port``'s real path; a by-id link whose device is unplugged is its
+    own name, as it is once the device is back (see the module docstring for why)."""
+    given = Path(port)
+    if given.parent == BY_ID_DIR:
+        return str(given)  # the stable name itself, whether its device is there now or not
+    real = os.path.realpath(port)
+    try:
+        links = sorted(BY_ID_DIR.iterdir())
+    except OSError:  # no USB serial adapter plugged in (or not Linux)
+        return real
+    for link in links:
+        if os.path.realpath(link) == real:
+            return str(link)
+    return real
 
 
 def _parse(raw: object) -> Spans:

@@ -181,7 +181,7 @@ def test_a_hardware_dome_keeps_its_ledger_under_its_port(tmp_path: Path) -> None
     with serve_on_pty(board, "elexol-24r1") as link:
         cfg = emulated_dome_as_hardware(tmp_path, "emulated_elexol.toml", link.port)
         r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
-        # the port is a link to the pty: keyed by what it points to, as a by-id link is
+        # the port is a link to the pty: keyed by what it points to (no by-id name does)
         ledger = DutyLedger.for_port(link.port).path
         assert ledger == DutyLedger.for_port(os.path.realpath(link.port)).path
     text = said(r)

@@ -212,3 +212,26 @@ def test_the_guard_tells_an_earlier_commands_lighting_from_its_own() -> None:
     )  # 2 s of it may stay
     guard.record(0, 50.0, 55.0)
     assert guard.spans() == {0: [(-20.0, -10.0), (50.0, 55.0)]}
+
+
+def test_a_dome_back_on_usb_under_another_number_keeps_its_ledger(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A dome that drops off USB while a command holds its ``ttyACM0`` comes back as
+    ``ttyACM1``: its by-id name is the same dome, and keeps the LEDs the last command lit."""
+    dev = tmp_path / "dev"
+    by_id = dev / "serial" / "by-id"
+    by_id.mkdir(parents=True)
+    (dev / "ttyACM0").write_text("")
+    (dev / "ttyACM1").write_text("")
+    name = by_id / "usb-Arduino_Dome_7543-if00"
+    name.symlink_to(dev / "ttyACM0")
+    monkeypatch.setattr(duty_ledger, "BY_ID_DIR", by_id)
+    first = DutyLedger.for_port(str(dev / "ttyACM0")).path  # a config naming the node
+    assert DutyLedger.for_port(str(name)).path == first  # one naming the by-id link
+    name.unlink()  # unplugged: the link is gone, a config naming it is still that dome
+    assert DutyLedger.for_port(str(name)).path == first
+    name.symlink_to(dev / "ttyACM1")  # back, under the next number
+    assert DutyLedger.for_port(str(name)).path == first  # had been ttyACM1's: no ledger
+    assert DutyLedger.for_port(str(dev / "ttyACM1")).path == first
+    assert DutyLedger.for_port(str(dev / "ttyACM0")).path != first  # now another device's
