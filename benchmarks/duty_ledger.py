@@ -28,32 +28,44 @@ WINDOW_S = 60.0
 
 def measure() -> tuple[list[float], list[float], int]:
     """Wall-clock seconds of each ``save`` and ``load``, and the ledger's size in bytes."""
-    with tempfile.TemporaryDirectory() as folder:
-        os.environ[LEDGER_DIR_ENV] = folder
-        ledger = DutyLedger("port:/dev/ttyACM0")
-        now = time.time()
-        step = WINDOW_S / (LEDS * LIGHTINGS)
-        spans = {
-            i: [
-                (
-                    now - WINDOW_S + (k * LEDS + i) * step,
-                    now - WINDOW_S + (k * LEDS + i + 0.8) * step,
-                )
-                for k in range(LIGHTINGS)
-            ]
-            for i in range(LEDS)
-        }
-        save_s, load_s = [], []
-        for _ in range(REPEATS):
-            t0 = time.perf_counter()
-            ledger.save(spans, now, WINDOW_S)
-            t1 = time.perf_counter()
-            read = ledger.load(WINDOW_S)
-            t2 = time.perf_counter()
-            save_s.append(t1 - t0)
-            load_s.append(t2 - t1)
-        assert len(read.spans) == LEDS
-        size = ledger.path.stat().st_size
+    before = os.environ.get(LEDGER_DIR_ENV)
+    try:
+        with tempfile.TemporaryDirectory() as folder:
+            os.environ[LEDGER_DIR_ENV] = folder
+            return _measure_in_folder()
+    finally:  # the variable named a folder that no longer exists
+        if before is None:
+            os.environ.pop(LEDGER_DIR_ENV, None)
+        else:
+            os.environ[LEDGER_DIR_ENV] = before
+
+
+def _measure_in_folder() -> tuple[list[float], list[float], int]:
+    """The measurement, in the ledger folder the caller set."""
+    ledger = DutyLedger("port:/dev/ttyACM0")
+    now = time.time()
+    step = WINDOW_S / (LEDS * LIGHTINGS)
+    spans = {
+        i: [
+            (
+                now - WINDOW_S + (k * LEDS + i) * step,
+                now - WINDOW_S + (k * LEDS + i + 0.8) * step,
+            )
+            for k in range(LIGHTINGS)
+        ]
+        for i in range(LEDS)
+    }
+    save_s, load_s = [], []
+    for _ in range(REPEATS):
+        t0 = time.perf_counter()
+        ledger.save(spans, now, WINDOW_S)
+        t1 = time.perf_counter()
+        read = ledger.load(WINDOW_S)
+        t2 = time.perf_counter()
+        save_s.append(t1 - t0)
+        load_s.append(t2 - t1)
+    assert len(read.spans) == LEDS
+    size = ledger.path.stat().st_size
     return save_s, load_s, size
 
 

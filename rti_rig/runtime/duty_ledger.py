@@ -60,6 +60,12 @@ SAVE_EVERY_S = 10.0
 #: The system's stable names of USB serial adapters (udev), one link per adapter.
 BY_ID_DIR = Path("/dev/serial/by-id")
 
+#: A ledger file (or a write's stray temporary file) left untouched this long is removed when
+#: any ledger of the folder is written: no config's ``duty_window_s`` reaches back that far (it
+#: is at most a day), so it can hold no lighting that still counts. Why: a dome that is never
+#: driven again (a temporary copy of a config, an emulated rehearsal) left its file for ever.
+STALE_AFTER_S = 2 * 86400.0
+
 #: Ledger times ahead of the wall clock by up to this are clock noise, not a clock set back.
 _FUTURE_SLACK_S = 1.0
 
@@ -126,7 +132,7 @@ class DutyLedger:
             return LedgerRead({})
         try:
             spans = _parse(json.loads(data.decode("utf-8")))
-        except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        except (ValueError, KeyError, TypeError, AttributeError, RecursionError) as exc:
             self._warn(
                 f"is damaged ({exc})",
                 _UNKNOWN_EARLIER + "; it is written afresh when this command ends",
@@ -195,12 +201,26 @@ class DutyLedger:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
             raise
+        # (by the file system's own clock: its times are not the ledger's, which a test may move)
+        _remove_stale(self.path.parent, keep=self.path, before=time.time() - STALE_AFTER_S)
 
     def _warn(self, what: str, advice: str) -> None:
         """One line, said by the console as a note: the command goes on."""
         warnings.warn(
             f"the dome's duty ledger {self.path} {what}{advice}", RuntimeWarning, stacklevel=3
         )
+
+
+def _remove_stale(folder: Path, *, keep: Path, before: float) -> None:
+    """Remove the folder's ledgers and stray temporary files last written before ``before``
+    (see :data:`STALE_AFTER_S`); one that cannot be removed is left, unsaid."""
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(folder):
+            if entry.path == str(keep) or not entry.name.endswith((".json", ".tmp")):
+                continue
+            with contextlib.suppress(OSError):
+                if entry.is_file(follow_symlinks=False) and entry.stat().st_mtime < before:
+                    os.unlink(entry.path)
 
 
 def stable_port_name(port: str) -> str:

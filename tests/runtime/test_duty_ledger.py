@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import time
 import warnings
 from pathlib import Path
 
@@ -144,7 +145,14 @@ def test_a_ledger_from_the_future_counts_as_just_ended(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(
     "body",
-    [b"{broken", b"\xff\xfe", b'{"format": 1, "lit": {"3": [[5, 1]]}}', b'{"format": 99}', b"[]"],
+    [
+        b"{broken",
+        b"\xff\xfe",
+        b'{"format": 1, "lit": {"3": [[5, 1]]}}',
+        b'{"format": 99}',
+        b"[]",
+        b"[" * 100_000 + b"]" * 100_000,  # nested past the parser's recursion limit
+    ],
 )
 def test_a_damaged_ledger_is_a_note_and_is_written_afresh(tmp_path: Path, body: bytes) -> None:
     wall = Wall()
@@ -235,3 +243,24 @@ def test_a_dome_back_on_usb_under_another_number_keeps_its_ledger(
     assert DutyLedger.for_port(str(name)).path == first  # had been ttyACM1's: no ledger
     assert DutyLedger.for_port(str(dev / "ttyACM1")).path == first
     assert DutyLedger.for_port(str(dev / "ttyACM0")).path != first  # now another device's
+
+
+def test_ledgers_no_window_can_reach_are_removed_as_another_is_written(tmp_path: Path) -> None:
+    """A temporary config's or a retired dome's ledger (and a write's stray temporary file)
+    older than any duty window is removed; a recent one, and anything not a ledger, is kept."""
+    wall = Wall()
+    ledger = DutyLedger("port:/dev/ttyACM0", wall=wall)
+    folder = ledger.path.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    old_json, old_tmp = folder / "old-0123.json", folder / ".x.tmp"
+    recent, other = folder / "recent-4567.json", folder / "notes.txt"
+    for f in (old_json, old_tmp, recent, other):
+        f.write_text("{}")
+    now = time.time()  # files are dated by the file system's clock, not the ledger's
+    long_ago = now - duty_ledger.STALE_AFTER_S - 60
+    for f in (old_json, old_tmp, other):
+        os.utime(f, (long_ago, long_ago))
+    os.utime(recent, (now - 3600, now - 3600))
+    ledger.save({2: [(wall.t - 5, wall.t - 1)]}, wall.t, 60.0)
+    assert ledger.path.exists() and recent.exists() and other.exists()
+    assert not old_json.exists() and not old_tmp.exists()
