@@ -51,6 +51,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.photometric_stereo import fit_photometric_stereo
+from rti_rig.reconstruct.qa_bands import median_by_rows, row_bands
 from rti_rig.reconstruct.qa_directions import (
     MISFIT_LIMIT,
     consensus_images,
@@ -694,6 +695,26 @@ def _reduced(
     return frac, small, small_sat
 
 
+def _crop_stack(
+    frames: Sequence[ArrayLike], rs: slice, cs: slice, saturation: float
+) -> NDArray[np.float32]:
+    """The crop ``rs``, ``cs`` of every frame, grey, as a fraction of ``saturation`` (N, h, w).
+
+    Filled in place and scaled in place: a list of the crops, its stack and the scaled stack
+    had held three copies of every image's crop at once (the same values: each is one
+    float32 division by the same float32 scale)."""
+    n = len(frames)
+    out: NDArray[np.float32] | None = None
+    for i, f in enumerate(frames):
+        g = _grey(np.asarray(f[rs])[:, cs])
+        if out is None:
+            out = np.empty((n, *g.shape), np.float32)
+        out[i] = g
+    assert out is not None  # validate_lights refused an empty acquisition
+    out /= np.float32(saturation if np.isfinite(saturation) else 1.0)
+    return out
+
+
 #: The crop moves off the centre only when its window holds this many times the centre's lit
 #: structure (:func:`_choose_crop`): only a centre that is nearly plain is left. An object
 #: with structure at its centre keeps the central crop, where its checks were measured: the
@@ -726,18 +747,21 @@ def _choose_crop(
     n, sh, sw = small.shape
     if (ch, cw) == (h, w) or n == 0:
         return slice(0, h), slice(0, w)
-    grads = []
+    # filled in place (a list and its stack held every gradient image twice)
+    grads = np.empty(small.shape, np.float32)
+    k = 0
     for img in small:
         scale = float(np.percentile(img, 99.0))
         if not np.isfinite(scale) or scale <= 0:
             continue
         gx = cv2.Sobel(img, cv2.CV_32F, 1, 0)
         gy = cv2.Sobel(img, cv2.CV_32F, 0, 1)
-        grads.append(np.hypot(gx, gy) / scale)
-    if not grads:
+        grads[k] = np.hypot(gx, gy) / scale
+        k += 1
+    if not k:
         top, left = centre
         return slice(top, top + ch), slice(left, left + cw)
-    structure = np.median(np.stack(grads), axis=0)
+    structure = median_by_rows(grads[:k])
     lit = (small > dark).mean(axis=0) >= 0.5
     score = (structure * lit * (1.0 - small_sat.mean(axis=0))).astype(np.float64)
     wh = min(sh, max(1, round(ch * sh / h)))
@@ -1248,19 +1272,18 @@ def assess(
     factor = max(1, int(np.ceil(max(h, w) / COVERAGE_SIDE)))
     small_shape = (max(1, w // factor), max(1, h // factor))
     sat_frac = np.zeros(n)
-    small_list, small_sat_list, sample_list = [], [], []
+    sample_list = []
     channels = int(np.prod(first.shape[2:], dtype=int))
     # the pixels fit --no-qa's check samples (fewer at many lights: the sample's memory)
     rows, cols = sample_grid(h, w, sample_pixels(n, channels))
-    for f in frames:  # one frame in memory at a time
+    # filled in place, not stacked from a list: a list and its stack held the reduced images
+    # twice at once (at 1000 lights of 256 px, 260 MB more)
+    small = np.empty((n, small_shape[1], small_shape[0]), np.float32)
+    small_sat = np.empty(small.shape, bool)
+    for i, f in enumerate(frames):  # one frame in memory at a time
         a = np.asarray(f[0:h])
         sample_list.append(a[rows[:, None], cols[None, :]].reshape(rows.size * cols.size, -1))
-        frac, s, s_sat = _reduced(a, saturation, small_shape)
-        sat_frac[len(small_list)] = frac
-        small_list.append(s)
-        small_sat_list.append(s_sat)
-    small = np.stack(small_list)
-    small_sat = np.stack(small_sat_list)
+        sat_frac[i], small[i], small_sat[i] = _reduced(a, saturation, small_shape)
     peak = (
         # its brightest 0.1 %, not 1 %: a small object on black velvet (under 1 % of the frame)
         # reads as black at its 99th percentile
@@ -1290,9 +1313,11 @@ def assess(
     # per-image evidence on a full-resolution crop where the object has lit structure (a
     # second pass reads only its rows)
     rs, cs = _choose_crop(small, small_sat, dark, h, w)
-    crop = [_grey(np.asarray(f[rs])[:, cs]) for f in frames]
-    crop_arr = np.stack(crop) / np.float32(saturation if np.isfinite(saturation) else 1.0)
-    del crop
+    # the frame's mean level (qa_exposure) is the last the reduced images give: they are let
+    # go before the crop is read, so the two stacks are never held at once
+    level = small.reshape(n, -1).mean(axis=1, dtype=np.float64)
+    del small, small_sat
+    crop_arr = _crop_stack(frames, rs, cs, saturation)
     sat_level = 1.0 if np.isfinite(saturation) else None
     crop_sat = crop_arr >= 1.0 if sat_level is not None else np.zeros_like(crop_arr, bool)
     dark_level = dark / saturation if np.isfinite(saturation) else dark
@@ -1371,7 +1396,6 @@ def assess(
     # read "misfired or dim: 33%"; left out, the surface it lit had too few lights and
     # image_002 read 36%. The image itself is still judged as captured, below. A frame with
     # next to no light (NO_LIGHT_GAIN) has nothing to scale: its noise is not made an image.
-    level = small.reshape(n, -1).mean(axis=1, dtype=np.float64)
     clipped = sat_frac > SATURATED_LIMIT
     early_exposure, _ = exposure_ratios(level, lt, ~clipped)
     levelled = np.array(
@@ -1714,7 +1738,7 @@ def assess(
     pooled = [r for i, r in enumerate(ev.resid) if i not in flagged and r.size] or [
         r for r in ev.resid if r.size
     ]
-    sigma = float(1.4826 * np.median(np.abs(np.concatenate(pooled)))) if pooled else float("nan")
+    sigma = float(1.4826 * _pooled_abs_median(pooled)) if pooled else float("nan")
     valid = ps.valid
     rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
     expected = _expected_error_deg(ps.normals[valid], rho[valid], lt, sigma)
@@ -2003,7 +2027,7 @@ def _evidence(
         & (over >= GRAZING_DIM_MIN_DEG)
     )
     nb_ratio[grazing] = np.where(top_trusted, top_ratio, np.nan)[grazing]
-    rel_gain, rel_top, rel_count = _reliable_gains(np.stack(images), crop_sat, ps, lt, dark)
+    rel_gain, rel_top, rel_count = _reliable_gains(images, crop_sat, ps, lt, dark)
     rel_gain[unjudged | nb_dark | near_surface] = np.nan
     # The bright end of image / prediction is a misfire only where the pixels the fit
     # explains agree (_reliable_gains): on a glossy coin the Lambertian prediction misjudges a
@@ -2241,7 +2265,7 @@ def _evidence(
 
 
 def _reliable_gains(
-    images: NDArray, crop_sat: NDArray, ps: Any, lt: NDArray, dark: float
+    images: Sequence[NDArray], crop_sat: NDArray, ps: Any, lt: NDArray, dark: float
 ) -> tuple[NDArray, NDArray, NDArray]:
     """Each image's median ratio to the fit's prediction over the pixels the fit explains
     (:data:`RELIABLE_RESIDUAL`), where its light reaches them unclipped, and the ratio's
@@ -2252,28 +2276,40 @@ def _reliable_gains(
     misses (gloss, cast shadows, a grazing light's masking) as if it were the light's output.
     Where the fit explains a pixel across the session, the ratio there is the light's own: a
     misfire scales it with the rest of the image. The median residual is taken over every
-    image lighting the pixel (one sort of the stack: a misfired image is one of them)."""
+    image lighting the pixel (one sort of each pixel's values: a misfired image is one of
+    them), a band of rows at a time (:mod:`~rti_rig.reconstruct.qa_bands`): over the whole
+    crop at once its prediction, residual and sort had held six copies of every image's crop
+    (at 1000 lights of 256 px, 1.6 GB)."""
     n = len(images)
     valid = ps.valid
     rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
-    shade = np.einsum("hwc,nc->nhw", ps.normals, lt.astype(np.float32))
-    pred = rho[None] * np.maximum(shade, 0.0)
-    lit = valid[None] & (shade > 0.2) & ~crop_sat & (images > dark)
-    rel = np.where(lit, np.abs(images - pred) / np.maximum(pred, 1e-12), np.inf)
-    rel = np.sort(rel.reshape(n, -1), axis=0)
-    count = lit.reshape(n, -1).sum(axis=0)
-    middle = np.take_along_axis(rel, ((np.maximum(count, 1) - 1) // 2)[None], axis=0)[0]
-    explained = (count >= RELIABLE_MIN_IMAGES) & (middle < RELIABLE_RESIDUAL)
+    lt32 = lt.astype(np.float32)
+    h, w = valid.shape
+    explained = np.zeros(h * w, bool)
+    for band in row_bands(n, h, w):
+        shade = np.einsum("hwc,nc->nhw", ps.normals[band], lt32)
+        pred = rho[band][None] * np.maximum(shade, 0.0)
+        imgs = np.stack([im[band] for im in images])
+        lit = valid[band][None] & (shade > 0.2) & ~crop_sat[:, band] & (imgs > dark)
+        rel = np.where(lit, np.abs(imgs - pred) / np.maximum(pred, 1e-12), np.inf)
+        rel = np.sort(rel.reshape(n, -1), axis=0)
+        count = lit.reshape(n, -1).sum(axis=0)
+        middle = np.take_along_axis(rel, ((np.maximum(count, 1) - 1) // 2)[None], axis=0)[0]
+        explained[band.start * w : band.stop * w] = (count >= RELIABLE_MIN_IMAGES) & (
+            middle < RELIABLE_RESIDUAL
+        )
     explained &= valid.ravel()
+    kind = np.result_type(*images)  # the type their stack had (an image moved back: float64)
     gains = np.full(n, np.nan)
     bright_end = np.full(n, np.nan)
     used = np.zeros(n, int)
     for i in range(n):
-        p = pred[i].ravel()
-        px = explained & (shade[i].ravel() > 0.05) & ~crop_sat[i].ravel() & (p > 0)
+        shade_i = np.einsum("hwc,nc->nhw", ps.normals, lt32[i : i + 1])[0].ravel()
+        p = (rho[None] * np.maximum(shade_i.reshape(1, h, w), 0.0))[0].ravel()
+        px = explained & (shade_i > 0.05) & ~crop_sat[i].ravel() & (p > 0)
         used[i] = int(px.sum())
         if used[i] >= RELIABLE_MIN_PIXELS:
-            ratio = images[i].ravel()[px] / p[px]
+            ratio = np.asarray(images[i], dtype=kind).ravel()[px] / p[px]
             gains[i] = float(np.median(ratio))
             bright_end[i] = float(np.percentile(ratio, DIM_PERCENTILE))
     return gains, bright_end, used
@@ -2487,6 +2523,23 @@ def _unit_rows(v: NDArray) -> NDArray:
     return v / np.where(nrm > 0, nrm, 1.0)
 
 
+def _pooled_abs_median(parts: list[NDArray]) -> float:
+    """``np.median(np.abs(np.concatenate(parts)))``, the same value, in one buffer: the
+    concatenation, its absolute values and the median's partitioned copy had held every
+    image's residuals three times over (the median partitions that one buffer in place)."""
+    out = np.empty(sum(r.size for r in parts), np.result_type(*parts))
+    at = 0
+    for r in parts:
+        np.abs(r.ravel(), out=out[at : at + r.size])
+        at += r.size
+    return float(np.median(out, overwrite_input=True))
+
+
+#: Pixels :func:`_expected_error_deg` builds its per-pixel light sums for at once (its lit
+#: mask and normal matrices are pixels × lights: at 1000 lights, 9 kB a pixel).
+EXPECTED_ERROR_CHUNK = 2048
+
+
 def _expected_error_deg(
     normals: NDArray, rho: NDArray, lights: NDArray[np.float64], sigma: float
 ) -> float:
@@ -2496,10 +2549,15 @@ def _expected_error_deg(
     step = max(1, normals.shape[0] // 20000)
     nn = normals[::step].astype(np.float64)
     rr = rho[::step].astype(np.float64)
-    lit = (nn @ lights.T) > 0  # (P, N)
     ll = (lights[:, :, None] * lights[:, None, :]).reshape(-1, 9)
-    m = (lit.astype(np.float64) @ ll).reshape(-1, 3, 3)
-    ok = (lit.sum(axis=1) >= 3) & (np.linalg.det(m) > 1e-9) & (rr > 0)
+    m = np.empty((len(nn), 3, 3))
+    lit_count = np.empty(len(nn), int)
+    for at in range(0, len(nn), EXPECTED_ERROR_CHUNK):  # (P, N) a chunk of pixels at a time
+        part = slice(at, at + EXPECTED_ERROR_CHUNK)
+        lit = (nn[part] @ lights.T) > 0
+        m[part] = (lit.astype(np.float64) @ ll).reshape(-1, 3, 3)
+        lit_count[part] = lit.sum(axis=1)
+    ok = (lit_count >= 3) & (np.linalg.det(m) > 1e-9) & (rr > 0)
     if not ok.any():
         return float("nan")
     inv = np.linalg.inv(m[ok])

@@ -55,6 +55,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.reconstruct.qa_bands import median_of_images
+
 #: Blur (sigma, pixels) before the gradient: noise out, edges kept.
 EDGE_BLUR = 1.5
 #: A phase-correlation peak below this response is no measurement (no common structure).
@@ -185,7 +187,7 @@ def measure_drift(
     for _ in range(ROUNDS):
         # only measured shifts move an image back: a wrong one would drag the reference
         back = [_move(edges[i], -shifts[i, 0], -shifts[i, 1]) for i in have]
-        ref = np.median(np.stack(back), axis=0).astype(np.float64)
+        ref = median_of_images(back).astype(np.float64)
         ref_spectrum = _spectrum(ref, window)
         for i in have:
             e = edges[i].astype(np.float64)
@@ -279,7 +281,7 @@ def step_candidates(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> It
     window = cv2.createHanningWindow((crops.shape[2], crops.shape[1]), cv2.CV_64F)
 
     def median_of(images: list[int]) -> NDArray[np.float64]:
-        return np.median(np.stack([edges[i] for i in images]), axis=0).astype(np.float64)
+        return median_of_images([edges[i] for i in images]).astype(np.float64)
 
     def peaks_against(ref: NDArray[np.float64]) -> NDArray[np.float64]:
         """Each image's whole-pixel peak against ``ref`` (NaN: none within the search)."""
