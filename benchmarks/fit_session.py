@@ -234,6 +234,7 @@ def memory_at(width: int, height: int, lights: int, write: bool) -> None:
 MANY_LIGHTS_CASES = [
     ("PTM only", ["--model", "ptm", "--no-qa"]),
     ("HSH2 only", ["--model", "hsh2", "--no-qa"]),
+    ("everything but the QA", ["--no-qa"]),
     ("everything (auto, normals, .ptm, .rti, QA)", []),
 ]
 
@@ -244,9 +245,11 @@ def many_lights(side: int, counts: list[int]) -> None:
     The fit's memory should be bounded by its budgets (a band's, the pixel sample's), not grow
     with lights × pixels: at 1000 RGB lights of 128 × 128 a PTM fit peaked at 1.4 GB while the
     sample was 30 000 pixels at any light count. The QA works on a crop and a coverage grid of
-    every image, so its memory does grow with the lights (see the docs)."""
+    every image, so its memory does grow with the lights: the last two cases differ only by
+    the QA, and their difference is printed as the QA's share."""
     work = Path(tempfile.mkdtemp(prefix="fit_many_"))
     rows = []
+    shares = []  # (lights, peak without the QA, peak with it)
     try:
         for n in counts:
             session = make_session(work / f"s{n}", side, side, n)
@@ -255,6 +258,9 @@ def many_lights(side: int, counts: list[int]) -> None:
                 wall, peak, cpu = time_fit(session, extra)
                 rows.append((n, pixel_mb, label, wall, cpu, peak))
                 print(f"{n} lights, {label}: {wall:.1f} s, peak RSS {peak:.0f} MB", flush=True)
+            without, with_qa = (r[-1] for r in rows[-2:])
+            shares.append((n, without, with_qa))
+            print(f"{n} lights: the QA's share {with_qa - without:.0f} MB", flush=True)
             shutil.rmtree(session, ignore_errors=True)
     finally:
         shutil.rmtree(work, ignore_errors=True)
@@ -272,6 +278,10 @@ def many_lights(side: int, counts: list[int]) -> None:
                     f"| {n} | {mb:.1f} | {label} | {w:.1f} | {c:.1f} | {p:.0f} |"
                     for n, mb, label, w, c, p in rows
                 ],
+                "",
+                "| lights | without QA (MB) | with QA (MB) | the QA's share (MB) |",
+                "|---|---|---|---|",
+                *[f"| {n} | {a:.0f} | {b:.0f} | {b - a:.0f} |" for n, a, b in shares],
             ]
         )
     )
