@@ -296,6 +296,19 @@ class DomePolicy:
         #: Where a reopening of a lost port is said as it happens (the command line's console,
         #: set by :meth:`listen`); None: said nowhere but in the stats and the log.
         self._say: Callable[[str], None] | None = None
+        #: A teardown's all-off has begun (:meth:`ending`, :meth:`close`; a :meth:`connect`
+        #: clears it): a port lost now is reopened to send that all-off again, and nothing
+        #: goes on after it.
+        self._ending = False
+
+    def ending(self) -> None:
+        """Mark what follows as a teardown (its all-off, then perhaps :meth:`close`), until the
+        next :meth:`connect`.
+
+        Why: a port lost during the teardown's all-off (the end of a run, or a Ctrl-C's) had
+        been said as "…; the session goes on once it is back", of a session that was ending
+        or had been stopped."""
+        self._ending = True
 
     def listen(self, say: Callable[[str], None] | None) -> None:
         """Have each reopening of a lost port said through ``say`` as it happens: one line
@@ -312,12 +325,15 @@ class DomePolicy:
             self._say(text)
 
     def _goes_on(self) -> str:
+        if self._ending:
+            return "its all-off is sent again once it is back"
         what = "session" if self.lights_images else "check"
         return f"the {what} goes on once it is back"
 
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> None:
+        self._ending = False
         self._read_ledger()
         if self.settings.intensity_correction is not None and not self.link.can_dim:
             # before the port opens (the Nab sketch boots lit): every corrected level of an
@@ -671,6 +687,7 @@ class DomePolicy:
     def close(self) -> None:
         """All off (best effort), then release the port. Safe twice and after a failed connect."""
         self._held = False
+        self._ending = True
         if self.info is not None:
             try:
                 self.all_off()
@@ -918,10 +935,13 @@ class DomePolicy:
                     lost = self._lit
                     self._lit = None
                     self.guard.record(lost.index, lost.since, self.clock.now())
+                    # "went dark with it" was not established: a board powered apart from
+                    # its USB link keeps its LED lit through a drop of the port
+                    lit = f"LED {lost.index} was meant to be lit when the port went"
                     stops = (
-                        f"LED {lost.index} went dark with it, so the session stops at its image"
+                        f"{lit}, so the session stops at its image"
                         if self.lights_images
-                        else f"LED {lost.index} went dark with it, so the check fails there"
+                        else f"{lit}, so the check fails there"
                     )
                     back = self._recover(exc, command, goes_on=stops)
                     what = "rebooted" if fault is LinkFault.RESET else "dropped off the USB bus"

@@ -75,3 +75,44 @@ def test_a_port_lost_at_the_handshake_that_does_not_come_back_is_said_before_the
     assert said.index(lost) < gone < said.index("port was lost during the handshake ("), said
     for raw in RAW_RECORDS:
         assert raw not in said, (raw, said)
+
+
+def test_a_port_lost_at_the_teardowns_all_off_is_not_said_to_let_the_session_go_on(
+    tmp_path: Path,
+) -> None:
+    """The Nab sketch, two lights: command 9 is the teardown's all-off, after the last image.
+    The session was ending ("the session goes on once it is back" had been said of it): the
+    reopening is said for what it is, the all-off sent again."""
+    r, said, out = _run_lights(tmp_path, 'at_command = 9\nkind = "disconnect"', 2)
+    assert r.exit_code == 0, said  # type: ignore[attr-defined]
+    lost = (
+        "The dome dropped off the USB bus during 'all off': reopening its port (up to 4 "
+        "attempts over 7.5 s); its all-off is sent again once it is back."
+    )
+    assert said.count(lost) == 1, said
+    assert "goes on once it is back" not in said, said
+    assert "2 image(s) in the session" in said, said
+    assert "All-off sent and acknowledged by the dome: lights are off." in said, said
+    runner = json.loads((out / "manifest.json").read_text())["runner"]
+    assert [k["outcome"] for k in runner["dome_reconnections"]] == ["reconnected"]
+
+
+def test_a_port_lost_with_an_led_lit_does_not_say_it_went_dark(tmp_path: Path) -> None:
+    """Command 7 is the all-off after the second light: the port goes with LED 9 lit. A board
+    powered apart from its USB link keeps it lit, so its going dark is not claimed."""
+    r, said, _out = _run_lights(tmp_path, 'at_command = 7\nkind = "disconnect"', 2)
+    assert r.exit_code == 2, said  # type: ignore[attr-defined]
+    assert (
+        "LED 9 was meant to be lit when the port went, so the session stops at its image."
+    ) in said, said
+    assert "went dark with it" not in said, said
+
+
+def _run_lights(tmp_path: Path, fault: str, lights: int) -> tuple[object, str, Path]:
+    cfg = tmp_path / "rig.toml"
+    text = (CONFIGS / "emulated_nab_rti_v1.toml").read_text()
+    cfg.write_text(text + f"\n[[emulator.faults]]\n{fault}\n")
+    out = tmp_path / "S"
+    argv = ["run", str(cfg), "--lights", str(lights), "--out", str(out), "--no-verdict"]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    return r, " ".join(r.output.split()), out
