@@ -28,6 +28,7 @@ import rti_rig.app.usecases.session as session_usecase
 import rti_rig.runtime.controller as controller
 from rti_rig.cli import app
 from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.runtime.session import SessionFolder
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
 
@@ -103,9 +104,17 @@ def test_an_arm_run_whose_end_a_stop_cut_has_its_lamp_switched_off(
         real_lamp(self)
 
     monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
+    real_record = SessionFolder.record_cut_end
+
+    def record_cut_end(self: SessionFolder, reason: str) -> None:
+        # the lamp as the stop is written down: off already (safety before the disk's fsync)
+        lit.append(seen["opened"].rig.emulator.servos[2].get(ct.LED))
+        real_record(self, reason)
+
+    monkeypatch.setattr(SessionFolder, "record_cut_end", record_cut_end)
     r, said = _run(cfg, tmp_path / "s")
     assert r.exit_code == 143, said
-    assert lit == [1], said
+    assert lit == [1, 0], said
     assert seen["opened"].rig.emulator.servos[2].get(ct.LED) == 0, said  # switched off
     assert "Emergency stop (SIGTERM): lamp off and stop were requested" in said, said
     assert "teardown problem" not in said and "Traceback" not in said, said

@@ -227,16 +227,18 @@ class OpenedSession:
         rig = self.rig
         try:
             with signals_deferred():
-                if not self.teardown_ran and self.cut_by is not None:
-                    # a stop cut the run's end before the controller recorded it: said on
-                    # disk as a stop, not left as a kill leaves it (first: the images are in)
-                    self.folder.record_cut_end(self.cut_by)
                 if not self.teardown_ran:
                     if rig.lighting.link_open:
                         self.close_failures += rig.lighting.safe(emergency=True)
                     self.close_failures += attempt_all(
                         [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
                     )
+                    if self.cut_by is not None:
+                        # a stop cut the run's end before the controller recorded it: said on
+                        # disk as a stop, not left as a kill leaves it. After the devices are
+                        # safe: the manifest's fsync (seconds behind a slow card's pending
+                        # images) had kept a lamp or an LED lit while it ran
+                        self.folder.record_cut_end(self.cut_by)
                 rig.close()
         finally:
             unlock_session(self.folder.root)  # a resume's lock, also for a run never started
