@@ -341,8 +341,24 @@ def host_baud(master: int) -> int | None:
 
 #: The temporary folders the emulated ports live in: ``<tempdir>/rti-rig-pty-XXXX``.
 PTY_FOLDER_PREFIX = "rti-rig-pty-"
-#: The file in such a folder naming the process that serves it: ``<pid> <start time>``.
+#: The file in such a folder naming the process that serves it:
+#: ``<pid> <start time> <pid namespace>``.
 PTY_OWNER_FILE = "owner"
+
+
+def _pid_namespace() -> str:
+    """This process's pid namespace (``pid:[4026531836]``), or "" where it cannot be read: a
+    pid means a process only within its namespace."""
+    try:
+        return os.readlink("/proc/self/ns/pid")
+    except OSError:
+        return ""
+
+
+def owner_line() -> str:
+    """What this process writes in the owner file of a pty folder it serves."""
+    pid = os.getpid()
+    return f"{pid} {_start_time(pid)} {_pid_namespace()}".rstrip() + "\n"
 
 
 def _start_time(pid: int) -> str:
@@ -358,13 +374,19 @@ def _start_time(pid: int) -> str:
 
 
 def _owner_alive(owner: str) -> bool:
-    """Whether the process an owner file names (``<pid> <start time>``) is still running."""
-    pid_text, _, started = owner.strip().partition(" ")
+    """Whether the process an owner file names (``<pid> <start time> <pid namespace>``) is
+    still running; True where that cannot be told.
+
+    A process of another pid namespace (a container sharing this temporary directory) is
+    never taken for dead: its pid means another process here, or none, while it serves on."""
+    pid_text, started, namespace = [*owner.split(), "", "", ""][:3]
     try:
         pid = int(pid_text)
     except ValueError:
         return True  # unreadable: never taken for dead
     if pid <= 0:
+        return True
+    if namespace and namespace != _pid_namespace():
         return True
     try:
         os.kill(pid, 0)
@@ -413,7 +435,10 @@ def serve_on_pty(device: PtyDevice, name: str = "dome") -> Iterator[PtyLink]:
     outright left behind are removed first (:func:`remove_stale_pty_folders`)."""
     remove_stale_pty_folders()
     folder = Path(tempfile.mkdtemp(prefix=PTY_FOLDER_PREFIX))
-    (folder / PTY_OWNER_FILE).write_text(f"{os.getpid()} {_start_time(os.getpid())}\n")
+    # written whole, then named: another emulator's clean-up reading it half-written ("12" of
+    # "12345 …") could take a live folder for a dead process's
+    (folder / f"{PTY_OWNER_FILE}.new").write_text(owner_line())
+    os.replace(folder / f"{PTY_OWNER_FILE}.new", folder / PTY_OWNER_FILE)
     link_path = folder / f"tty-{name}"
     stop = threading.Event()
     server = _Server(device, link_path, stop)

@@ -21,6 +21,7 @@ from rti_rig.simulator.pty_link import (
     PTY_FOLDER_PREFIX,
     PTY_OWNER_FILE,
     _start_time,
+    owner_line,
     remove_stale_pty_folders,
 )
 
@@ -53,6 +54,18 @@ def test_only_folders_whose_owner_is_gone_are_removed(tmp_path: Path) -> None:
     assert not dead.exists() and not reused.exists()
     assert live.is_dir() and unknown.is_dir() and garbled.is_dir()
     assert Path("/dev/null").exists()
+
+
+def test_a_folder_of_another_pid_namespace_is_left_alone(tmp_path: Path) -> None:
+    """A container sharing this temporary directory serves its emulator under a pid that
+    means nothing here: its folder is kept, as any whose owner cannot be told."""
+    here = owner_line().split()
+    assert len(here) == 3 and here[0] == str(os.getpid()), here  # as serve_on_pty writes it
+    dead = _dead_pid()
+    other = _folder(tmp_path, "other", f"{dead} 1 pid:[1]\n")
+    ours = _folder(tmp_path, "ours", f"{dead} 1 {here[2]}\n")
+    assert remove_stale_pty_folders(tmp_path) == [ours]
+    assert other.is_dir() and not ours.exists()
 
 
 @pytest.mark.slow  # two emulator processes
