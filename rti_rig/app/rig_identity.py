@@ -233,9 +233,11 @@ def recorded_images_stamped(
     sets its mtime and ctime to the clock, and a file replaced (an editor's save, a re-export,
     a copy over it) changes them too; ``touch -r``/``os.utime`` can set the mtime back, but the
     ctime only the kernel sets, to now. An edit that kept size, mtime *and* ctime (a write to
-    the disk beneath the filesystem, or the system clock set back to the instant of the stamp)
-    would go unseen here: the verdict would then name the recorded file a clipped image replays
-    from its light, as for an unchanged acquisition; a resume hashes every file in full, and
+    the disk beneath the filesystem, the system clock set back to the instant of the stamp, or
+    a FAT/exFAT card, which stores no ctime: once mounted again its ctime reads as the mtime
+    a tool kept, ``touch -r`` or ``exiftool -P``) would go unseen here: the verdict would then
+    name the recorded file a clipped image replays from its light, as for an unchanged
+    acquisition; a resume hashes every file in full, and
     refuses such an acquisition. A folder copied elsewhere (a new ctime) is hashed in full on
     each verdict: its stamps are not written back (a verdict writes nothing to the session)."""
     from rti_rig.core.lp_format import image_path
