@@ -133,8 +133,15 @@ class DynamixelArm:
         *,
         config_path: str | None = None,
         power_cycle: str = ct.POWER_CYCLE,
+        powered_between_commands: bool = True,
     ) -> None:
         self.settings = settings
+        #: Whether the servos keep their RAM (torque, Status Return Level) between two
+        #: commands, as a real chain's powered servos do; an emulated chain keeps only its
+        #: latched errors (in a state file), each command finding its servos otherwise as at
+        #: power-on, so advice to switch its power off and on to reset that RAM is said as
+        #: what it is there.
+        self.powered_between_commands = powered_between_commands
         self.name = settings.name
         self.clock = clock
         self.kin = ArmKinematics(settings)
@@ -268,6 +275,10 @@ class DynamixelArm:
         fix = (
             "it is 2 at power-on (RAM area): switch the servos' power off and on, or set "
             "Status Return Level (address 68) to 2 with Dynamixel Wizard 2.0"
+            if self.powered_between_commands
+            else "it is 2 at power-on (RAM area), and each command finds this emulated "
+            "chain's servos as at power-on (it keeps only their latched errors): run the "
+            "command again"
         )
         try:
             level = self._bus.read(sid, ct.STATUS_RETURN_LEVEL, check_alert=False)
@@ -494,6 +505,21 @@ class DynamixelArm:
         told the torque was off pushed against servos holding under torque. And ``home`` runs
         this check on a connected arm, torque on."""
         on, unknown = self._torque_as_read()
+        if not self.powered_between_commands:
+            # an emulated chain keeps no torque from an earlier command and has no power
+            # switch: "switch the servos' power off and on" was advice no one could follow
+            if on:
+                return (
+                    f"(its torque is ON, as read: {self._servos_named(on)} holding in this "
+                    "command; each command finds this emulated chain's torque off, as at "
+                    "power-on: it keeps only latched errors between commands)"
+                )
+            if unknown:
+                return (
+                    "(whether its torque is off could not be read; each command finds this "
+                    "emulated chain's torque off, as at power-on)"
+                )
+            return "(its torque is off, as read)"
         if on:
             held = self._servos_named(on)
             return (
@@ -593,11 +619,16 @@ class DynamixelArm:
         on, unknown = self._torque_after_release
         policy = 'torque_policy = "release_on_close"'
         if on:
+            release = (
+                "to release it, support the arm and switch the servos' power off and on"
+                if self.powered_between_commands
+                else "this emulated chain keeps no torque past the command (the next one "
+                "finds its servos as at power-on, torque off)"
+            )
             return (
                 f"torque-off sent ({policy}), but Torque Enable reads back ON from "
                 f"{self._servos_named(on)}: that joint still holds (the torque-off, a "
-                "broadcast no servo answers, did not reach it); to release it, support the "
-                "arm and switch the servos' power off and on"
+                f"broadcast no servo answers, did not reach it); {release}"
             )
         said = (
             f"torque-off sent ({policy}), Torque Enable not read back from "

@@ -300,7 +300,13 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     try:
         # the advice's power cycle is what clears the emulated chain's kept errors
         arm = DynamixelArm(
-            settings, port, clock, config_path=loaded.path, power_cycle=latch.power_cycle_said()
+            settings,
+            port,
+            clock,
+            config_path=loaded.path,
+            power_cycle=latch.power_cycle_said(),
+            # only its latched errors outlive a command: its torque and RAM do not
+            powered_between_commands=False,
         )
         camera = _simulated_camera(loaded, _ArmLamp(arm, emulator, settings), clock)
     except BaseException:
