@@ -321,6 +321,7 @@ def fix_session_exposure(
     *,
     shot_per_lighting: bool = False,
     within: tuple[Bound, Bound] | None = None,
+    say: Callable[[str], None] | None = None,
 ) -> LightSchedule:
     """Meter at the brightest-ranked planned light, check up to ``probes`` - 1 more with
     ``recheck`` (each may shorten the exposure, never lengthen it), and return the schedule
@@ -343,6 +344,10 @@ def fix_session_exposure(
     connect to the teardown; on a dry run the simulated rig's) and on the wall
     (``wall_time_s``): the session's time on the real rig includes it (it had left out the
     test shots: 7 shots, about 8 s, on the emulated card dome).
+
+    ``say``: where a dome's lost port, reopened while metering, is said as it happens, as a
+    run says it (the metering's connect had no listener: a drop there was reopened with
+    nothing said); its teardown's reopening is said as being for the all-off.
     """
     if probes < 1:
         raise ValueError(f"probes must be at least 1, got {probes}")
@@ -367,6 +372,9 @@ def fix_session_exposure(
         # dome's last all-off, the one between two metered lights, was then reported as the
         # state of the lights ("acknowledged by the dome: lights are off")
         with signals_deferred():
+            ending = getattr(rig.lighting, "ending", None)
+            if ending is not None:  # a reopening now is for the closing all-off
+                ending()
             failures = rig.lighting.safe()
             # a dome kept open (hold) only once its all-off went through: one that failed is
             # closed, and the error says so
@@ -381,6 +389,9 @@ def fix_session_exposure(
     at = steps[0]
     tested: list[list[float]] = []
     started, wall_started = rig.clock.now(), time.perf_counter()
+    listen = getattr(rig.lighting, "listen", None)
+    if listen is not None:
+        listen(say)
     try:
         rig.lighting.connect()
         rig.camera.connect()

@@ -544,6 +544,8 @@ def fix_exposure(
             probes,
             shot_per_lighting=limit is not None,
             within=within,
+            # a dome's lost port, reopened while metering, said as the run says it
+            say=lambda text: on_note(Note(text)),
         )
     except (Exception, KeyboardInterrupt, EmergencyStop) as exc:
         # what metering's teardown established about the lights travels with the error, the
