@@ -621,6 +621,13 @@ def _dome_reconnections(lighting: object) -> dict[str, Any]:
     return {"dome_reconnections": found} if found else {}
 
 
+def _resends(lighting: object) -> tuple[dict[str, Any], str | None]:
+    """The manifest's ``dome_resent`` / ``arm_resent`` (each command sent again after a fault
+    and then answered) and the line that counts them for the user; nothing when none was."""
+    resends = getattr(lighting, "resends", None)
+    return ({}, None) if resends is None else resends()
+
+
 def _teardown_failure(label: str, exc: Exception, earlier: list[str]) -> str:
     """``label: what failed``, or a pointer to the earlier failure it repeats word for word.
 
@@ -838,6 +845,9 @@ def run_session(
     finally:
         cancel.capture_over()
         with signals_deferred():
+            ending = getattr(rig.lighting, "ending", None)
+            if ending is not None:  # a reopening now is for the closing all-off
+                ending()
             teardown += rig.lighting.safe(emergency=reason is FinishReason.EMERGENCY_STOP)
             for label, close in (
                 ("camera close", rig.camera.close),
@@ -849,6 +859,7 @@ def run_session(
                     teardown.append(_teardown_failure(label, exc, teardown))
             rig_time = clock.now() - rig_t0
             wall_time = time.perf_counter() - wall_t0
+            resent, resends_said = _resends(rig.lighting)
             try:
                 folder.finish(
                     records,
@@ -862,6 +873,7 @@ def run_session(
                         **({"end_check": end_notes} if rig.end_check is not None else {}),
                         **_arm_end(rig.lighting),
                         **_dome_reconnections(rig.lighting),
+                        **resent,
                         **({"led_error": led_error} if led_error is not None else {}),
                     },
                     timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
@@ -871,6 +883,8 @@ def run_session(
                 if error is None:  # nothing else went wrong: this is the session's failure
                     raise
                 teardown.append(f"session record: {exc}")  # the first failure is the story
+            if resends_said is not None:
+                emit(DeviceSays(rig.lighting.name, resends_said))
     return SessionResult(
         reason, tuple(records), rig_time, wall_time, error, tuple(teardown), tuple(end_notes)
     )

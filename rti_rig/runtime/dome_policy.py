@@ -319,6 +319,7 @@ class DomePolicy:
         (which configures no logging) printed raw on stderr in the middle of the progress
         bar, once per failed attempt, with the port's path three times over."""
         self._say = say
+        self._ending = False
 
     def _tell(self, text: str) -> None:
         if self._say is not None:
@@ -326,9 +327,32 @@ class DomePolicy:
 
     def _goes_on(self) -> str:
         if self._ending:
-            return "its all-off is sent again once it is back"
+            return "the closing all-off is sent again once it is back"
         what = "session" if self.lights_images else "check"
         return f"the {what} goes on once it is back"
+
+    def resends_said(self) -> str | None:
+        """One line for the faults resent after (a reply lost, late or garbled) whose commands
+        then went through, counted by fault; None when there were none.
+
+        Why: each resend had been a raw log record on stderr, printed in the middle of the
+        progress bar ("light LED 1 at level 1 failed (timeout, attempt 1): …"). A resend that
+        went through changes nothing the user must do, but a count at the end says the link is
+        not clean (a cable, a port, a board to look at). A lost port is left out: its reopening
+        is said as it happens (:meth:`listen`)."""
+        faults = [
+            entry.rsplit(": ", 1)[-1]
+            for entry in self.stats.recovered
+            if not entry.endswith(f": {LinkFault.DISCONNECTED}")
+        ]
+        if not faults:
+            return None
+        counts = ", ".join(f"{faults.count(f)} {f}" for f in dict.fromkeys(faults))
+        n = len(faults)
+        return (
+            f"The dome's commands were resent {n} time{'s' if n != 1 else ''} after a fault "
+            f"({counts}); each resent command then went through."
+        )
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -460,10 +484,13 @@ class DomePolicy:
                 self.name,
             )
         elif not self.link.echoes_light and not self.settings.confirm_with_query:
-            log.warning(
-                "%s: this profile's light acknowledgement does not say which LED was lit; set "
-                "confirm_with_query = true to have the firmware confirm every LED",
-                self.name,
+            # advice for the user, said once as the product speaks (a raw log record had been
+            # printed on stderr by the command line, which configures no logging)
+            log.info("%s: this profile's light acknowledgement names no LED", self.name)
+            self._tell(
+                "The dome's light acknowledgement does not say which LED was lit: set "
+                "confirm_with_query = true in the rig config's [dome.serial] to have the firmware "
+                "confirm every LED."
             )
         self._run(self.link.all_off, "all off")  # start from the safe state
         if self.link.off_outcome is not OffOutcome.ACKNOWLEDGED:
@@ -620,7 +647,7 @@ class DomePolicy:
             attempt += 1
             self.stats.retries += 1
             recovered.append(f"{exc.command}: {exc.fault}")
-            log.warning(
+            log.info(  # counted at the end (:meth:`resends_said`), never printed raw
                 "%s: %s failed while connecting (%s, attempt %d): %s",
                 self.name,
                 exc.command,
@@ -628,6 +655,13 @@ class DomePolicy:
                 attempt,
                 exc.message,
             )
+            if exc.slow_boot and self.lights_images:
+                # what to change in the config, said once in words (a check's report says it
+                # in its own line): it had reached the user only as that raw log record
+                self._tell(
+                    f"Slow boot: {exc.message}; the commands were sent again after the banner "
+                    "and the session goes on, but each session on this board meets the same wait."
+                )
             self._back_off(self.settings.retry_backoff_s)
             try:
                 return self._counted(self.link.hello)
@@ -692,7 +726,8 @@ class DomePolicy:
             try:
                 self.all_off()
             except DeviceError as exc:
-                log.warning("%s: could not switch all off while closing: %s", self.name, exc)
+                # the lights line says what the all-off established (off_report), in words
+                log.info("%s: could not switch all off while closing: %s", self.name, exc)
         if self._lit is not None:
             # not known off: its lighting counts up to now at least (the next command's guard
             # then errs towards waiting)
@@ -920,10 +955,11 @@ class DomePolicy:
                 result = self._counted(op)
             except DomeLinkError as exc:
                 fault = exc.fault
-                # a lost port is said in words as it is reopened (:meth:`_reopen`), not as a
-                # log record that the command line would print raw beside its progress bar
-                log.log(
-                    logging.INFO if fault is LinkFault.DISCONNECTED else logging.WARNING,
+                # never a warning the command line would print raw beside its progress bar: a
+                # lost port is said as it is reopened (:meth:`_reopen`), a resend that went
+                # through is counted at the end (:meth:`resends_said`), and one that gave up
+                # raises the error the command says
+                log.info(
                     "%s: %s failed (%s, attempt %d): %s",
                     self.name,
                     command,
@@ -943,7 +979,7 @@ class DomePolicy:
                         if self.lights_images
                         else f"{lit}, so the check fails there"
                     )
-                    back = self._recover(exc, command, goes_on=stops)
+                    back = self._recover(exc, command, goes_on=None if self._ending else stops)
                     what = "rebooted" if fault is LinkFault.RESET else "dropped off the USB bus"
                     # "off again" only once the handshake after the reboot went through: a
                     # board that rebooted again there (the Nab sketch boots lit) had been said
@@ -1035,7 +1071,7 @@ class DomePolicy:
                     self._reconnect(command, again, goes_on)
                     return True
                 # the resend that follows is bounded by the retry count anyway
-                log.warning("%s: handshake after a reset failed: %s", self.name, again)
+                log.info("%s: handshake after a reset failed: %s", self.name, again)
                 return False
             problem = self._check_identity(info)
             if problem:
@@ -1286,7 +1322,8 @@ class DomePolicy:
             "a further stop cut the all-off short",
             boots_lit=self._lit_at_boot(),
         )
-        log.warning("%s: stopped while connecting: switching the dome off first", self.name)
+        # the stop and the lights line say this in words (the off_report set above)
+        log.info("%s: stopped while connecting: switching the dome off first", self.name)
         self._finish_boot()
         self._attempt_off("after the connection was interrupted", after_open=True)
 
@@ -1316,11 +1353,12 @@ class DomePolicy:
             "the stop came while the port was being opened, and it was not opened again",
             boots_lit=self._lit_at_boot(),
         )
-        log.warning("%s: reopening the port a stop cut short, to send the all-off", self.name)
+        # said in words by the lights line (the off_report set here and below)
+        log.info("%s: reopening the port a stop cut short, to send the all-off", self.name)
         try:
             self._counted(self.link.reopen_port)
         except DomeLinkError as exc:
-            log.warning("%s: the port did not open again: %s", self.name, exc)
+            log.info("%s: the port did not open again: %s", self.name, exc)
             self.off_report = replace(
                 self.off_report, detail=f"the port did not open again after the stop: {exc}"
             )
@@ -1345,7 +1383,7 @@ class DomePolicy:
         try:
             self._counted(self.link.finish_boot)
         except DomeLinkError as exc:
-            log.warning("%s: waiting for the board to boot failed: %s", self.name, exc)
+            log.info("%s: waiting for the board to boot failed: %s", self.name, exc)
 
     def _link_hint(self) -> str:
         """``settings.link_hint`` as the end of an advice sentence ("" when there is none)."""
@@ -1394,7 +1432,7 @@ class DomePolicy:
                 except DomeLinkError as again:
                     exc = again
                 except DeviceError as other:
-                    log.warning("%s: all off %s failed: %s", self.name, when, other)
+                    log.info("%s: all off %s failed: %s", self.name, when, other)
                     self.off_report = OffReport(
                         OffOutcome.SENT_UNCONFIRMED, str(other), boots_lit=lit_at_boot
                     )
@@ -1404,7 +1442,7 @@ class DomePolicy:
             if exc.fault is LinkFault.FOREIGN:
                 self._switch_off_foreign(when)
                 return
-            log.warning("%s: all off %s failed: %s", self.name, when, exc)
+            log.info("%s: all off %s failed: %s", self.name, when, exc)
             self.off_report = replace(_failed_off(exc), boots_lit=lit_at_boot)
             if at_published_rate and lit_at_boot and exc.fault is not LinkFault.DISCONNECTED:
                 if self.link.bytes_heard:
@@ -1412,7 +1450,7 @@ class DomePolicy:
                 else:
                     self._not_reopened_silent(lit_at_boot)
         except DeviceError as exc:
-            log.warning("%s: all off %s failed: %s", self.name, when, exc)
+            log.info("%s: all off %s failed: %s", self.name, when, exc)
             self.off_report = OffReport(
                 OffOutcome.SENT_UNCONFIRMED, str(exc), boots_lit=lit_at_boot
             )
@@ -1433,7 +1471,7 @@ class DomePolicy:
         firmware does, establishes what the reboot left. Only once: a board that keeps
         rebooting is said so, and sent to its power supply."""
         first = "was not written" if not reset.sent else "was met by its boot banner"
-        log.warning(
+        log.info(
             "%s: the board rebooted and the all-off %s %s: sending it once more",
             self.name,
             when,
@@ -1490,7 +1528,7 @@ class DomePolicy:
         switch = getattr(self.link, "switch_off_at_published_rate", None)
         if rate is None or switch is None:
             return
-        log.warning(
+        log.info(
             "%s: reopening the port at %d baud, the %s firmware's published rate, to switch the "
             "board off (it boots with every LED lit)",
             self.name,
@@ -1500,7 +1538,7 @@ class DomePolicy:
         try:
             outcome = self._counted(switch)
         except DomeLinkError as exc:
-            log.warning("%s: all off at %d baud failed: %s", self.name, rate, exc)
+            log.info("%s: all off at %d baud failed: %s", self.name, rate, exc)
             self.off_report = replace(_failed_off(exc), boots_lit=firmware, reopened_at=rate)
             return
         self.off_report = OffReport(outcome, boots_lit=firmware, reopened_at=rate)
@@ -1527,9 +1565,7 @@ class DomePolicy:
         try:
             outcome = self._counted(switch)
         except DomeLinkError as exc:
-            log.warning(
-                "%s: the %s firmware's all-off %s failed: %s", self.name, firmware, when, exc
-            )
+            log.info("%s: the %s firmware's all-off %s failed: %s", self.name, firmware, when, exc)
             self.off_report = _failed_off(exc)
             return
         self.off_report = OffReport(
@@ -1891,6 +1927,8 @@ def self_test(
         slow = getattr(link, "slow_boot_advice", None)
         if isinstance(slow, str) and not _ended_by_slow_boot(ended_by):
             report.slow_boot = slow  # recovered from; one that ended the check is its error
+        if isinstance(source, DomePolicy):
+            source.ending()  # a reopening now is for the closing all-off, said so
         try:
             source.close()
         except DeviceError as exc:

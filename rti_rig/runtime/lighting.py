@@ -175,6 +175,23 @@ class DomeLighting:
         if listen is not None:
             listen(say)
 
+    def ending(self) -> None:
+        """The command tears down from here: a reopening of the dome's port is then said as
+        being for the closing all-off, never as "the session goes on"."""
+        ending = getattr(self.source, "ending", None)
+        if ending is not None:
+            ending()
+
+    def resends(self) -> tuple[dict[str, list[str]], str | None]:
+        """The manifest's ``dome_resent`` (each fault resent after whose command then went
+        through, ``"<command>: <fault>"``) and the one line that counts them for the user;
+        nothing and None when none was resent."""
+        stats = getattr(self.source, "stats", None)
+        said = getattr(self.source, "resends_said", None)
+        found = list(getattr(stats, "recovered", None) or [])
+        line = None if said is None else said()
+        return ({"dome_resent": found} if line is not None else {}), line
+
     def reconnections(self) -> list[dict[str, object]]:
         """Each reopening of the dome's lost port so far (what was lost, the outcome), for the
         session's manifest: the user is told of it in a line, the detail is kept there."""
@@ -226,6 +243,14 @@ class ArmLighting:
         self._stop_asked: int | None = None
         #: the last :meth:`connect` raised (the arm was never reached): no park, no end
         self.connect_failed = False
+
+    def resends(self) -> tuple[dict[str, list[str]], str | None]:
+        """The manifest's ``arm_resent`` (each command sent once more after its status packet
+        was lost or damaged, then answered) and the one line that counts them for the user;
+        nothing and None when none was (or the carrier keeps no count)."""
+        resends = getattr(self.carrier, "resends", None)
+        found, line = ([], None) if resends is None else resends()
+        return ({"arm_resent": found} if found else {}), line
 
     def connect(self) -> None:
         self.arm_failure = None

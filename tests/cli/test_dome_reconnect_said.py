@@ -87,7 +87,7 @@ def test_a_port_lost_at_the_teardowns_all_off_is_not_said_to_let_the_session_go_
     assert r.exit_code == 0, said  # type: ignore[attr-defined]
     lost = (
         "The dome dropped off the USB bus during 'all off': reopening its port (up to 4 "
-        "attempts over 7.5 s); its all-off is sent again once it is back."
+        "attempts over 7.5 s); the closing all-off is sent again once it is back."
     )
     assert said.count(lost) == 1, said
     assert "goes on once it is back" not in said, said
