@@ -30,7 +30,7 @@ from rti_rig.core.errors import MoveCancelled
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
-from rti_rig.drivers.dynamixel.bus import DxlBus
+from rti_rig.drivers.dynamixel.bus import DxlBus, resends_said
 from rti_rig.drivers.dynamixel.faults import (
     CommunicationError,
     ConfigMismatchError,
@@ -602,6 +602,12 @@ class DynamixelArm:
                 "when parked, where the arm cannot drop onto the object)",
                 self.name,
             )
+
+    def resends(self) -> tuple[list[str], str | None]:
+        """The commands sent once more after a lost or damaged status packet that then got
+        their answer (for the session's manifest), and the one line that counts them for the
+        user (None: none)."""
+        return list(self._bus.resent), resends_said(self._bus.resent)
 
     def torque_release_note(self) -> str | None:
         """What a user must know of an arm whose last close sent its torque-off at the park

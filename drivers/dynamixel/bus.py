@@ -126,6 +126,10 @@ class DxlBus:
         self.config = config
         #: how this chain's servos are power-cycled (the advice's other way to clear a fault)
         self.power_cycle = power_cycle
+        #: ``"<command>: <what was lost>"`` for each status packet lost or damaged whose
+        #: command, sent once more, then got its answer (counted for the user at the end:
+        #: :func:`resends_said`).
+        self.resent: list[str] = []
         self.ph = _ReleasingHandler(packet_handler or sdk.PacketHandler(2.0), port, device)
         #: the line speed the port was opened at (named when a servo does not answer)
         self.baudrate: int | None = None
@@ -307,7 +311,11 @@ class DxlBus:
         included: the servo plans its profile to the same goal from where it is)."""
         reply = call()
         if reply[-2] in self.RETRYABLE:
-            log.warning(
+            # never a warning the command line would print raw beside its progress bar: a
+            # retry that got its answer is counted at the end (:attr:`resent`), one that did
+            # not raises the error the command says
+            first = reply[-2]
+            log.info(
                 "%s: id %d %s: %s; retrying once",
                 self.device,
                 dxl_id,
@@ -318,6 +326,11 @@ class DxlBus:
                 # a reply that was only late must not be read as the answer to a later command
                 self.drain_reply()
             reply = call()
+            if reply[-2] == sdk.COMM_SUCCESS:
+                lost = (
+                    "no status packet" if first == sdk.COMM_RX_TIMEOUT else "damaged status packet"
+                )
+                self.resent.append(f"id {dxl_id} {what}: {lost}")
         return reply
 
     # -- commands ---------------------------------------------------------------------------
@@ -392,7 +405,7 @@ class DxlBus:
                     self.port.setBaudRate(configured)
                     self._lock_exclusively()
             except Exception as exc:  # the caller's error says what the bus gave
-                log.warning(
+                log.info(  # the caller's error is said; this is its detail
                     "%s: could not set the port back to %d baud: %s", self.device, configured, exc
                 )
 
@@ -523,3 +536,22 @@ def _span_name(address: int, length: int) -> str:
     if first is None or last is None:
         return f"{address}+{length}"
     return first.name if first is last else f"{first.name}..{last.name}"
+
+
+def resends_said(resent: list[str]) -> str | None:
+    """One line for the commands sent once more after their status packet was lost or damaged
+    and then answered, counted by what was lost; None when there were none.
+
+    Why: each had been a raw log record ("arm: id 2 read Velocity Limit: COMM_RX_TIMEOUT: …;
+    retrying once") printed on stderr in the middle of the progress bar. A retry that got its
+    answer changes nothing the user must do, but a count says the bus is not clean (a cable,
+    a connector, the termination to look at)."""
+    if not resent:
+        return None
+    lost = [entry.rsplit(": ", 1)[-1] for entry in resent]
+    counts = ", ".join(f"{lost.count(x)} {x}" for x in dict.fromkeys(lost))
+    n = len(resent)
+    return (
+        f"The arm's servos were asked again {n} time{'s' if n != 1 else ''} after a status "
+        f"packet was lost or damaged ({counts}); each then answered."
+    )

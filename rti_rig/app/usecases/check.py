@@ -120,7 +120,10 @@ def check_rig(
                     rig.clock,
                     park=rig.lighting.park_after_session,
                 )
-                notes = (*config_note_lines(loaded), *_lamp_notes(rig))
+                # the status packets lost and asked again, counted once (each had been a raw
+                # log record on stderr)
+                resent = rig.lighting.resends()[1]
+                notes = (*config_note_lines(loaded), *_lamp_notes(rig), *filter(None, [resent]))
                 return WithCamera(lights, camera_line(rig, auto_exposure=req.auto_exposure), notes)
         except EmergencyStop as exc:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out

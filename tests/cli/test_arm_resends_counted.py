@@ -1,0 +1,78 @@
+"""A status packet lost or damaged on an emulated arm's bus, and asked again, is counted once at
+the end of a run or a check, never printed as a raw log record.
+
+Before, each retry was a WARNING record ("arm: id 2 read Velocity Limit: COMM_RX_TIMEOUT:
+[TxRxResult] There is no status packet!; retrying once"), which the command line (configuring
+no logging) printed raw on stderr in the middle of the progress bar.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+#: Commands 12 and 20 of the emulated chain: reads of the connect's limit checks.
+FAULTS = (
+    '[[emulator.faults]]\nat_command = 12\nkind = "drop_reply"\n'
+    '[[emulator.faults]]\nat_command = 20\nkind = "garble_reply"'
+)
+LINE = (
+    "The arm's servos were asked again 2 times after a status packet was lost or damaged "
+    "(1 no status packet, 1 damaged status packet); each then answered."
+)
+
+
+def _config(tmp_path: Path, faults: str) -> Path:
+    cfg = tmp_path / "rig.toml"
+    cfg.write_text((CONFIGS / "simulated_arm.toml").read_text() + f"\n{faults}\n")
+    return cfg
+
+
+def _invoke(argv: list[str], caplog: pytest.LogCaptureFixture) -> tuple[object, str]:
+    with caplog.at_level(logging.DEBUG):
+        r = CliRunner().invoke(app, argv, terminal_width=400)
+    said = " ".join(r.output.split())
+    loud = [x.getMessage() for x in caplog.records if x.levelno >= logging.WARNING]
+    assert not [m for m in loud if "retrying once" in m], loud
+    for raw in ("retrying once", "COMM_RX_TIMEOUT", "COMM_RX_CORRUPT", "WARNING:"):
+        assert raw not in said, (raw, said)
+    return r, said
+
+
+def test_a_run_counts_the_status_packets_asked_again_once_and_keeps_them(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    out = tmp_path / "S"
+    argv = ["run", str(_config(tmp_path, FAULTS)), "--lights", "6", "--out", str(out)]
+    r, said = _invoke([*argv, "--no-verdict"], caplog)
+    assert r.exit_code == 0, said  # type: ignore[attr-defined]
+    assert said.count(LINE) == 1, said
+    runner = json.loads((out / "manifest.json").read_text())["runner"]
+    assert runner["arm_resent"] == [
+        "id 2 read Velocity Limit: no status packet",
+        "id 1 read Max Position Limit: damaged status packet",
+    ]
+
+
+def test_a_check_counts_them_in_its_report(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    r, said = _invoke(["check", str(_config(tmp_path, FAULTS))], caplog)
+    assert r.exit_code == 0, said  # type: ignore[attr-defined]
+    assert said.count(LINE) == 1 and said.index(LINE) < said.index("RESULT: PASS"), said
+
+
+def test_a_clean_run_says_nothing_of_it(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    out = tmp_path / "S"
+    argv = ["run", str(_config(tmp_path, "")), "--lights", "6", "--out", str(out)]
+    r, said = _invoke([*argv, "--no-verdict"], caplog)
+    assert r.exit_code == 0, said  # type: ignore[attr-defined]
+    assert "asked again" not in said, said
+    assert "arm_resent" not in json.loads((out / "manifest.json").read_text())["runner"]
