@@ -162,10 +162,7 @@ class DomeLighting:
         return None if report is None else str(report.outcome)
 
     def safe(self, emergency: bool = False) -> list[str]:
-        # a teardown's all-off: a port lost during it is not said to let the session go on
-        ending = getattr(self.source, "ending", None)
-        if ending is not None:
-            ending()
+        self.ending()  # a teardown's all-off: a port lost in it is not said to let things go on
         return attempt_all([("all LEDs off", self.source.all_off)])
 
     def listen(self, say: Callable[[str], None] | None) -> None:
