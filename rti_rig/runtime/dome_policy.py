@@ -997,7 +997,10 @@ class DomePolicy:
                         )
                     else:
                         lost_what = (
-                            f"LED {lost.index} went dark with it (this check takes no image); "
+                            # not "went dark with it": a board powered apart from its USB
+                            # link stays lit, and the Nab sketch boots with every LED on
+                            f"this check takes no image under LED {lost.index}, so nothing is "
+                            f"lost with it; "
                             f"{state}; a board that {what} by itself points to its power "
                             "supply or its USB cable: check them, then run the check again"
                         )
