@@ -1306,9 +1306,9 @@ def assess(
     coverage = ((small > dark) & ~small_sat).sum(axis=0).astype(np.int16)
     # every image the same picture: said once, for every image, as no per-image check sees it
     unchanged = None if all_black else unchanging_spread(small, small_sat, dark, lt)
-    # one image of one level among images that shade with their light: named, in place of
+    # one image of one level where the images of its nearest lights shade: named, in place of
     # the dim or bright claims its level against the fit would give it
-    flat = {} if all_black or unchanged is not None else flat_images(small, small_sat, dark)
+    flat = {} if all_black or unchanged is not None else flat_images(small, small_sat, dark, lt)
 
     # per-image evidence on a full-resolution crop where the object has lit structure (a
     # second pass reads only its rows)

@@ -95,16 +95,26 @@ FLAT_FRAME = "a flat frame: no picture of the object"
 FLAT_AGAINST = 5.0
 #: The fewest lit, unclipped reduced pixels a flat image is judged on.
 FLAT_MIN_PIXELS = 16
+#: The images an image's spread is judged against: those of its nearest lights by angle. Why
+#: not every image: a light near the camera axis shades a gently sloped matte object (a sheet
+#: of paper, a plaster cast) by the cosine of its slope, under 2 % across the frame at slopes
+#: of 1-1.5°, while raking lights shade it by tens of per cent (16-bit images of such a sheet
+#: under the real replay's lights: its two highest lights, 80-82°, read 1.2-1.7 % against a
+#: median 11 % and were called flat). Lights near it shade it alike; a frame from another
+#: source differs from them.
+FLAT_NEIGHBOURS = 4
 
 
 def flat_images(
     small: NDArray[np.floating],
     small_sat: NDArray[np.bool_],
     dark: float,
+    lights: NDArray[np.floating],
 ) -> dict[int, tuple[float, float]]:
     """The images of ``small`` (N, h, w; ``small_sat`` and ``dark`` as in
-    :func:`unchanging_spread`) that are one level across the frame while the others are not:
-    each with its spread and the other images' median spread.
+    :func:`unchanging_spread`) that are one level across the frame while the images of their
+    :data:`FLAT_NEIGHBOURS` nearest ``lights`` (N×3) are not: each with its spread and those
+    images' median spread.
 
     Why: one flat grey frame among lit ones (a frame from another source, a lens covered, a
     camera that sent a blank buffer) was judged "good" at a level near its mates', and "too
@@ -123,9 +133,13 @@ def flat_images(
         return {}
     lo, hi = np.percentile(stack[:, usable], [10.0, 90.0], axis=1)
     spread = np.where(hi > dark, (hi - lo) / np.where(hi > 0.0, hi, 1.0), np.nan)
+    lt = np.asarray(lights, dtype=np.float64).reshape(n, 3)
+    lt = lt / np.maximum(np.linalg.norm(lt, axis=1, keepdims=True), 1e-12)
     found: dict[int, tuple[float, float]] = {}
     for i in np.flatnonzero(spread < UNCHANGING_SPREAD):
-        others = np.delete(spread, i)
+        near = np.argsort(-(lt @ lt[i]), kind="stable")
+        near = near[near != i][:FLAT_NEIGHBOURS]
+        others = spread[near]
         others = others[np.isfinite(others)]
         typical = float(np.median(others)) if others.size >= 2 else 0.0
         if typical >= FLAT_AGAINST * UNCHANGING_SPREAD:
@@ -137,6 +151,6 @@ def flat_problem(spread: float, typical: float) -> str:
     """What the verdict says of a flat image (:func:`flat_images`), and what to do."""
     return (
         f"{FLAT_FRAME} (one level across the frame: it varies {spread:.1%} across it, where "
-        f"the other images vary a median {typical:.0%} under their lights); a frame from "
+        f"the images of the nearest lights vary a median {typical:.0%}); a frame from "
         "another source, a covered lens or a camera fault; reshoot it"
     )

@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 from conftest import qa_of
 
-from rti_rig.core.lp_format import read_lp, write_lp
+from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
 
 REPO = Path(__file__).resolve().parents[2]
 ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
@@ -64,3 +64,47 @@ def test_a_flat_frame_at_its_mates_level_in_a_simulated_session(
     said, _ = qa_of(acq, tmp_path / "f")
     assert f"image_005 ({FLAT}" in said, said
     assert "QA verdict: good" not in said
+
+
+def _gentle_sheet(folder: Path, slope_deg: float = 1.2, side: int = 128) -> Path:
+    """A matte sheet of one albedo, undulating by ``slope_deg`` (RMS), under every third light
+    of the real acquisition (6-82° elevation), as 16-bit images with little noise: a light near
+    the camera axis shades it by the cosine of its slope, under 2 % across the frame."""
+    folder.mkdir()
+    rng = np.random.default_rng(0)
+    z = cv2.GaussianBlur(rng.normal(0.0, 1.0, (side, side)), (0, 0), side / 20)
+    gy, gx = np.gradient(z)
+    k = np.tan(np.radians(slope_deg)) / float(np.hypot(gx, gy).std())
+    normals = np.stack([-gx * k, -gy * k, np.ones_like(z)], axis=-1)
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    entries = []
+    for i, e in enumerate(read_lp(REPO / "tests" / "data" / "neuralrti" / "dirs.lp")[::3]):
+        light = np.asarray(e.direction, np.float64) / np.linalg.norm(e.direction)
+        value = 0.7 * np.clip(normals @ light, 0.0, None) + rng.normal(0.0, 5e-4, z.shape)
+        name = f"sheet{i:02d}.png"
+        cv2.imwrite(str(folder / name), np.clip(value * 65535, 0, 65535).astype(np.uint16))
+        entries.append(LpEntry(name, tuple(light)))
+    write_lp(folder / "dirs.lp", entries)
+    return folder / "dirs.lp"
+
+
+def test_a_high_light_on_a_gently_sloped_sheet_is_not_a_flat_frame(tmp_path: Path) -> None:
+    """Its highest lights' images vary 1.2-1.7 % across the frame, the session's median image
+    11 %: judged against every image they had been called flat; the images of their nearest
+    lights vary as little, as a real object's do."""
+    said, qa = qa_of(_gentle_sheet(tmp_path / "acq"), tmp_path / "f")
+    assert "QA verdict" in said
+    named = [c["name"] for c in qa["images"] if any(FLAT in p for p in c["problems"])]
+    assert named == [], said
+
+
+def test_a_flat_frame_among_the_sheets_images_is_named(tmp_path: Path) -> None:
+    """A mid-elevation image of the sheet made one level: its nearest lights' images shade."""
+    lp = _gentle_sheet(tmp_path / "acq")
+    entries = read_lp(lp)
+    mid = min(entries, key=lambda e: abs(np.degrees(np.arcsin(e.direction[2])) - 35.0)).name
+    img = cv2.imread(str(lp.parent / mid), cv2.IMREAD_UNCHANGED)
+    cv2.imwrite(str(lp.parent / mid), np.full_like(img, int(np.median(img))))
+    said, qa = qa_of(lp, tmp_path / "f")
+    named = [c["name"] for c in qa["images"] if any(FLAT in p for p in c["problems"])]
+    assert named == [mid[: -len(".png")]], said
