@@ -191,8 +191,10 @@ GRAZING_DIM_MIN_DEG = 1.5
 #: warns by), not by this level: the two rules had been written twice and could disagree.
 PEAK_PERCENTILE = 99.9
 #: The words of an acquisition black throughout, said once for the run of images
-#: (:attr:`QAReport.verdict`).
-BLACK_THROUGHOUT = "no light in any image"
+#: (:attr:`QAReport.verdict`). "Next to": black is a level, under 0.2 % of full scale
+#: (``signal_check.BLACK_FRACTION``), not an absence: a dome session at 500x too short an
+#: exposure (8-bit frames of 0-5 DN) holds a picture of the object under its lights.
+BLACK_THROUGHOUT = "next to no light in any image"
 #: A light is dim too when its image's median gain is at most this fraction of the median
 #: gain of its :data:`NEIGHBOUR_COUNT` nearest lights' images: the Lambertian prediction
 #: misjudges a glossy object's brightness light by light (bright-end gains of 0.8-5.4 on the

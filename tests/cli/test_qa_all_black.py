@@ -31,7 +31,7 @@ def test_a_black_acquisition_is_called_so(tmp_path: Path) -> None:
     assert "QA verdict: good" not in said, said
     # said once, with the count and the likely causes (it had come once per image)
     assert said.count("no light in any image") == 1, said
-    assert f"({len(entries)} images: no light in any image" in said, said
+    assert f"({len(entries)} images: next to no light in any image" in said, said
     assert "(a lens cap left on, lights that never fired, or an exposure far too short)" in said
     assert "misfired" not in said, said
 
@@ -55,3 +55,20 @@ def test_a_small_object_on_black_velvet_is_not_called_black_throughout(tmp_path:
     assert "QA verdict" in said, said
     assert "no light in any image" not in said, said
     assert said.count("misfired, no light") == 0, said
+
+
+def test_a_very_dark_acquisition_is_not_said_to_have_no_light(tmp_path: Path) -> None:
+    """The real replay at a far too short exposure (its frames scaled to 0-5 DN): below the
+    black level of every image, so reshot, but each still a picture of the object under its
+    light; the verdict had said "no light in any image" of it."""
+    entries = read_lp(ACQ)
+    for e in entries:
+        img = cv2.imread(str(ACQ.parent / e.name)).astype(np.float32)
+        cv2.imwrite(str(tmp_path / e.name), np.round(img * (5.0 / img.max())).astype(np.uint8))
+    lp = tmp_path / "dirs.lp"
+    write_lp(lp, entries)
+    r = CliRunner().invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-ptm"])
+    said = " ".join(r.output.split())
+    assert "QA verdict: good" not in said, said
+    assert said.count("next to no light in any image") == 1, said
+    assert ": no light in any image" not in said, said
