@@ -127,11 +127,15 @@ def flat_images(
     n = small.shape[0]
     if n < 3:
         return {}
-    stack = small.reshape(n, -1).astype(np.float64)
+    # the images as they are, one row at a time in float64: a float64 copy of the stack and
+    # the percentile's copy of it had held the reduced images three times over
+    stack = small.reshape(n, -1)
     usable = (stack.max(axis=0) > dark) & ~small_sat.reshape(n, -1).any(axis=0)
     if int(usable.sum()) < FLAT_MIN_PIXELS:
         return {}
-    lo, hi = np.percentile(stack[:, usable], [10.0, 90.0], axis=1)
+    lo, hi = np.array(
+        [np.percentile(row[usable].astype(np.float64), [10.0, 90.0]) for row in stack]
+    ).T
     spread = np.where(hi > dark, (hi - lo) / np.where(hi > 0.0, hi, 1.0), np.nan)
     lt = np.asarray(lights, dtype=np.float64).reshape(n, 3)
     lt = lt / np.maximum(np.linalg.norm(lt, axis=1, keepdims=True), 1e-12)
