@@ -80,8 +80,10 @@ from rti_rig.app.usecases.worker_code import (
     Untagged,
     WorkerCode,
     describe,
+    describe_library,
     local_identity,
     plugin_outcomes,
+    stack_differences,
     tag_for,
     tagging_plugin,
     worker_identities,
@@ -496,9 +498,12 @@ def _refuse_other_code(client: Any, address: str) -> frozenset[str]:
             "this command runs. Nothing was sent: run the same command again"
         )
     workers = worker_identities(client)
+    _refuse_other_libraries(workers, mine, address)
     untold = {w: ident for w, ident in workers.items() if isinstance(ident, Unasked)}
     differ = {
-        w: ident for w, ident in workers.items() if isinstance(ident, WorkerCode) and ident != mine
+        w: ident
+        for w, ident in workers.items()
+        if isinstance(ident, WorkerCode) and not ident.same_code(mine)
     }
     if differ:
         named = "; ".join(f"{w} ({describe(ident)})" for w, ident in sorted(differ.items()))
@@ -519,6 +524,47 @@ def _refuse_other_code(client: Any, address: str) -> frozenset[str]:
             f"the same command; they must run this same rti-rig ({describe(mine)})"
         )
     return frozenset(workers)
+
+
+def _refuse_other_libraries(
+    workers: dict[str, WorkerCode | Unasked], mine: WorkerCode, address: str
+) -> None:
+    """Refuse a cluster some of whose workers run other versions of the libraries the fit's
+    tasks travel through (:data:`~rti_rig.app.usecases.worker_code.STACK_PACKAGES`), naming
+    each such worker, the versions that differ, and the ones to install.
+
+    Why: a worker of another distributed was let through (its rti-rig was this one); Dask
+    printed its "Mismatched versions found" table as a note, the worker died on its first
+    task (``TypeError: ComputeTaskEvent…``) and about 80 s later the fit said the checked
+    workers "have all left", exit 2, without saying why. Checked before the rti-rig code:
+    such a worker cannot run this fit whatever rti-rig it has."""
+    differ = {
+        w: found
+        for w, ident in workers.items()
+        if isinstance(ident, WorkerCode) and (found := stack_differences(mine, ident))
+    }
+    if not differ:
+        return
+    named = "; ".join(
+        f"{w} ({', '.join(describe_library(name, theirs) for name, _, theirs in found)})"
+        for w, found in sorted(differ.items())
+    )
+    needed = {name: ours for found in differ.values() for name, ours, _ in found}
+    ours_said = ", ".join(describe_library(name, version) for name, version in needed.items())
+    pins = " ".join(
+        f"'{name}=={version.removesuffix('.x')}{'.*' if version.endswith('.x') else ''}'"
+        for name, version in needed.items()
+        if version
+    )
+    raise SchedulerError(
+        f"{len(differ)} of the {len(workers)} workers of the Dask cluster at {address!r} run "
+        f"other versions of the libraries this fit's tasks pass through than this machine "
+        f"({ours_said}): {named}. Dask's client and workers must run the same distributed, "
+        "dask and cloudpickle, and the same major numpy (their tasks and results cannot be "
+        "read from one side to the other: such a worker dies on its first task), so nothing "
+        f"was sent: install these versions on those workers (pip install {pins}), restart "
+        "them, and run the same command"
+    )
 
 
 def _close_quietly(client: Any) -> None:

@@ -38,6 +38,26 @@ MAPPED_PACKAGES: tuple[str, ...] = (
     "rti_rig.rig_configs",
 )
 
+#: The libraries whose versions a worker must share with this machine, and how much of the
+#: version must agree: ``"exact"``, or ``"major"`` (the number before the first dot).
+#:
+#: Why these: ``distributed`` and ``dask`` exchange the scheduler's and the workers' messages
+#: and the task graph, whose forms change between releases (a worker of distributed 2025.1.0
+#: under a 2026.8.0 client died on its first task, ``TypeError: ComputeTaskEvent…``, and the
+#: fit said after 80 s only that the checked workers "have all left"); ``cloudpickle`` writes
+#: the fit's functions and this module's check classes by value on this machine and reads them
+#: on the worker (Dask lists all three as required to match). ``numpy`` carries the bands'
+#: results: arrays pickled by numpy 2 name ``numpy._core``, which numpy 1 cannot import, while
+#: within one major version array pickles are read both ways, so only the major must agree
+#: (an exact pin would refuse clusters that work). Not compared: Dask's transport libraries
+#: (tornado, msgpack), which distributed's own requirements keep working together.
+STACK_PACKAGES: tuple[tuple[str, str], ...] = (
+    ("distributed", "exact"),
+    ("dask", "exact"),
+    ("cloudpickle", "exact"),
+    ("numpy", "major"),
+)
+
 #: The files a wheel ships (code and the rig configs' package data): stray files of a
 #: checkout (editor backups, caches) would otherwise tell an editable install from a wheel.
 FINGERPRINTED_SUFFIXES: tuple[str, ...] = (".py", ".toml", ".lp")
@@ -52,6 +72,14 @@ class WorkerCode:
     version: str | None
     fingerprint: str | None
     problem: str | None = None
+    #: the :data:`STACK_PACKAGES` versions found there, as ``(name, version)`` pairs ("" for
+    #: a library that is not there); empty when not reported (see :func:`stack_differences`)
+    stack: tuple[tuple[str, str], ...] = ()
+
+    def same_code(self, other: WorkerCode) -> bool:
+        """Whether ``other`` runs this rti-rig (its libraries' versions aside)."""
+        mine = (self.version, self.fingerprint, self.problem)
+        return mine == (other.version, other.fingerprint, other.problem)
 
 
 @dataclass(frozen=True)
@@ -63,13 +91,39 @@ class Unasked:
 
 
 def _identity_function(
-    mapped: tuple[str, ...] = MAPPED_PACKAGES, suffixes: tuple[str, ...] = FINGERPRINTED_SUFFIXES
-) -> Callable[[], dict[str, str | None]]:
+    mapped: tuple[str, ...] = MAPPED_PACKAGES,
+    suffixes: tuple[str, ...] = FINGERPRINTED_SUFFIXES,
+    compared: tuple[tuple[str, str], ...] = STACK_PACKAGES,
+) -> Callable[[], dict[str, Any]]:
     """The function that reports, as a plain dict of :class:`WorkerCode`'s fields, the rti-rig
-    of the process it runs in. Nested, so that it is pickled by value (see the module's note);
-    it refers to no global of this module (``mapped`` and ``suffixes`` travel with it)."""
+    of the process it runs in and the versions of the libraries its tasks need (``stack``, a
+    dict, reported whatever became of rti-rig's import). Nested, so that it is pickled by
+    value (see the module's note); it refers to no global of this module (``mapped``,
+    ``suffixes`` and ``compared`` travel with it)."""
 
-    def rti_rig_identity() -> dict[str, str | None]:
+    def rti_rig_identity() -> dict[str, Any]:
+        stack = library_versions()
+        found = code_identity()
+        return {**found, "stack": stack}
+
+    def library_versions() -> dict[str, str]:
+        """The version of each compared library in this process, as it must agree: the
+        imported module's ``__version__`` (the code that runs, not the installed metadata),
+        cut to its major where only that must agree; "" where it cannot be imported."""
+        import importlib
+
+        versions: dict[str, str] = {}
+        for name, agree in compared:
+            try:
+                version = str(getattr(importlib.import_module(name), "__version__", ""))
+            except Exception:  # not installed there (or broken): told as missing
+                version = ""
+            if agree == "major" and version:
+                version = version.split(".")[0] + ".x"
+            versions[name] = version
+        return versions
+
+    def code_identity() -> dict[str, str | None]:
         import hashlib
         import importlib.util
         import sys
@@ -236,7 +290,28 @@ def _as_worker_code(answer: Mapping[str, Any]) -> WorkerCode:
         value = answer.get(key)
         return None if value is None else str(value)
 
-    return WorkerCode(field("version"), field("fingerprint"), field("problem"))
+    told = answer.get("stack")
+    stack = tuple((str(k), str(v)) for k, v in told.items()) if isinstance(told, Mapping) else ()
+    return WorkerCode(field("version"), field("fingerprint"), field("problem"), stack)
+
+
+def stack_differences(mine: WorkerCode, theirs: WorkerCode) -> list[tuple[str, str, str]]:
+    """The compared libraries (:data:`STACK_PACKAGES`) whose version differs between ``mine``
+    and ``theirs``, as ``(name, mine, theirs)``; none when ``theirs`` reported no versions (a
+    check of an rti-rig from before this one: it cannot be told, and its code differs)."""
+    if not theirs.stack:
+        return []
+    ours, found = dict(mine.stack), dict(theirs.stack)
+    return [
+        (name, ours.get(name, ""), found.get(name, ""))
+        for name, _ in STACK_PACKAGES
+        if ours.get(name, "") != found.get(name, "")
+    ]
+
+
+def describe_library(name: str, version: str) -> str:
+    """``distributed 2026.8.0``, ``numpy 2.x``, or ``no numpy``."""
+    return f"{name} {version}" if version else f"no {name}"
 
 
 @lru_cache(maxsize=1)
@@ -305,7 +380,9 @@ class Untagged(NamedTuple):
 def tagging_plugin(code: WorkerCode) -> Any:
     """A Dask ``WorkerPlugin`` that, on every worker it is set up on — those there when it is
     registered and every one that joins or restarts later, before that worker takes any task —
-    computes that worker's own rti-rig and, only if it is ``code``, gives the worker the
+    computes that worker's own rti-rig and, only if it is ``code`` (with the same
+    :data:`STACK_PACKAGES` versions: a worker joining later with another distributed would die
+    on its first task), gives the worker the
     resource :func:`tag_for` names (and takes it back from a worker holding it whose code is
     no longer ``code``: its source changed since it was tagged).
 
@@ -333,7 +410,12 @@ def tagging_plugin(code: WorkerCode) -> Any:
     tasks when it resumes by itself — the tag never resumes a paused worker."""
     from distributed import WorkerPlugin
 
-    expected = {"version": code.version, "fingerprint": code.fingerprint, "problem": None}
+    expected = {
+        "version": code.version,
+        "fingerprint": code.fingerprint,
+        "problem": None,
+        "stack": dict(code.stack),  # a worker of other library versions is not tagged either
+    }
     resource = tag_for(code)
     identity = _identity_function()
     # the kinds as closure values, sent with the class: never looked up in the worker's module
@@ -366,6 +448,14 @@ def tagging_plugin(code: WorkerCode) -> Any:
                         said += f", code {found['fingerprint']}"
                     if found.get("problem"):
                         said += f" ({found['problem']})"
+                    stack = found.get("stack") or {}
+                    other = [
+                        f"{name} {stack.get(name) or '(none)'} (this fit's {version or 'none'})"
+                        for name, version in self.expected["stack"].items()
+                        if stack.get(name) != version
+                    ]
+                    if other:
+                        said += f", with {', '.join(other)}"
                     self.outcome = (other_code, f"it runs other code than this fit: {said}")
                     return
                 if held != self.amount:

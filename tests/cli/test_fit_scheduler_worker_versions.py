@@ -1,0 +1,100 @@
+"""`rti-rig fit --scheduler` on a cluster whose workers run other versions of the libraries the
+fit's tasks pass through (distributed, dask, cloudpickle; numpy's major): refused before any
+band is sent, naming the workers, their versions and the ones to install. A worker of
+distributed 2025.1.0 under a 2026.8.0 client had died on its first task (``TypeError:
+ComputeTaskEvent…``) and the fit said, 80 s later, only that the checked workers "have all
+left"."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from rti_rig.app.usecases.worker_code import (
+    STACK_PACKAGES,
+    WorkerCode,
+    local_identity,
+    stack_differences,
+)
+from rti_rig.cli import app
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from fit_sessions import make_session
+
+runner = CliRunner()
+
+#: A `dask worker` whose distributed and dask say they are 2025.1.0: what the check reads on a
+#: worker of that release (the imported modules' ``__version__``), without a second venv.
+OLDER_DASK_WORKER = (
+    "import dask, distributed\n"
+    "dask.__version__ = distributed.__version__ = '2025.1.0'\n"
+    "from distributed.cli.dask_worker import main\n"
+    "main()\n"
+)
+
+
+def test_a_worker_of_another_distributed_is_refused_before_any_band(tmp_path: Path) -> None:
+    import dask
+    import distributed
+    from distributed import Client, LocalCluster
+
+    session = make_session(tmp_path / "A", size=(24, 32))[0]
+    with LocalCluster(
+        n_workers=1,
+        threads_per_worker=1,
+        processes=False,
+        protocol="tcp",  # reachable from the worker process
+        host="127.0.0.1",
+        dashboard_address=None,
+    ) as cluster:
+        address = cluster.scheduler_address
+        ours = set(cluster.scheduler.workers)
+        worker = subprocess.Popen(
+            [sys.executable, "-c", OLDER_DASK_WORKER, address, "--nthreads", "1",
+             "--no-nanny", "--no-dashboard"],
+            cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        )  # fmt: skip
+        try:
+            with Client(address, set_as_default=False) as watcher:
+                watcher.wait_for_workers(2, timeout=300)  # a bound on a hang, not a timing
+                (other,) = set(watcher.scheduler_info()["workers"]) - ours
+            out = tmp_path / "F"
+            args = ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps"]
+            r = runner.invoke(app, [*args, "--scheduler", address])
+        finally:
+            worker.terminate()
+            worker.wait(timeout=120)
+    assert r.exit_code == 2, r.output
+    said = " ".join(r.output.split())
+    assert f"1 of the 2 workers of the Dask cluster at '{address}' run other versions" in said
+    assert f"{other} (distributed 2025.1.0, dask 2025.1.0)" in said, said
+    mine = f"distributed {distributed.__version__}, dask {dask.__version__}"
+    assert f"than this machine ({mine})" in said, said
+    assert (
+        f"pip install 'distributed=={distributed.__version__}' 'dask=={dask.__version__}'" in said
+    ), said
+    assert "have all left" not in said and "Traceback" not in r.output
+    assert not out.exists()
+
+
+def _with(**versions: str) -> WorkerCode:
+    here = local_identity()
+    stack = tuple((name, versions.get(name, dict(here.stack)[name])) for name, _ in STACK_PACKAGES)
+    return WorkerCode(here.version, here.fingerprint, here.problem, stack)
+
+
+def test_numpy_is_compared_by_major_and_the_dask_libraries_exactly() -> None:
+    """numpy's array pickles are read across one major version, not from 2 to 1; distributed,
+    dask and cloudpickle must agree to the release."""
+    mine = local_identity()
+    major = dict(mine.stack)["numpy"]
+    assert major.endswith(".x") and not stack_differences(mine, _with())
+    assert stack_differences(mine, _with(numpy="1.x")) == [("numpy", major, "1.x")]
+    assert [d[0] for d in stack_differences(mine, _with(cloudpickle="2.2.1"))] == ["cloudpickle"]
+    assert [d[2] for d in stack_differences(mine, _with(dask=""))] == [""]  # none there
+    # an rti-rig from before this check reports no versions: its code differs, said as such
+    older = WorkerCode(mine.version, "0123456789ab", None)
+    assert stack_differences(mine, older) == []
