@@ -540,6 +540,13 @@ def fit_one(
         kept = f" (the earlier fit in {final} is kept)" if outgrown and final.exists() else ""
         return BatchItem(source, final, Outcome.FAILED, f": {exc}{kept}", notes=said)
     moved_on = changed_while_fitted(partial, source)
+    if outgrown is not None and final.exists() and earlier_fit(final, source).stands:
+        # Another attempt put a current fit in place while this one ran (a worker of a batch
+        # whose Dask scheduler was lost goes on with its session, and the user's rerun fits it
+        # too): the swap below would have set that finished fit aside and put this one in,
+        # replacing a finished output. It is kept; this attempt's copy is discarded.
+        shutil.rmtree(partial, ignore_errors=True)
+        return BatchItem(source, final, Outcome.DONE, DONE_ELSEWHERE, notes=said)
     if outgrown is not None and final.exists():
         # the earlier fit is set aside only now that its successor is complete, under a
         # backup's name: a batch killed between the renames is finished by the next run's
