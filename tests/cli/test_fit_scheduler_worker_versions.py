@@ -7,8 +7,10 @@ left"."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 from typer.testing import CliRunner
@@ -27,7 +29,8 @@ from fit_sessions import make_session
 runner = CliRunner()
 
 #: A `dask worker` whose distributed and dask say they are 2025.1.0: what the check reads on a
-#: worker of that release (the imported modules' ``__version__``), without a second venv.
+#: worker of that release (the imported modules' ``__version__``), without a second venv; its
+#: installed metadata says so too (:func:`older_metadata`), as Dask's own version table reads.
 OLDER_DASK_WORKER = (
     "import dask, distributed\n"
     "dask.__version__ = distributed.__version__ = '2025.1.0'\n"
@@ -36,10 +39,22 @@ OLDER_DASK_WORKER = (
 )
 
 
+def older_metadata(where: Path) -> Path:
+    """A folder that, first on a worker's ``sys.path``, makes ``importlib.metadata`` (which
+    Dask's version table reads) say distributed and dask 2025.1.0."""
+    for name in ("distributed", "dask"):
+        info = where / f"{name}-2025.1.0.dist-info"
+        info.mkdir(parents=True)
+        meta = f"Metadata-Version: 2.1\nName: {name}\nVersion: 2025.1.0\n"
+        (info / "METADATA").write_text(meta, encoding="utf-8")
+    return where
+
+
 def test_a_worker_of_another_distributed_is_refused_before_any_band(tmp_path: Path) -> None:
     import dask
     import distributed
     from distributed import Client, LocalCluster
+    from distributed.versions import VersionMismatchWarning
 
     session = make_session(tmp_path / "A", size=(24, 32))[0]
     with LocalCluster(
@@ -56,6 +71,7 @@ def test_a_worker_of_another_distributed_is_refused_before_any_band(tmp_path: Pa
             [sys.executable, "-c", OLDER_DASK_WORKER, address, "--nthreads", "1",
              "--no-nanny", "--no-dashboard"],
             cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            env={**os.environ, "PYTHONPATH": str(older_metadata(tmp_path / "meta"))},
         )  # fmt: skip
         try:
             with Client(address, set_as_default=False) as watcher:
@@ -63,7 +79,9 @@ def test_a_worker_of_another_distributed_is_refused_before_any_band(tmp_path: Pa
                 (other,) = set(watcher.scheduler_info()["workers"]) - ours
             out = tmp_path / "F"
             args = ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps"]
-            r = runner.invoke(app, [*args, "--scheduler", address])
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                r = runner.invoke(app, [*args, "--scheduler", address])
         finally:
             worker.terminate()
             worker.wait(timeout=120)
@@ -77,6 +95,8 @@ def test_a_worker_of_another_distributed_is_refused_before_any_band(tmp_path: Pa
         f"pip install 'distributed=={distributed.__version__}' 'dask=={dask.__version__}'" in said
     ), said
     assert "have all left" not in said and "Traceback" not in r.output
+    # Dask's own table of the same versions is not said besides this command's words
+    assert not [w for w in caught if issubclass(w.category, VersionMismatchWarning)], caught
     assert not out.exists()
 
 

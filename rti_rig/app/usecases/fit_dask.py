@@ -34,6 +34,7 @@ import os
 import socket
 import threading
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager, suppress
@@ -359,11 +360,53 @@ def scheduler_client(address: str) -> Iterator[Cluster | None]:
         reached = probe(address, CONNECT_TIMEOUT_S)  # its host not looked up again by Dask
         target, security = reached.address, reached.security()
     try:
-        client = Client(target, timeout=CONNECT_TIMEOUT_S, set_as_default=False, security=security)
+        with _version_mismatch_held() as held:
+            client = Client(
+                target, timeout=CONNECT_TIMEOUT_S, set_as_default=False, security=security
+            )
     except (OSError, TimeoutError, ValueError, TypeError) as exc:
         raise unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
-    with _reconnect_failure_unlogged(), _cluster_of(client, address) as cluster:
+    with _reconnect_failure_unlogged(), _cluster_of(client, address, held) as cluster:
         yield cluster
+
+
+@contextmanager
+def _version_mismatch_held() -> Iterator[list[warnings.WarningMessage]]:
+    """Dask's "Mismatched versions found" warning, raised as the ``Client`` connects, kept
+    back in the list yielded (every other warning is let through as it came).
+
+    Why: a worker of another distributed is refused by this command in its own words, naming
+    the worker, its versions and what to install (:func:`_refuse_other_libraries`); Dask's
+    table had been printed first as a note, a second account of it in another voice. Said
+    once the workers pass the checks: then it names libraries this command does not compare."""
+    from distributed.versions import VersionMismatchWarning
+
+    held: list[warnings.WarningMessage] = []
+    caught: list[warnings.WarningMessage] = []
+    try:
+        with warnings.catch_warnings(record=True) as recorded:
+            warnings.simplefilter("always", VersionMismatchWarning)
+            caught = recorded or []
+            yield held
+    finally:  # a Client that failed to connect lets the others through too
+        _let_through(caught, held, VersionMismatchWarning)
+
+
+def _let_through(
+    caught: list[warnings.WarningMessage], held: list[warnings.WarningMessage], kept: type
+) -> None:
+    """Warn again the ``caught`` warnings, but those of category ``kept``, added to ``held``."""
+    for record in caught:
+        if issubclass(record.category, kept):
+            held.append(record)
+        else:
+            warnings.warn_explicit(record.message, record.category, record.filename, record.lineno)
+
+
+def _say_held(held: list[warnings.WarningMessage]) -> None:
+    """Raise again the warnings :func:`_version_mismatch_held` kept back."""
+    for record in held:
+        warnings.warn(record.message, stacklevel=2)
 
 
 @contextmanager
@@ -388,9 +431,13 @@ class _DropReconnectFailure(logging.Filter):
 
 
 @contextmanager
-def _cluster_of(client: Any, address: str) -> Iterator[Cluster]:
+def _cluster_of(
+    client: Any, address: str, held: list[warnings.WarningMessage] | None = None
+) -> Iterator[Cluster]:
     """The :class:`Cluster` of a connected ``client``: workers waited for and checked, the
-    tagging plugin registered (removed afterwards); the client closed at the end."""
+    tagging plugin registered (removed afterwards); the client closed at the end. ``held``:
+    Dask's version warnings, said once the workers passed the checks (see
+    :func:`_version_mismatch_held`)."""
     try:
         try:
             client.wait_for_workers(1, timeout=WORKERS_TIMEOUT_S)
@@ -401,6 +448,7 @@ def _cluster_of(client: Any, address: str) -> Iterator[Cluster]:
                 f"{SHARED_PATHS}."
             ) from None
         checked = _refuse_other_code(client, address)
+        _say_held(held or [])
         mine = local_identity()
         _remove_stale_plugins(client)
         # This fit's, named after its client: removed after it, or by a later fit once this
