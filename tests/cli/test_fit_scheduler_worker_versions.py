@@ -118,3 +118,29 @@ def test_numpy_is_compared_by_major_and_the_dask_libraries_exactly() -> None:
     # an rti-rig from before this check reports no versions: its code differs, said as such
     older = WorkerCode(mine.version, "0123456789ab", None)
     assert stack_differences(mine, older) == []
+
+
+def test_a_worker_joining_later_with_another_distributed_is_not_tagged() -> None:
+    """The plugin that tags each worker as it joins (a nanny's restart mid-fit) gives no tag,
+    and so no task, to one of other library versions, and says why."""
+    import asyncio
+    from types import SimpleNamespace
+
+    from rti_rig.app.usecases.worker_code import OTHER_CODE, tagging_plugin
+
+    mine = local_identity()
+    plugin = tagging_plugin(mine)
+    real = plugin.identity
+    plugin.identity = lambda: {**real(), "stack": {**dict(mine.stack), "distributed": "2025.1.0"}}
+    given: list[dict[str, float]] = []
+
+    async def set_resources(**resources: float) -> None:
+        given.append(resources)
+
+    worker = SimpleNamespace(
+        state=SimpleNamespace(total_resources={}), set_resources=set_resources, status=None
+    )
+    asyncio.run(plugin.setup(worker))
+    kind, words = plugin.outcome
+    assert kind == OTHER_CODE and not given, (kind, words)
+    assert "distributed 2025.1.0 (this fit's " in words, words
