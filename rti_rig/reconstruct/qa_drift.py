@@ -186,7 +186,12 @@ def measure_drift(
     window = cv2.createHanningWindow((crops.shape[2], crops.shape[1]), cv2.CV_64F)
     for _ in range(ROUNDS):
         # only measured shifts move an image back: a wrong one would drag the reference
-        back = [_move(edges[i], -shifts[i, 0], -shifts[i, 1]) for i in have]
+        # (an image not moved is itself, not a warped copy: the identity warp gives the same
+        # values, and a copy of every edge image had set the QA's peak at many lights)
+        back = [
+            _move(edges[i], -shifts[i, 0], -shifts[i, 1]) if shifts[i].any() else edges[i]
+            for i in have
+        ]
         ref = median_of_images(back).astype(np.float64)
         ref_spectrum = _spectrum(ref, window)
         for i in have:
