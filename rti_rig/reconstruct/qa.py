@@ -1350,7 +1350,9 @@ def assess(
     move_px = DRIFT_PX if edges_trusted else TREND_TRUSTED_MOVE_PX
     trend_trusted = still_spread_px(edge_dev - trend) <= TRUSTED_SPREAD_PX
     edge_moved = np.zeros(n, bool)
-    captured = crop_arr  # before any image is moved back by its edges alone
+    # the images moved back by their edges alone, as they were before (restored below where
+    # the edges of a glossy object are refuted): only those, not a second copy of the stack
+    captured: dict[int, NDArray] = {}
     # the move is the shift off the trend, and so is what is said and moved back: the trend's
     # part is where a still image's edges read under that light (image_004 of the uneven-LED
     # tablet, moved (0, 1) px, was said "shifted (+0.5, -1.2)", its light's lean included)
@@ -1365,8 +1367,10 @@ def assess(
             edge_moved &= edges_place(edge_agreement(crop_arr, edge_shift), still)
         if edge_moved.any():
             step_fit = None  # crop_arr changes below
-        crop_arr = crop_arr.copy()
+        # moved back in place: the stack is assess's own (read by _crop_stack or moved back by
+        # _confirmed_step), and nothing else holds it
         for i in np.flatnonzero(edge_moved):
+            captured[int(i)] = crop_arr[i].copy()
             crop_arr[i] = move_back(crop_arr[i], float(off_trend[i, 0]), float(off_trend[i, 1]))
     # the shift each image was moved back by (image axes); a step's images are moved, all
     moved_by = np.where(edge_moved[:, None], off_trend, 0.0)
@@ -1419,7 +1423,9 @@ def assess(
         else fit_photometric_stereo(fit_stack(crop_arr), lt, robust=True, saturation=sat_level)
     )
     ev = evidence_of(ps)
-    before = (ps, ev)  # the fit and evidence a refit replaced
+    # the fit and evidence a refit replaced, kept only where they named a wrong light: the one
+    # case they stand again (below); else two evidences (each image's residuals) were held
+    before: tuple[Any, _Evidence] | None = (ps, ev) if ev.wrong.any() else None
     for rnd in range(MAX_ROUNDS):
         bad = ev.dim | ev.wrong | (ev.moved & ~edge_moved)  # edge-moved: moved back already
         # (a large median error means something only where directions can be judged)
@@ -1431,7 +1437,7 @@ def assess(
             # a refit most images contradict judges nothing; where the fit before it named
             # wrong lights, that fit stands (its finding is not erased by a refit that can
             # find nothing); else the refit's "not checked" is the honest word
-            if before[1].wrong.any():
+            if before is not None:
                 ps, ev = before
             break
         new_keep = ~bad
@@ -1457,8 +1463,9 @@ def assess(
             )
         except ReconstructionError:  # the remaining lights cannot determine normals
             break
-        before = (ps, ev)
+        before = (ps, ev) if ev.wrong.any() else None
         keep, ps = new_keep, ps_next
+        del ev  # released before the next is gathered (unless ``before`` holds it)
         ev = evidence_of(ps)
     if ev.object_typical >= DIRECTION_CHECK_MAX_TYPICAL_DEG:
         # Judged against the object's own error, not the loop's (whose refits follow the
@@ -1481,6 +1488,8 @@ def assess(
                 keep = unfaulted
             except ReconstructionError:
                 pass  # the remaining lights cannot determine normals: the loop's fit stands
+        before = None
+        del ev  # released before the next is gathered
         ev = evidence_of(ps)
     # Against a fit that explains the images poorly (a glossy coin) the shift against it is
     # no measurement: a move is claimed only where the image's own edges moved the same way,
@@ -1496,9 +1505,10 @@ def assess(
         # edges alone are a move only beyond GLOSSY_EDGE_NOISE_FACTOR times that spread.
         bar = max(DRIFT_PX, GLOSSY_EDGE_NOISE_FACTOR * still_spread_px(edge_dev))
         refuted = edge_only & ~(np.hypot(*np.nan_to_num(edge_dev).T) > bar)
+        for i in np.flatnonzero(refuted):
+            crop_arr[i] = captured[int(i)]
+        captured.clear()
         if refuted.any():
-            crop_arr = crop_arr.copy()
-            crop_arr[refuted] = captured[refuted]
             edge_moved &= ~refuted
             moved_by[refuted] = 0.0
         # A shift against this fit alone (its edges did not move the image, no step holds it)
@@ -1518,6 +1528,7 @@ def assess(
             dtype=bool,
         )
         if refuted.any() or unborne.any():
+            del ev  # released before the next is gathered
             ev = evidence_of(ps, still=refuted | unborne)
             finite = np.isfinite(ev.misfit)
             poor_fit = float(np.median(ev.misfit[finite])) if finite.any() else float("inf")
@@ -1543,6 +1554,7 @@ def assess(
             # was judged: moved 113-125 px on a 256 px crop, the warp's black fill made the
             # emulated coin's two brightest images "misfired or dim: 0% of the brightness of
             # the images of its 4 nearest lights". Judge them again as captured.
+            del ev  # released before the next is gathered
             ev = evidence_of(ps, still=unclaimed)
             finite = np.isfinite(ev.misfit)
             poor_fit = float(np.median(ev.misfit[finite])) if finite.any() else float("inf")
@@ -1582,8 +1594,11 @@ def assess(
     if int(ev.dim.sum()) >= 2:
         # the images called dim as captured: _dim_rejudged scales each back by its own gain
         # (levelled here as well, a halved one was scaled twice and image_002 read dim again)
+        # (one stack: crop_arr itself where none is levelled, else the levelled copy with the
+        # dim images put back as captured)
         rejudge_arr = fit_stack(crop_arr)
-        rejudge_arr = np.where(ev.dim[:, None, None], crop_arr, rejudge_arr)
+        if rejudge_arr is not crop_arr:
+            rejudge_arr[ev.dim] = crop_arr[ev.dim]
         ev = _dim_rejudged(ev, rejudge_arr, lt, keep & ~ev.dim, sat_level, evidence_of)
     light_scatter, within_scatter = _light_scatter(ev.gain, ev.misfit)
     bright_as_mates = _bright_as_its_elevation(ev.gain, lt)
@@ -2368,14 +2383,16 @@ def _dim_rejudged(
         others = ev.dim.copy()
         others[i] = False
         lit = others & (scale >= NO_LIGHT_GAIN)
-        arr = crop_arr.copy()
-        arr[lit] = arr[lit] / scale[lit][:, None, None].astype(arr.dtype)
         use = base | lit
         use[i] = True
         if use.sum() < 6:
             continue
+        # only the images the fit takes, copied once (not the whole stack, then its subset)
+        arr = crop_arr[use]
+        scaled = lit[use]
+        arr[scaled] = arr[scaled] / scale[use][scaled][:, None, None].astype(arr.dtype)
         try:
-            ps_i = fit_photometric_stereo(arr[use], lt[use], robust=True, saturation=sat_level)
+            ps_i = fit_photometric_stereo(arr, lt[use], robust=True, saturation=sat_level)
         except ReconstructionError:  # the remaining lights cannot determine normals
             continue
         ev_i = evidence_of(ps_i, still=~ev.moved)
