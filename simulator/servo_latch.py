@@ -32,6 +32,8 @@ import tempfile
 import warnings
 from pathlib import Path
 
+from rti_rig.core.state_files import replace_text
+
 #: Overrides where the state files are kept (a test's own folder, say).
 STATE_DIR_ENV = "RTI_RIG_EMULATOR_STATE_DIR"
 
@@ -111,7 +113,6 @@ class LatchedErrors:
             with contextlib.suppress(FileNotFoundError):
                 self.path.unlink()
             return
-        self.path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
         body = json.dumps(
             {
                 "config": str(self.config_path),
@@ -121,12 +122,4 @@ class LatchedErrors:
             },
             indent=1,
         )
-        fd, tmp = tempfile.mkstemp(dir=self.path.parent, prefix=".", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(body)
-            os.replace(tmp, self.path)
-        except BaseException:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
-            raise
+        replace_text(self.path, body)

@@ -44,12 +44,13 @@ import json
 import math
 import os
 import re
-import tempfile
 import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+
+from rti_rig.core.state_files import replace_text
 
 #: Overrides where the ledgers are kept (a test's own folder, say).
 LEDGER_DIR_ENV = "RTI_RIG_DUTY_LEDGER_DIR"
@@ -180,7 +181,6 @@ class DutyLedger:
             with contextlib.suppress(FileNotFoundError):
                 self.path.unlink()
             return
-        self.path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
         body = json.dumps(
             {
                 "format": _FORMAT,
@@ -192,15 +192,7 @@ class DutyLedger:
             },
             separators=(",", ":"),
         )
-        fd, tmp = tempfile.mkstemp(dir=self.path.parent, prefix=".", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(body)
-            os.replace(tmp, self.path)
-        except BaseException:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
-            raise
+        replace_text(self.path, body)
         # (by the file system's own clock: its times are not the ledger's, which a test may move)
         _remove_stale(self.path.parent, keep=self.path, before=time.time() - STALE_AFTER_S)
 
