@@ -845,9 +845,7 @@ def run_session(
     finally:
         cancel.capture_over()
         with signals_deferred():
-            ending = getattr(rig.lighting, "ending", None)
-            if ending is not None:  # a reopening now is for the closing all-off
-                ending()
+            # (a dome's safe() marks the teardown first: a reopening now is for its all-off)
             teardown += rig.lighting.safe(emergency=reason is FinishReason.EMERGENCY_STOP)
             for label, close in (
                 ("camera close", rig.camera.close),

@@ -372,9 +372,7 @@ def fix_session_exposure(
         # dome's last all-off, the one between two metered lights, was then reported as the
         # state of the lights ("acknowledged by the dome: lights are off")
         with signals_deferred():
-            ending = getattr(rig.lighting, "ending", None)
-            if ending is not None:  # a reopening now is for the closing all-off
-                ending()
+            # (a dome's safe() marks the teardown first: a reopening now is for its all-off)
             failures = rig.lighting.safe()
             # a dome kept open (hold) only once its all-off went through: one that failed is
             # closed, and the error says so
