@@ -61,10 +61,11 @@ SAVE_EVERY_S = 10.0
 #: The system's stable names of USB serial adapters (udev), one link per adapter.
 BY_ID_DIR = Path("/dev/serial/by-id")
 
-#: A ledger file (or a write's stray temporary file) left untouched this long is removed when
-#: any ledger of the folder is written: no config's ``duty_window_s`` reaches back that far (it
-#: is at most a day), so it can hold no lighting that still counts. Why: a dome that is never
-#: driven again (a temporary copy of a config, an emulated rehearsal) left its file for ever.
+#: A ledger file (or a write's stray temporary file) left untouched this long is removed when a
+#: command first writes another ledger of the folder: no config's ``duty_window_s`` reaches
+#: back that far (it is at most a day), so it can hold no lighting that still counts. Why: a
+#: dome never driven again (a temporary copy of a config, an emulated rehearsal) left its file
+#: for ever.
 STALE_AFTER_S = 2 * 86400.0
 
 #: Ledger times ahead of the wall clock by up to this are clock noise, not a clock set back.
@@ -107,6 +108,10 @@ class DutyLedger:
         digest = hashlib.sha256(key.encode()).hexdigest()[:16]
         stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", Path(key.split(":", 1)[-1]).name)[:40] or "dome"
         self.path = ledger_dir() / f"{stem}-{digest}.json"
+        #: The folder was swept of stale ledgers by this object's first write: once a command
+        #: is enough (a session writes every :data:`SAVE_EVERY_S` at an all-off, and each
+        #: write had listed and stat'ed the whole folder again on that path).
+        self._swept = False
 
     @classmethod
     def for_port(cls, port: str) -> DutyLedger:
@@ -193,8 +198,11 @@ class DutyLedger:
             separators=(",", ":"),
         )
         replace_text(self.path, body)
-        # (by the file system's own clock: its times are not the ledger's, which a test may move)
-        _remove_stale(self.path.parent, keep=self.path, before=time.time() - STALE_AFTER_S)
+        if not self._swept:
+            self._swept = True
+            # (by the file system's own clock: its times are not the ledger's, which a test
+            # may move)
+            _remove_stale(self.path.parent, keep=self.path, before=time.time() - STALE_AFTER_S)
 
     def _warn(self, what: str, advice: str) -> None:
         """One line, said by the console as a note: the command goes on."""

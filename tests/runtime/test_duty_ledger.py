@@ -264,3 +264,19 @@ def test_ledgers_no_window_can_reach_are_removed_as_another_is_written(tmp_path:
     ledger.save({2: [(wall.t - 5, wall.t - 1)]}, wall.t, 60.0)
     assert ledger.path.exists() and recent.exists() and other.exists()
     assert not old_json.exists() and not old_tmp.exists()
+
+
+def test_the_stale_sweep_is_made_once_per_command_not_at_every_write(tmp_path: Path) -> None:
+    """A session writes its ledger every SAVE_EVERY_S at an all-off: only the first write of a
+    command lists the folder for stale ledgers (the next command sweeps what is left)."""
+    wall = Wall()
+    ledger = DutyLedger("port:/dev/ttyACM0", wall=wall)
+    ledger.save({2: [(wall.t - 5, wall.t - 1)]}, wall.t, 60.0)
+    stale = ledger.path.parent / "old-0123.json"
+    stale.write_text("{}")
+    long_ago = time.time() - duty_ledger.STALE_AFTER_S - 60
+    os.utime(stale, (long_ago, long_ago))
+    ledger.save({2: [(wall.t - 5, wall.t - 1)]}, wall.t, 60.0)
+    assert stale.exists()
+    DutyLedger("port:/dev/ttyACM0", wall=wall).save({2: [(wall.t - 5, wall.t - 1)]}, wall.t, 60.0)
+    assert not stale.exists()
