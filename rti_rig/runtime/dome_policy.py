@@ -708,7 +708,7 @@ class DomePolicy:
         (light dose matters to pigments, dyes and paper), and one more boot wait. An all-off
         that fails raises as :meth:`all_off` does, and the port is then closed."""
         try:
-            self.all_off()
+            self._all_off()
         except BaseException:
             self.close()
             raise
@@ -724,7 +724,7 @@ class DomePolicy:
         self._ending = True
         if self.info is not None:
             try:
-                self.all_off()
+                self._all_off()
             except DeviceError as exc:
                 # the lights line says what the all-off established (off_report), in words
                 log.info("%s: could not switch all off while closing: %s", self.name, exc)
@@ -858,6 +858,12 @@ class DomePolicy:
 
     def all_off(self) -> None:
         """Every LED off (the safe state); reports an LED that overran its on-time."""
+        self._all_off()
+        self._keep_ledger(throttled=True)
+
+    def _all_off(self) -> None:
+        """:meth:`all_off` without its throttled ledger write: :meth:`close` and :meth:`hold`
+        write the ledger themselves, unthrottled, right after (it had been written twice)."""
         if self.info is None:
             return
         try:
@@ -876,7 +882,6 @@ class DomePolicy:
         if self._lit is not None:
             self.guard.record(self._lit.index, self._lit.since, self.clock.now())
         self._lit = None
-        self._keep_ledger(throttled=True)
 
     def shutter(self, pulse_ms: int | None = None) -> None:
         """Pulse the camera release line. Never resent: a resend could take a second picture."""

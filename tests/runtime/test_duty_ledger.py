@@ -280,3 +280,29 @@ def test_the_stale_sweep_is_made_once_per_command_not_at_every_write(tmp_path: P
     assert stale.exists()
     DutyLedger("port:/dev/ttyACM0", wall=wall).save({2: [(wall.t - 5, wall.t - 1)]}, wall.t, 60.0)
     assert not stale.exists()
+
+
+class CountingLedger(DutyLedger):
+    """A ledger that counts its writes."""
+
+    def __init__(self, key: str, *, wall: Wall) -> None:
+        super().__init__(key, wall=wall)
+        self.saves = 0
+
+    def save(self, spans, now, window_s):  # type: ignore[no-untyped-def]
+        self.saves += 1
+        super().save(spans, now, window_s)
+
+
+def test_a_close_writes_the_ledger_once(tmp_path: Path) -> None:
+    """The closing all-off's throttled write and the close's own were both made (a close
+    SAVE_EVERY_S after the last write had the ledger written twice over)."""
+    ledger = CountingLedger("port:/dev/ttyACM0", wall=Wall())
+    dome, clock = command(ledger)
+    dome.connect()
+    clock.sleep(duty_ledger.SAVE_EVERY_S)
+    dome.light(7, 1.0)
+    clock.sleep(THERMAL["max_on_s"] - 1.0)
+    dome.close()
+    assert ledger.saves == 1
+    assert json.loads(ledger.path.read_text())["lit"]["7"]
