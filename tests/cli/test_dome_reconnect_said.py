@@ -77,13 +77,15 @@ def test_a_port_lost_at_the_handshake_that_does_not_come_back_is_said_before_the
         assert raw not in said, (raw, said)
 
 
+@pytest.mark.parametrize("command", [8, 9])
 def test_a_port_lost_at_the_teardowns_all_off_is_not_said_to_let_the_session_go_on(
-    tmp_path: Path,
+    tmp_path: Path, command: int
 ) -> None:
-    """The Nab sketch, two lights: command 9 is the teardown's all-off, after the last image.
-    The session was ending ("the session goes on once it is back" had been said of it): the
-    reopening is said for what it is, the all-off sent again."""
-    r, said, out = _run_lights(tmp_path, 'at_command = 9\nkind = "disconnect"', 2)
+    """The Nab sketch, two lights: commands 8 and 9 are the teardown's all-offs after the last
+    image (the lighting's safe() one, then its close's). The session was ending ("the session
+    goes on once it is back" had been said of it): the reopening is said for what it is, the
+    all-off sent again."""
+    r, said, out = _run_lights(tmp_path, f'at_command = {command}\nkind = "disconnect"', 2)
     assert r.exit_code == 0, said  # type: ignore[attr-defined]
     lost = (
         "The dome dropped off the USB bus during 'all off': reopening its port (up to 4 "
