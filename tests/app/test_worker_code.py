@@ -75,7 +75,20 @@ def test_a_planner_file_changes_the_fingerprint_and_the_layout_does_not(tmp_path
     assert third["fingerprint"] != first["fingerprint"]
     # the same content, mapped from top-level folders by this environment's install
     assert _fingerprint_in(None, tmp_path) == first
-    assert local_identity() == WorkerCode(rti_rig.__version__, first["fingerprint"], None)
+    mine = local_identity()
+    assert mine == WorkerCode(rti_rig.__version__, first["fingerprint"], None, mine.stack)
+    # the libraries a worker must agree on, as this process imports them (numpy by its major)
+    import cloudpickle
+    import dask
+    import distributed
+    import numpy
+
+    assert dict(mine.stack) == {
+        "distributed": distributed.__version__,
+        "dask": dask.__version__,
+        "cloudpickle": cloudpickle.__version__,
+        "numpy": numpy.__version__.split(".")[0] + ".x",
+    }
 
 
 def test_a_missing_version_is_none_not_a_sentinel_that_reads_as_unknown() -> None:
