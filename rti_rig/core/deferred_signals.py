@@ -27,6 +27,29 @@ def stop_words(signum: signal.Signals) -> str:
     return "Ctrl-C" if signum == signal.SIGINT else signum.name
 
 
+#: How many :func:`after_a_stop` blocks are open (in the main thread, where handlers run).
+_after_a_stop = 0
+
+
+@contextlib.contextmanager
+def after_a_stop() -> Iterator[None]:
+    """Within this block, the holds a further stop may end (``signals_deferred(second_stops=
+    True)``, a serial port's opening) hold nothing: a stop was already acted on, and the one
+    that comes now is the user's second.
+
+    Why: after a stop cut a port's opening short, the teardown reopens the port to send the
+    all-off; a stop during that reopening is the user insisting, but the opening's own hold
+    counted it as the first of *its* block and held it until the open returned: the port was
+    opened again (a board that resets on open reset once more) and an open that hung could not
+    be ended."""
+    global _after_a_stop
+    _after_a_stop += 1
+    try:
+        yield
+    finally:
+        _after_a_stop -= 1
+
+
 @contextlib.contextmanager
 def signals_deferred(
     on_held: Callable[[int], None] | None = None, *, second_stops: bool = False
@@ -56,6 +79,9 @@ def signals_deferred(
     """
     if threading.current_thread() is not threading.main_thread():
         yield  # handlers can only be set from the main thread, where they run
+        return
+    if second_stops and _after_a_stop:
+        yield  # a stop was already acted on: a further one acts at once (see after_a_stop)
         return
     pending: list[tuple[int, Any]] = []
     raised: list[BaseException] = []  # by a pending signal's handler as a handler was swapped

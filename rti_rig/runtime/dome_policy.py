@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.clock import Clock, VirtualClock
-from rti_rig.core.deferred_signals import signals_deferred
+from rti_rig.core.deferred_signals import after_a_stop, signals_deferred
 from rti_rig.core.devices import DiscreteLightSource
 from rti_rig.core.dome_link import (
     DomeInfo,
@@ -1364,7 +1364,8 @@ class DomePolicy:
         # said in words by the lights line (the off_report set here and below)
         log.info("%s: reopening the port a stop cut short, to send the all-off", self.name)
         try:
-            self._counted(self.link.reopen_port)
+            with after_a_stop():  # a further stop ends this reopening at once
+                self._counted(self.link.reopen_port)
         except DomeLinkError as exc:
             log.info("%s: the port did not open again: %s", self.name, exc)
             self.off_report = replace(
