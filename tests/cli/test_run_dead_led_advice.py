@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 
 from rti_rig.cli import app
 
-runner = CliRunner()
+runner = CliRunner(env={"COLUMNS": "400"})  # rich folds a long path mid-word at 80
 
 DEAD = 2
 
