@@ -52,6 +52,9 @@ class CheckRequest:
     auto_exposure: bool = False
 
 
+#: what a check stopped while its arm rig was being built may say of the arm: no byte was sent
+ARM_NOT_REACHED = "nothing was sent to the arm: the check stopped before connecting it"
+
 #: the LED drive level of a dome's walk when ``--intensity`` is not given
 DEFAULT_INTENSITY = 0.2
 
@@ -106,7 +109,15 @@ def check_rig(
         from rti_rig.app.flash_sync import flash_sync_check
 
         return flash_sync_check(loaded)
-    with build_rig(loaded) as rig:
+    try:
+        built = build_rig(loaded)
+    except EmergencyStop as exc:
+        if loaded.config.arm is None:
+            raise  # a dome's port may have been opened (a board that boots lit): said as before
+        # the stop came while the rig was being built, before the arm's connect sent its
+        # first byte: "check the rig's lights" had been said of an arm, nothing of the arm
+        raise CheckStopped(exc, ARM_NOT_REACHED) from None
+    with built as rig:
         try:
             if isinstance(rig.lighting, DomeLighting):
                 rig.lighting.listen(on_note)
