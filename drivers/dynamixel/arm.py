@@ -162,6 +162,8 @@ class DynamixelArm:
         #: those that did not answer the read (both empty: every servo read back off).
         self._torque_after_release: tuple[list[Any], list[Any]] = ([], [])
         self._goal: tuple[int, int] | None = None
+        #: (servo id, Hardware Error Status) of each alert a stop has said it held despite
+        self._alerts_said: set[tuple[int, int]] = set()
         #: The ticks read when the last move ended in position: the pose whose direction the
         #: capture that follows is recorded under, which :meth:`check_held` compares with.
         self._reached: tuple[int, int] | None = None
@@ -774,7 +776,10 @@ class DynamixelArm:
                     failed.append((sid, exc))
                     del present[sid]
         for sid, fault in alerted.items():
-            if sid in present:
+            # said once per servo and fault: a teardown stops the arm twice (its stop, then
+            # the close's), and the fault's whole paragraph of advice had been said twice
+            if sid in present and (sid, fault.status) not in self._alerts_said:
+                self._alerts_said.add((sid, fault.status))
                 log.warning("%s: servo %d held despite a hardware alert: %s", self.name, sid, fault)
         if len(present) == len(self.settings.servo_ids) or self._goal is not None:
             # a joint not held keeps the goal it was last sent (a later move's turn choice
