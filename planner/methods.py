@@ -113,6 +113,16 @@ def get_method(name: str) -> PlanMethod:
     try:
         return _METHODS[name]
     except KeyError:
+        # "adaptive" is what a user who read docs/adaptive.md asks for: it is a way to run a
+        # session, not a plan (each light is chosen from the images already captured), and
+        # the bare refusal had not said where it is
+        adaptive = (
+            " (an adaptive session is not planned ahead: it chooses each next light from the "
+            "images captured so far; run it with rti-rig run RIG.toml --adaptive --lights N "
+            "--out DIR)"
+            if name.strip().lower() == "adaptive"
+            else ""
+        )
         raise ScheduleError(
-            f"--method {name!r} is not known; choose {', '.join(_METHODS)}"
+            f"--method {name!r} is not known; choose {', '.join(_METHODS)}{adaptive}"
         ) from None

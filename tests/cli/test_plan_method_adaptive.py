@@ -1,0 +1,33 @@
+"""``rti-rig plan --method adaptive`` is refused, and the refusal says where adaptive is.
+
+An adaptive session is a way to run, not a plan: it chooses each light from the images it
+has captured. The refusal had been only "--method 'adaptive' is not known; choose uniform,
+kmeans, optimal", leaving a user who read docs/adaptive.md no way on."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from conftest import CONFIGS, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+
+def test_plan_method_adaptive_points_to_run_adaptive(tmp_path: Path) -> None:
+    out = tmp_path / "plan.lp"
+    args = ["plan", "--rig", str(CONFIGS / "simulated_arm.toml"), "--method", "adaptive"]
+    r = CliRunner(env={"COLUMNS": "400"}).invoke(app, [*args, "--out", str(out)])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "--method 'adaptive' is not known; choose uniform" in text, text
+    assert "rti-rig run RIG.toml --adaptive --lights N" in text, text
+    assert not out.exists()
+
+
+def test_another_unknown_method_is_not_sent_to_run_adaptive(tmp_path: Path) -> None:
+    args = ["plan", "--rig", str(CONFIGS / "simulated_arm.toml"), "--method", "random"]
+    r = CliRunner(env={"COLUMNS": "400"}).invoke(app, [*args, "--out", str(tmp_path / "p.lp")])
+    text = said(r)
+    assert r.exit_code == 2 and "--method 'random' is not known" in text, text
+    assert "--adaptive" not in text, text
