@@ -29,6 +29,24 @@ class ServoStatusError(DynamixelError):
         super().__init__(device, detail, command, servo_id)
 
 
+def _voltage_said(voltage: tuple[int, int, int]) -> str:
+    """Present Input Voltage and the servo's Min/Max Voltage Limit as read (0.1 V units), said
+    beside an input-voltage error.
+
+    Why the second wording: the error is kept until a reboot, so a servo whose supply is back
+    inside its limits (the next command, or a sag under load that passed) still reports it,
+    and "11.1 V as read; this servo's limits are 6.0..14.0 V" left a user checking a supply
+    that reads right with no idea why the servo still refuses."""
+    now, low, high = (v / 10 for v in voltage)
+    if low <= now <= high:
+        return (
+            f" (input {now:.1f} V as read, within this servo's limits {low:.1f}..{high:.1f} V "
+            "now: the error was raised when the supply left them, under load or at switch-on, "
+            "and is kept until a reboot)"
+        )
+    return f" (input {now:.1f} V as read; this servo's limits are {low:.1f}..{high:.1f} V)"
+
+
 class HardwareFaultError(DynamixelError):
     """Hardware Error Status has bits set; whether torque went off is said only as read.
 
@@ -64,8 +82,7 @@ class HardwareFaultError(DynamixelError):
         advice = "; ".join(
             ct.FAULT_ADVICE[f]
             + (
-                f" (input {voltage[0] / 10:.1f} V as read; this servo's limits are "
-                f"{voltage[1] / 10:.1f}..{voltage[2] / 10:.1f} V)"
+                _voltage_said(voltage)
                 if f is ct.HardwareFault.INPUT_VOLTAGE and voltage is not None
                 else ""
             )
