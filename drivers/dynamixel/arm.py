@@ -167,6 +167,12 @@ class DynamixelArm:
         #: The ticks read when the last move ended in position: the pose whose direction the
         #: capture that follows is recorded under, which :meth:`check_held` compares with.
         self._reached: tuple[int, int] | None = None
+        #: Where the arm says what a user must know as it happens (the command line's
+        #: console, set by :meth:`listen`); None: said as a warning record, which the command
+        #: line says as a note (``rti_rig.cli.app.records_as_notes``).
+        self._say: Callable[[str], None] | None = None
+        #: Every line said through :meth:`_tell`, in order (what the user was told).
+        self.said: list[str] = []
 
     @property
     def commanded(self) -> bool:
@@ -318,11 +324,10 @@ class DynamixelArm:
         if not found:
             if found is None:
                 return exc
-            log.warning(
-                "%s: no servo answers at %d baud; looking for them at the other X-series rates "
-                "(a broadcast ping each, read-only: up to about 10 s)",
-                self.name,
-                self.settings.baudrate,
+            self._tell(
+                f"{self.name}: no servo answers at {self.settings.baudrate} baud (the "
+                "[arm.dynamixel] baudrate); looking for the servos at the other X-series "
+                "rates, a read-only broadcast ping each (up to about 10 s)."
             )
             rates: list[int] = []
             elsewhere = self._bus.scan_rates(_RATES_TO_TRY, rates)
@@ -558,22 +563,34 @@ class DynamixelArm:
         (the arm may be stopped against an obstruction). So ``close`` never parks; call
         ``park()`` before it when that is wanted. Safe to call twice and after a failed
         ``connect``. The first error during teardown is re-raised after the port has been
-        closed; any later one is logged."""
+        closed; any later one is said through :meth:`_tell`."""
         if not self._connected:
             self._bus.close()
             return
         first: BaseException | None = None
-        steps = [lambda: self.lamp(False), self.stop]
+        steps: list[tuple[str, Callable[[], None], str]] = [
+            ("the lamp-off", lambda: self.lamp(False), "check that the lamp is off"),
+            (
+                "the stop",
+                self.stop,
+                "the arm may still be moving: switch off the servos' power if it is",
+            ),
+        ]
         if self.settings.torque_policy == "release_on_close":
-            steps.append(self._release_if_parked)
-        for step in steps:
+            steps.append(
+                ("the torque release", self._release_if_parked, "its torque may still be on")
+            )
+        for what, step, advice in steps:
             try:
                 step()
             except Exception as exc:  # keep tearing down
                 if first is None:
                     first = exc  # raised below, and said by whoever called close
-                else:  # only logged: said once, not a second time beside the raised one
-                    log.error("%s: teardown step failed: %s", self.name, exc)
+                else:  # a second failure is said in its own line, never lost
+                    self._tell(
+                        f"{self.name}: while closing after an earlier failure, {what} failed "
+                        f"too: {exc}; {advice}."
+                    )
         self._connected = False
         self._bus.close()
         if first is not None:
@@ -599,11 +616,30 @@ class DynamixelArm:
             # a broadcast write gets no status reply: whether each servo let go is read back
             self._torque_after_release = self._torque_as_read()
         else:
-            log.warning(
-                "%s: not at the park pose, so torque stays on (release_on_close releases only "
-                "when parked, where the arm cannot drop onto the object)",
-                self.name,
+            self._tell(
+                f"{self.name}: torque stays on: the arm is not at its park pose, and "
+                'torque_policy = "release_on_close" releases it only there, where it cannot '
+                "drop onto the object. Park it with 'rti-rig check' before switching off the "
+                "servos' power."
             )
+
+    def listen(self, say: Callable[[str], None] | None) -> None:
+        """Have what a user must know as it happens (the search for the servos at other baud
+        rates, a torque kept on at the close, a second failure while making the arm safe)
+        said through ``say``; ``None`` stops it.
+
+        Why: these had been warning and error records, which the command line (configuring no
+        logging) printed raw on stderr, in the middle of the progress bar."""
+        self._say = say
+
+    def _tell(self, text: str) -> None:
+        """Say ``text`` once, through the listener, or as a warning record with none (never
+        lost); kept in :attr:`said`."""
+        self.said.append(text)
+        if self._say is not None:
+            self._say(text)
+        else:
+            log.warning("%s", text)
 
     def resends(self) -> tuple[list[str], str | None]:
         """The commands sent once more after a lost or damaged status packet that then got
@@ -776,11 +812,11 @@ class DynamixelArm:
                     failed.append((sid, exc))
                     del present[sid]
         for sid, fault in alerted.items():
-            # said once per servo and fault: a teardown stops the arm twice (its stop, then
-            # the close's), and the fault's whole paragraph of advice had been said twice
+            # said once per servo and fault (a teardown stops the arm twice: its stop, then the
+            # close's), and only as a detail: the alert itself is the error said by whoever met it
             if sid in present and (sid, fault.status) not in self._alerts_said:
                 self._alerts_said.add((sid, fault.status))
-                log.warning("%s: servo %d held despite a hardware alert: %s", self.name, sid, fault)
+                log.info("%s: servo %d held despite a hardware alert: %s", self.name, sid, fault)
         if len(present) == len(self.settings.servo_ids) or self._goal is not None:
             # a joint not held keeps the goal it was last sent (a later move's turn choice
             # starts from where each joint is headed)
@@ -1056,8 +1092,11 @@ class DynamixelArm:
                 said = self._not_in_position(late)  # before the stop's hold rewrites goals
                 try:
                     self.stop()
-                except Exception as exc:  # report the timeout, not the failed stop
-                    log.error("%s: stop after timeout failed: %s", self.name, exc)
+                except Exception as exc:  # the timeout is raised; the failed stop said too
+                    self._tell(
+                        f"{self.name}: the stop after the move timed out failed too: {exc}; "
+                        "the arm may still be moving: switch off the servos' power if it is."
+                    )
                 raise MoveTimeoutError(
                     self.name,
                     f"not in position after {s.move_timeout_s:g} s: {said} (goal {goal}, "

@@ -249,6 +249,14 @@ class ArmLighting:
         found, line = ([], None) if resends is None else resends()
         return ({"arm_resent": found} if found else {}), line
 
+    def listen(self, say: Callable[[str], None] | None) -> None:
+        """Have the arm say through ``say`` what a user must know as it happens (its search
+        for the servos at other baud rates, a torque kept on at the close, a second failure
+        while making it safe); a carrier with nothing to say ignores it."""
+        listen = getattr(self.carrier, "listen", None)
+        if listen is not None:
+            listen(say)
+
     def connect(self) -> None:
         self.arm_failure = None
         self.end = None

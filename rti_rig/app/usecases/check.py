@@ -125,6 +125,7 @@ def check_rig(
                 camera = camera_line(rig, auto_exposure=req.auto_exposure)
                 return WithCamera(lights, camera, config_note_lines(loaded))
             if isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
+                rig.lighting.listen(on_note)
                 lights = arm_self_test(
                     rig.lighting.carrier,
                     rig.geometry,
