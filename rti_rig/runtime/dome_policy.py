@@ -296,6 +296,8 @@ class DomePolicy:
         #: Where a reopening of a lost port is said as it happens (the command line's console,
         #: set by :meth:`listen`); None: said nowhere but in the stats and the log.
         self._say: Callable[[str], None] | None = None
+        #: Each failure to close the port, as said to the user (a close never raises it).
+        self.close_errors: list[str] = []
         #: A teardown's all-off has begun (:meth:`ending`, :meth:`close`; a :meth:`connect`
         #: clears it): a port lost now is reopened to send that all-off again, and nothing
         #: goes on after it.
@@ -1600,7 +1602,17 @@ class DomePolicy:
         try:
             self.link.close()
         except Exception as exc:  # closing must never mask the error that led here
-            log.warning("%s: error while closing the port: %s", self.name, exc)
+            # said in words (a raw warning record had been printed mid-progress-bar), and
+            # with no listener as a warning, which the command line says as a note: never lost
+            text = (
+                f"{self.name}: its port did not close cleanly: {exc}. The next command opens "
+                "it anew; if that fails, unplug the dome's USB cable and plug it in again."
+            )
+            self.close_errors.append(text)
+            if self._say is not None:
+                self._say(text)
+            else:
+                log.warning("%s", text)
 
 
 #: Faults of a board that may not be the one the profile describes (or no board at all).
