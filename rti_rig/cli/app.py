@@ -147,6 +147,47 @@ def quiet_library_logs() -> None:
         logging.getLogger(name).propagate = False
 
 
+#: The logger every rti-rig module logs under (``rti_rig.dome``, ``rti_rig.dynamixel.arm`` …).
+PRODUCT_LOGGER = "rti_rig"
+
+
+def records_as_notes() -> None:
+    """Say each rti-rig log record at warning level or above as a note on stderr, in its own
+    words, once; records below it (the drivers' diagnostics) stay off the terminal.
+
+    Why: the command line configures no logging, so such a record reached Python's
+    last-resort handler and was printed raw ("arm: not at the park pose …", or with a
+    ``WARNING:rti_rig.dome:`` prefix under a configured root logger) in the middle of the
+    progress bar. A device says what a user must know through its own channel (a dome's or an
+    arm's ``listen``); this is the fallback for a record said with no listener, so that none
+    is lost and none is printed raw. They propagate no further: a root handler that something
+    configured (pyserial's ``socket://…?logging=`` and ``loop://`` URLs call
+    ``logging.basicConfig``) had printed them again as ``WARNING:rti_rig.dome:…``. Only the
+    command line calls this: a program that configures logging, or a test's ``caplog``,
+    receives the records as before."""
+    import logging
+
+    logger = logging.getLogger(PRODUCT_LOGGER)
+    if any(getattr(h, "_rti_rig_notes", False) for h in logger.handlers):
+        return
+    said: set[str] = set()
+
+    class AsNotes(logging.Handler):
+        _rti_rig_notes = True
+
+        def emit(self, record: logging.LogRecord) -> None:
+            try:
+                text = record.getMessage()
+            except Exception:  # a record whose arguments do not fit its format: said as given
+                text = str(record.msg)
+            if text not in said:
+                said.add(text)
+                warning_note(text)
+
+    logger.addHandler(AsNotes(logging.WARNING))
+    logger.propagate = False
+
+
 def warning_note(text: str) -> None:
     """Say a warning's message as a note on stderr (the one form both :func:`warnings_as_notes`
     and the run's verdict use for a warning no command words otherwise)."""
@@ -182,5 +223,6 @@ def warnings_as_notes() -> None:
 
 def main() -> None:
     quiet_library_logs()
+    records_as_notes()
     warnings_as_notes()
     app()
