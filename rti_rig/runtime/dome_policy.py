@@ -1605,9 +1605,12 @@ class DomePolicy:
             # said in words (a raw warning record had been printed mid-progress-bar), and
             # with no listener as a warning, which the command line says as a note: never lost
             text = (
-                f"{self.name}: its port did not close cleanly: {exc}. The next command opens "
-                "it anew; if that fails, unplug the dome's USB cable and plug it in again."
+                f"{self.name}: its port did not close cleanly: {exc}. It is opened anew when "
+                "next needed; if that fails, unplug the dome's USB cable and plug it in again."
             )
+            if text in self.close_errors:  # once: a reconnection's attempts close it each
+                log.info("%s", text)
+                return
             self.close_errors.append(text)
             if self._say is not None:
                 self._say(text)

@@ -70,10 +70,36 @@ def test_a_port_that_does_not_close_cleanly_is_said_once(
     text = said(r)
     line = _line(text)
     assert line.endswith(
-        f"{WORDS}: [Errno 5] Input/output error. The next command opens it anew; if that "
-        "fails, unplug the dome's USB cable and plug it in again."
+        f"{WORDS}: [Errno 5] Input/output error. It is opened anew when next needed; if "
+        "that fails, unplug the dome's USB cable and plug it in again."
     ), line
     assert "(emulated" in line.split(WORDS)[0], line  # the dome, by its port and firmware
     assert text.count(WORDS) == 1, text
     assert not _loud(caplog), _loud(caplog)
     assert "error while closing the port" not in text and "WARNING:" not in text, text
+
+
+def test_a_close_failing_alike_again_is_said_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The port is closed again (a second close, a reconnection's attempts): the same failure
+    is said once, kept once, and the repeat goes to the log's diagnostics."""
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.drivers.led_dome import DomeSerialSettings
+    from rti_rig.simulator.dome_firmware import InProcessDomeTransport, firmware_for
+
+    clock = VirtualClock()
+    settings = DomeSerialSettings(port="emulated", profile="default")
+    firmware = firmware_for(settings, clock=clock, led_count=8, boot_delay_s=0.2)
+    dome = build_dome(settings, clock, transport=InProcessDomeTransport(firmware))
+    heard: list[str] = []
+    dome.listen(heard.append)
+    dome.connect()
+
+    def close() -> None:
+        raise OSError(5, "Input/output error")
+
+    monkeypatch.setattr(dome.link, "close", close)
+    dome.close()
+    dome.close()
+    assert len(heard) == 1 and WORDS in heard[0], heard
+    assert dome.close_errors == heard
