@@ -91,7 +91,10 @@ def check(
     visits poses spanning its band (checking where it really got to), flashes the lamp at each
     if it hangs on a servo's LED output (lamp = "servo_led"; a "software" lamp is not switched)
     and parks; then the camera is opened and released (no image taken). A recorded
-    acquisition's .lp (a replay rig) has no device: its images are checked instead."""
+    acquisition's .lp (a replay rig) has no device: its images are checked instead.
+
+    Exit codes: 0 passed (or RESULT: SENT, NOT VERIFIED, a dome that cannot answer); 1
+    RESULT: FAIL; 2 refused or an error; 130 / 143 stopped by Ctrl-C / SIGTERM."""
     from rti_rig.app.usecases.check import CheckRequest, CheckStopped, check_rig
     from rti_rig.runtime.controller import EmergencyStop
 

@@ -210,6 +210,13 @@ def run(
     --resume. Exit 130 after a Ctrl-C stop, 143 after a SIGTERM, also one that comes while a
     stop or an error is being reported (the report is finished first) or while the QA verdict
     of a complete session is computed (the session stays complete; rti-rig fit gives it).
+
+    Exit codes: 0 the session is complete, whatever its QA verdict (advice: rti-rig fit writes
+    it to qa.json); 1 complete, but the rig was not brought to a known safe state, or a fault
+    rti-rig did not name; 2 refused (bad input, --out not empty, too little disk, the session
+    or the dome's port in use) or an error during the capture (a device fault, a failed
+    write: the images so far kept; manifest.json's runner.finish_reason says which); 130 /
+    143 stopped (docs/guide.md, section 11).
     """
     from rti_rig.app.usecases.session import (
         NewSessionRequest,
