@@ -399,6 +399,12 @@ class QAReport:
     #: The verdict's word for images with problems: "reshoot", or what fits a session that
     #: cannot reshoot (a replayed acquisition's images are the recording's: "flawed").
     verdict_word: str = "reshoot"
+    #: Whether the session judged had completed (its manifest's finish_reason), set by the
+    #: application; None where there is no session record (a plain ``.lp`` acquisition). Why:
+    #: a session stopped at 11 of 12 images was ``"good": true`` in ``qa.json``, its being
+    #: unfinished said only in the words of a caveat, so a script reading ``good`` took it
+    #: for a session to archive.
+    session_complete: bool | None = None
     #: Images of the session lost since capture that the fitted ``.lp`` does not list, so no
     #: check above saw them (set by the application). The session is not whole whatever the
     #: fitted images show: a rebuilt journal that set a changed JPEG aside had left the verdict
@@ -594,6 +600,7 @@ class QAReport:
             "verdict": self.verdict,
             "good": self.good,
             "reshoot": [c.name for c in self.reshoot] + list(self.lost_unfitted),
+            "session_complete": self.session_complete,
             "expected_normal_error_deg": self.expected_normal_error_deg,
             "noise_sigma": self.noise_sigma,
             "undercovered_fraction": self.undercovered_fraction,

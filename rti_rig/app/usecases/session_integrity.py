@@ -331,7 +331,8 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
     runner = manifest.get("runner") or {}
     reason = runner.get("finish_reason")
     if reason == "completed":
-        return qa
+        return replace(qa, session_complete=True)
+    qa = replace(qa, session_complete=False)
     total = planned_steps(manifest)
     # the journal's steps and those the manifest records (a lost journal had made it "0 of 8
     # images" of a session with 4 on disk, fitted and judged)
