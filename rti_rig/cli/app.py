@@ -236,9 +236,60 @@ def unwrapped_when_piped() -> None:
             console.soft_wrap = True
 
 
+class ReaderGoneTolerant:
+    """A console's stream whose reader closing the pipe (``| head -1``, a script that read the
+    line it wanted) sends the rest of the command's words to ``/dev/null`` instead of ending
+    the command.
+
+    Why: click turns the first ``BrokenPipeError`` into exit 1 without a word, so ``rti-rig run
+    ... | head -1`` ended a session that had completed with exit 1 (read as "the rig was not
+    made safe or a fault rti-rig did not name"), its summary and verdict unsaid; one broken
+    mid-capture would have ended the capture. The words are for people; the session's files
+    hold what happened. The stream's file descriptor is pointed at ``/dev/null`` (not merely
+    this wrapper), so the interpreter's own flush at exit cannot fail either."""
+
+    def __init__(self, stream) -> None:  # type: ignore[no-untyped-def]
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._reader_gone()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._reader_gone()
+
+    def _reader_gone(self) -> None:
+        import os
+
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        try:
+            os.dup2(devnull, self._stream.fileno())
+        finally:
+            os.close(devnull)
+
+    def __getattr__(self, name: str):  # type: ignore[no-untyped-def]
+        return getattr(self._stream, name)
+
+
+def reader_gone_tolerated() -> None:
+    """Give :data:`out` and :data:`err` the process's stdout and stderr through
+    :class:`ReaderGoneTolerant` (the console entry only, as :func:`unwrapped_when_piped`)."""
+    import sys
+
+    out.file = ReaderGoneTolerant(sys.stdout)
+    err.file = ReaderGoneTolerant(sys.stderr)
+
+
 def main() -> None:
     quiet_library_logs()
     records_as_notes()
     warnings_as_notes()
     unwrapped_when_piped()
+    reader_gone_tolerated()
     app()
