@@ -47,7 +47,10 @@ def held_batch(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, a: Path, b: Path
         assert proc.poll() is None, proc.communicate()
         assert time.monotonic() < deadline, "the batch never reached A's fit.json"
         time.sleep(0.05)
-    (partial,) = [p for p in fq.iterdir() if p.name.startswith(f".A.{proc.pid}-")]
+    # its partial folder (beside it, the attempt's .owner record)
+    (partial,) = [
+        p for p in fq.iterdir() if p.name.startswith(f".A.{proc.pid}-") and p.suffix == ".partial"
+    ]
     return proc, hold, partial
 
 

@@ -33,6 +33,13 @@ from rti_rig.app.usecases.fit_inputs import (
     journal_lost,
     judged_by_stat,
 )
+from rti_rig.app.usecases.fit_owners import (
+    OWNER_SUFFIX,
+    Owner,
+    owner_of,
+    remove_owner_record,
+    write_owner_record,
+)
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
 from rti_rig.runtime.session import JOURNAL, file_sha256
@@ -120,8 +127,19 @@ def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[Bat
     naming its partial folder, after the batch folder was made inside the session).
     """
     refuse_out_inside_a_session(root)
-    prepare_batch(sources, root)  # each session is judged at its turn (fit_one)
-    return [fit_one(source, root, template) for source in sources]
+    said = prepare_batch(sources, root)  # each session is judged at its turn (fit_one)
+    return with_notes([fit_one(source, root, template) for source in sources], said)
+
+
+def with_notes(items: list[BatchItem], said: dict[Path, tuple[str, ...]]) -> list[BatchItem]:
+    """``items`` with what :func:`prepare_batch` said of each one's session before its notes
+    (matched by source)."""
+    from dataclasses import replace
+
+    return [
+        replace(item, notes=(*said[item.source], *item.notes)) if said.get(item.source) else item
+        for item in items
+    ]
 
 
 def partial_folders(root: Path, name: str) -> list[Path]:
@@ -151,37 +169,77 @@ def owner_gone(folder: Path, *, mine_too: bool = False) -> bool:
     that begins and fits nothing yet). A folder naming no PID counts as gone.
 
     Why: two batches given one ``--out`` each removed the other's in-progress partial
-    folder, and both reported a session "failed … No such file or directory". The PID is
-    asked of this host (``os.kill(pid, 0)``): the batch is assumed to run where its
-    ``--out`` was made; a Dask worker on another host sharing the folder is not seen, and
-    its attempt's folder is kept (or, its PID reused here, left for a later run)."""
+    folder, and both reported a session "failed … No such file or directory". The process
+    is judged by its owner record (:func:`~rti_rig.app.usecases.fit_owners.owner_of`): only
+    one of this host's is ever called gone; another host's (a Dask worker sharing the
+    folder) is left to it."""
+    return owner_of(folder, mine_too=mine_too).gone
+
+
+def remove_attempt_folder(folder: Path) -> None:
+    """Remove an attempt's folder, and its owner record once none of its folders is left."""
+    import shutil
+
+    shutil.rmtree(folder, ignore_errors=True)
     attempt = AttemptFolder.parse(folder.name)
-    pid = None if attempt is None else attempt.pid
-    if pid is None:
-        return True
-    if pid == os.getpid():
-        return mine_too
+    if attempt is None or attempt.attempt is None:
+        return
+    if not any(attempt.as_kind(k).path(folder.parent).exists() for k in Kind):
+        remove_owner_record(attempt, folder.parent)
+
+
+def _left_to_its_owner(folder: Path, owner: Owner) -> str:
+    """What a batch says, once, of an attempt's folder it leaves to a process elsewhere."""
+    pid = "" if owner.pid is None else f" (PID {owner.pid} there)"
+    return (
+        f"{folder} is the folder of a fit running on {owner.elsewhere}{pid}, which this host "
+        "cannot see: it is left to that fit. If it still runs there, let it finish; if that "
+        f"host is gone or its fit was stopped, remove the folder by hand (rm -r '{folder}') "
+        "and run the same command again"
+    )
+
+
+def _removed_unrecorded(folder: Path, owner: Owner) -> str:
+    """What a batch says of an older rti-rig's folder, recording no host, that it removed."""
+    return (
+        f"removed {folder}, left by an interrupted fit of an older rti-rig, which records no "
+        f"host: its PID {owner.pid} was taken as this host's, where no such process runs (a "
+        "fit of that older rti-rig still running on another host sharing this folder fails "
+        "there; run it again with this rti-rig)"
+    )
+
+
+def _orphan_records(root: Path, name: str) -> list[AttemptFolder]:
+    """The attempts of session output ``root/name`` whose owner record is left without any
+    of their folders (a batch killed between its last rename and the record's removal)."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    except OSError:  # PermissionError: it runs, as another user
-        return False
-    return False
+        listed = [p.name for p in root.iterdir()]
+    except OSError:
+        return []
+    found = []
+    for entry in listed:
+        stem = entry.removesuffix(f".{OWNER_SUFFIX}")
+        if stem == entry:
+            continue
+        attempt = AttemptFolder.parse(f"{stem}.{Kind.PARTIAL.value}", name)
+        if attempt is None or attempt.attempt is None:
+            continue
+        if not any(attempt.as_kind(k).path(root).exists() for k in Kind):
+            found.append(attempt)
+    return found
 
 
 def plan_batch(sources: list[Path], root: Path) -> dict[Path, EarlierFit]:
     """What a batch finds of each source's earlier fit (:func:`earlier_fit`; the sources still
-    to fit are those whose fit does not stand), once :func:`prepare_batch` has made its
-    folders ready, keeping each earlier fit's record a hash brought up to date
-    (:func:`keep_confirmed`).
+    to fit are those whose fit does not stand), once :func:`prepare_batch` (the caller's, whose
+    notes it keeps) has made its folders ready, keeping each earlier fit's record a hash
+    brought up to date (:func:`keep_confirmed`).
 
     Why apart from :func:`prepare_batch`: only a cluster batch judges here, to know which
     sessions to send at once. A batch that fits its sessions one after another leaves each to
     :func:`fit_one`'s judgement at its turn, which one made when the batch began cannot
     replace (a session may change meanwhile); judging here as well had read each session's
     record and stat-ed its images twice."""
-    prepare_batch(sources, root)
     plan: dict[Path, EarlierFit] = {}
     for source in sources:
         plan[source] = earlier_fit(batch_out_dir(root, source), source)
@@ -189,12 +247,12 @@ def plan_batch(sources: list[Path], root: Path) -> dict[Path, EarlierFit]:
     return plan
 
 
-def prepare_batch(sources: list[Path], root: Path) -> None:
+def prepare_batch(sources: list[Path], root: Path) -> dict[Path, tuple[str, ...]]:
     """Make ``root`` ready for a batch of ``sources``: two sources with one output name are
     refused, the folder is made, and the partial folders (and outgrown earlier fits) killed
-    runs left for these sources are removed; another batch's running attempts are left."""
-    import shutil
-
+    runs left for these sources are removed; another batch's running attempts are left.
+    Returns what is to be said of each source's session (a folder left to a fit on another
+    host, an older rti-rig's folder removed), for :func:`with_notes`."""
     by_name: dict[str, list[Path]] = {}
     for s in sources:
         by_name.setdefault(batch_out_dir(root, s).name, []).append(s)
@@ -222,21 +280,34 @@ def prepare_batch(sources: list[Path], root: Path) -> None:
             f"--out {root}: cannot create the batch folder ({exc.strerror or exc}); choose a "
             "folder you can write to"
         ) from None
+    notes: dict[Path, tuple[str, ...]] = {}
     for source in sources:
         final = batch_out_dir(root, source)
         # a finished session's too: a Dask worker killed mid-session leaves its attempt's
         # partial folder while the retry finishes the session (see fit_one)
         # an interrupted swap's new fit is kept for fit_one to put in place (finish_swap)
         keep = {_swap_partial(b) for b in earlier_backups(root, final.name)}
+        held = list(partial_folders(root, final.name))
         if final.exists():  # the swap had ended: its backup is an outgrown fit
             keep = set()
-            for backup in earlier_backups(root, final.name):
-                if owner_gone(backup, mine_too=True):
-                    shutil.rmtree(backup, ignore_errors=True)
-        for partial in partial_folders(root, final.name):
+            held += earlier_backups(root, final.name)
+        said: list[str] = []
+        for folder in held:
             # another batch's attempt, running now into the same --out, is left to it
-            if partial not in keep and owner_gone(partial, mine_too=True):
-                shutil.rmtree(partial, ignore_errors=True)
+            if folder in keep:
+                continue
+            owner = owner_of(folder, mine_too=True)
+            if owner.gone:
+                remove_attempt_folder(folder)
+                if owner.unrecorded:
+                    said.append(_removed_unrecorded(folder, owner))
+            elif owner.elsewhere:
+                said.append(_left_to_its_owner(folder, owner))
+        for orphan in _orphan_records(root, final.name):
+            if owner_of(orphan.path(root), mine_too=True).gone:
+                remove_owner_record(orphan, root)
+        notes[source] = tuple(said)
+    return notes
 
 
 def earlier_backups(root: Path, name: str) -> list[Path]:
@@ -274,8 +345,6 @@ def finish_swap(root: Path, final: Path) -> str:
     it is removed, not put back (it had been, said "interrupted before its new fit was
     complete"). A swap whose process still runs (another batch into the same ``--out``) is
     left to it."""
-    import shutil
-
     backups = earlier_backups(root, final.name)
     if not backups or final.exists():
         return ""
@@ -285,7 +354,7 @@ def finish_swap(root: Path, final: Path) -> str:
     new = _swap_partial(backup)
     if not new.is_dir():
         for stale in (*older, backup):
-            shutil.rmtree(stale, ignore_errors=True)
+            remove_attempt_folder(stale)
         return ""
     try:
         if (new / "fit.json").is_file():
@@ -305,7 +374,7 @@ def finish_swap(root: Path, final: Path) -> str:
             raise
         return ""
     for stale in (*older, backup, new):
-        shutil.rmtree(stale, ignore_errors=True)
+        remove_attempt_folder(stale)
     return words
 
 
@@ -516,18 +585,42 @@ def fit_one(
     ``--out`` may have finished it (a swap finished here puts another fit in place). Its
     images are stat-ed again; only one whose size or time changed is hashed. A session that
     changed while its own fit ran is said so (:func:`changed_while_fitted`)."""
-    import shutil
-    from dataclasses import replace
-
     final = batch_out_dir(root, source)
     swapped = finish_swap(root, final)
     said = (swapped,) if swapped else ()
     earlier = earlier_fit(final, source)
     keep_confirmed(earlier)
-    outgrown = earlier.outgrown
     if earlier.stands:
         return BatchItem(source, final, Outcome.SKIPPED, earlier.skip_detail, notes=said)
     attempt = AttemptFolder.new(final.name)
+    # who makes the attempt's folders, recorded before they exist: another run into this
+    # --out, on this host or another, leaves them to this process while it runs (fit_owners);
+    # a folder it cannot write in is left to run_fit to say, in its words
+    with contextlib.suppress(OSError):
+        write_owner_record(attempt, root)
+    try:
+        return _fit_attempt(source, root, template, bands, final, attempt, earlier, said)
+    finally:
+        if not any(attempt.as_kind(k).path(root).exists() for k in Kind):
+            remove_owner_record(attempt, root)
+
+
+def _fit_attempt(
+    source: Path,
+    root: Path,
+    template: FitRequest,
+    bands: BandRunner | None,
+    final: Path,
+    attempt: AttemptFolder,
+    earlier: EarlierFit,
+    said: tuple[str, ...],
+) -> BatchItem:
+    """:func:`fit_one`'s fit of ``source`` into ``attempt``'s partial folder, put in place in
+    ``final`` (an ``earlier`` fit its session outgrew replaced once the new one is complete)."""
+    import shutil
+    from dataclasses import replace
+
+    outgrown = earlier.outgrown
     partial = attempt.path(root)
     try:
         result = run_fit(replace(template, source=source, out_dir=partial), bands)
@@ -578,7 +671,7 @@ def fit_one(
     # host) is left alone: it finds the session finished and discards its own copy.
     for stale in partial_folders(root, final.name):
         if owner_gone(stale):
-            shutil.rmtree(stale, ignore_errors=True)
+            remove_attempt_folder(stale)
     detail = "" if outgrown is None else f" ({outgrown})"
     if moved_on is not None:
         # the fit is of the session as it was read, and its record says so: the next batch

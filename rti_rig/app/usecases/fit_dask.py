@@ -67,6 +67,7 @@ from rti_rig.app.usecases.fit_batch import (
     fit_one,
     plan_batch,
     prepare_batch,
+    with_notes,
 )
 from rti_rig.app.usecases.scheduler_probe import (
     SHARED_PATHS,
@@ -887,8 +888,9 @@ def run_batch_dask(
     ``root`` inside a session folder is refused before the cluster is reached."""
     refuse_out_inside_a_session(root)  # as given, as run_batch does
     if scheduler == THREADS:
-        prepare_batch(sources, root)  # each session is judged at its turn (fit_one)
-        return [fit_one(s, root, template, bands=dask_bands(None, s)) for s in sources]
+        said = prepare_batch(sources, root)  # each session is judged at its turn (fit_one)
+        items = [fit_one(s, root, template, bands=dask_bands(None, s)) for s in sources]
+        return with_notes(items, said)
     # Absolute, as workers do not share this process's working directory, but not resolved:
     # ``resolve()`` followed a symlinked session folder, so its output was named after the
     # link's target (OUT/s1 for sess/coin_day2 -> s1, OUT/coin_day2 without Dask, so a rerun
@@ -900,7 +902,8 @@ def run_batch_dask(
     with scheduler_client(scheduler) as cluster:
         assert cluster is not None  # an address, not THREADS
         client = cluster.client
-        plan = plan_batch(sources, root)  # refuses a source given twice, as without Dask
+        said = prepare_batch(sources, root)  # refuses a source given twice, as without Dask
+        plan = plan_batch(sources, root)
         threads = blas_threads()
         # A source missing here too is the user's typo, not the workers' filesystem: it is
         # refused here in the words of the batch without Dask ("does not exist: give a session
@@ -919,6 +922,7 @@ def run_batch_dask(
                 s: submit(s) for s, earlier in plan.items() if not earlier.stands and s.exists()
             }
             items = _batch_results(cluster, sources, given, root, template, plan, futures, submit)
+        items = with_notes(items, said)
         return [replace(item, source=g) for item, (_, g) in zip(items, given, strict=True)]
 
 
