@@ -84,6 +84,7 @@ def test_a_planner_file_changes_the_fingerprint_and_the_layout_does_not(tmp_path
     import numpy
 
     assert dict(mine.stack) == {
+        "python": f"{sys.version_info[0]}.{sys.version_info[1]}",  # to its minor
         "distributed": distributed.__version__,
         "dask": dask.__version__,
         "cloudpickle": cloudpickle.__version__,

@@ -78,6 +78,7 @@ from rti_rig.app.usecases.scheduler_probe import (
     unreachable_scheduler,
 )
 from rti_rig.app.usecases.worker_code import (
+    PYTHON,
     Unasked,
     Untagged,
     WorkerCode,
@@ -89,6 +90,7 @@ from rti_rig.app.usecases.worker_code import (
     tag_for,
     tagging_plugin,
     worker_identities,
+    worker_pythons,
 )
 from rti_rig.core.errors import RtiRigError
 from rti_rig.reconstruct.lazy_stack import ImageReadError, StackSource, lazy_stack
@@ -546,6 +548,7 @@ def _refuse_other_code(client: Any, address: str) -> frozenset[str]:
             f"this machine's {describe(mine)}: the workers cannot be checked against the code "
             "this command runs. Nothing was sent: run the same command again"
         )
+    _refuse_other_python(client, mine, address)  # before any function of ours runs there
     workers = worker_identities(client)
     _refuse_other_libraries(workers, mine, address)
     untold = {w: ident for w, ident in workers.items() if isinstance(ident, Unasked)}
@@ -573,6 +576,33 @@ def _refuse_other_code(client: Any, address: str) -> frozenset[str]:
             f"the same command; they must run this same rti-rig ({describe(mine)})"
         )
     return frozenset(workers)
+
+
+def _refuse_other_python(client: Any, mine: WorkerCode, address: str) -> None:
+    """Refuse a cluster some of whose workers run another Python minor version than this
+    machine (:data:`~rti_rig.app.usecases.worker_code.PYTHON` says why), naming each, both
+    versions and what to do; asked of Dask's own version report, before the rti-rig check
+    (a function pickled by value) is sent to them.
+
+    Why: the workers' distributed, dask, cloudpickle and numpy were compared, not their
+    Python, and cloudpickle's functions of a 3.11 client failed on a 3.12 worker in ways that
+    named no version (the check itself "could not be asked", or the worker died)."""
+    ours = dict(mine.stack).get(PYTHON, "")
+    pythons = worker_pythons(client)
+    differ = {w: v for w, v in pythons.items() if ours and v != ours}
+    if not differ:
+        return
+    named = "; ".join(f"{w} (Python {v})" for w, v in sorted(differ.items()))
+    raise SchedulerError(
+        f"{len(differ)} of the {len(pythons)} workers of the Dask cluster at {address!r} run "
+        f"another Python than this machine (Python {ours}): {named}. The fit's functions "
+        f"travel to the workers as Python {ours}'s byte code (cloudpickle), which another "
+        "Python minor version cannot run (such a worker fails or dies with errors that name "
+        f"no version), so nothing was sent: run those workers under Python {ours} (an "
+        f"environment made with python{ours}, this rti-rig and the same distributed, dask, "
+        f"cloudpickle and numpy installed in it, then `dask worker {address}` from it), and "
+        "run the same command"
+    )
 
 
 def _refuse_other_libraries(
@@ -603,16 +633,19 @@ def _refuse_other_libraries(
     pins = " ".join(
         f"'{name}=={version.removesuffix('.x')}{'.*' if version.endswith('.x') else ''}'"
         for name, version in needed.items()
-        if version
+        if version and name != PYTHON  # no pip install gives another Python
     )
+    todo = f"install these versions on those workers (pip install {pins})" if pins else ""
+    if needed.get(PYTHON):  # a worker Dask's own report left out (_refuse_other_python)
+        under = f"run those workers under Python {needed[PYTHON]}"
+        todo = f"{under}, with {todo.removeprefix('install ')}" if todo else under
     raise SchedulerError(
         f"{len(differ)} of the {len(workers)} workers of the Dask cluster at {address!r} run "
         f"other versions of the libraries this fit's tasks pass through than this machine "
         f"({ours_said}): {named}. Dask's client and workers must run the same distributed, "
-        "dask and cloudpickle, and the same major numpy (their tasks and results cannot be "
-        "read from one side to the other: such a worker dies on its first task), so nothing "
-        f"was sent: install these versions on those workers (pip install {pins}), restart "
-        "them, and run the same command"
+        "dask and cloudpickle, the same major numpy and the same Python minor version (their "
+        "tasks and results cannot be read from one side to the other: such a worker dies on "
+        f"its first task), so nothing was sent: {todo}, restart them, and run the same command"
     )
 
 

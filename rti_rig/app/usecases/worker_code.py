@@ -58,6 +58,16 @@ STACK_PACKAGES: tuple[tuple[str, str], ...] = (
     ("numpy", "major"),
 )
 
+#: The Python a worker must share with this machine, to its minor version (``3.11``): reported
+#: in a worker's ``stack`` under this name beside :data:`STACK_PACKAGES`.
+#:
+#: Why: cloudpickle sends the fit's functions and this module's check classes by value, as the
+#: byte code of this machine's Python, which another minor version does not run (3.11's under
+#: 3.12 fails, or crashes the worker, in errors that name no version); within one minor the
+#: byte code is the same. It is asked first of Dask itself (:func:`worker_pythons`), which
+#: needs no pickled function on the worker.
+PYTHON = "python"
+
 #: The files a wheel ships (code and the rig configs' package data): stray files of a
 #: checkout (editor backups, caches) would otherwise tell an editable install from a wheel.
 FINGERPRINTED_SUFFIXES: tuple[str, ...] = (".py", ".toml", ".lp")
@@ -111,8 +121,9 @@ def _identity_function(
         imported module's ``__version__`` (the code that runs, not the installed metadata),
         cut to its major where only that must agree; "" where it cannot be imported."""
         import importlib
+        import sys
 
-        versions: dict[str, str] = {}
+        versions: dict[str, str] = {"python": f"{sys.version_info[0]}.{sys.version_info[1]}"}
         for name, agree in compared:
             try:
                 version = str(getattr(importlib.import_module(name), "__version__", ""))
@@ -297,20 +308,53 @@ def _as_worker_code(answer: Mapping[str, Any]) -> WorkerCode:
 
 def stack_differences(mine: WorkerCode, theirs: WorkerCode) -> list[tuple[str, str, str]]:
     """The compared libraries (:data:`STACK_PACKAGES`) whose version differs between ``mine``
-    and ``theirs``, as ``(name, mine, theirs)``; none when ``theirs`` reported no versions (a
-    check of an rti-rig from before this one: it cannot be told, and its code differs)."""
+    and ``theirs``, as ``(name, mine, theirs)``, the :data:`PYTHON` first; none when ``theirs``
+    reported no versions (a check of an rti-rig from before this one: it cannot be told, and
+    its code differs), and no Python when it reported none (an rti-rig from before 2026-12-01)."""
     if not theirs.stack:
         return []
     ours, found = dict(mine.stack), dict(theirs.stack)
+    names = [name for name, _ in STACK_PACKAGES]
+    if PYTHON in found:
+        names.insert(0, PYTHON)
     return [
         (name, ours.get(name, ""), found.get(name, ""))
-        for name, _ in STACK_PACKAGES
+        for name in names
         if ours.get(name, "") != found.get(name, "")
     ]
 
 
+def python_minor(version: str) -> str:
+    """``3.11`` of ``3.11.7.final.0`` (Dask's form of a Python version)."""
+    return ".".join(version.split(".")[:2])
+
+
+def worker_pythons(client: Any) -> dict[str, str]:
+    """Each worker's Python, to its minor version (``3.11``), as Dask's own version report
+    gives it (``Client.get_versions``): no function of this machine runs on the worker, so a
+    worker of another Python answers (the rti-rig check, pickled by value, may not run there).
+    Workers that did not answer are missing; none when the report cannot be had."""
+    try:
+        report = client.get_versions(check=False)
+        workers = report["workers"]
+    except Exception:  # the scheduler lost, or an older Dask: the rti-rig check still runs
+        return {}
+    found: dict[str, str] = {}
+    for worker, answer in workers.items():
+        if not isinstance(answer, Mapping):
+            continue
+        packages = answer.get("packages") or {}
+        host = answer.get("host") or {}
+        version = packages.get(PYTHON) or host.get(PYTHON)
+        if version:
+            found[worker] = python_minor(str(version))
+    return found
+
+
 def describe_library(name: str, version: str) -> str:
-    """``distributed 2026.8.0``, ``numpy 2.x``, or ``no numpy``."""
+    """``distributed 2026.8.0``, ``numpy 2.x``, ``Python 3.11``, or ``no numpy``."""
+    if name == PYTHON:
+        return f"Python {version}" if version else "no Python version"
     return f"{name} {version}" if version else f"no {name}"
 
 
