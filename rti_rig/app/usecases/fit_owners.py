@@ -75,8 +75,13 @@ def write_owner_record(attempt: AttemptFolder, root: Path) -> Path:
     finds one of them finds the record too). Written whole and renamed into place."""
     path = owner_record_path(attempt, root)
     tmp = path.with_name(f"{path.name}.tmp")
-    tmp.write_text(json.dumps(this_process()), encoding="utf-8")
-    tmp.replace(path)
+    try:
+        tmp.write_text(json.dumps(this_process()), encoding="utf-8")
+        tmp.replace(path)
+    except OSError:  # a full disk: nothing half-written is left beside the batch's folders
+        with suppress(OSError):
+            tmp.unlink()
+        raise
     return path
 
 
