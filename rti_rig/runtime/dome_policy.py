@@ -319,9 +319,13 @@ class DomePolicy:
 
         Why: the reopening had been told only as Python log records, which the command line
         (which configures no logging) printed raw on stderr in the middle of the progress
-        bar, once per failed attempt, with the port's path three times over."""
+        bar, once per failed attempt, with the port's path three times over.
+
+        Only *where* things are said changes: whether a teardown has begun (:meth:`ending`)
+        is left as it is, as only :meth:`connect` ends it. Why: this had cleared it too, so a
+        listener set (or removed) once the teardown had begun made a port lost in its all-off
+        be said as "the session goes on once it is back", of a session that was ending."""
         self._say = say
-        self._ending = False
 
     def _tell(self, text: str) -> None:
         if self._say is not None:

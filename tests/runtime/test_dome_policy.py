@@ -1047,3 +1047,22 @@ def test_an_all_off_never_written_for_reboot_banners_is_said_not_sent():
     said = lights_state_sentence(dome)
     assert said.startswith("all-off could NOT be sent"), said
     assert "it was not written to the port" in said, said
+
+
+def test_a_listener_set_during_the_teardown_keeps_its_all_off_said_as_the_closing_one():
+    """``listen`` changes where a reopening is said, not whether the teardown began: it had
+    cleared the teardown mark, so a port lost in the all-off after ``ending()`` was said as
+    "the session goes on once it is back" of a session that was ending."""
+    dome, fw, _clock = make("default", [Fault(5, FaultKind.DISCONNECT, delay_s=0.5)])
+    dome.connect()  # commands 1 and 2: the handshake and its all-off
+    dome.light(0, 1.0)  # command 3
+    dome.all_off()  # command 4
+    dome.ending()
+    said: list[str] = []
+    dome.listen(said.append)
+    dome.all_off()  # command 5: its port lost, reopened, the all-off sent again
+    text = " ".join(said)
+    assert "the closing all-off is sent again once it is back" in text, said
+    assert "goes on once it is back" not in text, said
+    assert dome.stats.reconnects == 1
+    assert fw.lit is None
