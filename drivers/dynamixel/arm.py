@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core.clock import Clock
+from rti_rig.core.devices import ReadBackCarrier
 from rti_rig.core.errors import MoveCancelled
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.drivers.dynamixel import control_table as ct
@@ -117,7 +118,7 @@ def _fault_names(status: int) -> str:
     return ", ".join(f.name.lower().replace("_", " ") for f in ct.decode_hardware_error(status))
 
 
-class DynamixelArm:
+class DynamixelArm(ReadBackCarrier):
     """Two-axis light arm (azimuth + elevation) on Dynamixel Protocol 2.0 servos.
 
     ``port`` is a ``dynamixel_sdk.PortHandler`` (a real device or an emulator's pty path) or an

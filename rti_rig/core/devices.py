@@ -17,6 +17,7 @@ Devices open their transport in ``connect()`` (never in ``__init__``) and releas
 
 from __future__ import annotations
 
+from abc import abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
@@ -107,6 +108,41 @@ class LightCarrier(Protocol):
         """Move to the park pose; once ``cancelled()`` says True, hold where it stands and
         raise :class:`~rti_rig.core.errors.MoveCancelled` (a stop during the teardown)."""
         ...
+
+
+@runtime_checkable
+class ReadBackCarrier(Protocol):
+    """What a :class:`LightCarrier` that reads its servos back (a Dynamixel arm) can say of
+    itself beyond moving: the commands it sent again, a torque its close released, whether
+    the arm still holds the pose an image is recorded under.
+
+    Declared by the concrete class (``class DynamixelArm(ReadBackCarrier)``), its methods
+    abstract: a class that declares it and renames or drops one of them cannot be built (a
+    ``TypeError`` at construction), where the caller's ``getattr`` had silently answered "none"
+    for a misspelt name. A carrier that does not declare it (the simulated arm, whose moves are
+    exact and which has no bus to lose a packet on) is answered for by
+    :class:`rti_rig.runtime.lighting.ArmLighting`'s documented defaults, on purpose.
+    """
+
+    @abstractmethod
+    def resends(self) -> tuple[list[str], str | None]:
+        """The commands sent once more after a lost or damaged reply that then got their
+        answer, and the one line that counts them for the user (None: none)."""
+
+    @abstractmethod
+    def torque_release_note(self) -> str | None:
+        """What the last close's release of the torque (at the park pose) leaves the user to
+        know, or None when it released nothing."""
+
+    @abstractmethod
+    def check_held(self) -> None:
+        """Raise unless the arm still holds, fault-free, the pose its last move reached."""
+
+    @abstractmethod
+    def listen(self, say: Callable[[str], None] | None) -> None:
+        """Have what a user must know as it happens (a search at other baud rates, a torque
+        kept on at the close, a second failure while making the arm safe) said through
+        ``say``; ``None`` stops it."""
 
 
 @runtime_checkable

@@ -317,17 +317,14 @@ def shoot_step(
 
 
 def lit_limit_s(rig: Rig) -> float | None:
-    """How long the rig's light may stay lit at a time (a dome's ``max_on_s``), or None."""
-    limit_of = getattr(rig.lighting, "lit_limit_s", None)
-    return limit_of() if limit_of is not None else None
+    """How long the rig's light may stay lit at a time (a dome's ``max_on_s``), or None
+    (:meth:`rti_rig.runtime.lighting.Lighting.lit_limit_s`, which every lighting answers)."""
+    return rig.lighting.lit_limit_s()
 
 
 def lit_limit_said(rig: Rig) -> str:
     """What sets :func:`lit_limit_s`, as a message names it (``max_on_s = 8 s``)."""
-    said_of = getattr(rig.lighting, "lit_limit_said", None)
-    if said_of is not None:
-        return str(said_of())
-    return f"max_on_s = {lit_limit_s(rig):g} s"
+    return rig.lighting.lit_limit_said()
 
 
 def check_capture_fits_lit(rig: Rig, exposures_s: Iterable[float], before: str) -> None:

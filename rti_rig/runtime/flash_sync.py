@@ -19,7 +19,7 @@ from rti_rig.core.devices import Frame
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.schedule import LightStep
-from rti_rig.runtime.lighting import ActualLight
+from rti_rig.runtime.lighting import NO_LIT_LIMIT, ActualLight
 
 
 class LightSlipError(RtiRigError):
@@ -82,6 +82,15 @@ class CameraTriggeredLighting:
 
     def safe(self, emergency: bool = False) -> list[str]:
         return []  # nothing can be sent: lights_state says what the firmware does by itself
+
+    def lit_limit_s(self) -> None:
+        """None: the host lights nothing, so it keeps no lit-time limit (the firmware's own
+        ``timeout_s`` bounds each flash, checked against the exposure in :meth:`problem`)."""
+        return None
+
+    def lit_limit_said(self) -> str:
+        """No limit to name (:meth:`lit_limit_s` is None)."""
+        return NO_LIT_LIMIT
 
     @property
     def link_open(self) -> bool:

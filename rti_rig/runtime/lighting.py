@@ -11,23 +11,25 @@ from __future__ import annotations
 import signal
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
 import numpy as np
 
 from rti_rig.core.deferred_signals import signals_deferred, stop_words
-from rti_rig.core.devices import DiscreteLightSource, LightCarrier
+from rti_rig.core.devices import DiscreteLightSource, LightCarrier, ReadBackCarrier
 from rti_rig.core.errors import DeviceError, MoveCancelled
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.schedule import LightStep
 from rti_rig.runtime.arm_end import ArmEnd, left_end, park_end
-
-if TYPE_CHECKING:
-    from rti_rig.runtime.dome_policy import DutyWait
+from rti_rig.runtime.dome_policy import DomePolicy, DutyWait
 
 #: A dome step's direction must match its LED's calibrated direction this closely (degrees).
 LED_MATCH_TOLERANCE_DEG = 0.5
+
+#: :meth:`Lighting.lit_limit_said` of a light with no limit (never in a message: it is asked
+#: only of a light whose :meth:`Lighting.lit_limit_s` is not None).
+NO_LIT_LIMIT = "no limit on how long a light stays lit"
 
 
 @dataclass(frozen=True)
@@ -53,6 +55,19 @@ class Lighting(Protocol):
 
     def safe(self, emergency: bool = False) -> list[str]: ...
 
+    def lit_limit_s(self) -> float | None:
+        """How long one light may stay lit at a time (a dome's ``max_on_s``, or a timed
+        firmware's shorter window), None when nothing limits it (an arm's lamp, a simulated
+        dome, a dome the camera steps). Each implementation answers it: the controller had
+        guessed with ``getattr(rig.lighting, "lit_limit_s", None)``, which a rename would have
+        silently answered "no limit", and the busy camera's relight would have lit past it."""
+        ...
+
+    def lit_limit_said(self) -> str:
+        """What sets :meth:`lit_limit_s`, as a message names it (``max_on_s = 8 s``); asked
+        only of a light that has a limit."""
+        ...
+
     @property
     def link_open(self) -> bool:
         """Whether the lights' link to the host is open now, so that :meth:`safe` can be sent
@@ -70,6 +85,19 @@ class DomeLighting:
         self.source = source
         self.geometry = geometry
         self.name = source.name
+
+    @property
+    def policy(self) -> DomePolicy | None:
+        """The runtime's own dome policy this lighting drives (a dome on a port, real or
+        emulated), or None for a source without one (the simulated dome: no port to lose or
+        hold, no resends, no thermal guard, no all-off outcome to record).
+
+        Why: each ability below is asked of it by name, typed, and answers its documented
+        default for None on purpose. They had been guessed at with ``getattr`` on the source
+        (``hold``, ``lit_limit_s``, ``guard``, ``off_report``, ``stats``…), which a renamed or
+        misspelt attribute would have silently answered "none": a dome never held open, no
+        thermal limit, no resends to report."""
+        return self.source if isinstance(self.source, DomePolicy) else None
 
     def connect(self) -> None:
         self.source.connect()
@@ -89,18 +117,17 @@ class DomeLighting:
         thermal guard (a simulated dome). Why typed: the run's time line had guessed at the
         source's ``stats`` and ``settings`` with ``getattr``, which a rename would have
         silently turned into "never waited"."""
-        from rti_rig.runtime.dome_policy import DomePolicy
-
-        return self.source.duty_wait() if isinstance(self.source, DomePolicy) else None
+        policy = self.policy
+        return None if policy is None else policy.duty_wait()
 
     def hold(self) -> None:
         """Lights off, the dome's port kept open for the next :meth:`connect` where its driver
         can (a board that resets on open boots lit: the Nab sketch), closed otherwise."""
-        hold = getattr(self.source, "hold", None)
-        if hold is None:
+        policy = self.policy
+        if policy is None:
             self.source.close()
         else:
-            hold()
+            policy.hold()
 
     def problem(self, step: LightStep) -> str | None:
         if step.led is None:
@@ -131,34 +158,30 @@ class DomeLighting:
 
         The controller switches the LED off while a busy camera is awaited past this, and
         lights it again for the shot (:func:`rti_rig.runtime.controller.shoot_step`)."""
-        own = getattr(self.source, "lit_limit_s", None)
-        if own is not None:
-            return float(own())
-        thermal = getattr(getattr(self.source, "settings", None), "thermal", None)
-        return None if thermal is None else float(thermal.max_on_s)
+        policy = self.policy
+        return None if policy is None else float(policy.lit_limit_s())
 
     def lit_limit_said(self) -> str:
         """What sets :meth:`lit_limit_s`, as a message names it (``max_on_s = 8 s``)."""
-        own = getattr(self.source, "lit_limit_said", None)
-        if own is not None:
-            return str(own())
-        return f"max_on_s = {self.lit_limit_s():g} s"
+        policy = self.policy
+        return NO_LIT_LIMIT if policy is None else str(policy.lit_limit_said())
 
     def cool_down_s(self, step: LightStep, at: float) -> float:
         """How long after ``at`` (on the rig's clock) the step's LED must still cool before
         its duty limit lets it light again (0: it may light at ``at``), as the dome's thermal
         guard will wait in ``set``: said to the user before a wait in the dark, which that
         cool-down lengthens."""
-        guard = getattr(self.source, "guard", None)
-        if guard is None or step.led is None:
+        policy = self.policy
+        if policy is None or step.led is None:
             return 0.0
-        return max(0.0, float(guard.earliest_start(step.led, at)) - at)
+        return max(0.0, float(policy.guard.earliest_start(step.led, at)) - at)
 
     def off_said(self) -> str | None:
         """What the last all-off established, as the dome policy recorded it
         (``"acknowledged"``, ``"sent-no-ack"``, ``"self-timed"``…), None when it keeps no
         record: a step's journal says what was established, never more."""
-        report = getattr(self.source, "off_report", None)
+        policy = self.policy
+        report = None if policy is None else policy.off_report
         return None if report is None else str(report.outcome)
 
     def safe(self, emergency: bool = False) -> list[str]:
@@ -168,39 +191,40 @@ class DomeLighting:
     def listen(self, say: Callable[[str], None] | None) -> None:
         """Have the dome say through ``say`` each reopening of its lost port and its outcome,
         as it happens (a source that never reopens a port says nothing)."""
-        listen = getattr(self.source, "listen", None)
-        if listen is not None:
-            listen(say)
+        policy = self.policy
+        if policy is not None:
+            policy.listen(say)
 
     def ending(self) -> None:
         """The command tears down from here: a reopening of the dome's port is then said as
         being for the closing all-off, never as "the session goes on"."""
-        ending = getattr(self.source, "ending", None)
-        if ending is not None:
-            ending()
+        policy = self.policy
+        if policy is not None:
+            policy.ending()
 
     def resends(self) -> tuple[dict[str, list[str]], str | None]:
         """The manifest's ``dome_resent`` (each fault resent after whose command then went
         through, ``"<command>: <fault>"``) and the one line that counts them for the user;
         nothing and None when none was resent."""
-        stats = getattr(self.source, "stats", None)
-        said = getattr(self.source, "resends_said", None)
-        found = list(getattr(stats, "recovered", None) or [])
-        line = None if said is None else said()
+        policy = self.policy
+        if policy is None:
+            return {}, None
+        found, line = list(policy.stats.recovered), policy.resends_said()
         return ({"dome_resent": found} if line is not None else {}), line
 
     def reconnections(self) -> list[dict[str, object]]:
         """Each reopening of the dome's lost port so far (what was lost, the outcome), for the
         session's manifest: the user is told of it in a line, the detail is kept there."""
-        stats = getattr(self.source, "stats", None)
-        return list(getattr(stats, "reconnections", None) or [])
+        policy = self.policy
+        return [] if policy is None else list(policy.stats.reconnections)
 
     @property
     def link_open(self) -> bool:
         """Whether the dome's port is open now (connected, or held open after metering): an
-        all-off can then be sent without opening it, which may reset a board that boots lit."""
-        link = getattr(self.source, "link", self.source)
-        return bool(getattr(link, "port_open", False))
+        all-off can then be sent without opening it, which may reset a board that boots lit.
+        A simulated dome has no link: False."""
+        policy = self.policy
+        return False if policy is None else bool(policy.link.port_open)
 
 
 class ArmLighting:
@@ -244,18 +268,35 @@ class ArmLighting:
     def resends(self) -> tuple[dict[str, list[str]], str | None]:
         """The manifest's ``arm_resent`` (each command sent once more after its status packet
         was lost or damaged, then answered) and the one line that counts them for the user;
-        nothing and None when none was (or the carrier keeps no count)."""
-        resends = getattr(self.carrier, "resends", None)
-        found, line = ([], None) if resends is None else resends()
+        nothing and None when none was (or the carrier keeps no count: one that does not
+        read its servos back, :class:`rti_rig.core.devices.ReadBackCarrier`)."""
+        carrier = self.read_back
+        found, line = ([], None) if carrier is None else carrier.resends()
         return ({"arm_resent": found} if found else {}), line
 
     def listen(self, say: Callable[[str], None] | None) -> None:
         """Have the arm say through ``say`` what a user must know as it happens (its search
         for the servos at other baud rates, a torque kept on at the close, a second failure
         while making it safe); a carrier with nothing to say ignores it."""
-        listen = getattr(self.carrier, "listen", None)
-        if listen is not None:
-            listen(say)
+        if self.read_back is not None:
+            self.read_back.listen(say)
+
+    @property
+    def read_back(self) -> ReadBackCarrier | None:
+        """The carrier, when it declares that it reads its servos back (a Dynamixel arm), or
+        None (the simulated arm): its resends, its close's torque release and its check that
+        the pose held are then asked of it by name, and a carrier without them gets the
+        defaults documented on each method, on purpose (they had been guessed at with
+        ``getattr``, which a misspelt name answered "none")."""
+        return self.carrier if isinstance(self.carrier, ReadBackCarrier) else None
+
+    def lit_limit_s(self) -> None:
+        """None: an arm's lamp has no thermal limit the controller keeps."""
+        return None
+
+    def lit_limit_said(self) -> str:
+        """No limit to name (:meth:`lit_limit_s` is None)."""
+        return NO_LIT_LIMIT
 
     def connect(self) -> None:
         self.arm_failure = None
@@ -282,8 +323,8 @@ class ArmLighting:
             self._record_release()
 
     def _record_release(self) -> None:
-        note = getattr(self.carrier, "torque_release_note", None)
-        said = note() if callable(note) else None
+        carrier = self.read_back
+        said = None if carrier is None else carrier.torque_release_note()
         if not said or self.end is None:
             return
         why = self.end.why
@@ -311,11 +352,11 @@ class ArmLighting:
         no servo fault (a carrier that cannot tell does nothing). The image is then not kept:
         a servo that overloaded during the exposure went limp and the arm may have sagged,
         and the image had been kept under the direction read before it."""
-        check = getattr(self.carrier, "check_held", None)
-        if check is None:
+        carrier = self.read_back
+        if carrier is None:
             return
         try:
-            check()
+            carrier.check_held()
         except Exception as exc:  # the arm's own failure: no park after it
             self.arm_failure = exc
             raise
