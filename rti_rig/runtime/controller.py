@@ -21,6 +21,7 @@ from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.runtime.lighting import Lighting
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
     FRAME_SIZE_KEY,
@@ -408,12 +409,10 @@ def fire_lit(
         except CameraBusyError as busy:
             off_at = clock.now()
             rig.lighting.off()  # raises, stopping the session, if the dome did not take it
-            said_of = getattr(rig.lighting, "off_said", None)
-            off_said = said_of() if said_of is not None else None
-            cool_of = getattr(rig.lighting, "cool_down_s", None)
+            off_said = rig.lighting.off_said()
             if on_dark is not None:
                 after = clock.now() + busy.retry_in_s
-                cool_s = cool_of(step, after) if cool_of is not None else 0.0
+                cool_s = rig.lighting.cool_down_s(step, after)
                 on_dark(
                     {
                         "lit_s": off_at - lit_at,
@@ -425,10 +424,9 @@ def fire_lit(
                     }
                 )
             _wait_dark(rig, clock.now() + busy.retry_in_s, cancelled)
-            if cool_of is not None:
-                # the cool-down the thermal guard would wait in ``set``, waited here where a
-                # cancel is seen (it may be a minute)
-                _wait_dark(rig, clock.now() + cool_of(step, clock.now()), cancelled)
+            # the cool-down the thermal guard would wait in ``set``, waited here where a
+            # cancel is seen (it may be a minute)
+            _wait_dark(rig, clock.now() + rig.lighting.cool_down_s(step, clock.now()), cancelled)
             rig.lighting.set(step)  # the thermal guard may let the LED cool first
             relit.append(
                 {
@@ -609,20 +607,18 @@ def _arm_end(lighting: object) -> dict[str, Any]:
     return {} if to_dict is None else {"arm_end": to_dict()}
 
 
-def _dome_reconnections(lighting: object) -> dict[str, Any]:
+def _dome_reconnections(lighting: Lighting) -> dict[str, Any]:
     """The manifest's ``dome_reconnections``: each reopening of a dome's lost port in this run
     (during which command, what was lost, the attempts, the outcome), the detail of what the
     user was told in a line as it happened; nothing when none was reopened."""
-    said = getattr(lighting, "reconnections", None)
-    found = [] if said is None else said()
+    found = lighting.reconnections()
     return {"dome_reconnections": found} if found else {}
 
 
-def _resends(lighting: object) -> tuple[dict[str, Any], str | None]:
+def _resends(lighting: Lighting) -> tuple[dict[str, Any], str | None]:
     """The manifest's ``dome_resent`` / ``arm_resent`` (each command sent again after a fault
     and then answered) and the line that counts them for the user; nothing when none was."""
-    resends = getattr(lighting, "resends", None)
-    return ({}, None) if resends is None else resends()
+    return lighting.resends()
 
 
 def _teardown_failure(label: str, exc: Exception, earlier: list[str]) -> str:
@@ -700,9 +696,7 @@ def run_session(
     try:
         rig.bind_session(folder.root)
         # a lost port's reopening is said as the product speaks, between the bar's redraws
-        listen = getattr(rig.lighting, "listen", None)
-        if listen is not None:
-            listen(lambda text: emit(DeviceSays(rig.lighting.name, text)))
+        rig.lighting.listen(lambda text: emit(DeviceSays(rig.lighting.name, text)))
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.off()
@@ -766,9 +760,7 @@ def run_session(
             # an arm whose servo faulted (or that moved) during the exposure: the image is not
             # kept under the direction read before it; the error stops the run, a resume
             # retakes this step
-            held = getattr(rig.lighting, "check_held", None)
-            if held is not None:
-                held()
+            rig.lighting.check_held()
             got = frame_layout(frame)
             if layout is not None and got != layout:
                 _refuse_other_layout(rig, folder, i, frame, got, layout)

@@ -376,20 +376,18 @@ def fix_session_exposure(
             failures = rig.lighting.safe()
             # a dome kept open (hold) only once its all-off went through: one that failed is
             # closed, and the error says so
-            hold = getattr(rig.lighting, "hold", None) if keep_lights and not failures else None
+            hold = keep_lights and not failures
             return failures + attempt_all(
                 [
                     ("camera close", rig.camera.close),
-                    ("lights close", hold or rig.lighting.close),
+                    ("lights close", rig.lighting.hold if hold else rig.lighting.close),
                 ]
             )
 
     at = steps[0]
     tested: list[list[float]] = []
     started, wall_started = rig.clock.now(), time.perf_counter()
-    listen = getattr(rig.lighting, "listen", None)
-    if listen is not None:
-        listen(say)
+    rig.lighting.listen(say)
     try:
         rig.lighting.connect()
         rig.camera.connect()

@@ -92,6 +92,34 @@ class CameraTriggeredLighting:
         """No limit to name (:meth:`lit_limit_s` is None)."""
         return NO_LIT_LIMIT
 
+    # no link, nothing commanded: each other ability of the Lighting protocol has nothing to
+    # say, and says so here (the controller had guessed at them with getattr)
+
+    def hold(self) -> None:
+        """No link to keep open."""
+
+    def off_said(self) -> None:
+        """None: no all-off is sent, so none is recorded (:meth:`lights_state` says why)."""
+        return None
+
+    def cool_down_s(self, step: LightStep, at: float) -> float:
+        """0: the host keeps no thermal guard over LEDs it does not light."""
+        return 0.0
+
+    def listen(self, say: Callable[[str], None] | None) -> None:
+        """Nothing to say: no link to lose."""
+
+    def check_held(self) -> None:
+        """Nothing to check: an LED does not move (a slip is the capture check's)."""
+
+    def resends(self) -> tuple[dict[str, list[str]], str | None]:
+        """Nothing: no command is sent, so none is resent."""
+        return {}, None
+
+    def reconnections(self) -> list[dict[str, object]]:
+        """[]: no link to reopen."""
+        return []
+
     @property
     def link_open(self) -> bool:
         """Always False: this dome has no link to the host (the camera's flash signal steps

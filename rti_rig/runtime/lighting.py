@@ -68,6 +68,43 @@ class Lighting(Protocol):
         only of a light that has a limit."""
         ...
 
+    # What follows is answered by every lighting too, a light without the ability giving the
+    # default each names: the controller had asked each with ``getattr``, which a rename would
+    # have silently answered with that default.
+
+    def hold(self) -> None:
+        """Lights off, the link kept open for the next :meth:`connect` where it can be (a
+        dome's port); :meth:`close` otherwise."""
+        ...
+
+    def off_said(self) -> str | None:
+        """What the last all-off established, as recorded (None: no record kept)."""
+        ...
+
+    def cool_down_s(self, step: LightStep, at: float) -> float:
+        """How long after ``at`` the step's light must still cool before it may light (0: no
+        thermal guard)."""
+        ...
+
+    def listen(self, say: Callable[[str], None] | None) -> None:
+        """Have the lights say through ``say`` each reopening of their lost link as it happens
+        (a light whose link is never reopened says nothing)."""
+        ...
+
+    def check_held(self) -> None:
+        """After a capture: raise unless the light still is where it was recorded (an arm's
+        pose; a light that cannot move or cannot tell does nothing)."""
+        ...
+
+    def resends(self) -> tuple[dict[str, list[str]], str | None]:
+        """The manifest's record of commands resent after a fault that then went through, and
+        the line that counts them for the user (nothing and None: none, or none counted)."""
+        ...
+
+    def reconnections(self) -> list[dict[str, object]]:
+        """Each reopening of the lights' lost link so far, for the manifest (none: [])."""
+        ...
+
     @property
     def link_open(self) -> bool:
         """Whether the lights' link to the host is open now, so that :meth:`safe` can be sent
@@ -119,6 +156,10 @@ class DomeLighting:
         silently turned into "never waited"."""
         policy = self.policy
         return None if policy is None else policy.duty_wait()
+
+    def check_held(self) -> None:
+        """Nothing to check: an LED does not move during a capture (what it lit is the
+        dome's all-off's and the thermal guard's to say)."""
 
     def hold(self) -> None:
         """Lights off, the dome's port kept open for the next :meth:`connect` where its driver
@@ -297,6 +338,25 @@ class ArmLighting:
     def lit_limit_said(self) -> str:
         """No limit to name (:meth:`lit_limit_s` is None)."""
         return NO_LIT_LIMIT
+
+    def hold(self) -> None:
+        """An arm keeps no link open between commands: :meth:`close` (lamp off, stop)."""
+        self.close()
+
+    def off_said(self) -> None:
+        """None: a lamp-off's outcome is not recorded apart (a failure raises)."""
+        return None
+
+    def cool_down_s(self, step: LightStep, at: float) -> float:
+        """0: an arm's lamp has no thermal guard here."""
+        return 0.0
+
+    def listen(self, say: Callable[[str], None] | None) -> None:
+        """Nothing to say: a carrier does not reopen a lost port mid-session."""
+
+    def reconnections(self) -> list[dict[str, object]]:
+        """[]: a carrier does not reopen a lost port mid-session."""
+        return []
 
     def connect(self) -> None:
         self.arm_failure = None

@@ -76,7 +76,29 @@ def test_each_adapter_ability_answers_from_its_source(name: str) -> None:
         elif kind == "SimulatedArm":
             _simulated_arm(rig)
         else:
-            assert rig.lighting.lit_limit_s() is None  # the host lights nothing
+            _camera_stepped(rig)
+
+
+def _no_link_defaults(lighting: Any, step: LightStep, at: float) -> None:
+    """What a lighting with no port to lose, record or guard answers (on purpose)."""
+    assert lighting.lit_limit_s() is None
+    assert lighting.off_said() is None and lighting.cool_down_s(step, at) == 0.0
+    assert lighting.resends() == ({}, None) and lighting.reconnections() == []
+    assert lighting.link_open is False
+
+
+def _camera_stepped(rig: Rig) -> None:
+    lighting = rig.lighting
+    lighting.listen(lambda text: pytest.fail(text))
+    lighting.connect()
+    step = _lit_step(rig)
+    lighting.set(step)
+    lighting.check_held()
+    lighting.off()
+    _no_link_defaults(lighting, step, rig.clock.now())
+    lighting.hold()
+    assert lighting.safe() == []
+    lighting.close()
 
 
 def _dome_policy(rig: Rig, connect: bool) -> None:
@@ -133,10 +155,9 @@ def _simulated_dome(rig: Rig) -> None:
     lighting.connect()
     step = _lit_step(rig)
     lighting.set(step)
+    lighting.check_held()  # an LED does not move
     lighting.off()
-    assert lighting.off_said() is None and lighting.cool_down_s(step, rig.clock.now()) == 0.0
-    assert lighting.link_open is False
-    assert lighting.resends() == ({}, None) and lighting.reconnections() == []
+    _no_link_defaults(lighting, step, rig.clock.now())
     lighting.hold()  # no port to keep open: closed
     lighting.connect()  # and opened again
     assert lighting.safe() == []
@@ -154,12 +175,12 @@ def _read_back_arm(rig: Rig) -> None:
     lighting = rig.lighting
     assert isinstance(lighting, ArmLighting)
     assert lighting.read_back is lighting.carrier
-    assert lighting.lit_limit_s() is None
     lighting.connect()
-    lighting.set(_reachable_step(rig))
+    step = _reachable_step(rig)
+    lighting.set(step)
     lighting.check_held()  # holds: nothing raised, no failure remembered
     assert lighting.arm_failure is None
-    assert lighting.resends() == ({}, None)
+    _no_link_defaults(lighting, step, rig.clock.now())  # its resends counted: none yet
     # a servo that overloads during the exposure: the check reads it back and raises
     rig.emulator.inject_hardware_error(1, 0x20)  # type: ignore[attr-defined]
     with pytest.raises(Exception, match=r"(?i)overload"):
@@ -176,11 +197,15 @@ def _simulated_arm(rig: Rig) -> None:
     lighting = rig.lighting
     assert isinstance(lighting, ArmLighting) and lighting.read_back is None
     assert lighting.lit_limit_s() is None
+    lighting.listen(lambda text: pytest.fail(text))
     lighting.connect()
-    lighting.set(_reachable_step(rig))
+    step = _reachable_step(rig)
+    lighting.set(step)
     lighting.check_held()  # a carrier that cannot tell: nothing to check
     assert lighting.arm_failure is None
-    assert lighting.resends() == ({}, None)
+    _no_link_defaults(lighting, step, rig.clock.now())
+    lighting.hold()  # an arm keeps no link open: its close (lamp off, stop)
+    lighting.connect()
     assert lighting.safe() == []
     lighting.close()
     assert lighting.end is not None and lighting.end.outcome == "parked"
