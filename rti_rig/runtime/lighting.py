@@ -87,8 +87,9 @@ class Lighting(Protocol):
         ...
 
     def listen(self, say: Callable[[str], None] | None) -> None:
-        """Have the lights say through ``say`` each reopening of their lost link as it happens
-        (a light whose link is never reopened says nothing)."""
+        """Have the lights say through ``say`` what a user must know as it happens: a dome's
+        reopening of its lost link, an arm's search for its servos at other baud rates or a
+        torque kept on at its close (a light with nothing such to say says nothing)."""
         ...
 
     def check_held(self) -> None:
@@ -350,9 +351,6 @@ class ArmLighting:
     def cool_down_s(self, step: LightStep, at: float) -> float:
         """0: an arm's lamp has no thermal guard here."""
         return 0.0
-
-    def listen(self, say: Callable[[str], None] | None) -> None:
-        """Nothing to say: a carrier does not reopen a lost port mid-session."""
 
     def reconnections(self) -> list[dict[str, object]]:
         """[]: a carrier does not reopen a lost port mid-session."""
