@@ -61,9 +61,13 @@ def png_colour_type(path: Path) -> int | None:
     drivers (a driver may import the core, not the other way)."""
     try:
         with Path(path).open("rb") as f:
-            head = f.read(26)
+            return _ihdr_colour_type(f.read(26))
     except OSError:
         return None
+
+
+def _ihdr_colour_type(head: bytes) -> int | None:
+    """The colour type in a file's first 26 bytes when they are a PNG's signature and IHDR."""
     if len(head) < 26 or head[:8] != PNG_MAGIC or head[12:16] != b"IHDR":
         return None
     return head[25]
@@ -77,14 +81,15 @@ def png_transparency(path: Path) -> str | None:
     Why the key too: OpenCV drops it from a grey PNG and turns it into an alpha sample of a
     colour or palette one, which the readers then drop: either way it had gone unsaid, where
     an alpha channel was said. Read from the chunks before the pixels (the PNG spec puts tRNS
-    before the first IDAT)."""
-    kind = png_colour_type(path)
-    if kind is None:
-        return None
-    if kind in PNG_ALPHA_TYPES:
-        return PNG_ALPHA_TYPES[kind]
+    before the first IDAT). The file is opened once for both (it had been opened once for
+    the colour type and again for the chunks: two opens of every image of an acquisition)."""
     try:
         with Path(path).open("rb") as f:
+            kind = _ihdr_colour_type(f.read(26))
+            if kind is None:
+                return None
+            if kind in PNG_ALPHA_TYPES:
+                return PNG_ALPHA_TYPES[kind]
             f.seek(8)
             while True:
                 head = f.read(8)

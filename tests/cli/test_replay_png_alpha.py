@@ -163,3 +163,39 @@ def test_a_grey_alpha_png_preview_is_planned_from_as_grey_its_alpha_said(tmp_pat
     assert code == 0 and "Traceback" not in text, text
     assert text.count("alpha channel") == 1, text
     assert "1 of 1 image(s) are PNGs with an alpha channel (im00.png)" in " ".join(text.split())
+
+
+@pytest.mark.parametrize(("colour_type", "trns"), [(0, True), (2, False), (6, False)])
+def test_fit_reads_each_png_once_to_learn_its_transparency(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, colour_type: int, trns: bool
+) -> None:
+    """`rti-rig fit` of a PNG acquisition learns each image's transparency (its colour type,
+    then its chunks up to the pixels) from one opening of the file: it had opened every PNG
+    once for the colour type and again for the chunks. The note is said as before."""
+    import inspect
+
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lp, _ = _acquisition(acq, colour_type, 16, trns=trns)
+    opened: dict[str, int] = {}
+    real_open = Path.open
+
+    def counting_open(self: Path, *args, **kwargs):  # type: ignore[no-untyped-def]
+        if self.suffix == ".png" and any(
+            f.function == "png_transparency" for f in inspect.stack(context=0)[1:4]
+        ):
+            opened[self.name] = opened.get(self.name, 0) + 1
+        return real_open(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "open", counting_open)
+    r = CliRunner().invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    assert opened == {f"im{i:02d}.png": 1 for i in range(12)}, opened
+    kind = {0: "transparency key", 2: None, 6: "alpha channel"}[colour_type]
+    assert (kind is None) == ("12 of 12 image(s) are PNGs with" not in r.output), r.output
+    if kind is not None:
+        assert r.output.count(kind) == 1, r.output
