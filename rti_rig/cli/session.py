@@ -1933,6 +1933,8 @@ def export_lp(
         err.print(f"[yellow]note:[/] {escape(done.relisted)}", soft_wrap=True)
     if done.misnamed:
         err.print(f"[yellow]note:[/] {escape(done.misnamed)}", soft_wrap=True)
+    if done.in_session:
+        err.print(f"[yellow]note:[/] {escape(done.in_session)}", soft_wrap=True)
     if done.unchecked:
         err.print(
             f"[yellow]note:[/] left out, not verifiable as captured "

@@ -83,3 +83,43 @@ def test_an_export_beside_another_sessions_images_says_they_lie_there(tmp_path: 
 
     assert r.exit_code == 2, r.output
     assert "where b's own images of the same names lie" in said(r), r.output
+
+
+def test_an_export_into_its_own_session_says_so_and_never_replaces_its_lights_lp(
+    tmp_path: Path,
+) -> None:
+    """An export written at the top of its own session had been written without a word: it
+    says it is inside the session, beside the session's lights.lp left as captured (and which
+    of the two `rti-rig fit` of the folder reads); --force onto lights.lp itself is refused,
+    and a lights.lp the session lost is written again, said as such."""
+    a = _session(tmp_path, "séance a", "6")
+    own = a / "lights.lp"
+    captured = own.read_bytes()
+    wide = CliRunner(env={"COLUMNS": "400"})
+
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(a / "mine.lp"), "--linear"])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert (
+        f"{a / 'mine.lp'} is written inside the session {a}, beside its own lights.lp, which "
+        f"is left as captured (a session's files are never replaced); rti-rig fit {a} reads "
+        f"lights.lp: give {a / 'mine.lp'} itself to use this one"
+    ) in text, text
+    assert own.read_bytes() == captured
+
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(own), "--force"])
+    assert r.exit_code == 2, r.output
+    assert "would replace a file of the session" in said(r), said(r)
+    assert own.read_bytes() == captured
+
+    own.unlink()  # lost: export-lp writes it again, and says what it wrote
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(own)])
+    assert r.exit_code == 0, r.output
+    assert (
+        f"{own} is the session's own lights.lp, which was missing: written again from its journal"
+    ) in said(r), said(r)
+    assert own.read_bytes() == captured
+
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(tmp_path / "outside.lp")])
+    assert r.exit_code == 0, r.output
+    assert "inside the session" not in said(r), said(r)

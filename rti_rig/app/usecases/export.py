@@ -16,6 +16,7 @@ from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
+    LP_NAME,
     MANIFEST,
     JournalScan,
     files_lost_since_capture,
@@ -72,6 +73,9 @@ class ExportedLp:
     mosaic: str = ""
     #: What to say of a file written under a name that is not ``.lp`` ("" if it is one).
     misnamed: str = ""
+    #: What was written into the session's own folder and what was left as captured ("" for
+    #: a file written elsewhere: :attr:`outside_session` says that).
+    in_session: str = ""
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -89,7 +93,8 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     scan = scan_journal(root, image_names(total) if total else None)
     entries, left_out = session_lp_report(root, req.linear, scan, manifest)
     _refuse_another_session(Path(req.out_file), root, entries[0].name if entries else None)
-    check_output_file(req.out_file, req.force, {})
+    check_output_file(req.out_file, req.force, {})  # never the session's own files
+    in_session = _in_session_said(Path(req.out_file), root)  # said before lights.lp is written
     write_lp(req.out_file, entries)
     # lights.lp one image short of the session (a run stopped between a step's record file
     # and its journal line): completed once the export is written, so that both list alike
@@ -118,6 +123,33 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
             lost_image_advice(root, adaptive, scan) if len(left_out) > len(renamed) else ""
         ),
         misnamed=lp_name_note(Path(req.out_file)) or "",
+        in_session=in_session,
+    )
+
+
+def _in_session_said(out_file: Path, root: Path) -> str:
+    """What an export written at the top of its own session folder does there ("" elsewhere).
+
+    Why: it was written there without a word, beside the session's captured files, and whether
+    the session's own lights.lp was replaced (it never is: :func:`check_output_file` refuses
+    it), or which of the two ``rti-rig fit`` of the folder reads, was left to guess."""
+    if out_file.resolve().parent != root.resolve():
+        return ""
+    own = root / LP_NAME
+    if out_file.name == LP_NAME:  # refused if it existed: so the session had lost it
+        return (
+            f"{out_file} is the session's own {LP_NAME}, which was missing: written again from "
+            "its journal"
+        )
+    if own.is_file():
+        return (
+            f"{out_file} is written inside the session {root}, beside its own {LP_NAME}, "
+            f"which is left as captured (a session's files are never replaced); rti-rig fit "
+            f"{root} reads {LP_NAME}: give {out_file} itself to use this one"
+        )
+    return (
+        f"{out_file} is written inside the session {root}, which has no {LP_NAME}: rti-rig "
+        f"export-lp {root} --out {own} writes the session's own {LP_NAME} again"
     )
 
 
