@@ -4,6 +4,8 @@ Found by a front-door audit: `--plan` an image (a JPEG of the session) was told 
 line holds NUL bytes: not plain text (UTF-16 …?) … save it again as UTF-8", `--plan` the rig
 config "line 4: expected 'name x y z'", and `--plan` a session folder "cannot read: Is a
 directory". Nothing was shot in any case; the messages sent the user after the wrong fault.
+A rig config given as the plan was then told "this is a TOML file (a rig config?)", a guess:
+it is said to be one, with what --plan takes and the commands that make and run a plan.
 """
 
 from __future__ import annotations
@@ -25,7 +27,6 @@ runner = CliRunner()
     ("given", "said"),
     [
         (ACQ / "image01.jpg", "this is an image, not an .lp file"),
-        (CONFIGS / "simulated_dome.toml", "this is a TOML file (a rig config?), not an .lp"),
         (ACQ, "is a folder, not an .lp file"),
     ],
 )
@@ -42,3 +43,49 @@ def test_a_plan_that_is_not_an_lp_is_named_for_what_it_is(
     assert "".join(f"{given}: {said}: give the .lp light list".split()) in text, r.output
     assert "NUL" not in text and "expected'namexyz'" not in text
     assert not out.exists()
+
+
+def test_a_rig_config_given_as_the_plan_is_said_to_be_one_with_the_commands_to_make_a_plan(
+    tmp_path: Path,
+) -> None:
+    rig = CONFIGS / "simulated_dome.toml"
+    for given in (rig, CONFIGS / "example_dome_48_folder_watch.toml"):
+        out = tmp_path / "session"
+        r = CliRunner(env={"COLUMNS": "400"}).invoke(
+            app, ["run", str(rig), "--out", str(out), "--plan", str(given)]
+        )
+        assert r.exit_code == 2, r.output
+        assert "Traceback" not in r.output
+        text = " ".join(r.output.split())
+        assert f"--plan {given} is a rig config (" in text, text
+        assert (
+            "), not a plan: --plan takes a plan file, the .lp light list (a count line, then "
+            "'name x y z' per image) that rti-rig plan writes; make one with: rti-rig plan "
+            f"--rig {rig} --out plan.lp, then run it with: rti-rig run {rig} --plan plan.lp "
+            "--out SESSION"
+        ) in text, text
+        assert "a rig config?" not in text
+        assert not out.exists()
+
+
+def test_a_toml_file_that_is_no_rig_config_given_as_the_plan_is_said_to_be_toml(
+    tmp_path: Path,
+) -> None:
+    """Only a file that is a rig config is called one: another TOML file (a light
+    calibration) is told it is TOML, not an .lp."""
+    other = tmp_path / "calibration.toml"
+    other.write_text('format = "rti-rig-light-calibration/1"\nrig = "x"\n', encoding="utf-8")
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(CONFIGS / "simulated_dome.toml"),
+            "--out",
+            str(tmp_path / "s"),
+            "--plan",
+            str(other),
+        ],
+    )
+    assert r.exit_code == 2, r.output
+    text = "".join(r.output.split())
+    assert "thisisaTOMLfile" in text and "isarigconfig" not in text, r.output

@@ -913,6 +913,35 @@ def refuse_unmeterable_camera(loaded) -> None:  # type: ignore[no-untyped-def]
         )
 
 
+def _refuse_rig_config_as_plan(plan: Path, rig_config: Path) -> None:
+    """Refuse a rig config given as ``--plan``, saying that it is one, what ``--plan`` takes
+    and the commands that make and run a plan.
+
+    Why: it had been told "this is a TOML file (a rig config?), not an .lp", a guess that left
+    the user to work out that a plan is another file and where one comes from. Told by its
+    content (a TOML table with a rig's ``kind``), not its name alone; any other file is left to
+    the .lp reader, which says what it is."""
+    import tomllib
+
+    if plan.suffix.lower() != ".toml" or not plan.is_file():
+        return
+    try:
+        data = tomllib.loads(plan.read_bytes().decode("utf-8-sig"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return  # the .lp reader says what the file is
+    if data.get("kind") not in ("dome", "arm"):
+        return
+    name = f" ({data['name']})" if isinstance(data.get("name"), str) and data["name"] else ""
+    rig = shlex.quote(str(rig_config))
+    raise RtiRigError(
+        f"--plan {plan} is a rig config{name}, not a plan: --plan takes a plan file, the .lp "
+        "light list (a count line, then 'name x y z' per image) that rti-rig plan writes; "
+        f"make one with: rti-rig plan --rig {rig} --out plan.lp, then run it with: rti-rig run "
+        f"{rig} --plan plan.lp --out SESSION (or give --lights N for a homogeneous layout "
+        "without a plan)"
+    )
+
+
 def new_session_schedule(  # type: ignore[no-untyped-def]
     req: NewSessionRequest, loaded, on_note: NoteSink = _ignore
 ) -> LightSchedule:
@@ -930,6 +959,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     if req.plan is not None:
         if req.lights is not None:
             raise RtiRigError("give either --plan or --lights, not both")
+        _refuse_rig_config_as_plan(Path(req.plan), Path(req.rig_config))
         plan_notes: list[str] = []
         entries = read_lp(req.plan, upper_hemisphere=True, notes=plan_notes)
         for note in plan_notes:
