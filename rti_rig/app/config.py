@@ -14,7 +14,7 @@ import math
 import tomllib
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -622,13 +622,9 @@ CALIBRATION_FORMAT = "rti-rig-light-calibration/1"
 MEASURED_KEY = "intensity_correction_measured"
 
 
-def read_measured_leds(path: Path, count: int) -> list[bool] | None:
-    """The ``measured`` flags of a calibration file (one per LED), or None if it has none of
-    that length (an older or hand-made file): what is not said is not claimed."""
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
-        return None
+def measured_leds(data: dict[str, Any], count: int) -> list[bool] | None:
+    """The ``measured`` flags of a calibration file's ``data`` (one per LED), or None if it has
+    none of that length (an older or hand-made file): what is not said is not claimed."""
     measured = data.get("measured")
     if not isinstance(measured, list) or len(measured) != count:
         return None
@@ -637,17 +633,49 @@ def read_measured_leds(path: Path, count: int) -> list[bool] | None:
     return list(measured)
 
 
-def read_correction_file(path: Path, rig_name: str) -> list[float]:
-    """The ``intensity_correction`` list of a calibration file, checked against the rig.
+#: What a text file refused by :func:`_config_text` is not, and what to give instead.
+class _TextFileKind(NamedTuple):
+    not_a: str
+    give: str
+    #: name the .lp files beside an image given (a rig: an acquisition's .lp replays it)
+    lps_beside: bool = False
+
+
+#: A light calibration file, as ``[dome.serial] intensity_correction_file`` names one.
+_CALIBRATION_FILE = _TextFileKind(
+    "a light calibration file",
+    "give the light_calibration.toml that rti-rig calibrate-lights wrote",
+)
+
+
+def read_calibration_file(path: Path) -> tuple[dict[str, Any], bytes]:
+    """A light calibration file's parsed TOML and its bytes, from one read.
+
+    Read as tolerantly as a rig config (:func:`_config_text`: UTF-8 with or without a BOM,
+    UTF-16 with one), an image or other binary file refused as such. Why: it had been read as
+    UTF-8 alone, so a file saved again by Notepad as "Unicode" was told Python's decoder's
+    words ("not valid TOML: 'utf-8' codec can't decode byte 0xff"), and an image given for it
+    the same; and it was read three times (values, measured flags, checksum).
+
+    Raises ``ValueError`` with what is wrong (the config loader names the file and key)."""
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
+    try:
+        return tomllib.loads(_config_text(path, raw, _CALIBRATION_FILE)), raw
+    except ConfigError as exc:  # an image, a binary file, another encoding: said as such
+        raise ValueError(str(exc)) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{path} is not valid TOML: {exc}") from None
+
+
+def correction_factors(data: dict[str, Any], path: Path, rig_name: str) -> list[float]:
+    """The ``intensity_correction`` list of calibration file ``path`` (its parsed ``data``),
+    checked against the rig.
 
     Raises ``ValueError`` with what is wrong (the config loader names the file and key).
     """
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a BOM (Notepad) is no error
-    except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{path} is not valid TOML: {exc}") from None
     if data.get("format") != CALIBRATION_FORMAT:
         raise ValueError(
             f"{path} is not an rti-rig light calibration (format {CALIBRATION_FORMAT!r})"
@@ -710,11 +738,12 @@ def _with_correction_file(
         raise ConfigError(path, key, "must be the path of a calibration file (a string)")
     file = (path.resolve().parent / name).resolve()
     try:
-        values = read_correction_file(file, str(data.get("name")))
+        calibration, raw = read_calibration_file(file)
+        values = correction_factors(calibration, file, str(data.get("name")))
     except ValueError as exc:
         raise ConfigError(path, key, str(exc)) from None
     recorded = {**serial, "intensity_correction": values}
-    measured = read_measured_leds(file, len(values))
+    measured = measured_leds(calibration, len(values))
     if measured is not None:  # which LEDs it evens out, for metering and the QA verdict
         recorded[MEASURED_KEY] = measured
     settings = {
@@ -723,7 +752,7 @@ def _with_correction_file(
     return (
         {**data, "dome": {**dome, "serial": recorded}},  # type: ignore[dict-item]
         {**data, "dome": {**dome, "serial": settings}},  # type: ignore[dict-item]
-        file.read_bytes(),
+        raw,
     )
 
 
@@ -738,14 +767,17 @@ def _with_led_map_path(data: dict[str, Any], folder: Path) -> dict[str, Any]:
     return {**data, "dome": {**dome, "serial": resolved}}  # type: ignore[dict-item]
 
 
-#: What to give instead of a file that is no rig config (said after what the file is).
-_GIVE_RIG = (
-    "give the rig config (.toml), or the .lp of a recorded acquisition that lists its images"
+#: A rig config, as ``run``, ``check`` and ``plan --rig`` read one (or an acquisition's .lp).
+_RIG_FILE = _TextFileKind(
+    "a rig config or an .lp",
+    "give the rig config (.toml), or the .lp of a recorded acquisition that lists its images",
+    lps_beside=True,
 )
 
 
-def _config_text(path: Path, raw: bytes) -> str:
-    """The text of rig config ``path`` (its bytes ``raw``): UTF-8, with or without a BOM, or
+def _config_text(path: Path, raw: bytes, kind: _TextFileKind = _RIG_FILE) -> str:
+    """The text of rig config ``path`` (its bytes ``raw``), or of another TOML file it names
+    (``kind``: what the file should be, and what to give): UTF-8, with or without a BOM, or
     UTF-16 with one (Notepad's "Unicode"); else a :class:`ConfigError` saying what the file is
     and what to give.
 
@@ -756,12 +788,10 @@ def _config_text(path: Path, raw: bytes) -> str:
     import codecs
 
     if looks_like_image(raw):
-        kind = _image_kind(path, raw)
-        lps = _lps_beside(path)
+        image = _image_kind(path, raw)
+        lps = _lps_beside(path) if kind.lps_beside else []
         beside = f" ({path.parent} holds {', '.join(lps)}: give that)" if lps else ""
-        raise ConfigError(
-            path, None, f"this is {kind}, not a rig config or an .lp: {_GIVE_RIG}{beside}"
-        )
+        raise ConfigError(path, None, f"this is {image}, not {kind.not_a}: {kind.give}{beside}")
     if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
         with contextlib.suppress(UnicodeDecodeError):
             return raw.decode("utf-16")
@@ -771,7 +801,7 @@ def _config_text(path: Path, raw: bytes) -> str:
         raise ConfigError(
             path,
             None,
-            f"this is a binary file (not text), so not a rig config or an .lp: {_GIVE_RIG}",
+            f"this is a binary file (not text), so not {kind.not_a}: {kind.give}",
         )
     try:
         return raw.decode("utf-8-sig")  # a BOM (Notepad) is no error
