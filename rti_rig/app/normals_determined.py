@@ -189,9 +189,13 @@ def refuse_undetermined(lights: np.ndarray, what: str, advice: str, nothing_done
     what was left undone ("nothing was written"). One refusal for ``rti-rig plan`` and ``rti-rig
     run``: each had its own copy of it, and each worked out "was a band given" itself.
     """
+    from rti_rig.app.usecases.fit_outlook import fit_without_normals
+
     reason = undetermined_normals(lights, what)
     if reason is not None:
+        # what the fit makes of this many: below a PTM's 6 --model auto writes fit.rti alone or
+        # nothing, where "--model auto ... write the relighting files" had been offered
         raise RtiRigError(
-            f"{reason}; {fit_without_normals_words(len(lights))}. "
+            f"{reason}; {fit_without_normals(len(lights))}. "
             f"{advice[0].upper()}{advice[1:]}; {nothing_done}"
         )

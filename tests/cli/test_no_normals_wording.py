@@ -84,3 +84,41 @@ def test_nine_lights_are_offered_hsh2(tmp_path: Path) -> None:
     )
     assert r.exit_code == 0, r.output
     assert "--model auto, --model hsh2 or --model ptm write the relighting files" in said(r)
+
+
+@pytest.mark.parametrize(
+    ("n", "way"),
+    [
+        (3, "`rti-rig fit` with its default --model auto cannot fit them"),
+        (4, "`rti-rig fit --model hsh1` writes fit.rti of them now"),
+        (5, "`rti-rig fit` will make fit.rti (ridge-regularised) but no fit.ptm (a PTM needs 6)"),
+    ],
+)
+def test_fewer_lights_than_a_ptm_are_offered_only_what_fits_them(
+    tmp_path: Path, n: int, way: str
+) -> None:
+    """Below a PTM's 6 lights, `fit --model ps`'s refusal and `run --plan`'s offered
+    "--model auto (--model hsh2 needs 9 lights; --model ptm needs 6 lights, these are N) write
+    the relighting files (fit.rti, fit.ptm)": auto writes nothing of 3 or 4 such lights and
+    fit.rti alone of 5. Each says what the fit does make of them, and how to get more."""
+    plan = _one_azimuth(tmp_path / "one_az.lp", n)
+    rig = str(CONFIGS / "virtual_arm.toml")
+    refused = CliRunner().invoke(
+        app, ["run", rig, "--plan", str(plan), "--out", str(tmp_path / "x")]
+    )
+    assert refused.exit_code == 2, refused.output
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app,
+        ["run", rig, "--plan", str(plan), "--out", str(out), "--no-verdict", "--allow-no-normals"],
+    )
+    assert r.exit_code == 0, r.output
+    fit = CliRunner().invoke(app, ["fit", str(out), "--out", str(tmp_path / "f"), "--model", "ps"])
+    assert fit.exit_code == 2, fit.output
+    for text in (said(refused), said(fit)):
+        assert "Traceback" not in text
+        assert "write the relighting files" not in text and "--model auto (" not in text, text
+        assert f"{n} lights that cannot determine a normal: `rti-rig fit`" in text, text
+        assert way in text, text
+        if n < 5:
+            assert f"for --model auto add {5 - n} more light" in text, text

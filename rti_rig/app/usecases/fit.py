@@ -39,7 +39,7 @@ from rti_rig.app.usecases.fit_inputs import (
 )
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
-from rti_rig.app.usecases.fit_outlook import auto_way_out
+from rti_rig.app.usecases.fit_outlook import auto_way_out, fit_outlook
 from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.app.usecases.fit_signal import no_signal_warning
 from rti_rig.app.usecases.session_integrity import with_lost_files
@@ -1260,11 +1260,19 @@ def _refuse_undetermined_normals(req: FitRequest, model_name: str, lights: np.nd
     if reason is None:
         return
     asked = f"--model auto chose {model_name}" if req.model == AUTO else f"--model {req.model}"
+    n = len(lights)
+    outlook = fit_outlook(n, normals_determined=False)
+    # below a PTM's lights --model auto writes fit.rti alone (5) or nothing (3, 4): "--model
+    # auto ... write the relighting files" had been offered there all the same
+    way = (
+        f"{relighting_models(n)} write the relighting files (fit.rti, fit.ptm), "
+        "ridge-regularised, without normal maps"
+        if outlook is None
+        else f"Without normal maps, {outlook}"
+    )
     raise FitInputError(
         f"{asked}, photometric stereo, but {reason}: ill-conditioned for photometric stereo. "
-        f"{relighting_models(len(lights))} write the relighting files (fit.rti, fit.ptm), "
-        "ridge-regularised, without normal maps; for normals, capture again with lights at "
-        "several elevations and azimuths"
+        f"{way}; for normals, capture again with lights at several elevations and azimuths"
     )
 
 
