@@ -55,3 +55,26 @@ def test_distinct_lights_are_not_said_to_repeat(tmp_path: Path) -> None:
     )
     assert r.exit_code == 0, said(r)
     assert "repeated" not in said(r)
+
+
+@pytest.mark.parametrize(
+    ("args", "ptm_named"),
+    [
+        (("--model", "auto", "--no-ptm"), False),
+        (("--model", "hsh1", "--no-ptm"), False),
+        (("--model", "ptm", "--no-ptm"), True),  # the model itself: fitted, not written
+        (("--model", "hsh1"), True),  # fit.ptm written beside fit.rti
+    ],
+)
+def test_the_repeat_names_a_ptm_only_where_one_is_fitted(
+    tmp_path: Path, args: tuple[str, ...], ptm_named: bool
+) -> None:
+    """With --no-ptm the note had said "too few distinct for --model ptm (6 terms), fitted
+    ridge-regularised and not to be trusted" of a fit that fitted and wrote no PTM."""
+    lp = _seven(tmp_path / "acq", (0, 3, 5))
+    r = CliRunner().invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa", *args])
+    text = said(r)
+    assert r.exit_code == 0, text
+    assert "lights repeated: image01, image13 and image21 share one direction" in text, text
+    assert ("--model ptm (6 terms)" in text) == ptm_named, text
+    assert (tmp_path / "f" / "fit.ptm").exists() == ("--no-ptm" not in args)

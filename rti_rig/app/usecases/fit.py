@@ -738,9 +738,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     notes: list[str] = []
     inputs = acquisition_inputs(req.source)  # before reading: a later change is a change
     frames, lights, names, what = load_acquisition(req.source, notes)
-    repeated = repeated_lights_note(lights, names)
-    if repeated is not None:
-        notes.append(repeated)
+    said_at = len(notes)  # the repeated lights' note goes here, once what was fitted is known
     release_free_memory()  # the decode buffers
     out = req.out_dir
     created = not out.exists()
@@ -767,18 +765,27 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
         raise
     finally:
         pool.shutdown(wait=False, cancel_futures=True)
+    ptm = result.model == "ptm" or result.normals_from == "ptm"
+    ptm = ptm or any(f.name == "fit.ptm" for f in result.files)
+    repeated = repeated_lights_note(lights, names, ptm_fitted=ptm)
+    if repeated is not None:
+        result.notes.insert(said_at, repeated)
     result.seconds = time.perf_counter() - t0
     return result
 
 
-def repeated_lights_note(lights: np.ndarray, names: Sequence[str]) -> str | None:
+def repeated_lights_note(
+    lights: np.ndarray, names: Sequence[str], *, ptm_fitted: bool = True
+) -> str | None:
     """What a fit says of lights that repeat a direction, whatever its model, or None.
 
     Why: a plan or a dome's calibration that repeats a light is refused, saying so, but a fit
     of 7 images of which 3 share one direction said nothing of it with ``--model ptm``: only
     "these lights cannot separate its 6 terms", leaving the user to find that 7 images gave
     5 directions. The models the distinct lights are too few for are named (the coefficient
-    counts of ``core.fit_minimums``)."""
+    counts of ``core.fit_minimums``); a PTM only where one was fitted (``ptm_fitted``: the
+    model, the normals' source or fit.ptm): with ``--no-ptm`` it had been called "fitted
+    ridge-regularised and not to be trusted" of a fit that made none."""
     from rti_rig.core.fit_minimums import N_COEFFICIENTS
     from rti_rig.core.rig_geometry import COINCIDENT_LED_DEG, repeated_directions
 
@@ -790,7 +797,8 @@ def repeated_lights_note(lights: np.ndarray, names: Sequence[str]) -> str | None
     shown = [", ".join(str(names[i]) for i in g[:-1]) + f" and {names[g[-1]]}" for g in groups[:4]]
     more = f" and {len(groups) - 4} more groups" if len(groups) > 4 else ""
     share = "share one direction" if len(groups) == 1 else "each share a direction"
-    short = [m for m in ("ptm", "hsh2", "hsh3") if distinct < N_COEFFICIENTS[m] <= n]
+    named = ("ptm", "hsh2", "hsh3") if ptm_fitted else ("hsh2", "hsh3")
+    short = [m for m in named if distinct < N_COEFFICIENTS[m] <= n]
     tail = (
         "; too few distinct for "
         + ", ".join(f"--model {m} ({N_COEFFICIENTS[m]} terms)" for m in short)
