@@ -1318,6 +1318,7 @@ def assess(
     # one image of one level where the images of its nearest lights shade: named, in place of
     # the dim or bright claims its level against the fit would give it
     flat = {} if all_black or unchanged is not None else flat_images(small, small_sat, dark, lt)
+    flat_mask = np.isin(np.arange(n), list(flat))  # no direction is judged in them (_evidence)
 
     # per-image evidence on a full-resolution crop where the object has lit structure (a
     # second pass reads only its rows)
@@ -1390,7 +1391,9 @@ def assess(
     object_error_limit = float("inf")
 
     def evidence_of(fit: Any, still: NDArray[np.bool_] | None = None) -> _Evidence:
-        ev = _evidence(crop_arr, crop_sat, fit, lt, dark_level, names, still, object_error_limit)
+        ev = _evidence(
+            crop_arr, crop_sat, fit, lt, dark_level, names, still, object_error_limit, flat_mask
+        )
         for i in np.flatnonzero(edge_moved):
             ev.moved[i] = True
             ev.drift_judged[i] = True
@@ -1933,6 +1936,7 @@ def _evidence(
     names: Sequence[str],
     still: NDArray[np.bool_] | None = None,
     object_error_limit: float = float("inf"),
+    pictureless: NDArray[np.bool_] | None = None,
 ) -> _Evidence:
     """Every image judged against one fit ``ps``. Images in ``still`` are judged as captured,
     never moved back by a shift against the fit: one the verdict does not claim (see
@@ -2085,14 +2089,21 @@ def _evidence(
     best = _unit_rows(sols)
     err = np.array([_angle(best[i], lt[i]) if np.any(sols[i]) else np.nan for i in range(n)])
     dead = np.isfinite(lit_gain) & (lit_gain < NO_LIGHT_GAIN)
+    # no direction to judge either in a flat frame (one level, no picture of the object:
+    # qa_unchanging.flat_images, named as such): its best direction, fitted to one level, and
+    # its misfit are no light's and no surface's. It had been said "best direction 44° from
+    # the recorded light ... on this object gloss, shadows or clipping pull the best
+    # direction" beside "a flat frame", and counted among the images too far from any
+    # rendering ("a glossy, saturated or non-Lambertian surface")
+    nodir = dead | (pictureless if pictureless is not None else np.zeros(n, bool))
     # a wrong light can look dim (its recorded light predicts a brighter image): only a frame
     # with no light at all has no direction to judge
     # an image clipped over most of the object keeps only the pixels its light barely
     # reaches: its best direction is fitted on those and means nothing (96-100 % clipped, the
     # tablet's images had been told "wrong light: … 9-22° … (swapped?)" beside "saturated")
     clipped = np.array([float(crop_sat[i][valid].mean()) if valid.any() else 0.0 for i in range(n)])
-    blinded = ~dead & (clipped > CLIPPED_DIRECTION_LIMIT)
-    cand = ~dead & ~blinded & np.isfinite(misfit) & (misfit <= MISFIT_LIMIT) & np.isfinite(err)
+    blinded = ~nodir & (clipped > CLIPPED_DIRECTION_LIMIT)
+    cand = ~nodir & ~blinded & np.isfinite(misfit) & (misfit <= MISFIT_LIMIT) & np.isfinite(err)
     nv = ps.normals[valid].astype(np.float64)
     moment = nv.T @ nv / max(len(nv), 1)
     spread_deg = float(np.degrees(np.arcsin(np.sqrt(max(np.linalg.eigvalsh(moment)[0], 0.0)))))
@@ -2103,7 +2114,7 @@ def _evidence(
     object_typical = float("nan")
     note = ""
     most_disagree = False
-    undimmed = int((~dead).sum())
+    undimmed = int((~nodir).sum())
     if spread_deg < MIN_NORMAL_SPREAD_DEG:
         note = (
             f"light directions not checked: the fitted normals spread only {spread_deg:.1f}° "
@@ -2116,7 +2127,7 @@ def _evidence(
             f"wrong light from the others (at least {MIN_DIRECTION_IMAGES} are needed)"
         )
     elif cand.sum() < (needed := max(MIN_DIRECTION_IMAGES, (undimmed + 1) // 2)):
-        spread = float(np.median(misfit[~dead & np.isfinite(misfit)])) if undimmed else np.nan
+        spread = float(np.median(misfit[~nodir & np.isfinite(misfit)])) if undimmed else np.nan
         # how many are needed is said: "median misfit 9%, limit 10%" alone had read as a
         # check passed (6 images need 5 close; a median under the limit says 3 or 4 are)
         note = (
@@ -2200,7 +2211,7 @@ def _evidence(
                 mv = _confirmed_shift(pred_best, crop_arr[i], dx, dy, valid & ~crop_sat[i])[0]
             moved[i] = mv
             drift[i] = (dx, -dy)
-        skipped = [i for i in range(n) if not cand[i] and not dead[i] and not blinded[i]]
+        skipped = [i for i in range(n) if not cand[i] and not nodir[i] and not blinded[i]]
         if skipped and judged.any():
             note = (
                 f"light direction not checked on {_names([names[i] for i in skipped])} "
@@ -2234,7 +2245,7 @@ def _evidence(
             raws,
             usable_raw,
             lt,
-            ~dead & ~blinded & np.isfinite(misfit),
+            ~nodir & ~blinded & np.isfinite(misfit),
             best,
             misfit,
             WRONG_LIGHT_MISFIT_RATIO,

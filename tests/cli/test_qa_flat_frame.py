@@ -108,3 +108,22 @@ def test_a_flat_frame_among_the_sheets_images_is_named(tmp_path: Path) -> None:
     said, qa = qa_of(lp, tmp_path / "f")
     named = [c["name"] for c in qa["images"] if any(FLAT in p for p in c["problems"])]
     assert named == [mid[: -len(".png")]], said
+
+
+def test_a_flat_frames_light_direction_is_not_judged(tmp_path: Path, arm_tablet_12: Path) -> None:
+    """A flat frame holds no picture, so no direction: the verdict had named it a flat frame
+    and, beside it, "image_005: best direction 44° from the recorded light, but the recorded
+    light explains the image nearly as well (... on this object gloss, shadows or clipping pull
+    the best direction)", a judgement of a direction no image of it can give."""
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    for f in [*arm_tablet_12.glob("image_*.jpg"), arm_tablet_12 / "lights.lp"]:
+        shutil.copy(f, acq / f.name)
+    img = cv2.imread(str(acq / "image_005.jpg"))
+    cv2.imwrite(str(acq / "image_005.jpg"), np.full_like(img, int(img.mean())))
+    said, qa = qa_of(acq, tmp_path / "f")
+    assert f"image_005 ({FLAT}" in said, said
+    assert said.count("image_005") == 1, said  # named once: as the flat frame it is
+    assert "best direction" not in said and "direction not checked" not in said, said
+    (flat,) = [c for c in qa["images"] if c["name"] == "image_005"]
+    assert [p for p in flat["problems"] if FLAT not in p] == [], flat["problems"]
