@@ -98,6 +98,15 @@ class SerialTransport:
         on" of a dome it had never reached."""
         return "://" not in self.port
 
+    @property
+    def is_open(self) -> bool:
+        """The port is open, this transport's to close. Also after :meth:`open` raised a stop
+        held over the opening: the hold acts on it once the port is this transport's, so the
+        caller holds an open (and locked) port, where one cut short inside pyserial's open has
+        none. Why asked: a caller that took every stop out of :meth:`open` for the latter
+        opened the port again while this one still held its lock."""
+        return self._ser is not None
+
     def open(self) -> None:
         """Open (and lock) the port; nothing to do if it is open.
 

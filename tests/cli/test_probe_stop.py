@@ -360,3 +360,40 @@ def test_a_stop_as_the_first_port_closes_leaves_it_unlocked_for_the_all_off(
     assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
     assert "Traceback" not in said, said
     assert board.lit_once_booted() == frozenset()
+
+
+@pytest.mark.parametrize(("opening", "boots"), [(1, 1), (2, 2)], ids=["listen", "nab-found"])
+def test_a_stop_held_over_an_opening_is_torn_down_on_the_open_port(
+    monkeypatch: pytest.MonkeyPatch, opening: int, boots: int
+) -> None:
+    """A SIGTERM as the system opens the port (the board resets), held by the transport over
+    pyserial's open and raised once the port is the transport's: open and locked. The probe
+    took it for a stop inside the opening (port closed) and opened the port again while this
+    one still held its lock: "another program holds it (it could not be locked)", the dome
+    left lit. A real signal sent as the emulator sees the port open lands there whenever the
+    probe is descheduled within pyserial's open (the SIGTERM case of the first test failed so
+    on a loaded machine); here the signal is raised inside that hold, every time. The stop is
+    finished on the port already open: no further opening (``boots``), the dome switched off.
+    ``opening`` 1 is the first listen's, 2 the Nab sketch's own once its banner was heard."""
+    real_open = serial.serial_for_url
+    openings: list[str] = []
+
+    def opened_then_stopped(url: str, *args: Any, **kwargs: Any) -> Any:
+        port = real_open(url, *args, **kwargs)
+        openings.append(url)
+        if len(openings) == opening:
+            signal.raise_signal(signal.SIGTERM)  # inside the transport's hold over the opening
+        return port
+
+    monkeypatch.setattr(serial, "serial_for_url", opened_then_stopped)
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = CliRunner().invoke(app, ["probe", link.port])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 143, said
+    assert len(openings) == boots, openings
+    assert "could not be locked" not in said, said
+    assert "Probe stopped (SIGTERM): the sketch boots with every LED on; all-off sent and " in said
+    assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
+    assert _boots(board) == boots, board.events
+    assert board.lit_once_booted() == frozenset()

@@ -290,21 +290,31 @@ def _exchange(
     (:func:`_stopped_on_open_port`), then :class:`ProbeStopped` is raised."""
     t = SerialTransport(result.port, baud)
     result.openings += 1
+    held: EmergencyStop | None = None
     try:
         t.open()
     except TransportError as exc:
         raise _PortNotOpened(str(exc), errno=exc.errno) from exc
     except EmergencyStop as exc:
-        # inside pyserial's open, which closes the port as the stop goes through: the opening
-        # may have reset the board all the same (the Nab sketch then boots with every LED on)
-        _stopped_inside_opening(result, t, wait_s)
-        raise ProbeStopped(exc, result) from None
+        if not t.is_open:
+            # inside pyserial's open, which closes the port as the stop goes through: the
+            # opening may have reset the board all the same (the Nab sketch then boots lit)
+            _stopped_inside_opening(result, t, wait_s)
+            raise ProbeStopped(exc, result) from None
+        # held over the opening (the transport's hold) and raised once the port was open: the
+        # port is ours, at ``baud``, as for a stop at the start of the listen below. Taken for
+        # a stop inside the opening, the port was opened again while this one still held its
+        # lock ("another program holds it"), and the Nab dome was left lit (a SIGTERM sent as
+        # the board reset, on a loaded machine, lands there)
+        held = exc
     opened = time.monotonic()
     # the bytes are collected here as they come, not when a listen returns: a stop inside a
     # listen had lost all it heard (a Nab banner already in, then "stopped before a firmware
     # answered" and no all-off, the dome left lit)
     heard = bytearray()
     try:
+        if held is not None:
+            raise held  # its teardown, below, on the port open at ``baud``
         _listen(t, wait_s, into=heard)
         if send:
             t.write(send)
@@ -322,6 +332,8 @@ def _exchange(
         except TransportError as failed:
             result.error = ProbeError(ProbeFailure.PORT_FAILED, str(failed))
             _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
+        finally:
+            t.close()  # its all-off sent on it (closing resets no board; opening does)
         raise ProbeStopped(exc, result) from None
     except BaseException:
         t.close()
@@ -482,13 +494,23 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
     result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
     t = SerialTransport(result.port, _NAB_BAUD)
     result.openings += 1
-    t.open()
+    stop: EmergencyStop | None = None
+    try:
+        t.open()
+    except EmergencyStop as exc:
+        if not t.is_open:
+            raise  # cut short inside pyserial's open (the port closed): the caller reopens it
+        # held over the opening and raised once the port was open: finished on this port, as
+        # a stop in the boot listen is (left open, it had been reopened by the caller's
+        # teardown while still locked, and the dome left lit)
+        stop = exc
     opened = time.monotonic()
     deadline = opened + _nab_boot_s(wait)
     booted = bytearray()
-    stop: EmergencyStop | None = None
     try:
         try:
+            if stop is not None:
+                raise stop  # the teardown below: the rest of the boot, then the all-off
             # the board resets as the port opens: its bootloader, then its banner
             _listen(t, deadline - time.monotonic(), until=_NAB_READY, into=booted)
         except EmergencyStop as exc:
