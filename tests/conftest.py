@@ -9,6 +9,7 @@ import re
 import signal
 import socket
 import subprocess
+import sys
 import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -245,6 +246,29 @@ def _emulated_servos_power_cycled(
     from rti_rig.simulator.servo_latch import STATE_DIR_ENV
 
     monkeypatch.setenv(STATE_DIR_ENV, str(tmp_path_factory.mktemp("servo-state")))
+
+
+#: The terminal width every test's CLI output is rendered at (:func:`_wide_console`).
+WIDE_COLUMNS = 400
+
+
+@pytest.fixture(autouse=True)
+def _wide_console(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every test's rich consoles (the CLI's ``out``/``err``, typer's help) render
+    :data:`WIDE_COLUMNS` wide, as rich reads ``COLUMNS`` when it prints; a child process
+    (``python -m rti_rig``) inherits it.
+
+    Why: with no terminal rich wraps at 80 and folds a token longer than the line mid-word
+    (``x.l p``), so a test looking for a path in the output failed wherever pytest's basetemp
+    was long (``/tmp/pytest-of-root/pytest-2NN/test_name_with_long_words0/...``), and
+    ``said()``'s unwrapping cannot mend a fold. ``CliRunner.invoke(terminal_width=...)`` sets
+    click's width only, not rich's. A test of the wrapping at a user's width says its own
+    (``CliRunner(env={"COLUMNS": "80"})``). Users' output is unchanged: this is the tests'."""
+    monkeypatch.setenv("COLUMNS", str(WIDE_COLUMNS))
+    cli_app = sys.modules.get("rti_rig.cli.app")
+    if cli_app is not None:  # a width fixed as it was imported (COLUMNS exported then) yields
+        for console in (cli_app.out, cli_app.err):
+            monkeypatch.setattr(console, "_width", None)
 
 
 @pytest.fixture(autouse=True)

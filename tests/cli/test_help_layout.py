@@ -17,6 +17,9 @@ from rti_rig.cli import app
 from rti_rig.cli.bench import bench_app
 
 runner = CliRunner()
+#: A user's terminal, 80 columns: where a description wraps (the tests' own consoles are wider,
+#: tests/conftest.py's ``_wide_console``, where a description would fit on one line).
+at_80 = CliRunner(env={"COLUMNS": "80"})
 
 #: Every command's help, as a user asks for it.
 COMMANDS = [
@@ -38,7 +41,7 @@ def test_every_command_is_listed() -> None:
 
 @pytest.mark.parametrize("command", COMMANDS, ids=" ".join)
 def test_a_description_is_wrapped_by_the_terminal_not_by_its_source(command: list[str]) -> None:
-    r = runner.invoke(app, [*command, "--help"])
+    r = at_80.invoke(app, [*command, "--help"])
     assert r.exit_code == 0, r.output
     width = max(len(ln) for ln in r.output.splitlines())  # the console's width
     described = description_lines(r.output)
