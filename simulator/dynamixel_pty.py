@@ -42,6 +42,7 @@ from typing import Any
 
 import dynamixel_sdk
 
+from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
 from rti_rig.simulator.pty_link import host_baud
 
@@ -226,11 +227,8 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
                     if ledger.host_got >= ledger.device_sent:
                         ledger.listening = False
                         return
-            waiting = self.ser.in_waiting
-            if waiting:
-                data = self.ser.read(waiting)
-                with ledger.lock:
-                    ledger.host_got += len(data)
+            if self.ser.in_waiting:
+                self._take_waiting()
             else:
                 select.select([self.ser.fileno()], [], [], HOST_WAIT_S)
 
@@ -248,25 +246,47 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
         ledger = self._ledger
         with ledger.lock:
             ledger.listening = False
-        waiting = self.ser.in_waiting
-        data = self.ser.read(waiting) if waiting else b""
-        with ledger.lock:
-            ledger.host_got += len(data)
+        self._take_waiting()
+
+    def _take_waiting(self) -> None:
+        """Read and drop what has arrived, counted as consumed (as one step: see
+        :meth:`writePort`)."""
+        with signals_deferred():
+            waiting = self.ser.in_waiting
+            data = self.ser.read(waiting) if waiting else b""
+            with self._ledger.lock:
+                self._ledger.host_got += len(data)
 
     def writePort(self, packet: Any) -> int:
+        """The SDK's write, and its bytes counted in the ledger, as one step: SIGINT/SIGTERM
+        are held over the two (:func:`signals_deferred`; a pty write of a packet is a few
+        microseconds) and acted on right after.
+
+        Why: the CLI's emergency stop is raised wherever its signal lands, and one landing
+        between pyserial's write and the count left ``host_sent`` short of what the emulator
+        read; every later reply wait then ended as soon as the emulator had read as many
+        bytes as the host had counted, before it had read the new instruction, and the run's
+        teardown said the servos were "asked again 2 times after a status packet was lost",
+        no packet having been. A stop between a read and its count left ``host_got`` short:
+        each later wait for a silent servo lasted :data:`LOST_LINK_S`. The link's bookkeeping
+        is this emulator's, not the device's; the stop still lands mid-exchange (after the
+        write, before the reply is read) as on a real bus, for the driver to recover from."""
         ledger = self._ledger
-        with ledger.lock:
-            ledger.listening = False
-        n = super().writePort(packet)
-        with ledger.lock:
-            ledger.host_sent += int(n or 0)
+        with signals_deferred():
+            with ledger.lock:
+                ledger.listening = False
+            n = super().writePort(packet)
+            with ledger.lock:
+                ledger.host_sent += int(n or 0)
         return n
 
     def readPort(self, length: int) -> bytes:
+        """The SDK's read and its count as one step (see :meth:`writePort`)."""
         self._listen()
-        data = super().readPort(length)
-        with self._ledger.lock:
-            self._ledger.host_got += len(data)
+        with signals_deferred():
+            data = super().readPort(length)
+            with self._ledger.lock:
+                self._ledger.host_got += len(data)
         return data
 
     def isPacketTimeout(self) -> bool:
