@@ -59,7 +59,12 @@ from rti_rig.planner.surface_estimate import (
     tilt_stats,
 )
 from rti_rig.planner.topography import DepthModelSpec
-from rti_rig.planner.uniform import arm_below, order_nearest_neighbour, select_uniform_leds
+from rti_rig.planner.uniform import (
+    arm_band_note,
+    arm_below,
+    order_nearest_neighbour,
+    select_uniform_leds,
+)
 
 __all__ = ["MANY_LIGHTS", "PlanRequest", "make_plan", "plan", "plan_with_report"]
 
@@ -323,7 +328,9 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
     t0 = time.perf_counter()
     geometry, n = req.geometry, req.n
     relit_band, cut = _relit_band(geometry, req.min_elevation_deg, req.max_elevation_deg)
+    band_note = None
     if isinstance(geometry, ArmGeometry):
+        band_note = arm_band_note(geometry, req.min_elevation_deg, req.max_elevation_deg)
         geometry = arm_below(geometry, req.max_elevation_deg)
     candidates, starts = _candidates_and_starts(
         geometry, n, req.min_elevation_deg, req.max_elevation_deg
@@ -339,6 +346,8 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
         req.max_elevation_deg if cut else 90.0,  # a ceiling above every light changes nothing
         material=req.material,
     )
+    if band_note is not None:
+        report.notes.append(band_note)
     prov: dict[str, Any] = {
         "n": n,
         "min_elevation_deg": req.min_elevation_deg,

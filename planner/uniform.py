@@ -102,6 +102,32 @@ def arm_below(arm: ArmGeometry, max_elevation_deg: float) -> ArmGeometry:
     return replace(arm, max_elevation_deg=max_elevation_deg)
 
 
+def arm_band_note(
+    arm: ArmGeometry, min_elevation_deg: float, max_elevation_deg: float
+) -> str | None:
+    """What an elevation band asked for (``--min/--max-elevation-deg``) became on ``arm``,
+    when part of it is beyond the arm's reach; None when the band is used as given (or not
+    given at all: 0..90 means every elevation the rig offers).
+
+    Why: the layout was spread over the reachable part alone, silently: on an arm reaching
+    75°, "--min-elevation-deg 70 --max-elevation-deg 90" gave lights between 70° and 75° and
+    nothing said the top 15° of the band had been cut."""
+    if (min_elevation_deg, max_elevation_deg) == (0.0, 90.0):
+        return None
+    top = min(arm.max_elevation_deg, 90.0 - arm.keep_out_half_angle_deg)
+    lo = max(min_elevation_deg, arm.min_elevation_deg)
+    hi = min(max_elevation_deg, top)
+    if lo >= hi or (lo, hi) == (min_elevation_deg, max_elevation_deg):
+        return None  # refused elsewhere (no band left), or used as asked
+    asked = f"--min-elevation-deg {min_elevation_deg:g} --max-elevation-deg {max_elevation_deg:g}"
+    return (
+        f"{asked}: the arm reaches elevations {arm.min_elevation_deg:g}°..{top:g}° (its "
+        f"elevation limits {arm.min_elevation_deg:g}°..{arm.max_elevation_deg:g}° and the "
+        f"{arm.keep_out_half_angle_deg:g}° keep-out cone around the camera), so the lights "
+        f"are spread over {lo:g}°..{hi:g}° only"
+    )
+
+
 def order_nearest_neighbour(
     directions: NDArray[np.float64], start: NDArray[np.float64]
 ) -> NDArray[np.intp]:

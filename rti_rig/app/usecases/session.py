@@ -951,9 +951,10 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     from rti_rig.app.config import rig_geometry
     from rti_rig.app.normals_determined import band_advice
     from rti_rig.core.lp_format import read_lp
+    from rti_rig.core.rig_geometry import ArmGeometry
     from rti_rig.planner.from_lp import schedule_from_lp
     from rti_rig.planner.make_plan import check_elevation_band
-    from rti_rig.planner.uniform import plan_uniform
+    from rti_rig.planner.uniform import arm_band_note, plan_uniform
 
     geometry = rig_geometry(loaded)
     if req.plan is not None:
@@ -1000,6 +1001,10 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     schedule = plan_uniform(
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
     )
+    if isinstance(geometry, ArmGeometry):  # a band beyond the arm's reach, cut: said once
+        cut = arm_band_note(geometry, req.min_elevation_deg, req.max_elevation_deg)
+        if cut is not None:
+            on_note(Note(cut, "warning"))
     _check_determined(
         req,
         schedule,

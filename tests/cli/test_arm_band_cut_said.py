@@ -1,0 +1,57 @@
+"""An elevation band asked of an arm beyond its reach is said to be cut, once, by ``run`` and by
+``plan``; a band within reach is used as given, and nothing is said.
+
+Why: the layout was spread over the reachable part alone, silently: "--min-elevation-deg 70
+--max-elevation-deg 90" on the shipped virtual arm (which reaches 80°) lit only 70°..80°.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from conftest import CONFIGS, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
+
+runner = CliRunner(env={"COLUMNS": "400"})
+ARM = str(CONFIGS / "virtual_arm.toml")
+CUT = "the arm reaches elevations 5°..80°"
+
+
+def _elevations(lp: Path) -> list[float]:
+    import numpy as np
+
+    from rti_rig.core.geometry import az_el_from_direction
+
+    dirs = np.array([e.direction for e in read_lp(lp, upper_hemisphere=True)])
+    return [float(x) for x in az_el_from_direction(dirs)[1]]
+
+
+def test_run_says_once_that_the_band_was_cut(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    band = ["--min-elevation-deg", "70", "--max-elevation-deg", "90"]
+    r = runner.invoke(app, ["run", ARM, "--lights", "6", "--out", str(out), "--no-verdict", *band])
+    text = said(r)
+    assert r.exit_code == 0, text
+    assert text.count(CUT) == 1, text
+    assert "so the lights are spread over 70°..80° only" in text, text
+    assert all(69.9 <= el <= 80.1 for el in _elevations(out / "lights.lp"))
+
+
+def test_plan_says_that_the_band_was_cut(tmp_path: Path) -> None:
+    out = tmp_path / "p.lp"
+    argv = ["plan", "--rig", ARM, "--lights", "8", "--method", "uniform", "--out", str(out)]
+    r = runner.invoke(app, [*argv, "--min-elevation-deg", "0", "--max-elevation-deg", "50"])
+    text = said(r)
+    assert r.exit_code == 0, text
+    assert CUT in text and "spread over 5°..50° only" in text, text
+
+
+def test_a_band_within_reach_is_not_said(tmp_path: Path) -> None:
+    out = tmp_path / "p.lp"
+    argv = ["plan", "--rig", ARM, "--lights", "8", "--method", "uniform", "--out", str(out)]
+    r = runner.invoke(app, [*argv, "--min-elevation-deg", "20", "--max-elevation-deg", "60"])
+    assert r.exit_code == 0, said(r)
+    assert "the arm reaches" not in said(r)
