@@ -167,14 +167,20 @@ class ArmGeometry:
         return lo, hi
 
     def homogeneous(self, n: int, min_elevation_deg: float = 0.0) -> NDArray[np.float64]:
-        """``n`` directions spread evenly over the reachable band, azimuths within range."""
+        """``n`` directions spread evenly over the reachable band and the reachable azimuths.
+
+        The even layout's azimuths (-180°..180°) are mapped linearly onto the arm's azimuth
+        range, so that the spread stays even within it. Why: they had been moved onto the
+        nearest limit instead, so an arm turning ±170° lit every light of the 20° it cannot
+        reach at exactly ±170° (two or three lights of 24 at one place, a gap beside them)."""
         if n <= 0:
             raise ScheduleError(f"--lights must be at least 1, got {n}")
         lo, hi = self.elevation_band(min_elevation_deg)
-        # :meth:`clamp_azimuth` for all at once (the same numbers; a plan asks for 5 layouts)
         az, el = az_el_from_direction(fibonacci_cap(n, lo, hi))
         a = np.where(az > 180.0, az - 360.0, az)
-        a = np.minimum(np.maximum(a, self.min_azimuth_deg), self.max_azimuth_deg)
+        span = self.max_azimuth_deg - self.min_azimuth_deg
+        if span < 360.0:
+            a = self.min_azimuth_deg + (a + 180.0) * (span / 360.0)
         return direction_from_az_el(a, el)
 
     def clamp_azimuth(self, direction: ArrayLike) -> NDArray[np.float64]:
