@@ -154,7 +154,9 @@ FAULT_ADVICE = {
 POWER_CYCLE = "switch the servos' power off and on"
 
 
-def reboot_how(config: str | None = None, power_cycle: str = POWER_CYCLE) -> str:
+def reboot_how(
+    config: str | None = None, power_cycle: str = POWER_CYCLE, torque_on: bool | None = False
+) -> str:
     """The advice's last clause: how to clear a latched fault, ``config`` (the rig config's
     path, shell-quoted) named in the command when known, so that it can be pasted; the
     placeholder ``RIG.toml`` only for a bus opened without a rig config (the manual tools).
@@ -167,11 +169,33 @@ def reboot_how(config: str | None = None, power_cycle: str = POWER_CYCLE) -> str
     --reboot-faulted" was said by ``run`` and ``check`` of a config they had just opened,
     which the user had to put in by hand. ``power_cycle``: how this rig's servos are power-
     cycled (an emulated chain has no power switch: "switch the servos' power off and on" was
-    advice no one could follow on it)."""
+    advice no one could follow on it).
+
+    ``torque_on``: Torque Enable as read after the fault (None: not read). What a real servo
+    does, said as it is: a Reboot clears Hardware Error Status only if the fault's cause is
+    gone (the e-manual's Shutdown; a servo still too hot shuts down again, ROBOTIS forum,
+    "Reboot after Shutdown with XM430-W210-R"), and ``--reboot-faulted`` reboots only a
+    servo whose torque is off (a reboot switches torque off: a held joint would drop). Why:
+    every fault had been told to run ``--reboot-faulted``, an input-voltage error on an
+    XL430 too, whose torque stays on (its Shutdown 0x34 does not select it): the check then
+    refused to reboot it, and nothing had said that a reboot before the cause is fixed
+    leaves the fault set."""
     rig = shlex.quote(config) if config else "RIG.toml"
+    cause_first = (
+        "a reboot clears the fault only once its cause is gone, else the servo reports it again"
+    )
+    if torque_on is True:
+        return (
+            f"then, as its torque is on, rti-rig check {rig} --reboot-faulted will not reboot "
+            f"it (a reboot switches torque off and the joint would drop): support the arm and "
+            f"{power_cycle} to clear it ({cause_first}), then run rti-rig check {rig}"
+        )
+    only_off = "it reboots the faulted servos whose torque is off, and nothing moves"
+    if torque_on is None:
+        only_off = "it reboots a faulted servo only if its torque is off, and nothing moves"
     return (
-        f"then run rti-rig check {rig} --reboot-faulted (it reboots the faulted servos whose "
-        f"torque is off, and nothing moves), or {power_cycle}, to clear it"
+        f"then run rti-rig check {rig} --reboot-faulted ({only_off}), or {power_cycle}, to "
+        f"clear it ({cause_first})"
     )
 
 

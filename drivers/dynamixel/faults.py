@@ -91,7 +91,7 @@ class HardwareFaultError(DynamixelError):
         super().__init__(
             device,
             f"hardware fault {names} (Hardware Error Status 0x{status:02X}); {advice}; "
-            f"{ct.reboot_how(config, power_cycle)}. " + torque_statement(torque_on),
+            f"{ct.reboot_how(config, power_cycle, torque_on)}. " + torque_statement(torque_on),
             command,
             servo_id,
         )
