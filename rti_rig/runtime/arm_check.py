@@ -24,6 +24,7 @@ from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direc
 from rti_rig.core.rig_geometry import ArmGeometry
 from rti_rig.runtime.arm_end import PARK_TOLERANCE_DEG, ArmEnd, left_end, park_end
 from rti_rig.runtime.lighting import attempt_all
+from rti_rig.runtime.teardown_repeats import failed_as_before
 
 #: Largest angle between the asked and the reached direction that passes (degrees).
 TOLERANCE_DEG = 1.0
@@ -356,7 +357,7 @@ def _check_end(carrier: LightCarrier, report: ArmSelfTestReport, connected: bool
 
 def _point_back(failures: list[str]) -> list[str]:
     """Teardown failures, one that repeats an earlier one word for word replaced by a pointer
-    to it (``close: failed as 'stop' above``).
+    to it (:func:`~rti_rig.runtime.teardown_repeats.failed_as_before`).
 
     Why: the driver's ``close`` stops the arm again, so one servo fault had been printed in
     full twice, a paragraph for the stop and the same paragraph for the close (``rti-rig run``
@@ -365,5 +366,5 @@ def _point_back(failures: list[str]) -> list[str]:
     for failure in failures:
         label, _, text = failure.partition(": ")
         first = next((f.partition(": ")[0] for f in out if f.partition(": ")[2] == text), None)
-        out.append(f"{label}: failed as '{first}' above" if first is not None else failure)
+        out.append(failed_as_before(label, first) if first is not None else failure)
     return out

@@ -34,6 +34,7 @@ from rti_rig.runtime.session import (
     recorded_frame_size,
     steps_to_hold,
 )
+from rti_rig.runtime.teardown_repeats import failed_as_before
 
 
 class FinishReason(StrEnum):
@@ -630,7 +631,7 @@ def _teardown_failure(label: str, exc: Exception, earlier: list[str]) -> str:
     for failure in earlier:
         first, _, said = failure.partition(": ")
         if said == text:
-            return f"{label}: failed as '{first}' above"
+            return failed_as_before(label, first)
     return f"{label}: {text}"
 
 

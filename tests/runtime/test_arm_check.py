@@ -298,4 +298,4 @@ def test_an_arm_whose_stop_failed_is_not_said_to_have_been_stopped(
     assert "stopped where it was" not in said, said
     assert "the stop did not hold every joint" in said
     assert said.count("it may still be moving") == 1, said
-    assert "teardown FAILED: close: failed as 'stop' above" in said
+    assert "teardown FAILED: close: failed with the same error as 'stop' above" in said
