@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.clock import Clock
-from rti_rig.core.devices import LightCarrier
+from rti_rig.core.devices import LightCarrier, ReadBackCarrier
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.rig_geometry import ArmGeometry
@@ -311,8 +311,9 @@ def arm_self_test(
         # read back before the close releases the port (and, by its torque policy, the joints)
         report.end = _check_end(carrier, report, connected)
         failures += attempt_all([("close", carrier.close)])
-        note = getattr(carrier, "torque_release_note", None)
-        released = note() if callable(note) else None
+        # asked by name of a carrier that reads its servos back (a rename fails there, at
+        # construction); one that does not (the simulated arm) releases nothing
+        released = carrier.torque_release_note() if isinstance(carrier, ReadBackCarrier) else None
         if report.end is not None and released:
             # the end a stopped check is said by (``end.sentence()``) carries the release too:
             # a check stopped with the arm at its park pose was said "not parked and left at

@@ -13,11 +13,11 @@ from __future__ import annotations
 def failed_as_before(label: str, first: str) -> str:
     """``label: …`` for a step whose error is word for word that of the earlier ``first``.
 
-    Only what the repetition establishes is said: the step tried again what ``first`` had
-    tried (a close switches the lights off and stops the arm again) and failed the same way,
-    so nothing better than what ``first``'s line says is known of the rig."""
+    Only what the repetition establishes is said: the step failed with ``first``'s error, so
+    nothing better than what ``first``'s line says is known of the rig. What the step tried is
+    not said: a close switches the lights off and stops the arm again, but the same error
+    after a park does not show that the close parked."""
     return (
-        f"{label}: failed with the same error as '{first}' above (it tried that again as it "
-        f"closed); nothing more was established of the lights or the arm than the '{first}' "
-        "line says"
+        f"{label}: failed with the same error as '{first}' above; nothing more was "
+        f"established of the lights or the arm than the '{first}' line says"
     )
