@@ -30,8 +30,7 @@ def test_the_close_failing_as_the_stop_did_is_said_plainly(tmp_path: Path) -> No
     assert r.returncode == 2 and "Traceback" not in said, said
     assert "teardown problem: stop: " in said, said
     assert (
-        "teardown problem: light close: failed with the same error as 'stop' above (it tried "
-        "that again as it closed); nothing more was established of the lights or the arm than "
-        "the 'stop' line says"
+        "teardown problem: light close: failed with the same error as 'stop' above; nothing "
+        "more was established of the lights or the arm than the 'stop' line says"
     ) in said, said
     assert "failed as 'stop' above" not in said, said
