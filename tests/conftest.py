@@ -381,6 +381,28 @@ def servo_fault(at_command: int, servo_id: int, kind: str = "overload") -> str:
     )
 
 
+def run_faulted_arm(tmp_path: Path, kind: str, servo_id: int = 1) -> str:
+    """Run ``rti-rig run`` (12 lights, no verdict) in a process of its own on the in-process
+    emulated arm whose servo ``servo_id`` reports ``kind`` from its 150th packet, as a user
+    would, and return all it printed, whitespace joined. The run must end on the fault (exit
+    2), with no traceback. A process of its own: the stop's warnings are log records, printed
+    on the real stderr, which a CliRunner does not show as a user sees them."""
+    import os
+
+    cfg = inprocess_arm_config(tmp_path, servo_fault(150, servo_id, kind))
+    run = ["run", str(cfg), "--lights", "12", "--out", str(tmp_path / "s"), "--no-verdict"]
+    r = subprocess.run(
+        [sys.executable, "-m", "rti_rig", *run],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={**os.environ, "COLUMNS": "400"},
+    )
+    said = " ".join((r.stdout + r.stderr).split())
+    assert r.returncode == 2 and "Traceback" not in said, said
+    return said
+
+
 def emulators_built_by_check(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
     """The emulators of the rigs ``rti-rig check`` builds from here on (``build_rig`` wrapped
     where compose and the check use case import it): what a test reads the servos' state

@@ -9,27 +9,13 @@ its cause is gone (a servo still too hot, or on a supply outside its limits, rep
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
-from conftest import inprocess_arm_config, servo_fault
+from conftest import run_faulted_arm
 
 
 def _run(tmp_path: Path, kind: str) -> str:
-    cfg = inprocess_arm_config(tmp_path, servo_fault(150, 1, kind))
-    run = ["run", str(cfg), "--lights", "12", "--out", str(tmp_path / "s"), "--no-verdict"]
-    r = subprocess.run(
-        [sys.executable, "-m", "rti_rig", *run],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        env={**os.environ, "COLUMNS": "400"},
-    )
-    said = " ".join((r.stdout + r.stderr).split())
-    assert r.returncode == 2 and "Traceback" not in said, said
-    return said.split("error: ", 1)[1]  # the error that ended the run
+    return run_faulted_arm(tmp_path, kind).split("error: ", 1)[1]  # the error that ended the run
 
 
 def test_a_fault_that_leaves_torque_on_is_not_sent_to_reboot_faulted(tmp_path: Path) -> None:
