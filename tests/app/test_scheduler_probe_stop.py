@@ -1,0 +1,106 @@
+"""A stop (Ctrl-C) during the scheduler probe leaves no coroutine of its event loop to be
+closed after the loop is: such a coroutine, closed later by the garbage collector, closes its
+half-made connection on the closed loop and Python prints "Exception ignored in: <coroutine
+object open_connection …> Traceback … Event loop is closed" under "Stopped (Ctrl-C)".
+
+CI met it once in thousands of runs (the test of a Ctrl-C on a silent port): the Ctrl-C cut
+through the probe's coroutines at a moment that left one suspended, held by the stop's own
+traceback or by a task the stop had left pending. These tests make both cases on purpose.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import gc
+import sys
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from rti_rig.app.usecases.scheduler_probe import _run_quietly
+
+
+@pytest.fixture
+def unraisable() -> Iterator[list[Any]]:
+    """What Python would print as "Exception ignored in: …" while the test runs."""
+    seen: list[Any] = []
+    before = sys.unraisablehook
+    sys.unraisablehook = seen.append
+    try:
+        yield seen
+    finally:
+        sys.unraisablehook = before
+
+
+async def _half_made_connection(opened: asyncio.Event) -> None:
+    """Like asyncio's connection set-up: suspended on a future, and closing its transport on
+    the loop (``call_soon``) if it is ended there."""
+    loop = asyncio.get_running_loop()
+    opened.set()
+    try:
+        await loop.create_future()  # never resolved
+    except BaseException:
+        loop.call_soon(lambda: None)  # transport.close(): fails on a closed loop
+        raise
+
+
+def _no_coroutine_closed_on_a_closed_loop(seen: list[Any]) -> None:
+    gc.collect()
+    assert [str(s.exc_value) for s in seen] == []
+
+
+def test_a_stop_that_leaves_a_coroutine_suspended_in_its_traceback(
+    unraisable: list[Any],
+) -> None:
+    """The Ctrl-C is raised in a frame that awaits another coroutine (not a task): the
+    awaited one is left suspended, referenced only by the stop's traceback."""
+
+    async def main() -> None:
+        opened = asyncio.Event()
+        inner = _half_made_connection(opened)
+        inner.send(None)  # started and suspended, as a coroutine awaited by this frame is
+        assert opened.is_set()
+        raise KeyboardInterrupt  # the Ctrl-C lands here, in this frame, not in ``inner``
+
+    with pytest.raises(KeyboardInterrupt):
+        _run_quietly(main())
+    _no_coroutine_closed_on_a_closed_loop(unraisable)
+
+
+def test_a_stop_that_leaves_a_task_that_outlives_its_cancellation(
+    unraisable: list[Any],
+) -> None:
+    """A task still pending after the bounded wait for the cancelled tasks is ended while
+    its loop is open, not left to the garbage collector."""
+
+    async def stubborn(opened: asyncio.Event) -> None:
+        loop = asyncio.get_running_loop()
+        opened.set()
+        try:
+            while True:
+                try:
+                    await asyncio.sleep(3600)
+                except asyncio.CancelledError:
+                    continue  # outlives the bounded wait
+        finally:
+            loop.call_soon(lambda: None)
+
+    async def main() -> None:
+        opened = asyncio.Event()
+        task = asyncio.get_running_loop().create_task(stubborn(opened))
+        await opened.wait()
+        del task
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        _run_quietly(main())
+    _no_coroutine_closed_on_a_closed_loop(unraisable)
+
+
+def test_a_probe_that_ends_normally_is_returned() -> None:
+    async def main() -> int:
+        await asyncio.sleep(0)
+        return 7
+
+    assert _run_quietly(main()) == 7
