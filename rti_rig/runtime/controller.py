@@ -49,6 +49,18 @@ class FinishReason(StrEnum):
     NO_SPACE = "no-space"
 
 
+def run_state(reason: FinishReason) -> str:
+    """The manifest's ``runner.state`` for a run that recorded its end with ``reason``:
+    ``finished`` for a run that completed its plan, ``stopped`` for one that ended before it
+    (a stop, an error, a full disk), as :meth:`SessionFolder.record_cut_end` says of a run
+    whose end a stop cut short.
+
+    Why: every recorded end had read ``finished``, a SIGTERM mid-capture too, while the same
+    SIGTERM a moment later (cutting the end record short) read ``stopped``: one stop, two
+    states, and a ``finished`` of a session with most of its images still to take."""
+    return "finished" if reason is FinishReason.COMPLETED else "stopped"
+
+
 class EmergencyStop(BaseException):
     """Raised (e.g. from a SIGTERM handler) to abandon the current step at once.
 
@@ -852,7 +864,7 @@ def run_session(
                 folder.finish(
                     records,
                     runner={
-                        "state": "finished",
+                        "state": run_state(reason),
                         "finish_reason": str(reason),
                         "error": error,
                         "teardown_failures": teardown,
