@@ -1194,7 +1194,13 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
             total = max(total, journal_rig_time(folder.root))
             ended = [
                 *([f"{cut} run(s) stopped"] if cut else []),
-                *([f"{untimed - cut} run(s) killed"] if untimed - cut else []),
+                # a kill, a power cut or a disk too full for the end record: which, it did
+                # not say (a full disk's run had been said "killed")
+                *(
+                    [f"{untimed - cut} run(s) killed, powered off or out of disk"]
+                    if untimed - cut
+                    else []
+                ),
             ]
             beside.append(
                 f"{' and '.join(ended)} before recording their time, counted from their "

@@ -1762,7 +1762,7 @@ def _prepare_resume(
             # is the same command again, and "drop --reshoot-lost" left the rest to guess
             raise SessionError(
                 f"{root}: --reshoot-lost is for a session that completed; this one did not "
-                f"({_ended_as(runner.get('finish_reason'))}), "
+                f"({_ended_as(runner.get('finish_reason'), root)}), "
                 "and its resume sets aside and shoots again whatever it cannot verify anyway "
                 "(nothing in this folder was changed): continue it with rti-rig run --resume "
                 f"{shlex.quote(str(root))}"
@@ -1872,10 +1872,14 @@ RUN_ENDED = {
 }
 
 
-def _ended_as(reason: object) -> str:
-    """``its last run …`` for :data:`RUN_ENDED`'s ``reason`` (None: killed before saying)."""
+def _ended_as(reason: object, root: Path) -> str:
+    """``its last run …`` for :data:`RUN_ENDED`'s ``reason`` (None: it recorded no end, by
+    :func:`~rti_rig.runtime.unrecorded_end.unrecorded_end`: "killed" had been said of a run
+    whose disk was too full to record its end)."""
     if reason is None:
-        return "its last run was killed before recording how it ended"
+        from rti_rig.runtime.unrecorded_end import unrecorded_end
+
+        return f"its last run: {unrecorded_end(root)}"
     said = RUN_ENDED.get(reason) if isinstance(reason, str) else None
     return f"its last run: {said}" if said else "its last run did not finish"
 

@@ -44,6 +44,7 @@ from rti_rig.runtime.session import (
     unchecked_images,
     unresumable,
 )
+from rti_rig.runtime.unrecorded_end import unrecorded_end
 
 V = TypeVar("V")
 
@@ -343,11 +344,7 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
         if isinstance(s, dict) and isinstance(s.get("index"), int)
     }
     taken = len({r["index"] for r in scan_journal(source, image_names(total)).records} | recorded)
-    how = (
-        RUN_ENDED.get(reason or "", f"it ended: {reason}")
-        if reason
-        else ("it stopped without recording why (killed, or a power cut?)")
-    )
+    how = RUN_ENDED.get(reason or "", f"it ended: {reason}") if reason else unrecorded_end(source)
     of = f"of at most {total}" if manifest.get("adaptive") else f"of {total}"
     # of the images taken, those lost since: "12 of 12 images" of a session not finished (a
     # --reshoot-lost stopped part-way) had read as a contradiction

@@ -1,0 +1,73 @@
+"""How a run that never recorded its end most likely ended, for the messages that say it.
+
+A run records its end in ``manifest.json`` (``runner.finish_reason``). Killed outright (kill
+-9, a power cut) it cannot; nor where the disk filled so far that the manifest's new copy
+could not be written: the manifest then still says ``running`` and ``null``, as during a
+capture. ``fit``'s verdict and a refused resume had called every such run "killed" (or "a
+power cut?"), which sent a user whose disk had filled looking for a crash. The journal names
+the last image the run committed; if the session's disk has less room now than that image
+took, the full disk is named as the likely cause; otherwise all three causes are.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+#: the causes a run's missing end can have, as messages list them
+CAUSES = "killed, a power cut, or a disk too full to record its end"
+
+
+def last_image_bytes(root: Path) -> int | None:
+    """The bytes on disk of the last image the journal of ``root`` lists (its JPEG and linear
+    TIFF), None where the journal or the files cannot tell (junk, missing, unreadable)."""
+    try:
+        lines = (root / "journal.jsonl").read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    for line in reversed(lines.splitlines()):
+        try:
+            entry = json.loads(line)
+        except ValueError:
+            continue
+        if not isinstance(entry, dict) or not isinstance(entry.get("image"), str):
+            continue
+        names = [entry["image"]]
+        if isinstance(entry.get("linear_image"), str):
+            names.append(entry["linear_image"])
+        try:
+            return sum((root / name).stat().st_size for name in names)
+        except OSError:
+            return None
+    return None
+
+
+def full_disk_now(root: Path) -> str | None:
+    """``"its disk has … free, less than its last image took (…)"`` where the disk of ``root``
+    could not hold another image like the journal's last one; None where it could, or where
+    either cannot be known."""
+    size = last_image_bytes(root)
+    try:
+        free = shutil.disk_usage(root).free
+    except OSError:
+        return None
+    if size is None or free >= size:
+        return None
+    return f"its disk has {_mb(free)} free, less than its last image took ({_mb(size)})"
+
+
+def unrecorded_end(root: Path) -> str:
+    """``root``'s last run ended without recording how: the words for it, naming a full disk
+    as the likely cause where :func:`full_disk_now` finds one."""
+    full = full_disk_now(root)
+    if full is not None:
+        return (
+            f"it stopped without recording why, and {full}: most likely the disk filled "
+            "(free space on it before continuing)"
+        )
+    return f"it stopped without recording why ({CAUSES})"
+
+
+def _mb(n: int) -> str:
+    return f"{n / 1e6:.1f} MB"
