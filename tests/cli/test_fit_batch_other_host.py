@@ -170,3 +170,53 @@ def test_a_cluster_batch_leaves_another_host_s_attempt_and_says_so(tmp_path: Pat
     assert r.exit_code == 0, said
     assert folder.is_dir() and (out / "A" / "fit.json").is_file(), said
     assert said.count(f"{folder} is the folder of a fit running on host lab-node-7") == 1, said
+
+
+def _without_machine_id(monkeypatch: pytest.MonkeyPatch) -> None:
+    """This host lacks /etc/machine-id (as some containers and minimal installs do)."""
+    from rti_rig.app.usecases import fit_owners
+
+    real = fit_owners._read
+    monkeypatch.setattr(
+        fit_owners, "_read", lambda path: None if path == "/etc/machine-id" else real(path)
+    )
+
+
+def test_a_host_of_the_same_name_without_machine_ids_is_left_and_said(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Two hosts sharing a host name, neither with a machine id: the other's boot id differs
+    from this one's, which had been read as this host restarted since (its running fit's
+    folder removed). Which host it is cannot be told: the folder is left, and said once."""
+    _without_machine_id(monkeypatch)
+    a, b = two_sessions(tmp_path)
+    out = tmp_path / "FQ"
+    pid = dead_pid()  # means nothing here: the PID of the other host's running fit
+    record = {**this_process(), "boot_id": "the-other-host-s-boot", "pid": pid, "started": "9"}
+    assert record["machine_id"] is None and record["host"] == this_process()["host"]
+    folder = left_attempt(out, pid, record)
+    code, said = batch(a, b, out)
+    assert code == 0, said
+    assert folder.is_dir() and (folder / "normals.npy").read_bytes() == b"half", said
+    assert (out / "A" / "fit.json").is_file()
+    note = f"{folder} is the folder of a fit running on host {record['host']}, or on this host"
+    assert said.count(note) == 1, said
+    assert "which of the two cannot be told" in said and f"rm -r '{folder}'" in said, said
+
+
+def test_without_machine_ids_the_same_boot_tells_this_host(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same boot id is one running kernel, this host's: a killed fit's folder there is
+    still removed without a machine id; and a machine id of the record's alone (this host
+    has none) establishes nothing."""
+    _without_machine_id(monkeypatch)
+    pid = dead_pid()
+    folder = left_attempt(tmp_path, pid, {**this_process(), "pid": pid, "started": "1"})
+    assert owner_of(folder, mine_too=True).gone
+    record = {**this_process(), "machine_id": "abc", "boot_id": "x", "pid": pid}
+    owner_record_path(AttemptFolder.parse(folder.name), tmp_path).write_text(  # type: ignore[arg-type]
+        json.dumps(record), encoding="utf-8"
+    )
+    owner = owner_of(folder, mine_too=True)
+    assert not owner.gone and "cannot be told" in owner.elsewhere, owner

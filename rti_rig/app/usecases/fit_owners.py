@@ -9,7 +9,8 @@ folder was removed under it. An attempt now records, before its folders exist, t
 on (its name, its machine id, its boot id), its PID namespace, its PID and the process's start
 time, in ``.OUTPUT.ATTEMPT.owner`` beside them (a file: the partial folder must begin empty,
 and a refit's set-aside ``.earlier`` folder is the same attempt's). A folder is removed only
-when that host is this one and the process is gone (or its PID now names another process).
+when that host is established to be this one (the same machine id, or the same boot id: a host
+name alone may be two hosts') and the process is gone (or its PID now names another process).
 """
 
 from __future__ import annotations
@@ -131,17 +132,36 @@ def owner_of(folder: Path, *, mine_too: bool = False) -> Owner:
     host = str(record.get("host"))
     pid = record.get("pid") if isinstance(record.get("pid"), int) else pid
 
+    def known(key: str) -> bool:  # recorded there and read here
+        return None not in (record.get(key), here[key])
+
     def differs(key: str) -> bool:  # known on both sides, and not the same
-        return None not in (record.get(key), here[key]) and record.get(key) != here[key]
+        return known(key) and record.get(key) != here[key]
+
+    def same(key: str) -> bool:  # known on both sides, and the same
+        return known(key) and record.get(key) == here[key]
 
     if host != here["host"] or differs("machine_id"):
         return Owner(gone=False, elsewhere=f"host {host}", pid=pid)
+    # This very machine only when established: the same machine id, or the same boot id (one
+    # running kernel). A host name alone is not: two hosts lacking /etc/machine-id may share
+    # one, and the other's boot id, unlike this one's, had been read as this host restarted
+    # since, and its running fit's folder removed. In doubt the folder is left, and said.
+    if not (same("machine_id") or same("boot_id")):
+        return Owner(gone=False, elsewhere=_UNTOLD.format(host=host), pid=pid)
     if differs("boot_id"):  # this host, restarted since: every process of then is gone
         return Owner(gone=True, pid=pid)
     if differs("pid_namespace"):  # a container sharing this host's name: its PIDs are its own
         return Owner(gone=False, elsewhere=f"host {host} (another PID namespace)", pid=pid)
     started = record.get("started")
     return Owner(gone=_gone_here(pid, started, mine_too), pid=pid)
+
+
+#: Where a fit runs whose record names this host's name but cannot be told to be this machine.
+_UNTOLD = (
+    "host {host}, or on this host before a restart (its record and this host share neither "
+    "a machine id nor a boot id: which of the two cannot be told)"
+)
 
 
 def _gone_here(pid: int, started: Any, mine_too: bool) -> bool:
