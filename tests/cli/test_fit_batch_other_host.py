@@ -220,3 +220,62 @@ def test_without_machine_ids_the_same_boot_tells_this_host(
     )
     owner = owner_of(folder, mine_too=True)
     assert not owner.gone and "cannot be told" in owner.elsewhere, owner
+
+
+def set_aside(out: Path, fit: Path, pid: int, attempt: str, record: dict[str, Any]) -> Path:
+    """A copy of finished fit ``fit`` as session A's earlier fit set aside by a refit's
+    attempt ``PID-attempt`` (``.A.PID-attempt.earlier``), with ``record`` as its owner."""
+    import shutil
+
+    folder = AttemptFolder("A", f"{pid}-{attempt}", Kind.EARLIER)
+    shutil.copytree(fit, folder.path(out))
+    owner_record_path(folder, out).write_text(json.dumps(record), encoding="utf-8")
+    return folder.path(out)
+
+
+@pytest.mark.parametrize("scheduler", [False, True], ids=["here", "on a local cluster"])
+def test_an_interrupted_swap_is_finished_leaving_another_host_s_set_aside_fit(
+    tmp_path: Path, scheduler: bool
+) -> None:
+    """A refit of this host killed between its two renames is finished by the next run (its
+    complete new fit put in place); another host's refit, which set its own earlier fit aside
+    in the same ``--out`` (older, by time), is running as far as this host can tell: its folder
+    had been removed unjudged with this host's older set-aside fits. It is left, and said
+    once with what to do if that host is gone."""
+    import os
+    import shutil
+
+    a, b = two_sessions(tmp_path)
+    out = tmp_path / "FQ"
+    code, said = batch(a, b, out)
+    assert code == 0, said
+    fitted = tmp_path / "fitted-A"
+    shutil.move(out / "A", fitted)  # session A's fit, to stand for the set-aside fits
+    pid, theirs = dead_pid(), dead_pid()
+    other = {**this_process(), "host": "lab-node-7", "pid": theirs, "started": "5"}
+    elsewhere = set_aside(out, fitted, theirs, "0badf00d", other)
+    os.utime(elsewhere, (1_000_000_000, 1_000_000_000))  # set aside first: the older
+    mine = set_aside(out, fitted, pid, "0badc0de", {**this_process(), "pid": pid, "started": "1"})
+    new = AttemptFolder("A", f"{pid}-0badc0de", Kind.PARTIAL).path(out)
+    shutil.copytree(fitted, new)  # the new fit, complete: the kill came between the renames
+    args = ["fit", str(a), str(b), "--out", str(out), *FIT]
+    if scheduler:
+        from distributed import LocalCluster
+
+        with LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+        ) as cluster:
+            r = runner.invoke(app, [*args, "--scheduler", cluster.scheduler_address])
+    else:
+        r = runner.invoke(app, args)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "the new fit, complete, was put in place in" in said, said
+    assert (out / "A" / "fit.json").is_file() and not mine.exists() and not new.exists()
+    assert (elsewhere / "fit.json").read_bytes() == (fitted / "fit.json").read_bytes(), said
+    note = f"{elsewhere} is the folder of a fit running on host lab-node-7 (PID {theirs} there)"
+    assert said.count(note) == 1, said
+    assert f"rm -r '{elsewhere}'" in said and "if that host is gone" in said, said
+    # this host's attempt leaves nothing behind; the other host's record stays with its folder
+    assert not owner_record_path(AttemptFolder.parse(mine.name), out).exists()  # type: ignore[arg-type]
+    assert owner_record_path(AttemptFolder.parse(elsewhere.name), out).exists()  # type: ignore[arg-type]

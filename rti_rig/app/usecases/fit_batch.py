@@ -332,9 +332,10 @@ def _swap_partial(backup: Path) -> Path:
     return attempt.as_kind(Kind.PARTIAL).path(backup.parent)
 
 
-def finish_swap(root: Path, final: Path) -> str:
+def finish_swap(root: Path, final: Path) -> tuple[str, ...]:
     """Finish or undo a refit's swap that a kill interrupted, so that ``final`` holds a fit
-    again; what was done, in words (``""`` when there was nothing to do).
+    again; what was done, and what was left to another host's fit, in words (none when there
+    was nothing to do).
 
     Why: the swap is two renames (the earlier fit aside, the new one in); a batch killed
     between them had left neither in ``final``, and the next run removed both as partial
@@ -343,19 +344,27 @@ def finish_swap(root: Path, final: Path) -> str:
     folder is there, the earlier fit is put back. Without it, the swap had ended (the new
     fit was put in place, and removed since, by the user) and the earlier fit is outgrown:
     it is removed, not put back (it had been, said "interrupted before its new fit was
-    complete"). A swap whose process still runs (another batch into the same ``--out``) is
-    left to it."""
+    complete"). A swap whose process still runs on this host (another batch into the same
+    ``--out``) is left to it. Only set-aside fits whose process is gone are ever removed: the
+    older ones had been removed unjudged, and on a shared ``--out`` another host's running
+    refit lost the earlier fit it had set aside (its owner cannot be seen from here: its
+    folder is left, and said, with what to do if that host is gone)."""
     backups = earlier_backups(root, final.name)
     if not backups or final.exists():
-        return ""
-    backup, older = backups[-1], backups[:-1]
-    if not owner_gone(backup):
-        return ""
+        return ()
+    owners = {b: owner_of(b) for b in backups}
+    if any(not o.gone and not o.elsewhere for o in owners.values()):
+        return ()  # a swap of this host's, running now: left to it, and the rest with it
+    left = tuple(_left_to_its_owner(b, o) for b, o in owners.items() if not o.gone)
+    gone = [b for b in backups if owners[b].gone]
+    if not gone:
+        return left
+    backup, older = gone[-1], gone[:-1]
     new = _swap_partial(backup)
     if not new.is_dir():
         for stale in (*older, backup):
             remove_attempt_folder(stale)
-        return ""
+        return left
     try:
         if (new / "fit.json").is_file():
             new.rename(final)
@@ -372,10 +381,10 @@ def finish_swap(root: Path, final: Path) -> str:
     except OSError:  # another attempt finished it meanwhile
         if not final.exists():
             raise
-        return ""
+        return left
     for stale in (*older, backup, new):
         remove_attempt_folder(stale)
-    return words
+    return (words, *left)
 
 
 #: What a batch says of a session another run into the same --out fitted meanwhile, after
@@ -586,8 +595,7 @@ def fit_one(
     images are stat-ed again; only one whose size or time changed is hashed. A session that
     changed while its own fit ran is said so (:func:`changed_while_fitted`)."""
     final = batch_out_dir(root, source)
-    swapped = finish_swap(root, final)
-    said = (swapped,) if swapped else ()
+    said = finish_swap(root, final)
     earlier = earlier_fit(final, source)
     keep_confirmed(earlier)
     if earlier.stands:
