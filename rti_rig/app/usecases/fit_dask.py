@@ -253,23 +253,38 @@ def checked_gone(cluster: Cluster, kept: str) -> str:
         others: set[str] | None = workers_by_tag(cluster)[1]
     except Exception:  # the scheduler lost meanwhile: who is there is not known
         others = None
+    # a worker of another Python (joined after the check) is refused in the check's words,
+    # naming both versions, asked of Dask's own report: the tag check's "other code" (or "the
+    # rti-rig check was never set up there", where our functions cannot run) named neither
+    ours = dict(local_identity().stack).get(PYTHON, "")
+    pythons = worker_pythons(cluster.client) if others and ours else {}
+    other_python = {w: v for w, v in pythons.items() if w in (others or ()) and v != ours}
+    rest = None if others is None else others - set(other_python)
     why: dict[str, Untagged] = {}
-    if others:
+    if rest:
         try:
-            why = plugin_outcomes(cluster.client, cluster.plugin, sorted(others))
+            why = plugin_outcomes(cluster.client, cluster.plugin, sorted(rest))
         except Exception:  # the scheduler lost meanwhile: the workers are named alone
             why = {}
     failed = sorted(w for w, o in why.items() if not o.other_code)
-    named = ", ".join(f"{w} ({why[w].reason})" if w in why else w for w in sorted(others or ()))
-    if others is None:  # not "no worker is there now": the scheduler did not say
+    named = ", ".join(f"{w} ({why[w].reason})" if w in why else w for w in sorted(rest or ()))
+    if rest is None:  # not "no worker is there now": the scheduler did not say
         there = "which workers are there now is not known (the scheduler did not answer)"
     elif failed:
         there = "the workers there now were not tagged, the rti-rig check failing on "
         there += f"{', '.join(failed)} (see their logs, restart them): {named}"
-    elif others:
+    elif rest:
         there = f"the workers there now were refused, their rti-rig being another or none: {named}"
+    elif other_python:
+        there = ""
     else:
         there = "no worker is there now"
+    if other_python:
+        lead = f"{len(other_python)} of the {len(others or ())} workers there now"
+        python = other_python_said(
+            other_python, ours, cluster.address, lead, "they were given no task"
+        )
+        there = f"{there}; {python}" if there else python
     lead = (
         f"the {len(cluster.workers)} worker(s) of the Dask cluster at {cluster.address!r} whose "
         "rti-rig was checked when the fit began have all left it"
@@ -548,8 +563,10 @@ def _refuse_other_code(client: Any, address: str) -> frozenset[str]:
             f"this machine's {describe(mine)}: the workers cannot be checked against the code "
             "this command runs. Nothing was sent: run the same command again"
         )
-    _refuse_other_python(client, mine, address)  # before any function of ours runs there
+    asked = _refuse_other_python(client, mine, address)  # before any function of ours runs
     workers = worker_identities(client)
+    if set(workers) - asked:  # joined meanwhile (or missed by the report): asked in its words
+        _refuse_other_python(client, mine, address, asked)
     _refuse_other_libraries(workers, mine, address)
     untold = {w: ident for w, ident in workers.items() if isinstance(ident, Unasked)}
     differ = {
@@ -578,30 +595,45 @@ def _refuse_other_code(client: Any, address: str) -> frozenset[str]:
     return frozenset(workers)
 
 
-def _refuse_other_python(client: Any, mine: WorkerCode, address: str) -> None:
+def _refuse_other_python(
+    client: Any, mine: WorkerCode, address: str, asked: frozenset[str] = frozenset()
+) -> frozenset[str]:
     """Refuse a cluster some of whose workers run another Python minor version than this
     machine (:data:`~rti_rig.app.usecases.worker_code.PYTHON` says why), naming each, both
     versions and what to do; asked of Dask's own version report, before the rti-rig check
-    (a function pickled by value) is sent to them.
+    (a function pickled by value) is sent to them. The workers whose Python was asked (found
+    the same), with ``asked`` (those asked before, not judged again).
 
     Why: the workers' distributed, dask, cloudpickle and numpy were compared, not their
     Python, and cloudpickle's functions of a 3.11 client failed on a 3.12 worker in ways that
     named no version (the check itself "could not be asked", or the worker died)."""
     ours = dict(mine.stack).get(PYTHON, "")
     pythons = worker_pythons(client)
-    differ = {w: v for w, v in pythons.items() if ours and v != ours}
+    differ = {w: v for w, v in pythons.items() if ours and v != ours and w not in asked}
     if not differ:
-        return
-    named = "; ".join(f"{w} (Python {v})" for w, v in sorted(differ.items()))
+        return asked | frozenset(pythons)
+    total = len(set(pythons) | asked)
+    lead = f"{len(differ)} of the {total} workers of the Dask cluster at {address!r}"
     raise SchedulerError(
-        f"{len(differ)} of the {len(pythons)} workers of the Dask cluster at {address!r} run "
-        f"another Python than this machine (Python {ours}): {named}. The fit's functions "
-        f"travel to the workers as Python {ours}'s byte code (cloudpickle), which another "
-        "Python minor version cannot run (such a worker fails or dies with errors that name "
-        f"no version), so nothing was sent: run those workers under Python {ours} (an "
+        f"{other_python_said(differ, ours, address, lead, 'nothing was sent')}, and run the "
+        "same command"
+    )
+
+
+def other_python_said(differ: dict[str, str], ours: str, address: str, lead: str, sent: str) -> str:
+    """The words that refuse the workers of ``differ`` (address: their Python minor version)
+    for running another Python than this machine's ``ours``: ``lead`` (who), both versions,
+    why, ``sent`` (what became of the fit's tasks) and what to do. One wording for a worker
+    found at the check and one joining after it (:func:`checked_gone`): a late joiner had
+    been said only as "other code" by the tag check, its Python unnamed."""
+    named = "; ".join(f"{w} (Python {v})" for w, v in sorted(differ.items()))
+    return (
+        f"{lead} run another Python than this machine (Python {ours}): {named}. The fit's "
+        f"functions travel to the workers as Python {ours}'s byte code (cloudpickle), which "
+        "another Python minor version cannot run (such a worker fails or dies with errors "
+        f"that name no version), so {sent}: run those workers under Python {ours} (an "
         f"environment made with python{ours}, this rti-rig and the same distributed, dask, "
-        f"cloudpickle and numpy installed in it, then `dask worker {address}` from it), and "
-        "run the same command"
+        f"cloudpickle and numpy installed in it, then `dask worker {address}` from it)"
     )
 
 
