@@ -147,6 +147,10 @@ class Body:
     disk_free_bytes: int = 0
     powered: bool = True
     off_at_shot: int | None = None  # switched off when asked for this shot (1-based)
+    #: unplugged as this download (1-based, of every ``file_get``) begins: the shot is taken,
+    #: its file never comes
+    off_at_download: int | None = None
+    downloads: int = 0
     shots: int = 0
     card: dict[str, bytes] = field(default_factory=dict)
     ram: dict[str, bytes] = field(default_factory=dict)
@@ -425,6 +429,10 @@ def make_module(body: Body) -> types.ModuleType:
             return GP_EVENT_TIMEOUT, None
 
         def file_get(self, folder: str, name: str, kind: int) -> CameraFile:
+            body.downloads += 1
+            if body.off_at_download is not None and body.downloads == body.off_at_download:
+                body.off_at_download = None
+                body.switch_off()
             body.check("file_get")
             if body.download_s:
                 body.download_clock.sleep(body.download_s)

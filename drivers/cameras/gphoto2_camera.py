@@ -649,8 +649,8 @@ class Gphoto2Camera:
                     "download",
                     lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL),
                 )
-            except CameraGoneError:
-                raise  # said already: images taken are kept, resume continues
+            except CameraGoneError as exc:
+                raise self._gone_at_download(exc, folder, name) from exc
             except CaptureError as exc:
                 raise self._download_failed(exc, folder, name) from exc
             self._save(camera_file, target, folder, name)
@@ -876,6 +876,23 @@ class Gphoto2Camera:
             f"{exc.message}; downloading {on_camera} failed, {where}. Its step is not "
             "recorded: 'rti-rig run --resume SESSION' shoots it again (check the USB cable "
             "and that no other program holds the camera first)",
+            "download",
+        )
+
+    def _gone_at_download(self, exc: CameraGoneError, folder: str, name: str) -> CameraGoneError:
+        """The error for a camera that went away (unplugged, switched off) while this shot's
+        file was being downloaded: that, and where the shot is now.
+
+        Why: it said only "the camera stopped answering during 'download' … Images already
+        taken are kept", beside the run's "Nothing was captured": shot into the camera's RAM
+        the picture is lost with the body's power, on a card its copy stays there (never
+        deleted before it is downloaded), and neither was said."""
+        on_camera = f"{folder.rstrip('/')}/{name}"
+        return CameraGoneError(
+            self.name,
+            f"{exc.message}. This shot was taken but its file {on_camera} was not "
+            f"downloaded: {self._where(folder, name)}; its step is not recorded, so the resume "
+            "shoots it again",
             "download",
         )
 
