@@ -147,10 +147,10 @@ class Body:
     disk_free_bytes: int = 0
     powered: bool = True
     off_at_shot: int | None = None  # switched off when asked for this shot (1-based)
-    #: unplugged as this download (1-based, of every ``file_get``) begins: the shot is taken,
-    #: its file never comes
-    off_at_download: int | None = None
-    downloads: int = 0
+    #: unplugged as the n-th (1-based) call of an op begins, as (op, n): ("file_get", 3) at
+    #: the third download, ("wait_for_event", 1) as the first shot's files are announced
+    off_at_call: tuple[str, int] | None = None
+    op_counts: dict[str, int] = field(default_factory=dict)
     shots: int = 0
     card: dict[str, bytes] = field(default_factory=dict)
     ram: dict[str, bytes] = field(default_factory=dict)
@@ -177,6 +177,10 @@ class Body:
 
     def check(self, op: str) -> None:
         self.calls.append(op)
+        self.op_counts[op] = self.op_counts.get(op, 0) + 1
+        if self.off_at_call == (op, self.op_counts[op]):
+            self.off_at_call = None
+            self.switch_off()
         if not self.powered:
             raise GPhoto2Error(-7 if op != "autodetect" else -52)
         queue = self.failures.get(op)
@@ -429,10 +433,6 @@ def make_module(body: Body) -> types.ModuleType:
             return GP_EVENT_TIMEOUT, None
 
         def file_get(self, folder: str, name: str, kind: int) -> CameraFile:
-            body.downloads += 1
-            if body.off_at_download is not None and body.downloads == body.off_at_download:
-                body.off_at_download = None
-                body.switch_off()
             body.check("file_get")
             if body.download_s:
                 body.download_clock.sleep(body.download_s)

@@ -623,8 +623,11 @@ class Gphoto2Camera:
         gp = self._gp
         cam = self._cam
         files = [(str(path.folder), str(path.name))]
-        files, late, strays = self._more_files(files)
-        strays.extend(self._unannounced(str(path.folder), files + late + strays, strays))
+        try:
+            files, late, strays = self._more_files(files)
+            strays.extend(self._unannounced(str(path.folder), files + late + strays, strays))
+        except CameraGoneError as exc:  # gone while it announced the shot's files
+            raise self._gone_at_download(exc, str(path.folder), str(path.name)) from exc
         self._delete(late)  # a previous shot's file announced late: never this shot's
         self._count += 1
         raw_files = [f for f in files if is_camera_raw(Path(f[1]))]
@@ -880,8 +883,9 @@ class Gphoto2Camera:
         )
 
     def _gone_at_download(self, exc: CameraGoneError, folder: str, name: str) -> CameraGoneError:
-        """The error for a camera that went away (unplugged, switched off) while this shot's
-        file was being downloaded: that, and where the shot is now.
+        """The error for a camera that went away (unplugged, switched off) after it took this
+        shot, before its file was downloaded (while its files were announced or at the
+        download): that, and where the shot is now.
 
         Why: it said only "the camera stopped answering during 'download' … Images already
         taken are kept", beside the run's "Nothing was captured": shot into the camera's RAM
@@ -893,7 +897,7 @@ class Gphoto2Camera:
             f"{exc.message}. This shot was taken but its file {on_camera} was not "
             f"downloaded: {self._where(folder, name)}; its step is not recorded, so the resume "
             "shoots it again",
-            "download",
+            exc.command,
         )
 
     def _download_gone(self, raw_path: Path, camera_file: tuple[str, str]) -> CaptureError:

@@ -2,10 +2,11 @@
 shipped DSLR example (its dome firmware emulated on a pty, python-gphoto2 replaced at its
 API boundary by tests/fake_gphoto2.py), then `--resume` once it is plugged back in.
 
-The shot is taken, its download fails with libgphoto2's -7 (I/O error) and every call after
-it too. The stop said only "the camera stopped answering during 'download' … Images already
-taken are kept": nothing of the shot just taken, lost with the camera's RAM or left on its
-card (never deleted before it is downloaded).
+The shot is taken; its download, or the wait for the body's announcement of its files, fails
+with libgphoto2's -7 (I/O error), and every call after it too. The stop said only "the camera
+stopped answering during 'download' … Images already taken are kept": nothing of the shot
+just taken, lost with the camera's RAM or left on its card (never deleted before it is
+downloaded).
 """
 
 from __future__ import annotations
@@ -48,11 +49,14 @@ def _raw(body: Body) -> bytes:
 
 
 @pytest.mark.parametrize("target", ["Internal RAM", "Memory card"])
+@pytest.mark.parametrize("op", ["file_get", "wait_for_event"])
 def test_a_camera_unplugged_at_a_download_says_where_the_shot_is_and_the_resume_shoots_it(
-    tmp_path, monkeypatch, target
+    tmp_path, monkeypatch, target, op
 ):
+    """Unplugged at the third shot's download, or as the body announces its files (the
+    event wait after the capture returned): the third shot is taken, never downloaded."""
     cfg = _config(tmp_path, target)
-    body = Body(render=_raw, off_at_download=3)  # the third shot is taken, never downloaded
+    body = Body(render=_raw, off_at_call=(op, 3))
     monkeypatch.setitem(sys.modules, "gphoto2", make_module(body))
     out = tmp_path / "s"
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
@@ -61,7 +65,7 @@ def test_a_camera_unplugged_at_a_download_says_where_the_shot_is_and_the_resume_
     said = " ".join(r.output.split())
     assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
     assert body.shots == 3, body.shots
-    assert "stopped answering during 'download'" in said, said
+    assert f"stopped answering during '{'download' if op == 'file_get' else op}'" in said, said
     assert "This shot was taken but its file" in said and "IMG_0003.CR2" in said, said
     assert "the resume shoots it again" in said and "rti-rig run --resume" in said, said
     if target == "Internal RAM":
