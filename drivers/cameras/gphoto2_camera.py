@@ -372,7 +372,8 @@ class Gphoto2Camera:
                 raise DeviceError(
                     self.name,
                     f"'{value}' is not offered for {name} (settings "
-                    f"key '{key}'); the camera offers {choices}",
+                    f"key '{key}'); the camera offers {choices}: set {key} in "
+                    "[camera.device] to one of them, as the camera spells it",
                     f"set {name}",
                 )
             widget.set_value(value)

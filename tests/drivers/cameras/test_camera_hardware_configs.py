@@ -1227,3 +1227,17 @@ def test_a_monochrome_bodys_raw_is_refused_with_advice_a_gphoto2_rig_can_follow(
     assert 'with a folder-watch camera (patterns = ["*.tif"] in its [camera.device])' in said
     kept = out / "raw" / ".incoming" / "cap0001_IMG_0001.DNG"
     assert f"kept at {kept}" in said and kept.read_bytes() == mono, said
+
+
+def test_a_format_the_body_names_otherwise_says_the_key_to_set_and_its_values(body, tmp_path):
+    """The shipped example asks for Canon's "RAW"; a Nikon body calls it "NEF (Raw)". The
+    refusal listed the body's values but not what to do with them: the key and its section,
+    its value to be one of them, as the camera spells it."""
+    body.choices["imageformat"] = ["JPEG Fine", "NEF (Raw)", "NEF+Fine"]
+    body.config["imageformat"] = "JPEG Fine"
+    result = CliRunner().invoke(app, ["check", str(DSLR_CONFIG)])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert "'RAW' is not offered for imageformat" in said, said
+    assert "set image_format in [camera.device] to one of them, as the camera spells it" in said
+    assert "'NEF (Raw)'" in said and body.shots == 0, said
