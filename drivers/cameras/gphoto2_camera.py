@@ -99,6 +99,21 @@ NO_CAMERA_HELP = (
 )
 
 
+def _not_latched(name: str, value: str, got: str, key: str) -> str:
+    """Why a setting read back otherwise than it was set, and what to do.
+
+    Why: every such setting was answered "put the camera in manual (M) mode with auto-ISO
+    off", advice for the exposure settings (a mode dial on Av or auto keeps its own ISO and
+    shutter) that says nothing of an image format or capture target the body kept."""
+    said = f"{name} set to '{value}' but the camera reports '{got}'"
+    if key in ("iso", "aperture", "shutter_config"):
+        return f"{said}: put the camera in manual (M) mode with auto-ISO off"
+    return (
+        f"{said}: the camera did not take it; set it on the camera itself (its menu), or set "
+        f'{key} = "" in [camera.device] to leave it as the camera has it'
+    )
+
+
 def load_gphoto2() -> Any:
     """Import python-gphoto2 lazily, with an error that says how to install it."""
     try:
@@ -382,12 +397,7 @@ class Gphoto2Camera:
         for name, (value, key) in values.items():
             got = str(self._widget(check, name, key).get_value())
             if got != value:
-                raise DeviceError(
-                    self.name,
-                    f"{name} set to '{value}' but the camera reports '{got}': put the camera in "
-                    "manual (M) mode with auto-ISO off",
-                    f"set {name}",
-                )
+                raise DeviceError(self.name, _not_latched(name, value, got, key), f"set {name}")
 
     def _configure(self) -> None:
         s = self.settings

@@ -1241,3 +1241,16 @@ def test_a_format_the_body_names_otherwise_says_the_key_to_set_and_its_values(bo
     assert "'RAW' is not offered for imageformat" in said, said
     assert "set image_format in [camera.device] to one of them, as the camera spells it" in said
     assert "'NEF (Raw)'" in said and body.shots == 0, said
+
+
+def test_a_format_the_body_does_not_take_is_not_blamed_on_the_mode_dial(body, tmp_path):
+    """The body accepts "RAW" and keeps its JPEG (a format it will not change over USB).
+    The refusal said "put the camera in manual (M) mode with auto-ISO off", the advice for an
+    exposure setting, nothing of the format."""
+    body.read_only = {"imageformat"}
+    result = CliRunner().invoke(app, ["check", str(DSLR_CONFIG)])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert "imageformat set to 'RAW' but the camera reports 'Large Fine JPEG'" in said, said
+    assert "auto-ISO" not in said and "set it on the camera itself" in said, said
+    assert 'image_format = "" in [camera.device]' in said and body.shots == 0, said
