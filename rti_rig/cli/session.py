@@ -1118,7 +1118,10 @@ def _print_teardown_failures(  # type: ignore[no-untyped-def]
     folder's ``finish``, not the manifest's, which a resume that never connected leaves with
     the previous run's; the lights' state line that follows refers to it); True if any.
     ``said_below``: the session's error, printed in full after these lines."""
-    failures = (folder.run_end or {}).get("teardown_failures")
+    from rti_rig.runtime.lighting import unsafe_failures
+
+    # a port's close failure was said as it happened (see :func:`_summarise`)
+    failures = unsafe_failures((folder.run_end or {}).get("teardown_failures"))
     return _print_failures(failures, said_below)
 
 
@@ -1647,17 +1650,18 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
     True when it completed but its teardown failed (see :func:`_refuse_unsafe_end`)."""
     from rti_rig.runtime.controller import FinishReason
     from rti_rig.runtime.disowned import MARKER
-    from rti_rig.runtime.lighting import ArmLighting
+    from rti_rig.runtime.lighting import ArmLighting, unsafe_failures
     from rti_rig.runtime.session import LP_NAME
 
     rig, folder = opened.rig, opened.folder
 
+    unsafe = unsafe_failures(result.teardown_failures)
     if result.finish_reason is FinishReason.CANCELLED:
         from rti_rig.app.usecases.safe_state import lights_state
 
         # what the teardown established, as a stop says it (a cancel had said nothing of the
         # lights: not even "sent but not acknowledged" on a firmware that never confirms)
-        lights = _sentence(lights_state(rig, bool(result.teardown_failures))) + "."
+        lights = _sentence(lights_state(rig, bool(unsafe))) + "."
     if result.finish_reason is FinishReason.CANCELLED and not folder.images_kept:
         # stopped before the first image: no lights.lp to speak of, no resume for nothing
         err.print(
@@ -1682,7 +1686,9 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         err.print(f"[yellow]note:[/] {escape(str(note))}")
     for note in result.notes:
         err.print(f"[yellow]note:[/] {escape(str(note))}")
-    for failure in result.teardown_failures:
+    # (a port that did not close cleanly was said as it happened, by the dome's own line: the
+    # manifest keeps it among the teardown failures, it is not said twice nor taken as unsafe)
+    for failure in unsafe:
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
     if result.finish_reason is not FinishReason.CANCELLED and (
         getattr(rig.loaded.config, "backend", None) in ("hardware", "emulated")
@@ -1694,7 +1700,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         # stop does (it had said nothing: the user took the object out not told whether the
         # dome had acknowledged its all-off, or that a firmware with none switches itself off)
         out.print(
-            _sentence(lights_state(rig, bool(result.teardown_failures))) + ".",
+            _sentence(lights_state(rig, bool(unsafe))) + ".",
             markup=False,
             highlight=False,
         )
@@ -1720,7 +1726,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         raise typer.Exit(code=stop_exit_code(signal.SIGINT))
     from rti_rig.app.usecases.safe_state import safe_state_unsure
 
-    return bool(result.teardown_failures) or safe_state_unsure(rig)
+    return bool(unsafe) or safe_state_unsure(rig)
 
 
 def _park_stopped_by(rig) -> int | None:  # type: ignore[no-untyped-def]

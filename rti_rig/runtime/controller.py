@@ -21,7 +21,7 @@ from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.runtime.lighting import Lighting
+from rti_rig.runtime.lighting import Lighting, port_close_failures
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
     FRAME_SIZE_KEY,
@@ -857,6 +857,9 @@ def run_session(
                     close()
                 except Exception as exc:  # keep tearing down whatever fails
                     teardown.append(_teardown_failure(label, exc, teardown))
+            # a port that did not close cleanly is said as it happens, never raised: recorded
+            # here too (it had been in no record of the run)
+            teardown += port_close_failures(rig.lighting)
             rig_time = clock.now() - rig_t0
             wall_time = time.perf_counter() - wall_t0
             resent, resends_said = _resends(rig.lighting)

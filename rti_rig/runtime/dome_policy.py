@@ -298,6 +298,11 @@ class DomePolicy:
         self._say: Callable[[str], None] | None = None
         #: Each failure to close the port, as said to the user (a close never raises it).
         self.close_errors: list[str] = []
+        #: How the last :meth:`close` failed to release the port, in the words said to the user
+        #: (None: it closed cleanly). Why apart from :attr:`close_errors`: that list keeps each
+        #: text once, so a teardown's close failing as a reconnection's had was in no record of
+        #: the teardown (the run's ``teardown_failures``), only said.
+        self.close_failure: str | None = None
         #: A teardown's all-off has begun (:meth:`ending`, :meth:`close`; a :meth:`connect`
         #: clears it): a port lost now is reopened to send that all-off again, and nothing
         #: goes on after it.
@@ -741,7 +746,7 @@ class DomePolicy:
             self.guard.record(lit.index, lit.since, max(now, lit.since))
         self.info = None
         self._lit = None
-        self._quiet_close()
+        self.close_failure = self._quiet_close()
         self._keep_ledger()
 
     # ------------------------------------------------------------------ duty ledger
@@ -1602,7 +1607,8 @@ class DomePolicy:
                 f"light LED {index}",
             )
 
-    def _quiet_close(self) -> None:
+    def _quiet_close(self) -> str | None:
+        """Close the link, never raising; return what went wrong, as said (None: closed)."""
         try:
             self.link.close()
         except Exception as exc:  # closing must never mask the error that led here
@@ -1614,12 +1620,14 @@ class DomePolicy:
             )
             if text in self.close_errors:  # once: a reconnection's attempts close it each
                 log.info("%s", text)
-                return
+                return text
             self.close_errors.append(text)
             if self._say is not None:
                 self._say(text)
             else:
                 log.warning("%s", text)
+            return text
+        return None
 
 
 #: Faults of a board that may not be the one the profile describes (or no board at all).

@@ -120,6 +120,10 @@ class CameraTriggeredLighting:
         """[]: no link to reopen."""
         return []
 
+    def port_close_failure(self) -> None:
+        """None: no port to close."""
+        return None
+
     @property
     def link_open(self) -> bool:
         """Always False: this dome has no link to the host (the camera's flash signal steps

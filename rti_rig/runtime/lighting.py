@@ -9,7 +9,7 @@ arm reached, which is what the session's `.lp` records.
 from __future__ import annotations
 
 import signal
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from typing import Protocol
 
@@ -104,6 +104,12 @@ class Lighting(Protocol):
 
     def reconnections(self) -> list[dict[str, object]]:
         """Each reopening of the lights' lost link so far, for the manifest (none: [])."""
+        ...
+
+    def port_close_failure(self) -> str | None:
+        """How the last :meth:`close` failed to release the lights' port, in the words said
+        to the user as it happened (None: it closed cleanly, or the lights have no port of
+        their own to close: an arm's carrier raises its close's failures)."""
         ...
 
     @property
@@ -260,6 +266,12 @@ class DomeLighting:
         policy = self.policy
         return [] if policy is None else list(policy.stats.reconnections)
 
+    def port_close_failure(self) -> str | None:
+        """How the dome's last close failed to release its port (the policy says it as it
+        happens and never raises it); None for a clean close or a simulated dome."""
+        policy = self.policy
+        return None if policy is None else policy.close_failure
+
     @property
     def link_open(self) -> bool:
         """Whether the dome's port is open now (connected, or held open after metering): an
@@ -355,6 +367,10 @@ class ArmLighting:
     def reconnections(self) -> list[dict[str, object]]:
         """[]: a carrier does not reopen a lost port mid-session."""
         return []
+
+    def port_close_failure(self) -> None:
+        """None: the carrier's close raises what failed (its port's release included)."""
+        return None
 
     def connect(self) -> None:
         self.arm_failure = None
@@ -530,6 +546,29 @@ class ArmLighting:
             return failures + parked
         self.end = park_end(self.carrier, None)
         return failures
+
+
+#: The label of a teardown failure that is the lights' port not closing cleanly (its words said
+#: to the user as it happened): recorded among the run's ``teardown_failures``, but no sign
+#: that the lights are unsafe, as the all-off before it says what it established.
+PORT_CLOSE = "port close"
+
+
+def port_close_failures(lighting: Lighting) -> list[str]:
+    """The run's record of the lights' last close failing to release their port (``port
+    close: …``, the shape of every teardown failure), none when it closed cleanly.
+
+    Why: a dome's close never raises its port's failure (it must not mask the error that led
+    to the close), so the teardown's ``try`` around the close never saw it: the user was told,
+    the manifest's and journal's ``teardown_failures`` said nothing went wrong."""
+    said = lighting.port_close_failure()
+    return [] if said is None else [f"{PORT_CLOSE}: {said}"]
+
+
+def unsafe_failures(failures: Iterable[str] | None) -> list[str]:
+    """The teardown failures that leave the lights' safe state in doubt (each but a port's
+    close, said as it happened and coming after the all-off that says what it established)."""
+    return [f for f in failures or () if not str(f).startswith(f"{PORT_CLOSE}: ")]
 
 
 def attempt_all(actions: list[tuple[str, object]]) -> list[str]:

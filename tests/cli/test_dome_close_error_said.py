@@ -10,6 +10,7 @@ or with none as a warning record that the command line says as a note.
 
 from __future__ import annotations
 
+import json
 import logging
 import sys
 from pathlib import Path
@@ -103,3 +104,21 @@ def test_a_close_failing_alike_again_is_said_once(monkeypatch: pytest.MonkeyPatc
     dome.close()
     assert len(heard) == 1 and WORDS in heard[0], heard
     assert dome.close_errors == heard
+
+
+def test_a_run_s_port_close_failure_is_in_its_teardown_failures(
+    tmp_path: Path, close_fails: None
+) -> None:
+    """The run's record keeps what its teardown's close said (the manifest's
+    ``teardown_failures`` had said nothing went wrong), in the shape of every teardown failure;
+    it is said once, and the session, its all-off acknowledged, is not called unsafe."""
+    out = tmp_path / "S"
+    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "3", "--out", str(out)]
+    r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 0, text
+    failures = json.loads((out / "manifest.json").read_text())["runner"]["teardown_failures"]
+    assert failures == [f"port close: {_line(text)}"], failures
+    assert text.count(WORDS) == 1, text
+    assert "known safe state" not in text and "teardown problem" not in text, text
+    assert "acknowledged" in text, text  # the lights' line says what the all-off established
