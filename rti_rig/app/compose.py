@@ -6,7 +6,6 @@ This is the one place in the core that imports ``simulator`` (and, as backends a
 
 from __future__ import annotations
 
-import contextlib
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -15,7 +14,7 @@ from rti_rig.core.clock import Clock, SystemClock, VirtualClock
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.runtime.duty_ledger import DutyLedger
 from rti_rig.runtime.lighting import ArmLighting, DomeLighting
-from rti_rig.runtime.rig import Rig
+from rti_rig.runtime.rig import Rig, RigResources
 
 if TYPE_CHECKING:
     from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
@@ -130,8 +129,8 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
         ),
         clock=SystemClock(),
     )
-    stack = contextlib.ExitStack()
-    link = stack.enter_context(emulated_dome_on_pty(firmware))
+    stack = RigResources()
+    link = stack.enter_context(emulated_dome_on_pty(firmware), "dome emulator")
     try:
         dome = build_dome(
             serial.model_copy(update={"port": link.port}),
@@ -151,7 +150,7 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
             clock,
         )
     except BaseException:
-        stack.close()
+        stack.close_said(cfg.name)
         raise
     rig = Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock, stack)
     rig.emulator = firmware  # type: ignore[attr-defined]  # for tests and the fault campaign
@@ -227,8 +226,8 @@ def _build_emulated_firmware_dome(
     )
     if clock is None:
         clock = SystemClock() if board.self_timed else VirtualClock()
-    stack = contextlib.ExitStack()
-    link = stack.enter_context(serve_on_pty(board, serial.profile))
+    stack = RigResources()
+    link = stack.enter_context(serve_on_pty(board, serial.profile), "dome emulator")
     try:
         dome = build_dome(
             serial.model_copy(update={"port": link.port}),
@@ -241,7 +240,7 @@ def _build_emulated_firmware_dome(
         light = _BoardLight(board, geometry, link, power, cfg.emulator.dead_leds)
         camera = _simulated_camera(loaded, light, clock)
     except BaseException:
-        stack.close()
+        stack.close_said(cfg.name)
         raise
     rig = Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock, stack)
     rig.emulator = board  # type: ignore[attr-defined]  # for tests and the fault campaign
@@ -285,9 +284,9 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     arm_cfg = loaded.config.arm
     assert arm_cfg is not None and arm_cfg.dynamixel is not None
     settings = arm_cfg.dynamixel
-    stack = contextlib.ExitStack()
+    stack = RigResources()
     port, emulator = stack.enter_context(
-        emulated_arm_port(settings, clock, transport=arm_cfg.transport)
+        emulated_arm_port(settings, clock, transport=arm_cfg.transport), "arm emulator"
     )
     # [[emulator.faults]]: the status of the K-th instruction packet lost or damaged, or a
     # servo's hardware error (overload …) raised as that packet arrives
@@ -310,7 +309,7 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
         )
         camera = _simulated_camera(loaded, _ArmLamp(arm, emulator, settings), clock)
     except BaseException:
-        stack.close()
+        stack.close_said(loaded.config.name)
         raise
     rig = Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock, stack)
     rig.emulator = emulator  # type: ignore[attr-defined]  # for tests and the fault campaign

@@ -7,16 +7,63 @@ what it reads of the loaded config is written here as protocols; the composition
 
 from __future__ import annotations
 
-import contextlib
+import logging
 from collections.abc import Callable
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Protocol, TypeVar
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Camera
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.runtime.lighting import Lighting
+
+log = logging.getLogger("rti_rig.rig")
+
+T = TypeVar("T")
+
+
+class RigResources:
+    """What a rig holds open besides its devices (an emulator, its pseudo-terminal), closed
+    last opened first, each whatever the others did, every failure kept.
+
+    Why not a ``contextlib.ExitStack``: its close raises the last failure alone (the others
+    only chained to it), and raised from a close in a ``finally`` or an ``except`` it replaced
+    the error that led there: an emulator that did not close cleanly after a run stopped on a
+    servo's overload made the run end on "unexpected OSError", the overload unsaid."""
+
+    def __init__(self) -> None:
+        self._open: list[tuple[str, Callable[[], object]]] = []
+
+    def enter_context(self, cm: AbstractContextManager[T], what: str) -> T:
+        """Enter ``cm``; its exit is the close of ``what`` (as a failure names it)."""
+        value = cm.__enter__()
+        self._open.append((what, lambda: cm.__exit__(None, None, None)))
+        return value
+
+    def callback(self, close: Callable[[], object], what: str) -> None:
+        """Call ``close`` at the close, named ``what`` in its failure."""
+        self._open.append((what, close))
+
+    def close(self) -> list[str]:
+        """Close everything, last opened first; each failure as ``"<what> close: <error>"``
+        (never raised: a close must not hide the error that led to it). Safe twice."""
+        failures: list[str] = []
+        while self._open:
+            what, close = self._open.pop()
+            try:
+                close()
+            except Exception as exc:  # every resource is closed whatever one does
+                failures.append(f"{what} close: {exc}")
+        return failures
+
+    def close_said(self, owner: str) -> None:
+        """:meth:`close`, each failure said as a warning record naming ``owner`` (the command
+        line says it as a note): for a close on the way out of an error, whose caller has
+        nobody else to hand them to."""
+        for failure in self.close():
+            log.warning("%s: %s", owner, failure)
 
 
 class CameraConfig(Protocol):
@@ -70,7 +117,7 @@ class Rig:
     camera: Camera
     clock: Clock
     #: Things the rig holds open besides its devices (an emulator's pseudo-terminal…).
-    resources: contextlib.ExitStack = field(default_factory=contextlib.ExitStack)
+    resources: RigResources = field(default_factory=RigResources)
     #: Called with the session folder before the devices connect: a DSLR's downloads go there
     #: (the composition root registers what its devices need to know of the session).
     session_hooks: list[Callable[[Path], None]] = field(default_factory=list)
@@ -95,15 +142,22 @@ class Rig:
         for hook in self.session_hooks:
             hook(Path(root))
 
-    def close(self) -> None:
-        """Release what ``build_rig`` opened; the controller has already made devices safe."""
-        self.resources.close()
+    def close(self) -> list[str]:
+        """Release what ``build_rig`` opened (the controller has already made the devices
+        safe); return each failure (``"<what> close: <error>"``) for the caller to say, never
+        raising it: the error that led to the close, if any, is the one that goes on."""
+        return self.resources.close()
+
+    def close_said(self) -> None:
+        """:meth:`close`, each failure said as a warning record (the command line says it as a
+        note): for a close on the way out of an error, or with nobody to hand them to."""
+        self.resources.close_said(self.name)
 
     def __enter__(self) -> Rig:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        self.close()
+        self.close_said()
 
     @property
     def name(self) -> str:

@@ -1656,7 +1656,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         validate_schedule(rig, schedule)  # the starting layout, before anything moves
         folder = SessionFolder.create(out_dir, source.total)
     except BaseException:
-        rig.close()
+        rig.close_said()  # its failures said, never in place of the error raised
         raise
     return rig, schedule, folder, source
 

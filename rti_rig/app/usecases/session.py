@@ -227,19 +227,28 @@ class OpenedSession:
         rig = self.rig
         try:
             with signals_deferred():
-                if not self.teardown_ran:
-                    if rig.lighting.link_open:
-                        self.close_failures += rig.lighting.safe(emergency=True)
-                    self.close_failures += attempt_all(
-                        [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
-                    )
-                    if self.cut_by is not None:
-                        # a stop cut the run's end before the controller recorded it: said on
-                        # disk as a stop, not left as a kill leaves it. After the devices are
-                        # safe: the manifest's fsync (seconds behind a slow card's pending
-                        # images) had kept a lamp or an LED lit while it ran
-                        self.folder.record_cut_end(self.cut_by)
-                rig.close()
+                try:
+                    if not self.teardown_ran:
+                        if rig.lighting.link_open:
+                            self.close_failures += rig.lighting.safe(emergency=True)
+                        self.close_failures += attempt_all(
+                            [
+                                ("camera close", rig.camera.close),
+                                ("lights close", rig.lighting.close),
+                            ]
+                        )
+                        if self.cut_by is not None:
+                            # a stop cut the run's end before the controller recorded it: said
+                            # on disk as a stop, not left as a kill leaves it. After the devices
+                            # are safe: the manifest's fsync (seconds behind a slow card's
+                            # pending images) had kept a lamp or an LED lit while it ran
+                            self.folder.record_cut_end(self.cut_by)
+                finally:
+                    # every resource closed whatever the record did, each failure kept for the
+                    # command to say, never raised: it had replaced the session's own error (an
+                    # emulator's close after a servo's overload: "unexpected OSError", the
+                    # overload unsaid)
+                    self.close_failures += rig.close()
         finally:
             unlock_session(self.folder.root)  # a resume's lock, also for a run never started
 
@@ -334,7 +343,7 @@ def checked_rig(loaded, schedule: LightSchedule) -> Rig:  # type: ignore[no-unty
     try:
         validate_schedule(rig, schedule)
     except BaseException:
-        rig.close()
+        rig.close_said()  # its failures said, never in place of the error raised
         raise
     return rig
 
@@ -864,7 +873,7 @@ def _open_new(
         folder = SessionFolder.create(out_dir, len(schedule))
         folder.rig_identity = identity
     except BaseException:
-        rig.close()
+        rig.close_said()  # its failures said, never in place of the error raised
         raise
     return OpenedSession(rig, schedule, folder, Path(out_dir))
 
@@ -1719,7 +1728,7 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         try:
             source = resume_adaptive_source(rig, folder, req.objective)
         except BaseException:
-            rig.close()
+            rig.close_said()  # its failures said, never in place of the error raised
             raise
     return OpenedSession(
         rig, schedule, folder, Path(req.session_dir), resumed=True, source=source, request=req
