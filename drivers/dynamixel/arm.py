@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core.clock import Clock
-from rti_rig.core.devices import ReadBackCarrier
+from rti_rig.core.devices import ReadBackCarrier, TorqueAtClose
 from rti_rig.core.errors import MoveCancelled
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.drivers.dynamixel import control_table as ct
@@ -162,6 +162,8 @@ class DynamixelArm(ReadBackCarrier):
         #: Torque Enable as read back after that torque-off: the servos still holding, and
         #: those that did not answer the read (both empty: every servo read back off).
         self._torque_after_release: tuple[list[Any], list[Any]] = ([], [])
+        #: What the last close established of the torque (:meth:`torque_at_close`).
+        self._torque_at_close: TorqueAtClose | None = None
         self._goal: tuple[int, int] | None = None
         #: (servo id, Hardware Error Status) of each alert a stop has said it held despite
         self._alerts_said: set[tuple[int, int]] = set()
@@ -216,6 +218,7 @@ class DynamixelArm(ReadBackCarrier):
         self._connected = self.ever_connected = True
         self.torque_released = False
         self._torque_after_release = ([], [])
+        self._torque_at_close = None
         self._lamp_on = False
         self._emergency_stopped = False
         self._goal = self.joint_ticks()  # multi-turn choices start from where the arm is
@@ -569,6 +572,10 @@ class DynamixelArm(ReadBackCarrier):
             self._bus.close()
             return
         first: BaseException | None = None
+        # "hold" sends no torque-off and reads nothing back: recorded as such (the release's
+        # record is made by the release itself, once it has read the servos back)
+        hold = self.settings.torque_policy != "release_on_close"
+        self._torque_at_close = TorqueAtClose(self.settings.torque_policy, False) if hold else None
         steps: list[tuple[str, Callable[[], None], str]] = [
             ("the lamp-off", lambda: self.lamp(False), "check that the lamp is off"),
             (
@@ -616,13 +623,47 @@ class DynamixelArm(ReadBackCarrier):
             self.torque_released = True
             # a broadcast write gets no status reply: whether each servo let go is read back
             self._torque_after_release = self._torque_as_read()
-        else:
+            self._torque_at_close = self._torque_record(True, *self._torque_after_release)
+            return
+        # kept on: read back, so that the record (and the words) say what the servos hold,
+        # not what the policy meant (a servo an overload shut down reads its torque off)
+        on, unknown = self._torque_as_read()
+        self._torque_at_close = self._torque_record(False, on, unknown)
+        if len(on) == len(self.settings.joints):
             self._tell(
                 f"{self.name}: torque stays on: the arm is not at its park pose, and "
                 'torque_policy = "release_on_close" releases it only there, where it cannot '
                 "drop onto the object. Park it with 'rti-rig check' before switching off the "
                 "servos' power."
             )
+            return
+        off = [j for j in self.settings.joints if j not in on and j not in unknown]
+        read = "; ".join(
+            f"{what} from {self._servos_named(joints)}"
+            for what, joints in (("reads back ON", on), ("reads back OFF (limp)", off))
+            if joints
+        )
+        unread = f"; not read back from {self._servos_named(unknown)}" if unknown else ""
+        self._tell(
+            f"{self.name}: no torque-off sent: the arm is not at its park pose, and "
+            'torque_policy = "release_on_close" releases it only there; Torque Enable '
+            f"{read}{unread}. Support the arm before switching off the servos' power, and "
+            "park it with 'rti-rig check'."
+        )
+
+    def _torque_record(self, off_sent: bool, on: list[Any], unknown: list[Any]) -> TorqueAtClose:
+        """The close's :class:`TorqueAtClose` from Torque Enable as read back."""
+        read = {
+            j.servo_id: "on" if j in on else "unread" if j in unknown else "off"
+            for j in self.settings.joints
+        }
+        return TorqueAtClose("release_on_close", off_sent, read)
+
+    def torque_at_close(self) -> TorqueAtClose | None:
+        """What the last close established of the torque (see :class:`TorqueAtClose`); None
+        when that close did not get as far as its torque policy (a failed read of the pose
+        before the release: the failure is the close's error) or was never connected."""
+        return self._torque_at_close
 
     def listen(self, say: Callable[[str], None] | None) -> None:
         """Have what a user must know as it happens (the search for the servos at other baud

@@ -110,6 +110,29 @@ class LightCarrier(Protocol):
         ...
 
 
+@dataclass(frozen=True)
+class TorqueAtClose:
+    """What a carrier's close established of its joints' torque, for the session's manifest
+    (``runner.arm_end.torque_at_close``).
+
+    ``policy``: the torque policy the close applied (``"hold"``, ``"release_on_close"``);
+    ``off_sent``: whether the close sent a torque-off; ``read_back``: Torque Enable as read
+    back from each servo after it (servo id → ``"on"``, ``"off"`` or ``"unread"``), None where
+    the close read nothing back (``"hold"`` touches no torque: it stays as the session left it).
+
+    Why: ``release_on_close`` keeps the torque on away from the park pose, which the user was
+    told in words while the manifest said nothing of the torque, as of an arm whose close
+    released nothing: a script could not tell an arm held under torque from a limp one."""
+
+    policy: str
+    off_sent: bool
+    read_back: dict[int, str] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        read = None if self.read_back is None else {str(k): v for k, v in self.read_back.items()}
+        return {"policy": self.policy, "off_sent": self.off_sent, "read_back": read}
+
+
 @runtime_checkable
 class ReadBackCarrier(Protocol):
     """What a :class:`LightCarrier` that reads its servos back (a Dynamixel arm) can say of
@@ -133,6 +156,11 @@ class ReadBackCarrier(Protocol):
     def torque_release_note(self) -> str | None:
         """What the last close's release of the torque (at the park pose) leaves the user to
         know, or None when it released nothing."""
+
+    @abstractmethod
+    def torque_at_close(self) -> TorqueAtClose | None:
+        """What the last close established of the joints' torque (None: that close did not
+        get as far as its torque policy, or the arm was not connected)."""
 
     @abstractmethod
     def check_held(self) -> None:

@@ -37,13 +37,18 @@ class ArmEnd:
     to the joints' torque when it released them (``torque_policy = "release_on_close"``, see
     :meth:`rti_rig.drivers.dynamixel.arm.DynamixelArm.torque_release_note`), None when it
     released nothing. Why: the close comes after the teardown's read-back, and ``run`` had
-    said "held where it stopped, torque on" of an arm its close then let go limp."""
+    said "held where it stopped, torque on" of an arm its close then let go limp.
+    ``torque_at_close``: what the close established of the torque, for a script
+    (:meth:`rti_rig.core.devices.TorqueAtClose.to_dict`: the policy, whether a torque-off was
+    sent, Torque Enable read back per servo), None when the carrier's close did not say (it
+    failed before its torque policy, or the carrier does not read its servos back)."""
 
     outcome: Outcome
     azimuth_deg: float | None = None
     elevation_deg: float | None = None
     why: str | None = None
     torque: str | None = None
+    torque_at_close: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -56,12 +61,14 @@ class ArmEnd:
             raise ValueError(f"not an arm end outcome: {outcome!r}")
         az, el = data.get("azimuth_deg"), data.get("elevation_deg")
         why, torque = data.get("why"), data.get("torque")
+        at_close = data.get("torque_at_close")
         return cls(
             outcome,  # type: ignore[arg-type]
             None if az is None else float(az),
             None if el is None else float(el),
             None if why is None else str(why),
             None if torque is None else str(torque),
+            dict(at_close) if isinstance(at_close, dict) else None,
         )
 
     def _at(self) -> str:

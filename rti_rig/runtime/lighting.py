@@ -398,8 +398,15 @@ class ArmLighting:
 
     def _record_release(self) -> None:
         carrier = self.read_back
-        said = None if carrier is None else carrier.torque_release_note()
-        if not said or self.end is None:
+        if carrier is None or self.end is None:
+            return
+        # what the close established of the torque, whatever it did (kept on away from the
+        # park pose had been in no record: read the same as "released nothing")
+        at_close = carrier.torque_at_close()
+        if at_close is not None:
+            self.end = replace(self.end, torque_at_close=at_close.to_dict())
+        said = carrier.torque_release_note()
+        if not said:
             return
         why = self.end.why
         if self.stopped_by is not None:  # "torque on" no longer true: the close released it

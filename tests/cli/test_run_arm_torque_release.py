@@ -119,3 +119,112 @@ def test_a_preview_s_released_park_is_said(tmp_path: Path, monkeypatch: pytest.M
     assert f"within 1° of its park pose); {RELEASED}" in said, said
     (emu,) = emulators
     assert all(s.get(ct.TORQUE_ENABLE) == 0 for s in emu.servos.values())
+
+
+KEPT = (
+    "arm: torque stays on: the arm is not at its park pose, and torque_policy = "
+    '"release_on_close" releases it only there'
+)
+
+
+def _run_unparked(tmp_path: Path) -> tuple[int, str, dict]:  # type: ignore[type-arg]
+    """Run 2 lights, no park (``park_after_session = false``): the close keeps the torque on."""
+    cfg = _config(tmp_path)
+    text = cfg.read_text()
+    assert "\n[arm]\n" in text
+    cfg.write_text(text.replace("\n[arm]\n", "\n[arm]\npark_after_session = false\n", 1))
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app,
+        ["run", str(cfg), "--lights", "2", "--out", str(out), "--no-verdict"],
+        terminal_width=400,
+    )
+    said = " ".join(r.output.split())
+    assert "Traceback" not in said, said
+    end = json.loads((out / "manifest.json").read_text())["runner"]["arm_end"]
+    return r.exit_code, said, end
+
+
+def test_a_torque_kept_on_at_the_close_is_in_the_manifest(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Away from the park pose the close keeps the torque on and says so; the manifest had
+    recorded no torque at all, as of an arm whose close released nothing. It now records what
+    the close established: no torque-off sent, Torque Enable read back on from each servo,
+    with the pose read back."""
+    emulators = emulators_built_by_check(monkeypatch)
+    code, said, end = _run_unparked(tmp_path)
+    assert code == 0, said
+    assert said.count(KEPT) == 1, said
+    assert end["outcome"] == "left" and end["azimuth_deg"] is not None, end
+    assert end["torque"] is None, end  # nothing released: no release note
+    assert end["torque_at_close"] == {
+        "policy": "release_on_close",
+        "off_sent": False,
+        "read_back": {"1": "on", "2": "on"},
+    }, end
+    (emu,) = emulators  # the truth: both still hold
+    assert all(s.get(ct.TORQUE_ENABLE) == 1 for s in emu.servos.values())
+
+
+def test_a_kept_torque_read_back_off_is_not_said_to_hold(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A servo whose torque went off before the close (switched off on the bus, as a servo's
+    shutdown does) is recorded and said limp, never "torque stays on"."""
+    emulators = emulators_built_by_check(monkeypatch)
+    real_safe = ArmLighting.safe
+
+    def safe(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+        failures = real_safe(self, *args, **kwargs)
+        emulators[0].servos[2].write(ct.TORQUE_ENABLE.address, b"\x00")
+        return failures
+
+    monkeypatch.setattr(ArmLighting, "safe", safe)
+    code, said, end = _run_unparked(tmp_path)
+    assert code == 0, said
+    assert "torque stays on" not in said, said
+    assert (
+        "Torque Enable reads back ON from servo 1 (azimuth); reads back OFF (limp) from servo 2 "
+        "(elevation)" in said
+    ), said
+    assert end["torque_at_close"] == {
+        "policy": "release_on_close",
+        "off_sent": False,
+        "read_back": {"1": "on", "2": "off"},
+    }, end
+
+
+def test_a_released_torque_is_in_the_manifest_as_read_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    emulators_built_by_check(monkeypatch)
+    code, said, end = _run(tmp_path, "--lights", "2")
+    assert code == 0, said
+    assert end["torque_at_close"] == {
+        "policy": "release_on_close",
+        "off_sent": True,
+        "read_back": {"1": "off", "2": "off"},
+    }, end
+
+
+def test_a_held_torque_is_recorded_as_the_policy_left_it(tmp_path: Path) -> None:
+    """``torque_policy = "hold"`` (the shipped arm): the close sends no torque-off and reads
+    nothing back, and the record says just that."""
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app,
+        [
+            "run",
+            str(inprocess_arm_config(tmp_path)),
+            "--lights",
+            "2",
+            "--out",
+            str(out),
+            "--no-verdict",
+        ],
+        terminal_width=400,
+    )
+    assert r.exit_code == 0, r.output
+    end = json.loads((out / "manifest.json").read_text())["runner"]["arm_end"]
+    assert end["torque_at_close"] == {"policy": "hold", "off_sent": False, "read_back": None}
