@@ -11,11 +11,12 @@ rig's resources failing to close as an emulator whose pty went away may.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import inprocess_arm_config, said, servo_fault
+from conftest import CONFIGS, inprocess_arm_config, said, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -68,6 +69,39 @@ def test_an_emulator_close_failure_does_not_hide_the_servo_fault(
     two = text.index("teardown problem: second pty close: [Errno 9] pty two went away")
     one = text.index("teardown problem: first pty close: [Errno 5] pty one went away")
     assert two < one, text
+
+
+@pytest.mark.pty
+@pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux")
+def test_an_emulator_close_failure_does_not_hide_a_failed_all_off(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The dome is gone at the teardown's all-off (its 8th command, as in
+    test_unsafe_end_exit.py): that failure, the lights' line and the unsafe end's exit 1 stand,
+    and the emulators' close failures are said after them."""
+    closed = _closes_failing(monkeypatch)
+    cfg = tmp_path / "rig.toml"
+    cfg.write_text(
+        (CONFIGS / "emulated_nab_rti_v1.toml")
+        .read_text()
+        .replace("reconnect_attempts = 4", "reconnect_attempts = 1")
+        .replace("reconnect_backoff_s = 0.5", "reconnect_backoff_s = 0.05")
+        + '\n[emulator]\nfaults = [{at_command = 8, kind = "disconnect", delay_s = 60.0}]\n'
+    )
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app,
+        ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"],
+        terminal_width=400,
+    )
+    text = said(r)
+    assert "Traceback" not in text and "unexpected" not in text, text
+    assert r.exit_code == 1, text
+    assert "teardown problem: all LEDs off" in text, text
+    assert "the rig was not brought to a known safe state" in text, text
+    assert closed == ["pty two", "pty one"], closed
+    assert "teardown problem: second pty close: [Errno 9] pty two went away" in text, text
+    assert "teardown problem: first pty close: [Errno 5] pty one went away" in text, text
 
 
 def test_every_resource_is_closed_and_every_failure_kept() -> None:
