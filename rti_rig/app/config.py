@@ -616,6 +616,12 @@ def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
 #: Format tag of a light calibration file (``rti-rig calibrate-lights``).
 CALIBRATION_FORMAT = "rti-rig-light-calibration/1"
 
+#: What ``dome.lp_file`` names, said where it names no ``.lp``.
+DOME_LP_WANTED = (
+    "dome.lp_file names the dome's .lp light list (a count line, then 'name x y z' per LED, "
+    "in the order of the LEDs)"
+)
+
 
 #: The key under which a loaded rig's raw ``[dome.serial]`` (and so a session's manifest)
 #: records which LEDs its calibration file measured (the others were assumed median).
@@ -1379,7 +1385,7 @@ def dome_led_directions(
                 f"file {lp_path} does not exist (paths are relative to the config file's folder)",
             )
         try:
-            entries = read_lp(lp_path, upper_hemisphere=True, notes=notes)
+            entries = read_lp(lp_path, upper_hemisphere=True, notes=notes, wanted=DOME_LP_WANTED)
         except LpFormatError as exc:
             raise ConfigError(rig.path, "dome.lp_file", str(exc)) from None
         dirs = np.array([e.direction for e in entries])

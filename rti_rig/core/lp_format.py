@@ -683,8 +683,16 @@ def parse_lp(
     return entries
 
 
+#: What a reader wants where it is given no ``.lp``, unless its command says it in its own words.
+LP_WANTED = "give the .lp light list (a count line, then 'name x y z' per image)"
+
+
 def read_lp(
-    path: Path | str, upper_hemisphere: bool = False, notes: list[str] | None = None
+    path: Path | str,
+    upper_hemisphere: bool = False,
+    notes: list[str] | None = None,
+    *,
+    wanted: str = LP_WANTED,
 ) -> list[LpEntry]:
     """Read an `.lp` file tolerantly; errors and ``notes`` name the file and line (see
     :func:`parse_lp`).
@@ -692,9 +700,10 @@ def read_lp(
     A folder, an image or a TOML file given where an `.lp` goes (``run --plan``, ``bench
     tradeoff --from``) is said to be one: they had been told "cannot read: Is a directory",
     "line 1: the line holds NUL bytes … save it again as UTF-8" and "line 4: expected 'name x
-    y z'"."""
+    y z'". ``wanted`` says what the command reading it takes, in its words: a TOML file had
+    been asked "(a rig config?)" by every reader, ``--plan`` and a rig's ``dome.lp_file``
+    included, where no rig config is meant."""
     path = Path(path)
-    wanted = "give the .lp light list (a count line, then 'name x y z' per image)"
     if path.is_dir():
         raise LpFormatError(path, None, f"is a folder, not an .lp file: {wanted}")
     try:
@@ -704,9 +713,7 @@ def read_lp(
     if looks_like_image(raw):
         raise LpFormatError(path, None, f"this is an image, not an .lp file: {wanted}")
     if path.suffix.lower() == ".toml":
-        raise LpFormatError(
-            path, None, f"this is a TOML file (a rig config?), not an .lp: {wanted}"
-        )
+        raise LpFormatError(path, None, f"this is a TOML file, not an .lp: {wanted}")
     return parse_lp(_decode(raw), str(path), upper_hemisphere, notes)
 
 

@@ -40,7 +40,9 @@ def test_a_plan_that_is_not_an_lp_is_named_for_what_it_is(
     text = "".join(r.output.split())
     assert r.exit_code == 2, r.output
     assert "Traceback" not in r.output
-    assert "".join(f"{given}: {said}: give the .lp light list".split()) in text, r.output
+    assert "".join(f"{given}: {said}: --plan takes a plan, the .lp light list".split()) in text, (
+        r.output
+    )
     assert "NUL" not in text and "expected'namexyz'" not in text
     assert not out.exists()
 
@@ -72,7 +74,8 @@ def test_a_toml_file_that_is_no_rig_config_given_as_the_plan_is_said_to_be_toml(
     tmp_path: Path,
 ) -> None:
     """Only a file that is a rig config is called one: another TOML file (a light
-    calibration) is told it is TOML, not an .lp."""
+    calibration) is told it is TOML, not an .lp, and what --plan takes; it had been asked
+    "(a rig config?)", where the file had just been found to be none."""
     other = tmp_path / "calibration.toml"
     other.write_text('format = "rti-rig-light-calibration/1"\nrig = "x"\n', encoding="utf-8")
     r = runner.invoke(
@@ -89,3 +92,31 @@ def test_a_toml_file_that_is_no_rig_config_given_as_the_plan_is_said_to_be_toml(
     assert r.exit_code == 2, r.output
     text = "".join(r.output.split())
     assert "thisisaTOMLfile" in text and "isarigconfig" not in text, r.output
+    assert "arigconfig?" not in text, r.output
+    assert (
+        "".join(f"{other}: this is a TOML file, not an .lp: --plan takes a plan, the .lp".split())
+        in text
+    ), r.output
+
+
+def test_a_dome_lp_file_that_is_toml_is_told_what_the_key_names(tmp_path: Path) -> None:
+    """A rig whose ``dome.lp_file`` names a TOML file is told what that key names, not asked
+    "(a rig config?)": the rig config is the file that names it."""
+    other = tmp_path / "lights.toml"
+    other.write_text("a = 1\n", encoding="utf-8")
+    text = (CONFIGS / "example_dome_48.toml").read_text(encoding="utf-8")
+    assert 'lp_file = "example_dome_48.lp"' in text
+    rig = tmp_path / "rig.toml"
+    rig.write_text(text.replace('"example_dome_48.lp"', '"lights.toml"'), encoding="utf-8")
+    r = runner.invoke(app, ["check", str(rig)])
+    assert r.exit_code == 2, r.output
+    assert "Traceback" not in r.output
+    said = "".join(r.output.split())
+    assert "arigconfig?" not in said, r.output
+    assert (
+        "".join(
+            f"{rig}: key 'dome.lp_file': {other}: this is a TOML file, not an .lp: dome.lp_file "
+            "names the dome's .lp light list".split()
+        )
+        in said
+    ), r.output

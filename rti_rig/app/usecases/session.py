@@ -922,6 +922,13 @@ def refuse_unmeterable_camera(loaded) -> None:  # type: ignore[no-untyped-def]
         )
 
 
+#: What ``--plan`` takes, said where it is given no ``.lp``.
+PLAN_WANTED = (
+    "--plan takes a plan, the .lp light list (a count line, then 'name x y z' per image) that "
+    "rti-rig plan writes"
+)
+
+
 def _refuse_rig_config_as_plan(plan: Path, rig_config: Path) -> None:
     """Refuse a rig config given as ``--plan``, saying that it is one, what ``--plan`` takes
     and the commands that make and run a plan.
@@ -971,7 +978,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
             raise RtiRigError("give either --plan or --lights, not both")
         _refuse_rig_config_as_plan(Path(req.plan), Path(req.rig_config))
         plan_notes: list[str] = []
-        entries = read_lp(req.plan, upper_hemisphere=True, notes=plan_notes)
+        entries = read_lp(req.plan, upper_hemisphere=True, notes=plan_notes, wanted=PLAN_WANTED)
         for note in plan_notes:
             on_note(Note(note, "warning"))
         check_light_count(len(entries))
