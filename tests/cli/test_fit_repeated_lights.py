@@ -78,3 +78,41 @@ def test_the_repeat_names_a_ptm_only_where_one_is_fitted(
     assert "lights repeated: image01, image13 and image21 share one direction" in text, text
     assert ("--model ptm (6 terms)" in text) == ptm_named, text
     assert (tmp_path / "f" / "fit.ptm").exists() == ("--no-ptm" not in args)
+
+
+def _twelve(folder: Path) -> Path:
+    """The replay's first 12 images, 5 of them lit from the first one's direction: 8
+    distinct lights, too few for hsh2's 9 terms, enough for hsh1 and a PTM."""
+    folder.mkdir()
+    entries = read_lp(ACQ)[:12]
+    for e in entries:
+        shutil.copy(ACQ.parent / e.name, folder / e.name)
+    first = entries[0].direction
+    lp = folder / "dirs.lp"
+    repeat = (0, 2, 4, 6, 8)
+    write_lp(
+        lp, [LpEntry(e.name, first if k in repeat else e.direction) for k, e in enumerate(entries)]
+    )
+    return lp
+
+
+@pytest.mark.parametrize(
+    ("args", "hsh2_named"),
+    [
+        (("--model", "hsh2"), True),
+        (("--model", "ptm", "--hsh-order", "1"), False),
+        (("--model", "ptm", "--no-hsh"), False),
+    ],
+)
+def test_the_repeat_names_an_hsh_only_where_one_is_fitted(
+    tmp_path: Path, args: tuple[str, ...], hsh2_named: bool
+) -> None:
+    """The note had named hsh2 as "fitted ridge-regularised and not to be trusted" of fits
+    whose fit.rti was hsh1, or that wrote no fit.rti."""
+    lp = _twelve(tmp_path / "acq")
+    r = CliRunner().invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa", *args])
+    text = said(r)
+    assert r.exit_code == 0, text
+    assert "the 12 images give 8 distinct lights" in text, text
+    assert ("--model hsh2 (9 terms)" in text) == hsh2_named, text
+    assert ("fit.rti: hsh2" in text) == hsh2_named, text

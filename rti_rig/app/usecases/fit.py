@@ -182,6 +182,8 @@ class FitResult:
     normals_from: str = ""
     #: fit.rti's HSH order and why (``""`` when no fit.rti was written)
     rti: str = ""
+    #: the relighting models fitted (``ptm``, ``hsh1``…``hsh3``), written or kept for normals
+    fitted: tuple[str, ...] = ()
 
 
 def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
@@ -765,9 +767,9 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
         raise
     finally:
         pool.shutdown(wait=False, cancel_futures=True)
-    ptm = result.model == "ptm" or result.normals_from == "ptm"
-    ptm = ptm or any(f.name == "fit.ptm" for f in result.files)
-    repeated = repeated_lights_note(lights, names, ptm_fitted=ptm)
+    # the model asked for is named even where only another source's normals were written
+    # (``--model ptm --no-ptm``): it is the model the user chose
+    repeated = repeated_lights_note(lights, names, fitted=(*result.fitted, result.model))
     if repeated is not None:
         result.notes.insert(said_at, repeated)
     result.seconds = time.perf_counter() - t0
@@ -775,7 +777,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
 
 
 def repeated_lights_note(
-    lights: np.ndarray, names: Sequence[str], *, ptm_fitted: bool = True
+    lights: np.ndarray, names: Sequence[str], *, fitted: Sequence[str] = ("ptm", "hsh2", "hsh3")
 ) -> str | None:
     """What a fit says of lights that repeat a direction, whatever its model, or None.
 
@@ -783,9 +785,9 @@ def repeated_lights_note(
     of 7 images of which 3 share one direction said nothing of it with ``--model ptm``: only
     "these lights cannot separate its 6 terms", leaving the user to find that 7 images gave
     5 directions. The models the distinct lights are too few for are named (the coefficient
-    counts of ``core.fit_minimums``); a PTM only where one was fitted (``ptm_fitted``: the
-    model, the normals' source or fit.ptm): with ``--no-ptm`` it had been called "fitted
-    ridge-regularised and not to be trusted" of a fit that made none."""
+    counts of ``core.fit_minimums``), only those this fit made (``fitted``: written, or kept
+    for the normals): with ``--no-ptm`` a PTM had been called "fitted ridge-regularised and
+    not to be trusted" of a fit that made none, and hsh2 of a fit whose fit.rti was hsh1."""
     from rti_rig.core.fit_minimums import N_COEFFICIENTS
     from rti_rig.core.rig_geometry import COINCIDENT_LED_DEG, repeated_directions
 
@@ -797,7 +799,7 @@ def repeated_lights_note(
     shown = [", ".join(str(names[i]) for i in g[:-1]) + f" and {names[g[-1]]}" for g in groups[:4]]
     more = f" and {len(groups) - 4} more groups" if len(groups) > 4 else ""
     share = "share one direction" if len(groups) == 1 else "each share a direction"
-    named = ("ptm", "hsh2", "hsh3") if ptm_fitted else ("hsh2", "hsh3")
+    named = [m for m in ("ptm", "hsh1", "hsh2", "hsh3") if m in fitted]
     short = [m for m in named if distinct < N_COEFFICIENTS[m] <= n]
     tail = (
         "; too few distinct for "
@@ -1171,6 +1173,7 @@ def _fit_all(
         warnings=skipped,
         normals_from=normal_source,
         rti=rti_why if f"hsh{order}" in exported else "",
+        fitted=tuple(k for k in linear if k != "lambert"),
     )
 
 
