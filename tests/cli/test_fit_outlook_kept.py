@@ -51,7 +51,9 @@ def _promise(said: str, normals: bool) -> tuple[set[str], set[str]] | None:
         assert "will make" not in said and "will write the" not in said, said  # one story
         return None
     if m := re.search(
-        r"`rti-rig fit` will (?:make|write) (.+?) (?:but no|without) (.+?)[(.;]", said
+        r"`rti-rig fit`(?: with its default --model auto)? will (?:make|write) (.+?) "
+        r"(?:but no|without) (.+?)[(.;]",
+        said,
     ):
         return _named(m.group(1)), _named(m.group(2))
     every = set(FILES.values()) if normals else {"fit.ptm", "fit.rti"}

@@ -91,7 +91,11 @@ def test_nine_lights_are_offered_hsh2(tmp_path: Path) -> None:
     [
         (3, "`rti-rig fit` with its default --model auto cannot fit them"),
         (4, "`rti-rig fit --model hsh1` writes fit.rti of them now"),
-        (5, "`rti-rig fit` will make fit.rti (ridge-regularised) but no fit.ptm (a PTM needs 6)"),
+        (
+            5,
+            "`rti-rig fit` with its default --model auto will make fit.rti (ridge-regularised) "
+            "but no fit.ptm (a PTM needs 6)",
+        ),
     ],
 )
 def test_fewer_lights_than_a_ptm_are_offered_only_what_fits_them(
@@ -100,7 +104,9 @@ def test_fewer_lights_than_a_ptm_are_offered_only_what_fits_them(
     """Below a PTM's 6 lights, `fit --model ps`'s refusal and `run --plan`'s offered
     "--model auto (--model hsh2 needs 9 lights; --model ptm needs 6 lights, these are N) write
     the relighting files (fit.rti, fit.ptm)": auto writes nothing of 3 or 4 such lights and
-    fit.rti alone of 5. Each says what the fit does make of them, and how to get more."""
+    fit.rti alone of 5. Each says what the fit does make of them, and how to get more; of 5,
+    `fit --model ps` had been told "`rti-rig fit` will make fit.rti", which it does not: the
+    default --model auto does, and is named."""
     plan = _one_azimuth(tmp_path / "one_az.lp", n)
     rig = str(CONFIGS / "virtual_arm.toml")
     refused = CliRunner().invoke(

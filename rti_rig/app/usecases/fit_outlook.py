@@ -79,7 +79,9 @@ def auto_way_out(auto: AutoFit) -> str:
 
 def _undetermined_outlook(auto: AutoFit, lights: str) -> str | None:
     """:func:`fit_outlook` of lights that cannot determine a normal: no normal maps whatever the
-    count, and fit.rti and fit.ptm from the counts auto needs without photometric stereo."""
+    count, and fit.rti and fit.ptm from the counts auto needs without photometric stereo.
+    Each names ``--model auto``: ``fit --model ps``'s refusal says it too, and of 5 lights it
+    had said "`rti-rig fit` will make fit.rti", which ``fit --model ps`` does not."""
     least = FIT_MINIMUMS
     if not auto.fits:
         return (
@@ -92,8 +94,9 @@ def _undetermined_outlook(auto: AutoFit, lights: str) -> str | None:
     if not auto.ptm:
         more = least.ptm - auto.n
         return (
-            f"{lights} that cannot determine a normal: `rti-rig fit` will make fit.rti "
-            f"(ridge-regularised) but no fit.ptm (a PTM needs {least.ptm}); "
+            f"{lights} that cannot determine a normal: `rti-rig fit` with its default --model "
+            f"auto will make fit.rti (ridge-regularised) but no fit.ptm (a PTM needs "
+            f"{least.ptm}); "
             f"for fit.ptm as well add {more} more light{'s' if more != 1 else ''}"
         )
     return None
