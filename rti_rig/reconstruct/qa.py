@@ -2115,6 +2115,12 @@ def _evidence(
     note = ""
     most_disagree = False
     undimmed = int((~nodir).sum())
+    # the flat frames left out of that count are said: "4 image(s) with light" of 6 images, 2
+    # of them flat and lit, had read as 2 images with no light
+    flat_out = int((pictureless & ~dead).sum()) if pictureless is not None else 0
+    not_counted = (
+        f" ({flat_out} flat frame{'s' if flat_out != 1 else ''} not counted)" if flat_out else ""
+    )
     if spread_deg < MIN_NORMAL_SPREAD_DEG:
         note = (
             f"light directions not checked: the fitted normals spread only {spread_deg:.1f}° "
@@ -2123,16 +2129,18 @@ def _evidence(
         )
     elif undimmed < MIN_DIRECTION_IMAGES:
         note = (
-            f"light directions not checked: {undimmed} image(s) with light, too few to tell a "
-            f"wrong light from the others (at least {MIN_DIRECTION_IMAGES} are needed)"
+            f"light directions not checked: {undimmed} image(s) with light{not_counted}, too "
+            f"few to tell a wrong light from the others (at least {MIN_DIRECTION_IMAGES} are "
+            "needed)"
         )
     elif cand.sum() < (needed := max(MIN_DIRECTION_IMAGES, (undimmed + 1) // 2)):
         spread = float(np.median(misfit[~nodir & np.isfinite(misfit)])) if undimmed else np.nan
         # how many are needed is said: "median misfit 9%, limit 10%" alone had read as a
         # check passed (6 images need 5 close; a median under the limit says 3 or 4 are)
         note = (
-            f"light directions not checked: only {int(cand.sum())} of {undimmed} images are "
-            f"close to any Lambertian rendering of the fit (misfit within {MISFIT_LIMIT:.0%}; "
+            f"light directions not checked: only {int(cand.sum())} of {undimmed} images"
+            f"{not_counted} are close to any Lambertian rendering of the fit (misfit within "
+            f"{MISFIT_LIMIT:.0%}; "
             f"{needed} are needed to judge the lights; median misfit {spread:.0%}): a glossy, "
             "saturated or non-Lambertian surface"
         )

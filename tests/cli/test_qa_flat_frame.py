@@ -127,3 +127,32 @@ def test_a_flat_frames_light_direction_is_not_judged(tmp_path: Path, arm_tablet_
     assert "best direction" not in said and "direction not checked" not in said, said
     (flat,) = [c for c in qa["images"] if c["name"] == "image_005"]
     assert [p for p in flat["problems"] if FLAT not in p] == [], flat["problems"]
+
+
+def _first(folder: Path, n: int, flat: tuple[str, ...]) -> Path:
+    """The replay's first ``n`` images, those of ``flat`` made one grey level (their median)."""
+    folder.mkdir()
+    entries = read_lp(ACQ)[:n]
+    for e in entries:
+        img = cv2.imread(str(ACQ.parent / e.name))
+        if e.name in flat:
+            img = np.full_like(img, int(np.median(img)))
+        cv2.imwrite(str(folder / e.name), img)
+    write_lp(folder / "dirs.lp", entries)
+    return folder / "dirs.lp"
+
+
+def test_the_flat_frames_left_out_of_the_direction_count_are_said(tmp_path: Path) -> None:
+    """Of 6 lit images, 2 of them flat frames, the QA had said "4 image(s) with light", as if
+    2 had been dark; the flat frames it did not count are said beside the count."""
+    said, _ = qa_of(_first(tmp_path / "acq", 6, ("image05.jpg", "image13.jpg")), tmp_path / "f")
+    assert f"image05 ({FLAT}" in said and f"image13 ({FLAT}" in said, said
+    assert (
+        "light directions not checked: 4 image(s) with light (2 flat frames not counted), too "
+        "few to tell a wrong light"
+    ) in said, said
+
+
+def test_no_flat_frame_no_word_of_one_in_the_direction_count(tmp_path: Path) -> None:
+    said, _ = qa_of(_first(tmp_path / "acq", 6, ()), tmp_path / "f")
+    assert "not counted" not in said and "flat frame" not in said, said
