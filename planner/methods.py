@@ -107,8 +107,10 @@ def method_names() -> tuple[str, ...]:
     return tuple(_METHODS)
 
 
-def get_method(name: str) -> PlanMethod:
-    """The method called ``name``; an unknown name is refused with the known ones."""
+def get_method(name: str, rig: str = "RIG.toml") -> PlanMethod:
+    """The method called ``name``; an unknown name is refused with the known ones. ``rig``: the
+    rig config as the user's command gave it, for the command the refusal offers (it had
+    always said ``RIG.toml``, where the command line at hand named the config)."""
     _load_builtins()
     try:
         return _METHODS[name]
@@ -118,7 +120,7 @@ def get_method(name: str) -> PlanMethod:
         # the bare refusal had not said where it is
         adaptive = (
             " (an adaptive session is not planned ahead: it chooses each next light from the "
-            "images captured so far; run it with rti-rig run RIG.toml --adaptive --lights N "
+            f"images captured so far; run it with rti-rig run {rig} --adaptive --lights N "
             "--out DIR)"
             if name.strip().lower() == "adaptive"
             else ""

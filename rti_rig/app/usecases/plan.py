@@ -171,6 +171,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         max_elevation_deg=req.max_elevation_deg,
         signal_noise=req.signal_noise or 0.0,
         material=req.material,
+        rig=_config_shown(req.rig),
     )
     bare_lp = req.rig.suffix.lower() == ".lp"
     loaded = None if bare_lp else load_rig_config(req.rig)
@@ -350,6 +351,12 @@ def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: li
         )
 
 
+def _config_shown(rig: Path) -> str:
+    """The rig config ``plan`` was given, as a ``run`` command line names it: a bare ``.lp``
+    rig is no config, and ``RIG.toml`` stands for the one whose lights it lists."""
+    return "RIG.toml" if Path(rig).suffix.lower() == ".lp" else shlex.quote(str(rig))
+
+
 def run_plan_command(rig: Path, plan_file: Path) -> str:
     """The ``rti-rig run`` command line that runs ``plan_file`` on ``rig`` with
     ``--allow-no-normals``: the rig config given to ``plan`` (a bare ``.lp`` rig is no config:
@@ -357,8 +364,8 @@ def run_plan_command(rig: Path, plan_file: Path) -> str:
 
     Why: the advice had been ``rti-rig run --plan PLAN.lp --allow-no-normals``, which ``run``
     refuses ("give a RIG_CONFIG and --out DIR")."""
-    config = "RIG.toml" if Path(rig).suffix.lower() == ".lp" else shlex.quote(str(rig))
-    return f"rti-rig run {config} --plan {shlex.quote(str(plan_file))} --out DIR --allow-no-normals"
+    plan = shlex.quote(str(plan_file))
+    return f"rti-rig run {_config_shown(rig)} --plan {plan} --out DIR --allow-no-normals"
 
 
 def _lp_labels(labels: list[str]) -> list[str]:
