@@ -103,7 +103,7 @@ def arm_below(arm: ArmGeometry, max_elevation_deg: float) -> ArmGeometry:
 
 
 def arm_band_note(
-    arm: ArmGeometry, min_elevation_deg: float, max_elevation_deg: float
+    arm: ArmGeometry, min_elevation_deg: float, max_elevation_deg: float, given: bool = False
 ) -> str | None:
     """What an elevation band asked for (``--min/--max-elevation-deg``) became on ``arm``,
     when part of it is beyond the arm's reach; None when the band is used as given (or not
@@ -111,8 +111,10 @@ def arm_band_note(
 
     Why: the layout was spread over the reachable part alone, silently: on an arm reaching
     75°, "--min-elevation-deg 70 --max-elevation-deg 90" gave lights between 70° and 75° and
-    nothing said the top 15° of the band had been cut."""
-    if (min_elevation_deg, max_elevation_deg) == (0.0, 90.0):
+    nothing said the top 15° of the band had been cut. ``given``: the band was typed (either
+    option on the command line): "--max-elevation-deg 90" typed on that arm had been cut to 75°
+    in silence, as the default is."""
+    if (min_elevation_deg, max_elevation_deg) == (0.0, 90.0) and not given:
         return None
     top = min(arm.max_elevation_deg, 90.0 - arm.keep_out_half_angle_deg)
     lo = max(min_elevation_deg, arm.min_elevation_deg)

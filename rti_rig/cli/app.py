@@ -93,6 +93,15 @@ def print_note(note) -> None:  # type: ignore[no-untyped-def]
         out.print(note.text, highlight=False, markup=False)
 
 
+def option_given(ctx: typer.Context, name: str) -> bool:
+    """Whether option ``name`` was on the command line (or in the environment), not defaulted.
+
+    By the source's name: typer's context may be its own click's, whose enum is not
+    ``click.core.ParameterSource``."""
+    source = ctx.get_parameter_source(name)
+    return source is not None and source.name not in ("DEFAULT", "DEFAULT_MAP")
+
+
 def parse_az_el(text: str | None, option: str = "--preview-light") -> tuple[float, float] | None:
     """``"AZ,EL"`` in degrees → a pair; a clear error naming ``option`` otherwise."""
     if text is None:

@@ -7,7 +7,16 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_notes, stop_exit_code
+from rti_rig.cli.app import (
+    app,
+    err,
+    fail,
+    option_given,
+    out,
+    parse_az_el,
+    print_notes,
+    stop_exit_code,
+)
 from rti_rig.cli.stopping import Stamp, Terminated, sigterm_stops, stamp, stop_signal, written_since
 from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
@@ -181,7 +190,7 @@ def plan(
             lights=lights,
             # the default had been refused as if asked for ("asked for 12 lights but the dome
             # has only 8 LEDs") on the shipped 8-LED configs
-            lights_given=_given(ctx, "lights"),
+            lights_given=option_given(ctx, "lights"),
             preview=preview,
             method=method,
             objective=objective,
@@ -189,6 +198,8 @@ def plan(
             depth_model=depth_model,
             min_elevation_deg=min_elevation_deg,
             max_elevation_deg=max_elevation_deg,
+            elevation_band_given=option_given(ctx, "min_elevation_deg")
+            or option_given(ctx, "max_elevation_deg"),
             signal_noise=signal_noise,
             material=material,
             figure=figure,
@@ -266,12 +277,3 @@ def _stopped(why: str, request: PlanLightsRequest, before: Stamp, done: dict[str
         else f"; the map {figure} was not drawn"
     )
     return f"Stopped ({why}): the plan {out_file} is written{count}{map_said}"
-
-
-def _given(ctx: typer.Context, name: str) -> bool:
-    """Whether option ``name`` was on the command line (or in the environment), not defaulted.
-
-    By the source's name: typer's context may be its own click's, whose enum is not
-    ``click.core.ParameterSource``."""
-    source = ctx.get_parameter_source(name)
-    return source is not None and source.name not in ("DEFAULT", "DEFAULT_MAP")

@@ -18,7 +18,16 @@ import typer
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_note, stop_exit_code
+from rti_rig.cli.app import (
+    app,
+    err,
+    fail,
+    option_given,
+    out,
+    parse_az_el,
+    print_note,
+    stop_exit_code,
+)
 from rti_rig.cli.stopping import stop_signal
 from rti_rig.core.deferred_signals import handlers_settable, put_back, signal_handlers
 from rti_rig.core.errors import RtiRigError
@@ -43,6 +52,7 @@ MaxSaturatedOption = Annotated[
 
 @app.command()
 def run(
+    ctx: typer.Context,
     rig_config: Annotated[
         Path | None,
         typer.Argument(
@@ -281,6 +291,8 @@ def run(
                 plan=plan,
                 min_elevation_deg=min_elevation_deg,
                 max_elevation_deg=max_elevation_deg,
+                elevation_band_given=option_given(ctx, "min_elevation_deg")
+                or option_given(ctx, "max_elevation_deg"),
                 auto_exposure=auto_exposure,
                 **_metering_limit(max_saturated),
                 adaptive=adaptive,

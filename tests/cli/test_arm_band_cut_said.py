@@ -55,3 +55,27 @@ def test_a_band_within_reach_is_not_said(tmp_path: Path) -> None:
     r = runner.invoke(app, [*argv, "--min-elevation-deg", "20", "--max-elevation-deg", "60"])
     assert r.exit_code == 0, said(r)
     assert "the arm reaches" not in said(r)
+
+
+def test_an_explicit_full_band_beyond_reach_is_said_by_run_and_plan(tmp_path: Path) -> None:
+    """``--max-elevation-deg 90`` typed on an arm reaching 80° had been cut in silence, as the
+    default 0..90 is (every elevation the rig offers); typed, it is said, with the arm's limit."""
+    run = ["run", ARM, "--lights", "6", "--out", str(tmp_path / "s"), "--no-verdict"]
+    plan = ["plan", "--rig", ARM, "--lights", "8", "--out", str(tmp_path / "p.lp")]
+    for argv in (run, plan):
+        r = runner.invoke(app, [*argv, "--max-elevation-deg", "90"])
+        text = said(r)
+        assert r.exit_code == 0, text
+        assert text.count(CUT) == 1, text
+        assert "--max-elevation-deg 90: the arm reaches elevations 5°..80° (its elevation " in text
+        assert "so the lights are spread over 5°..80° only" in text, text
+
+
+def test_the_default_band_is_not_said_to_be_cut(tmp_path: Path) -> None:
+    """Not typed, 0..90 means every elevation the arm offers: nothing to say."""
+    run = ["run", ARM, "--lights", "6", "--out", str(tmp_path / "s"), "--no-verdict"]
+    plan = ["plan", "--rig", ARM, "--lights", "8", "--out", str(tmp_path / "p.lp")]
+    for argv in (run, plan):
+        r = runner.invoke(app, argv)
+        assert r.exit_code == 0, said(r)
+        assert "the arm reaches" not in said(r), said(r)

@@ -65,6 +65,8 @@ class NewSessionRequest:
     plan: Path | None = None
     min_elevation_deg: float = 0.0
     max_elevation_deg: float = 90.0
+    #: the band was typed, not defaulted: an arm that cannot reach it says so even of 0..90
+    elevation_band_given: bool = False
     auto_exposure: bool = False
     max_saturated: float = 0.001
     #: Choose each next light from the images so far (up to ``lights``; docs/adaptive.md).
@@ -1018,7 +1020,9 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
     )
     if isinstance(geometry, ArmGeometry):  # a band beyond the arm's reach, cut: said once
-        cut = arm_band_note(geometry, req.min_elevation_deg, req.max_elevation_deg)
+        cut = arm_band_note(
+            geometry, req.min_elevation_deg, req.max_elevation_deg, req.elevation_band_given
+        )
         if cut is not None:
             on_note(Note(cut, "warning"))
     _check_determined(
