@@ -689,6 +689,13 @@ class DynamixelArm(ReadBackCarrier):
         user (None: none)."""
         return list(self._bus.resent), resends_said(self._bus.resent)
 
+    def lamp_servo(self) -> int | None:
+        """The servo whose LED register switches the lamp (``lamp = "servo_led"``), else None:
+        a ``"software"`` lamp is switched by nothing on the bus."""
+        if self.settings.lamp != "servo_led" or self.settings.lamp_servo_id is None:
+            return None
+        return int(self.settings.lamp_servo_id)
+
     def torque_release_note(self) -> str | None:
         """What a user must know of an arm whose last close sent its torque-off at the park
         pose (None when it did not): the park pose is not held, and whether each servo was

@@ -163,6 +163,11 @@ class ReadBackCarrier(Protocol):
         get as far as its torque policy, or the arm was not connected)."""
 
     @abstractmethod
+    def lamp_servo(self) -> int | None:
+        """The id of the servo whose LED output the lamp hangs on, whose writes the servo
+        answers (None: the lamp's switch is outside the bus, and no command reaches it)."""
+
+    @abstractmethod
     def check_held(self) -> None:
         """Raise unless the arm still holds, fault-free, the pose its last move reached."""
 

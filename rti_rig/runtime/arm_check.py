@@ -85,6 +85,11 @@ class ArmSelfTestReport:
     #: ``torque`` is what the close then did to the joints' torque (released, by its policy),
     #: the one record of it that the park line and a stopped check's end sentence both say
     end: ArmEnd | None = None
+    #: the servo whose LED the lamp hangs on (None: no command reaches the lamp), and at how
+    #: many poses its on and its off were both answered: the check flashed a servo LED and
+    #: had never said so, nor that the servo took the writes
+    lamp_servo: int | None = None
+    lamp_flashes: int = 0
 
     @property
     def park_confirmed(self) -> bool:
@@ -131,6 +136,12 @@ class ArmSelfTestReport:
         moves = [c.move_s for c in self.checks if c.move_s is not None]
         if moves:
             out.append(f"move time: median {np.median(moves):.2f} s, longest {max(moves):.2f} s")
+        if self.lamp_servo is not None and self.lamp_flashes:
+            poses = "each pose" if self.lamp_flashes == done else f"{self.lamp_flashes} pose(s)"
+            out.append(
+                f"lamp: flashed at {poses} on servo {self.lamp_servo}'s LED, on and off each "
+                "answered by the servo"
+            )
         if self.aborted and self.not_connected:
             # no stop or hold to speak of (it had said "stopped where it was" of an arm whose
             # port could not even be opened)
@@ -263,6 +274,8 @@ def arm_self_test(
     report = ArmSelfTestReport(carrier.name, tolerance_deg, park_wanted=park)
     poses = self_test_poses(geometry)
     report.planned = len(poses)
+    if isinstance(carrier, ReadBackCarrier):
+        report.lamp_servo = carrier.lamp_servo()
     # validate every pose before anything connects or moves
     for label, d in poses:
         reason = geometry.unreachable_reason(d) or carrier.unreachable_reason(d)
@@ -289,6 +302,7 @@ def arm_self_test(
             carrier.lamp(True)
             clock.sleep(lamp_s)
             carrier.lamp(False)
+            report.lamp_flashes += 1  # both writes returned: answered by the servo
         if park:
             carrier.park()
             report.parked = True  # returned: whether it is at the park pose is read below
