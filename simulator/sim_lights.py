@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.arm_motion import joint_move_time_s
 from rti_rig.core.clock import Clock
+from rti_rig.core.devices import KnownStateLightSource
 from rti_rig.core.errors import DeviceError, MoveCancelled
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
@@ -28,8 +29,12 @@ class LightState:
     intensity: float = 0.0
 
 
-class SimulatedDome:
-    """An LED dome with calibrated directions; lighting an LED takes ``switch_s``."""
+class SimulatedDome(KnownStateLightSource):
+    """An LED dome with calibrated directions; lighting an LED takes ``switch_s``.
+
+    Its link is open while it is connected, and its close switches all off first, as a real
+    dome's driver does (:meth:`rti_rig.runtime.dome_policy.DomePolicy.close`): a dry run
+    rehearses the real teardown, and what is said of its lights is what it was sent."""
 
     def __init__(
         self, geometry: DomeGeometry, state: LightState, clock: Clock, switch_s: float = 0.02
@@ -41,13 +46,27 @@ class SimulatedDome:
         self._switch_s = switch_s
         self._connected = False
         self.lit: int | None = None
+        self._switched_off = False
         self.history: list[tuple[float, int | None]] = []
 
     def connect(self) -> None:
         self._connected = True
 
     def close(self) -> None:
+        """All off while connected, then release (safe twice and after a failed connect)."""
+        if self._connected:
+            self.all_off()
         self._connected = False
+
+    @property
+    def link_open(self) -> bool:
+        return self._connected
+
+    def lit_now(self) -> int | None:
+        return self.lit
+
+    def switched_off(self) -> bool:
+        return self._switched_off
 
     def light_count(self) -> int:
         return self._geometry.count
@@ -64,6 +83,7 @@ class SimulatedDome:
             )
         self._clock.sleep(self._switch_s)
         self.lit = index
+        self._switched_off = False
         self._state.direction = self._geometry.directions[index].copy()
         self._state.intensity = intensity
         self.history.append((self._clock.now(), index))
@@ -71,6 +91,9 @@ class SimulatedDome:
     def all_off(self) -> None:
         # Safe state must be reachable even when not connected (teardown after a failed connect).
         self.lit = None
+        # received only on an open link: one sent after the close (a teardown after a failed
+        # connect) leaves nothing lit, but is not said as switching anything off
+        self._switched_off = self._switched_off or self._connected
         self._state.direction = None
         self._state.intensity = 0.0
         self.history.append((self._clock.now(), None))

@@ -79,6 +79,35 @@ class DiscreteLightSource(Protocol):
 
 
 @runtime_checkable
+class KnownStateLightSource(Protocol):
+    """What a :class:`DiscreteLightSource` whose lit state is known exactly (a simulated dome:
+    its state is the simulation's) says of itself: whether its link is open, and what its
+    last commands left lit.
+
+    Why: a simulated dome had no link to ask (``link_open`` False), so a session closed before
+    the controller's teardown sent it no all-off, and the run said "lights were switched off"
+    of a dome its last command had left lit. A dry run rehearses the real teardown: the
+    all-off a dome on a port gets, said only when it was sent. Declared by the concrete class
+    (``class SimulatedDome(KnownStateLightSource)``), its members abstract, as
+    :class:`ReadBackCarrier` is.
+    """
+
+    @property
+    @abstractmethod
+    def link_open(self) -> bool:
+        """Whether it is connected now, so that an all-off can be sent on it."""
+
+    @abstractmethod
+    def lit_now(self) -> int | None:
+        """The light its last command left lit (None: none is lit)."""
+
+    @abstractmethod
+    def switched_off(self) -> bool:
+        """Whether an all-off reached it after the last light it lit (False: none did, or it
+        never lit one)."""
+
+
+@runtime_checkable
 class LightCarrier(Protocol):
     """A lamp moved to arbitrary directions (a servo arm).
 

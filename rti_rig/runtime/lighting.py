@@ -16,7 +16,12 @@ from typing import Protocol
 import numpy as np
 
 from rti_rig.core.deferred_signals import signals_deferred, stop_words
-from rti_rig.core.devices import DiscreteLightSource, LightCarrier, ReadBackCarrier
+from rti_rig.core.devices import (
+    DiscreteLightSource,
+    KnownStateLightSource,
+    LightCarrier,
+    ReadBackCarrier,
+)
 from rti_rig.core.errors import DeviceError, MoveCancelled
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
@@ -142,6 +147,12 @@ class DomeLighting:
         misspelt attribute would have silently answered "none": a dome never held open, no
         thermal limit, no resends to report."""
         return self.source if isinstance(self.source, DomePolicy) else None
+
+    @property
+    def known_state(self) -> KnownStateLightSource | None:
+        """The source, when it declares that its lit state is known exactly (the simulated
+        dome): its link and what its last commands left lit are then asked of it by name."""
+        return self.source if isinstance(self.source, KnownStateLightSource) else None
 
     def connect(self) -> None:
         self.source.connect()
@@ -276,9 +287,14 @@ class DomeLighting:
     def link_open(self) -> bool:
         """Whether the dome's port is open now (connected, or held open after metering): an
         all-off can then be sent without opening it, which may reset a board that boots lit.
-        A simulated dome has no link: False."""
+        A simulated dome's is open while it is connected, as a real dome's port is: a dry run
+        rehearses the all-off a session closed before its teardown sends (it had answered
+        False, and such a close left the simulated dome lit, said as "switched off")."""
         policy = self.policy
-        return False if policy is None else bool(policy.link.port_open)
+        if policy is not None:
+            return bool(policy.link.port_open)
+        known = self.known_state
+        return False if known is None else bool(known.link_open)
 
 
 class ArmLighting:

@@ -31,9 +31,9 @@ def kinds(config: str) -> tuple[str, ...]:
     ("config", "open_when_connected"),
     [
         ("rig_configs/emulated_dome.toml", True),  # a serial port, open while connected
-        ("rig_configs/simulated_dome.toml", False),
+        ("rig_configs/simulated_dome.toml", True),  # connected: an all-off reaches it
         ("rig_configs/simulated_arm.toml", False),  # an arm's safe state is its teardown's
-        ("tests/data/neuralrti_replay/dirs.lp", False),  # a replay has no lights
+        ("tests/data/neuralrti_replay/dirs.lp", True),  # its simulated dome, connected
         ("rig_configs/emulated_cceh_rti.toml", False),  # stepped by the camera's flash signal
     ],
 )

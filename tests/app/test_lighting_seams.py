@@ -79,12 +79,14 @@ def test_each_adapter_ability_answers_from_its_source(name: str) -> None:
             _camera_stepped(rig)
 
 
-def _no_link_defaults(lighting: Any, step: LightStep, at: float) -> None:
-    """What a lighting with no port to lose, record or guard answers (on purpose)."""
+def _no_link_defaults(lighting: Any, step: LightStep, at: float, link_open: bool = False) -> None:
+    """What a lighting with no port to lose, record or guard answers (on purpose); its link
+    is open only where ``link_open`` (a connected simulated dome, which gets the all-off a
+    session's close sends as a real dome does)."""
     assert lighting.lit_limit_s() is None
     assert lighting.off_said() is None and lighting.cool_down_s(step, at) == 0.0
     assert lighting.resends() == ({}, None) and lighting.reconnections() == []
-    assert lighting.link_open is False
+    assert lighting.link_open is link_open
 
 
 def _camera_stepped(rig: Rig) -> None:
@@ -157,8 +159,9 @@ def _simulated_dome(rig: Rig) -> None:
     lighting.set(step)
     lighting.check_held()  # an LED does not move
     lighting.off()
-    _no_link_defaults(lighting, step, rig.clock.now())
+    _no_link_defaults(lighting, step, rig.clock.now(), link_open=True)
     lighting.hold()  # no port to keep open: closed
+    assert lighting.link_open is False
     lighting.connect()  # and opened again
     assert lighting.safe() == []
     lighting.close()

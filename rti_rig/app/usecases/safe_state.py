@@ -8,6 +8,7 @@ servo bus (``lamp = "software"``), that nothing switched it.
 
 from __future__ import annotations
 
+from rti_rig.core.devices import KnownStateLightSource
 from rti_rig.core.dome_link import OffOutcome
 from rti_rig.runtime.arm_check import not_connected_sentence
 from rti_rig.runtime.arm_end import ArmEnd
@@ -29,10 +30,13 @@ def lights_state(  # type: ignore[no-untyped-def]
     if callable(own):  # a lighting that knows best what it can say (a camera-triggered dome)
         return str(own())
     if isinstance(lighting, DomeLighting):
-        source = lighting.source
-        if hasattr(source, "off_report"):
-            return lights_state_sentence(source)
-        return "lights were switched off"  # a simulated dome: its state is the simulation's
+        policy = lighting.policy  # asked by type: a dome on a port keeps its all-off's outcome
+        if policy is not None:
+            return lights_state_sentence(policy)
+        known = lighting.known_state
+        if known is not None:  # a simulated dome: what it was sent, which it keeps exactly
+            return simulated_lights_sentence(known)
+        return "no all-off was attempted: check the dome's lights"
     carrier = getattr(lighting, "carrier", None)
     unreached = not_connected_sentence(carrier)
     if unreached is not None:
@@ -57,17 +61,35 @@ def lights_state(  # type: ignore[no-untyped-def]
     return said + after
 
 
+def simulated_lights_sentence(known: KnownStateLightSource) -> str:
+    """What a dome whose state is known exactly (a simulated one) was left with: "switched
+    off" only when an all-off reached it after its last light (it had been said of every
+    simulated dome, also of one a session closed before its teardown had left lit)."""
+    lit = known.lit_now()
+    if lit is not None:
+        return f"LED {lit} was left lit: no all-off reached the dome after it"
+    if known.switched_off():
+        return "lights were switched off"
+    return "nothing was lit"
+
+
 def safe_state_unsure(rig) -> bool:  # type: ignore[no-untyped-def]
     """True when the rig's lights are not known to be safe after its teardown: the dome's last
     all-off was not sent or went unconfirmed (what :func:`lights_state` then tells the user to
     deal with by hand). A firmware that never acknowledges, or switches itself off, is as safe
-    as it can be said to be; a simulated dome has nothing to be unsure of."""
+    as it can be said to be; a simulated dome is unsure only with an LED left lit."""
     lighting = rig.lighting
     if not isinstance(lighting, DomeLighting):
         return False
-    report = getattr(lighting.source, "off_report", None)
+    known = lighting.known_state
+    if known is not None:  # a simulated dome: unsure only of an LED its commands left lit
+        return known.lit_now() is not None
+    policy = lighting.policy
+    if policy is None:  # a source neither on a port nor known exactly: nothing established
+        return True
+    report = policy.off_report
     if report is None:
-        return hasattr(lighting.source, "off_report")  # a real dome that sent no all-off
+        return True  # a real dome that sent no all-off
     return report.outcome in (
         OffOutcome.SENT_UNCONFIRMED,
         OffOutcome.NOT_SENT,
