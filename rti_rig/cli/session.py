@@ -757,9 +757,10 @@ def _cannot_resume(rig) -> str | None:  # type: ignore[no-untyped-def]
     (None: it can): a camera-triggered dome, whose own count went on, or an image-sequence
     camera, read from its first file again by every run (a stopped dry run had been told to
     resume, and the resume gave the remaining lights the pictures of the first ones)."""
+    from rti_rig.runtime.flash_sync import CameraTriggeredLighting
     from rti_rig.runtime.session import image_sequence_restarts
 
-    if getattr(rig.lighting, "resume_hint", None):
+    if isinstance(rig.lighting, CameraTriggeredLighting):  # by type, not a getattr probe
         return str(rig.lighting.resume_hint)
     why = image_sequence_restarts(rig.loaded.config.camera.device, _arg(rig.loaded.path))
     return None if why is None else f"It cannot be resumed: {why}."
@@ -1744,8 +1745,12 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
 def _park_stopped_by(rig) -> int | None:  # type: ignore[no-untyped-def]
     """The signal (SIGINT, SIGTERM) that stopped the arm's final park, None if none did (or
     the rig has no arm): a stop during the teardown's park holds the arm where it stands
-    (:meth:`rti_rig.runtime.lighting.ArmLighting.safe`)."""
-    return getattr(rig.lighting, "stopped_by", None)
+    (:meth:`rti_rig.runtime.lighting.ArmLighting.safe`). Asked of an arm by type: a
+    ``getattr`` had answered "none" for a renamed attribute."""
+    from rti_rig.runtime.lighting import ArmLighting
+
+    lighting = rig.lighting
+    return lighting.stopped_by if isinstance(lighting, ArmLighting) else None
 
 
 def _exit_if_park_stopped(  # type: ignore[no-untyped-def]

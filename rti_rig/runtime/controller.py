@@ -21,7 +21,7 @@ from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.runtime.lighting import Lighting, port_close_failures
+from rti_rig.runtime.lighting import ArmLighting, Lighting, port_close_failures
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
     FRAME_SIZE_KEY,
@@ -614,10 +614,11 @@ def led_error_record(exc: BaseException) -> dict[str, Any] | None:
 
 def _arm_end(lighting: object) -> dict[str, Any]:
     """The manifest's ``arm_end``: where an arm's teardown left it, as read back
-    (:class:`rti_rig.runtime.arm_end.ArmEnd`); nothing for a dome, or an arm not gone safe."""
-    end = getattr(lighting, "end", None)
-    to_dict = getattr(end, "to_dict", None)
-    return {} if to_dict is None else {"arm_end": to_dict()}
+    (:class:`rti_rig.runtime.arm_end.ArmEnd`); nothing for a dome, or an arm not gone safe.
+    Asked of an :class:`ArmLighting` by name (it had been ``getattr(lighting, "end")``, which
+    a renamed attribute would have silently answered "no record")."""
+    end = lighting.end if isinstance(lighting, ArmLighting) else None
+    return {} if end is None else {"arm_end": end.to_dict()}
 
 
 def _dome_reconnections(lighting: Lighting) -> dict[str, Any]:

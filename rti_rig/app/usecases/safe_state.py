@@ -13,7 +13,8 @@ from rti_rig.core.dome_link import OffOutcome
 from rti_rig.runtime.arm_check import not_connected_sentence
 from rti_rig.runtime.arm_end import ArmEnd
 from rti_rig.runtime.dome_policy import lights_state_sentence
-from rti_rig.runtime.lighting import DomeLighting
+from rti_rig.runtime.flash_sync import CameraTriggeredLighting
+from rti_rig.runtime.lighting import ArmLighting, DomeLighting
 
 
 def lights_state(  # type: ignore[no-untyped-def]
@@ -26,9 +27,8 @@ def lights_state(  # type: ignore[no-untyped-def]
     lighting = rig.lighting
     if getattr(rig.loaded.config, "backend", None) == "replay":
         return "a replayed acquisition has no lights to switch off"
-    own = getattr(lighting, "lights_state", None)
-    if callable(own):  # a lighting that knows best what it can say (a camera-triggered dome)
-        return str(own())
+    if isinstance(lighting, CameraTriggeredLighting):  # it knows best what it can say
+        return lighting.lights_state()
     if isinstance(lighting, DomeLighting):
         policy = lighting.policy  # asked by type: a dome on a port keeps its all-off's outcome
         if policy is not None:
@@ -37,7 +37,7 @@ def lights_state(  # type: ignore[no-untyped-def]
         if known is not None:  # a simulated dome: what it was sent, which it keeps exactly
             return simulated_lights_sentence(known)
         return "no all-off was attempted: check the dome's lights"
-    carrier = getattr(lighting, "carrier", None)
+    carrier = lighting.carrier if isinstance(lighting, ArmLighting) else None
     unreached = not_connected_sentence(carrier)
     if unreached is not None:
         return unreached
@@ -54,9 +54,9 @@ def lights_state(  # type: ignore[no-untyped-def]
         said = "lamp off and stop were requested"
     # where the arm was left, as read back at the teardown (it had gone unsaid: "lamp off and
     # stop were requested" after a park, after no park, and after a park that failed alike)
-    if end is None:
-        end = getattr(lighting, "end", None)
-    if isinstance(end, ArmEnd):
+    if end is None and isinstance(lighting, ArmLighting):
+        end = lighting.end
+    if end is not None:
         said += f"; {end.sentence()}"
     return said + after
 
