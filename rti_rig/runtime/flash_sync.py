@@ -85,7 +85,16 @@ class CameraTriggeredLighting:
 
     def lit_limit_s(self) -> None:
         """None: the host lights nothing, so it keeps no lit-time limit (the firmware's own
-        ``timeout_s`` bounds each flash, checked against the exposure in :meth:`problem`)."""
+        ``timeout_s`` bounds each flash, checked against the exposure in :meth:`problem`).
+
+        Why not ``timeout_s``: this limit is what the host must keep a light it lit within.
+        Given one, the controller would switch "off" and "relight" the LED around a busy
+        camera (:func:`rti_rig.runtime.controller.fire_lit`), and say an all-off was sent to
+        a dome that has no link; here the LED lights only with the flash pulse, so a busy
+        camera keeps nothing lit. The firmware's window bounds the exposure instead, refused
+        before anything is lit: ``camera.exposure_s`` at the config's load
+        (:func:`rti_rig.app.flash_sync.check_exposure`), a planned step's exposure here, and
+        the metering (``--auto-exposure``) and ``--plan`` are refused on this dome."""
         return None
 
     def lit_limit_said(self) -> str:

@@ -54,3 +54,29 @@ def test_more_leds_in_the_order_than_the_firmware_fires_is_refused(tmp_path: Pat
         ConfigError, match="61 LEDs in the order, but the cceh-rti firmware fires 60"
     ):
         build_rig(load_rig_config(path))
+
+
+def test_a_planned_exposure_past_the_firmware_timeout_is_refused_before_anything_moves() -> None:
+    """The firmware's off-timeout bounds each exposure (not a host lit-time limit, which
+    ``lit_limit_s`` stays None for: the host lights nothing, see its docstring): a step whose
+    exposure the firmware would cut short is refused by the schedule's check, nothing shot."""
+    from rti_rig.core.errors import ScheduleError
+    from rti_rig.core.schedule import LightSchedule, LightStep
+    from rti_rig.runtime.controller import validate_schedule
+
+    with build_rig(load_rig_config(CONFIGS / "emulated_cceh_rti.toml")) as rig:
+        lighting = rig.lighting
+        assert isinstance(lighting, CameraTriggeredLighting)
+        assert lighting.lit_limit_s() is None
+        d = rig.geometry.directions
+        steps = [
+            LightStep(tuple(float(x) for x in d[i]), led=i, exposure_s=e)  # type: ignore[arg-type]
+            for i, e in ((0, 4.0), (1, 4.5))
+        ]
+        with pytest.raises(ScheduleError) as refused:
+            validate_schedule(rig, LightSchedule(steps))
+        said = str(refused.value)
+        assert "nothing has moved" in said and "1 problem(s)" in said, said
+        assert "step 2" in said and "exposure 4.5 s" in said, said
+        assert "switches its LED off 4 s after the flash pulse" in said, said
+        assert rig.camera.exposures == 0  # type: ignore[attr-defined]

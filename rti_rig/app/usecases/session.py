@@ -669,9 +669,9 @@ def _lit_exposure_cap(rig: Rig) -> float | None:
     Why: metering a dry run's simulated camera on a dome with max_on_s = 2 s (LEDs dim) chose
     the exposure that left settle and readout only, whose test shot then held its LED through
     the transfer too, and stopped at the thermal guard before the session began ("LED 41
-    stayed on 2.691 s, beyond max_on_s = 2 s")."""
-    limit_of = getattr(getattr(rig, "lighting", None), "lit_limit_s", None)
-    limit = limit_of() if limit_of is not None else None
+    stayed on 2.691 s, beyond max_on_s = 2 s"). Asked of the lighting by name (the Lighting
+    protocol's): a ``getattr`` had answered "no limit" for a renamed method."""
+    limit = rig.lighting.lit_limit_s()
     if limit is None:
         return None
     return limit - rig.timing.settle_s - rig.timing.readout_s - _held_after_s(rig)
