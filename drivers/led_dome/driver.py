@@ -108,6 +108,8 @@ class LedDomeDriver(PortOpening):
         self.identifies_itself = True
         #: Every all-off is acknowledged, or fails.
         self.off_outcome = OffOutcome.ACKNOWLEDGED
+        #: The handshake is answered by a board that powers up (and resets) with every LED off.
+        self.hello_leaves_dark = True
 
     # ------------------------------------------------------------------ lifecycle
 

@@ -94,6 +94,15 @@ class ScriptedDomeDriver(PortOpening):
             if spec.all_off.reply.kind == "none"
             else OffOutcome.ACKNOWLEDGED
         )
+        #: ``hello`` sends an all-off the board acknowledges (the Nab sketch's init): only
+        #: then is a board it reached known dark; a firmware without one, or that never
+        #: answers, exchanges nothing that says so.
+        off = spec.all_off
+        self.hello_leaves_dark = (
+            off is not None
+            and off.reply.kind != "none"
+            and any(cmd.send == off.send for cmd in spec.init)
+        )
         self._rx = bytearray()
         self._open = False
         self._last_end = -1e9

@@ -132,6 +132,13 @@ class DomeLink(Protocol):
     #: What a completed all-off establishes on this firmware (acknowledged, sent with no
     #: acknowledgement to wait for, or self-timed): the lights line says exactly that.
     off_outcome: OffOutcome
+    #: A completed ``hello`` establishes that the board is dark: its handshake or init got an
+    #: answer that says so (the Nab sketch's init is an acknowledged all-off; this project's
+    #: protocols answer the handshake of a board that powers up dark). False where ``hello``
+    #: exchanges nothing (hadrian2/RTI_Dome, minirti): a board back on USB after a drop is
+    #: then said off only by a later acknowledged all-off. It had been said "off again" as soon
+    #: as its port reopened, beside a lights line saying the all-off was not confirmed.
+    hello_leaves_dark: bool
     #: A stop came while the port was being opened by :meth:`reopen_port`, on a port whose
     #: opening may reset the board: the policy then reopens it to send the all-off, because
     #: the reset may have lit the board (the Nab sketch boots with every LED on).

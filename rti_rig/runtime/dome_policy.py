@@ -1000,8 +1000,14 @@ class DomePolicy:
                     # "off again" only once the handshake after the reboot went through: a
                     # board that rebooted again there (the Nab sketch boots lit) had been said
                     # off while every LED was on
+                    # and only where that handshake says so (an acknowledged all-off): one
+                    # that exchanges nothing (RTI_Dome, minirti) had the dome said "off
+                    # again" with nothing sent since its port came back
                     state = (
                         "the dome is off again"
+                        if back and self.link.hello_leaves_dark
+                        else "whether the dome is dark is what the closing all-off "
+                        "established (see the lights line)"
                         if back
                         else "its handshake after the reboot failed too, so whether the dome "
                         "is lit is unknown until the closing all-off (see the lights line)"
@@ -1228,7 +1234,17 @@ class DomePolicy:
         attempts = f"{tries} attempt{'s' if tries != 1 else ''}"
         if info is not None:
             outcome = "reconnected"
-            self._tell(f"The dome is back: its port reopened and it answered, after {attempts}.")
+            # "it answered" only of a board whose connect exchanged a reply: a firmware
+            # without a handshake (RTI_Dome never replies) had been said to have answered
+            if self.link.identifies_itself or self.link.hello_leaves_dark:
+                self._tell(
+                    f"The dome is back: its port reopened and it answered, after {attempts}."
+                )
+            else:
+                self._tell(
+                    f"The dome is back: its port reopened after {attempts} (this firmware has "
+                    "no handshake, so nothing has answered yet)."
+                )
         elif came_back:
             outcome = "port back, no handshake"
             self._tell(

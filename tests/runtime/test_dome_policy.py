@@ -873,6 +873,7 @@ class _TimedLink:
     # boot wait answers them
     identifies_itself = True
     off_outcome = OffOutcome.ACKNOWLEDGED
+    hello_leaves_dark = True
     open_cut_short = False
     port_open = True
     profile_heard = False
