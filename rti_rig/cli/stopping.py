@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -62,9 +63,15 @@ def stop_signal(exc: BaseException) -> signal.Signals:
     """The signal a caught stop came from: an
     :class:`~rti_rig.runtime.controller.EmergencyStop`'s own, SIGTERM for :class:`Terminated`,
     else SIGINT (KeyboardInterrupt). The exit code is decided on it (the words said derive
-    from it too): it had been decided by comparing the words with "SIGTERM"."""
-    from rti_rig.runtime.controller import EmergencyStop
+    from it too): it had been decided by comparing the words with "SIGTERM".
 
-    if isinstance(exc, EmergencyStop):
+    Why the controller is looked up, not imported: a stop is often caught while a command
+    still imports lazily (``fit`` imports OpenCV and numpy once its stop handling is set), and
+    a Ctrl-C that cut numpy's C core mid-import leaves it unloadable: importing the controller
+    here (which imports numpy) then raised "ImportError: cannot load module more than once per
+    process", and a traceback reached the user, exit 1, instead of "Stopped (Ctrl-C)". An
+    EmergencyStop can only have been raised once its module is loaded."""
+    controller = sys.modules.get("rti_rig.runtime.controller")
+    if controller is not None and isinstance(exc, controller.EmergencyStop):
         return exc.signum
     return signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT
