@@ -13,6 +13,7 @@ from __future__ import annotations
 import asyncio
 import gc
 import sys
+import warnings
 from collections.abc import Iterator
 from typing import Any
 
@@ -64,7 +65,7 @@ def test_a_stop_that_leaves_a_coroutine_suspended_in_its_traceback(
         raise KeyboardInterrupt  # the Ctrl-C lands here, in this frame, not in ``inner``
 
     with pytest.raises(KeyboardInterrupt):
-        _run_quietly(main())
+        _run_quietly(main)
     _no_coroutine_closed_on_a_closed_loop(unraisable)
 
 
@@ -94,7 +95,7 @@ def test_a_stop_that_leaves_a_task_that_outlives_its_cancellation(
         raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        _run_quietly(main())
+        _run_quietly(main)
     _no_coroutine_closed_on_a_closed_loop(unraisable)
 
 
@@ -103,4 +104,59 @@ def test_a_probe_that_ends_normally_is_returned() -> None:
         await asyncio.sleep(0)
         return 7
 
-    assert _run_quietly(main()) == 7
+    assert _run_quietly(main) == 7
+
+
+class _StoppedAsItStarts(asyncio.SelectorEventLoop):
+    """A loop whose ``run_until_complete`` is cut by a Ctrl-C in its first lines, before it
+    wraps the coroutine in a task (where a real one can land)."""
+
+    def run_until_complete(self, future: Any) -> Any:
+        if asyncio.iscoroutine(future) and not getattr(self, "stopped", False):
+            self.stopped = True
+            raise KeyboardInterrupt
+        return super().run_until_complete(future)
+
+
+def test_a_stop_before_the_coroutine_is_started_leaves_it_closed_not_unawaited(
+    monkeypatch: pytest.MonkeyPatch, unraisable: list[Any]
+) -> None:
+    """The stopped fit said "note: coroutine 'probe.<locals>.bounded' was never awaited"
+    under "Stopped (Ctrl-C)": the coroutine, made before the loop took it, was never
+    started."""
+    loops: list[_StoppedAsItStarts] = []
+
+    def new_event_loop() -> asyncio.AbstractEventLoop:
+        loops.append(_StoppedAsItStarts())
+        return loops[-1]
+
+    async def main() -> int:
+        return 7
+
+    monkeypatch.setattr(asyncio, "new_event_loop", new_event_loop)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        with pytest.raises(KeyboardInterrupt):
+            _run_quietly(main)
+        gc.collect()
+    assert [str(w.message) for w in said if "never awaited" in str(w.message)] == []
+    assert [loop.is_closed() for loop in loops] == [True]
+    _no_coroutine_closed_on_a_closed_loop(unraisable)
+
+
+def test_a_stop_while_the_loop_is_made_leaves_no_coroutine_unawaited(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def new_event_loop() -> asyncio.AbstractEventLoop:
+        raise KeyboardInterrupt  # the Ctrl-C lands while the loop is being made
+
+    async def main() -> None:
+        pass
+
+    monkeypatch.setattr(asyncio, "new_event_loop", new_event_loop)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        with pytest.raises(KeyboardInterrupt):
+            _run_quietly(main)
+        gc.collect()
+    assert [str(w.message) for w in said if "never awaited" in str(w.message)] == []

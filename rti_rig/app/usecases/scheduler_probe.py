@@ -16,7 +16,7 @@ import copy
 import gc
 import socket
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Coroutine, Sequence
 from contextlib import suppress
 from dataclasses import dataclass, replace
 from typing import Any
@@ -340,8 +340,8 @@ def _other_dask(address: str, versions: Any) -> SchedulerError | None:
     )
 
 
-def _run_quietly(main: Any) -> Any:
-    """``asyncio.run(main)``, without asyncio's report of the tasks a stop leaves behind.
+def _run_quietly(make: Callable[[], Coroutine[Any, Any, Any]]) -> Any:
+    """``asyncio.run(make())``, without asyncio's report of the tasks a stop leaves behind.
 
     Why: a Ctrl-C that lands while the probe connects cancels the connection's tasks, and one
     that ends with an exception of its own (a comm closed under it) was printed by
@@ -355,21 +355,35 @@ def _run_quietly(main: Any) -> Any:
     pending after that second, or a coroutine the Ctrl-C cut through in the frame awaiting it,
     held by the stop's own traceback) was closed later by the garbage collector; closing its
     half-made connection on the closed loop printed "Exception ignored in: <coroutine object
-    open_connection …> … Event loop is closed" under "Stopped (Ctrl-C)" (CI, once)."""
-    loop = asyncio.new_event_loop()
+    open_connection …> … Event loop is closed" under "Stopped (Ctrl-C)" (CI, once).
+
+    Why the coroutine is made here, from ``make``, once the loop is, and closed at the end:
+    made by the caller and passed in, a Ctrl-C landing before the loop had wrapped it in a
+    task (while the loop was being made, or in ``run_until_complete``'s first lines) left it
+    never started, and the stopped ``fit`` said "note: coroutine 'probe.<locals>.bounded' was
+    never awaited" under "Stopped (Ctrl-C)". Closing a coroutine never started, or one already
+    ended, does nothing else."""
+    loop: asyncio.AbstractEventLoop | None = None
+    main: Coroutine[Any, Any, Any] | None = None
     cut = False
     try:
+        loop = asyncio.new_event_loop()
+        main = make()
         return loop.run_until_complete(main)
     except BaseException as exc:  # a stop, or an error the caller words: its frames let go
         exc.__traceback__ = None  # what is said never shows them; they hold the cut coroutines
         cut = True
         raise
     finally:
-        loop.set_exception_handler(lambda _loop, _context: None)
-        try:
-            _end_what_is_left(loop, cut)
-        finally:
-            loop.close()
+        if loop is not None:
+            loop.set_exception_handler(lambda _loop, _context: None)
+            try:
+                _end_what_is_left(loop, cut)
+            finally:
+                if main is not None:  # never wrapped in a task, if the stop came first
+                    with suppress(BaseException):
+                        main.close()
+                loop.close()
 
 
 def _end_what_is_left(loop: asyncio.AbstractEventLoop, cut: bool) -> None:
@@ -599,7 +613,7 @@ def probe(address: str, timeout: float) -> Reached:
         return await asyncio.wait_for(_identity(address, timeout, args, ips), left)
 
     try:
-        identity, reached, versions = _run_quietly(bounded())
+        identity, reached, versions = _run_quietly(bounded)
     except TimeoutError:  # asyncio's is the builtin's since 3.11; Dask's own names the address
         raise unreachable_scheduler(
             address,
