@@ -114,6 +114,10 @@ def _not_latched(name: str, value: str, got: str, key: str) -> str:
     )
 
 
+#: How a session's lost step is shot again unless the use case says otherwise (``preview``).
+SHOOT_AGAIN_BY_RESUME = "'rti-rig run --resume SESSION' shoots it again"
+
+
 def load_gphoto2() -> Any:
     """Import python-gphoto2 lazily, with an error that says how to install it."""
     try:
@@ -171,7 +175,7 @@ class Gphoto2Camera:
         #: how the user shoots a lost step again, as a clause ("… then {again}"): a session's
         #: resume, or what the use case that opened the session sets (``rti-rig preview``
         #: says to run the preview again, the command its user typed)
-        self.shoot_again = "'rti-rig run --resume SESSION' shoots it again"
+        self.shoot_again = SHOOT_AGAIN_BY_RESUME
         self._clock = clock or SystemClock()
         self._gp = gp_module
         self._cam: Any = None
@@ -253,8 +257,7 @@ class Gphoto2Camera:
             return CameraGoneError(
                 self.name,
                 f"the camera stopped answering during '{command}' (switched off, "
-                f"unplugged or powered down?); {text}. Images already taken are kept: "
-                "reconnect it, then continue with 'rti-rig run --resume SESSION'",
+                f"unplugged or powered down?); {text}. {self._reconnect_then()}",
                 command,
             )
         if code == -115:
@@ -903,13 +906,36 @@ class Gphoto2Camera:
         the picture is lost with the body's power, on a card its copy stays there (never
         deleted before it is downloaded), and neither was said."""
         on_camera = f"{folder.rstrip('/')}/{name}"
+        # a session's step, or a metering shot (no session bound): a resume had been advised
+        # of a test shot whose run said "nothing was captured or written", and of a preview
+        if self.output_dir is None:
+            fate = "it was a test shot outside any session (metering)"
+        elif self.shoot_again == SHOOT_AGAIN_BY_RESUME:
+            fate = "its step is not recorded, so the resume shoots it again"
+        else:
+            fate = "nothing of it was recorded"  # the command again: said before
         return CameraGoneError(
             self.name,
             f"{exc.message}. This shot was taken but its file {on_camera} was not "
-            f"downloaded: {self._where(folder, name)}; its step is not recorded, so the resume "
-            "shoots it again",
+            f"downloaded: {self._where(folder, name)}; {fate}",
             exc.command,
         )
+
+    def _reconnect_then(self) -> str:
+        """What a camera gone (unplugged, switched off) leaves the user to do: a session's
+        images are kept and ``shoot_again`` says how the rest is shot (a resume, or the
+        preview again); before any session is bound (metering, a check) the command is run
+        again. Why: every gone camera had been told "continue with 'rti-rig run --resume
+        SESSION'", also in a preview and at a metering shot, whose run said nothing was
+        captured or written."""
+        if self.output_dir is None:
+            return "Reconnect it, then run the command again"
+        if self.shoot_again == SHOOT_AGAIN_BY_RESUME:
+            return (
+                "Images already taken are kept: reconnect it, then continue with "
+                "'rti-rig run --resume SESSION'"
+            )
+        return f"Reconnect it, then {self.shoot_again}"
 
     def _download_gone(self, raw_path: Path, camera_file: tuple[str, str]) -> CaptureError:
         """The error for a RAW downloaded and then gone before it was decoded: the file the
