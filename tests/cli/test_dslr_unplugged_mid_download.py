@@ -11,15 +11,12 @@ downloaded).
 
 from __future__ import annotations
 
-import shutil
 import sys
-from pathlib import Path
 
-import numpy as np
 import pytest
-from conftest import CONFIGS, shipped_dome_on_pty
-from dng_spec_writer import dng, mosaic_from_rgb
+from conftest import shipped_dome_on_pty
 from fake_gphoto2 import Body, make_module
+from test_dslr_download_disk_full import _config, _raw  # the same shipped DSLR, small
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -28,24 +25,6 @@ pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
     pytest.mark.pty,
 ]
-
-
-def _config(tmp_path: Path, target: str) -> Path:
-    """The shipped DSLR example beside its .lp, small frames, shooting into ``target``."""
-    shutil.copy(CONFIGS / "example_dome_48.lp", tmp_path / "example_dome_48.lp")
-    text = (CONFIGS / "example_dome_48.toml").read_text()
-    old = 'capture_target = "Internal RAM"'
-    assert old in text
-    text = text.replace(old, f'capture_target = "{target}"')
-    text = text.replace("width = 6000", "width = 48").replace("height = 4000", "height = 32")
-    cfg = tmp_path / "dslr.toml"
-    cfg.write_text(text)
-    return cfg
-
-
-def _raw(body: Body) -> bytes:
-    rgb = np.broadcast_to(np.array([0.2, 0.5, 0.8]), (32, 48, 3))
-    return dng(mosaic_from_rgb(np.array(rgb), "RGGB", (0,) * 4, 4095), "RGGB", (0,) * 4, 4095)
 
 
 @pytest.mark.parametrize("target", ["Internal RAM", "Memory card"])

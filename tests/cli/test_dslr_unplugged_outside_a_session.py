@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from conftest import shipped_dome_on_pty
 from fake_gphoto2 import Body, make_module
-from test_dslr_unplugged_mid_download import _config, _raw
+from test_dslr_download_disk_full import _config, _raw
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
