@@ -94,14 +94,14 @@ class ScriptedDomeDriver(PortOpening):
             if spec.all_off.reply.kind == "none"
             else OffOutcome.ACKNOWLEDGED
         )
-        #: ``hello`` sends an all-off the board acknowledges (the Nab sketch's init): only
-        #: then is a board it reached known dark; a firmware without one, or that never
-        #: answers, exchanges nothing that says so.
+        #: ``hello`` sends an all-off and waits for the board's answer to it (the Nab sketch's
+        #: init): only then is a board it reached known dark; a firmware without one, or that
+        #: never answers, exchanges nothing that says so. The init command's own reply is the
+        #: one ``hello`` waits for: an init described with none, beside an acknowledged
+        #: ``all_off`` of the same bytes, had been taken as answered.
         off = spec.all_off
-        self.hello_leaves_dark = (
-            off is not None
-            and off.reply.kind != "none"
-            and any(cmd.send == off.send for cmd in spec.init)
+        self.hello_leaves_dark = off is not None and any(
+            cmd.send == off.send and cmd.reply.kind != "none" for cmd in spec.init
         )
         self._rx = bytearray()
         self._open = False
