@@ -36,7 +36,9 @@ def lights_state(  # type: ignore[no-untyped-def]
         known = lighting.known_state
         if known is not None:  # a simulated dome: what it was sent, which it keeps exactly
             return simulated_lights_sentence(known)
-        return "no all-off was attempted: check the dome's lights"
+        # a source that keeps no record of its all-off: the teardown sent one all the same
+        # (it had been said "no all-off was attempted", of a dome the controller had sent one)
+        return "whether the dome's lights are off is not known: check them"
     carrier = lighting.carrier if isinstance(lighting, ArmLighting) else None
     unreached = not_connected_sentence(carrier)
     if unreached is not None:
