@@ -433,7 +433,10 @@ def test_a_resume_after_a_kill_says_its_time_is_a_lower_bound(
     assert r.exit_code == 0, r.output
     line = re.search(r"Session time on the real rig: at least ([0-9.]+) s", said(r))
     assert line, said(r)
-    assert "1 run(s) killed, powered off or out of disk before recording their time" in said(r)
+    assert (
+        "1 run(s) killed, powered off or out of disk before recording their time, counted "
+        "from their images" in said(r)
+    ), said(r)
     # the killed run's images are counted from the journal: the whole session's time, not
     # the resumed run's alone (the same session uninterrupted is the yardstick)
     whole = manifest(ref)["timing"]["rig_time_s"]
