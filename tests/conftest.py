@@ -710,3 +710,12 @@ def sigint_as_the_system_opens(path: str) -> Iterator[list[int]]:
             yield opened
     finally:
         os.open = real_open
+
+
+class UnlimitedLighting:
+    """What ``fix_exposure`` asks of a rig's lighting before it meters, for the fake rigs of
+    tests that stop the metering at its start: lights with no lit-time limit (the cap from a
+    limit is tested on built rigs, tests/cli/test_auto_exposure_lit_limit.py)."""
+
+    def lit_limit_s(self) -> None:
+        return None

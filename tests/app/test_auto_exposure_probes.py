@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, write_config
+from conftest import CONFIGS, UnlimitedLighting, write_config
 
 from rti_rig.app.config import load_rig_config, rig_geometry
 from rti_rig.app.usecases.session import Note, fix_exposure
@@ -32,6 +32,7 @@ class FakeRig:
     def __init__(self, cfg: Path) -> None:
         self.loaded = load_rig_config(cfg)
         self.camera_config = self.loaded.config.camera
+        self.lighting = UnlimitedLighting()
 
 
 def _probes(cfg: Path, monkeypatch: pytest.MonkeyPatch, lights: int = 48) -> tuple[int, list[str]]:

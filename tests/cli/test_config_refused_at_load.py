@@ -16,6 +16,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from conftest import UnlimitedLighting
 from typer.testing import CliRunner
 
 from rti_rig.app.config import load_rig_config
@@ -119,6 +120,7 @@ def test_auto_exposure_meters_no_longer_than_the_window_holds(
         def __init__(self) -> None:
             self.loaded = loaded
             self.camera_config = loaded.config.camera
+            self.lighting = UnlimitedLighting()
 
     def planned():  # type: ignore[no-untyped-def]
         from rti_rig.app.config import rig_geometry

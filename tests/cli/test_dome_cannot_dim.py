@@ -14,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, write_config
+from conftest import CONFIGS, UnlimitedLighting, write_config
 from typer.testing import CliRunner
 
 from rti_rig.app.config import load_rig_config
@@ -190,6 +190,7 @@ def _metered_at(loaded: object, monkeypatch: pytest.MonkeyPatch) -> tuple[int, l
         def __init__(self) -> None:
             self.loaded = loaded
             self.camera_config = loaded.config.camera  # type: ignore[attr-defined]
+            self.lighting = UnlimitedLighting()
 
     notes: list[object] = []
     schedule = plan_uniform(rig_geometry(loaded), 12)  # type: ignore[arg-type]
