@@ -336,10 +336,17 @@ def test_preview_refuses_before_anything_moves(
 
 
 class _FakeRig:
+    """What the start closes of a rig it opened (:class:`rti_rig.runtime.rig.Rig`'s close
+    returns its failures; its ``close_said`` says them)."""
+
     closed = False
 
-    def close(self) -> None:
+    def close(self) -> list[str]:
         self.closed = True
+        return []
+
+    def close_said(self) -> None:
+        self.close()
 
 
 def test_the_rig_is_closed_whatever_interrupts_the_start(
