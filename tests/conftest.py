@@ -719,3 +719,20 @@ class UnlimitedLighting:
 
     def lit_limit_s(self) -> None:
         return None
+
+
+def opened_session_kept(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
+    """A dict whose ``"opened"`` is, once ``run`` has opened its session in this process, the
+    :class:`~rti_rig.app.usecases.session.OpenedSession` it runs: for tests that look at the
+    rig's devices (an emulator's LED, a simulated dome's lit LED) as the session ends."""
+    import rti_rig.app.usecases.session as session_usecase
+
+    seen: dict[str, Any] = {}
+    real_run = session_usecase.run_opened_session
+
+    def run_opened_session(opened: Any, *args: Any, **kwargs: Any) -> Any:
+        seen["opened"] = opened
+        return real_run(opened, *args, **kwargs)
+
+    monkeypatch.setattr(session_usecase, "run_opened_session", run_opened_session)
+    return seen

@@ -20,11 +20,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import CONFIGS, inprocess_arm_config
+from conftest import CONFIGS, inprocess_arm_config, opened_session_kept
 from conftest import said as unwrapped
 from typer.testing import CliRunner
 
-import rti_rig.app.usecases.session as session_usecase
 import rti_rig.runtime.controller as controller
 from rti_rig.cli import app
 from rti_rig.drivers.dynamixel import control_table as ct
@@ -84,14 +83,7 @@ def test_an_arm_run_whose_end_a_stop_cut_has_its_lamp_switched_off(
     text = cfg.read_text()
     assert 'lamp = "software"' in text
     cfg.write_text(text.replace('lamp = "software"', 'lamp = "servo_led"\nlamp_servo_id = 2'))
-    seen: dict[str, Any] = {}
-    real_run = session_usecase.run_opened_session
-
-    def run_opened_session(opened, *args: Any, **kwargs: Any) -> Any:
-        seen["opened"] = opened
-        return real_run(opened, *args, **kwargs)
-
-    monkeypatch.setattr(session_usecase, "run_opened_session", run_opened_session)
+    seen = opened_session_kept(monkeypatch)
     lit: list[int] = []
     real_lamp = controller.CancelToken.capture_over
 

@@ -11,14 +11,12 @@ from __future__ import annotations
 import signal
 import sys
 from pathlib import Path
-from typing import Any
 
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, opened_session_kept
 from conftest import said as unwrapped
 from typer.testing import CliRunner
 
-import rti_rig.app.usecases.session as session_usecase
 import rti_rig.runtime.controller as controller
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
@@ -31,14 +29,7 @@ from rti_rig.runtime.session import SessionFolder
 def test_a_simulated_dome_lit_as_a_stop_cuts_the_teardown_is_switched_off_by_the_close(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    seen: dict[str, Any] = {}
-    real_run = session_usecase.run_opened_session
-
-    def run_opened_session(opened, *args: Any, **kwargs: Any) -> Any:
-        seen["opened"] = opened
-        return real_run(opened, *args, **kwargs)
-
-    monkeypatch.setattr(session_usecase, "run_opened_session", run_opened_session)
+    seen = opened_session_kept(monkeypatch)
     lit: list[int | None] = []
     real_over = controller.CancelToken.capture_over
 
