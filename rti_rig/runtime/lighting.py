@@ -571,27 +571,48 @@ class ArmLighting:
         return failures
 
 
-#: The label of a teardown failure that is the lights' port not closing cleanly (its words said
-#: to the user as it happened): recorded among the run's ``teardown_failures``, but no sign
-#: that the lights are unsafe, as the all-off before it says what it established.
+#: The label of a teardown failure that is the lights' port not closing cleanly, as the
+#: manifest's ``teardown_failures`` records it (``"port close: …"``, the shape of every teardown
+#: failure, which readers of older sessions know).
 PORT_CLOSE = "port close"
 
 
+class PortCloseFailure(str):
+    """A teardown failure that is the lights' port not closing cleanly (its words said to the
+    user as it happened): recorded among the run's ``teardown_failures`` as its text, like
+    every teardown failure, but no sign that the lights are unsafe, as the all-off before it
+    says what it established.
+
+    Why a type: :func:`unsafe_failures` had told it from an all-off's failure by its text's
+    prefix, so a change of wording (or another failure worded alike) could have changed what
+    the run calls safe. A ``str`` so that every list of teardown failures, and the manifest's
+    JSON, holds it as it held its text."""
+
+    __slots__ = ()
+
+    @classmethod
+    def said(cls, words: str) -> PortCloseFailure:
+        """The record of a close said in ``words`` (``"port close: <words>"``)."""
+        return cls(f"{PORT_CLOSE}: {words}")
+
+
 def port_close_failures(lighting: Lighting) -> list[str]:
-    """The run's record of the lights' last close failing to release their port (``port
-    close: …``, the shape of every teardown failure), none when it closed cleanly.
+    """The run's record of the lights' last close failing to release their port (one
+    :class:`PortCloseFailure`), none when it closed cleanly.
 
     Why: a dome's close never raises its port's failure (it must not mask the error that led
     to the close), so the teardown's ``try`` around the close never saw it: the user was told,
     the manifest's and journal's ``teardown_failures`` said nothing went wrong."""
     said = lighting.port_close_failure()
-    return [] if said is None else [f"{PORT_CLOSE}: {said}"]
+    return [] if said is None else [PortCloseFailure.said(said)]
 
 
 def unsafe_failures(failures: Iterable[str] | None) -> list[str]:
-    """The teardown failures that leave the lights' safe state in doubt (each but a port's
-    close, said as it happened and coming after the all-off that says what it established)."""
-    return [f for f in failures or () if not str(f).startswith(f"{PORT_CLOSE}: ")]
+    """The teardown failures that leave the lights' safe state in doubt: each but a
+    :class:`PortCloseFailure` (said as it happened, and coming after the all-off that says
+    what it established). Told by type, never by wording: a plain text that reads like a port's
+    close is kept as unsafe."""
+    return [f for f in failures or () if not isinstance(f, PortCloseFailure)]
 
 
 def attempt_all(actions: list[tuple[str, object]]) -> list[str]:
