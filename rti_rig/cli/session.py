@@ -479,7 +479,7 @@ def _stopped_while_opening(
 ) -> typer.Exit:
     """Say a stop (Ctrl-C, SIGTERM) that came while the session opened, and what metering's
     teardown established of the lights if it was metering; the exit a stop by ``why`` asks."""
-    _print_failures(getattr(exc, "teardown_failures", None))
+    _print_metering_failures(exc)
     state = getattr(exc, "lights_state", None)
     if state is not None:  # stopped while metering: what its teardown established
         said += f"; metering was stopped, and then: {state}"
@@ -490,6 +490,31 @@ def _stopped_while_opening(
         )
     err.print(f"[yellow]{escape(said)}.[/]")
     return typer.Exit(code=stop_exit_code(stop_signal(exc)))
+
+
+def _print_metering_failures(exc: BaseException) -> None:
+    """What metering's teardown could not do, carried by the error or stop that ended it: each
+    that leaves the lights in doubt as a teardown problem; a port that did not close cleanly
+    (said as it happened, by the dome's own line) as being in no record, which it is: the
+    session's record is written only once the capture begins (it had been said as a teardown
+    problem, or not kept at all)."""
+    from rti_rig.runtime.lighting import unsafe_failures
+
+    failures = list(getattr(exc, "teardown_failures", None) or ())
+    unsafe = unsafe_failures(failures)
+    _print_failures(unsafe)
+    if len(unsafe) < len(failures):
+        _unrecorded_port_close("metering ended before the session began")
+
+
+def _unrecorded_port_close(why: str) -> None:
+    """Say that the port's close failure said above is kept in no session record (``why``:
+    the reason none was written), rather than make up a record for it."""
+    err.print(
+        f"[yellow]note:[/] the port's close failure above is in no session record: {why}, so "
+        "none was written for it.",
+        markup=True,
+    )
 
 
 @dataclass(frozen=True)
@@ -524,7 +549,7 @@ def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
             if opening.capture:
                 handover.hold()  # a stop from here on: the capture answers it
     except RtiRigError as exc:
-        _print_failures(getattr(exc, "teardown_failures", None))  # metering's
+        _print_metering_failures(exc)
         raise _opening_failed(exc, opening.out_dir) from None
     except (KeyboardInterrupt, EmergencyStop) as exc:
         # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
@@ -533,7 +558,7 @@ def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
         said = opening.stopped(why, exc)
         raise _stopped_while_opening(exc, why, said, opening.auto_exposure) from None
     except Exception as exc:  # no part of rti-rig named it: said, not a traceback
-        _print_failures(getattr(exc, "teardown_failures", None))
+        _print_metering_failures(exc)
         said = opening.not_opened
         state = getattr(exc, "lights_state", None)
         if state is not None:  # metering failed: what its teardown established
@@ -1310,13 +1335,22 @@ def _close_left_open(opened) -> list[str]:  # type: ignore[no-untyped-def]
     moment the opened rig is handed over, whatever ends the command; the close's own failures
     are taken here too when the capture's ``with`` closed the rig (a stop inside it, before
     the controller's ``try``)."""
+    from rti_rig.runtime.lighting import unsafe_failures
+
     failures: list[str] = []
     if not opened.closed:
         try:
             opened.close()
         except Exception as exc:  # closing what the opening opened: said, never a traceback
             failures.append(f"closing the rig failed: {exc}")
-    return [*opened.take_close_failures(), *failures]
+    taken = opened.take_close_failures()
+    unsafe = unsafe_failures(taken)
+    if len(unsafe) < len(taken) and not opened.close_recorded:
+        # a port that did not close cleanly was said as it happened, by the dome's own line;
+        # where this run wrote no record to keep it in, that is said rather than a record
+        # made up for it
+        _unrecorded_port_close("this run had not begun")
+    return [*unsafe, *failures]
 
 
 def _stopped_before_capture(  # type: ignore[no-untyped-def]

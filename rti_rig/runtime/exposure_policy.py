@@ -46,7 +46,7 @@ from rti_rig.runtime.controller import (
     shoot_step,
     validate_schedule,
 )
-from rti_rig.runtime.lighting import attempt_all
+from rti_rig.runtime.lighting import attempt_all, port_close_failures, unsafe_failures
 from rti_rig.runtime.rig import Rig
 
 #: ``meter(camera, start_exposure_s) -> choice`` where ``choice.exposure_s`` is the pick,
@@ -377,12 +377,17 @@ def fix_session_exposure(
             # a dome kept open (hold) only once its all-off went through: one that failed is
             # closed, and the error says so
             hold = keep_lights and not failures
-            return failures + attempt_all(
+            failures += attempt_all(
                 [
                     ("camera close", rig.camera.close),
                     ("lights close", rig.lighting.hold if hold else rig.lighting.close),
                 ]
             )
+            if not (hold and rig.lighting.link_open):  # closed (a hold that cannot, closes)
+                # a port that did not close cleanly was said as it happened, never raised:
+                # kept with the rest, as the run's teardown keeps it (it had been in no record)
+                failures += port_close_failures(rig.lighting)
+            return failures
 
     at = steps[0]
     tested: list[list[float]] = []
@@ -420,10 +425,10 @@ def fix_session_exposure(
         raise
     failures = teardown(keep_lights=True)
     rig_time_s, wall_time_s = rig.clock.now() - started, time.perf_counter() - wall_started
-    if failures:
+    if unsafe := unsafe_failures(failures):
         raise DeviceError(
             rig.name,
-            "metering could not make the rig safe (" + "; ".join(failures) + "): check the "
+            "metering could not make the rig safe (" + "; ".join(unsafe) + "): check the "
             "lights before anything else",
             "meter",
         )
@@ -437,6 +442,9 @@ def fix_session_exposure(
         "metering_shots": max(len(tested[0]), 1) + sum(len(t) for t in tested[1:]),
         "shot_per_lighting": shot_per_lighting,
         **({"metering_strays": strays} if strays else {}),
+        # what the teardown could not do, none unsafe (a port's close, said as it happened):
+        # recorded with the exposure it fixed, in the session's manifest
+        **({"teardown_failures": failures} if failures else {}),
         "rig_time_s": rig_time_s,
         "wall_time_s": wall_time_s,
     }

@@ -819,7 +819,7 @@ class SessionFolder:
         _write_json_atomic(self.root / MANIFEST, self.manifest)
         self.begun = True
 
-    def record_cut_end(self, reason: str) -> None:
+    def record_cut_end(self, reason: str, teardown_failures: list[str] | None = None) -> bool:
         """Record in the manifest that this run was stopped (``reason``: a finish reason such
         as ``"emergency-stop"``) where the stop cut the run's end before :meth:`finish` could
         record it; nothing for a session never begun, or a run whose end is recorded.
@@ -829,9 +829,15 @@ class SessionFolder:
         manifest is written, atomically, from what it held at the run's start: the images,
         their records, the journal and ``lights.lp`` are left as they are (the resume reads
         them as after a kill); the run's time is not known here and stays unrecorded. A write
-        that fails changes nothing on disk (the run then reads as killed, as before)."""
+        that fails changes nothing on disk (the run then reads as killed, as before).
+
+        ``teardown_failures``: what making the rig safe in the teardown's stead could not do
+        (a port that did not close cleanly among them), recorded as the controller's teardown
+        records its own (``runner.teardown_failures``): said in words alone, it had been in no
+        record of the run. True when the manifest was written with them (False: nothing to
+        record them in, or the write failed)."""
         if not self.begun or self.run_end is not None or not self.manifest.get("runs"):
-            return
+            return False
         run = self.manifest["runs"][-1]
         run.update({"finished_at": _now_iso(), "finish_reason": reason, "end_cut": True})
         self.manifest["runner"] = {
@@ -839,9 +845,13 @@ class SessionFolder:
             "state": "stopped",
             "finish_reason": reason,
             "end_cut": True,
+            "teardown_failures": list(teardown_failures or []),
         }
-        with contextlib.suppress(OSError, SessionWriteError):
+        try:
             _write_json_atomic(self.root / MANIFEST, self.manifest)
+        except (OSError, SessionWriteError):
+            return False
+        return True
 
     def write_step(self, index: int, frame: Frame, record_fields: dict[str, Any]) -> StepRecord:
         """Write one captured frame (linear TIFF, then sRGB JPEG), then journal it.

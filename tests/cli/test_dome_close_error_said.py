@@ -122,3 +122,89 @@ def test_a_run_s_port_close_failure_is_in_its_teardown_failures(
     assert text.count(WORDS) == 1, text
     assert "known safe state" not in text and "teardown problem" not in text, text
     assert "acknowledged" in text, text  # the lights' line says what the all-off established
+
+
+NO_RECORD = "the port's close failure above is in no session record"
+
+
+def _run_three(out: Path, *more: str) -> tuple[int, str]:
+    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "3", "--out", str(out)]
+    r = CliRunner().invoke(app, [*argv, "--no-verdict", *more], terminal_width=400)
+    return r.exit_code, said(r)
+
+
+def test_a_port_close_in_a_run_whose_end_a_stop_cut_is_recorded_on_disk(
+    tmp_path: Path, close_fails: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A SIGTERM as the controller's teardown begins: the session's close makes the dome safe
+    and closes its port in the teardown's stead, and records the run's cut end. The port's
+    close failure is in that record as the teardown's own would be (it had been said and in
+    no record), said once, and is no teardown problem."""
+    import signal
+
+    import rti_rig.runtime.controller as controller
+
+    real_over = controller.CancelToken.capture_over
+
+    def capture_over(self) -> None:  # type: ignore[no-untyped-def]
+        signal.raise_signal(signal.SIGTERM)
+        real_over(self)
+
+    monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
+    out = tmp_path / "S"
+    code, text = _run_three(out)
+    assert code == 143, text
+    runner = json.loads((out / "manifest.json").read_text())["runner"]
+    assert runner["end_cut"] is True, runner
+    assert runner["teardown_failures"] == [f"port close: {_line(text)}"], runner
+    assert text.count(WORDS) == 1, text
+    assert "teardown problem" not in text and NO_RECORD not in text, text
+    assert "all-off sent and acknowledged by the dome: lights are off" in text, text
+
+
+def test_metering_s_port_close_is_said_once_and_as_in_no_record(
+    tmp_path: Path, close_fails: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Metering fails on a camera fault and its teardown closes the dome's port, which fails:
+    kept with metering's teardown failures (it had been in none), said once by the dome's
+    line, not as a teardown problem, and said to be in no session record, since none was
+    written; the lights' line says what the all-off established."""
+    import rti_rig.runtime.exposure_policy as exposure_policy
+    from rti_rig.core.errors import DeviceError
+
+    def camera_fails(*args: object, **kwargs: object) -> float:
+        raise DeviceError("camera", "stopped answering (injected)", "capture")
+
+    monkeypatch.setattr(exposure_policy, "metering_start_s", camera_fails)
+    out = tmp_path / "S"
+    code, text = _run_three(out, "--auto-exposure")
+    assert code == 2, text
+    assert "stopped answering (injected)" in text, text
+    assert text.count(WORDS) == 1 and text.count(NO_RECORD) == 1, text
+    assert "metering ended before the session began" in text, text
+    assert "teardown problem" not in text, text
+    assert "All-off sent and acknowledged by the dome: lights are off; nothing was" in text, text
+    assert not out.exists()  # no record made up for it
+
+
+def test_a_port_close_of_a_run_stopped_before_it_began_is_said_as_in_no_record(
+    tmp_path: Path, close_fails: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A SIGTERM as the capture checks the free space, the dome held open after metering: the
+    session's close sends the all-off and closes the port, which fails. The run never began,
+    so no manifest keeps it: that is said, and no folder is made for it."""
+    import signal
+
+    import rti_rig.runtime.controller as controller
+
+    def check_free_space(*args: object, **kwargs: object) -> None:
+        signal.raise_signal(signal.SIGTERM)
+
+    monkeypatch.setattr(controller, "check_free_space", check_free_space)
+    out = tmp_path / "S"
+    code, text = _run_three(out, "--auto-exposure")
+    assert code == 143, text
+    assert text.count(WORDS) == 1 and text.count(NO_RECORD) == 1, text
+    assert "this run had not begun" in text, text
+    assert "teardown problem" not in text, text
+    assert not out.exists()

@@ -98,10 +98,10 @@ def test_an_arm_run_whose_end_a_stop_cut_has_its_lamp_switched_off(
     monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
     real_record = SessionFolder.record_cut_end
 
-    def record_cut_end(self: SessionFolder, reason: str) -> None:
+    def record_cut_end(self: SessionFolder, reason: str, *more: Any) -> bool:
         # the lamp as the stop is written down: off already (safety before the disk's fsync)
         lit.append(seen["opened"].rig.emulator.servos[2].get(ct.LED))
-        real_record(self, reason)
+        return real_record(self, reason, *more)
 
     monkeypatch.setattr(SessionFolder, "record_cut_end", record_cut_end)
     r, said = _run(cfg, tmp_path / "s")

@@ -45,9 +45,9 @@ def test_a_simulated_dome_lit_as_a_stop_cuts_the_teardown_is_switched_off_by_the
     monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
     real_record = SessionFolder.record_cut_end
 
-    def record_cut_end(self: SessionFolder, reason: str) -> None:
+    def record_cut_end(self: SessionFolder, reason: str, *more: list[str]) -> bool:
         lit.append(seen["opened"].rig.lighting.source.lit_now())  # off before the disk's fsync
-        real_record(self, reason)
+        return real_record(self, reason, *more)
 
     monkeypatch.setattr(SessionFolder, "record_cut_end", record_cut_end)
     out = tmp_path / "s"

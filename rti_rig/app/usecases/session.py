@@ -165,6 +165,10 @@ class OpenedSession:
     #: what :meth:`close` could not do in making safe a rig the controller's teardown never
     #: took (for the command to say, through :meth:`take_close_failures`)
     close_failures: list[str] = field(default_factory=list)
+    #: whether :attr:`close_failures` are recorded on disk too, in the run's cut end
+    #: (``runner.teardown_failures``); False where this run wrote no record to keep them in (it
+    #: never began: no manifest of it exists, and none is made up for them)
+    close_recorded: bool = False
     #: the finish reason of the stop that left the capture's ``with`` (an emergency stop, a
     #: Ctrl-C), for :meth:`close` to record where it cut the run's end; None: no stop
     cut_by: str | None = None
@@ -220,7 +224,7 @@ class OpenedSession:
         trusting the controller to have made the devices safe: a SIGTERM as the capture
         checked the free space left the emulated dome's held port open, its all-off unsent."""
         from rti_rig.core.deferred_signals import signals_deferred
-        from rti_rig.runtime.lighting import attempt_all
+        from rti_rig.runtime.lighting import attempt_all, port_close_failures
         from rti_rig.runtime.session import unlock_session
 
         if self.closed:
@@ -231,20 +235,26 @@ class OpenedSession:
             with signals_deferred():
                 try:
                     if not self.teardown_ran:
+                        done: list[str] = []
                         if rig.lighting.link_open:
-                            self.close_failures += rig.lighting.safe(emergency=True)
-                        self.close_failures += attempt_all(
+                            done += rig.lighting.safe(emergency=True)
+                        done += attempt_all(
                             [
                                 ("camera close", rig.camera.close),
                                 ("lights close", rig.lighting.close),
                             ]
                         )
+                        # a port that did not close cleanly was said as it happened, never
+                        # raised: kept as the controller's teardown keeps it (it had been said
+                        # to the user and in no record of the run)
+                        done += port_close_failures(rig.lighting)
+                        self.close_failures += done
                         if self.cut_by is not None:
                             # a stop cut the run's end before the controller recorded it: said
                             # on disk as a stop, not left as a kill leaves it. After the devices
                             # are safe: the manifest's fsync (seconds behind a slow card's
                             # pending images) had kept a lamp or an LED lit while it ran
-                            self.folder.record_cut_end(self.cut_by)
+                            self.close_recorded = self.folder.record_cut_end(self.cut_by, done)
                 finally:
                     # every resource closed whatever the record did, each failure kept for the
                     # command to say, never raised: it had replaced the session's own error (an
@@ -565,8 +575,10 @@ def fix_exposure(
         # dome whose all-off metering had sent and seen acknowledged); a state that cannot be
         # told leaves the fault to be said as it is
         from rti_rig.app.usecases.safe_state import lights_state
+        from rti_rig.runtime.lighting import unsafe_failures
 
-        failures = getattr(exc, "teardown_failures", None)
+        # (a port that did not close cleanly is no doubt about the lights: the all-off says)
+        failures = unsafe_failures(getattr(exc, "teardown_failures", None))
         with contextlib.suppress(Exception):  # never said in place of the fault raised
             exc.lights_state = lights_state(rig, bool(failures))  # type: ignore[attr-defined]
         raise
