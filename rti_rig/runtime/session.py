@@ -69,6 +69,7 @@ from rti_rig.core.image_files import (
 from rti_rig.core.lp_format import LpEntry, format_lp
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
 from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
+from rti_rig.runtime.unrecorded_end import unrecorded_end
 
 MANIFEST = "manifest.json"
 JOURNAL = "journal.jsonl"
@@ -1887,8 +1888,6 @@ def _ended_as(reason: object, root: Path) -> str:
     :func:`~rti_rig.runtime.unrecorded_end.unrecorded_end`: "killed" had been said of a run
     whose disk was too full to record its end)."""
     if reason is None:
-        from rti_rig.runtime.unrecorded_end import unrecorded_end
-
         return f"its last run: {unrecorded_end(root)}"
     said = RUN_ENDED.get(reason) if isinstance(reason, str) else None
     return f"its last run: {said}" if said else "its last run did not finish"

@@ -13,24 +13,26 @@ from __future__ import annotations
 
 import json
 import shutil
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 #: the causes a run's missing end can have, as messages list them
 CAUSES = "killed, a power cut, or a disk too full to record its end"
 
 
-def last_image_bytes(root: Path) -> int | None:
+def last_image_bytes(root: Path, journal: Sequence[dict[str, Any]] | None = None) -> int | None:
     """The bytes on disk of the last image the journal of ``root`` lists (its JPEG and linear
-    TIFF), None where the journal or the files cannot tell (junk, missing, unreadable)."""
-    try:
-        lines = (root / "journal.jsonl").read_text(encoding="utf-8", errors="replace")
-    except OSError:
-        return None
-    for line in reversed(lines.splitlines()):
-        try:
-            entry = json.loads(line)
-        except ValueError:
-            continue
+    TIFF), None where the journal or the files cannot tell (junk, missing, unreadable).
+
+    ``journal``: its records as the caller already read them (``scan_journal``'s, a step
+    proven by its record file where its line was never written among them, last), so that it
+    is not read again; None: read here, line by line, tolerating junk."""
+    if journal is None:
+        journal = _journal_lines(root)
+        if journal is None:
+            return None
+    for entry in reversed(journal):
         if not isinstance(entry, dict) or not isinstance(entry.get("image"), str):
             continue
         names = [entry["image"]]
@@ -43,11 +45,28 @@ def last_image_bytes(root: Path) -> int | None:
     return None
 
 
-def full_disk_now(root: Path) -> str | None:
+def _journal_lines(root: Path) -> list[dict[str, Any]] | None:
+    """The journal's lines that are JSON objects, in order (None: it cannot be read)."""
+    try:
+        lines = (root / "journal.jsonl").read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    entries = []
+    for line in lines.splitlines():
+        try:
+            entry = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(entry, dict):
+            entries.append(entry)
+    return entries
+
+
+def full_disk_now(root: Path, journal: Sequence[dict[str, Any]] | None = None) -> str | None:
     """``"its disk has … free, less than its last image took (…)"`` where the disk of ``root``
     could not hold another image like the journal's last one; None where it could, or where
-    either cannot be known."""
-    size = last_image_bytes(root)
+    either cannot be known (``journal``: as for :func:`last_image_bytes`)."""
+    size = last_image_bytes(root, journal)
     try:
         free = shutil.disk_usage(root).free
     except OSError:
@@ -57,10 +76,11 @@ def full_disk_now(root: Path) -> str | None:
     return f"its disk has {_mb(free)} free, less than its last image took ({_mb(size)})"
 
 
-def unrecorded_end(root: Path) -> str:
+def unrecorded_end(root: Path, journal: Sequence[dict[str, Any]] | None = None) -> str:
     """``root``'s last run ended without recording how: the words for it, naming a full disk
-    as the likely cause where :func:`full_disk_now` finds one."""
-    full = full_disk_now(root)
+    as the likely cause where :func:`full_disk_now` finds one (``journal``: the journal's
+    records where the caller has read them, as for :func:`last_image_bytes`)."""
+    full = full_disk_now(root, journal)
     if full is not None:
         return (
             f"it stopped without recording why, and {full}: most likely the disk filled "

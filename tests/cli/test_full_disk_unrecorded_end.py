@@ -77,3 +77,30 @@ def test_a_run_the_full_disk_kept_from_recording_its_end_is_said_so(
     assert "1 run(s) killed, powered off or out of disk before recording" in said(r), said(r)
     runner = json.loads((out / "manifest.json").read_text())["runner"]
     assert runner["finish_reason"] == "completed" and runner["state"] == "finished"
+
+
+def test_the_full_disk_is_named_from_a_step_whose_journal_line_it_kept_out(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The disk filled as the journal's lines were to be written: the images are proven by
+    their record files alone. The verdict reads the journal once (its records, the record
+    files' among them) and sizes the last image from them: it had read the journal again, line
+    by line, found no image there, and named three causes where the disk was full."""
+    out = tmp_path / "s"
+    argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), "--lights", "6"]
+    with monkeypatch.context() as full:
+        _full_after(full, out, 3)
+        with failing_writes("manifest", after=1, errno_code=errno.ENOSPC):
+            r = CliRunner().invoke(app, [*argv, "--no-verdict"])
+        assert r.exit_code == 2, said(r)
+        (out / "journal.jsonl").write_bytes(b"")  # its lines never reached the disk
+        assert len(list((out / "records").glob("image_*.json"))) == 3
+
+        r = CliRunner().invoke(
+            app, ["fit", str(out), "--out", str(tmp_path / "f"), "--model", "ps"]
+        )
+        assert r.exit_code == 0, said(r)
+        verdict = json.loads((tmp_path / "f" / "qa.json").read_text())["verdict"]
+        assert "the session is not finished (3 of 6 images; it stopped without" in verdict
+        assert "its disk has 0.0 MB free, less than its last image took" in verdict, verdict
+        assert "most likely the disk filled" in verdict, verdict

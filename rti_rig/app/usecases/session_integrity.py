@@ -343,8 +343,16 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
         for s in (steps if isinstance(steps, list) else [])
         if isinstance(s, dict) and isinstance(s.get("index"), int)
     }
-    taken = len({r["index"] for r in scan_journal(source, image_names(total)).records} | recorded)
-    how = RUN_ENDED.get(reason or "", f"it ended: {reason}") if reason else unrecorded_end(source)
+    # read once: its records also name the last image, whose size tells a full disk (it had
+    # been read again for that, line by line, and a step proven by its record file alone, the
+    # line a full disk never let the run write, was not among them)
+    journal = scan_journal(source, image_names(total)).records
+    taken = len({r["index"] for r in journal} | recorded)
+    how = (
+        RUN_ENDED.get(reason or "", f"it ended: {reason}")
+        if reason
+        else unrecorded_end(source, journal)
+    )
     of = f"of at most {total}" if manifest.get("adaptive") else f"of {total}"
     # of the images taken, those lost since: "12 of 12 images" of a session not finished (a
     # --reshoot-lost stopped part-way) had read as a contradiction
