@@ -101,6 +101,28 @@ def test_a_teardown_that_fails_after_metering_is_an_error_not_silence(tmp_path: 
     assert closed == ["lights"]
 
 
+def test_a_port_that_did_not_close_after_metering_is_recorded_not_called_unsafe(
+    tmp_path: Path,
+) -> None:
+    """Metering's lights closed at its end (a simulated dome is never held open), their port's
+    close failing: kept in the exposure's evidence, which the session's manifest holds (it had
+    been in no record), and no reason to refuse the metering (its all-off went through)."""
+    rig = build_rig(load_rig_config(write_config(tmp_path, SMALL_DOME)))
+    schedule = plan_uniform(rig.geometry, 6)
+    said = "dome: its port did not close cleanly: [Errno 5] Input/output error."
+    rig.lighting.port_close_failure = lambda: said  # type: ignore[method-assign]
+
+    class Choice:
+        exposure_s = 0.02
+
+        def to_manifest(self) -> dict:
+            return {"exposure_s": 0.02}
+
+    fixed = fix_session_exposure(rig, schedule, lambda camera, start_s: Choice())
+    assert fixed.provenance["exposure"]["teardown_failures"] == [f"port close: {said}"]
+    assert not rig.lighting.link_open
+
+
 def test_a_stop_during_metering_carries_what_the_teardown_could_not_do(tmp_path: Path) -> None:
     """A Ctrl-C while metering had dropped the teardown's failures, and the user was told an
     all-off had been sent."""
