@@ -504,17 +504,13 @@ def _print_metering_failures(exc: BaseException) -> None:
     unsafe = unsafe_failures(failures)
     _print_failures(unsafe)
     if len(unsafe) < len(failures):
-        _unrecorded_port_close("metering ended before the session began")
+        _unrecorded_port_close("metering ended before the session began, so none was written")
 
 
 def _unrecorded_port_close(why: str) -> None:
     """Say that the port's close failure said above is kept in no session record (``why``:
-    the reason none was written), rather than make up a record for it."""
-    err.print(
-        f"[yellow]note:[/] the port's close failure above is in no session record: {why}, so "
-        "none was written for it.",
-        markup=True,
-    )
+    how that came about), rather than make up a record for it."""
+    err.print(f"[yellow]note:[/] the port's close failure above is in no session record: {why}.")
 
 
 @dataclass(frozen=True)
@@ -1349,7 +1345,11 @@ def _close_left_open(opened) -> list[str]:  # type: ignore[no-untyped-def]
         # a port that did not close cleanly was said as it happened, by the dome's own line;
         # where this run wrote no record to keep it in, that is said rather than a record
         # made up for it
-        _unrecorded_port_close("this run had not begun")
+        _unrecorded_port_close(
+            "this run had not begun, so it wrote none"
+            if not opened.folder.begun
+            else "the run's manifest was not written with it"
+        )
     return [*unsafe, *failures]
 
 
