@@ -204,6 +204,8 @@ class EmulatedServo:
         self._set(ct.PRESENT_TEMPERATURE, 30)
         self._set(ct.GOAL_POSITION, present_ticks)
         self._profile = _Profile(present_ticks, present_ticks, clock.now(), 1.0, 1.0)
+        #: True while the motion is the load's (a limp joint falling), not a profile's
+        self._back_driven = False
         self._registered: tuple[int, bytes] | None = None
         self._shut_down = False
         #: how long a Reboot keeps it silent (:data:`RESTART_S`), and until when it is
@@ -253,11 +255,21 @@ class EmulatedServo:
 
     def _refresh(self) -> None:
         now = self.clock.now()
-        moving = self._profile.moving(now)
+        # a profile is one the servo runs towards its Goal Position; a limp joint falling
+        # under its load (:meth:`_go_limp`) moves, but runs no profile
+        profile = self._profile.moving(now) and not self._back_driven
         present = round(self._profile.position(now))
         self._set(ct.PRESENT_POSITION, present)
-        units = self._profile.velocity(now) / (ct.RPM_PER_VELOCITY_UNIT / 60 * ct.TICKS_PER_REV)
-        self._set(ct.PRESENT_VELOCITY, round(units))
+        units = round(
+            self._profile.velocity(now) / (ct.RPM_PER_VELOCITY_UNIT / 60 * ct.TICKS_PER_REV)
+        )
+        self._set(ct.PRESENT_VELOCITY, units)
+        # e-manual, Moving (122): set when |Present Velocity| exceeds Moving Threshold (24),
+        # and always while a profile is in progress after a Goal Position update
+        # (ROBOTIS-GIT/emanual _includes/en/dxl/x/moving.md @ d45c8b26). It had been the
+        # emulator's motion alone, so a joint sagging with its torque off, slower than the
+        # threshold, read Moving = 1 and "profile ongoing", which no servo reports.
+        moving = profile or abs(units) > self.get(ct.MOVING_THRESHOLD)
         self._set(ct.MOVING, 1 if moving else 0)
         # e-manual, Moving Status (123): bit 1 "Profile Ongoing", bit 0 "In-Position: Whether
         # or not the DYNAMIXEL has arrived to the desired Goal Position(116)", set "when the
@@ -268,13 +280,14 @@ class EmulatedServo:
         # deviation is not published for the X series: IN_POSITION_TICKS is assumed. The
         # velocity-profile bits (4-5) are not modelled.
         arrived = not moving and abs(present - self.get(ct.GOAL_POSITION)) <= IN_POSITION_TICKS
-        self._set(ct.MOVING_STATUS, (0x02 if moving else 0) | (0x01 if arrived else 0))
+        self._set(ct.MOVING_STATUS, (0x02 if profile else 0) | (0x01 if arrived else 0))
         self._set(ct.REALTIME_TICK, int(now * 1000) % 32768)
 
     def _freeze(self) -> None:
         now = self.clock.now()
         p = self._profile.position(now)
         self._profile = _Profile(p, p, now, 1.0, 1.0)
+        self._back_driven = False
 
     def _go_limp(self) -> None:
         """Torque just went off: a loaded joint (:attr:`sag_to`) falls towards its rest at
@@ -291,6 +304,7 @@ class EmulatedServo:
         now = self.clock.now()
         p = self._profile.position(now)
         self._profile = _Profile(p, self.sag_to, now, self.sag_ticks_per_s, math.inf)
+        self._back_driven = True
 
     # -- faults -----------------------------------------------------------------------------
     @property
@@ -479,6 +493,7 @@ class EmulatedServo:
         self._profile = _Profile(
             self._profile.position(now), float(goal), now, _ticks_per_s(v_units), a
         )
+        self._back_driven = False
 
     def reg_write(self, address: int, data: bytes) -> int:
         self._registered = (address, bytes(data))
@@ -498,6 +513,7 @@ class EmulatedServo:
             return p2.ERR_RESULT_FAIL
         p = round(self.position()) % ct.TICKS_PER_REV
         self._profile = _Profile(p, p, self.clock.now(), 1.0, 1.0)
+        self._back_driven = False
         self._set(ct.GOAL_POSITION, p)
         return 0
 

@@ -7,6 +7,7 @@ import pytest
 
 from rti_rig.core.clock import VirtualClock
 from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.bus import DxlBus
 from rti_rig.drivers.dynamixel.faults import (
     CommunicationError,
@@ -512,3 +513,43 @@ def test_the_arms_loaded_elevation_joint_falls_to_its_stop_once_its_torque_goes_
     clock.sleep(60.0)
     stop = settings.elevation.zero_offset_ticks  # 0 deg, the lower limit of the shipped arm
     assert elevation.position() == pytest.approx(stop)
+
+
+def test_moving_is_a_profile_or_a_speed_above_the_moving_threshold() -> None:
+    """e-manual, Moving (122): 1 while a profile runs after a Goal Position update, otherwise
+    1 only when |Present Velocity| exceeds Moving Threshold (24); Moving Status (123) bit 1 is
+    the profile. A limp joint falling under its load runs no profile: at the assumed sag
+    rate (about 7 velocity units) it is below the factory threshold of 10 and reads Moving 0
+    though it moves; with the threshold lowered it reads 1. The emulator had reported its own
+    motion as Moving and "profile ongoing" whatever the threshold."""
+    from rti_rig.simulator.dynamixel_emulator import arm_settings_of, emulator_for_arm
+
+    settings, _ = arm_settings_of(None)
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    port = InProcessPort(emu)
+    assert port.openPort() and port.setBaudRate(57600)
+    ph = sdk.PacketHandler(2.0)
+
+    def read(reg: ct.Register) -> int:
+        read_n = {1: ph.read1ByteTxRx, 4: ph.read4ByteTxRx}[reg.size]
+        value, result, _error = read_n(port, 2, reg.address)
+        assert result == sdk.COMM_SUCCESS
+        return p2.to_signed(value, reg.size)
+
+    assert ph.write1ByteTxRx(port, 2, ct.TORQUE_ENABLE.address, 1)[0] == sdk.COMM_SUCCESS
+    assert ph.write4ByteTxRx(port, 2, ct.PROFILE_VELOCITY.address, 40)[0] == sdk.COMM_SUCCESS
+    start = read(ct.PRESENT_POSITION)
+    assert ph.write4ByteTxRx(port, 2, ct.GOAL_POSITION.address, start + 300)[0] == 0
+    clock.sleep(0.1)
+    assert (read(ct.MOVING), read(ct.MOVING_STATUS) & 0x02) == (1, 0x02)  # a profile
+    emu.inject_hardware_error(2, ct.HardwareFault.OVERLOAD)  # shut down: limp, it falls
+    clock.sleep(0.5)
+    before = read(ct.PRESENT_POSITION)
+    assert 0 < -read(ct.PRESENT_VELOCITY) <= read(ct.MOVING_THRESHOLD)  # falling, slowly
+    assert (read(ct.MOVING), read(ct.MOVING_STATUS) & 0x02) == (0, 0)
+    clock.sleep(0.5)
+    assert read(ct.PRESENT_POSITION) < before  # it does move
+    # Moving Threshold is EEPROM, writable with the torque off
+    assert ph.write4ByteTxRx(port, 2, ct.MOVING_THRESHOLD.address, 2)[0] == sdk.COMM_SUCCESS
+    assert (read(ct.MOVING), read(ct.MOVING_STATUS) & 0x02) == (1, 0)  # fast enough, no profile
