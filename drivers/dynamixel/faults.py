@@ -88,10 +88,13 @@ class HardwareFaultError(DynamixelError):
             )
             for f in self.faults
         )
+        at_connect = command == "connect"
         super().__init__(
             device,
-            f"hardware fault {names} (Hardware Error Status 0x{status:02X}); {advice}; "
-            f"{ct.reboot_how(config, power_cycle, torque_on)}. " + torque_statement(torque_on),
+            f"hardware fault {names} (Hardware Error Status 0x{status:02X})"
+            + (FOUND_AT_CONNECT if at_connect else "")
+            + f"; {advice}; {ct.reboot_how(config, power_cycle, torque_on)}. "
+            + torque_statement(torque_on, at_connect),
             command,
             servo_id,
         )
@@ -102,11 +105,24 @@ class HardwareFaultError(DynamixelError):
         return [f.name.lower() for f in self.faults]
 
 
-def torque_statement(torque_on: bool | None) -> str:
-    """What a fault left of the servo's torque, as read (never assumed)."""
+#: Said of a fault found as the arm connects, before the command drove anything. Why: a servo
+#: keeps Hardware Error Status (70) until a Reboot or a power-off (ROBOTIS e-manual, Shutdown
+#: (63)), so the fault met at connect is usually one an earlier session left; the error had
+#: read as if this command had just overloaded the arm ("Its torque is off (as read after the
+#: fault)"), and a user looked for what the check or run had done wrong.
+FOUND_AT_CONNECT = (
+    " found already set as the arm connected, before this command drove it: a servo keeps "
+    "its fault until it is rebooted or powered off, so it may date from an earlier session"
+)
+
+
+def torque_statement(torque_on: bool | None, at_connect: bool = False) -> str:
+    """What a fault left of the servo's torque, as read (never assumed); ``at_connect``: read
+    as the arm connected (the fault predates the command)."""
     if torque_on is False:
+        when = "at connect" if at_connect else "after the fault"
         return (
-            "Its torque is off (as read after the fault): the joint is limp; if the servo shut "
+            f"Its torque is off (as read {when}): the joint is limp; if the servo shut "
             "down for this fault, only a reboot lets its torque back on."
         )
     if torque_on is True:

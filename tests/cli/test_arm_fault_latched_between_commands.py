@@ -34,6 +34,8 @@ def test_a_faulted_run_is_recovered_by_reboot_faulted_then_resumed(tmp_path: Pat
     words = said(r)
     assert r.exit_code == 2 and "Traceback" not in words, words
     assert "servo 2: hardware fault overload" in words, words
+    assert "found already set" not in words, words  # met mid-run: this run's own fault
+    assert "Its torque is off (as read after the fault)" in words, words
     kept = len(journal(out))
     assert 0 < kept < 6, words
 
@@ -42,6 +44,13 @@ def test_a_faulted_run_is_recovered_by_reboot_faulted_then_resumed(tmp_path: Pat
     words = said(r)
     assert r.exit_code != 0 and "Traceback" not in words, words
     assert "arm during 'connect': servo 2: hardware fault overload" in words, words
+    # said as one found at connect, left by an earlier command, not as this one's doing
+    assert (
+        "(Hardware Error Status 0x20) found already set as the arm connected, before this "
+        "command drove it: a servo keeps its fault until it is rebooted or powered off, so it "
+        "may date from an earlier session" in words
+    ), words
+    assert "Its torque is off (as read at connect)" in words, words
     assert "Nothing was commanded: the arm could not be connected" in words, words
     assert len(journal(out)) == kept
 
