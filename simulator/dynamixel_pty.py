@@ -26,7 +26,8 @@ its answer — the SDK pitfall the driver must handle, reproduced every time ins
 
 A plain ``dynamixel_sdk.PortHandler`` opened on :attr:`PtyServoServer.device_path` (or any other
 client) still works: without a ledger, replies are written in real time after
-``reply_delay_s``, as before, and the SDK's wall-time timeout applies.
+each servo's own Return Delay Time (address 9) plus the packet's wire time at the host's
+baud rate (:func:`real_time_replies`), and the SDK's wall-time timeout applies.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ from typing import Any
 import dynamixel_sdk
 
 from rti_rig.core.deferred_signals import signals_deferred
+from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
 from rti_rig.simulator.pty_link import host_baud
 
@@ -81,6 +83,39 @@ class LinkLedger:
         )
 
 
+#: Bits one byte takes on the wire: start bit, 8 data bits, stop bit (ROBOTIS e-manual, X
+#: series specifications, Physical Connection: "8bit, 1stop, No Parity").
+BITS_PER_BYTE = 10
+#: Return Delay Time (9) unit, seconds (e-manual, X-series control table: 2 [μsec]).
+RETURN_DELAY_UNIT_S = 2e-6
+
+
+def real_time_replies(
+    emulator: DynamixelBusEmulator, reply: bytes, baud: int | None
+) -> list[tuple[float, bytes]]:
+    """Each status packet of ``reply`` with the wall time to wait before it is complete on
+    the wire: its servo's Return Delay Time (9, 2 µs units, as that servo's table holds it
+    now), then its bytes at ``baud`` (no wire time when the host's rate is unknown). Several
+    packets (a Sync Read's) follow one another, each servo waiting its own delay.
+
+    Why: replies to a plain ``PortHandler`` had come after a fixed 0.5 ms whatever the servo's
+    Return Delay Time, and at no wire speed, so a host rehearsing against the served pty met
+    a faster bus than its own (a 15-byte status takes 2.6 ms at the factory 57600 baud)."""
+    out: list[tuple[float, bytes]] = []
+    i = 0
+    while i + 7 <= len(reply):
+        n = 7 + int.from_bytes(reply[i + 5 : i + 7], "little")  # header, id, LEN, then LEN
+        packet = reply[i : i + n]
+        servo = emulator.servos.get(reply[i + 4])
+        delay = servo.get(ct.RETURN_DELAY_TIME) * RETURN_DELAY_UNIT_S if servo else 0.0
+        wire = len(packet) * BITS_PER_BYTE / baud if baud else 0.0
+        out.append((delay + wire, packet))
+        i += n
+    if i < len(reply):  # not a whole packet: sent as it is, at once
+        out.append((0.0, reply[i:]))
+    return out
+
+
 def _write_all(fd: int, data: bytes) -> None:
     view = memoryview(data)
     while view:
@@ -95,15 +130,15 @@ class PtyServoServer:
     A slave fd stays open for the server's lifetime (otherwise reads fail with EIO whenever the
     SDK closes its port); ``stop()`` joins the thread within a bounded time.
 
-    ``reply_delay_s`` applies only to clients without a ledger (a plain ``PortHandler``): it
-    models the servos' Return Delay Time (default 250 x 2 µs = 0.5 ms) in real time."""
+    Clients without a ledger (a plain ``PortHandler``) get their replies in real time, as
+    :func:`real_time_replies` paces them (``real_time = False``: at once)."""
 
     def __init__(
-        self, emulator: DynamixelBusEmulator, poll_s: float = 0.02, reply_delay_s: float = 0.0005
+        self, emulator: DynamixelBusEmulator, poll_s: float = 0.02, real_time: bool = True
     ) -> None:
         self.emulator = emulator
         self.poll_s = poll_s
-        self.reply_delay_s = reply_delay_s
+        self.real_time = real_time
         self.device_path: str | None = None
         self.ledger: LinkLedger | None = None
         self._fds: tuple[int, int] | None = None
@@ -161,11 +196,16 @@ class PtyServoServer:
                     elif reply:
                         ledger.held.append(reply)
                 continue
-            if reply:
-                if self.reply_delay_s > 0:
-                    time.sleep(self.reply_delay_s)  # emulator thread only; tests never sleep
+            if not reply:
+                continue
+            if not self.real_time:
                 with contextlib.suppress(OSError):
                     _write_all(master, reply)
+                continue
+            for wait_s, packet in real_time_replies(self.emulator, reply, self.emulator.host_baud):
+                time.sleep(wait_s)  # emulator thread only; tests never sleep
+                with contextlib.suppress(OSError):
+                    _write_all(master, packet)
 
     def stop(self, timeout_s: float = 1.0) -> None:
         self._stop.set()

@@ -553,3 +553,25 @@ def test_moving_is_a_profile_or_a_speed_above_the_moving_threshold() -> None:
     # Moving Threshold is EEPROM, writable with the torque off
     assert ph.write4ByteTxRx(port, 2, ct.MOVING_THRESHOLD.address, 2)[0] == sdk.COMM_SUCCESS
     assert (read(ct.MOVING), read(ct.MOVING_STATUS) & 0x02) == (1, 0)  # fast enough, no profile
+
+
+def test_real_time_replies_wait_each_servos_return_delay_time_and_wire_time() -> None:
+    """A plain ``PortHandler`` on the served pty gets each status packet after its servo's own
+    Return Delay Time (9, 2 µs units; factory 250 = 0.5 ms) and the packet's wire time at
+    the host's baud rate (10 bits a byte): it had been a fixed 0.5 ms whatever the register,
+    at no wire speed. Checked as the schedule the server sleeps by (no timed test)."""
+    from rti_rig.simulator.dynamixel_pty import real_time_replies
+
+    clock = VirtualClock()
+    emu = two_servos(clock)
+    ping = emu.receive(p2.ping(1))
+    assert real_time_replies(emu, ping, 57600) == [(pytest.approx(0.0005 + 140 / 57600), ping)]
+    assert real_time_replies(emu, ping, None) == [(pytest.approx(0.0005), ping)]
+    # servo 2 set to answer at once (a Write of Return Delay Time, torque off)
+    assert p2.decode(emu.receive(p2.write(2, ct.RETURN_DELAY_TIME.address, b"\x00"))).error == 0
+    both = emu.receive(p2.sync_read(ct.PRESENT_POSITION.address, 4, [1, 2]))
+    first, second = both[:15], both[15:]
+    assert real_time_replies(emu, both, 1_000_000) == [
+        (pytest.approx(0.0005 + 150e-6), first),
+        (pytest.approx(150e-6), second),
+    ]
