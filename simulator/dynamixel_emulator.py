@@ -430,6 +430,11 @@ class EmulatedServo:
                 lo, hi = self.get(ct.MIN_POSITION_LIMIT), self.get(ct.MAX_POSITION_LIMIT)
             else:
                 lo, hi = -ct.EXTENDED_TICK_LIMIT, ct.EXTENDED_TICK_LIMIT
+            # e-manual, Min/Max Position Limit (48, 52): "Provided Goal Position(116) values
+            # must be within the configured position limit range" (ROBOTIS-GIT/emanual
+            # _includes/en/dxl/x/position_limit.md @ f9dea50c); an XL430 given a goal outside
+            # them does nothing at all, it is not clamped onto the limit (ROBOTIS forum,
+            # "Position limit in joint mode", forum.robotis.com/t/452): refused, nothing moves
             if not lo <= goal <= hi:
                 return p2.ERR_DATA_LIMIT
         torque_bytes = covered(ct.TORQUE_ENABLE)

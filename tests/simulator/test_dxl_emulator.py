@@ -575,3 +575,25 @@ def test_real_time_replies_wait_each_servos_return_delay_time_and_wire_time() ->
         (pytest.approx(0.0005 + 150e-6), first),
         (pytest.approx(150e-6), second),
     ]
+
+
+def test_a_goal_outside_the_position_limits_is_refused_and_nothing_moves() -> None:
+    """e-manual, Min/Max Position Limit: Goal Position "must be within the configured position
+    limit range"; an XL430 given one outside does nothing at all, it does not go to the limit
+    (ROBOTIS forum, "Position limit in joint mode"). The emulator refuses it with a Data Limit
+    Error, keeps the goal it had and stays put; a goal on the limit is taken."""
+    clock = VirtualClock()
+    servo = EmulatedServo(1, 1060, clock, min_position=1000, max_position=3000)
+    emu = DynamixelBusEmulator([servo], clock)
+    port = InProcessPort(emu)
+    assert port.openPort() and port.setBaudRate(57600)
+    ph = sdk.PacketHandler(2.0)
+    assert ph.write1ByteTxRx(port, 1, ct.TORQUE_ENABLE.address, 1) == (sdk.COMM_SUCCESS, 0)
+    result, error = ph.write4ByteTxRx(port, 1, ct.GOAL_POSITION.address, 3001)
+    assert (result, error) == (sdk.COMM_SUCCESS, p2.ERR_DATA_LIMIT)
+    clock.sleep(5.0)
+    assert ph.read4ByteTxRx(port, 1, ct.GOAL_POSITION.address)[0] == 2048
+    assert ph.read4ByteTxRx(port, 1, ct.PRESENT_POSITION.address)[0] == 2048
+    assert ph.write4ByteTxRx(port, 1, ct.GOAL_POSITION.address, 3000) == (sdk.COMM_SUCCESS, 0)
+    clock.sleep(30.0)
+    assert ph.read4ByteTxRx(port, 1, ct.PRESENT_POSITION.address)[0] == 3000
