@@ -21,7 +21,8 @@ file (:mod:`rti_rig.simulator.servo_latch`; delete it to "power-cycle" the servo
 Deliberate simplifications: a new goal during a move restarts the profile from the present
 position at zero velocity (the firmware blends); no load, current or temperature dynamics.
 Return Delay Time is modelled by the pty server (:mod:`rti_rig.simulator.dynamixel_pty`): a
-status reaches the host only once it listens, never in wall time.
+status reaches the rig's own host only once it listens, never in wall time; a plain
+``PortHandler`` gets it after the servo's Return Delay Time (9) and its wire time.
 
 Like a real servo, a unicast Action and unicast writes *are* answered; the SDK does not read
 those replies (a pitfall the driver handles). Instruction packets are parsed by length, because
