@@ -91,16 +91,19 @@ RETURN_DELAY_UNIT_S = 2e-6
 
 
 def real_time_replies(
-    emulator: DynamixelBusEmulator, reply: bytes, baud: int | None
+    emulator: DynamixelBusEmulator, reply: bytes, baud: int | None, heard: int = 0
 ) -> list[tuple[float, bytes]]:
     """Each status packet of ``reply`` with the wall time to wait before it is complete on
     the wire: its servo's Return Delay Time (9, 2 µs units, as that servo's table holds it
     now), then its bytes at ``baud`` (no wire time when the host's rate is unknown). Several
-    packets (a Sync Read's) follow one another, each servo waiting its own delay.
+    packets (a Sync Read's) follow one another, each servo waiting its own delay. The first
+    also waits for the ``heard`` instruction bytes to cross the wire (a servo answers a
+    packet it has received whole; the host's write to the pty is instant).
 
     Why: replies to a plain ``PortHandler`` had come after a fixed 0.5 ms whatever the servo's
     Return Delay Time, and at no wire speed, so a host rehearsing against the served pty met
     a faster bus than its own (a 15-byte status takes 2.6 ms at the factory 57600 baud)."""
+    byte_s = BITS_PER_BYTE / baud if baud else 0.0
     out: list[tuple[float, bytes]] = []
     i = 0
     while i + 7 <= len(reply):
@@ -108,7 +111,7 @@ def real_time_replies(
         packet = reply[i : i + n]
         servo = emulator.servos.get(reply[i + 4])
         delay = servo.get(ct.RETURN_DELAY_TIME) * RETURN_DELAY_UNIT_S if servo else 0.0
-        wire = len(packet) * BITS_PER_BYTE / baud if baud else 0.0
+        wire = (len(packet) + (heard if not out else 0)) * byte_s
         out.append((delay + wire, packet))
         i += n
     if i < len(reply):  # not a whole packet: sent as it is, at once
@@ -202,7 +205,8 @@ class PtyServoServer:
                 with contextlib.suppress(OSError):
                     _write_all(master, reply)
                 continue
-            for wait_s, packet in real_time_replies(self.emulator, reply, self.emulator.host_baud):
+            baud = self.emulator.host_baud
+            for wait_s, packet in real_time_replies(self.emulator, reply, baud, len(data)):
                 time.sleep(wait_s)  # emulator thread only; tests never sleep
                 with contextlib.suppress(OSError):
                     _write_all(master, packet)

@@ -557,9 +557,10 @@ def test_moving_is_a_profile_or_a_speed_above_the_moving_threshold() -> None:
 
 def test_real_time_replies_wait_each_servos_return_delay_time_and_wire_time() -> None:
     """A plain ``PortHandler`` on the served pty gets each status packet after its servo's own
-    Return Delay Time (9, 2 µs units; factory 250 = 0.5 ms) and the packet's wire time at
-    the host's baud rate (10 bits a byte): it had been a fixed 0.5 ms whatever the register,
-    at no wire speed. Checked as the schedule the server sleeps by (no timed test)."""
+    Return Delay Time (9, 2 µs units; factory 250 = 0.5 ms) and the wire time of the packet
+    (and of the instruction before it) at the host's baud rate (10 bits a byte): it had
+    been a fixed 0.5 ms whatever the register, at no wire speed. Checked as the schedule the
+    server sleeps by (no timed test)."""
     from rti_rig.simulator.dynamixel_pty import real_time_replies
 
     clock = VirtualClock()
@@ -567,6 +568,10 @@ def test_real_time_replies_wait_each_servos_return_delay_time_and_wire_time() ->
     ping = emu.receive(p2.ping(1))
     assert real_time_replies(emu, ping, 57600) == [(pytest.approx(0.0005 + 140 / 57600), ping)]
     assert real_time_replies(emu, ping, None) == [(pytest.approx(0.0005), ping)]
+    # the instruction (a ping is 10 bytes) crosses the wire before the servo can answer it
+    assert real_time_replies(emu, ping, 57600, heard=10) == [
+        (pytest.approx(0.0005 + 240 / 57600), ping)
+    ]
     # servo 2 set to answer at once (a Write of Return Delay Time, torque off)
     assert p2.decode(emu.receive(p2.write(2, ct.RETURN_DELAY_TIME.address, b"\x00"))).error == 0
     both = emu.receive(p2.sync_read(ct.PRESENT_POSITION.address, 4, [1, 2]))
