@@ -249,10 +249,12 @@ class _Server:
                         if self.openers == 0:
                             self.opened = False
                             self.pending.clear()
+                            self._closed()
             if hup:
                 if self.opened and not self.watch.available:
                     self.opened = False
                     self.pending.clear()  # nobody listens: output is lost, as on a real board
+                    self._closed()
                 time.sleep(0.002)
             elif not self.opened and not self.watch.available:
                 self.opened = True
@@ -274,6 +276,13 @@ class _Server:
                 self._unplug(down)
                 continue
             self._flush_due()
+
+    def _closed(self) -> None:
+        """The host closed the port (DTR dropped): told to a device that acts on it (an
+        ATmega32u4 set to 1200 baud jumps to its bootloader)."""
+        closed = getattr(self.device, "on_port_closed", None)
+        if closed is not None:
+            closed()
 
     def _reset_by_late_opens(self) -> None:
         """An open of the port the loop had not read when the server was asked to stop still

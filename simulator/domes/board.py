@@ -72,6 +72,12 @@ class Board:
     #: no UART lies between host and firmware, so the host's baud rate is a setting nobody
     #: reads and any rate works. Behind a USB-serial chip (FTDI, 16U2) both UARTs must agree.
     native_usb = False
+    #: The host's baud rate at which closing the port drops the board into its bootloader (the
+    #: ATmega32u4 core's "1200-baud touch": line rate 1200, then DTR low); None: no such rate.
+    bootloader_touch_baud: int | None = None
+    #: Seconds such a bootloader waits for an upload before it starts the sketch again
+    #: (Caterina: 8 s); bytes sent meanwhile never reach the sketch.
+    bootloader_wait_s = 8.0
     #: The firmware switches its LEDs on its own clock, with no command (RTIPy's LED goes dark
     #: when its window ends): what is lit when the camera exposes depends on the time the rig
     #: spends between two commands, so a dry run must spend that time on the board's clock too
@@ -202,6 +208,19 @@ class Board:
                 self._power_on(now)
             return self._take(now)
 
+    def on_port_closed(self) -> None:
+        """The host closed the port (its DTR dropped). At :attr:`bootloader_touch_baud` the
+        board jumps to its bootloader: the sketch stops, and starts again from ``setup()``
+        after :attr:`bootloader_wait_s`, as after a reset."""
+        with self._lock:
+            now = self.clock.now()
+            self._advance(now)
+            touch = self.bootloader_touch_baud
+            if touch is None or self.host_baud != touch or not self.powered:
+                return
+            self._power_on(now, self.bootloader_wait_s)
+            self.event("bootloader (1200-baud touch)")
+
     def receive(self, data: bytes) -> list[Output]:
         with self._lock:
             now = self.clock.now()
@@ -241,7 +260,7 @@ class Board:
     def _lit_off_unpowered(self) -> None:
         self.set_lit(frozenset())
 
-    def _power_on(self, now: float) -> None:
+    def _power_on(self, now: float, boot_s: float | None = None) -> None:
         self._unplugged = False
         self.t = now
         self.event("boot")
@@ -251,9 +270,10 @@ class Board:
         self._mode = None
         self.set_lit(frozenset())  # pins float low while in the bootloader
         self.powered = True
-        self._boot_until = now + self.boot_s
+        boot = self.boot_s if boot_s is None else boot_s
+        self._boot_until = now + boot
         self._gen = self.firmware()
-        self._wait = Sleep(self.boot_s)
+        self._wait = Sleep(boot)
         self._wait_start = now
 
     def _take(self, now: float) -> list[Output]:

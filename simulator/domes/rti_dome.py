@@ -8,7 +8,10 @@ line 100 ms, waits 100 ms; ``A`` runs the whole 32-LED sequence (not emulated). 
 board is an ATmega32u4 (the sketch drives ``LED_BUILTIN_TX``, which only the 32u4 boards
 define, and uses pins 0 and 1, the UART's, as outputs while ``Serial`` still works): its
 ``Serial`` is native USB, so opening the port does not reset it and the host's baud rate is
-not used (``Serial.begin(9600)`` sets nothing on a USB CDC port): any rate reaches the sketch.
+not used (``Serial.begin(9600)`` sets nothing on a USB CDC port): any rate reaches the sketch,
+except 1200: the Arduino core's USB code jumps to the bootloader when a port set to 1200 baud
+drops DTR (the "1200-baud touch" an uploader uses), so a host that opens the port at 1200 and
+closes it leaves the sketch stopped for the bootloader's 8 s, then restarted from ``setup()``.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ class RtiDomeBoard(Board):
     boot_s = 0.0
     resets_on_open = False
     native_usb = True
+    bootloader_touch_baud = 1200  # the 32u4 core's CDC code: 1200 baud, then DTR low
 
     def firmware(self) -> Firmware:
         while True:

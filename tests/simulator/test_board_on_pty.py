@@ -142,3 +142,35 @@ def test_an_open_unread_when_the_server_stops_still_resets_the_board(tmp_path) -
     server.run()  # the loop ends at once: the open was never read by it
     assert boots(board) == 1
     assert board.lit_once_booted() == frozenset(range(board.led_count))  # never sent the all-off
+
+
+def touches(board) -> int:  # type: ignore[no-untyped-def]
+    return sum(1 for _, what in board.events if what == "bootloader (1200-baud touch)")
+
+
+@pytest.mark.parametrize(("baud", "jumps"), [(1200, 1), (9600, 0)])
+def test_closing_the_32u4_port_at_1200_baud_drops_it_into_its_bootloader(
+    baud: int, jumps: int
+) -> None:
+    """The ATmega32u4 core's USB code jumps to the bootloader when a port set to 1200 baud
+    drops DTR (the Arduino "1200-baud touch"): the sketch stops for the bootloader's 8 s and
+    the M5 sent once the port is opened again never reaches it. At any other rate a
+    close changes nothing (the board does not even reset when the port opens)."""
+    board = board_for("rti-dome-m")
+    board.bootloader_wait_s = 600.0  # however slow the host, the M5 comes while it waits
+    with serve_on_pty(board, "rti-dome") as link:
+        port = serial.Serial(link.port, baud, timeout=0.1)
+        assert eventually(lambda: board.host_baud == baud), board.host_baud
+        port.close()
+        if jumps:
+            assert eventually(lambda: touches(board) == 1), board.events
+        with serial.Serial(link.port, 9600, timeout=0.1) as port:
+            port.write(b"M5 ")
+            port.flush()
+            # what the board makes of it is settled once the pty handed the bytes over: the
+            # sketch, if running, lights LED 5 at once (the space ends parseInt)
+            heard = eventually(
+                lambda: board.lit == frozenset({5}), timeout_s=3.0 if jumps else 10.0
+            )
+    assert touches(board) == jumps, board.events
+    assert heard is not bool(jumps), board.timeline
