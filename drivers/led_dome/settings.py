@@ -22,6 +22,7 @@ from pydantic import (
 from rti_rig.core.validation_text import error_text, key_of
 from rti_rig.drivers.led_dome.dome_profiles import (
     all_profiles,
+    bootloader_touch_baud,
     builtin_spec,
     described_profiles,
     merge,
@@ -268,6 +269,21 @@ class DomeSerialSettings(_Strict):
             raise ValueError(
                 "profile = 'custom' needs a [dome.serial.protocol] table describing the firmware "
                 "(docs/domes.md, 'Describing a new dome')"
+            )
+        touch = bootloader_touch_baud(self.profile)
+        if touch is not None and self.baudrate == touch:
+            # refused here, at load: a check or run would open the port at this rate, and its
+            # close (DTR dropping at 1200 baud) jumps an ATmega32u4 into its bootloader, the
+            # dome then gone from the port for its next command or a resumed run
+            key = "dome.serial.baudrate"
+            if self.protocol is not None and "baudrate" in self.protocol:
+                key = "dome.serial.protocol.baudrate"
+            raise ValueError(
+                f"{key} = {touch} is the rate at which the {self.profile} firmware's board (an "
+                f"ATmega32u4 on its own USB) jumps to its bootloader when the port closes (the "
+                f"Arduino 1200-baud touch), so no port is opened at it; this board takes any "
+                f"other rate: remove {key} (the firmware's own "
+                f"{builtin_spec(self.profile)['baudrate']} is used) or set another rate"
             )
         if described:
             self.protocol_spec()  # refuse a bad description now, naming its key

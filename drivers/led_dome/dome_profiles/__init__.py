@@ -50,6 +50,17 @@ def any_baudrate(name: str) -> bool:
     return bool(getattr(module, "ANY_BAUDRATE", False))
 
 
+def bootloader_touch_baud(name: str) -> int | None:
+    """The baud rate at which opening and closing the port resets built-in firmware ``name``'s
+    board into its bootloader (its module's ``BOOTLOADER_TOUCH_BAUD``: the ATmega32u4's
+    1200-baud touch), or None where no rate does."""
+    if name not in _MODULES:
+        return None
+    module = importlib.import_module(f"{__name__}.{_MODULES[name]}")
+    rate = getattr(module, "BOOTLOADER_TOUCH_BAUD", None)
+    return None if rate is None else int(rate)
+
+
 def max_led_count(name: str) -> int | None:
     """The most LEDs built-in firmware ``name`` can address (its module's ``MAX_LED_COUNT``), or
     None where no fixed maximum is known (an LED map decides, or ``custom``)."""

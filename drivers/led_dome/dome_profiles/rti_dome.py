@@ -15,6 +15,13 @@ MAX_LED_COUNT = 32
 #: ``Serial.begin(9600)`` sets no rate, so any host baud rate reaches the sketch.
 ANY_BAUDRATE = True
 
+#: The Arduino "1200-baud touch" of an ATmega32u4 (the core's ``CDC.cpp``): a port whose line
+#: rate is set to 1200 and whose DTR then drops (the host closing it) makes the board jump to
+#: its bootloader (Caterina: about 8 s as another USB device, waiting for a new sketch). Any
+#: rate reaches the sketch *except* this one, so a rig config asking for it is refused before
+#: the port is opened: every close would reset the dome.
+BOOTLOADER_TOUCH_BAUD = 1200
+
 #: Can the link dim an LED? No: ``M<n>`` lights LED n; the serial command carries no
 #: brightness (the drivers' grey-scale is set in the sketch, not by the host).
 NO_DIMMING = "its only light command, M<n>, lights LED n (it carries no brightness)"
