@@ -106,6 +106,9 @@ class ScriptedDomeDriver(PortOpening):
         self._rx = bytearray()
         self._open = False
         self._last_end = -1e9
+        #: A byte acknowledgement is owed: the last command's timed out, and the board may
+        #: still send it until this time (None: none owed). See :meth:`_wait_owed_ack`.
+        self._ack_owed_until: float | None = None
         self._lit: frozenset[int] = frozenset()
         self._window_end: float | None = None
         self._timed_led: int | None = None
@@ -328,6 +331,7 @@ class ScriptedDomeDriver(PortOpening):
 
     def close(self) -> None:
         self._open = False
+        self._ack_owed_until = None  # an opening resets the board: nothing it owed will come
         self._heard = False
         self._bytes_heard = False
         self._heard_text = ""
@@ -513,6 +517,7 @@ class ScriptedDomeDriver(PortOpening):
         clock = self.transport.clock
         try:
             try:
+                self._wait_owed_ack()
                 self._drain_stale(name)
             except DomeLinkError as exc:
                 # found before this command was written (a reboot banner, stale refusal):
@@ -585,6 +590,10 @@ class ScriptedDomeDriver(PortOpening):
                         LinkFault.MISMATCH,
                     )
             remaining = deadline - clock.now()
+            if remaining <= 0 and reply.kind == "byte" and not self._rx:
+                # the board may have taken the command and acknowledge it late: that byte must
+                # not be read as the next command's acknowledgement
+                self._ack_owed_until = clock.now() + timeout
             if remaining <= 0:
                 if text.strip() and self._banner_may_be_coming():
                     # unmatched text from a board silent through its boot wait, on a profile
@@ -684,6 +693,26 @@ class ScriptedDomeDriver(PortOpening):
             and self.spec.ready_pattern is not None
             and self.spec.reset_pattern is not None
         )
+
+    def _wait_owed_ack(self) -> None:
+        """Before a command after one whose byte acknowledgement timed out: wait, up to one
+        more reply timeout, for that late byte, so the drain that follows drops it.
+
+        Why: an acknowledgement that carries nothing but one byte (minirti's ``0x01``) cannot
+        be matched to its command. Only the input already there was dropped before each
+        command, so a late ``0x01`` arriving once the next command was written was counted as
+        that command's own: a light the board had not acknowledged, or an all-off, was said
+        acknowledged. Acknowledgements come in order, so waiting out the owed one (or the
+        time it could still take) leaves the next byte to the next command. One later than
+        two reply timeouts is not told apart; raise ``reply_timeout_s`` for so slow a board."""
+        until, self._ack_owed_until = self._ack_owed_until, None
+        if until is None:
+            return
+        clock = self.transport.clock
+        while not self._rx and (left := until - clock.now()) > 0:
+            self._feed(self.transport.read(left))
+        if self._rx:
+            traffic_log.debug("%s: late acknowledgement %r dropped", self.device, bytes(self._rx))
 
     def _drain_stale(self, name: str) -> None:
         self._feed(self.transport.read(0.0))
