@@ -106,6 +106,10 @@ class ScriptedDomeDriver(PortOpening):
         self._rx = bytearray()
         self._open = False
         self._last_end = -1e9
+        #: When the last command's first byte was written, and its length (a timed LED's
+        #: window is counted from them).
+        self._written_at = -1e9
+        self._written_n = 0
         #: A byte acknowledgement is owed: the last command's timed out, and the board may
         #: still send it until this time (None: none owed). See :meth:`_wait_owed_ack`.
         self._ack_owed_until: float | None = None
@@ -427,8 +431,15 @@ class ScriptedDomeDriver(PortOpening):
         self._lit = frozenset({index})
         secs = self.spec.window_s
         if secs is not None:
-            # the reply is printed just before the LED lights: the window starts about now
-            self._window_end = self.transport.clock.now() + secs
+            # The window is counted from the earliest moment the LED can have lit: the end of
+            # the command on the wire plus the silence that frames it (RTIPy's readString
+            # returns 1 s after the last byte, prints its reply, and lights the LED as the
+            # reply starts out of its 64-byte buffer). Counted from the reply's arrival, the
+            # end had been placed one reply on the wire (about 50 ms at 9600 baud) and the
+            # port's latency after the LED went dark: a capture ending in that gap was taken
+            # as lit.
+            start = self._written_at + self._wire_s(self._written_n) + self.spec.frame_silence_s
+            self._window_end = start + secs
             self._timed_led = index
 
     def all_off(self) -> None:
@@ -529,6 +540,7 @@ class ScriptedDomeDriver(PortOpening):
                 clock.sleep(gap - clock.now())
             data = self.spec.render(cmd.send, index, lit)
             traffic_log.debug("%s >> %s", self.device, data.hex(" "))
+            self._written_at, self._written_n = clock.now(), len(data)
             self.transport.write(data)
             sent_at = clock.now()
             heard = self._await(cmd, index, name, sent_at, len(data))
