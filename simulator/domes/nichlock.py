@@ -19,7 +19,12 @@ Facts from the firmware (``main.cpp``'s ``setup`` and ``serialReact``, ``pattern
   its LEDs; ``c`` at a menu's first question cancels it with no prompt after;
 * **scans**: ``1``, ``2`` and ``3`` light each of that channel's 64 LEDs in turn (1 s on, 0.1 s
   off; channel 3 0.5 s and 0.2 s): about a minute during which the serial port is not read;
-* ``s`` restarts the sketch (a software reset, no bootloader) unless ``c`` comes within 4 s.
+* ``s`` restarts the sketch (a software reset, no bootloader) unless ``c`` comes within 4 s;
+* **verbose serial** (EEPROM byte 0, bit 7, toggled by ``a`` ``4``): ``setShutter``
+  (``shutterCtrl.cpp``) prints ``Shutter turning on at: S seconds(Mms)`` for the LED ``0``
+  lights, inside its reply (before the ``>``), and ``loop``'s ``checkShutters`` prints
+  ``Shutter turning off at: 0 seconds(1ms)`` a moment after the prompt; ``beginShutters``
+  prints ``\tStartig shutters...`` after the boot's prompt.
 
 What a setting changes takes effect as on the board: a new baud rate at the next boot, a
 cleared EEPROM (``er`` / ``ec``) at the next boot too (the boot then says the baud rate was
@@ -89,11 +94,19 @@ class NichlockBoard(Board):
     boot_s = 1.0
 
     def __init__(
-        self, baudrate: int = DEFAULT_BAUD_RATE, *, touch_calibrated: bool = True, **kw: object
+        self,
+        baudrate: int = DEFAULT_BAUD_RATE,
+        *,
+        touch_calibrated: bool = True,
+        verbose: bool = False,
+        **kw: object,
     ) -> None:
         #: The board's EEPROM: ``baudrate`` is the rate stored there, ``touch_calibrated``
-        #: whether its touch screen was calibrated (if not, every boot waits in calibration).
-        self.eeprom = Eeprom(baud=baudrate, touch_calibrated=touch_calibrated)
+        #: whether its touch screen was calibrated (if not, every boot waits in calibration),
+        #: ``verbose`` its verbose serial output (the settings menu's option 4).
+        self.eeprom = Eeprom(baud=baudrate, touch_calibrated=touch_calibrated, verbose=verbose)
+        #: ``millis()`` at which a shutter waits for ``checkShutters`` (None: none waits).
+        self._shutter_due: int | None = None
         self.baudrate = baudrate
         super().__init__(**kw)  # type: ignore[arg-type]
 
@@ -107,6 +120,7 @@ class NichlockBoard(Board):
                     c = chr((yield Read()) or 0)
                     if self.begin_command():
                         yield from self._react(c)
+                    yield from self._check_shutters()
             except _SoftReset:
                 self.event("soft reset")
 
@@ -115,6 +129,7 @@ class NichlockBoard(Board):
         return names[channel] if 0 <= channel < len(names) else ""
 
     def _setup(self) -> Firmware:
+        self._started = self.t  # millis() counts from here
         self.count = 0
         self.added_last = True
         rom = self.eeprom
@@ -142,6 +157,22 @@ class NichlockBoard(Board):
             self.println(self._name(channel))
         self.print("\nFor help, press 'h'\n>")
         self.set_lit(set())  # setPinModes: every port low
+        if rom.verbose:
+            self.println("\tStartig shutters...")  # beginShutters (the sketch's spelling)
+        self._shutter_due = None
+
+    def _millis(self) -> int:
+        return int((self.t - self._started) * 1000)
+
+    def _check_shutters(self) -> Firmware:
+        """``loop``'s ``checkShutters``: the shutter the last ``0`` set on is switched on once
+        its millis() passed (shutterOnTime 0: held while the LED is), said when verbose."""
+        if self._shutter_due is None:
+            return
+        yield Sleep(0.002)  # millisDelay < millis(): the next millisecond, in loop()
+        self._shutter_due = None
+        if self.eeprom.verbose:
+            self.println("Shutter turning off at: 0 seconds(1ms)")  # activationFromQ, del 0
 
     # ------------------------------------------------------------------ serialReact
 
@@ -200,6 +231,11 @@ class NichlockBoard(Board):
         n = self.count
         self.println(f"LED number: {n}; on pin {n % 8 + 1}")
         self.set_lit({n} if 0 <= n < N_LEDS else set())
+        # trigger(1, 1) -> setShutter(channel, 1, …, shutterOnWait 0): millisDelay = millis()
+        due = self._millis()
+        if self.eeprom.verbose:
+            self.println(f"Shutter turning on at: {due // 1000} seconds({due}ms)")
+        self._shutter_due = due
 
     def _key(self) -> Generator[Sleep | Read, int | None, str]:
         """``while (!Serial.available()) {}`` then ``Serial.read()``: waits however long."""

@@ -117,3 +117,23 @@ def test_er_clears_the_stored_baud_rate_and_the_calibration_for_the_next_boot() 
     assert "Baud rate was NOT FOUND, and has been newly written into EEPROM" in said
     assert board.baudrate == 115200
     assert "Starting Calibration.." in said and PROMPT not in said
+
+
+def test_verbose_serial_says_each_steps_shutter_inside_its_reply_and_after_the_prompt() -> None:
+    """``setShutter`` (``shutterCtrl.cpp``) prints when verbose serial is on (the settings
+    menu's option 4, kept in EEPROM): ``0``'s ``trigger(1, 1)`` says the shutter before the
+    prompt, and ``loop``'s ``checkShutters`` says it again a moment after; the boot's
+    ``beginShutters`` says it starts them after the boot prompt."""
+    board, clock = booted(verbose=True)
+    boot = send(board, clock, b"", 3.0)
+    assert boot.endswith(PROMPT + "\tStartig shutters...\r\n")
+    said = send(board, clock, b"0", 0.5)
+    assert said.startswith("0\r\nLED number: 0; on pin 1\r\nShutter turning on at: ")
+    head, tail = said.split(">", 1)
+    assert head.endswith("ms)\r\n")
+    assert tail == "Shutter turning off at: 0 seconds(1ms)\r\n"
+    assert board.lit == frozenset({0})
+    # quiet (the EEPROM's default): the reply as before, nothing after the prompt
+    board, clock = booted()
+    send(board, clock, b"", 3.0)
+    assert send(board, clock, b"0", 0.5) == "0\r\nLED number: 0; on pin 1\r\n>"
