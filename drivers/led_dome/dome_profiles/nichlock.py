@@ -5,7 +5,10 @@ From the firmware: one character a command, no line endings (a ``\\n`` gets
 prompt. ``0`` lights the next LED and prints ``LED number: N; on pin P``; ``x`` switches all off
 and rewinds to LED 0 (``All LEDs shut off, active LED number reset to zero.``). There is no
 addressing, so the driver steps and checks the number the firmware prints (a missed or double
-step is a named error). Baud rate from EEPROM, 115200 on a fresh board: ``headers.h`` sets
+step is a named error). With verbose serial on (the settings menu's option 4, in EEPROM) each
+step's reply also says ``Shutter turning on at: S seconds(Mms)`` before the prompt, and
+``Shutter turning off at: …`` follows it a moment later (read past as stale text). Baud rate
+from EEPROM, 115200 on a fresh board: ``headers.h`` sets
 ``DEFAULT_BAUD_RATE 115200`` and its settings menu lists "115200 (Default)"; the comment in
 ``setup()`` that says 9600 is stale. A board whose EEPROM was set otherwise needs ``baudrate``
 in the rig config. Arduino Mega: resets when the port opens and prints a banner ending with
@@ -31,7 +34,15 @@ SPEC = {
     "stepping": True,
     "light": {
         "send": "0",
-        "reply": {"kind": "pattern", "pattern": r"LED number: {index}; on pin \d+\r\n>"},
+        # verbose serial (the settings menu's option 4) puts "Shutter turning on at: S
+        # seconds(Mms)" between the LED line and the prompt (shutterCtrl.cpp's setShutter)
+        "reply": {
+            "kind": "pattern",
+            "pattern": (
+                r"LED number: {index}; on pin \d+\r\n"
+                r"(?:Shutter turning on at: [^\r\n>]*\r\n)?>"
+            ),
+        },
     },
     "all_off": {
         "send": "x",
