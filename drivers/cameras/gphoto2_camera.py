@@ -205,6 +205,8 @@ class Gphoto2Camera:
         self._left_on_card = 0
         self.retries_used = 0
         self.camera_model: str | None = None
+        #: the USB port the camera was found on (``usb:001,005``), to name it in errors
+        self.camera_port: str | None = None
         #: the image-format choices the camera offered at connect (for the first-shot refusal)
         self._format_choices: list[str] = []
         #: what connect could not establish of the image format (said by ``rti-rig check``)
@@ -248,6 +250,8 @@ class Gphoto2Camera:
         said to have been tried "over 15.5 s" after some 75 s."""
         code = getattr(exc, "code", None)
         hint = GP_ERROR_HINTS.get(code, "see `gphoto2 --debug` output")
+        if command == "capture":
+            hint = self._capture_advice(code, hint)
         over = f" over {waited_s:g} s" if waited_s else ""
         if waited_s and spent_s is not None and spent_s > waited_s + 1.0:
             over = f" over {spent_s:.0f} s ({waited_s:g} s of them the waits between tries)"
@@ -263,6 +267,64 @@ class Gphoto2Camera:
         if code == -115:
             return CardFullError(self.name, text + self._card_filled_by_copies(), command)
         return error(self.name, text, command)
+
+    def _device(self) -> str:
+        """The camera as a user finds it: its config name, model and USB port."""
+        said = [w for w in (self.camera_model, self.camera_port) if w]
+        return f"{self.name} ({' on '.join(said)})" if said else self.name
+
+    def _capture_advice(self, code: int | None, hint: str) -> str:
+        """What a capture that failed for good means, per libgphoto2 code: whether the camera
+        took the picture (said only where the code tells), where it would be, what to do.
+
+        Why: a capture answered GP_ERROR (-1, libgphoto2's generic failure) said only "see
+        `gphoto2 --debug` output", and no capture failure said whether a picture had been
+        taken, nor where to look for it: on the card (``capture_target``), or in the
+        camera's RAM, lost with the next capture."""
+        device = self._device()
+        if self.settings.capture_target == "Internal RAM":
+            look = (
+                "a picture taken went into the camera's RAM (capture_target = 'Internal "
+                "RAM'), which keeps it only until the next capture: it cannot be recovered"
+            )
+        else:
+            look = (
+                "a picture taken is on the camera's card, newest file last: look there "
+                "(rti-rig never records it)"
+            )
+        if code == -53:
+            return (
+                f"the USB device of {device} is claimed by another program (on desktops "
+                "gvfs-gphoto2-volume-monitor or a file manager mounts a camera as it is "
+                "plugged in), so the capture never reached the camera: no picture was taken. "
+                "Unmount the camera in the file manager or stop that program (`gio mount -s "
+                "gphoto2`; `systemctl --user stop gvfs-gphoto2-volume-monitor` until the next "
+                "login), then check that `gphoto2 --auto-detect` lists it"
+            )
+        if code == -110:
+            return (
+                f"{device} answered 'busy' (PTP Device Busy, I/O in progress), refusing the "
+                "shot: a body so refusing normally takes no picture, but some fire all the "
+                f"same (pibooth #466), and then {look}. {hint}"
+            )
+        if code == -7:
+            return (
+                f"USB I/O error with {device}: whether the camera took the picture is not "
+                f"known (the error may come before or after its shutter fires); {look}. "
+                "Check the USB cable (short, no unpowered hub) and that the camera's auto "
+                "power-off is disabled"
+            )
+        if code == -1:
+            return (
+                f"libgphoto2's generic error (GP_ERROR): {device} refused the capture or "
+                "answered it in a way libgphoto2 could not name, so whether it took the "
+                f"picture is not known; {look}. Bodies answer so for reasons of their own "
+                "(libgphoto2 issues #808, #1126): switch it off and on, set its mode dial to M "
+                "and close its menus, then run `env LANG=C gphoto2 --debug --debug-logfile="
+                "gphoto2.log --capture-image` to see what the camera answered; a body newer "
+                "than the installed libgphoto2 may need it updated (pip install -U gphoto2)"
+            )
+        return hint
 
     # -- lifecycle -------------------------------------------------------------------------
     def connect(self) -> None:
@@ -303,6 +365,7 @@ class Gphoto2Camera:
         self._call("init", cam.init, DeviceError)
         self._cam = cam
         self.camera_model = model
+        self.camera_port = port
         try:
             self._configure()
         except BaseException:

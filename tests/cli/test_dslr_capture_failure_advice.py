@@ -1,0 +1,60 @@
+"""A tethered DSLR whose capture fails for good, through `rti-rig run` on the shipped DSLR
+example (its dome firmware emulated on a pty, python-gphoto2 replaced at its API boundary by
+tests/fake_gphoto2.py): each libgphoto2 code is said with what the user should do, naming the
+camera (its model and USB port), and whether it took the picture only where the code tells.
+
+Why: GP_ERROR (-1, libgphoto2's generic failure) at a capture said only "see `gphoto2 --debug`
+output"; no capture failure said whether a picture had been taken, nor where it would be (the
+camera's card, or its RAM, which keeps it only until the next capture).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+from fake_gphoto2 import Body
+from test_dslr_download_disk_full import _config, _raw, _shot_with
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+NOT_KNOWN = "whether it took the picture is not known"
+
+
+@pytest.mark.parametrize(
+    ("code", "said_of_it"),
+    [
+        (-1, ["libgphoto2's generic error (GP_ERROR)", NOT_KNOWN, "--debug-logfile"]),
+        (-7, ["USB I/O error with", "whether the camera took the picture is not known"]),
+        (-53, ["is claimed by another program", "no picture was taken", "gio mount -s gphoto2"]),
+        (-110, ["answered 'busy'", "normally takes no picture", "busy_retries"]),
+    ],
+)
+@pytest.mark.parametrize("target", ["Internal RAM", "Memory card"])
+def test_a_failed_capture_says_the_camera_what_to_do_and_what_is_known_of_the_picture(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, code: int, said_of_it: list[str], target: str
+) -> None:
+    cfg = _config(tmp_path, target)
+    body = Body(render=_raw, failures={"capture": [code] * 10})
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "2"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert body.shots == 0, said
+    assert f"gphoto2 error {code}" in said, said
+    assert "dslr (Canon EOS 600D on usb:001,005)" in said, said
+    for words in said_of_it:
+        assert words in said, (words, said)
+    assert "see `gphoto2 --debug` output" not in said, said
+    if code == -53:
+        return  # never reached the camera: no card or RAM to look in
+    if target == "Internal RAM":
+        assert "a picture taken went into the camera's RAM" in said, said
+        assert "it cannot be recovered" in said, said
+    else:
+        assert "a picture taken is on the camera's card" in said, said
