@@ -32,7 +32,13 @@ from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError
 from rti_rig.core.image_files import is_camera_raw
 from rti_rig.drivers.cameras.gphoto2_formats import gives_raw, raw_choices
-from rti_rig.drivers.cameras.raw_decode import RawDecodeError, RawFileMissingError, decode_raw
+from rti_rig.drivers.cameras.raw_decode import (
+    RawDecodeError,
+    RawFileMissingError,
+    UnsupportedRawError,
+    decode_raw,
+    libraw_named,
+)
 from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 
 #: libgphoto2's name for an object of a capture kept in the camera's RAM when the body gives
@@ -662,6 +668,59 @@ class Gphoto2Camera:
                         tries=spell.tries,
                     ) from exc
                 self._clock.sleep(delay)
+
+    def test_shot(self) -> str:
+        """Take one shot at the fastest shutter speed offered, download and decode its RAW,
+        and say what it showed (for ``rti-rig check``, after its lights' walk); raise the
+        error a session's first shot would have met.
+
+        Why: a body whose RAW the installed LibRaw cannot read (a body newer than it, a new
+        CR3 or RAF variant) passed the check, which took no image, and the session was
+        refused at its first shot, its LED lit, after the schedule had begun. The shot goes
+        to the private staging folder (no session is bound) and is never kept; on a card it
+        is deleted there once downloaded unless ``delete_from_camera = false``."""
+        if self._cam is None:
+            raise CaptureError(
+                self.name, "camera is not connected; call connect() first", "test shot"
+            )
+        bound, self.output_dir = self.output_dir, None  # never into a session's raw/
+        own = self._shutter_label  # the camera's own speed, put back as connect found it
+        try:
+            self.expose(self._shutters[0][0])
+            try:
+                frame = self.collect()
+            except CaptureError as exc:
+                if isinstance(exc.__cause__, UnsupportedRawError):
+                    raise self._unreadable_raw(exc.__cause__) from exc
+                raise
+        finally:
+            self.output_dir = bound
+        if own is not None and own != self._shutter_label:
+            self._set_config_values({self.settings.shutter_config: (own, "shutter_config")})
+            self._shutter_label = own
+        self._format_note = None  # the shot gave a RAW: nothing left to say of the format
+        files = [str(f) for f in frame.metadata.get("camera_files") or []]
+        raw = next((f for f in files if is_camera_raw(Path(f))), files[0] if files else "?")
+        said = f"one test shot: its RAW {raw} reads with the installed {libraw_named()}"
+        if self.settings.capture_target != "Internal RAM" and not self.settings.delete_from_camera:
+            said += " (its file stays on the card: delete_from_camera = false)"
+        return said
+
+    def _unreadable_raw(self, exc: UnsupportedRawError) -> CaptureError:
+        """The check's refusal of a body whose RAW the installed LibRaw cannot read: the
+        camera, the LibRaw version, and what to do."""
+        model = self.camera_model or "this camera"
+        return CaptureError(
+            self.name,
+            f"{self._device()} gives RAW files the installed {libraw_named()} cannot read "
+            f"(a test shot's RAW: {exc.libraw_said or 'unsupported format'}): every shot of "
+            "a session would be refused at its decode. Update rawpy (pip install -U rawpy) "
+            f"to one whose LibRaw reads the {model} (https://www.libraw.org/supported-cameras), "
+            "then run the check again. Shooting JPEG is no way round it: every decode mode "
+            "reads the RAW (the camera's JPEG is only kept beside it, keep_jpeg); a body that "
+            "offers DNG as an image_format may shoot that instead",
+            "test shot",
+        )
 
     def exposure_problem(self, exposure_s: float) -> str | None:
         """Why ``exposure_s`` cannot be shot on this camera (None: it can), once connected.

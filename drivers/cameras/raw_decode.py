@@ -70,6 +70,11 @@ class RawDecodeError(CaptureError):
         return f"{file}: {self.problem}"
 
 
+def libraw_named() -> str:
+    """The installed LibRaw and the rawpy that bundles it, as a refusal names them."""
+    return f"LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy {rawpy.__version__})"
+
+
 def libraw_words(exc: BaseException) -> str:
     """LibRaw's own words for ``exc`` as text: rawpy raises them as bytes, whose repr
     ("b'Input/output error'") had reached the user's sentence."""
@@ -537,7 +542,7 @@ def decode_raw(
         # DNG whose tags are damaged, for which "Update rawpy" had been the advice: a DNG's
         # own tags tell which where they can (dng_tags), and both are said where they cannot
         said = libraw_words(exc)
-        libraw = f"LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy {rawpy.__version__})"
+        libraw = libraw_named()
         dng = None if read is None else dng_refusal(read)
         problem = (
             f"{libraw} refuses it as of a format it does not read ({said}){_reported(printed)}"

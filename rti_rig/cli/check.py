@@ -90,7 +90,9 @@ def check(
     """Self-test the rig: a dome lights each LED in turn and reports what answered; an arm
     visits poses spanning its band (checking where it really got to), flashes the lamp at each
     if it hangs on a servo's LED output (lamp = "servo_led"; a "software" lamp is not switched)
-    and parks; then the camera is opened and released (no image taken). A recorded
+    and parks; then the camera is opened and released (no image taken; a tethered DSLR takes
+    one test shot, its RAW decoded, so that a RAW the installed LibRaw cannot read is found
+    before a session lights anything). A recorded
     acquisition's .lp (a replay rig) has no device: its images are checked instead.
 
     Exit codes: 0 passed (or RESULT: SENT, NOT VERIFIED, a dome that cannot answer); 1

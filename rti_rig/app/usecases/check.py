@@ -2,7 +2,8 @@
 
 A dome lights each LED in turn and reports what answered; an arm visits poses spanning its band,
 checking where it really got to, flashes its lamp at each and parks (if its config says so).
-Then the camera is opened and released. The rig is closed — lights off, arm stopped — whatever
+Then the camera is opened, takes one test shot if it is a tethered stills camera (its RAW
+decoded), and is released. The rig is closed — lights off, arm stopped — whatever
 happens.
 """
 
@@ -122,7 +123,7 @@ def check_rig(
             if isinstance(rig.lighting, DomeLighting):
                 rig.lighting.listen(on_note)
                 lights = self_test(rig.lighting.source, rig.clock, intensity=intensity)
-                camera = camera_line(rig, auto_exposure=req.auto_exposure)
+                camera = camera_line(rig, auto_exposure=req.auto_exposure, test_shot=True)
                 return WithCamera(lights, camera, config_note_lines(loaded))
             if isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
                 rig.lighting.listen(on_note)
@@ -136,7 +137,8 @@ def check_rig(
                 # log record on stderr)
                 resent = rig.lighting.resends()[1]
                 notes = (*config_note_lines(loaded), *_lamp_notes(rig), *filter(None, [resent]))
-                return WithCamera(lights, camera_line(rig, auto_exposure=req.auto_exposure), notes)
+                camera = camera_line(rig, auto_exposure=req.auto_exposure, test_shot=True)
+                return WithCamera(lights, camera, notes)
         except EmergencyStop as exc:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
             report = getattr(exc, "self_test_report", None)
@@ -280,7 +282,7 @@ def _lamp_notes(rig) -> tuple[str, ...]:  # type: ignore[no-untyped-def]
 
 
 def camera_line(  # type: ignore[no-untyped-def]
-    rig, why_no_image: str = "", *, auto_exposure: bool = False
+    rig, why_no_image: str = "", *, auto_exposure: bool = False, test_shot: bool = False
 ) -> tuple[str, bool]:
     """Open and release the rig's camera, taking no image (after a lights' walk the lights are
     off; on a camera-triggered dome a shot would step it: ``why_no_image``): the line to print
@@ -290,10 +292,26 @@ def camera_line(  # type: ignore[no-untyped-def]
 
     What the camera could not establish at connect (``connect_notes``: a gphoto2 image format
     whose name does not tell whether it gives a RAW) is said after the line: left unsaid, a
-    check passed what the first shot might refuse."""
+    check passed what the first shot might refuse.
+
+    ``test_shot`` (the walk is over, nothing is stepped by a shot): a camera that can take a
+    test shot (``test_shot``, a tethered DSLR) takes one and decodes its RAW, once its
+    exposure is known to be one it takes. Why: a body whose RAW the installed LibRaw cannot
+    read passed the check and was refused at the session's first shot, its LED lit."""
+    shot: str | None = None
     try:
         rig.camera.connect()
         problem = _exposure_problem(rig, auto_exposure)
+        shoot = getattr(rig.camera, "test_shot", None) if test_shot else None
+        if problem is None and callable(shoot):
+            try:
+                shot = str(shoot())
+            except RtiRigError as exc:
+                return (
+                    f"camera: {rig.camera.name} connected, but FAILED its test shot: {exc}",
+                    False,
+                )
+        # after the shot: what it established (a RAW given) is no longer said to be unknown
         notes = getattr(rig.camera, "connect_notes", None)
         said = tuple(notes()) if callable(notes) else ()
     except RtiRigError as exc:
@@ -302,6 +320,8 @@ def camera_line(  # type: ignore[no-untyped-def]
         rig.camera.close()
     why = f": {why_no_image}" if why_no_image else ""
     unsure = "".join(f"; note: {n}" for n in said)
+    if shot is not None:
+        return f"camera: {rig.camera.name} connected ({shot}){unsure}", True
     if problem is not None:
         return (
             f"camera: {rig.camera.name} connected (no image taken{why}), but FAILED: "

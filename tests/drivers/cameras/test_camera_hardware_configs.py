@@ -453,7 +453,8 @@ def test_the_card_is_listed_for_a_run_only_and_said(body, tmp_path):
     assert result.exit_code == 0 and "RESULT: PASS" in result.output, result.output
     result = CliRunner().invoke(app, ["preview", str(config), "--out", str(tmp_path / "p")])
     assert result.exit_code == 0, result.output
-    assert "folder_list_folders" not in body.calls and body.shots == 1, body.calls
+    # the check's test shot (its RAW decoded) and the preview's: neither walks the card
+    assert "folder_list_folders" not in body.calls and body.shots == 2, body.calls
     result = run(str(config), "--out", str(tmp_path / "s"), "--lights", "2")
     said = " ".join(result.output.split())
     assert result.exit_code == 0, said
@@ -1155,22 +1156,30 @@ def test_a_camera_s_own_jpeg_format_is_refused_when_image_format_is_left(body, d
 
 def test_an_image_format_whose_name_cannot_be_judged_is_said_at_check(body, dome, tmp_path):
     """libgphoto2 names a code its table lacks "Unknown value 0007": whether it gives a RAW
-    is not known before a shot. `check` says so (never guessed), and the first shot still
-    refuses it when it gives none, naming the choices known to give RAW."""
+    is not known from its name (never guessed). `check`'s test shot tells: a format that gives
+    no RAW fails the check, naming the choices known to give RAW (it had passed with a note,
+    and the session's first shot refused it), as the first shot still does; one that gives a
+    RAW passes with nothing left unknown."""
     unknown = "Unknown value 0007"
     body.choices["imageformat"] = ["Large Fine JPEG", unknown, "RAW"]
     body.format_gives = {unknown: (False, True)}
     cfg = dslr_config(tmp_path, ('image_format = "RAW"', f'image_format = "{unknown}"'))
     result = CliRunner().invoke(app, ["check", str(cfg)])
     said = " ".join(result.output.split())
-    assert result.exit_code == 0 and "RESULT: PASS" in said, said
-    assert f"note: image_format = '{unknown}' in [camera.device]: libgphoto2's name" in said
-    assert "does not tell whether it gives a RAW file" in said, said
+    assert result.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert "camera: dslr connected, but FAILED its test shot" in said, said
+    assert "but no RAW file" in said and "RAW+JPEG) value: it offers ['RAW']" in said, said
+    assert body.shots == 1
     result = run(str(cfg), "--out", str(tmp_path / "s"), "--lights", "4")
     said = " ".join(result.output.split())
     assert result.exit_code == 2, said
     assert "but no RAW file" in said and "RAW+JPEG) value: it offers ['RAW']" in said, said
-    assert body.shots == 1
+    assert body.shots == 2
+    body.format_gives = {unknown: (True, False)}
+    result = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0 and "RESULT: PASS" in said, said
+    assert "its RAW" in said and "does not tell whether it gives a RAW" not in said, said
 
 
 def test_a_download_failed_from_the_camera_s_ram_says_the_shot_is_lost_and_resume_reshoots(

@@ -1,0 +1,78 @@
+"""`rti-rig check` on the shipped DSLR example (its dome firmware emulated on a pty,
+python-gphoto2 replaced at its API boundary by tests/fake_gphoto2.py) takes one test shot once
+the lights' walk is over and decodes its RAW.
+
+Why: the check took no image, so a body whose RAW the installed LibRaw cannot read (a body
+newer than it) passed it, and the session was refused at its first shot, its LED lit, the
+schedule begun.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+import rawpy
+from fake_gphoto2 import Body
+from test_dslr_download_disk_full import _config, _raw, _shot_with
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+LIBRAW = f"LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy {rawpy.__version__})"
+
+
+def _unreadable(body: Body) -> bytes:
+    """What a body newer than the installed LibRaw gives it: a file it cannot place."""
+    return b"FUTURE-RAW\x00" + bytes(4096)
+
+
+def test_a_raw_the_installed_libraw_cannot_read_fails_the_check_naming_its_version(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    cfg = _config(tmp_path, "Internal RAM")
+    body = Body(render=_unreadable)
+    r, said, lit_at_end = _shot_with(monkeypatch, cfg, body, ["check", str(cfg)])
+    assert r.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert "Traceback" not in said and lit_at_end is None, said
+    assert "lights are off" in said, said
+    assert body.shots == 1, said  # one test shot, after the walk
+    assert "camera: dslr connected, but FAILED its test shot" in said, said
+    assert "dslr (Canon EOS 600D on usb:001,005) gives RAW files the installed" in said, said
+    assert f"{LIBRAW} cannot read" in said, said
+    assert "pip install -U rawpy" in said and "Shooting JPEG is no way round it" in said, said
+
+
+@pytest.mark.parametrize("target", ["Internal RAM", "Memory card"])
+def test_a_readable_raw_passes_the_check_and_leaves_nothing_on_the_card(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, target: str
+) -> None:
+    cfg = _config(tmp_path, target)
+    body = Body(render=_raw)
+    r, said, lit_at_end = _shot_with(monkeypatch, cfg, body, ["check", str(cfg)])
+    assert r.exit_code == 0 and "RESULT: PASS" in said, said
+    assert lit_at_end is None and body.shots == 1, said
+    raw = "/IMG_0001.CR2" if target == "Internal RAM" else f"{body.card_dir()}/IMG_0001.CR2"
+    assert f"camera: dslr connected (one test shot: its RAW {raw} reads with the" in said, said
+    assert LIBRAW in said, said
+    assert body.card == {} and body.ram == {}, (body.card, body.ram)
+    if target == "Memory card":
+        assert body.deleted == ["IMG_0001.CR2"], body.deleted
+
+
+def test_a_test_shot_kept_on_the_card_is_said(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    cfg = _config(tmp_path, "Memory card")
+    text = cfg.read_text().replace(
+        "busy_retries = 6", "busy_retries = 6\ndelete_from_camera = false"
+    )
+    cfg.write_text(text)
+    body = Body(render=_raw)
+    r, said, _ = _shot_with(monkeypatch, cfg, body, ["check", str(cfg)])
+    assert r.exit_code == 0 and "RESULT: PASS" in said, said
+    assert "its file stays on the card: delete_from_camera = false" in said, said
+    assert list(body.card) == ["IMG_0001.CR2"] and body.deleted == [], body.card
