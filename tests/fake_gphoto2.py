@@ -145,6 +145,10 @@ class Body:
     #: ``fclose``, it returns as if all went well and leaves a truncated file
     disk_free_saves: int | None = None
     disk_free_bytes: int = 0
+    #: where the body writes its pictures whatever ``capturetarget`` reads back: "card" or
+    #: "ram" (None: as the setting says). Assumed, not from a cited source: a body with no
+    #: card in it keeps its captures in RAM, one that ignores the setting writes to its card
+    stores_in: str | None = None
     powered: bool = True
     off_at_shot: int | None = None  # switched off when asked for this shot (1-based)
     #: unplugged as the n-th (1-based) call of an op begins, as (op, n): ("file_get", 3) at
@@ -207,6 +211,8 @@ class Body:
         return [(self.model, self.port)] if self.detected is None else list(self.detected)
 
     def store(self) -> dict[str, bytes]:
+        if self.stores_in is not None:
+            return self.ram if self.stores_in == "ram" else self.card
         # a body without the setting (not every make has it in libgphoto2) shoots to its card
         return self.ram if self.config.get("capturetarget") == "Internal RAM" else self.card
 

@@ -209,6 +209,9 @@ class Gphoto2Camera:
         self._card_folders: set[str] | None = None
         #: files this session downloaded and left on the card (``delete_from_camera = false``)
         self._left_on_card = 0
+        #: (name, error code) of the card files whose delete after their download failed since
+        #: the last ``collect`` began: said as that shot's notice
+        self._undeleted: list[tuple[str, int | None]] = []
         self.retries_used = 0
         self.camera_model: str | None = None
         #: the USB port the camera was found on (``usb:001,005``), to name it in errors
@@ -704,7 +707,9 @@ class Gphoto2Camera:
         said = f"one test shot: its RAW {raw} reads with the installed {libraw_named()}"
         if self.settings.capture_target != "Internal RAM" and not self.settings.delete_from_camera:
             said += " (its file stays on the card: delete_from_camera = false)"
-        return said
+        # where it landed, and a card copy not deleted: said before any session, not after one
+        folder = raw.rsplit("/", 1)[0] or "/"
+        return "; ".join([said, *(f"note: {n}" for n in self._where_notices(folder))])
 
     def _unreadable_raw(self, exc: UnsupportedRawError) -> CaptureError:
         """The check's refusal of a body whose RAW the installed LibRaw cannot read: the
@@ -764,6 +769,7 @@ class Gphoto2Camera:
             strays.extend(self._unannounced(str(path.folder), files + late + strays, strays))
         except CameraGoneError as exc:  # gone while it announced the shot's files
             raise self._gone_at_download(exc, str(path.folder), str(path.name)) from exc
+        self._undeleted = []
         self._delete(late)  # a previous shot's file announced late: never this shot's
         self._count += 1
         raw_files = [f for f in files if is_camera_raw(Path(f[1]))]
@@ -835,6 +841,7 @@ class Gphoto2Camera:
         metadata = dict(decoded.metadata)
         camera_path = {n: f"{f.rstrip('/')}/{n}" for f, n in files}
         notices = list(metadata.get("notices") or [])
+        notices.extend(self._where_notices(str(path.folder)))
         if stray_saved:
             notices.append(
                 "the camera delivered a picture besides the shot's own file(s): one it took "
@@ -1070,7 +1077,9 @@ class Gphoto2Camera:
         what took it."""
         folder, name = camera_file
         on_camera = f"{folder.rstrip('/')}/{name}"
-        if self.settings.delete_from_camera:
+        if any(n == name for n, _ in self._undeleted):
+            copy = f"the camera's copy stays on its card at {on_camera} (its delete failed)"
+        elif self.settings.delete_from_camera:
             copy = "the camera's copy was deleted after the download, so this shot is lost"
         elif self.settings.capture_target == "Internal RAM":
             copy = (
@@ -1090,13 +1099,15 @@ class Gphoto2Camera:
             "decode",
         )
 
-    def _copy_said(self) -> str:
+    def _copy_said(self, name: str) -> str:
         """The camera's copy of a downloaded shot, as an error says it.
 
         Why: ``delete_from_camera = false`` leaves a copy on the card only: a capture to the
         camera's RAM (the shipped DSLR example's ``capture_target``) keeps none once it is
         downloaded, and had been said "the camera's copy kept" (and, of a download gone before
         its decode, "left on the camera at /IMG_0002.CR2")."""
+        if any(n == name for n, _ in self._undeleted):
+            return "still on the card (its delete there failed)"
         if self.settings.delete_from_camera:
             return "deleted"
         if self.settings.capture_target == "Internal RAM":
@@ -1116,7 +1127,7 @@ class Gphoto2Camera:
         return CaptureError(
             self.name,
             f"the camera's file {camera_name} would not decode; it is kept at {where}, the "
-            f"camera's copy {self._copy_said()}. "
+            f"camera's copy {self._copy_said(camera_name)}. "
             + (exc.problem if isinstance(exc, RawDecodeError) else exc.message),
             "decode",
         )
@@ -1357,14 +1368,67 @@ class Gphoto2Camera:
         )
 
     def _delete(self, files: list[tuple[str, str]]) -> None:
+        """Delete downloaded files on the camera (``delete_from_camera``); a card file whose
+        delete fails is remembered (:attr:`_undeleted`), to be said with the shot.
+
+        Why: every failed delete had been suppressed, for a RAM capture's object gone once
+        downloaded; on a card (locked, write-protected, or a body refusing deletes over USB)
+        the copy stayed there, filling it as the session went on, and nothing said so."""
         if not self.settings.delete_from_camera:
             self._left_on_card += len(files)
             return
         gp = self._gp
         for folder, name in files:
-            # files in camera RAM may vanish once downloaded
-            with contextlib.suppress(gp.GPhoto2Error):
+            try:
                 self._cam.file_delete(folder, name)
+            except gp.GPhoto2Error as exc:
+                if not _in_ram(folder):  # a RAM capture's object may vanish once downloaded
+                    self._undeleted.append((name, getattr(exc, "code", None)))
+
+    def _where_notices(self, folder: str) -> list[str]:
+        """What the shot's notices say of where the camera put it, when that is not where
+        ``capture_target`` asked, and of a card copy whose delete failed ([] else).
+
+        Why: the camera's folder was never compared with the target asked: a body that wrote
+        to its card with ``capture_target = "Internal RAM"`` filled a card the user thought
+        unused, and one that kept the shot in its RAM with the card asked (no card in it, or a
+        body ignoring the setting) left no copy on the card the user counted on as a backup.
+        Each text is the same for every shot, so the session says it once, with its count."""
+        s = self.settings
+        said: list[str] = []
+        if s.capture_target == "Internal RAM" and not _in_ram(folder):
+            fate = (
+                "each is deleted there once downloaded"
+                if s.delete_from_camera
+                else "each stays there (delete_from_camera = false)"
+            )
+            said.append(
+                f"the camera {self._device()} wrote its shots to its card ({folder.rstrip('/')}/)"
+                f", not to its RAM as capture_target = 'Internal RAM' asks: {fate}"
+            )
+        elif s.capture_target and s.capture_target != "Internal RAM" and _in_ram(folder):
+            said.append(
+                f"the camera {self._device()} kept its shots in its RAM, not on its card as "
+                f"capture_target = '{s.capture_target}' asks (no card in it, or a body that "
+                "ignores the setting): no copy of them stays on the card; the session's raw/ "
+                "holds the only one"
+            )
+        if self._undeleted:
+            codes = sorted({str(c) for _, c in self._undeleted})
+            said.append(
+                f"the camera's card copy of a shot could not be deleted there after its "
+                f"download (gphoto2 error {', '.join(codes)}: a locked or write-protected "
+                "card, or a body that refuses deletes over USB): it stays on the card, which "
+                "fills as the session goes on; the downloaded copy is kept whole. Free the "
+                "card, or set delete_from_camera = false in [camera.device] to stop trying"
+            )
+        return said
+
+
+def _in_ram(folder: str) -> bool:
+    """Whether a capture's folder is the camera's RAM: libgphoto2's PTP driver names a capture
+    kept there in ``/`` (``/capt0000.nef``), a card's in its storage (``/store_00020001/…``)."""
+    return folder.rstrip("/") == ""
 
 
 def _ram_number(name: str) -> int | None:
