@@ -1128,7 +1128,13 @@ class Gphoto2Camera:
             self.name,
             f"the camera's file {camera_name} would not decode; it is kept at {where}, the "
             f"camera's copy {self._copy_said(camera_name)}. "
-            + (exc.problem if isinstance(exc, RawDecodeError) else exc.message),
+            + (exc.problem if isinstance(exc, RawDecodeError) else exc.message)
+            + (
+                ". `rti-rig check` finds a RAW this LibRaw cannot read with a test shot, "
+                "before a session lights anything"
+                if isinstance(exc, UnsupportedRawError)
+                else ""
+            ),
             "decode",
         )
 

@@ -76,3 +76,22 @@ def test_a_test_shot_kept_on_the_card_is_said(
     assert r.exit_code == 0 and "RESULT: PASS" in said, said
     assert "its file stays on the card: delete_from_camera = false" in said, said
     assert list(body.card) == ["IMG_0001.CR2"] and body.deleted == [], body.card
+
+
+def test_a_run_refused_at_its_first_shot_for_an_unreadable_raw_points_to_the_check(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A session started without the check still meets it at its first shot: the refusal says
+    that the check finds it before anything is lit, and keeps the downloaded file."""
+    cfg = _config(tmp_path, "Internal RAM")
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch,
+        cfg,
+        Body(render=_unreadable),
+        ["run", str(cfg), "--out", str(out), "--lights", "2"],
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert f"{LIBRAW} does not read this file's format" in said, said
+    assert "`rti-rig check` finds a RAW this LibRaw cannot read with a test shot" in said, said
+    assert len(list((out / "raw" / ".incoming").glob("cap0001_IMG_0001.CR2"))) == 1
