@@ -209,9 +209,11 @@ class PlanRequest:
     seed: int = 0
     #: where ``preview_light`` came from: typed (given) or read from a record of the shot
     preview_light_origin: LightOrigin = LightOrigin.GIVEN
-    #: the elevation band was typed (``--min/--max-elevation-deg``), not the command's default:
-    #: an arm that cannot reach it all says so even of 0..90
-    elevation_band_given: bool = False
+    #: each bound of the elevation band was typed (``--min/--max-elevation-deg``), not the
+    #: command's default: an arm that cannot reach it all says so even of 0..90, naming only
+    #: the options typed
+    min_elevation_given: bool = False
+    max_elevation_given: bool = False
 
     def check(self) -> PlanMethod:
         """Refuse what cannot be planned, before any work; returns the method to plan with."""
@@ -336,7 +338,11 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
     band_note = None
     if isinstance(geometry, ArmGeometry):
         band_note = arm_band_note(
-            geometry, req.min_elevation_deg, req.max_elevation_deg, req.elevation_band_given
+            geometry,
+            req.min_elevation_deg,
+            req.max_elevation_deg,
+            min_given=req.min_elevation_given,
+            max_given=req.max_elevation_given,
         )
         geometry = arm_below(geometry, req.max_elevation_deg)
     candidates, starts = _candidates_and_starts(

@@ -103,7 +103,12 @@ def arm_below(arm: ArmGeometry, max_elevation_deg: float) -> ArmGeometry:
 
 
 def arm_band_note(
-    arm: ArmGeometry, min_elevation_deg: float, max_elevation_deg: float, given: bool = False
+    arm: ArmGeometry,
+    min_elevation_deg: float,
+    max_elevation_deg: float,
+    *,
+    min_given: bool = False,
+    max_given: bool = False,
 ) -> str | None:
     """What an elevation band asked for (``--min/--max-elevation-deg``) became on ``arm``,
     when part of it is beyond the arm's reach; None when the band is used as given (or not
@@ -111,9 +116,13 @@ def arm_band_note(
 
     Why: the layout was spread over the reachable part alone, silently: on an arm reaching
     75°, "--min-elevation-deg 70 --max-elevation-deg 90" gave lights between 70° and 75° and
-    nothing said the top 15° of the band had been cut. ``given``: the band was typed (either
-    option on the command line): "--max-elevation-deg 90" typed on that arm had been cut to 75°
-    in silence, as the default is."""
+    nothing said the top 15° of the band had been cut. ``min_given``/``max_given``: that bound
+    was typed (its option on the command line): "--max-elevation-deg 90" typed on that arm had
+    been cut to 75° in silence, as the default is. The note names the options typed only: it
+    had said "--min-elevation-deg 0 --max-elevation-deg 90" of "--max-elevation-deg 90" alone,
+    an option the user never gave. A bound not typed but not at its default (a caller's own
+    band) is named too."""
+    given = min_given or max_given
     if (min_elevation_deg, max_elevation_deg) == (0.0, 90.0) and not given:
         return None
     top = min(arm.max_elevation_deg, 90.0 - arm.keep_out_half_angle_deg)
@@ -121,7 +130,14 @@ def arm_band_note(
     hi = min(max_elevation_deg, top)
     if lo >= hi or (lo, hi) == (min_elevation_deg, max_elevation_deg):
         return None  # refused elsewhere (no band left), or used as asked
-    asked = f"--min-elevation-deg {min_elevation_deg:g} --max-elevation-deg {max_elevation_deg:g}"
+    asked = " ".join(
+        f"--{name}-elevation-deg {value:g}"
+        for name, value, typed, default in (
+            ("min", min_elevation_deg, min_given, 0.0),
+            ("max", max_elevation_deg, max_given, 90.0),
+        )
+        if typed or value != default
+    )
     return (
         f"{asked}: the arm reaches elevations {arm.min_elevation_deg:g}°..{top:g}° (its "
         f"elevation limits {arm.min_elevation_deg:g}°..{arm.max_elevation_deg:g}° and the "

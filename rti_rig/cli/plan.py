@@ -198,8 +198,8 @@ def plan(
             depth_model=depth_model,
             min_elevation_deg=min_elevation_deg,
             max_elevation_deg=max_elevation_deg,
-            elevation_band_given=option_given(ctx, "min_elevation_deg")
-            or option_given(ctx, "max_elevation_deg"),
+            min_elevation_given=option_given(ctx, "min_elevation_deg"),
+            max_elevation_given=option_given(ctx, "max_elevation_deg"),
             signal_noise=signal_noise,
             material=material,
             figure=figure,

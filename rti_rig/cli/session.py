@@ -291,8 +291,8 @@ def run(
                 plan=plan,
                 min_elevation_deg=min_elevation_deg,
                 max_elevation_deg=max_elevation_deg,
-                elevation_band_given=option_given(ctx, "min_elevation_deg")
-                or option_given(ctx, "max_elevation_deg"),
+                min_elevation_given=option_given(ctx, "min_elevation_deg"),
+                max_elevation_given=option_given(ctx, "max_elevation_deg"),
                 auto_exposure=auto_exposure,
                 **_metering_limit(max_saturated),
                 adaptive=adaptive,

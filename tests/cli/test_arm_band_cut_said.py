@@ -69,6 +69,22 @@ def test_an_explicit_full_band_beyond_reach_is_said_by_run_and_plan(tmp_path: Pa
         assert text.count(CUT) == 1, text
         assert "--max-elevation-deg 90: the arm reaches elevations 5°..80° (its elevation " in text
         assert "so the lights are spread over 5°..80° only" in text, text
+        # only what was typed: it had said "--min-elevation-deg 0 --max-elevation-deg 90"
+        assert "--min-elevation-deg" not in text, text
+
+
+def test_only_the_bound_typed_is_named_by_run_and_plan(tmp_path: Path) -> None:
+    """``--min-elevation-deg 2`` alone (below the arm's 5°) names that option, not a
+    ``--max-elevation-deg 90`` the user never typed."""
+    run = ["run", ARM, "--lights", "6", "--out", str(tmp_path / "s"), "--no-verdict"]
+    plan = ["plan", "--rig", ARM, "--lights", "8", "--out", str(tmp_path / "p.lp")]
+    for argv in (run, plan):
+        r = runner.invoke(app, [*argv, "--min-elevation-deg", "2"])
+        text = said(r)
+        assert r.exit_code == 0, text
+        assert text.count(CUT) == 1, text
+        assert "--min-elevation-deg 2: the arm reaches elevations 5°..80°" in text, text
+        assert "--max-elevation-deg" not in text, text
 
 
 def test_the_default_band_is_not_said_to_be_cut(tmp_path: Path) -> None:

@@ -68,8 +68,10 @@ class PlanLightsRequest:
     depth_model: Path | None = None
     min_elevation_deg: float = 0.0
     max_elevation_deg: float = 90.0
-    #: the band was typed, not defaulted: an arm that cannot reach it says so even of 0..90
-    elevation_band_given: bool = False
+    #: each bound of the band was typed, not defaulted: an arm that cannot reach the band says
+    #: so even of 0..90, naming only the options typed
+    min_elevation_given: bool = False
+    max_elevation_given: bool = False
     #: None: the rig config's ``[camera] signal_noise`` (0 for a bare ``.lp``).
     signal_noise: float | None = None
     material: str = "auto"
@@ -227,7 +229,8 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             depth_model=req.depth_model,
             min_elevation_deg=req.min_elevation_deg,
             max_elevation_deg=req.max_elevation_deg,
-            elevation_band_given=req.elevation_band_given,
+            min_elevation_given=req.min_elevation_given,
+            max_elevation_given=req.max_elevation_given,
             signal_noise=signal_noise,
             material=req.material,
             arm_order=arm_order,

@@ -65,8 +65,10 @@ class NewSessionRequest:
     plan: Path | None = None
     min_elevation_deg: float = 0.0
     max_elevation_deg: float = 90.0
-    #: the band was typed, not defaulted: an arm that cannot reach it says so even of 0..90
-    elevation_band_given: bool = False
+    #: each bound of the band was typed, not defaulted: an arm that cannot reach the band says
+    #: so even of 0..90, naming only the options typed
+    min_elevation_given: bool = False
+    max_elevation_given: bool = False
     auto_exposure: bool = False
     max_saturated: float = 0.001
     #: Choose each next light from the images so far (up to ``lights``; docs/adaptive.md).
@@ -1033,7 +1035,11 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     )
     if isinstance(geometry, ArmGeometry):  # a band beyond the arm's reach, cut: said once
         cut = arm_band_note(
-            geometry, req.min_elevation_deg, req.max_elevation_deg, req.elevation_band_given
+            geometry,
+            req.min_elevation_deg,
+            req.max_elevation_deg,
+            min_given=req.min_elevation_given,
+            max_given=req.max_elevation_given,
         )
         if cut is not None:
             on_note(Note(cut, "warning"))
