@@ -15,6 +15,7 @@ from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direc
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.planner.from_lp import SNAP_TOLERANCE_DEG
+from rti_rig.planner.uniform import arm_below
 
 #: Default preview light (degrees): top left of the image, as objects are conventionally lit,
 #: at the middle of the paper's 45–60° band.
@@ -60,6 +61,11 @@ def preview_schedule(
     option; a dome fires only an LED in the band, the nearest to the light asked for.
     """
     lo_band, hi_band = band
+    if isinstance(geometry, ArmGeometry):
+        # a ceiling at or below the arm's lowest elevation is refused naming the option, as
+        # run's and plan's layouts refuse it: the preview had blamed the light ("give a
+        # --light AZ,EL the arm can reach"), and any light the arm can reach is above the band
+        arm_below(geometry, hi_band)
     if az_el_deg is not None:
         az, el = az_el_deg
     else:  # the default direction, its elevation clamped into the band

@@ -40,3 +40,14 @@ def test_a_default_light_pushed_out_of_reach_by_the_band_says_so(tmp_path: Path)
     text = _refusal(tmp_path, "--min-elevation-deg", "85")
     assert "the default preview light (az 135°, el 85°): the arm cannot go there" in text, text
     assert "--min-elevation-deg / --max-elevation-deg" in text
+
+
+def test_a_ceiling_below_the_arm_is_refused_naming_the_option(tmp_path: Path) -> None:
+    """``--max-elevation-deg 3`` on an arm whose lowest elevation is 5° is refused as ``run``
+    and ``plan`` refuse it; the preview had blamed the light, and with ``--light`` had said to
+    give one the arm can reach, which the band then refused."""
+    run_said = "--max-elevation-deg 3 is at or below the arm's lowest elevation (5°): no light"
+    for light in ([], ["--light", "0,3"], ["--light", "0,20"]):
+        text = _refusal(tmp_path, "--max-elevation-deg", "3", *light)
+        assert run_said in text, text
+        assert "the arm cannot go there" not in text, text
