@@ -481,6 +481,25 @@ def test_ptm_normals_without_a_ptm_file(clean, tmp_path: Path) -> None:
     assert not (out / "fit.ptm").exists() and (out / "fit.rti").is_file()
     err = float(np.median(_angles(np.load(out / "normals.npy"), truth)))
     assert err < BOUNDS["ptm"]
+    # the model's line says no fit.ptm is written (it had said "Model: ptm: chosen by --model")
+    said = "fit.ptm not written (--no-ptm): the model is fitted for the normal maps only"
+    assert f"Model: ptm: chosen by --model; {said}" in " ".join(r.output.split()), r.output
+    assert said in json.loads((out / "fit.json").read_text())["why"]
+
+
+def test_a_model_not_written_is_said_on_its_line(clean, tmp_path: Path) -> None:
+    """`--model hsh1 --no-hsh`: no fit.rti, and the HSH gives no normal map: the model's line
+    says no file holds it (it named the HSH alone, as if written)."""
+    session, _, _ = clean
+    out = tmp_path / "out"
+    argv = ["fit", str(session), "--out", str(out), "--model", "hsh1", "--no-hsh", "--no-qa"]
+    r = runner.invoke(app, argv)
+    assert r.exit_code == 0, r.output
+    assert not (out / "fit.rti").exists()
+    text = " ".join(r.output.split())
+    assert "Model: hsh1: chosen by --model; fit.rti not written (--no-hsh): no file holds it" in (
+        text
+    ), r.output
 
 
 def test_the_fit_says_where_its_normals_come_from(tmp_path: Path) -> None:

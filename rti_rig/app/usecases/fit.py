@@ -1038,6 +1038,7 @@ def _fit_all(
             skipped.append(why)
     elif model_name in PHOTOMETRIC_STEREO:  # normals are the model: none, no fit
         _refuse_undetermined_normals(req, model_name, lights)
+    reason_line += _model_not_written(req, model_name, write_normals and normal_source == "ptm")
 
     # linear models to export, their solve matrices (warnings issued once, here)
     order, rti_why = rti_order(stack, lights, req, model_name, choice)
@@ -1219,6 +1220,22 @@ def hsh_evidence(stack: ImageStack, lights: np.ndarray) -> Any:
 #: The normal maps' estimator for the model a fit uses (``auto``'s choice or ``--model``): robust
 #: photometric stereo unless the model is least-squares PS, Lambert or the PTM.
 NORMALS_BY_MODEL = {"ps": "ps", "lambert": "lambert", "ptm": "ptm"}
+
+
+def _model_not_written(req: FitRequest, model_name: str, normals_from_it: bool) -> str:
+    """What becomes of the model used when its file is not asked for (``--no-ptm`` with a PTM,
+    ``--no-hsh`` with an HSH), appended to the model's line; "" when its file is written.
+
+    Why: ``fit --model ptm --no-ptm`` said "Model: ptm: chosen by --model" and wrote no
+    fit.ptm, leaving the user to look for the PTM it named."""
+    if model_name == "ptm" and not req.write_ptm:
+        file, option = "fit.ptm", "--no-ptm"
+    elif model_name.startswith("hsh") and not req.write_hsh:
+        file, option = "fit.rti", "--no-hsh"
+    else:
+        return ""
+    use = "the model is fitted for the normal maps only" if normals_from_it else "no file holds it"
+    return f"; {file} not written ({option}): {use}"
 
 
 def _normal_source(model_name: str) -> str:
