@@ -120,6 +120,25 @@ def _not_latched(name: str, value: str, got: str, key: str) -> str:
     )
 
 
+def _not_offered(name: str, value: str, key: str, choices: list[str]) -> str:
+    """Why ``value`` cannot be set on the camera's setting ``name``, and which key to change.
+
+    Why: a shutter speed had been answered "set shutter_config in [camera.device] to one of
+    them", the key that holds the setting's *name*; the speed is the camera's own, chosen for
+    ``[camera] exposure_s`` from the speeds it offered at connect, so only a mode dial moved
+    since (the speeds offered change with it) leaves it unoffered."""
+    if key == "shutter_config":
+        return (
+            f"shutter speed '{value}' (chosen for [camera] exposure_s from the speeds the camera "
+            f"offered at connect) is no longer offered for {name}; the camera offers {choices}: "
+            "put the camera back in manual (M) mode, then run the command again"
+        )
+    return (
+        f"'{value}' is not offered for {name} (settings key '{key}'); the camera offers "
+        f"{choices}: set {key} in [camera.device] to one of them, as the camera spells it"
+    )
+
+
 #: How a session's lost step is shot again unless the use case says otherwise (``preview``).
 SHOOT_AGAIN_BY_RESUME = "'rti-rig run --resume SESSION' shoots it again"
 
@@ -459,13 +478,7 @@ class Gphoto2Camera:
             widget = self._widget(config, name, key)
             choices = self._choices(widget)
             if choices and value not in choices:
-                raise DeviceError(
-                    self.name,
-                    f"'{value}' is not offered for {name} (settings "
-                    f"key '{key}'); the camera offers {choices}: set {key} in "
-                    "[camera.device] to one of them, as the camera spells it",
-                    f"set {name}",
-                )
+                raise DeviceError(self.name, _not_offered(name, value, key, choices), f"set {name}")
             widget.set_value(value)
         self._call("set_config", lambda: cam.set_config(config), DeviceError)
         check = self._call("get_config", cam.get_config, DeviceError)
@@ -495,10 +508,15 @@ class Gphoto2Camera:
             if secs is not None:
                 shutters.append((secs, label))
         if not shutters:
+            # the key and the section, and both ways out: it had asked "is the camera in
+            # manual (M) mode?" of a setting the config may have named wrongly
             raise DeviceError(
                 self.name,
-                f"'{s.shutter_config}' offers no timed shutter speeds: "
-                "is the camera in manual (M) mode?",
+                f"the camera's setting '{s.shutter_config}' (shutter_config in "
+                f"[camera.device]) offers no timed shutter speeds (it offers "
+                f"{self._choices(widget)}): put the camera in manual (M) mode; if "
+                f"'{s.shutter_config}' is not its shutter speed, set shutter_config in "
+                "[camera.device] to the name `gphoto2 --list-config` gives it",
                 "read shutter speeds",
             )
         self._shutters = sorted(shutters)

@@ -289,6 +289,35 @@ def test_exposure_not_offered_is_refused(tmp_path):
     assert "available_exposures_s" not in said
 
 
+def test_no_timed_shutter_speed_names_the_key_its_section_and_what_to_do(tmp_path):
+    """A body on Av/P or a wrong shutter_config offers no timed speed: the error names the
+    config key and section and both remedies (it had asked "is the camera in manual (M)
+    mode?" and named neither)."""
+    body = dslr()
+    body.choices["shutterspeed"] = ["bulb", "Auto"]
+    body.config["shutterspeed"] = "Auto"
+    with pytest.raises(DeviceError) as info:
+        camera(body, tmp_path).connect()
+    said = str(info.value)
+    assert "'shutterspeed' (shutter_config in [camera.device]) offers no timed" in said, said
+    assert "put the camera in manual (M) mode" in said, said
+    assert "set shutter_config in [camera.device] to the name `gphoto2 --list-config`" in said
+
+
+def test_a_shutter_speed_no_longer_offered_names_exposure_s_not_shutter_config(tmp_path):
+    """The speeds are read at connect; a mode dial moved since takes one away. The error had
+    said to set shutter_config (the key of the setting's *name*) to a speed."""
+    body = dslr()
+    with camera(body, tmp_path) as cam:
+        body.choices["shutterspeed"] = [s for s in SHUTTERS if s != "1/8"]
+        with pytest.raises(DeviceError) as info:
+            cam.capture(0.125)
+    said = str(info.value)
+    assert "shutter speed '1/8' (chosen for [camera] exposure_s" in said, said
+    assert "put the camera back in manual (M) mode" in said, said
+    assert "set shutter_config" not in said, said
+
+
 def test_unknown_config_name_points_to_list_config(tmp_path):
     with pytest.raises(DeviceError, match="list-config"):
         camera(dslr(), tmp_path, aperture="8", aperture_config="f-number").connect()
