@@ -9,8 +9,13 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import pytest
+from dxl_support import arm_settings
 
 from rti_rig.app.usecases.check import WithCamera, _lamp_notes
+from rti_rig.core.clock import VirtualClock
+from rti_rig.drivers.dynamixel.arm import DynamixelArm
+from rti_rig.runtime.lighting import ArmLighting
+from rti_rig.simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
 
 
 class _Report:
@@ -21,9 +26,14 @@ class _Report:
 
 
 def _rig(backend: str, lamp: str) -> SimpleNamespace:
-    carrier = SimpleNamespace(settings=SimpleNamespace(lamp=lamp))
+    """A rig whose lighting is a Dynamixel arm (on emulated servos) with ``lamp``: the note is
+    asked of the arm's declared type, so a bare namespace with a ``settings.lamp`` is none."""
+    overrides = {"lamp": lamp, "lamp_servo_id": 2} if lamp == "servo_led" else {"lamp": lamp}
+    settings = arm_settings(**overrides)
+    clock = VirtualClock()
+    arm = DynamixelArm(settings, InProcessPort(emulator_for_arm(settings, clock)), clock)
     return SimpleNamespace(
-        lighting=SimpleNamespace(carrier=carrier),
+        lighting=ArmLighting(arm),
         loaded=SimpleNamespace(config=SimpleNamespace(backend=backend)),
     )
 
@@ -41,3 +51,14 @@ def test_a_real_arm_with_a_software_lamp_is_told_no_flash_reached_it() -> None:
 @pytest.mark.parametrize(("backend", "lamp"), [("hardware", "servo_led"), ("emulated", "software")])
 def test_a_lamp_the_rig_switches_or_simulates_needs_no_note(backend: str, lamp: str) -> None:
     assert _lamp_notes(_rig(backend, lamp)) == ()
+
+
+def test_a_simulated_arm_needs_no_note(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """The shipped virtual arm's lamp is the simulation's: no note, on any backend."""
+    from conftest import CONFIGS
+
+    from rti_rig.app.compose import build_rig
+    from rti_rig.app.config import load_rig_config
+
+    rig = build_rig(load_rig_config(CONFIGS / "virtual_arm.toml"))
+    assert _lamp_notes(rig) == ()

@@ -17,7 +17,7 @@ from typing import Any
 
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
-from rti_rig.app.usecases.safe_state import lights_state
+from rti_rig.app.usecases.safe_state import lights_state, software_lamp
 from rti_rig.core.acquisition_images import AcquisitionImagesError
 from rti_rig.core.errors import DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry
@@ -246,15 +246,18 @@ def reboot_faulted(rig_config: Path, on_start: Callable[[], None] | None = None)
         )
     if on_start is not None:
         on_start()
+    from rti_rig.drivers.dynamixel.arm import DynamixelArm
+
     with build_rig(loaded) as rig:
-        carrier = getattr(rig.lighting, "carrier", None)
-        reboot = getattr(carrier, "reboot_faulted", None)
-        if reboot is None:
+        # asked of the type: a getattr had answered "none" for a misspelt name as for an arm
+        # that has no Dynamixel servos
+        carrier = rig.lighting.carrier if isinstance(rig.lighting, ArmLighting) else None
+        if not isinstance(carrier, DynamixelArm):
             raise RtiRigError(
                 f"{rig_config}: --reboot-faulted needs an arm on Dynamixel servos; this rig's "
                 "arm has none"
             )
-        return RebootReport(tuple(reboot()), rig_config)
+        return RebootReport(tuple(carrier.reboot_faulted()), rig_config)
 
 
 def config_note_lines(loaded: Any) -> tuple[str, ...]:
@@ -271,8 +274,7 @@ def _lamp_notes(rig) -> tuple[str, ...]:  # type: ignore[no-untyped-def]
     """What the arm check says of a lamp it cannot switch: a real arm's lamp whose switch is
     outside the servo bus (``lamp = "software"``, the default). The check is said to flash the
     lamp at each pose, and a user watching a lamp that never lit was told nothing of why."""
-    lamp = getattr(getattr(rig.lighting.carrier, "settings", None), "lamp", None)
-    if lamp != "software" or rig.loaded.config.backend != "hardware":
+    if not software_lamp(rig.lighting) or rig.loaded.config.backend != "hardware":
         return ()
     return (
         'lamp: not switched by rti-rig (lamp = "software" in [arm.dynamixel]: its switch is '

@@ -17,6 +17,18 @@ from rti_rig.runtime.flash_sync import CameraTriggeredLighting
 from rti_rig.runtime.lighting import ArmLighting, DomeLighting
 
 
+def software_lamp(lighting: object) -> bool:
+    """Whether ``lighting`` is an arm whose lamp no command of rti-rig reaches (``lamp =
+    "software"`` on a Dynamixel arm: its switch is outside the servo bus).
+
+    Asked of the arm's declared type (:class:`~rti_rig.core.devices.ReadBackCarrier`, whose
+    ``lamp_servo`` is None for such a lamp), where a ``getattr`` chain on ``settings.lamp`` had
+    answered "not software" for any carrier that renamed or lacked it. A simulated arm
+    declares no read-back: its lamp is the simulation's, switched."""
+    read_back = lighting.read_back if isinstance(lighting, ArmLighting) else None
+    return read_back is not None and read_back.lamp_servo() is None
+
+
 def lights_state(  # type: ignore[no-untyped-def]
     rig, teardown_failed: bool = False, *, end: ArmEnd | None = None
 ) -> str:
@@ -44,8 +56,7 @@ def lights_state(  # type: ignore[no-untyped-def]
     if unreached is not None:
         return unreached
     after = " (see the teardown problems above)" if teardown_failed else ""
-    lamp = getattr(getattr(carrier, "settings", None), "lamp", None)
-    if lamp == "software" and getattr(rig.loaded.config, "backend", None) == "hardware":
+    if software_lamp(lighting) and getattr(rig.loaded.config, "backend", None) == "hardware":
         # the lamp's own switch is outside the servo bus: its "off" is a flag in the driver,
         # and "lamp off ... requested" had told a user at a real arm that it was switched
         said = (
