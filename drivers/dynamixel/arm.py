@@ -152,8 +152,8 @@ class DynamixelArm(ReadBackCarrier):
             port, settings.name, packet_handler, config=config_path, power_cycle=power_cycle
         )
         self._connected = False
-        #: whether a connect ever completed (what a stop may say of an arm it never reached)
-        self.ever_connected = False
+        #: whether a connect ever completed (:attr:`ever_connected`)
+        self._ever_connected = False
         self._lamp_on = False
         self._emergency_stopped = False
         #: ``release_on_close`` sent the torque-off at the last close (see
@@ -176,6 +176,11 @@ class DynamixelArm(ReadBackCarrier):
         self._say: Callable[[str], None] | None = None
         #: Every line said through :meth:`_tell`, in order (what the user was told).
         self.said: list[str] = []
+
+    @property
+    def ever_connected(self) -> bool:
+        """Whether a connect ever completed (what a stop may say of an arm it never reached)."""
+        return self._ever_connected
 
     @property
     def commanded(self) -> bool:
@@ -215,7 +220,7 @@ class DynamixelArm(ReadBackCarrier):
         except BaseException:
             self._bus.close()
             raise
-        self._connected = self.ever_connected = True
+        self._connected = self._ever_connected = True
         self.torque_released = False
         self._torque_after_release = ([], [])
         self._torque_at_close = None

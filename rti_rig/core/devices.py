@@ -196,6 +196,23 @@ class ReadBackCarrier(Protocol):
         """The id of the servo whose LED output the lamp hangs on, whose writes the servo
         answers (None: the lamp's switch is outside the bus, and no command reaches it)."""
 
+    @property
+    @abstractmethod
+    def ever_connected(self) -> bool:
+        """Whether a connect ever completed: what a stop may say of an arm it never reached."""
+
+    @property
+    @abstractmethod
+    def commanded(self) -> bool:
+        """Whether anything was ever written to a servo: an arm whose connect failed after its
+        first write may hold under torque, so nothing may be said to have been commanded."""
+
+    @property
+    @abstractmethod
+    def driven(self) -> bool:
+        """Whether anything that could leave a servo driven was ever sent (any write but a
+        torque-off or an EEPROM write)."""
+
     @abstractmethod
     def check_held(self) -> None:
         """Raise unless the arm still holds, fault-free, the pose its last move reached."""

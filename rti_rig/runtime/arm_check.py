@@ -214,12 +214,20 @@ def not_connected_sentence(carrier: object, connected: bool | None = None) -> st
     ``connected``: known by the caller, else the carrier's ``ever_connected``). Nothing was
     commanded if nothing was ever written to a servo; nothing driven if only torque-off and
     EEPROM writes went out (:attr:`DynamixelArm.driven`); a connect that failed after another
-    write (profiles, a goal, torque on) may have left a servo holding under torque."""
-    if getattr(carrier, "ever_connected", True) if connected is None else connected:
+    write (profiles, a goal, torque on) may have left a servo holding under torque.
+
+    Asked of the carrier's declared type (:class:`ReadBackCarrier`), where ``getattr`` had
+    answered "connected" for a misspelt name; a carrier that declares none (the simulated
+    arm, connected in process) is taken as connected unless the caller knows otherwise, and
+    then as commanded and driven: nothing less may be said of it."""
+    read_back = carrier if isinstance(carrier, ReadBackCarrier) else None
+    if connected is None:
+        connected = read_back is None or read_back.ever_connected
+    if connected:
         return None
-    if getattr(carrier, "commanded", True) is False:
+    if read_back is not None and not read_back.commanded:
         return "nothing was commanded: the arm could not be connected"
-    if getattr(carrier, "driven", True) is False:
+    if read_back is not None and not read_back.driven:
         # only torque-off and EEPROM writes went out (the position limits a first connect
         # writes): "a servo may be holding under torque" had been said beside a refusal that
         # had just read every servo's torque off

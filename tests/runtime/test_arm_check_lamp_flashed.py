@@ -51,6 +51,7 @@ class _LedArm(ReadBackCarrier):
 
     name = "arm"
     park_pose_deg = (0.0, 45.0)
+    ever_connected = commanded = driven = True  # connected in process, as an arm that answers
 
     def __init__(self, fail_at: int | None) -> None:
         self.fail_at = fail_at
