@@ -677,7 +677,7 @@ def run_session(
     seen = recorded_frame_size(folder.manifest, cam.width, cam.height)
     if seen is not None and rig.size_from_frame is not None:  # a resume: its camera's real size
         per_image = rig.size_from_frame(*seen)[2]
-    sure = total if source is None else getattr(source, "sure_total", total)
+    sure = total if source is None else source.sure_total  # declared by StepSource
     check_free_space(
         folder.root, steps_to_hold(total, len(done), sure), per_image, holds_images=bool(done)
     )

@@ -1670,24 +1670,25 @@ def _failed_off(exc: DomeLinkError) -> OffReport:
     return OffReport(OffOutcome.SENT_UNCONFIRMED, f"{exc.fault}: {exc.message}")
 
 
-def lights_state_sentence(source: object) -> str:
-    """What is known about a light source's lights after it was closed (for messages).
+def lights_state_sentence(source: DomePolicy) -> str:
+    """What is known about a dome's lights after it was closed (for messages).
 
     A source that never began a connect (``reached`` None: a refusal of ``--out`` or the disk
     came first) never opened its port, so nothing can be lit by it: it had been told to "check
-    the dome's lights" beside the refusal."""
-    report = getattr(source, "off_report", None)
+    the dome's lights" beside the refusal. Its record is read by name (every caller holds a
+    :class:`DomePolicy`): ``getattr`` probes had answered "never reached" for a misspelt one."""
+    report = source.off_report
     if report is None:
-        if getattr(source, "reached", "") is None:
+        if source.reached is None:
             return "nothing was lit: the dome's port was never opened"
         return "no all-off was attempted (the dome was never reached): check the dome's lights"
     sentence = str(report.sentence())
-    window = getattr(source, "came_back_after_give_up", None)
+    window = source.came_back_after_give_up
     if window is not None:
         sentence += (
             f" (the dome came back after the reconnection gave up: its USB link was away longer "
             f"than the {window:.1f} s of reconnection attempts; check the USB cable, the hub and "
-            f"the dome's power, or {source._window_keys()})"  # type: ignore[attr-defined]
+            f"the dome's power, or {source._window_keys()})"
         )
     return sentence
 
