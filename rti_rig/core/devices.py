@@ -138,6 +138,16 @@ class LightCarrier(Protocol):
         raise :class:`~rti_rig.core.errors.MoveCancelled` (a stop during the teardown)."""
         ...
 
+    @property
+    def park_pose_deg(self) -> tuple[float, float]:
+        """(azimuth, elevation) of the park pose: what a read-back position is compared to."""
+        ...
+
+    def reached_direction(self) -> NDArray[np.float64]:
+        """The lamp's direction as read back from the joints now (may raise: a silent or
+        faulted servo). Where the teardown says the arm was left (``runtime.arm_end``)."""
+        ...
+
 
 @dataclass(frozen=True)
 class TorqueAtClose:

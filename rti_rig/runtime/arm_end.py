@@ -15,6 +15,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from rti_rig.core.devices import LightCarrier
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 
 #: A read-back position this close to the park pose (degrees, great circle) is "parked": the
@@ -100,13 +101,13 @@ class ArmEnd:
         return f"the arm's park is NOT confirmed: {self.why}{where}"
 
 
-def read_pose(carrier: object) -> tuple[float, float] | str:
-    """(azimuth, elevation) in degrees read back from ``carrier``, or why it could not be."""
-    read = getattr(carrier, "reached_direction", None)
-    if read is None:
-        return "this arm cannot report its position"
+def read_pose(carrier: LightCarrier) -> tuple[float, float] | str:
+    """(azimuth, elevation) in degrees read back from ``carrier``, or why it could not be.
+
+    Asked by name (:class:`LightCarrier` declares it; both arms have it), where a ``getattr``
+    had answered "this arm cannot report its position" for a misspelt name."""
     try:
-        direction = np.asarray(read(), dtype=np.float64)
+        direction = np.asarray(carrier.reached_direction(), dtype=np.float64)
     except Exception as exc:  # a silent or faulted servo: said, not raised in a teardown
         return f"its position could not be read back ({exc})"
     az, el = az_el_from_direction(direction)
@@ -114,7 +115,7 @@ def read_pose(carrier: object) -> tuple[float, float] | str:
     return (az_f - 360.0 if az_f >= 180.0 else az_f), float(el)
 
 
-def park_end(carrier: object, failure: str | None) -> ArmEnd:
+def park_end(carrier: LightCarrier, failure: str | None) -> ArmEnd:
     """The end of a park that was commanded (``failure``: its error, None if it returned)."""
     pose = read_pose(carrier)
     at = (None, None) if isinstance(pose, str) else pose
@@ -122,9 +123,7 @@ def park_end(carrier: object, failure: str | None) -> ArmEnd:
         return ArmEnd("park-unconfirmed", *at, f"the park failed ({failure})")
     if isinstance(pose, str):
         return ArmEnd("park-unconfirmed", None, None, pose)
-    park = getattr(carrier, "park_pose_deg", None)
-    if park is None:
-        return ArmEnd("park-unconfirmed", *pose, "this arm does not say its park pose")
+    park = carrier.park_pose_deg
     park_az, park_el = park
     off = float(angle_between_deg(direction_from_az_el(*pose), direction_from_az_el(*park)))
     if off > PARK_TOLERANCE_DEG:
@@ -136,7 +135,7 @@ def park_end(carrier: object, failure: str | None) -> ArmEnd:
     return ArmEnd("parked", *pose)
 
 
-def left_end(carrier: object, why: str) -> ArmEnd:
+def left_end(carrier: LightCarrier, why: str) -> ArmEnd:
     """The end of an arm not parked by policy (``why``: which policy)."""
     pose = read_pose(carrier)
     if isinstance(pose, str):
