@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core.clock import Clock
+from rti_rig.core.device_said import say_or_log
 from rti_rig.core.devices import ReadBackCarrier, TorqueAtClose
 from rti_rig.core.errors import MoveCancelled
 from rti_rig.core.geometry import az_el_from_direction
@@ -683,10 +684,7 @@ class DynamixelArm(ReadBackCarrier):
         """Say ``text`` once, through the listener, or as a warning record with none (never
         lost); kept in :attr:`said`."""
         self.said.append(text)
-        if self._say is not None:
-            self._say(text)
-        else:
-            log.warning("%s", text)
+        say_or_log(text, self._say, log)
 
     def resends(self) -> tuple[list[str], str | None]:
         """The commands sent once more after a lost or damaged status packet that then got

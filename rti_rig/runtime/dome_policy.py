@@ -40,6 +40,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.clock import Clock, VirtualClock
 from rti_rig.core.deferred_signals import after_a_stop, signals_deferred
+from rti_rig.core.device_said import say_or_log
 from rti_rig.core.devices import DiscreteLightSource
 from rti_rig.core.dome_link import (
     DomeInfo,
@@ -333,8 +334,9 @@ class DomePolicy:
         self._say = say
 
     def _tell(self, text: str) -> None:
-        if self._say is not None:
-            self._say(text)
+        """Say ``text`` through the listener, or as a warning record with none (it had been
+        dropped: a reopening said to no listener reached no one)."""
+        say_or_log(text, self._say, log)
 
     def _goes_on(self) -> str:
         if self._ending:

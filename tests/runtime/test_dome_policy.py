@@ -7,6 +7,7 @@ Every check compares with the emulator's truth (``firmware.lit``: the LED really
 from __future__ import annotations
 
 import itertools
+import logging
 
 import numpy as np
 import pytest
@@ -1067,3 +1068,19 @@ def test_a_listener_set_during_the_teardown_keeps_its_all_off_said_as_the_closin
     assert "goes on once it is back" not in text, said
     assert dome.stats.reconnects == 1
     assert fw.lit is None
+
+
+def test_a_reopening_said_with_no_listener_is_a_warning_record_not_lost(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """With no listener the dome's reopening had been dropped (its ``_tell`` said nothing);
+    it is a warning record, as the arm's is, which the command line says as a note."""
+    dome, _fw, _clock = make("default", [Fault(5, FaultKind.DISCONNECT, delay_s=0.5)])
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    with caplog.at_level(logging.WARNING, logger="rti_rig.dome"):
+        dome.all_off()  # command 5: its port lost, reopened, the all-off sent again
+    said = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+    assert any("goes on once it is back" in text for text in said), said
+    assert dome.stats.reconnects == 1
