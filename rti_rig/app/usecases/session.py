@@ -304,21 +304,25 @@ class RigChangedError(RtiRigError):
     """A resume was asked on a rig whose images would not match the session's."""
 
 
-def check_light_count(n: int) -> None:
+def check_light_count(n: int, asked: str | None = None, way_out: str = "") -> None:
     """Refuse a light count no session can run, before any layout is built, on every rig
-    (the planner names a dome's own limit, its LED count)."""
+    (the planner names a dome's own limit, its LED count).
+
+    ``asked`` says where ``n`` came from when no ``--lights`` gave it (a plan's lines, every
+    image of a recorded acquisition), ``way_out`` what to do then. Why: a dense acquisition
+    of 1100 images replayed without ``--lights`` had been told "--lights 1100: at most 1000",
+    of an option never given, and not how to run it at all."""
     from rti_rig.core.lp_format import MAX_LIGHTS
 
+    said = asked or f"--lights {n}"
     if n < 1:
         from rti_rig.app.usecases.fit_outlook import fit_needs
 
-        raise RtiRigError(
-            f"--lights {n}: give at least 1 light (1 or 2 make a test shot; {fit_needs()})"
-        )
+        raise RtiRigError(f"{said}: give at least 1 light (1 or 2 make a test shot; {fit_needs()})")
     if n > MAX_LIGHTS:
         raise RtiRigError(
-            f"--lights {n}: at most {MAX_LIGHTS} lights per session (the most an .lp file may "
-            "list for readers such as relight)"
+            f"{said}: at most {MAX_LIGHTS} lights per session (the most an .lp file may "
+            "list for readers such as relight)" + (f"; {way_out}" if way_out else "")
         )
 
 
@@ -982,7 +986,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     from rti_rig.app.compose import arm_order_for
     from rti_rig.app.config import rig_geometry
     from rti_rig.app.normals_determined import band_advice
-    from rti_rig.core.lp_format import read_lp
+    from rti_rig.core.lp_format import MAX_LIGHTS, read_lp
     from rti_rig.core.rig_geometry import ArmGeometry
     from rti_rig.planner.from_lp import schedule_from_lp
     from rti_rig.planner.make_plan import check_elevation_band
@@ -997,7 +1001,11 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         entries = read_lp(req.plan, upper_hemisphere=True, notes=plan_notes, wanted=PLAN_WANTED)
         for note in plan_notes:
             on_note(Note(note, "warning"))
-        check_light_count(len(entries))
+        check_light_count(
+            len(entries),
+            f"--plan {req.plan} lists {len(entries)} lights",
+            f"split it into plans of at most {MAX_LIGHTS} lights, each run into its own --out",
+        )
         schedule = schedule_from_lp(entries, geometry, str(req.plan))
         _check_determined(
             req,
@@ -1010,7 +1018,19 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         return _asked_for(schedule, req)
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     n = req.lights if req.lights is not None else default_lights(loaded, geometry)
-    check_light_count(n)
+    if req.lights is not None:
+        check_light_count(n)
+    else:
+        every = (
+            f"every image of the acquisition {loaded.path}"
+            if loaded.config.backend == "replay"
+            else f"the rig's default, from {loaded.path}"
+        )
+        check_light_count(
+            n,
+            f"{n} lights ({every})",
+            f"give --lights N, at most {MAX_LIGHTS}, to run N of them spread over the directions",
+        )
     if loaded.config.backend == "replay":  # its "LEDs" are images, in the band or not
         # (with --min/--max-elevation-deg the planner's refusal had said "the dome has only
         # 8 LEDs at or above 50° elevation" of an acquisition's images)
