@@ -31,6 +31,7 @@ averaged to grey, and shrunk to at most ``MAX_PX`` wide for speed.
 
 from __future__ import annotations
 
+import shlex
 import time
 from collections.abc import Callable
 from itertools import pairwise
@@ -388,7 +389,9 @@ def bench_from(
     ``--force`` when the folder's files were replaced with it)."""
     t0 = time.perf_counter()
     rows, held = run_tradeoff_from(lp, progress)
-    command = f"rti-rig bench tradeoff --from {lp}"
+    # quoted as a shell reads it: an archive's folder with a space (``Tablet 3/dirs.lp``) had
+    # been written bare, a command that fails when copied from summary.md
+    command = f"rti-rig bench tradeoff --from {shlex.quote(str(lp))}"
     if out_dir is None:
         return summarise_from(rows, time.perf_counter() - t0, command, held)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -396,7 +399,7 @@ def bench_from(
     for path in plot(rows, out_dir):
         if "arm_time" in path.name:  # a replayed acquisition is a dome: no arm time to plot
             path.unlink()
-    command += f" --out {out_dir}" + (" --force" if force else "")
+    command += f" --out {shlex.quote(str(out_dir))}" + (" --force" if force else "")
     text = summarise_from(rows, time.perf_counter() - t0, command, held)
     (out_dir / "summary.md").write_text(text + "\n", encoding="utf-8")
     return text

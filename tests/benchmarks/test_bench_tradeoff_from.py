@@ -17,8 +17,15 @@ ACQ = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay" / "dirs.
 
 
 def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
-    out = tmp_path / "trade"
-    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out)])
+    import re
+    import shlex
+    import shutil
+
+    # in folders with spaces, as an archive's are (``Tablet 3/dirs.lp``)
+    acq = tmp_path / "Tablet 3" / "dirs.lp"
+    shutil.copytree(ACQ.parent, acq.parent)
+    out = tmp_path / "trade off"
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(acq), "--out", str(out)])
     assert r.exit_code == 0, r.output
     rows = list(csv.DictReader((out / "results.csv").open()))
     counts = sorted({int(row["n"]) for row in rows})
@@ -41,6 +48,14 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
     assert not list(out.glob("*arm_time*"))
     text = (out / "summary.md").read_text()
     assert "--from" in text and "adaptive" in text
+    # its command line, pasted into a shell, names the same acquisition and --out (it had
+    # written the paths bare, a command that fails where a folder's name has a space)
+    found = re.search(r"Command: `([^`]*)`", text)
+    assert found is not None
+    words = shlex.split(found.group(1))
+    assert words[:3] == ["rti-rig", "bench", "tradeoff"], words
+    assert words[words.index("--from") + 1] == str(acq)
+    assert words[words.index("--out") + 1] == str(out)
     assert "on the same 3 held-out lights for every plan" in text
     # and what the user opens: the fit.rti `rti-rig fit` would write, on the same lights
     assert "**Relighting as `rti-rig fit` writes it**" in text
