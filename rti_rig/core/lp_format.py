@@ -249,33 +249,60 @@ def image_paths(lp_path: Path, entries: Sequence[LpEntry]) -> list[Path]:
 
 def case_hint(missing: Sequence[Path]) -> str:
     """What to say of images not found whose folder holds a file of the same name in another
-    case (``image01.JPG`` listed, ``image01.jpg`` there): "" when none does.
+    case (``image01.JPG`` listed, ``image01.jpg`` there), or of the same name with another
+    image extension (``image01.jpg`` listed, ``image01.jpeg`` or ``image01.JPEG`` there): ""
+    when none does.
 
     Windows and macOS find such a file, so an `.lp` written there reads there; Linux tells
     the two names apart (and a FAT card mounted with ``shortname=lower`` shows a camera's
     ``IMG_0001.JPG`` as ``img_0001.jpg``). The file is not read in its place — which of two
     names differing only in case is meant is not ours to guess — but named, since "missing"
-    of a file the user sees in the folder is no help."""
-    listings: dict[Path, dict[str, list[str]]] = {}
+    of a file the user sees in the folder is no help. Likewise another extension: an `.lp`
+    written for the camera's files (``.tif``, ``.CR2``) beside the JPEGs exported from them,
+    or an export that wrote ``.jpeg``, had been told to "copy them where their names point",
+    beside the very files; a file of another kind is never read as the one named (a RAW and
+    its JPEG are not the same data), only named."""
+    twins, kin = _name_twins(missing)
+    return _twins_said(twins, len(missing)) + _kin_said(kin, len(missing))
+
+
+def _name_twins(missing: Sequence[Path]) -> tuple[list[str], list[str]]:
+    """The files :func:`case_hint` names, as ``"listed -> there"``: those differing only in
+    upper/lower case, and those with the same name and another image extension."""
+    listings: dict[Path, tuple[dict[str, list[str]], dict[str, list[str]]]] = {}
     twins: list[str] = []
+    kin: list[str] = []
     for path in missing:
         folder = path.parent
         if folder not in listings:
             by_case: dict[str, list[str]] = {}
+            by_stem: dict[str, list[str]] = {}
             with contextlib.suppress(OSError):
-                for child in folder.iterdir():
+                for child in sorted(folder.iterdir()):
                     by_case.setdefault(child.name.casefold(), []).append(child.name)
-            listings[folder] = by_case
-        found = listings[folder].get(path.name.casefold(), [])
+                    if child.suffix.lower() in _IMAGE_ENDINGS and child.is_file():
+                        by_stem.setdefault(child.stem.casefold(), []).append(child.name)
+            listings[folder] = (by_case, by_stem)
+        by_case, by_stem = listings[folder]
+        found = by_case.get(path.name.casefold(), [])
         if found:
             twins.append(f"{path.name} -> {found[0]}")
+            continue
+        other = [n for n in by_stem.get(path.stem.casefold(), []) if n != path.name]
+        if other:
+            kin.append(f"{path.name} -> {other[0]}")
+    return twins, kin
+
+
+def _twins_said(twins: list[str], missing: int) -> str:
+    """:func:`case_hint`'s clause for names that differ only in upper/lower case."""
     if not twins:
         return ""
     why = (
         ": Windows and macOS ignore the case of file names, this system does not; rename the "
         "files or correct the names in the .lp"
     )
-    if len(missing) == 1:
+    if missing == 1:
         return (
             f"; {twins[0].split(' -> ')[1]} is there, the same name in other upper/lower case{why}"
         )
@@ -283,6 +310,23 @@ def case_hint(missing: Sequence[Path]) -> str:
     return (
         f"; {len(twins)} of them differ only in upper/lower case from a file there "
         f"({', '.join(twins[:3])}{more}){why}"
+    )
+
+
+def _kin_said(kin: list[str], missing: int) -> str:
+    """:func:`case_hint`'s clause for names whose file is there with another extension."""
+    if not kin:
+        return ""
+    why = (
+        ": an image is read only by the name the .lp gives it; rename the files or correct "
+        "the names in the .lp"
+    )
+    if missing == 1:
+        return f"; {kin[0].split(' -> ')[1]} is there, the same name with another extension{why}"
+    more = f" and {len(kin) - 3} more" if len(kin) > 3 else ""
+    are = "is" if len(kin) == 1 else "are"
+    return (
+        f"; {len(kin)} of them {are} there with another extension ({', '.join(kin[:3])}{more}){why}"
     )
 
 
@@ -342,7 +386,12 @@ def missing_images_advice(
         # been left out, the quotes' edit alone offered for every image)
         tail = others if len(names) < total else ""
         quoted += f"; for the other {rest} not found, {copy}{tail}"
-    return ("; " + where if absolute else "") + (case_hint(paths) or quoted or plain)
+    named = case_hint(paths)
+    if named and (rest := len(names) - sum(map(len, _name_twins(paths)))):
+        # the images with no such file are missing all the same: their way out is said too
+        tail = others if len(names) < total else ""
+        named += f"; for the other {rest} not found, {copy}{tail}"
+    return ("; " + where if absolute else "") + (named or quoted or plain)
 
 
 def quote_hint(names: Sequence[str], lp_dir: Path) -> str:

@@ -541,6 +541,40 @@ def test_image_names_differing_only_in_case_are_named_with_their_file(tmp_path: 
     assert said.split(": ", 2)[2] in ran, (said, ran)
 
 
+def test_images_there_with_another_extension_are_named_with_their_file(tmp_path: Path) -> None:
+    """An .lp that names ``image01.jpg`` where the export wrote ``image01.jpeg`` (or names the
+    camera's ``.tif`` beside the JPEGs made from them): `check`, `run` and `fit` had said "copy
+    them where their names point", beside the very files. Named, not read in their place; the
+    images with no such file keep their own way out."""
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lines = (ACQ / "dirs.lp").read_text().splitlines()[1:7]
+    for i, line in enumerate(lines):
+        name = line.split()[0]
+        if i < 5:  # the sixth is not there at all
+            shutil.copy(ACQ / name, acq / name.replace(".jpg", ".jpeg"))
+    (acq / "dirs.lp").write_text("\n".join(["6", *lines]) + "\n")
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "6 of 6 image(s) missing" in said, said
+    assert "5 of them are there with another extension" in said, said
+    assert "image01.jpg -> image01.jpeg" in said and "and 2 more" in said, said
+    assert "rename the files or correct the names in the .lp" in said, said
+    assert "for the other 1 not found, copy them where their names point" in said, said
+    assert not (tmp_path / "s").exists()
+    r = runner.invoke(app, ["check", str(acq / "dirs.lp")])
+    checked = " ".join(r.output.split())
+    assert "RESULT: FAIL" in checked and "5 of them are there with another extension" in checked
+    r = runner.invoke(app, ["fit", str(acq / "dirs.lp"), "--out", str(tmp_path / "f")])
+    fitted = " ".join(r.output.split())
+    assert r.exit_code == 2 and "image01.jpg -> image01.jpeg" in fitted, fitted
+    # one image, alone: said of that file
+    (acq / "dirs.lp").write_text("\n".join(["1", lines[0]]) + "\n")
+    r = runner.invoke(app, ["fit", str(acq / "dirs.lp"), "--out", str(tmp_path / "f1")])
+    one = " ".join(r.output.split())
+    assert "image01.jpeg is there, the same name with another extension" in one, one
+
+
 def test_an_acquisitions_folder_given_as_the_rig_names_its_lp(tmp_path: Path) -> None:
     """`rti-rig run ACQ --out S` (the folder, not its .lp) had said "cannot read the file: Is
     a directory"."""
