@@ -118,6 +118,9 @@ def test_a_dome_session_reads_in_relight_cli_and_rtibuilder_as_it_was_shot(
     _run(["run", str(config), "--out", str(session), "--lights", "8", "--no-verdict"])
     want = fired(session)
     assert len(want) == 8
+    # relight's GUI pairs by file name: each name, as written, is a file there (exact case)
+    names = [line.split()[0] for line in (session / "lights.lp").read_text().splitlines()[1:]]
+    assert sorted(names) == sorted(p.name for p in session.glob("*.jpg")) == sorted(want)
     assert_same_pairs(relight_cli_folder(session), want)
     assert_same_pairs(rtibuilder_pairs(session, session / "lights.lp"), want)
 
