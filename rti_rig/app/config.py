@@ -25,7 +25,7 @@ from rti_rig.core.errors import ConfigError, LpFormatError
 from rti_rig.core.exposure_range import Bound, shared_range
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
 from rti_rig.core.image_files import looks_like_image
-from rti_rig.core.lp_format import read_lp
+from rti_rig.core.lp_format import lp_files_in, read_lp
 from rti_rig.core.rig_geometry import (
     COINCIDENT_LED_DEG,
     ArmGeometry,
@@ -835,7 +835,7 @@ def _image_kind(path: Path, raw: bytes) -> str:
 def _lps_beside(path: Path) -> list[str]:
     """The ``.lp`` files beside ``path`` (at most three), by their path as given."""
     try:
-        return [str(path.parent / p.name) for p in sorted(path.parent.glob("*.lp"))][:3]
+        return [str(path.parent / p.name) for p in lp_files_in(path.parent)][:3]
     except OSError:
         return []
 

@@ -127,7 +127,9 @@ def _acquisition_lp(given: Path) -> Path:
                 "images, with the images beside it (or a session folder: its lights.lp)"
             )
         return given
-    found = sorted(given.glob("*.lp"))
+    from rti_rig.core.lp_format import lp_files_in
+
+    found = lp_files_in(given)
     if len(found) == 1:
         return found[0]
     raise RtiRigError(

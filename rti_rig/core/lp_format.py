@@ -110,6 +110,19 @@ def write_lp(path: Path, entries: Sequence[LpEntry]) -> Path:
     return path
 
 
+def lp_files_in(folder: Path) -> list[Path]:
+    """The ``.lp`` files of ``folder``, by name, whatever the case of their extension.
+
+    Why: Windows tools and FAT cards write ``DIRS.LP``; ``glob("*.lp")`` does not match it
+    on Linux, so ``fit FOLDER`` and ``bench tradeoff --from FOLDER`` had said the folder
+    "holds no .lp file" while ``run FOLDER`` named DIRS.LP in it."""
+    try:
+        found = [p for p in Path(folder).iterdir() if p.suffix.lower() == ".lp" and p.is_file()]
+    except OSError:
+        return []
+    return sorted(found)
+
+
 def is_absolute_name(name: str) -> bool:
     """An image name that is a path from the root, on either system's rules."""
     return any(

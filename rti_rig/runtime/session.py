@@ -66,7 +66,7 @@ from rti_rig.core.image_files import (
     write_linear_tiff,
     write_srgb_jpeg,
 )
-from rti_rig.core.lp_format import LpEntry, format_lp
+from rti_rig.core.lp_format import LpEntry, format_lp, lp_files_in
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
 from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
 from rti_rig.runtime.unrecorded_end import unrecorded_end
@@ -2778,7 +2778,7 @@ def read_manifest(root: Path) -> dict[str, Any]:
                 f"restore {MANIFEST} from a backup copy of the folder; without it the session "
                 f"cannot be resumed (its schedule and rig are recorded there){fit}"
             ) from None
-        lps = sorted(Path(root).glob("*.lp"))
+        lps = lp_files_in(Path(root))
         held = (
             f"; it holds {lps[0].name}{' and more .lp files' if len(lps) > 1 else ''}: "
             + _acquisition_lp_use(lps[0])

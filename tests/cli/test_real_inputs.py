@@ -575,6 +575,26 @@ def test_images_there_with_another_extension_are_named_with_their_file(tmp_path:
     assert "image01.jpeg is there, the same name with another extension" in one, one
 
 
+def test_a_folder_whose_lp_has_an_upper_case_extension_is_found_by_fit_and_bench(
+    tmp_path: Path,
+) -> None:
+    """A Windows tool or a FAT card writes ``DIRS.LP``: `fit FOLDER` and `bench tradeoff --from
+    FOLDER` had said the folder holds no .lp file, where `run FOLDER` named DIRS.LP in it."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    (acq / "dirs.lp").rename(acq / "DIRS.LP")
+    r = runner.invoke(app, ["fit", str(acq), "--out", str(tmp_path / "f"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "f" / "normals.png").is_file()
+    lines = (acq / "DIRS.LP").read_text().splitlines()
+    (acq / "DIRS.LP").write_text("\n".join(["6", *lines[1:7]]) + "\n")
+    r = runner.invoke(app, ["bench", "tradeoff", "--from", str(acq)])
+    said = " ".join(r.output.split())
+    # found, and judged: too few lights for a trade (it had been "no .lp file")
+    assert "no .lp file" not in said, said
+    assert f"{acq / 'DIRS.LP'}: 6 lights; at least 10 are needed" in said, said
+
+
 def test_an_acquisitions_folder_given_as_the_rig_names_its_lp(tmp_path: Path) -> None:
     """`rti-rig run ACQ --out S` (the folder, not its .lp) had said "cannot read the file: Is
     a directory"."""

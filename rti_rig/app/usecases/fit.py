@@ -55,6 +55,7 @@ from rti_rig.core.lp_format import (
     format_lp,
     image_file_name,
     image_paths,
+    lp_files_in,
     parse_lp,
     read_lp,
 )
@@ -357,7 +358,7 @@ def acquisition_files(
     each light (``linear/<stem>.tif`` when there, else the file the ``.lp`` names) and names."""
     refuse_if_in_use(source if source.is_dir() else source.parent, "fit it")
     if source.is_dir():
-        lps = sorted(source.glob("*.lp"))
+        lps = lp_files_in(source)
         if not lps:
             if (source / JOURNAL).is_file():  # a session that lost its lights.lp
                 raise FitInputError(

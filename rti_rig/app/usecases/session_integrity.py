@@ -20,7 +20,7 @@ import numpy as np
 
 from rti_rig.app.usecases.uneven_lights import with_uneven_lights
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.lp_format import read_lp
+from rti_rig.core.lp_format import lp_files_in, read_lp
 from rti_rig.reconstruct.qa import LESS_EXPOSURE, QAReport
 from rti_rig.runtime.session import (
     JOURNAL,
@@ -60,7 +60,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     source = Path(source)
     lp = source / LP_NAME
     if source.is_dir() and not lp.is_file():  # the .lp a fit of the folder reads instead
-        lp = next(iter(sorted(source.glob("*.lp"))), lp)
+        lp = next(iter(lp_files_in(source)), lp)
     fitted: set[str] | None = None  # the images judged, when not every one of the session's
     if not source.is_dir():
         lp, source = source, source.parent
