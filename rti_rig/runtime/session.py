@@ -69,7 +69,8 @@ from rti_rig.core.image_files import (
 from rti_rig.core.lp_format import LpEntry, format_lp, lp_files_in
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
 from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
-from rti_rig.runtime.unrecorded_end import unrecorded_end
+from rti_rig.runtime.unrecorded_end import CAUSES, unrecorded_end
+from rti_rig.runtime.unrecorded_end import UNRECORDED as RUN_UNRECORDED
 
 MANIFEST = "manifest.json"
 JOURNAL = "journal.jsonl"
@@ -780,7 +781,9 @@ class SessionFolder:
                 )
             runs = self.manifest.setdefault("runs", [])
             for old in runs:
-                old.setdefault("finish_reason", "crashed")
+                # a run that never recorded its end: killed, a power cut or a disk too full
+                # to record it (it had been marked "crashed", a cause nobody established)
+                old.setdefault("finish_reason", RUN_UNRECORDED)
             run["resumed_with_steps_done"] = len(self.resume.done)
             run["recovered_files"] = self.resume.recovered
             if self.resume.journal_repair:
@@ -1879,7 +1882,9 @@ RUN_ENDED = {
     "emergency-stop": "stopped by an emergency stop",
     "write-failed": "a file could not be written",
     "no-space": "the disk was full",
-    "crashed": "the program stopped without finishing it",
+    RUN_UNRECORDED: f"it stopped without recording why ({CAUSES})",
+    # what a resume had marked such a run before (older manifests)
+    "crashed": f"it stopped without recording why ({CAUSES})",
 }
 
 

@@ -20,6 +20,10 @@ from typing import Any
 #: the causes a run's missing end can have, as messages list them
 CAUSES = "killed, a power cut, or a disk too full to record its end"
 
+#: the ``finish_reason`` a resume records in ``runs`` for an earlier run that recorded no end:
+#: which of :data:`CAUSES` it was is not known (it had been recorded as ``"crashed"``)
+UNRECORDED = "unrecorded"
+
 
 def last_image_bytes(root: Path, journal: Sequence[dict[str, Any]] | None = None) -> int | None:
     """The bytes on disk of the last image the journal of ``root`` lists (its JPEG and linear
