@@ -538,12 +538,18 @@ def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
     lacked two of the run's answers (an unnamed fault while it opened reached the user as a
     traceback, and metering's teardown failures went unsaid on an error)."""
     from rti_rig.runtime.controller import EmergencyStop
+    from rti_rig.runtime.session import SessionComplete
 
     try:
         with _terminable_while_opening() as handover:
             opened = opening.open()
             if opening.capture:
                 handover.hold()  # a stop from here on: the capture answers it
+    except SessionComplete as exc:
+        # a resume of a complete, intact session (a script's same line after a run that did
+        # finish): no error, and the next step said (it had been exit 2, with none)
+        out.print(f"{exc}. Next: {exc.next_step}", markup=False)
+        raise typer.Exit(code=0) from None
     except RtiRigError as exc:
         _print_metering_failures(exc)
         raise _opening_failed(exc, opening.out_dir) from None

@@ -315,6 +315,19 @@ def recorded_frame_size(
     return int(frames[0]), int(frames[1])
 
 
+class SessionComplete(SessionError):
+    """A resume of a session that completed every step, each image as captured: nothing to
+    do, and no error (the command's exit says the session is complete).
+
+    Why: a lab's script runs ``run --resume`` with the same line after a run that may or may
+    not have finished; a complete session had been refused as an error (exit 2) with no word
+    of the next step, though nothing was wrong with it. ``next_step`` is that step."""
+
+    def __init__(self, message: str, next_step: str) -> None:
+        super().__init__(message)
+        self.next_step = next_step
+
+
 class NoSpaceError(SessionError):
     """The disk cannot hold the next image(s): checked before the rig starts and before each
     image, so the session stops cleanly rather than on a write that fails half-way.
@@ -1735,6 +1748,8 @@ def _prepare_resume(
         lost = {i: _lost_files(root, rec, renamed) for i, rec in latest.items()}
         lost = {i: gone for i, gone in lost.items() if gone}
         moved = f"; {renamed_note(renamed)}" if renamed else ""
+        if not reshoot_lost and not lost and not renamed and not unchecked_images(root)[0]:
+            _refuse_complete(root, manifest, total, finished)
         if manifest.get("adaptive") and finished < total:  # an adaptive session that stopped
             stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
             raise SessionError(
@@ -1869,6 +1884,25 @@ def _prepare_resume(
         journal_repair=repair,
         journal_rebuild=rebuild,
         lost_since_capture=lost_now,
+    )
+
+
+def _refuse_complete(root: Path, manifest: dict[str, Any], total: int, finished: int) -> None:
+    """Raise :class:`SessionComplete` for ``root``, a session that completed with every image
+    as captured (checked by the caller), naming its next step: ``rti-rig fit``."""
+    folder = shlex.quote(str(root))
+    if manifest.get("adaptive") and finished < total:
+        stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
+        done = (
+            f"this adaptive session is complete: it stopped after {finished} of at most "
+            f"{total} lights ({stop.get('reason', 'its stopping rule')})"
+        )
+    else:
+        done = f"this session is complete: all {finished} steps were captured"
+    raise SessionComplete(
+        f"{root}: {done}, and every image is as captured (each JPEG and linear TIFF matches "
+        "its journaled checksum); nothing to resume, nothing was changed",
+        f"rti-rig fit {folder} --out FOLDER (FOLDER new or empty, outside the session)",
     )
 
 

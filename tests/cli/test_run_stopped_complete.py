@@ -145,7 +145,9 @@ def test_a_sigterm_after_an_until_error_stop_says_complete_not_resume(tmp_path: 
     )
     assert f"Next: rti-rig fit {out} --out FOLDER" in said, said
     code, again = _cli("run", "--resume", str(out))
-    assert code != 0 and "already completed" in again, again  # what the advice would have met
+    # what the advice would have met: complete, said so, with the same next step
+    assert code == 0 and "this adaptive session is complete: it stopped after" in again, again
+    assert f"Next: rti-rig fit {out} --out FOLDER" in again, again
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")

@@ -170,8 +170,8 @@ def test_cancelled_session_resumes_and_corrupt_files_are_recaptured(
 @pytest.mark.e2e
 def test_resume_refuses_what_it_cannot_do(tmp_path: Path, reference: tuple[Path, Path]) -> None:
     _, ref = reference
-    r = runner.invoke(app, ["run", "--resume", str(ref)])
-    assert r.exit_code == 2 and "already completed" in said(r)
+    r = runner.invoke(app, ["run", "--resume", str(ref)])  # complete, intact: no error
+    assert r.exit_code == 0 and "this session is complete" in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(tmp_path)])
     assert r.exit_code == 2 and "not an rti-rig session folder" in " ".join(r.output.split())
     r = runner.invoke(app, ["run", "--resume", str(ref), "--lights", "3"])
