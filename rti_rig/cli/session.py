@@ -114,7 +114,10 @@ def run(
         typer.Option(
             "--resume",
             help="Continue an interrupted session folder: verify what is on disk and capture "
-            "only the steps not yet done (on the rig the session began on).",
+            "only the steps not yet done (on the rig the session began on). The options the "
+            "session began with (--out DIR, --lights, --plan, --adaptive …) may be given "
+            "again: they must be its own. A session already complete, every image intact, "
+            "is said so (exit 0).",
         ),
     ] = None,
     accept_rig_change: Annotated[
@@ -235,10 +238,18 @@ def run(
     )
 
     if resume is not None:
+        from rti_rig.app.usecases.resume_request import StartOptions
+
+        if out_dir is not None and not _same_folder(out_dir, resume):
+            raise fail(
+                RtiRigError(
+                    f"--out {out_dir} and --resume {resume} are two folders: a resume "
+                    f"continues the session in --resume's; drop --out (or give the same folder)"
+                )
+            )
         given = [
             flag
             for flag, value in (
-                ("--out", out_dir is not None),
                 ("--plan", plan is not None),
                 ("--lights", lights is not None),
                 ("--adaptive", adaptive),
@@ -252,13 +263,27 @@ def run(
             )
             if value
         ]
-        if given:
-            raise fail(
-                RtiRigError(
-                    "--resume continues a session as it began (its lights, stopping rule "
-                    f"and exposure are in its manifest): drop {', '.join(given)}"
-                )
+        # the options that began the session, given again (a script's same line): compared
+        # with what its manifest records once the rig config is read (they had been refused
+        # outright, "drop --lights", the identical request as much as another)
+        start = (
+            StartOptions(
+                tuple(given),
+                lights=lights,
+                plan=plan,
+                adaptive=adaptive,
+                until_error_deg=until_error,
+                min_lights=min_lights,
+                auto_exposure=auto_exposure,
+                max_saturated=max_saturated,
+                min_elevation_deg=min_elevation_deg,
+                max_elevation_deg=max_elevation_deg,
+                allow_no_normals=allow_no_normals,
+                objective=objective,
             )
+            if given
+            else None
+        )
         resume_request = ResumeRequest(
             resume,
             rig_config,
@@ -266,6 +291,7 @@ def run(
             objective=objective,
             reshoot_lost=reshoot_lost,
             rebuild_journal=rebuild_journal,
+            start=start,
         )
         if _rebuilt_finished(resume_request):  # a completed session: no rig, nothing to shoot
             return
@@ -364,6 +390,14 @@ def run(
                 except Exception as exc:
                     _verdict_failed(exc, opened.out_dir)
         _refuse_unsafe_end(unsafe)
+
+
+def _same_folder(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name one folder (``--out S --resume ./S``)."""
+    try:
+        return a.resolve() == b.resolve()
+    except OSError:
+        return False
 
 
 def _rebuilt_finished(req: Any) -> bool:

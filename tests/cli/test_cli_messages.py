@@ -53,16 +53,22 @@ def test_calibration_config_line_is_whole_and_a_good_second_report_is_no_failure
 
 def test_resume_refuses_options_it_would_otherwise_ignore(tmp_path):
     """A resumed session runs as it began: an option that would change it is refused, not
-    silently ignored (the user would believe the stopping rule or the exposure changed)."""
+    silently ignored (the user would believe the stopping rule or the exposure changed). The
+    session's own options are accepted (tests/cli/test_resume_same_command_line.py)."""
+    from conftest import SMALL_DOME, cut_new_session, write_config
     from typer.testing import CliRunner
 
+    from rti_rig.app.usecases.session import NewSessionRequest
     from rti_rig.cli import app
 
-    args = ["run", "--resume", str(tmp_path), "--until-error", "1", "--auto-exposure"]
+    out = tmp_path / "s"
+    cut_new_session(NewSessionRequest(write_config(tmp_path, SMALL_DOME), out, lights=6), 1)
+    args = ["run", "--resume", str(out), "--until-error", "1", "--auto-exposure"]
     r = CliRunner().invoke(app, args)
     assert r.exit_code == 2
     text = " ".join(r.output.split())
-    assert "drop --until-error, --auto-exposure" in text
+    assert "the session ran a planned layout; this asks for an adaptive one" in text
+    assert "It began with --lights 6" in text
 
 
 def _small_run(tmp_path: Path) -> tuple[int, str, Path]:

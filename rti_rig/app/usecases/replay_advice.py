@@ -63,6 +63,14 @@ def new_session_command(
         "--out",
         shlex.quote(str(new_session_dir(session_dir))),
     ]
+    return " ".join(words) + session_options(manifest)
+
+
+def session_options(manifest: dict[str, Any]) -> str:
+    """`` --lights 8``, `` --plan P``, `` --adaptive --lights 6 …``: the layout options the
+    session of ``manifest`` began with, as :func:`new_session_command` repeats them (and a
+    resume given other options says them)."""
+    words = [""]
     schedule = manifest.get("schedule") or {}
     provenance = schedule.get("provenance") or {}
     adaptive = manifest.get("adaptive")

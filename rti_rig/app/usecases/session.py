@@ -121,6 +121,10 @@ class ResumeRequest:
     #: A session whose journal lost records (deleted, cut short, overwritten): rebuild it from
     #: the manifest's records whose files and lights are as recorded (the rest set aside).
     rebuild_journal: bool = False
+    #: The options that begin a session, given again (a script's same command line): the
+    #: resume goes on only if they are the session's own (a ``StartOptions`` of
+    #: :mod:`rti_rig.app.usecases.resume_request`; None: none given).
+    start: Any = None
 
 
 @dataclass(frozen=True)
@@ -1670,6 +1674,10 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     loaded = load_rig_config(config_path)
     for note in loaded.notes:
         on_note(Note(note, "warning"))
+    if req.start is not None:  # the session's own options given again, or refused
+        from rti_rig.app.usecases.resume_request import check_same_start
+
+        check_same_start(req.start, manifest, loaded, Path(req.session_dir))
     from rti_rig.app.flash_sync import flash_sync_of, refuse_options
 
     runner = manifest.get("runner") or {}

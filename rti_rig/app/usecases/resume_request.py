@@ -1,0 +1,255 @@
+"""A resume given the options a session began with: the same request goes on, another is refused.
+
+Why: a lab's script runs ``rti-rig run RIG --out S --lights 24`` and, if that fails, the same
+line with ``--resume S`` added. Every option that begins a session had been refused with a
+resume ("drop --lights"), the identical request as much as a different one, so the script
+could not continue a session with the line that began it. The request is now compared with
+what the manifest records (the schedule the options give on this rig, the adaptive settings,
+the metering): identical goes on, as a plain ``--resume`` would; different is refused before
+anything on disk is touched, naming what differs and what to do.
+"""
+
+from __future__ import annotations
+
+import math
+import shlex
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rti_rig.core.errors import RtiRigError
+
+#: Two lights of a plan are the same light within this angle (°): an .lp carries six decimals
+#: (or fewer, rewritten by another program), which moves a direction by far less than this.
+SAME_LIGHT_DEG = 0.01
+
+
+@dataclass(frozen=True)
+class StartOptions:
+    """The options of ``run`` that begin a session, as given with ``--resume`` (defaults where
+    not given), and the flags as typed (``given``) for the messages."""
+
+    given: tuple[str, ...]
+    lights: int | None = None
+    plan: Path | None = None
+    adaptive: bool = False
+    until_error_deg: float | None = None
+    min_lights: int | None = None
+    auto_exposure: bool = False
+    #: None: not given (the default, 0.001)
+    max_saturated: float | None = None
+    min_elevation_deg: float = 0.0
+    max_elevation_deg: float = 90.0
+    allow_no_normals: bool = False
+    #: ``--objective`` (checked by the resume itself; here it is part of an adaptive request)
+    objective: str | None = None
+
+    @property
+    def is_adaptive(self) -> bool:
+        return self.adaptive or self.until_error_deg is not None
+
+
+def check_same_start(
+    asked: StartOptions, manifest: dict[str, Any], loaded: Any, root: Path
+) -> None:
+    """Refuse ``asked`` unless it is the request session ``root`` began with (its manifest
+    read by the caller; ``loaded`` its rig config, on which a layout is planned again to be
+    compared). Reads nothing in the folder and changes nothing."""
+    from rti_rig.app.usecases.replay_advice import session_options
+
+    diffs = _differences(asked, manifest, loaded)
+    if not diffs:
+        return
+    began = session_options(manifest).strip()
+    if _metered(manifest):
+        from rti_rig.app.usecases.session import NewSessionRequest
+
+        began += " --auto-exposure"
+        limit = _recorded_max_saturated(manifest)
+        if limit is not None and not _same_number(limit, NewSessionRequest.max_saturated):
+            began += f" --max-saturated {limit:g}"
+    folder = shlex.quote(str(root))
+    raise RtiRigError(
+        f"{root}: this resume asks for another session than the one in it ("
+        + "; ".join(diffs)
+        + f"). It began with {began or 'the defaults'} (nothing in the folder was changed): "
+        f"to continue it as it began, give those options or none (rti-rig run --resume "
+        f"{folder}); to shoot this request, start a new session in a new --out"
+    )
+
+
+def _differences(asked: StartOptions, manifest: dict[str, Any], loaded: Any) -> list[str]:
+    header = manifest.get("adaptive")
+    if isinstance(header, dict):
+        if not asked.is_adaptive:
+            return ["the session is adaptive; this asks for a planned layout"]
+        return _adaptive_differences(asked, header)
+    if asked.is_adaptive:
+        return ["the session ran a planned layout; this asks for an adaptive one"]
+    return [
+        *_schedule_differences(asked, manifest, loaded),
+        *_metering_differences(asked, manifest),
+    ]
+
+
+def _adaptive_differences(asked: StartOptions, header: dict[str, Any]) -> list[str]:
+    diffs = []
+    if asked.lights != header.get("design_lights"):
+        diffs.append(
+            f"--lights {_or_none(asked.lights)}, the session "
+            f"{_or_none(header.get('design_lights'))}"
+        )
+    if not _same_number(asked.until_error_deg, header.get("until_error_deg")):
+        diffs.append(
+            f"--until-error {_or_none(asked.until_error_deg)}, the session "
+            f"{_or_none(header.get('until_error_deg'))}"
+        )
+    if asked.min_lights != header.get("min_lights"):
+        diffs.append(
+            f"--min-lights {_or_none(asked.min_lights)}, the session "
+            f"{_or_none(header.get('min_lights'))}"
+        )
+    objective = asked.objective or "normals"
+    if objective != (header.get("objective") or "normals"):
+        diffs.append(f"--objective {objective}, the session {header.get('objective')}")
+    diffs += _band_differences(asked, header)
+    if asked.plan is not None:
+        diffs.append("--plan: the session chooses its own lights")
+    if asked.auto_exposure:
+        diffs.append("--auto-exposure: an adaptive session is not metered")
+    return diffs
+
+
+def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded: Any) -> list[str]:
+    """The schedule ``asked`` gives on this rig (planned again, as a new session plans it)
+    against the one recorded."""
+    from rti_rig.app.usecases.session import NewSessionRequest, new_session_schedule
+    from rti_rig.core.schedule import LightSchedule
+
+    recorded = LightSchedule.from_dict(manifest["schedule"])
+    request = NewSessionRequest(
+        Path(loaded.path),
+        Path("."),
+        lights=asked.lights,
+        plan=asked.plan,
+        min_elevation_deg=asked.min_elevation_deg,
+        max_elevation_deg=asked.max_elevation_deg,
+        allow_no_normals=asked.allow_no_normals,
+    )
+    wanted = new_session_schedule(request, loaded)
+    what = (
+        f"--plan {asked.plan}"
+        if asked.plan is not None
+        else f"--lights {asked.lights}"
+        if asked.lights is not None
+        else "the default lights"
+    )
+    if (wanted.method == "plan") != (recorded.method == "plan"):
+        began = "a plan" if recorded.method == "plan" else "a homogeneous layout"
+        return [f"{what} gives {_layout(wanted)}; the session ran {began}"]
+    if len(wanted) != len(recorded):
+        return [f"{what} gives {len(wanted)} lights; the session has {len(recorded)}"]
+    for i, (mine, theirs) in enumerate(zip(wanted.steps, recorded.steps, strict=True)):
+        # a dome's light is its LED (its recorded direction moves with a recalibration the
+        # resume accepts with --accept-rig-change); an arm's is its direction
+        if (mine.led, theirs.led) != (None, None):
+            differs = mine.led != theirs.led
+        else:
+            differs = _angle_deg(mine.direction, theirs.direction) > SAME_LIGHT_DEG
+        if differs:
+            return [f"{what}: its light {i + 1} is {_light(mine)}, the session's {_light(theirs)}"]
+    if recorded.method != "plan":  # the band asked, as recorded (the same LEDs or not)
+        band = _band_differences(asked, recorded.provenance or {})
+        if band:
+            return band
+    allowed = bool((recorded.provenance or {}).get("allow_no_normals", False))
+    if allowed != asked.allow_no_normals:
+        return [
+            "--allow-no-normals "
+            + ("not given; the session had it" if allowed else "given; the session had not")
+        ]
+    return []
+
+
+def _metering_differences(asked: StartOptions, manifest: dict[str, Any]) -> list[str]:
+    metered = _metered(manifest)
+    if asked.auto_exposure != metered:
+        return [
+            "--auto-exposure "
+            + (
+                "not given; the session's exposure was metered"
+                if metered
+                else "given; the session was not metered"
+            )
+        ]
+    if metered:
+        from rti_rig.app.usecases.session import NewSessionRequest
+
+        # not given: the default a new session meters with
+        limit = asked.max_saturated
+        limit = NewSessionRequest.max_saturated if limit is None else limit
+        recorded = _recorded_max_saturated(manifest)
+        if recorded is not None and not _same_number(limit, recorded):
+            given = (
+                f"--max-saturated {limit:g}"
+                if asked.max_saturated is not None
+                else (f"--max-saturated not given ({limit:g})")
+            )
+            return [f"{given}, the session {recorded:g}"]
+    return []
+
+
+def _band_differences(asked: StartOptions, header: dict[str, Any]) -> list[str]:
+    diffs = []
+    for flag, mine, key, default in (
+        ("--min-elevation-deg", asked.min_elevation_deg, "min_elevation_deg", 0.0),
+        ("--max-elevation-deg", asked.max_elevation_deg, "max_elevation_deg", 90.0),
+    ):
+        theirs = header.get(key, default)
+        if not _same_number(mine, theirs):
+            diffs.append(f"{flag} {mine:g}, the session {_or_none(theirs)}")
+    return diffs
+
+
+def _metered(manifest: dict[str, Any]) -> bool:
+    provenance = (manifest.get("schedule") or {}).get("provenance") or {}
+    return isinstance(provenance.get("exposure"), dict)
+
+
+def _recorded_max_saturated(manifest: dict[str, Any]) -> float | None:
+    exposure = ((manifest.get("schedule") or {}).get("provenance") or {}).get("exposure") or {}
+    rule = exposure.get("rule") if isinstance(exposure, dict) else None
+    value = rule.get("max_saturated_fraction") if isinstance(rule, dict) else None
+    return float(value) if isinstance(value, int | float) else None
+
+
+def _layout(schedule: Any) -> str:
+    return "a plan" if schedule.method == "plan" else f"a homogeneous layout of {len(schedule)}"
+
+
+def _light(step: Any) -> str:
+    """``LED 13`` (a dome's), or the light's azimuth/elevation."""
+    if step.led is not None:
+        return f"LED {step.led}"
+    x, y, z = step.direction
+    az = math.degrees(math.atan2(y, x)) % 360.0
+    el = math.degrees(math.atan2(z, math.hypot(x, y)))
+    return f"az {az:.2f}° el {el:.2f}°"
+
+
+def _angle_deg(a: Any, b: Any) -> float:
+    dot = sum(x * y for x, y in zip(a, b, strict=True))
+    norms = math.sqrt(sum(x * x for x in a) * sum(y * y for y in b))
+    return math.degrees(math.acos(max(-1.0, min(1.0, dot / norms)))) if norms else 180.0
+
+
+def _same_number(a: Any, b: Any) -> bool:
+    if a is None or b is None:
+        return a is None and b is None
+    return math.isclose(float(a), float(b), rel_tol=1e-9, abs_tol=1e-9)
+
+
+def _or_none(value: Any) -> str:
+    return (
+        "not given" if value is None else f"{value:g}" if isinstance(value, float) else str(value)
+    )

@@ -1,0 +1,254 @@
+"""A lab's script resumes with the line that began the session: ``rti-rig run RIG --out S
+--lights N`` and, if that fails, the same line with ``--resume S``.
+
+Before: the identical request was refused as a different one would be ("drop --out,
+--lights", exit 2); a resume of a session that had completed every step, every image intact,
+was an error (exit 2) with no next step; and a run that never recorded its end was marked
+``crashed`` by the next resume, a cause nobody had established (it may have been killed, a
+power cut or a full disk).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, cut_new_session, interrupted, manifest, said
+from typer.testing import CliRunner
+
+from rti_rig.app.usecases.session import NewSessionRequest
+from rti_rig.cli import app
+from rti_rig.runtime.controller import FinishReason
+
+runner = CliRunner()
+DOME = CONFIGS / "simulated_dome.toml"
+
+
+def tree(folder: Path) -> dict[str, str]:
+    """Every file under ``folder`` and its checksum: what a refusal must leave as it was."""
+    return {
+        p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+@pytest.fixture(scope="module")
+def stopped(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A session of ``--lights 8`` on the shipped simulated dome, stopped after 3 images."""
+    out = tmp_path_factory.mktemp("line") / "s"
+    run = cut_new_session(NewSessionRequest(DOME, out, lights=8), after_step=2)
+    assert run.finish_reason is FinishReason.CANCELLED
+    return out
+
+
+def copy_of(session: Path, tmp_path: Path) -> Path:
+    out = tmp_path / "s"
+    shutil.copytree(session, out)
+    return out
+
+
+def test_the_line_the_session_began_with_continues_it(stopped: Path, tmp_path: Path) -> None:
+    out = copy_of(stopped, tmp_path)
+    kept = {k: v for k, v in tree(out).items() if k.startswith(("image_", "linear/"))}
+    line = ["run", str(DOME), "--out", str(out), "--lights", "8", "--no-verdict"]
+    r = runner.invoke(app, [*line, "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "3 of 8 images verified on disk" in said(r)
+    assert manifest(out)["runner"]["finish_reason"] == "completed"
+    after = tree(out)
+    assert all(after[name] == digest for name, digest in kept.items())  # nothing overwritten
+    # the same line once more, on the session now complete: said so, with the next step
+    r = runner.invoke(app, [*line, "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "this session is complete: all 8 steps were captured" in said(r)
+    assert f"Next: rti-rig fit {out} --out FOLDER" in said(r)
+    assert tree(out) == after
+
+
+@pytest.mark.parametrize(
+    ("options", "named"),
+    [
+        (["--lights", "9"], "--lights 9 gives 9 lights; the session has 8"),
+        (
+            ["--lights", "8", "--min-elevation-deg", "10"],
+            "--min-elevation-deg 10, the session 0",
+        ),
+        (["--lights", "8", "--allow-no-normals"], "--allow-no-normals given; the session had not"),
+        (["--adaptive", "--lights", "8"], "the session ran a planned layout; this asks for an"),
+    ],
+)
+def test_another_request_is_refused_naming_what_differs(
+    stopped: Path, tmp_path: Path, options: list[str], named: str
+) -> None:
+    out = copy_of(stopped, tmp_path)
+    before = tree(out)
+    r = runner.invoke(app, ["run", str(DOME), "--out", str(out), "--resume", str(out), *options])
+    assert r.exit_code == 2, r.output
+    assert named in said(r)
+    assert "It began with --lights 8" in said(r)
+    assert f"rti-rig run --resume {out})" in said(r)
+    assert tree(out) == before
+
+
+def test_another_out_folder_is_refused(stopped: Path, tmp_path: Path) -> None:
+    out = copy_of(stopped, tmp_path)
+    before = tree(out)
+    other = tmp_path / "other"
+    r = runner.invoke(app, ["run", str(DOME), "--out", str(other), "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "are two folders" in said(r) and "drop --out" in said(r)
+    assert tree(out) == before and not other.exists()
+
+
+def test_the_same_plan_continues_its_session_however_its_numbers_are_written(
+    tmp_path: Path,
+) -> None:
+    plan = tmp_path / "plan.lp"
+    r = runner.invoke(
+        app,
+        ["plan", "--rig", str(DOME), "--lights", "10", "--method", "uniform", "--out", str(plan)],
+    )
+    assert r.exit_code == 0, r.output
+    lines = plan.read_text().splitlines()
+    rounded = tmp_path / "rounded.lp"  # another program's copy: four decimals
+    rounded.write_text(
+        "\n".join(
+            [lines[0]]
+            + [
+                f"{w[0]} " + " ".join(f"{float(v):.4f}" for v in w[1:])
+                for w in map(str.split, lines[1:])
+            ]
+        )
+        + "\n"
+    )
+    swapped = tmp_path / "swapped.lp"  # lights 3 and 4 exchanged: another session
+    a, b = lines[3].split(), lines[4].split()
+    swapped.write_text(
+        "\n".join([*lines[:3], " ".join([a[0], *b[1:]]), " ".join([b[0], *a[1:]]), *lines[5:]])
+        + "\n"
+    )
+    out = tmp_path / "s"
+    run = cut_new_session(NewSessionRequest(DOME, out, plan=plan), after_step=3)
+    assert run.finish_reason is FinishReason.CANCELLED
+    before = tree(out)
+    r = runner.invoke(app, ["run", str(DOME), "--resume", str(out), "--plan", str(swapped)])
+    assert r.exit_code == 2, r.output
+    assert "its light 3 is LED" in said(r) and f"It began with --plan {plan}" in said(r)
+    assert tree(out) == before
+    r = runner.invoke(
+        app, ["run", str(DOME), "--resume", str(out), "--plan", str(rounded), "--no-verdict"]
+    )
+    assert r.exit_code == 0, r.output
+    assert "4 of 10 images verified on disk" in said(r)
+
+
+def rewritten(plan: Path, to: Path, decimals: int, turn_light: int | None = None) -> Path:
+    """``plan`` written again with ``decimals`` decimals, light ``turn_light`` (1-based)
+    turned 1° in azimuth."""
+    lines = plan.read_text().splitlines()
+    out = [lines[0]]
+    for k, words in enumerate(map(str.split, lines[1:]), start=1):
+        x, y, z = (float(v) for v in words[1:4])
+        if k == turn_light:
+            c, s = math.cos(math.radians(1.0)), math.sin(math.radians(1.0))
+            x, y = c * x - s * y, s * x + c * y
+        out.append(f"{words[0]} {x:.{decimals}f} {y:.{decimals}f} {z:.{decimals}f}")
+    to.write_text("\n".join(out) + "\n")
+    return to
+
+
+def test_an_arm_plan_is_compared_light_by_light_within_its_numbers(tmp_path: Path) -> None:
+    arm = CONFIGS / "simulated_arm.toml"
+    plan = tmp_path / "plan.lp"
+    r = runner.invoke(
+        app, ["plan", "--rig", str(arm), "--lights", "8", "--method", "uniform", "--out", str(plan)]
+    )
+    assert r.exit_code == 0, r.output
+    out = tmp_path / "s"
+    run = cut_new_session(NewSessionRequest(arm, out, plan=plan), after_step=2)
+    assert run.finish_reason is FinishReason.CANCELLED
+    before = tree(out)
+    turned = rewritten(plan, tmp_path / "turned.lp", 6, turn_light=5)
+    r = runner.invoke(app, ["run", str(arm), "--resume", str(out), "--plan", str(turned)])
+    assert r.exit_code == 2, r.output
+    assert f"--plan {turned}: its light 5 is az" in said(r), r.output
+    assert tree(out) == before
+    rounded = rewritten(plan, tmp_path / "rounded.lp", 4)
+    line = ["run", str(arm), "--resume", str(out), "--plan", str(rounded), "--no-verdict"]
+    r = runner.invoke(app, line)
+    assert r.exit_code == 0, r.output
+    assert "3 of 8 images verified on disk" in said(r)
+
+
+def test_an_adaptive_session_continues_with_its_own_line(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    run = interrupted(DOME, out, after_step=4, lights=7)
+    assert run.finish_reason is FinishReason.CANCELLED
+    before = tree(out)
+    line = ["run", str(DOME), "--out", str(out), "--resume", str(out), "--no-verdict"]
+    r = runner.invoke(app, [*line, "--adaptive", "--lights", "8"])
+    assert r.exit_code == 2, r.output
+    assert "--lights 8, the session 7" in said(r) and "It began with --adaptive --lights 7" in said(
+        r
+    )
+    assert tree(out) == before
+    r = runner.invoke(app, [*line, "--adaptive", "--lights", "7"])
+    assert r.exit_code == 0, r.output
+    assert "5 of 7 images verified on disk" in said(r)
+    r = runner.invoke(app, [*line, "--adaptive", "--lights", "7"])
+    assert r.exit_code == 0, r.output
+    assert "this session is complete" in said(r) and "Next: rti-rig fit" in said(r)
+
+
+def test_a_metered_session_continues_with_its_own_metering_options(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    request = NewSessionRequest(DOME, out, lights=8, auto_exposure=True, max_saturated=0.002)
+    assert cut_new_session(request, after_step=2).finish_reason is FinishReason.CANCELLED
+    before = tree(out)
+    line = ["run", str(DOME), "--out", str(out), "--resume", str(out), "--lights", "8"]
+    for options, named in (
+        ([], "--auto-exposure not given; the session's exposure was metered"),
+        (["--auto-exposure"], "--max-saturated not given (0.001), the session 0.002"),
+    ):
+        r = runner.invoke(app, [*line, *options])
+        assert r.exit_code == 2, r.output
+        assert named in said(r), r.output
+        assert "It began with --lights 8 --auto-exposure --max-saturated 0.002" in said(r)
+        assert tree(out) == before
+    r = runner.invoke(app, [*line, "--auto-exposure", "--max-saturated", "0.002", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "3 of 8 images verified on disk" in said(r)
+    assert "Exposure fixed" not in said(r)  # the session's exposure, not metered again
+
+
+def test_a_complete_session_with_an_image_changed_is_still_refused(
+    stopped: Path, tmp_path: Path
+) -> None:
+    out = copy_of(stopped, tmp_path)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    (out / "image_002.jpg").write_bytes(b"not the image captured")
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 2, r.output
+    assert "is missing or changed since capture (image_002)" in said(r)
+    assert "--reshoot-lost" in said(r) and "is complete" not in said(r)
+
+
+def test_a_run_that_recorded_no_end_is_marked_unrecorded_not_crashed(
+    stopped: Path, tmp_path: Path
+) -> None:
+    out = copy_of(stopped, tmp_path)
+    # as a kill -9, a power cut or a full disk leaves it: the run's end never written
+    m = manifest(out)
+    m["runner"] = {"state": "running", "finish_reason": None}
+    m["runs"][-1] = {k: v for k, v in m["runs"][-1].items() if k in ("started_at", "software")}
+    (out / "manifest.json").write_text(json.dumps(m))
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    runs = manifest(out)["runs"]
+    assert [run.get("finish_reason") for run in runs] == ["unrecorded", "completed"]
