@@ -81,9 +81,12 @@ def check_same_start(
 def _differences(asked: StartOptions, manifest: dict[str, Any], loaded: Any) -> list[str]:
     header = manifest.get("adaptive")
     if isinstance(header, dict):
-        if not asked.is_adaptive:
-            return ["the session is adaptive; this asks for a planned layout"]
-        return _adaptive_differences(asked, header)
+        # what differs, option by option (an --until-error not given is said by its own)
+        plain = not asked.is_adaptive and header.get("until_error_deg") is None
+        return [
+            *(["--adaptive not given; the session is adaptive"] if plain else []),
+            *_adaptive_differences(asked, header),
+        ]
     if asked.is_adaptive:
         return ["the session ran a planned layout; this asks for an adaptive one"]
     return [
