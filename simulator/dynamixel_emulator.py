@@ -15,8 +15,10 @@ for the errors the Shutdown register selects, as the e-manual says), corrupted C
 and silent (disconnected) servos; a servo at another baud rate, or switched to Protocol 1.0
 (Protocol Type 13 = 1), answers nothing. A Hardware Error Status bit stays set until a Reboot (not
 verified for a non-shutdown error whose cause has passed), also between rti-rig commands: a
-rig's emulated chain is modelled as staying powered, its latched errors kept in a small state
-file (:mod:`rti_rig.simulator.servo_latch`; delete it to "power-cycle" the servos).
+rig's emulated chain is modelled as staying powered, each servo's control table (torque, goal,
+RAM, EEPROM, latched errors) and resting pose kept in a small state file
+(:mod:`rti_rig.simulator.servo_latch`, :meth:`EmulatedServo.powered_state`; delete it to
+"power-cycle" the servos).
 
 Deliberate simplifications: a new goal during a move restarts the profile from the present
 position at zero velocity (the firmware blends); no load, current or temperature dynamics.
@@ -377,6 +379,64 @@ class EmulatedServo:
         if was_on and not self.torque_on:
             self._go_limp()  # a reboot under torque drops the joint it held
 
+    # -- kept while powered -----------------------------------------------------------------
+    def powered_state(self) -> dict[str, Any]:
+        """What this servo keeps while it stays powered, for the next command on the rig
+        (:mod:`rti_rig.simulator.servo_latch`): its whole control table (the EEPROM area and
+        the RAM area: Torque Enable, Goal Position, profiles, LED, Status Return Level,
+        Hardware Error Status), a shutdown, a registered instruction, and where the joint
+        comes to rest.
+
+        Why the rest, not the present position: between two commands a servo with torque on
+        runs its profile to its Goal Position, and a limp loaded joint falls to its stop, so
+        the next command finds it at the end of its motion (ROBOTIS e-manual, Torque Enable
+        (64); RAM "reset to initial values when the power is reset", and only then)."""
+        self._refresh()
+        rest = self._profile.goal
+        table = bytearray(self.table)
+        table[ct.PRESENT_POSITION.address : ct.PRESENT_POSITION.address + 4] = (
+            round(rest) & 0xFFFFFFFF
+        ).to_bytes(4, "little")
+        return {
+            "model_number": self.get(ct.MODEL_NUMBER),
+            "table": table.hex(),
+            "rest_ticks": rest,
+            "shut_down": self._shut_down,
+            "registered": None
+            if self._registered is None
+            else [self._registered[0], self._registered[1].hex()],
+        }
+
+    def restore_powered(self, state: dict[str, Any]) -> bool:
+        """Take up a :meth:`powered_state` an earlier command left (the servo never lost
+        power); False, nothing changed, for one that is not this servo's (another model, a
+        damaged record): that chain is met as at power-on."""
+        try:
+            table = bytes.fromhex(str(state["table"]))
+            rest = float(state["rest_ticks"])
+            model = int(state["model_number"])
+            registered = state.get("registered")
+            reg = (
+                None
+                if registered is None
+                else (int(registered[0]), bytes.fromhex(str(registered[1])))
+            )
+        except (KeyError, TypeError, ValueError, IndexError):
+            return False
+        if len(table) != ct.TABLE_SIZE or model != self.get(ct.MODEL_NUMBER):
+            return False
+        if int.from_bytes(table[ct.ID.address : ct.ID.address + 1], "little") != self.dxl_id:
+            return False
+        if not math.isfinite(rest):
+            return False
+        self.table[:] = table
+        self._profile = _Profile(rest, rest, self.clock.now(), 1.0, 1.0)
+        self._back_driven = False
+        self._shut_down = bool(state.get("shut_down", False))
+        self._registered = reg
+        self._refresh()
+        return True
+
     # -- instructions -----------------------------------------------------------------------
     def status_error(self, number: int = 0) -> int:
         return number | (p2.ERR_ALERT if self.hardware_error else 0)
@@ -561,8 +621,8 @@ class DynamixelBusEmulator:
         self._parser = p2.PacketParser()
         self._lock = threading.RLock()
         #: Called with every servo's Hardware Error Status (id -> bits) whenever one changes:
-        #: how a command's latched errors outlive it (:mod:`rti_rig.simulator.servo_latch`,
-        #: the chain kept powered between commands). None: nothing outlives the emulator.
+        #: one moment the chain's powered state is kept, to outlive the command
+        #: (:mod:`rti_rig.simulator.servo_latch`). None: nothing outlives the emulator.
         self.on_errors_changed: Callable[[dict[int, int]], None] | None = None
         self._errors_seen = self.hardware_errors()
 
@@ -584,6 +644,20 @@ class DynamixelBusEmulator:
             self._errors_seen = now
             if self.on_errors_changed is not None:
                 self.on_errors_changed(now)
+
+    def powered_state(self) -> dict[int, dict[str, Any]]:
+        """Every servo's :meth:`EmulatedServo.powered_state`, by id."""
+        with self._lock:
+            return {i: s.powered_state() for i, s in self.servos.items()}
+
+    def restore_powered(self, states: dict[int, dict[str, Any]]) -> None:
+        """Give each servo the state an earlier command left it (see
+        :meth:`EmulatedServo.restore_powered`); one not on this bus is left alone."""
+        with self._lock:
+            for dxl_id, state in states.items():
+                if dxl_id in self.servos:
+                    self.servos[dxl_id].restore_powered(state)
+            self._errors_seen = self.hardware_errors()
 
     def inject_hardware_error(self, dxl_id: int, fault: int) -> None:
         with self._lock:

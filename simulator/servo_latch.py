@@ -1,4 +1,4 @@
-"""The emulated servos' latched hardware errors, kept between rti-rig commands.
+"""The emulated servos' powered state (latched errors, torque, pose, RAM), kept between commands.
 
 A real X-series servo keeps its Hardware Error Status (70) while it stays powered: after a
 shutdown "REBOOT is the only method to reset Torque Enable(64) to '1'" (ROBOTIS e-manual,
@@ -7,11 +7,20 @@ builds a fresh emulator, so an overload met by ``rti-rig run`` was gone by the n
 the documented recovery, ``rti-rig check ARM.toml --reboot-faulted``, found "no hardware
 fault: not rebooted": it could not be rehearsed.
 
-This models the emulated chain staying powered between commands: the errors latched by a
-command are written to a small state file, read back by the next command on the same rig, and
-cleared by a Reboot instruction (the file is removed once no servo has an error). Only the
-error bits are kept (and, through them, a shutdown's torque off); positions, RAM settings and
-the like start from power-on, a simplification.
+This models the emulated chain staying powered between commands: what each servo holds (its
+control table: Torque Enable, Goal Position, profiles, LED, Status Return Level, the Hardware
+Error Status, and the EEPROM area a connect synchronised; a shutdown; where the joint comes to
+rest) is written to a small state file, read back by the next command on the same rig. A real
+chain keeps all of it while powered: RAM is "reset to initial values when the power is reset"
+and only then (ROBOTIS e-manual, X-series control table, Area), so a command that left torque
+on (``torque_policy = "hold"``, or ``"release_on_close"`` away from the park pose, or a crash)
+leaves the next one a holding arm, whose EEPROM is then locked ("Data in the EEPROM Area can
+only be written when the value of Torque Enable(64) is cleared to '0'"). Only the errors had
+been kept, each command meeting servos otherwise as at power-on: the paths a real arm takes
+after a session that kept its torque on were never rehearsed. A Reboot resets the RAM area
+(errors included) as on a servo. Deleting the file is the power cycle: the next command meets
+a factory-fresh chain resting at the park pose (a real power cycle keeps the EEPROM and the
+pose; the emulator's is a simplification).
 
 The file is keyed by the rig config's absolute path, so another config meets a fresh chain;
 the same config with its ``[[emulator.faults]]`` edited (the obstruction cleared, as the
@@ -23,7 +32,6 @@ To "power-cycle" the emulated servos, delete that file (or the folder).
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import json
 import os
@@ -31,8 +39,10 @@ import shlex
 import tempfile
 import warnings
 from pathlib import Path
+from typing import Any
 
 from rti_rig.core.state_files import replace_text
+from rti_rig.drivers.dynamixel import control_table as ct
 
 #: Overrides where the state files are kept (a test's own folder, say).
 STATE_DIR_ENV = "RTI_RIG_EMULATOR_STATE_DIR"
@@ -51,7 +61,8 @@ def state_dir() -> Path:
 
 
 class LatchedErrors:
-    """The state file of one emulated chain: servo id -> latched Hardware Error Status bits."""
+    """The state file of one emulated chain: each servo's powered state (its latched Hardware
+    Error Status bits among them)."""
 
     def __init__(self, config_path: Path) -> None:
         self.config_path = Path(config_path).resolve()
@@ -70,9 +81,42 @@ class LatchedErrors:
         has no switch for; its errors outlive the command in this file, and deleting it is
         what clears them (as ``rti-rig check RIG.toml --reboot-faulted`` does)."""
         return (
-            f"delete {shlex.quote(str(self.path))} (where the emulated servos' latched errors "
-            "are kept: their power off and on)"
+            f"delete {shlex.quote(str(self.path))} (where the emulated servos' powered state "
+            "and latched errors are kept: their power off and on)"
         )
+
+    def load_state(self) -> dict[int, dict[str, Any]]:
+        """Each servo's powered state an earlier command left (``EmulatedServo.powered_state``);
+        {} if none or unreadable (as :meth:`load` says why)."""
+        try:
+            raw = json.loads(self.path.read_text(encoding="utf-8"))
+            servos = raw["servos"]
+            return {int(k): dict(v) for k, v in servos.items()}
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            return {}
+
+    def save_state(self, states: dict[int, dict[str, Any]]) -> None:
+        """Record every servo's powered state now (atomically): the chain stays powered, so
+        the file stays, errors or none, until it is deleted (the power cycle). A file that
+        cannot be written is a warning, as :meth:`_unkept` says why."""
+        errors = {
+            str(k): int(bytes.fromhex(v["table"])[ct.HARDWARE_ERROR_STATUS.address])
+            for k, v in sorted(states.items())
+        }
+        body = json.dumps(
+            {
+                "config": str(self.config_path),
+                "hardware_error_status": {k: v for k, v in errors.items() if v},
+                "servos": {str(k): v for k, v in sorted(states.items())},
+                "note": "emulated servos kept powered between rti-rig commands; "
+                "delete this file to power-cycle them",
+            },
+            indent=1,
+        )
+        try:
+            replace_text(self.path, body)
+        except OSError as exc:
+            self._unkept(exc)
 
     def load(self) -> dict[int, int]:
         """The errors the chain still has from an earlier command; {} if none or unreadable.
@@ -86,40 +130,19 @@ class LatchedErrors:
         except (OSError, ValueError, KeyError, TypeError, AttributeError):
             return {}
 
-    def save(self, errors: dict[int, int]) -> None:
-        """Record the chain's errors now (atomically); no error left removes the file.
+    def _unkept(self, exc: OSError) -> None:
+        """The warning of a state file that could not be written.
 
-        Why a file that cannot be written is a warning, not an error: this is called from
-        inside the emulated bus as a status packet goes out, so an OSError here (a full disk,
-        a state folder another user made in the shared temp folder) reached the driver as its
-        serial port failing, "check that the arm's USB adapter is still plugged in", and the
-        servo's own fault went unsaid. Unkept, the chain is met by the next command as if
-        power-cycled, which the warning says (the console prints it as a note)."""
-        try:
-            self._write(errors)
-        except OSError as exc:
-            warnings.warn(
-                f"the emulated servos' hardware error state could not be kept in {self.path} "
-                f"({exc}): the next command on this rig meets them as if power-cycled; set "
-                f"{STATE_DIR_ENV} to a writable folder to keep it",
-                RuntimeWarning,
-                stacklevel=2,
-            )
-
-    def _write(self, errors: dict[int, int]) -> None:
-        """:meth:`save`'s file work, which may raise OSError."""
-        latched = {str(k): v for k, v in sorted(errors.items()) if v}
-        if not latched:
-            with contextlib.suppress(FileNotFoundError):
-                self.path.unlink()
-            return
-        body = json.dumps(
-            {
-                "config": str(self.config_path),
-                "hardware_error_status": latched,
-                "note": "emulated servos kept powered between rti-rig commands; "
-                "delete this file to power-cycle them",
-            },
-            indent=1,
+        Why a warning, not an error: the state is saved from inside the emulated bus as a
+        status packet goes out, so an OSError here (a full disk, a state folder another user
+        made in the shared temp folder) reached the driver as its serial port failing, "check
+        that the arm's USB adapter is still plugged in", and the servo's own fault went
+        unsaid. Unkept, the chain is met by the next command as if power-cycled, which the
+        warning says (the console prints it as a note)."""
+        warnings.warn(
+            f"the emulated servos' powered state (torque, pose, latched errors) could not be "
+            f"kept in {self.path} ({exc}): the next command on this rig meets them as if "
+            f"power-cycled; set {STATE_DIR_ENV} to a writable folder to keep it",
+            RuntimeWarning,
+            stacklevel=3,
         )
-        replace_text(self.path, body)

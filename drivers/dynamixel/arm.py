@@ -135,15 +135,13 @@ class DynamixelArm(ReadBackCarrier):
         *,
         config_path: str | None = None,
         power_cycle: str = ct.POWER_CYCLE,
-        powered_between_commands: bool = True,
     ) -> None:
         self.settings = settings
-        #: Whether the servos keep their RAM (torque, Status Return Level) between two
-        #: commands, as a real chain's powered servos do; an emulated chain keeps only its
-        #: latched errors (in a state file), each command finding its servos otherwise as at
-        #: power-on, so advice to switch its power off and on to reset that RAM is said as
-        #: what it is there.
-        self.powered_between_commands = powered_between_commands
+        #: How this rig's servos are power-cycled, said in advice: what resets their RAM
+        #: (torque, Status Return Level), which they keep between two commands while powered
+        #: (an emulated chain keeps it too, in a state file whose deletion is its power cycle:
+        #: :mod:`rti_rig.simulator.servo_latch`).
+        self.power_cycle = power_cycle
         self.name = settings.name
         self.clock = clock
         self.kin = ArmKinematics(settings)
@@ -291,12 +289,8 @@ class DynamixelArm(ReadBackCarrier):
         in the RAM area, 2 at power-on (ROBOTIS e-manual, X-series control table)."""
         sid, role = joint.servo_id, self._role(joint)
         fix = (
-            "it is 2 at power-on (RAM area): switch the servos' power off and on, or set "
-            "Status Return Level (address 68) to 2 with Dynamixel Wizard 2.0"
-            if self.powered_between_commands
-            else "it is 2 at power-on (RAM area), and each command finds this emulated "
-            "chain's servos as at power-on (it keeps only their latched errors): run the "
-            "command again"
+            f"it is 2 at power-on (RAM area): {self.power_cycle}, or set Status Return Level "
+            "(address 68) to 2 with Dynamixel Wizard 2.0"
         )
         try:
             level = self._bus.read(sid, ct.STATUS_RETURN_LEVEL, check_alert=False)
@@ -489,6 +483,16 @@ class DynamixelArm(ReadBackCarrier):
                 self.name, f"position limits read back as {again}, wrote {(lo, hi)}", "connect", sid
             )
 
+    def _at_park(self) -> bool:
+        """Whether the arm reads back within :attr:`PARKED_TICKS` of its park pose."""
+        s = self.settings
+        park = self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg)
+        present = self.joint_ticks()
+        return (
+            max(abs(int(a) - int(b)) for a, b in zip(present, park, strict=True))
+            <= self.PARKED_TICKS
+        )
+
     def _check_in_limits(self) -> None:
         """Homing check: refuse to move an arm that powers up outside its safe range or inside
         the keep-out cone (absolute encoders: the reading is the pose, no search needed)."""
@@ -522,32 +526,18 @@ class DynamixelArm(ReadBackCarrier):
         told the torque was off pushed against servos holding under torque. And ``home`` runs
         this check on a connected arm, torque on."""
         on, unknown = self._torque_as_read()
-        if not self.powered_between_commands:
-            # an emulated chain keeps no torque from an earlier command and has no power
-            # switch: "switch the servos' power off and on" was advice no one could follow
-            if on:
-                return (
-                    f"(its torque is ON, as read: {self._servos_named(on)} holding in this "
-                    "command; each command finds this emulated chain's torque off, as at "
-                    "power-on: it keeps only latched errors between commands)"
-                )
-            if unknown:
-                return (
-                    "(whether its torque is off could not be read; each command finds this "
-                    "emulated chain's torque off, as at power-on)"
-                )
-            return "(its torque is off, as read)"
         if on:
             held = self._servos_named(on)
             return (
                 f"(its torque is ON, as read: {held} still holding, e.g. since an earlier "
-                "session with torque_policy = 'hold'; switch the servos' power off and on, "
-                "which starts them with torque off, supporting the arm so that it cannot drop "
-                "onto the object, then move it)"
+                f"session with torque_policy = 'hold'; {self.power_cycle}, which starts them "
+                "with torque off, supporting the arm so that it cannot drop onto the object, "
+                "then move it)"
             )
         if unknown:
             return (
-                "(whether its torque is off could not be read: switch the servos' power off first)"
+                "(whether its torque is off could not be read: power-cycle the servos first, "
+                f"supporting the arm: {self.power_cycle})"
             )
         return "(its torque is off, as read)"
 
@@ -618,13 +608,7 @@ class DynamixelArm(ReadBackCarrier):
 
         Anywhere else a limp arm can drop onto the object, so torque stays on (holding) and the
         reason is logged: close never parks (see :meth:`close`)."""
-        s = self.settings
-        park = self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg)
-        present = self.joint_ticks()
-        if (
-            max(abs(int(a) - int(b)) for a, b in zip(present, park, strict=True))
-            <= self.PARKED_TICKS
-        ):
+        if self._at_park():
             self._bus.broadcast_write(ct.TORQUE_ENABLE, 0)
             self.torque_released = True
             # a broadcast write gets no status reply: whether each servo let go is read back
@@ -715,12 +699,7 @@ class DynamixelArm(ReadBackCarrier):
         on, unknown = self._torque_after_release
         policy = 'torque_policy = "release_on_close"'
         if on:
-            release = (
-                "to release it, support the arm and switch the servos' power off and on"
-                if self.powered_between_commands
-                else "this emulated chain keeps no torque past the command (the next one "
-                "finds its servos as at power-on, torque off)"
-            )
+            release = f"to release it, support the arm and {self.power_cycle}"
             return (
                 f"torque-off sent ({policy}), but Torque Enable reads back ON from "
                 f"{self._servos_named(on)}: that joint still holds (the torque-off, a "

@@ -292,20 +292,21 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     # servo's hardware error (overload …) raised as that packet arrives
     for f in loaded.config.emulator.faults:
         emulator.add_fault(f.at_command, f.kind, f.servo_id)
-    # the chain stays powered between commands: an error latched by an earlier command on
-    # this rig is still set until a Reboot (the recovery, check --reboot-faulted, had found
-    # a fresh servo with nothing to reboot)
-    latch = _keep_latched_errors(loaded, emulator)
+    # the chain stays powered between commands: what its servos hold (torque, pose, RAM, an
+    # error latched by an earlier command on this rig) is still there until a Reboot or a
+    # power cycle (the recovery, check --reboot-faulted, had found a fresh servo with nothing
+    # to reboot; a session that kept torque on had left the next command a limp arm)
+    latch = _keep_powered_state(loaded, emulator)
+    # and kept as the rig closes, after the arm's own close (its torque policy applied)
+    stack.callback(lambda: latch.save_state(emulator.powered_state()), "arm emulator state")
     try:
-        # the advice's power cycle is what clears the emulated chain's kept errors
+        # the advice's power cycle is what clears the emulated chain's kept state
         arm = DynamixelArm(
             settings,
             port,
             clock,
             config_path=loaded.path,
             power_cycle=latch.power_cycle_said(),
-            # only its latched errors outlive a command: its torque and RAM do not
-            powered_between_commands=False,
         )
         camera = _simulated_camera(loaded, _ArmLamp(arm, emulator, settings), clock)
     except BaseException:
@@ -316,17 +317,26 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     return rig
 
 
-def _keep_latched_errors(loaded: LoadedRig, emulator: DynamixelBusEmulator) -> LatchedErrors:
-    """Give the emulated servos the Hardware Error Status an earlier command on this rig left
-    them (a real servo keeps it while powered), and record each change from here on; the
-    state file they are kept in."""
+def _keep_powered_state(loaded: LoadedRig, emulator: DynamixelBusEmulator) -> LatchedErrors:
+    """Give the emulated servos what an earlier command on this rig left them (a real servo
+    keeps its control table, torque, pose and Hardware Error Status while powered), and keep
+    it for the next at each change of an error (as the status goes out, so a crash after it
+    loses none; the caller keeps it again as the rig closes); the state file it is kept in."""
     from rti_rig.simulator.servo_latch import LatchedErrors
 
     latch = LatchedErrors(Path(loaded.path))
-    for dxl_id, bits in latch.load().items():
-        if dxl_id in emulator.servos:
-            emulator.inject_hardware_error(dxl_id, bits)
-    emulator.on_errors_changed = latch.save
+    states = latch.load_state()
+    if states:
+        emulator.restore_powered(states)
+    else:  # a state file of errors alone (kept by an earlier version)
+        for dxl_id, bits in latch.load().items():
+            if dxl_id in emulator.servos:
+                emulator.inject_hardware_error(dxl_id, bits)
+
+    def keep(_errors: object = None) -> None:
+        latch.save_state(emulator.powered_state())
+
+    emulator.on_errors_changed = keep
     return latch
 
 

@@ -110,7 +110,10 @@ def test_a_faulted_servo_whose_torque_is_on_is_left_alone_and_the_user_told_what
         "the arm and delete " in said
     ), said
     # an emulated chain has no power switch: its power cycle is deleting its kept state
-    assert "(where the emulated servos' latched errors are kept: their power off and on)" in said
+    assert (
+        "(where the emulated servos' powered state and latched errors are kept: their power "
+        "off and on)"
+    ) in said
     assert "switch the servos' power" not in said, said
     assert "nothing rebooted; no torque was switched on or off" in said
     assert "RESULT: FAIL" in said

@@ -88,9 +88,10 @@ def test_a_torque_off_that_did_not_reach_the_servos_is_not_called_released(
     said = " ".join(r.output.split())
     assert "torque then released" not in said and "are limp" not in said, said
     assert "torque-off sent" in said and "Torque Enable reads back ON from servo 1" in said, said
-    # an emulated chain has no power switch and keeps no torque into the next command: the
-    # advice to switch its servos' power off and on was one no one could follow
+    # an emulated chain has no power switch but keeps its torque into the next command, as
+    # a powered chain does: its power cycle is deleting its kept state, said to be pasted
     assert "switch the servos' power off and on" not in said, said
-    assert "this emulated chain keeps no torque past the command" in said, said
+    assert "to release it, support the arm and delete " in said, said
+    assert "(where the emulated servos' powered state and latched errors are kept" in said, said
     (emu,) = emulators  # the truth: both still hold
     assert all(s.get(ct.TORQUE_ENABLE) == 1 for s in emu.servos.values())

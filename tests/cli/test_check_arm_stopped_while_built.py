@@ -31,7 +31,7 @@ def test_a_check_stopped_before_the_arm_connects_says_nothing_was_sent_to_it(
     import rti_rig.app.compose as compose
 
     emulators: list[Any] = []
-    real_keep, real_camera = compose._keep_latched_errors, compose._simulated_camera
+    real_keep, real_camera = compose._keep_powered_state, compose._simulated_camera
 
     def keep(loaded: Any, emulator: Any) -> Any:
         emulators.append(emulator)
@@ -41,7 +41,7 @@ def test_a_check_stopped_before_the_arm_connects_says_nothing_was_sent_to_it(
         signal.raise_signal(sig)  # the stop, as the rig is built
         return real_camera(*args, **kwargs)
 
-    monkeypatch.setattr(compose, "_keep_latched_errors", keep)
+    monkeypatch.setattr(compose, "_keep_powered_state", keep)
     monkeypatch.setattr(compose, "_simulated_camera", camera)
     cfg: Path = CONFIGS / "simulated_arm.toml"
     r = CliRunner(env={"COLUMNS": "400"}).invoke(app, ["check", str(cfg)])
