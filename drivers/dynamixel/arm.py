@@ -470,6 +470,7 @@ class DynamixelArm(ReadBackCarrier):
             off = [
                 j.servo_id for j in self.settings.joints if j.model_number in ct.DUAL_AXIS_MODELS
             ]
+        self._refuse_torque_off_away_from_park(joint, off, have, (lo, hi))
         for servo_id in off:
             self._bus.write(servo_id, ct.TORQUE_ENABLE, 0)
         self._bus.write(sid, ct.MIN_POSITION_LIMIT, lo)
@@ -482,6 +483,42 @@ class DynamixelArm(ReadBackCarrier):
             raise ConfigMismatchError(
                 self.name, f"position limits read back as {again}, wrote {(lo, hi)}", "connect", sid
             )
+
+    def _refuse_torque_off_away_from_park(  # type: ignore[no-untyped-def]
+        self, joint, off: list[int], have: tuple[int, int], want: tuple[int, int]
+    ) -> None:
+        """Refuse, before any write, to switch torque off (to write the position limits, EEPROM)
+        on a servo that holds the arm away from its park pose.
+
+        Why: the EEPROM area is writable only with Torque Enable (64) cleared to 0 (ROBOTIS
+        e-manual, X-series control table), so the limits are written torque off; but a
+        servo keeps its torque while powered, and an earlier session may have left the arm
+        holding anywhere (``torque_policy = "hold"``, ``"release_on_close"`` away from park, a
+        crash). The connect had switched it off there without a word: the elevation joint,
+        back-driven by the lamp's weight, drops towards the object. At the park pose the arm
+        rests safely (as ``release_on_close`` judges it); elsewhere nothing is written."""
+        holding = []
+        for j in self.settings.joints:
+            if j.servo_id not in off:
+                continue
+            if self._bus.read(j.servo_id, ct.TORQUE_ENABLE, check_alert=False):
+                holding.append(j)
+        if not holding or self._at_park():
+            return
+        role = self._role(joint)
+        raise SafetyViolation(
+            self.name,
+            f"the {role} servo's Min/Max Position Limit are {have[0]}..{have[1]} but the "
+            f"config gives {want[0]}..{want[1]}, and writing them (EEPROM) needs its torque "
+            f"off, while {self._servos_named(holding)} holds the arm away from its park pose "
+            "(Torque Enable read back ON, e.g. since an earlier session): a torque-off there "
+            "would let the lamp drop onto the object. Nothing was written; park the arm with "
+            "the config's earlier limits (rti-rig check), or support the arm and "
+            f"{self.power_cycle} (the servos then start with torque off), then run the "
+            "command again",
+            "connect",
+            joint.servo_id,
+        )
 
     def _at_park(self) -> bool:
         """Whether the arm reads back within :attr:`PARKED_TICKS` of its park pose."""

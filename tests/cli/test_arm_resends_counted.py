@@ -18,10 +18,11 @@ from typer.testing import CliRunner
 
 from rti_rig.cli import app
 
-#: Commands 12 and 20 of the emulated chain: reads of the connect's limit checks.
+#: Commands 12 and 21 of the emulated chain: reads of the connect's limit checks (21: the
+#: connect reads each servo's Torque Enable before switching it off to write the limits).
 FAULTS = (
     '[[emulator.faults]]\nat_command = 12\nkind = "drop_reply"\n'
-    '[[emulator.faults]]\nat_command = 20\nkind = "garble_reply"'
+    '[[emulator.faults]]\nat_command = 21\nkind = "garble_reply"'
 )
 LINE = (
     "The arm's servos were asked again 2 times after a status packet was lost or damaged "
