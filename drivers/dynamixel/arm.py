@@ -512,8 +512,9 @@ class DynamixelArm(ReadBackCarrier):
             f"config gives {want[0]}..{want[1]}, and writing them (EEPROM) needs its torque "
             f"off, while {self._servos_named(holding)} holds the arm away from its park pose "
             "(Torque Enable read back ON, e.g. since an earlier session): a torque-off there "
-            "would let the lamp drop onto the object. Nothing was written; park the arm with "
-            "the config's earlier limits (rti-rig check), or support the arm and "
+            "would let the lamp drop onto the object. Nothing was written; park the arm "
+            "under the config's earlier limits first (rti-rig check parks it, with "
+            "park_after_session on), or support the arm and "
             f"{self.power_cycle} (the servos then start with torque off), then run the "
             "command again",
             "connect",
