@@ -1,0 +1,53 @@
+"""An emulated servo's powered state, as kept between two rti-rig commands.
+
+A powered servo keeps its RAM and EEPROM and, with torque on, runs its profile to its Goal
+Position; a limp loaded joint falls to its stop (ROBOTIS e-manual, X-series control table,
+Area; Torque Enable (64)). The next command's servo takes up that state, at the end of the
+motion; a record that is not that servo's is met as a power-cycled servo, never an error."""
+
+from __future__ import annotations
+
+from rti_rig.core.clock import VirtualClock
+from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel import protocol2 as p2
+from rti_rig.simulator.dynamixel_emulator import EmulatedServo
+
+
+def _moving(clock: VirtualClock) -> EmulatedServo:
+    servo = EmulatedServo(1, 1060, clock, present_ticks=1000)
+    assert servo.write(ct.PROFILE_VELOCITY.address, (20).to_bytes(4, "little")) == 0
+    assert servo.write(ct.TORQUE_ENABLE.address, b"\x01") == 0
+    assert servo.write(ct.GOAL_POSITION.address, (3000).to_bytes(4, "little")) == 0
+    clock.sleep(0.1)
+    assert servo.is_moving()
+    return servo
+
+
+def test_a_holding_servo_is_taken_up_at_its_goal_with_torque_on() -> None:
+    clock = VirtualClock()
+    state = _moving(clock).powered_state()
+    fresh = EmulatedServo(1, 1060, VirtualClock(), present_ticks=2048)
+    assert fresh.restore_powered(state)
+    assert fresh.get(ct.TORQUE_ENABLE) == 1
+    assert fresh.get(ct.PROFILE_VELOCITY) == 20
+    assert round(fresh.position()) == 3000 and not fresh.is_moving()
+    _, raw = fresh.read(ct.PRESENT_POSITION.address, 4)
+    assert int.from_bytes(raw, "little") == 3000
+    # EEPROM locked under the kept torque, as on the servo
+    assert fresh.write(ct.MAX_POSITION_LIMIT.address, (4000).to_bytes(4, "little")) == (
+        p2.ERR_ACCESS
+    )
+
+
+def test_a_record_of_another_servo_leaves_it_as_at_power_on() -> None:
+    clock = VirtualClock()
+    state = _moving(clock).powered_state()
+    other_model = EmulatedServo(1, 1020, VirtualClock())
+    assert not other_model.restore_powered(state)
+    other_id = EmulatedServo(2, 1060, VirtualClock())
+    assert not other_id.restore_powered(state)
+    damaged = EmulatedServo(1, 1060, VirtualClock())
+    assert not damaged.restore_powered({**state, "table": "zz"})
+    assert not damaged.restore_powered({"table": state["table"]})
+    for servo in (other_model, other_id, damaged):
+        assert servo.get(ct.TORQUE_ENABLE) == 0
