@@ -268,7 +268,6 @@ def run(
         # outright, "drop --lights", the identical request as much as another)
         start = (
             StartOptions(
-                tuple(given),
                 lights=lights,
                 plan=plan,
                 adaptive=adaptive,

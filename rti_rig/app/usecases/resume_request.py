@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
 
 #: Two lights of a plan are the same light within this angle (°): an .lp carries six decimals
 #: (or fewer, rewritten by another program), which moves a direction by far less than this.
@@ -27,9 +28,8 @@ SAME_LIGHT_DEG = 0.01
 @dataclass(frozen=True)
 class StartOptions:
     """The options of ``run`` that begin a session, as given with ``--resume`` (defaults where
-    not given), and the flags as typed (``given``) for the messages."""
+    not given)."""
 
-    given: tuple[str, ...]
     lights: int | None = None
     plan: Path | None = None
     adaptive: bool = False
@@ -158,7 +158,7 @@ def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded:
         if (mine.led, theirs.led) != (None, None):
             differs = mine.led != theirs.led
         else:
-            differs = _angle_deg(mine.direction, theirs.direction) > SAME_LIGHT_DEG
+            differs = float(angle_between_deg(mine.direction, theirs.direction)) > SAME_LIGHT_DEG
         if differs:
             return [f"{what}: its light {i + 1} is {_light(mine)}, the session's {_light(theirs)}"]
     if recorded.method != "plan":  # the band asked, as recorded (the same LEDs or not)
@@ -234,16 +234,8 @@ def _light(step: Any) -> str:
     """``LED 13`` (a dome's), or the light's azimuth/elevation."""
     if step.led is not None:
         return f"LED {step.led}"
-    x, y, z = step.direction
-    az = math.degrees(math.atan2(y, x)) % 360.0
-    el = math.degrees(math.atan2(z, math.hypot(x, y)))
-    return f"az {az:.2f}° el {el:.2f}°"
-
-
-def _angle_deg(a: Any, b: Any) -> float:
-    dot = sum(x * y for x, y in zip(a, b, strict=True))
-    norms = math.sqrt(sum(x * x for x in a) * sum(y * y for y in b))
-    return math.degrees(math.acos(max(-1.0, min(1.0, dot / norms)))) if norms else 180.0
+    az, el = az_el_from_direction(step.direction)
+    return f"az {float(az):.2f}° el {float(el):.2f}°"
 
 
 def _same_number(a: Any, b: Any) -> bool:
