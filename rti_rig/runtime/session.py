@@ -1748,7 +1748,9 @@ def _prepare_resume(
         lost = {i: _lost_files(root, rec, renamed) for i, rec in latest.items()}
         lost = {i: gone for i, gone in lost.items() if gone}
         moved = f"; {renamed_note(renamed)}" if renamed else ""
-        if not reshoot_lost and not lost and not renamed and not unchecked_images(root)[0]:
+        intact = not reshoot_lost and not lost and not renamed
+        # the manifest and journal as read above (they had been read again for this)
+        if intact and not unchecked_images(root, scan, manifest)[0]:
             _refuse_complete(root, manifest, total, finished)
         if manifest.get("adaptive") and finished < total:  # an adaptive session that stopped
             stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
