@@ -399,8 +399,9 @@ def missing_images_advice(
         # been left out, the quotes' edit alone offered for every image)
         tail = others if len(names) < total else ""
         quoted += f"; for the other {rest} not found, {copy}{tail}"
-    named = case_hint(paths)
-    if named and (rest := len(names) - sum(map(len, _name_twins(paths)))):
+    twins, kin = _name_twins(paths)  # listed once (case_hint's own, which had listed again)
+    named = _twins_said(twins, len(paths)) + _kin_said(kin, len(paths))
+    if named and (rest := len(names) - len(twins) - len(kin)):
         # the images with no such file are missing all the same: their way out is said too
         tail = others if len(names) < total else ""
         named += f"; for the other {rest} not found, {copy}{tail}"
