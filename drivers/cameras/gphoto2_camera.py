@@ -714,11 +714,16 @@ class Gphoto2Camera:
                 if isinstance(exc.__cause__, UnsupportedRawError):
                     raise self._unreadable_raw(exc.__cause__) from exc
                 raise
-        finally:
+        except BaseException:
+            # a failed shot (an unreadable RAW, a busy body) leaves the camera's own speed too:
+            # it had been put back only after a shot that decoded, the body left at its
+            # fastest speed by a check that failed. The shot's error is the one said.
             self.output_dir = bound
-        if own is not None and own != self._shutter_label:
-            self._set_config_values({self.settings.shutter_config: (own, "shutter_config")})
-            self._shutter_label = own
+            with contextlib.suppress(Exception):  # the camera is closed next either way
+                self._restore_shutter(own)
+            raise
+        self.output_dir = bound
+        self._restore_shutter(own)
         self._format_note = None  # the shot gave a RAW: nothing left to say of the format
         files = [str(f) for f in frame.metadata.get("camera_files") or []]
         raw = next((f for f in files if is_camera_raw(Path(f))), files[0] if files else "?")
@@ -728,6 +733,12 @@ class Gphoto2Camera:
         # where it landed, and a card copy not deleted: said before any session, not after one
         folder = raw.rsplit("/", 1)[0] or "/"
         return "; ".join([said, *(f"note: {n}" for n in self._where_notices(folder))])
+
+    def _restore_shutter(self, own: str | None) -> None:
+        """Put back the shutter speed the camera had before a test shot (``own``)."""
+        if own is not None and own != self._shutter_label:
+            self._set_config_values({self.settings.shutter_config: (own, "shutter_config")})
+            self._shutter_label = own
 
     def _unreadable_raw(self, exc: UnsupportedRawError) -> CaptureError:
         """The check's refusal of a body whose RAW the installed LibRaw cannot read: the

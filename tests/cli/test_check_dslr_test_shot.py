@@ -95,3 +95,23 @@ def test_a_run_refused_at_its_first_shot_for_an_unreadable_raw_points_to_the_che
     assert f"{LIBRAW} does not read this file's format" in said, said
     assert "`rti-rig check` finds a RAW this LibRaw cannot read with a test shot" in said, said
     assert len(list((out / "raw" / ".incoming").glob("cap0001_IMG_0001.CR2"))) == 1
+
+
+@pytest.mark.parametrize("readable", [True, False], ids=["decoded", "unreadable RAW"])
+def test_the_test_shot_puts_the_camera_s_own_shutter_speed_back_even_when_it_fails(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, readable: bool
+) -> None:
+    """The test shot is taken at the fastest speed offered; the body is left at the speed it
+    had, whether the shot's RAW decoded or not (a failed check had left it at 1/250)."""
+    cfg = _config(tmp_path, "Internal RAM")
+    shot_at: list[str] = []
+
+    def render(body: Body) -> bytes:
+        shot_at.append(body.config["shutterspeed"])
+        return _raw(body) if readable else _unreadable(body)
+
+    body = Body(render=render)
+    r, said, _ = _shot_with(monkeypatch, cfg, body, ["check", str(cfg)])
+    assert r.exit_code == (0 if readable else 1) and "Traceback" not in said, said
+    assert shot_at == ["1/250"], shot_at  # the fastest speed: the shot did change it
+    assert body.config["shutterspeed"] == "1/60", said  # the camera's own, as connect found it
