@@ -315,6 +315,14 @@ class Gphoto2Camera:
                 "a picture taken went into the camera's RAM (capture_target = 'Internal "
                 "RAM'), which keeps it only until the next capture: it cannot be recovered"
             )
+        elif self.settings.capture_target is None:
+            # capture_target = "" leaves the body's own target, never read: where a picture
+            # went is not known (it had been said "on the camera's card")
+            look = (
+                "a picture taken is where the camera's own capture target puts it "
+                '(capture_target = "" leaves it as the camera has it): on its card, newest '
+                "file last, or in its RAM, kept only until the next capture"
+            )
         else:
             look = (
                 "a picture taken is on the camera's card, newest file last: look there "

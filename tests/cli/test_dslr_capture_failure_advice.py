@@ -58,3 +58,21 @@ def test_a_failed_capture_says_the_camera_what_to_do_and_what_is_known_of_the_pi
         assert "it cannot be recovered" in said, said
     else:
         assert "a picture taken is on the camera's card" in said, said
+
+
+def test_a_failed_capture_of_a_camera_left_at_its_own_target_names_no_place_as_known(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """capture_target = "" leaves the body's own target, which rti-rig never reads: a picture
+    the failed capture may have taken is not said to be on the card (nor lost in RAM)."""
+    cfg = _config(tmp_path, "")
+    body = Body(render=_raw, failures={"capture": [-1] * 10})
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "2"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert NOT_KNOWN in said, said
+    assert "a picture taken is on the camera's card" not in said, said
+    assert "it cannot be recovered" not in said, said
+    assert "where the camera's own capture target puts it" in said, said
