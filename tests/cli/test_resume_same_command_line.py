@@ -80,6 +80,10 @@ def test_the_line_the_session_began_with_continues_it(stopped: Path, tmp_path: P
         ),
         (["--lights", "8", "--allow-no-normals"], "--allow-no-normals given; the session had not"),
         (["--adaptive", "--lights", "8"], "the session ran a planned layout; this asks for an"),
+        (
+            ["--lights", "8", "--max-saturated", "0.01"],
+            "--max-saturated 0.01 given; the session was not metered",
+        ),
     ],
 )
 def test_another_request_is_refused_naming_what_differs(
@@ -196,6 +200,11 @@ def test_an_adaptive_session_continues_with_its_own_line(tmp_path: Path) -> None
     assert "--lights 8, the session 7" in said(r) and "It began with --adaptive --lights 7" in said(
         r
     )
+    assert tree(out) == before
+    # a limit no metering reads: refused, as a new adaptive session refuses it
+    r = runner.invoke(app, [*line, "--adaptive", "--lights", "7", "--max-saturated", "0.01"])
+    assert r.exit_code == 2, r.output
+    assert "--max-saturated 0.01: an adaptive session is not metered" in said(r)
     assert tree(out) == before
     r = runner.invoke(app, [*line, "--adaptive", "--lights", "7"])
     assert r.exit_code == 0, r.output

@@ -120,6 +120,8 @@ def _adaptive_differences(asked: StartOptions, header: dict[str, Any]) -> list[s
         diffs.append("--plan: the session chooses its own lights")
     if asked.auto_exposure:
         diffs.append("--auto-exposure: an adaptive session is not metered")
+    elif asked.max_saturated is not None:  # a limit no metering reads, as a new session says
+        diffs.append(f"--max-saturated {asked.max_saturated:g}: an adaptive session is not metered")
     return diffs
 
 
@@ -185,6 +187,10 @@ def _metering_differences(asked: StartOptions, manifest: dict[str, Any]) -> list
                 else "given; the session was not metered"
             )
         ]
+    if not metered and asked.max_saturated is not None:
+        # a limit no metering reads (a new session refuses it without --auto-exposure): it had
+        # gone on, the option ignored in silence
+        return [f"--max-saturated {asked.max_saturated:g} given; the session was not metered"]
     if metered:
         from rti_rig.app.usecases.session import NewSessionRequest
 
