@@ -109,6 +109,23 @@ def test_another_out_folder_is_refused(stopped: Path, tmp_path: Path) -> None:
     assert tree(out) == before and not other.exists()
 
 
+def test_another_rig_given_with_the_sessions_own_options_is_refused_as_another_rig(
+    stopped: Path, tmp_path: Path
+) -> None:
+    """The session's own options on another rig: the rig is named, not the options (its
+    layout compared with the session's had been blamed on --lights 8, the session's own, with
+    the advice to give those very options)."""
+    out = copy_of(stopped, tmp_path)
+    before = tree(out)
+    arm = CONFIGS / "simulated_arm.toml"
+    line = ["run", str(arm), "--out", str(out), "--lights", "8", "--resume", str(out)]
+    r = runner.invoke(app, line)
+    assert r.exit_code == 2, r.output
+    assert "is a rig of kind 'arm', and this session was begun on a 'dome'" in said(r)
+    assert "asks for another session" not in said(r)
+    assert tree(out) == before
+
+
 def test_the_same_plan_continues_its_session_however_its_numbers_are_written(
     tmp_path: Path,
 ) -> None:

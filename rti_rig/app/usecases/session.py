@@ -1674,10 +1674,6 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     loaded = load_rig_config(config_path)
     for note in loaded.notes:
         on_note(Note(note, "warning"))
-    if req.start is not None:  # the session's own options given again, or refused
-        from rti_rig.app.usecases.resume_request import check_same_start
-
-        check_same_start(req.start, manifest, loaded, Path(req.session_dir))
     from rti_rig.app.flash_sync import flash_sync_of, refuse_options
 
     runner = manifest.get("runner") or {}
@@ -1693,9 +1689,20 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         )
     refuse_options(loaded, **{"--resume": True})
     _refuse_image_sequence_resume(loaded, Path(req.session_dir))
+    # the rig first: another rig given with the session's own options is refused as another
+    # rig (its layout compared with the session's had been blamed on the options, with the
+    # advice to give those very options); its notes (an accepted change) said only once the
+    # options are found the session's own
+    rig_notes: list[Note] = []
     identity, diffs = check_resume_rig(
-        manifest, loaded, config_path, req.accept_rig_change, on_note, req.session_dir
+        manifest, loaded, config_path, req.accept_rig_change, rig_notes.append, req.session_dir
     )
+    if req.start is not None:  # the session's own options given again, or refused
+        from rti_rig.app.usecases.resume_request import check_same_start
+
+        check_same_start(req.start, manifest, loaded, Path(req.session_dir))
+    for note in rig_notes:
+        on_note(note)
     check_done = None
     if "adaptive" in manifest:
         from rti_rig.app.usecases.adaptive import refuse_broken_run
