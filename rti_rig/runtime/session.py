@@ -1901,11 +1901,18 @@ def _refuse_complete(root: Path, manifest: dict[str, Any], total: int, finished:
         )
     else:
         done = f"this session is complete: all {finished} steps were captured"
-    raise SessionComplete(
+    said = (
         f"{root}: {done}, and every image is as captured (each JPEG and linear TIFF matches "
-        "its journaled checksum); nothing to resume, nothing was changed",
-        f"rti-rig fit {folder} --out FOLDER (FOLDER new or empty, outside the session)",
+        "its journaled checksum); nothing to resume, nothing was changed"
     )
+    fit = f"rti-rig fit {folder} --out FOLDER (FOLDER new or empty, outside the session)"
+    if not (root / LP_NAME).is_file():
+        # fit refuses a session folder without it (naming export-lp): the next step had been
+        # named as fit alone, which then failed
+        said += f"; only its {LP_NAME} is missing"
+        own = shlex.quote(str(root / LP_NAME))
+        fit = f"rti-rig export-lp {folder} --out {own} writes it from the journal, then {fit}"
+    raise SessionComplete(said, fit)
 
 
 #: How a run that did not finish ended, by the manifest's finish_reason (for a refusal).

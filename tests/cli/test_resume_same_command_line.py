@@ -278,3 +278,21 @@ def test_a_run_that_recorded_no_end_is_marked_unrecorded_not_crashed(
     assert r.exit_code == 0, r.output
     runs = manifest(out)["runs"]
     assert [run.get("finish_reason") for run in runs] == ["unrecorded", "completed"]
+
+
+def test_a_complete_session_without_its_lights_lp_names_export_lp_before_fit(
+    stopped: Path, tmp_path: Path
+) -> None:
+    """Its images are all there, so it is complete; but fit refuses a session folder without
+    its lights.lp, so the next step named is the export-lp that writes it, then fit (it had
+    named fit alone, which then failed)."""
+    out = copy_of(stopped, tmp_path)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    (out / "lights.lp").unlink()
+    before = tree(out)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "this session is complete" in said(r) and "only its lights.lp is missing" in said(r)
+    assert f"Next: rti-rig export-lp {out} --out {out / 'lights.lp'} writes it" in said(r)
+    assert tree(out) == before
