@@ -296,3 +296,23 @@ def test_a_complete_session_without_its_lights_lp_names_export_lp_before_fit(
     assert "this session is complete" in said(r) and "only its lights.lp is missing" in said(r)
     assert f"Next: rti-rig export-lp {out} --out {out / 'lights.lp'} writes it" in said(r)
     assert tree(out) == before
+
+
+def test_a_completed_sessions_journal_rebuild_refuses_the_options_it_cannot_check(
+    stopped: Path, tmp_path: Path
+) -> None:
+    """The rebuild of a completed session's journal opens no rig, so the options given with it
+    are compared with nothing: refused, the folder as it was (they had gone on unsaid)."""
+    out = copy_of(stopped, tmp_path)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    (out / "journal.jsonl").unlink()
+    before = tree(out)
+    line = ["run", "--resume", str(out), "--rebuild-journal"]
+    r = runner.invoke(app, [*line, "--lights", "9", "--auto-exposure"])
+    assert r.exit_code == 2, r.output
+    assert "so --lights, --auto-exposure would change nothing" in said(r), r.output
+    assert "drop them" in said(r) and tree(out) == before
+    r = runner.invoke(app, line)
+    assert r.exit_code == 0, r.output
+    assert (out / "journal.jsonl").is_file()

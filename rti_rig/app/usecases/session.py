@@ -1634,6 +1634,15 @@ def rebuild_finished_session(req: ResumeRequest) -> list[str] | None:
     manifest = read_manifest(req.session_dir)
     if (manifest.get("runner") or {}).get("finish_reason") != "completed":
         return None
+    if req.start is not None:
+        # no rig is read here to compare them with (the session's own or not): refused, as
+        # before they could be given again with --resume (they had gone unchecked, unsaid)
+        raise RtiRigError(
+            f"{req.session_dir}: --rebuild-journal of a session that completed opens no rig "
+            f"and shoots nothing, so {', '.join(req.start.given)} would change nothing "
+            "(nothing in the folder was changed): drop "
+            + ("it" if len(req.start.given) == 1 else "them")
+        )
     return rebuild_finished_journal(Path(req.session_dir))
 
 
