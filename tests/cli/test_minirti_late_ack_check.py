@@ -25,7 +25,9 @@ def test_a_late_ack_is_not_counted_for_the_resent_light(tmp_path: Path) -> None:
     assert "reply_timeout_s = 3.0" in text
     faults = (
         "\n[emulator]\nfaults = [\n"
-        '  {at_command = 2, kind = "delay_reply", delay_s = 3.3},  # after the 3 s timeout\n'
+        # after the 3 s timeout, 1.5 s from either edge of the 3 s more the driver waits for
+        # it (nearer an edge, a loaded machine could move it across)
+        '  {at_command = 2, kind = "delay_reply", delay_s = 4.5},\n'
         '  {at_command = 3, kind = "drop_reply"},  # the resent light: taken, not acknowledged\n'
         "]\n"
     )

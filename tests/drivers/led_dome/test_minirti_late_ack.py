@@ -32,8 +32,11 @@ pytestmark = [
 
 REPLY_TIMEOUT_S = 3.0
 #: The first command's acknowledgement comes this long after the command: after the driver's
-#: reply timeout, and well inside the one more reply timeout it waits for an owed one.
-LATE_S = REPLY_TIMEOUT_S + 0.3
+#: reply timeout, and before the end of the one more reply timeout it waits for an owed one —
+#: half a timeout (1.5 s) from either edge, so a test thread or the emulator's thread held up
+#: by a loaded machine cannot move the byte across one (at + 0.3 s a driver read delayed by
+#: 0.3 s would have taken it as the first command's own, on time).
+LATE_S = REPLY_TIMEOUT_S * 1.5
 
 
 def eventually(predicate, timeout_s: float = 10.0) -> bool:  # type: ignore[no-untyped-def]
