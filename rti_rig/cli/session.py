@@ -279,6 +279,7 @@ def run(
                 max_elevation_deg=max_elevation_deg,
                 allow_no_normals=allow_no_normals,
                 objective=objective,
+                given=tuple(given),
             )
             if given
             else None

@@ -206,6 +206,24 @@ def test_an_arm_plan_is_compared_light_by_light_within_its_numbers(tmp_path: Pat
     assert "3 of 8 images verified on disk" in said(r)
 
 
+def test_an_arm_band_that_moves_the_lights_is_named_not_the_sessions_own_lights(
+    tmp_path: Path,
+) -> None:
+    """On an arm a band moves every light: the refusal had named ``--lights 6`` (the
+    session's own) and its first light, not the ``--min-elevation-deg`` that differs."""
+    arm = CONFIGS / "simulated_arm.toml"
+    out = tmp_path / "s"
+    run = cut_new_session(NewSessionRequest(arm, out, lights=6), after_step=2)
+    assert run.finish_reason is FinishReason.CANCELLED
+    before = tree(out)
+    line = ["run", str(arm), "--out", str(out), "--lights", "6", "--resume", str(out)]
+    r = runner.invoke(app, [*line, "--min-elevation-deg", "30"])
+    assert r.exit_code == 2, r.output
+    assert "--min-elevation-deg 30, the session 0" in said(r), r.output
+    assert "its light 1 is" not in said(r)
+    assert tree(out) == before
+
+
 def test_an_adaptive_session_continues_with_its_own_line(tmp_path: Path) -> None:
     out = tmp_path / "s"
     run = interrupted(DOME, out, after_step=4, lights=7)

@@ -43,6 +43,9 @@ class StartOptions:
     allow_no_normals: bool = False
     #: ``--objective`` (checked by the resume itself; here it is part of an adaptive request)
     objective: str | None = None
+    #: the flags as typed, for the refusals that name them (``--rebuild-journal`` of a completed
+    #: session, which reads no rig to compare them with)
+    given: tuple[str, ...] = ()
 
     @property
     def is_adaptive(self) -> bool:
@@ -152,8 +155,11 @@ def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded:
     if (wanted.method == "plan") != (recorded.method == "plan"):
         began = "a plan" if recorded.method == "plan" else "a homogeneous layout"
         return [f"{what} gives {_layout(wanted)}; the session ran {began}"]
+    # the band asked, as recorded (the same LEDs or not); a band that differs is what moved
+    # the lights, so it is named rather than the --lights that was the session's own
+    band = _band_differences(asked, recorded.provenance or {}) if recorded.method != "plan" else []
     if len(wanted) != len(recorded):
-        return [f"{what} gives {len(wanted)} lights; the session has {len(recorded)}"]
+        return [f"{what} gives {len(wanted)} lights; the session has {len(recorded)}", *band]
     for i, (mine, theirs) in enumerate(zip(wanted.steps, recorded.steps, strict=True)):
         # a dome's light is its LED (its recorded direction moves with a recalibration the
         # resume accepts with --accept-rig-change); an arm's is its direction
@@ -162,11 +168,10 @@ def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded:
         else:
             differs = float(angle_between_deg(mine.direction, theirs.direction)) > SAME_LIGHT_DEG
         if differs:
-            return [f"{what}: its light {i + 1} is {_light(mine)}, the session's {_light(theirs)}"]
-    if recorded.method != "plan":  # the band asked, as recorded (the same LEDs or not)
-        band = _band_differences(asked, recorded.provenance or {})
-        if band:
-            return band
+            said = f"{what}: its light {i + 1} is {_light(mine)}, the session's {_light(theirs)}"
+            return band or [said]
+    if band:
+        return band
     allowed = bool((recorded.provenance or {}).get("allow_no_normals", False))
     if allowed != asked.allow_no_normals:
         return [
