@@ -11,6 +11,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, AnyStr, NamedTuple
@@ -736,3 +737,15 @@ def opened_session_kept(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
 
     monkeypatch.setattr(session_usecase, "run_opened_session", run_opened_session)
     return seen
+
+
+def eventually(predicate: Callable[[], object], timeout_s: float = 10.0) -> bool:
+    """True once ``predicate()`` is; bytes on a pty reach the emulator's thread after a delay
+    the CPU load decides, so a record is read once it has caught up (bounded: False if it has
+    not within ``timeout_s``)."""
+    end = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > end:
+            return False
+        time.sleep(0.005)
+    return True

@@ -11,6 +11,7 @@ import time
 
 import pytest
 import serial
+from conftest import eventually
 
 from rti_rig.simulator.domes import board_for
 from rti_rig.simulator.pty_link import serve_on_pty
@@ -62,16 +63,6 @@ def test_a_quick_close_and_reopen_resets_the_board_again() -> None:
         assert boots(board) == 2
         # and it booted lit again, as the sketch's setup() does at every reset
         assert board.lit == frozenset(range(64))
-
-
-def eventually(predicate, timeout_s: float = 10.0) -> bool:  # type: ignore[no-untyped-def]
-    """True once ``predicate()`` is (bounded): the pty hands bytes over when the CPU allows."""
-    end = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > end:
-            return False
-        time.sleep(0.005)
-    return True
 
 
 def test_a_native_usb_board_works_at_any_baud_rate() -> None:

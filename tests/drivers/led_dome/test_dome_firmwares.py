@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, line_within
+from conftest import CONFIGS, eventually, line_within
 from typer.testing import CliRunner
 
 from rti_rig.app.compose import build_rig
@@ -56,17 +56,6 @@ PROBED = ["nab-rti-v1", "rtipy", "minirti", "elexol-24r1", "nichlock"]
 
 def said(result) -> str:  # type: ignore[no-untyped-def]
     return " ".join(result.output.split())
-
-
-def eventually(predicate, timeout_s: float = 10.0) -> bool:  # type: ignore[no-untyped-def]
-    """True once ``predicate()`` is; bytes on a pty reach the emulator's thread after a delay
-    the CPU load decides, so the record is read once it has caught up (bounded)."""
-    end = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > end:
-            return False
-        time.sleep(0.005)
-    return True
 
 
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware

@@ -14,9 +14,9 @@ acknowledgement, real bytes on a pty to real pyserial.
 from __future__ import annotations
 
 import sys
-import time
 
 import pytest
+from conftest import eventually
 
 from rti_rig.core.dome_link import DomeLinkError, LinkFault
 from rti_rig.drivers.led_dome.factory import build_driver
@@ -37,15 +37,6 @@ REPLY_TIMEOUT_S = 3.0
 #: by a loaded machine cannot move the byte across one (at + 0.3 s a driver read delayed by
 #: 0.3 s would have taken it as the first command's own, on time).
 LATE_S = REPLY_TIMEOUT_S * 1.5
-
-
-def eventually(predicate, timeout_s: float = 10.0) -> bool:  # type: ignore[no-untyped-def]
-    end = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > end:
-            return False
-        time.sleep(0.005)
-    return True
 
 
 @pytest.mark.parametrize("second", ["light", "all off"])
