@@ -52,6 +52,50 @@ def _flags_show_no_type() -> None:
 _flags_show_no_type()
 
 
+def _is_path_annotation(annotation: object) -> bool:
+    """Whether a parameter's annotation is ``Path`` or a list of them (``fit S1 S2 …``)."""
+    import typing
+    from pathlib import Path
+
+    if annotation is Path:
+        return True
+    return typing.get_origin(annotation) is list and typing.get_args(annotation) == (Path,)
+
+
+def _empty_paths_refused() -> None:
+    """Refuse an empty path (``--out ""``, ``fit ""``) on every command as a usage error
+    (exit 2) naming the option, before any command runs.
+
+    Why: a path given as the empty string became ``Path("")``, the current folder: a script's
+    ``--out "$part"`` with ``part`` unset wrote its session into whatever empty folder the
+    script ran in (or was refused as ". is not empty", naming no empty argument), and
+    ``--resume ""`` resumed the current folder. An empty string is never a folder or file a
+    user meant; ``.`` is still accepted when written as such."""
+    from typer.core import _TyperParameter
+
+    original = _TyperParameter.process_value
+    if getattr(original, "_rti_rig", False):
+        return
+
+    def process_value(self, ctx, value):  # type: ignore[no-untyped-def]
+        if _is_path_annotation(self.type_descriptor.annotation):
+            given = value if isinstance(value, list | tuple) else [value]
+            if any(isinstance(v, str) and v == "" for v in given):
+                raise typer.BadParameter(
+                    "an empty path (a shell variable that was not set?): give a folder or "
+                    "file, or '.' for the current folder",
+                    ctx=ctx,
+                    param=self,
+                )
+        return original(self, ctx, value)
+
+    process_value._rti_rig = True  # type: ignore[attr-defined]
+    _TyperParameter.process_value = process_value  # type: ignore[method-assign]
+
+
+_empty_paths_refused()
+
+
 def reflowed(doc: str) -> str:
     """``doc`` with the line breaks inside each paragraph made spaces (blank lines still part
     paragraphs). Why: typer's rich help keeps a docstring's source line breaks, so ``--help``
