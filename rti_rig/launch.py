@@ -16,9 +16,38 @@ def main() -> None:
     """Import the command line and run it; a Ctrl-C no command handled ends quietly. However
     it ends, the exit status is the one raised here (see :func:`_exit_as_said`)."""
     try:
+        _standard_streams_opened()
         _main()
     finally:
         _exit_as_said()
+
+
+def _standard_streams_opened() -> None:
+    """Give a standard stream the process was started without (``>&-``, ``2>&-``, ``<&-``,
+    a supervisor that closed it) ``/dev/null``, as a daemon does, before anything is opened.
+
+    Why: Python then leaves ``sys.stdout`` (or ``sys.stderr``) ``None``, and the first word
+    printed raised ``AttributeError``: ``run … >&-`` ended before its session began with a
+    traceback and exit 1, and ``run … --lights 200 2>&-`` exited 1, not the refusal's 2. And
+    the closed descriptor is the lowest free one: the next file opened (a session file, the
+    dome's serial port) would have become descriptor 1 or 2, where a library's or a child
+    process's output goes. The words are dropped, as the caller chose; the exit code and the
+    session's files say what happened."""
+    import os
+
+    for fd, mode in ((0, os.O_RDONLY), (1, os.O_WRONLY), (2, os.O_WRONLY)):
+        try:
+            os.fstat(fd)
+        except OSError:
+            devnull = os.open(os.devnull, mode)
+            if devnull != fd:
+                os.dup2(devnull, fd)
+                os.close(devnull)
+    for name, fd, mode in (("stdin", 0, "r"), ("stdout", 1, "w"), ("stderr", 2, "w")):
+        if getattr(sys, name) is None:
+            stream = open(fd, mode, encoding="utf-8", errors="backslashreplace", closefd=False)  # noqa: SIM115
+            setattr(sys, name, stream)
+            setattr(sys, f"__{name}__", stream)
 
 
 def _exit_as_said() -> None:
