@@ -299,26 +299,45 @@ class ReaderGoneTolerant:
     made safe or a fault rti-rig did not name"), its summary and verdict unsaid; one broken
     mid-capture would have ended the capture. The words are for people; the session's files
     hold what happened. The stream's file descriptor is pointed at ``/dev/null`` (not merely
-    this wrapper), so the interpreter's own flush at exit cannot fail either."""
+    this wrapper), so the interpreter's own flush at exit cannot fail either.
 
-    def __init__(self, stream) -> None:  # type: ignore[no-untyped-def]
+    Any other failed write is taken the same way (a log file whose disk is full, ``EFBIG``, a
+    terminal gone with its ssh connection, ``EIO``), said once on stderr where stdout failed:
+    ``run … > log`` with the log's disk full had ended with a traceback and exit 1 at its first
+    line, and a disk that filled during the capture (a session and its log often share one)
+    would have ended the capture at the next progress update, from a print."""
+
+    def __init__(self, stream, said_on=None) -> None:  # type: ignore[no-untyped-def]
         self._stream = stream
+        #: where a failure other than a gone reader is said (stdout's: stderr), or nowhere
+        self._said_on = said_on
 
     def write(self, text: str) -> int:
         try:
             return self._stream.write(text)
-        except BrokenPipeError:
-            self._reader_gone()
+        except OSError as exc:
+            self._reader_gone(exc)
             return len(text)
 
     def flush(self) -> None:
         try:
             self._stream.flush()
-        except BrokenPipeError:
-            self._reader_gone()
+        except OSError as exc:
+            self._reader_gone(exc)
 
-    def _reader_gone(self) -> None:
+    def _reader_gone(self, exc: OSError | None = None) -> None:
         import os
+
+        if exc is not None and not isinstance(exc, BrokenPipeError) and self._said_on:
+            said_on, self._said_on = self._said_on, None  # said once
+            try:
+                said_on.write(
+                    f"note: output could not be written ({exc.strerror or exc}): the rest of "
+                    "it is dropped; the exit code and the files written say what happened\n"
+                )
+                said_on.flush()
+            except (OSError, ValueError):
+                pass
 
         devnull = os.open(os.devnull, os.O_WRONLY)
         try:
@@ -335,7 +354,7 @@ def reader_gone_tolerated() -> None:
     :class:`ReaderGoneTolerant` (the console entry only, as :func:`unwrapped_when_piped`)."""
     import sys
 
-    out.file = ReaderGoneTolerant(sys.stdout)
+    out.file = ReaderGoneTolerant(sys.stdout, said_on=sys.stderr)
     err.file = ReaderGoneTolerant(sys.stderr)
 
 
