@@ -287,6 +287,23 @@ def unwrapped_when_piped() -> None:
     for console in (out, err):
         if not console.is_terminal:
             console.soft_wrap = True
+    if not err.is_terminal:
+        _usage_errors_plain()
+
+
+def _usage_errors_plain() -> None:
+    """Say a usage error (an unknown option, a bad value) as click's plain lines, not typer's
+    box: where stderr is not a terminal, the box was drawn at 80 columns and its message
+    wrapped inside it (``│ Invalid value for '--out': an empty path (a shell variable that
+    was not      │`` / ``│ set?) …``), so a log kept the message in pieces between box
+    characters. Typer looks its formatter up at each error, so replacing it here is enough;
+    a terminal keeps the box."""
+    from typer import rich_utils
+
+    def plain(exc) -> None:  # type: ignore[no-untyped-def]
+        exc.show()
+
+    rich_utils.rich_format_error = plain  # type: ignore[assignment]
 
 
 class ReaderGoneTolerant:
