@@ -17,6 +17,7 @@ def main() -> None:
     it ends, the exit status is the one raised here (see :func:`_exit_as_said`)."""
     try:
         _standard_streams_opened()
+        _unencodable_replaced()
         _main()
     finally:
         _exit_as_said()
@@ -48,6 +49,24 @@ def _standard_streams_opened() -> None:
             stream = open(fd, mode, encoding="utf-8", errors="backslashreplace", closefd=False)  # noqa: SIM115
             setattr(sys, name, stream)
             setattr(sys, f"__{name}__", stream)
+
+
+def _unencodable_replaced() -> None:
+    """Print a character stdout's encoding cannot hold as ``?``, not raise (stderr already
+    prints it as ``\\u2192``).
+
+    Why: the words hold ``→``, ``°``, ``━`` and the user's own paths; with a legacy encoding
+    (a Latin-1 locale, ``PYTHONIOENCODING=ascii``, Windows' code page for a redirected
+    stream) the first of them raised ``UnicodeEncodeError``: ``run`` ended with a traceback and
+    exit 1 before its session began, or could have mid-capture. The words are for people: one
+    character of them replaced is no loss; the files keep every name as it is."""
+    from contextlib import suppress
+
+    stream = sys.stdout  # stderr's errors are backslashreplace already (Python's default)
+    encoding = (getattr(stream, "encoding", None) or "").lower().replace("_", "-")
+    if not encoding.startswith("utf"):
+        with suppress(AttributeError, ValueError, OSError):  # not a stream to reconfigure
+            stream.reconfigure(errors="replace")
 
 
 def _exit_as_said() -> None:
