@@ -175,6 +175,10 @@ class DynamixelArm(ReadBackCarrier):
         self._say: Callable[[str], None] | None = None
         #: Every line said through :meth:`_tell`, in order (what the user was told).
         self.said: list[str] = []
+        #: What the last failed connect read of the torque before it let the port go
+        #: (:meth:`holding_after_failed_connect`); None: no connect failed since the last one
+        #: that completed, or its port never opened.
+        self._holding_found: str | None = None
 
     @property
     def ever_connected(self) -> bool:
@@ -216,16 +220,77 @@ class DynamixelArm(ReadBackCarrier):
             self._send_goal(self.joint_ticks(), "connect")
             for joint in self.settings.joints:
                 self._bus.write(joint.servo_id, ct.TORQUE_ENABLE, 1)
-        except BaseException:
+        except BaseException as exc:
+            # read-only, and not after a stop (Ctrl-C ends the connect at once)
+            self._holding_found = (
+                self._read_holding_after_failed_connect() if isinstance(exc, Exception) else None
+            )
             self._bus.close()
             raise
         self._connected = self._ever_connected = True
+        self._holding_found = None
         self.torque_released = False
         self._torque_after_release = ([], [])
         self._torque_at_close = None
         self._lamp_on = False
         self._emergency_stopped = False
         self._goal = self.joint_ticks()  # multi-turn choices start from where the arm is
+
+    def holding_after_failed_connect(self) -> str | None:
+        """What the last failed connect established of the servos' torque, as a clause for the
+        user (None: no connect failed, or its port never opened: nothing could be read).
+
+        Why: a servo keeps Torque Enable (64) while it stays powered (ROBOTIS e-manual,
+        X-series control table: RAM is reset only at power-on), so an arm an earlier command
+        left holding (``torque_policy = "hold"``, a crash, a check with park_after_session
+        off) still holds the lamp wherever it stopped. A connect that failed before writing
+        anything was said as "nothing was commanded: the arm could not be connected" and
+        "NOT parked", with no word that the arm was still powered, holding the lamp away
+        from its park pose: a user reaching in to fix the fault met a live arm."""
+        return self._holding_found
+
+    def _read_holding_after_failed_connect(self) -> str | None:
+        """Read Torque Enable (and, of a holding arm, where it is) after a failed connect,
+        read-only, before the port is let go; None if the port never opened."""
+        if not getattr(self._bus.port, "is_open", False):
+            return None
+        on: list[Any] = []
+        unread: list[Any] = []
+        for joint in self.settings.joints:
+            try:
+                if self._bus.read(joint.servo_id, ct.TORQUE_ENABLE, check_alert=False):
+                    on.append(joint)
+            except Exception:  # what could not be read is said as unknown, never as off
+                unread.append(joint)
+        advice = (
+            "support the lamp before touching the arm, and switch the arm's power off "
+            f"({self.power_cycle}) or fix the fault and run the command again (its park "
+            "moves the lamp to the park pose)"
+        )
+        if on:
+            where = ""
+            try:
+                az, el = self.kin.pose_of_ticks(*self.joint_ticks())
+                place = "at its park pose" if self._at_park() else "away from its park pose"
+                where = f" at az {az:.1f}°, el {el:.1f}° (read back, {place})"
+            except Exception:
+                where = " (where could not be read)"
+            unknown = f"; {self._servos_named(unread)} did not answer the read" if unread else ""
+            return (
+                f"but the arm is still powered and holding the lamp{where}: "
+                f"{self._servos_named(on)} read Torque Enable ON (left on by an earlier "
+                f"command){unknown}; {advice}"
+            )
+        if unread:
+            answered = [j for j in self.settings.joints if j not in unread]
+            off = f" ({self._servos_named(answered)} read torque off)" if answered else ""
+            return (
+                f"whether the arm is still holding the lamp under torque is not known: "
+                f"{self._servos_named(unread)} did not answer a read of Torque Enable"
+                f"{off}, and an earlier command may have left it on; treat the arm as "
+                f"powered: {advice}"
+            )
+        return "every servo read its torque off"
 
     def _check_servo(self, joint) -> None:
         sid, dev = joint.servo_id, self.name

@@ -223,6 +223,13 @@ class ReadBackCarrier(Protocol):
         """Whether anything that could leave a servo driven was ever sent (any write but a
         torque-off or an EEPROM write)."""
 
+    def holding_after_failed_connect(self) -> str | None:
+        """What a failed connect read of the torque before letting the port go, as a clause
+        for the user ("but the arm is still powered and holding the lamp …"); None: nothing
+        was read (no connect failed, or its port never opened). Not abstract: a carrier that
+        reads nothing back at a failed connect says nothing more than before."""
+        return None
+
     @abstractmethod
     def check_held(self) -> None:
         """Raise unless the arm still holds, fault-free, the pose its last move reached."""

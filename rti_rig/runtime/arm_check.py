@@ -225,15 +225,20 @@ def not_connected_sentence(carrier: object, connected: bool | None = None) -> st
         connected = read_back is None or read_back.ever_connected
     if connected:
         return None
+    # what the failed connect read of the torque before it let the port go: an arm an
+    # earlier command left holding still holds (its RAM kept while powered), and "nothing
+    # was commanded … NOT parked" had been all a user reaching in to fix the fault was told
+    found = read_back.holding_after_failed_connect() if read_back is not None else None
+    tail = f"; {found}" if found else ""
     if read_back is not None and not read_back.commanded:
-        return "nothing was commanded: the arm could not be connected"
+        return "nothing was commanded: the arm could not be connected" + tail
     if read_back is not None and not read_back.driven:
         # only torque-off and EEPROM writes went out (the position limits a first connect
         # writes): "a servo may be holding under torque" had been said beside a refusal that
         # had just read every servo's torque off
         return (
             "the arm could not be connected; rti-rig switched no servo's torque on (it only "
-            "switched torque off to write servo settings)"
+            "switched torque off to write servo settings)" + tail
         )
     return (
         "the arm's connection failed part-way, after settings were written to its servos: a "
