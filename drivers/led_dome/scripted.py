@@ -33,6 +33,45 @@ traffic_log = logging.getLogger("rti_rig.dome.traffic")
 
 #: Extra seconds the host allows past the end of a timed LED's on-window.
 TIMED_MARGIN_S = 0.05
+#: The port's latency counted for a reply to be heard once its last byte is on the wire: a
+#: USB-serial adapter hands its bytes on when its latency timer runs out, 16 ms by default on
+#: the FTDI chips of many Arduino clones (an allowance: a board that is quicker loses 16 ms of
+#: the longest exposure admitted, one that is slower is caught by the all-off's own check).
+REPLY_LATENCY_S = 0.016
+
+
+def timed_reply_s(spec: ProtocolSpec) -> float:
+    """How long after a timed LED lights its light command's reply is all heard, the host's
+    capture beginning only then: the longest reply over the LEDs wired, on the wire at the
+    profile's baud rate, plus :data:`REPLY_LATENCY_S`; 0 for a firmware that is not timed.
+
+    Why: RTIPy's sketch (BeebBenjamin/RTIPy, ``arduino/rti_py/rti_py.ino``) prints ``I
+    received: <command> the instructionByte was: T`` and then lights the LED and blocks for
+    ``secs``, so the LED lights as the reply starts out of the board's transmit buffer (the
+    driver counts the window from there, :meth:`ScriptedDomeDriver.light`). The load-time
+    check of the exposure against the window (:func:`rti_rig.app.config.timed_exposure_limit`)
+    had counted the capture from the LED lighting, not from the reply's end, about 50 ms (46
+    characters at 9600 baud) plus the port's latency later: an exposure it admitted, at its
+    "at most" figure, had every capture refused by the all-off ("went dark by itself")."""
+    reply = spec.light.reply if spec.window_s is not None else None
+    if reply is None or reply.kind == "none":
+        return 0.0
+    if reply.kind == "byte":
+        chars = 1
+    elif reply.pattern is None:
+        return REPLY_LATENCY_S
+    else:
+        chars = max(
+            len(
+                re.sub(
+                    r"\\(.)", r"\1", reply.pattern.format(**spec.values(i, frozenset()), mask="")
+                )
+            )
+            for i in range(spec.led_count)
+        )
+    return chars * 10.0 / spec.baudrate + REPLY_LATENCY_S
+
+
 #: Characters of the text heard since the port opened that are kept to look for a banner in
 #: (the longest built-in banner, nichlock's, is under 1 kB).
 HEARD_KEPT = 4096

@@ -1253,10 +1253,11 @@ def _check_firmware_led_count(rig: LoadedRig, count: int) -> None:
 class TimedExposureLimit(BaseModel):
     """The longest exposure a timed firmware's self-timed on-window leaves room for.
 
-    The window (``light_on_s`` sent as whole seconds) starts when the firmware answers the light
-    command; the capture must end inside it: the all-off after each capture refuses an image
-    whose LED went dark first (``ScriptedDomeDriver._wait_window``), and a camera's capture ends
-    after the settle, the exposure, the readout and the transfer.
+    The window (``light_on_s`` sent as whole seconds) starts as the firmware's reply to the
+    light command starts (RTIPy prints it, then lights the LED); the capture must end inside
+    it: the all-off after each capture refuses an image whose LED went dark first
+    (``ScriptedDomeDriver._wait_window``), and a camera's capture ends after the reply is all
+    heard (``reply_s``), the settle, the exposure, the readout and the transfer.
     """
 
     model_config = ConfigDict(frozen=True)
@@ -1269,10 +1270,21 @@ class TimedExposureLimit(BaseModel):
     settle_s: float
     readout_s: float
     transfer_s: float
+    #: From the LED lighting to its light command's reply all heard, when the capture begins:
+    #: the reply on the wire plus the port's latency (RTIPy prints it, then lights the LED:
+    #: :func:`rti_rig.drivers.led_dome.scripted.timed_reply_s`).
+    reply_s: float = 0.0
 
     @property
     def max_exposure_s(self) -> float:
-        return self.window_s + self.margin_s - self.settle_s - self.readout_s - self.transfer_s
+        return (
+            self.window_s
+            + self.margin_s
+            - self.reply_s
+            - self.settle_s
+            - self.readout_s
+            - self.transfer_s
+        )
 
     def window_said(self) -> str:
         where = (
@@ -1287,10 +1299,10 @@ class TimedExposureLimit(BaseModel):
         )
 
     def refusal(self, cam: CameraConfig) -> str:
-        total = self.settle_s + cam.exposure_s + self.readout_s + self.transfer_s
+        total = self.reply_s + self.settle_s + cam.exposure_s + self.readout_s + self.transfer_s
         need = math.ceil(total - self.margin_s - 1e-9)
         room = self.max_exposure_s
-        fixed = self.settle_s + self.readout_s + self.transfer_s
+        fixed = self.reply_s + self.settle_s + self.readout_s + self.transfer_s
         shorten = (
             f"shorten exposure_s to at most {room:.3g} s"
             if room >= cam.min_exposure_s
@@ -1299,7 +1311,8 @@ class TimedExposureLimit(BaseModel):
         )
         return (
             f"{cam.exposure_s:g} s does not fit: {self.window_said()}, and each capture must end "
-            f"while its LED is lit (timing.settle_s {self.settle_s:g} + camera.exposure_s "
+            f"while its LED is lit (the firmware's reply {self.reply_s:.3f} s, heard after "
+            f"the LED lights, + timing.settle_s {self.settle_s:g} + camera.exposure_s "
             f"{cam.exposure_s:g} + timing.readout_s {self.readout_s:g} + timing.transfer_s "
             f"{self.transfer_s:g} = {total:.3g} s from the LED lighting to the end of the "
             f"capture); on the dome every capture would be refused. Raise "
@@ -1310,7 +1323,7 @@ class TimedExposureLimit(BaseModel):
 def timed_exposure_limit(rig: LoadedRig) -> TimedExposureLimit | None:
     """The exposure limit a timed firmware's on-window sets (RTIPy), or None (no such limit)."""
     from rti_rig.drivers.led_dome.factory import protocol_for
-    from rti_rig.drivers.led_dome.scripted import TIMED_MARGIN_S
+    from rti_rig.drivers.led_dome.scripted import TIMED_MARGIN_S, timed_reply_s
 
     cfg = rig.config
     serial = cfg.dome.serial if cfg.dome is not None else None
@@ -1329,6 +1342,7 @@ def timed_exposure_limit(rig: LoadedRig) -> TimedExposureLimit | None:
         settle_s=t.settle_s,
         readout_s=t.readout_s,
         transfer_s=t.transfer_s,
+        reply_s=timed_reply_s(spec),
     )
 
 

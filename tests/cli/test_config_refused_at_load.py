@@ -54,10 +54,16 @@ def test_an_exposure_longer_than_the_rtipy_window_is_refused_before_the_port_ope
     assert f"{cfg}: key 'camera.exposure_s'" in text
     assert "the rtipy firmware lights each LED for 2 s" in text
     assert "dome.serial.protocol.light_on_s = 2" in text
+    # the capture begins once the reply the sketch prints before lighting the LED is heard:
+    # 46 characters at 9600 baud plus the port's latency (it had been left out: 0.95 s was
+    # admitted, and every capture then refused by the all-off as "went dark by itself")
+    assert (
+        "the firmware's reply 0.064 s, heard after the LED lights, + timing.settle_s 0.1 " in text
+    )
     assert "settle_s 0.1 + camera.exposure_s 5 + timing.readout_s 0.3" in text
-    assert "= 6.1 s" in text
+    assert "= 6.16 s" in text
     assert "Raise dome.serial.protocol.light_on_s to 7" in text
-    assert "shorten exposure_s to at most 0.95 s" in text
+    assert "shorten exposure_s to at most 0.886 s" in text
     assert not out.exists()  # refused before anything was written or opened
     assert "Rig emulated-rtipy" not in text
 
@@ -90,7 +96,11 @@ def test_a_long_exposure_fits_a_window_raised_to_hold_it(tmp_path: Path) -> None
     loaded = load_rig_config(cfg)
     limit = timed_exposure_limit(loaded)
     assert limit is not None and limit.window_s == 7
-    assert limit.max_exposure_s == pytest.approx(7 + 0.05 - 0.1 - 0.3 - 0.7)
+    # "I received: T,7,0,7 the instructionByte was: T" (the longest of the 8 LEDs' replies,
+    # 46 characters at 9600 baud, 10 bits each) and the port's latency, before the settle
+    reply_s = len("I received: T,7,0,7 the instructionByte was: T") * 10 / 9600 + 0.016
+    assert limit.reply_s == pytest.approx(reply_s)
+    assert limit.max_exposure_s == pytest.approx(7 + 0.05 - reply_s - 0.1 - 0.3 - 0.7)
 
 
 def test_auto_exposure_meters_no_longer_than_the_window_holds(
@@ -131,8 +141,8 @@ def test_auto_exposure_meters_no_longer_than_the_window_holds(
     notes = []
     with pytest.raises(Metered):
         fix_exposure(FakeRig(), planned(), 0.001, notes.append)  # type: ignore[arg-type]
-    assert rules and rules[0].max_exposure_s == pytest.approx(0.95)
-    assert "Metering chooses no exposure longer than 0.95 s" in notes[0].text
+    assert rules and rules[0].max_exposure_s == pytest.approx(0.95 - 0.064, abs=1e-3)
+    assert "Metering chooses no exposure longer than 0.886 s" in notes[0].text
     assert "max_exposure_s = 30 s" in notes[0].text
     assert "And each test shot is taken under a window of its own" in notes[0].text
     # a dome with no self-timed window keeps the camera's own limit (and, uncalibrated, is
@@ -171,7 +181,7 @@ def test_a_plan_step_exposing_past_the_window_is_refused_before_the_port_opens(
     step = LightStep(direction=(0.0, 0.0, 1.0), led=0, exposure_s=3.0)
     with pytest.raises(ScheduleError, match=r"step 1: exposure 3 s") as info:
         checked_rig(loaded, LightSchedule((step,)))
-    assert "0.95 s that fit" in str(info.value)
+    assert "0.886 s that fit" in str(info.value)
 
 
 # ------------------------------------------------------------------ led_count of a firmware profile
