@@ -120,13 +120,24 @@ def _not_latched(name: str, value: str, got: str, key: str) -> str:
     )
 
 
-def _not_offered(name: str, value: str, key: str, choices: list[str]) -> str:
+def _not_offered(
+    name: str, value: str, key: str, choices: list[str], *, restoring: bool = False
+) -> str:
     """Why ``value`` cannot be set on the camera's setting ``name``, and which key to change.
 
     Why: a shutter speed had been answered "set shutter_config in [camera.device] to one of
     them", the key that holds the setting's *name*; the speed is the camera's own, chosen for
     ``[camera] exposure_s`` from the speeds it offered at connect, so only a mode dial moved
-    since (the speeds offered change with it) leaves it unoffered."""
+    since (the speeds offered change with it) leaves it unoffered. ``restoring``: the speed
+    is the one the camera had before a test shot, being put back, which no exposure_s chose
+    (it had been said "chosen for [camera] exposure_s" of it too)."""
+    if key == "shutter_config" and restoring:
+        return (
+            f"the camera's own shutter speed '{value}' (as connect found it, put back after "
+            f"the test shot) is no longer offered for {name}; the camera offers {choices}: "
+            "a mode dial moved since? put the camera back in manual (M) mode and set its "
+            "shutter speed on the camera"
+        )
     if key == "shutter_config":
         return (
             f"shutter speed '{value}' (chosen for [camera] exposure_s from the speeds the camera "
@@ -239,6 +250,9 @@ class Gphoto2Camera:
         self._format_choices: list[str] = []
         #: what connect could not establish of the image format (said by ``rti-rig check``)
         self._format_note: str | None = None
+        #: a shutter speed a failed test shot could not put back (said by ``rti-rig check``
+        #: beside the shot's own error: the camera is left at another speed than its own)
+        self._restore_note: str | None = None
 
     # -- error handling --------------------------------------------------------------------
     def _call(
@@ -411,7 +425,7 @@ class Gphoto2Camera:
     def connect_notes(self) -> tuple[str, ...]:
         """What connect could not establish and the first shot will (``rti-rig check`` says
         it): an image format whose name does not tell whether it gives a RAW file."""
-        return (self._format_note,) if self._format_note else ()
+        return tuple(n for n in (self._format_note, self._restore_note) if n)
 
     def close(self) -> None:
         """End the camera session and remove the private staging folder. Safe twice and after
@@ -476,8 +490,11 @@ class Gphoto2Camera:
         except Exception:  # text widgets have no choices
             return []
 
-    def _set_config_values(self, values: dict[str, tuple[str, str]]) -> None:
-        """Set {config name: (value, settings key)}, then read back and verify each."""
+    def _set_config_values(
+        self, values: dict[str, tuple[str, str]], *, restoring: bool = False
+    ) -> None:
+        """Set {config name: (value, settings key)}, then read back and verify each
+        (``restoring``: the values are the camera's own being put back, said as such)."""
         if not values:
             return
         cam = self._cam
@@ -486,7 +503,11 @@ class Gphoto2Camera:
             widget = self._widget(config, name, key)
             choices = self._choices(widget)
             if choices and value not in choices:
-                raise DeviceError(self.name, _not_offered(name, value, key, choices), f"set {name}")
+                raise DeviceError(
+                    self.name,
+                    _not_offered(name, value, key, choices, restoring=restoring),
+                    f"set {name}",
+                )
             widget.set_value(value)
         self._call("set_config", lambda: cam.set_config(config), DeviceError)
         check = self._call("get_config", cam.get_config, DeviceError)
@@ -714,21 +735,33 @@ class Gphoto2Camera:
             )
         bound, self.output_dir = self.output_dir, None  # never into a session's raw/
         own = self._shutter_label  # the camera's own speed, put back as connect found it
+        self._restore_note = None
         try:
             self.expose(self._shutters[0][0])
             try:
                 frame = self.collect()
             except CaptureError as exc:
                 if isinstance(exc.__cause__, UnsupportedRawError):
+                    self._format_note = None  # a RAW came: its format is not in doubt
                     raise self._unreadable_raw(exc.__cause__) from exc
                 raise
-        except BaseException:
+        except BaseException as exc:
             # a failed shot (an unreadable RAW, a busy body) leaves the camera's own speed too:
             # it had been put back only after a shot that decoded, the body left at its
-            # fastest speed by a check that failed. The shot's error is the one said.
+            # fastest speed by a check that failed. The shot's error is the one said; a
+            # restore that fails as well is said beside it (it had been suppressed: the
+            # check said nothing of a body left at its fastest speed)
             self.output_dir = bound
-            with contextlib.suppress(Exception):  # the camera is closed next either way
-                self._restore_shutter(own)
+            if isinstance(exc, Exception):  # not after a stop: the camera is closed next
+                try:
+                    self._restore_shutter(own)
+                except Exception as failed:
+                    self._restore_note = (
+                        f"the camera is left at shutter speed '{self._shutter_label}' (the "
+                        f"test shot's), not its own '{own}': putting it back failed ("
+                        f"{getattr(failed, 'message', None) or failed}); set it on the camera "
+                        "before shooting with it outside rti-rig"
+                    )
             raise
         self.output_dir = bound
         self._restore_shutter(own)
@@ -745,7 +778,9 @@ class Gphoto2Camera:
     def _restore_shutter(self, own: str | None) -> None:
         """Put back the shutter speed the camera had before a test shot (``own``)."""
         if own is not None and own != self._shutter_label:
-            self._set_config_values({self.settings.shutter_config: (own, "shutter_config")})
+            self._set_config_values(
+                {self.settings.shutter_config: (own, "shutter_config")}, restoring=True
+            )
             self._shutter_label = own
 
     def _unreadable_raw(self, exc: UnsupportedRawError) -> CaptureError:
@@ -812,6 +847,7 @@ class Gphoto2Camera:
         raw_files = [f for f in files if is_camera_raw(Path(f[1]))]
         if not raw_files:
             self._delete(files)
+            self._format_note = None  # the format is known now: this error says it
             raws = raw_choices(self._format_choices)
             offered = f": it offers {raws}" if raws else ""
             raise CaptureError(

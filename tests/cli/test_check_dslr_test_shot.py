@@ -115,3 +115,54 @@ def test_the_test_shot_puts_the_camera_s_own_shutter_speed_back_even_when_it_fai
     assert r.exit_code == (0 if readable else 1) and "Traceback" not in said, said
     assert shot_at == ["1/250"], shot_at  # the fastest speed: the shot did change it
     assert body.config["shutterspeed"] == "1/60", said  # the camera's own, as connect found it
+
+
+@pytest.mark.parametrize("how", ["set_config fails", "no longer offered"])
+def test_a_shutter_speed_a_failed_test_shot_could_not_put_back_is_said(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, how: str
+) -> None:
+    """The test shot fails (an unreadable RAW) and putting the camera's own speed back fails
+    too: the check had suppressed the second failure, leaving the body at 1/250 unsaid, and a
+    speed no longer offered had been said "chosen for [camera] exposure_s" (it is the
+    camera's own, as connect found it)."""
+    cfg = _config(tmp_path, "Internal RAM")
+
+    def render(body: Body) -> bytes:
+        if how == "set_config fails":
+            body.failures["set_config"] = [-1]  # the restore's write is refused
+        else:  # the mode dial turned to a mode that offers other speeds (the body's own gone)
+            body.choices["shutterspeed"] = [c for c in body.choices["shutterspeed"] if c != "1/60"]
+        return _unreadable(body)
+
+    body = Body(render=render)
+    r, said, _ = _shot_with(monkeypatch, cfg, body, ["check", str(cfg)])
+    assert r.exit_code == 1 and "Traceback" not in said, said
+    assert body.config["shutterspeed"] == "1/250", said  # the truth: left at the shot's speed
+    assert "camera: dslr connected, but FAILED its test shot: " in said, said
+    assert f"{LIBRAW} cannot read" in said, said  # the shot's own error, first
+    assert (
+        "; note: the camera is left at shutter speed '1/250' (the test shot's), not its own "
+        "'1/60': putting it back failed (" in said
+    ), said
+    if how == "no longer offered":
+        assert "the camera's own shutter speed '1/60' (as connect found it, put back" in said
+        assert "chosen for [camera] exposure_s" not in said, said
+
+
+def test_an_image_format_a_failed_test_shot_never_reached_is_said_unchecked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """image_format left as the camera has it, on a body with no 'imageformat' setting:
+    connect cannot judge it, and a test shot that fails before any file comes (the capture
+    refused) leaves it unknown. The note was said only beside an exposure the camera does not
+    offer, never beside a failed shot, where it is as true."""
+    cfg = _config(tmp_path, "Internal RAM")
+    cfg.write_text(cfg.read_text().replace('image_format = "RAW"', 'image_format = ""'))
+    body = Body(render=_raw)
+    del body.config["imageformat"], body.choices["imageformat"]
+    body.failures["capture"] = [-1]
+    r, said, _ = _shot_with(monkeypatch, cfg, body, ["check", str(cfg)])
+    assert r.exit_code == 1 and "Traceback" not in said, said
+    assert "camera: dslr connected, but FAILED its test shot: " in said, said
+    assert "; note: image format not checked: the camera has no setting 'imageformat'" in said
+    assert body.shots == 0, said
