@@ -437,6 +437,48 @@ class EmulatedServo:
         self._refresh()
         return True
 
+    def eeprom_state(self) -> dict[str, Any]:
+        """What this servo keeps through a power cycle: its EEPROM area (ID, baud rate,
+        Operating Mode, the position limits a connect wrote, ...) and where the joint rests
+        once unpowered: a loaded joint that held under torque falls to its stop
+        (:attr:`sag_to`), any other stays where it is.
+
+        Why apart from :meth:`powered_state`: the e-manual's RAM area is "reset to initial
+        values when the power is reset", the EEPROM area is not (X-series control table,
+        Area); the chain's power cycle had been the deletion of one state file holding both,
+        so it also reset the EEPROM and moved the joints back to the park pose, which a real
+        power cycle does not."""
+        self._refresh()
+        rest = self._profile.goal
+        if self.torque_on and self.sag_to is not None:
+            rest = self.sag_to
+        return {
+            "model_number": self.get(ct.MODEL_NUMBER),
+            "eeprom": bytes(self.table[: ct.EEPROM_END]).hex(),
+            "rest_ticks": rest,
+        }
+
+    def restore_eeprom(self, state: dict[str, Any]) -> bool:
+        """Power on with an :meth:`eeprom_state` kept from before the power cycle: the EEPROM
+        area as it was, the RAM area at its initial values (as built), the joint where it
+        rested. False, nothing changed, for a record that is not this servo's."""
+        try:
+            eeprom = bytes.fromhex(str(state["eeprom"]))
+            rest = float(state["rest_ticks"])
+            model = int(state["model_number"])
+        except (KeyError, TypeError, ValueError):
+            return False
+        if len(eeprom) != ct.EEPROM_END or model != self.get(ct.MODEL_NUMBER):
+            return False
+        if eeprom[ct.ID.address] != self.dxl_id or not math.isfinite(rest):
+            return False
+        self.table[: ct.EEPROM_END] = eeprom
+        self._profile = _Profile(rest, rest, self.clock.now(), 1.0, 1.0)
+        self._back_driven = False
+        self._set(ct.GOAL_POSITION, round(rest))
+        self._refresh()
+        return True
+
     # -- instructions -----------------------------------------------------------------------
     def status_error(self, number: int = 0) -> int:
         return number | (p2.ERR_ALERT if self.hardware_error else 0)
@@ -658,6 +700,19 @@ class DynamixelBusEmulator:
                 if dxl_id in self.servos:
                     self.servos[dxl_id].restore_powered(state)
             self._errors_seen = self.hardware_errors()
+
+    def eeprom_state(self) -> dict[int, dict[str, Any]]:
+        """Every servo's :meth:`EmulatedServo.eeprom_state`, by id."""
+        with self._lock:
+            return {i: s.eeprom_state() for i, s in self.servos.items()}
+
+    def restore_eeprom(self, states: dict[int, dict[str, Any]]) -> None:
+        """Power the chain on with the EEPROM each servo kept through a power cycle (see
+        :meth:`EmulatedServo.restore_eeprom`); one not on this bus is left alone."""
+        with self._lock:
+            for dxl_id, state in states.items():
+                if dxl_id in self.servos:
+                    self.servos[dxl_id].restore_eeprom(state)
 
     def inject_hardware_error(self, dxl_id: int, fault: int) -> None:
         with self._lock:

@@ -19,15 +19,20 @@ only be written when the value of Torque Enable(64) is cleared to '0'"). Only th
 been kept, each command meeting servos otherwise as at power-on: the paths a real arm takes
 after a session that kept its torque on were never rehearsed. A Reboot resets the RAM area
 (errors included) as on a servo. Deleting the file is the power cycle: the next command meets
-a factory-fresh chain resting at the park pose (a real power cycle keeps the EEPROM and the
-pose; the emulator's is a simplification).
+the chain at power-on, its RAM at its initial values (torque off, no error latched), its
+EEPROM area kept and each joint where it rested, a loaded joint that held under torque fallen
+to its stop. The EEPROM is kept in a second file beside it (``….eeprom.json``), which a
+power cycle leaves; deleting both is a factory-fresh chain as the config describes it at the
+park pose. (The one file had held both: its deletion had reset the EEPROM, position limits
+a connect wrote among it, and moved the joints back to the park pose, as no power cycle does.)
 
 The file is keyed by the rig config's absolute path, so another config meets a fresh chain;
 the same config with its ``[[emulator.faults]]`` edited (the obstruction cleared, as the
 error advises before the reboot) is the same chain, its error still latched. It lives
 in a per-user folder: ``$RTI_RIG_EMULATOR_STATE_DIR`` if set, else
 ``$XDG_RUNTIME_DIR/rti-rig/emulated-servos``, else ``<temp>/rti-rig-<uid>/emulated-servos``.
-To "power-cycle" the emulated servos, delete that file (or the folder).
+To "power-cycle" the emulated servos, delete that file (the EEPROM file beside it stays);
+delete the folder for factory-fresh servos.
 """
 
 from __future__ import annotations
@@ -72,6 +77,9 @@ class LatchedErrors:
         # that changed with them met a fresh chain, "no hardware fault: not rebooted"
         digest = hashlib.sha256(str(self.config_path).encode()).hexdigest()[:16]
         self.path = state_dir() / f"{self.config_path.stem}-{digest}.json"
+        #: what outlives a power cycle (the EEPROM area, the rest pose): kept apart, so that
+        #: deleting :attr:`path` (the power cycle) leaves it
+        self.eeprom_path = state_dir() / f"{self.config_path.stem}-{digest}.eeprom.json"
 
     def power_cycle_said(self) -> str:
         """How a fault's advice tells the user to power-cycle this emulated chain: delete its
@@ -115,6 +123,32 @@ class LatchedErrors:
         )
         try:
             replace_text(self.path, body)
+        except OSError as exc:
+            self._unkept(exc)
+
+    def load_eeprom(self) -> dict[int, dict[str, Any]]:
+        """Each servo's EEPROM and rest pose as kept through a power cycle
+        (``EmulatedServo.eeprom_state``); {} if none or unreadable (a factory-fresh chain)."""
+        try:
+            raw = json.loads(self.eeprom_path.read_text(encoding="utf-8"))
+            return {int(k): dict(v) for k, v in raw["servos"].items()}
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            return {}
+
+    def save_eeprom(self, states: dict[int, dict[str, Any]]) -> None:
+        """Record what each servo keeps through a power cycle (atomically); a file that
+        cannot be written is a warning, as :meth:`_unkept` says."""
+        body = json.dumps(
+            {
+                "config": str(self.config_path),
+                "servos": {str(k): v for k, v in sorted(states.items())},
+                "note": "emulated servos' EEPROM and rest pose, kept through a power cycle "
+                "(deleting the other file); delete this one too for factory-fresh servos",
+            },
+            indent=1,
+        )
+        try:
+            replace_text(self.eeprom_path, body)
         except OSError as exc:
             self._unkept(exc)
 

@@ -298,7 +298,7 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     # to reboot; a session that kept torque on had left the next command a limp arm)
     latch = _keep_powered_state(loaded, emulator)
     # and kept as the rig closes, after the arm's own close (its torque policy applied)
-    stack.callback(lambda: latch.save_state(emulator.powered_state()), "arm emulator state")
+    stack.callback(lambda: _keep_state(latch, emulator), "arm emulator state")
     try:
         # the advice's power cycle is what clears the emulated chain's kept state
         arm = DynamixelArm(
@@ -328,16 +328,25 @@ def _keep_powered_state(loaded: LoadedRig, emulator: DynamixelBusEmulator) -> La
     states = latch.load_state()
     if states:
         emulator.restore_powered(states)
-    else:  # a state file of errors alone (kept by an earlier version)
+    else:
+        # power-cycled (the powered state deleted): the EEPROM and the rest pose outlive it
+        emulator.restore_eeprom(latch.load_eeprom())
+        # a state file of errors alone (kept by an earlier version)
         for dxl_id, bits in latch.load().items():
             if dxl_id in emulator.servos:
                 emulator.inject_hardware_error(dxl_id, bits)
 
     def keep(_errors: object = None) -> None:
-        latch.save_state(emulator.powered_state())
+        _keep_state(latch, emulator)
 
     emulator.on_errors_changed = keep
     return latch
+
+
+def _keep_state(latch: LatchedErrors, emulator: DynamixelBusEmulator) -> None:
+    """Keep the chain's powered state and, apart, what outlives a power cycle (EEPROM)."""
+    latch.save_state(emulator.powered_state())
+    latch.save_eeprom(emulator.eeprom_state())
 
 
 def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:

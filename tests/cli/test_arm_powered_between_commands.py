@@ -192,3 +192,54 @@ def test_an_input_voltage_fault_leaves_the_servo_holding_for_the_reboot_check(
     Path(state).unlink()  # the power cycle the advice names clears the fault
     r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
     assert r.exit_code == 0 and said(r).endswith("RESULT: PASS"), said(r)
+
+
+def test_a_power_cycle_keeps_the_eeprom_and_where_the_joints_rest(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A power cycle resets the RAM area only ("reset to initial values when the power is
+    reset"; the EEPROM area is not: ROBOTIS e-manual, X-series control table, Area), and a
+    joint that held its load under torque falls to its stop as the power goes. The emulated
+    chain's power cycle (deleting its state file) had reset the EEPROM too and put the joints
+    back at the park pose: limits a connect wrote were gone, and a config set back to the old
+    limits met servos that already had them (no write), as no real chain would."""
+    from rti_rig.simulator.servo_latch import LatchedErrors
+
+    cfg = inprocess_arm_config(tmp_path)
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 0, said(r)  # parked, held at park (torque_policy "hold")
+    cfg.write_text(cfg.read_text().replace("max_deg = 90.0", "max_deg = 85.0"))
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 0, said(r)  # the elevation servo's Max Position Limit now 1991
+    latch = LatchedErrors(cfg)
+    latch.path.unlink()  # the power cycle, as the advice says
+    assert latch.eeprom_path.exists()
+
+    cfg.write_text(cfg.read_text().replace("max_deg = 85.0", "max_deg = 90.0"))
+    found = _servos_as_built(monkeypatch)
+    emulators = emulators_built_by_check(monkeypatch)
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    words = said(r)
+    assert r.exit_code == 0 and words.endswith("RESULT: PASS"), words
+    # RAM at power-on: torque off; azimuth where it held (the park pose, 0°: tick 2048), the
+    # loaded elevation joint fallen from 10° to its stop at 0° (tick 1024)
+    assert found[0] == {1: (0, 2048), 2: (0, 1024)}, found
+    (emu,) = emulators
+    limit_writes = [
+        p
+        for p in emu.instructions
+        if p.instruction == p2.INST_WRITE
+        and p.dxl_id == 2
+        and p.params[:2] == ct.MAX_POSITION_LIMIT.address.to_bytes(2, "little")
+    ]
+    assert limit_writes, "the kept limit (1991) was not found to differ from the config's"
+    assert emu.servos[2].get(ct.MAX_POSITION_LIMIT) == 2048
+
+    # both files deleted: a factory-fresh chain as the config describes it, at the park pose
+    latch.path.unlink()
+    latch.eeprom_path.unlink()
+    found.clear()
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 0, said(r)
+    park_el = found[0][2][1]
+    assert found[0][1] == (0, 2048) and park_el > 1024, found
