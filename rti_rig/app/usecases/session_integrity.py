@@ -74,6 +74,10 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         manifest = read_manifest(source)  # once, for what the session's kind and end allow
     except RtiRigError:
         manifest = None
+    if manifest is None and not any((source / n).exists() for n in (MANIFEST, JOURNAL, LINEAR_DIR)):
+        # no session record, nor a session's layout (a session that lost its manifest is
+        # still rti-rig's, and may be reshot): an acquisition rti-rig did not shoot here
+        qa = _with_imported(qa)
     if manifest is not None:
         qa = _with_relabelled(qa, lp, source, manifest)
     if manifest is not None:
@@ -283,6 +287,34 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
         for c in qa.images
     )
     return replace(qa, images=images, session_note=note if qa.reshoot else "", verdict_word=word)
+
+
+#: What a clipped image of an imported acquisition asks (it cannot be reshot here).
+IMPORTED_CLIPPED = (
+    "clipped in the acquisition; its clipped pixels are left out of the normals, and a new "
+    "acquisition with less exposure is the only fix"
+)
+
+
+def _with_imported(qa: QAReport) -> QAReport:
+    """``qa`` with advice an imported acquisition (an ``.lp`` and its images, no rti-rig
+    session record beside them) can follow. Why: its images were shot elsewhere, often long
+    ago, of an object no longer under any dome; "reshoot: image01 (... reshoot with less
+    exposure)" of a published archive acquisition told its user to do what nobody can. The
+    problems are still named, as the acquisition's ("flawed"), with what they cost the fit."""
+    if not qa.reshoot:
+        return qa
+    images = tuple(
+        replace(c, problems=tuple(p.replace(LESS_EXPOSURE, IMPORTED_CLIPPED) for p in c.problems))
+        for c in qa.images
+    )
+    note = (
+        "an imported acquisition (an .lp with no rti-rig session record beside it): the "
+        "problems named are its images', kept as they are; reshoot only if the object can be "
+        "photographed again, else leave the images named out of the .lp (or keep them and "
+        "accept what they cost the fit)"
+    )
+    return replace(_noted(qa, note), images=images, verdict_word="flawed")
 
 
 def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]

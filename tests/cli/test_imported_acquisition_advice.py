@@ -1,0 +1,79 @@
+"""An imported acquisition (an ``.lp`` and its JPEGs, no rti-rig session record) is not told to
+reshoot, through the front door.
+
+Found by an audit: ``rti-rig fit`` of a published archive acquisition (NeuralRTI's example, a
+gilded icon) said "QA verdict: reshoot: image01 (saturated ...; reshoot with less exposure)",
+advice for an object nobody can put back under that dome. The problems are still named, as
+the acquisition's, with what a user can do about them.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from conftest import qa_of
+
+from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from fit_sessions import make_session
+
+SATURATED = 4  # 0-based: image_005, six times over its exposure
+
+
+def _srgb8(linear: np.ndarray) -> np.ndarray:
+    v = np.clip(linear, 0.0, 1.0)
+    s = np.where(v <= 0.0031308, 12.92 * v, 1.055 * v ** (1 / 2.4) - 0.055)
+    return np.round(s * 255.0).astype(np.uint8)
+
+
+@pytest.fixture(scope="module")
+def shot(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A session laid out as rti-rig writes one (lights.lp, linear TIFFs), one image clipped."""
+    root = tmp_path_factory.mktemp("imported")
+    session, _, _ = make_session(root / "session", size=(64, 80), saturate=SATURATED)
+    return session
+
+
+@pytest.fixture(scope="module")
+def imported(shot: Path) -> Path:
+    """The same images as an archive acquisition: JPEGs and a dirs.lp, nothing else."""
+    acq = shot.parent / "acquisition"
+    acq.mkdir()
+    entries = []
+    for k, e in enumerate(read_lp(shot / "lights.lp")):
+        px = read_linear_tiff(shot / "linear" / f"{Path(e.name).stem}.tif") / 65535.0
+        name = f"image{k + 1:02d}.jpg"
+        cv2.imwrite(str(acq / name), _srgb8(px), [cv2.IMWRITE_JPEG_QUALITY, 95])
+        entries.append(LpEntry(name, e.direction))
+    write_lp(acq / "dirs.lp", entries)
+    return acq / "dirs.lp"
+
+
+def test_an_imported_acquisition_is_told_what_it_can_do(imported: Path, tmp_path: Path) -> None:
+    text, qa = qa_of(imported, tmp_path / "fit")
+    assert "QA verdict: flawed: image05 (saturated" in text, text
+    assert "reshoot with less exposure" not in text
+    assert "QA verdict: reshoot" not in text
+    assert "an imported acquisition" in text and "reshoot only if the object can be" in text
+    assert qa["good"] is False  # the problem is still the acquisition's: not a clean verdict
+    problems = qa["images"][SATURATED]["problems"]
+    assert any("clipped in the acquisition" in p for p in problems), problems
+    assert not any("reshoot" in p for p in problems), problems
+
+
+def test_a_session_of_this_rig_is_still_told_to_reshoot(shot: Path, tmp_path: Path) -> None:
+    """The same clipped image in a session's layout (rti-rig wrote it; its manifest may be
+    lost, the object may still be under the dome) keeps the advice to reshoot it."""
+    session = tmp_path / "session"
+    shutil.copytree(shot, session)
+    text, _ = qa_of(session, tmp_path / "fit")
+    assert "QA verdict: reshoot: image_005 (saturated" in text, text
+    assert "reshoot with less exposure" in text
+    assert "an imported acquisition" not in text
