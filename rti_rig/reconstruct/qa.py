@@ -55,6 +55,7 @@ from rti_rig.reconstruct.qa_bands import median_by_rows, row_bands
 from rti_rig.reconstruct.qa_directions import (
     MISFIT_LIMIT,
     consensus_images,
+    neighbour_likeness,
     recorded_misfit,
     relative_misfit,
     swapped_pairs,
@@ -148,6 +149,20 @@ WRONG_LIGHT_MISFIT_RATIO = 1.5
 #: (the crop's object pixels) has no light direction to judge: what is left unclipped is
 #: what its light barely reaches.
 CLIPPED_DIRECTION_LIMIT = 0.5
+#: Where most images point away from their lights, the lights are said to belong to the
+#: images at or under this :func:`~rti_rig.reconstruct.qa_directions.neighbour_likeness`
+#: (NeuralRTI's gilded icon reads 0.0), and to be wrong at or over the other (its .lp
+#: shuffled reads 0.40-0.55).
+LIKENESS_ORDERED = 0.1
+LIKENESS_UNORDERED = 0.3
+#: Said where the images do not follow their recorded lights' order.
+UNORDERED_SAID = (
+    "images under neighbouring recorded lights do not look alike (as they do wherever the "
+    "lights belong to the images): most recorded lights are likely wrong (the .lp of another "
+    "session, or of another image order?): check the .lp against the acquisition before "
+    "trusting the fit"
+)
+
 #: Light directions are judged only when the fitted normals spread at least this much (degrees,
 #: the smallest axis of their second moment): a flat card leaves the azimuth undetermined.
 MIN_NORMAL_SPREAD_DEG = 2.0
@@ -2144,6 +2159,11 @@ def _evidence(
             f"{needed} are needed to judge the lights; median misfit {spread:.0%}): a glossy, "
             "saturated or non-Lambertian surface"
         )
+        # ... or lights that are not these images': a matte sphere's .lp shuffled had been
+        # said to be "a glossy, saturated or non-Lambertian surface" (and images "brighter
+        # than predicted", "moved"): the lights' order against the images tells the two apart
+        if neighbour_likeness(crop_arr, lt) >= LIKENESS_UNORDERED:
+            note += f"; but {UNORDERED_SAID}"
     else:
         judged = cand.copy()
         agree = cand & (err <= WRONG_LIGHT_DEG)
@@ -2165,14 +2185,33 @@ def _evidence(
             # their median is no session's spread: on the gilded icon of
             # tests/data/neuralrti_replay, 12 lights replayed were 1 agreeing at 4° and
             # "wrong" lights at 11-120°, every one of them right.
-            note = (
+            head = (
                 f"light directions not checked: {int(off.sum())} of {int(cand.sum())} images "
                 f"point more than {limit:.0f}° from their recorded lights and only "
                 f"{int((cand & ~off).sum())} within it; a wrong light is one the others "
-                "contradict, and here most disagree: the fit cannot place this object's "
-                "lights (gloss, shadows or clipping), or most recorded lights are wrong (the "
-                ".lp of another session?)"
+                "contradict, and here most disagree"
             )
+            # which of the two it is, told by what needs no fit: images under neighbouring
+            # recorded lights look alike where the lights are this acquisition's (the gilded
+            # icon of NeuralRTI's example: 41 of 45 "off", each image's nearest light's
+            # image the one most like it); it had been left to the user to guess
+            likeness = neighbour_likeness(crop_arr, lt)
+            if likeness <= LIKENESS_ORDERED:
+                note = (
+                    f"{head}, yet each image looks most like the images of its nearest "
+                    "recorded lights: the lights belong to these images, and it is the fit "
+                    "that cannot place them on this object (gloss, shadows or clipping). No "
+                    "wrong light was found, nor could one be: the lights are taken as recorded"
+                )
+            elif likeness >= LIKENESS_UNORDERED:
+                note = f"{head}, and {UNORDERED_SAID}"
+            else:
+                note = (
+                    f"{head}: the fit cannot place this object's lights (gloss, shadows or "
+                    "clipping), or many recorded lights are wrong (the .lp of another "
+                    "session?); images under neighbouring recorded lights look alike only in "
+                    "part, which does not tell which"
+                )
             most_disagree = True
         if not most_disagree:
             object_typical = RAYLEIGH_MEDIAN_PER_Q25 * float(np.percentile(err[cand], 25.0))

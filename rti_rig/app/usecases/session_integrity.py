@@ -289,11 +289,8 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
     return replace(qa, images=images, session_note=note if qa.reshoot else "", verdict_word=word)
 
 
-#: What a clipped image of an imported acquisition asks (it cannot be reshot here).
-IMPORTED_CLIPPED = (
-    "clipped in the acquisition; its clipped pixels are left out of the normals, and a new "
-    "acquisition with less exposure is the only fix"
-)
+#: What a clipped image of an imported acquisition is said to be (what to do: the note, once).
+IMPORTED_CLIPPED = "clipped in the acquisition"
 
 
 def _with_imported(qa: QAReport) -> QAReport:
@@ -311,8 +308,8 @@ def _with_imported(qa: QAReport) -> QAReport:
     note = (
         "an imported acquisition (an .lp with no rti-rig session record beside it): the "
         "problems named are its images', kept as they are; reshoot only if the object can be "
-        "photographed again, else leave the images named out of the .lp (or keep them and "
-        "accept what they cost the fit)"
+        "photographed again (a clipped image with less exposure), else leave the images named "
+        "out of the .lp (or keep them and accept what they cost the fit)"
     )
     return replace(_noted(qa, note), images=images, verdict_word="flawed")
 
