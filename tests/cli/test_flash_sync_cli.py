@@ -340,17 +340,29 @@ def test_a_run_stopped_before_its_proof_is_not_used(tmp_path: Path, rigs) -> Non
 
 def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None:
     """A complete session had been told "--resume cannot be used with a camera-triggered dome:
-    the dome's own count no longer matches", as if something had interrupted it."""
+    the dome's own count no longer matches", as if something had interrupted it. Complete and
+    intact, its resume is exit 0 with the next step, as any other kind's (it had been exit 2);
+    with --reshoot-lost, or an image changed, it is refused: this dome cannot reshoot one."""
     out = tmp_path / "s"
     assert (
         runner.invoke(app, ["run", str(SHIPPED), "--out", str(out), "--no-verdict"]).exit_code == 0
     )
-    for extra in ([], ["--reshoot-lost"]):
+    result = runner.invoke(app, ["run", "--resume", str(out)])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "this session is complete: all 60 steps were captured" in text
+    assert f"Next: rti-rig fit {out} --out FOLDER" in text
+    assert "cannot be used" not in text and "error" not in text
+    image = out / "image_003.jpg"
+    for extra, change in ((["--reshoot-lost"], False), ([], True)):
+        if change:
+            image.write_bytes(image.read_bytes() + b"x")
         result = runner.invoke(app, ["run", "--resume", str(out), *extra])
         assert result.exit_code == 2, result.output
         text = " ".join(result.output.split())
         assert "this session already completed all 60 steps; nothing to resume" in text
-        assert "cannot be used" not in text
+        assert "cannot reshoot single images" in text
+        assert "cannot be used" not in text and "Next:" not in text
 
 
 def test_a_dead_led_is_named_as_such_and_the_dome_said_to_have_stepped_on(  # type: ignore[no-untyped-def]
