@@ -536,7 +536,8 @@ def _print_metering_failures(exc: BaseException) -> None:
 
     failures = list(getattr(exc, "teardown_failures", None) or ())
     unsafe = unsafe_failures(failures)
-    _print_failures(unsafe)
+    # those the error names itself (metering that could not make the rig safe) said once
+    _print_failures([f for f in unsafe if str(f) not in str(exc)])
     if len(unsafe) < len(failures):
         _unrecorded_port_close("metering ended before the session began, so none was written")
 

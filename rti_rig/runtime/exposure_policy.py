@@ -426,12 +426,20 @@ def fix_session_exposure(
     failures = teardown(keep_lights=True)
     rig_time_s, wall_time_s = rig.clock.now() - started, time.perf_counter() - wall_started
     if unsafe := unsafe_failures(failures):
-        raise DeviceError(
+        # the port's close too (said as it happened), and the failures carried with the error
+        # as with any other that ends metering: the error had named the all-off alone, and
+        # the port's failure went with nothing (never said to be in no record)
+        # (named, not repeated: the dome's own line said it in full)
+        closed = len(unsafe) < len(failures)
+        also = ", and its lights' port did not close cleanly (said above)" if closed else ""
+        error = DeviceError(
             rig.name,
-            "metering could not make the rig safe (" + "; ".join(unsafe) + "): check the "
-            "lights before anything else",
+            "metering could not make the rig safe (" + "; ".join(unsafe) + f"){also}: check "
+            "the lights before anything else",
             "meter",
         )
+        error.teardown_failures = failures  # type: ignore[attr-defined]
+        raise error
     steps_fixed = tuple(replace(s, exposure_s=float(choice.exposure_s)) for s in schedule.steps)
     evidence = {
         **choice.to_manifest(),

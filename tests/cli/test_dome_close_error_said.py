@@ -208,3 +208,32 @@ def test_a_port_close_of_a_run_stopped_before_it_began_is_said_as_in_no_record(
     assert "this run had not begun, so it wrote none" in text, text
     assert "teardown problem" not in text, text
     assert not out.exists()
+
+
+def test_metering_that_could_not_make_the_rig_safe_says_its_port_close_too(
+    tmp_path: Path, close_fails: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Metering's all-off fails, then its close of the dome's port: the error had named the
+    all-off alone, the port's failure carried nowhere (not said to be in no record), and the
+    lights' line not pointed at the failure. Both are named, each once."""
+    from rti_rig.runtime.lighting import DomeLighting
+
+    real_safe = DomeLighting.safe
+    calls: list[int] = []
+
+    def safe(self: DomeLighting, emergency: bool = False) -> list[str]:
+        calls.append(1)  # metering's is the first: its all-off never reaches the dome
+        if len(calls) > 1:
+            return real_safe(self, emergency)
+        return ["all LEDs off: no reply (injected)"]
+
+    monkeypatch.setattr(DomeLighting, "safe", safe)
+    out = tmp_path / "S"
+    code, text = _run_three(out, "--auto-exposure")
+    assert code == 2, text
+    assert "metering could not make the rig safe (all LEDs off: no reply (injected))" in text
+    assert "and its lights' port did not close cleanly (said above)" in text, text
+    assert text.count("all LEDs off: no reply (injected)") == 1, text
+    assert text.count(WORDS) == 1 and text.count(NO_RECORD) == 1, text
+    assert "teardown problem" not in text, text  # named in the error, not again
+    assert not out.exists()

@@ -96,9 +96,39 @@ def test_a_teardown_that_fails_after_metering_is_an_error_not_silence(tmp_path: 
     rig.lighting.safe = lambda emergency=False: ["all LEDs off: no reply"]  # type: ignore[method-assign]
     rig.lighting.close = lambda: (closed.append("lights"), real_close())  # type: ignore[method-assign]
     expected = r"metering could not make the rig safe \(all LEDs off: no reply\)"
-    with pytest.raises(DeviceError, match=expected):
+    with pytest.raises(DeviceError, match=expected) as failed:
         fix_session_exposure(rig, schedule, lambda camera, start_s: Choice())
     assert closed == ["lights"]
+    assert failed.value.teardown_failures == ["all LEDs off: no reply"]  # type: ignore[attr-defined]
+    assert "port" not in str(failed.value)
+
+
+def test_metering_unsafe_and_its_port_close_failing_both_named_and_carried(
+    tmp_path: Path,
+) -> None:
+    """The all-off and then the port's close fail: the error had named the all-off alone and
+    carried neither; both are named and carried (what the command line says and records)."""
+    from rti_rig.core.errors import DeviceError
+
+    rig = build_rig(load_rig_config(write_config(tmp_path, SMALL_DOME)))
+    schedule = plan_uniform(rig.geometry, 6)
+    said = "dome: its port did not close cleanly: [Errno 5] Input/output error."
+    rig.lighting.safe = lambda emergency=False: ["all LEDs off: no reply"]  # type: ignore[method-assign]
+    rig.lighting.port_close_failure = lambda: said  # type: ignore[method-assign]
+
+    class Choice:
+        exposure_s = 0.02
+
+        def to_manifest(self) -> dict:
+            return {"exposure_s": 0.02}
+
+    with pytest.raises(DeviceError) as failed:
+        fix_session_exposure(rig, schedule, lambda camera, start_s: Choice())
+    assert "(all LEDs off: no reply), and its lights' port did not close cleanly" in str(
+        failed.value
+    )
+    carried = failed.value.teardown_failures  # type: ignore[attr-defined]
+    assert carried == ["all LEDs off: no reply", f"port close: {said}"]
 
 
 def test_a_port_that_did_not_close_after_metering_is_recorded_not_called_unsafe(
