@@ -1793,7 +1793,7 @@ def _prepare_resume(
             # is the same command again, and "drop --reshoot-lost" left the rest to guess
             raise SessionError(
                 f"{root}: --reshoot-lost is for a session that completed; this one did not "
-                f"({_ended_as(runner.get('finish_reason'), root)}), "
+                f"({_ended_as(runner.get('finish_reason'), root, scan.records)}), "
                 "and its resume sets aside and shoots again whatever it cannot verify anyway "
                 "(nothing in this folder was changed): continue it with rti-rig run --resume "
                 f"{shlex.quote(str(root))}"
@@ -1931,12 +1931,13 @@ RUN_ENDED = {
 }
 
 
-def _ended_as(reason: object, root: Path) -> str:
+def _ended_as(reason: object, root: Path, journal: list[dict[str, Any]]) -> str:
     """``its last run …`` for :data:`RUN_ENDED`'s ``reason`` (None: it recorded no end, by
     :func:`~rti_rig.runtime.unrecorded_end.unrecorded_end`: "killed" had been said of a run
-    whose disk was too full to record its end)."""
+    whose disk was too full to record its end). ``journal``: the caller's records
+    (``scan_journal``'s), read once (it had been read again here)."""
     if reason is None:
-        return f"its last run: {unrecorded_end(root)}"
+        return f"its last run: {unrecorded_end(root, journal)}"
     said = RUN_ENDED.get(reason) if isinstance(reason, str) else None
     return f"its last run: {said}" if said else "its last run did not finish"
 

@@ -168,3 +168,24 @@ def test_a_reopened_session_not_begun_reads_the_earlier_runs_end(
     folder.begin({"rig": {}, "schedule": {"steps": [{}] * 3}})
     begun = read_run_ending(folder, 3)  # this run's entry now: not yet completed
     assert begun.begun and not begun.last_run_completed and not begun.run_completed
+
+
+def test_a_refused_reshoot_of_a_run_that_recorded_no_end_reads_its_journal_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--reshoot-lost of a session whose run recorded no end is refused, saying how it ended
+    from the journal's last image; that journal is the one the resume already read (it had
+    been read a second time for the words)."""
+    import rti_rig.runtime.unrecorded_end as unrecorded_end
+    from rti_rig.runtime.session import SessionError, prepare_resume, unlock_session
+
+    root = tmp_path / "s"
+    _session(root, 3, 1, None)
+    unlock_session(root)
+
+    def read_again(root: Path) -> None:
+        raise AssertionError("the journal was read again")
+
+    monkeypatch.setattr(unrecorded_end, "_journal_lines", read_again)
+    with pytest.raises(SessionError, match="its last run: it stopped without recording why"):
+        prepare_resume(root, reshoot_lost=True)
