@@ -1399,17 +1399,24 @@ def _stopped_before_capture(  # type: ignore[no-untyped-def]
 ) -> typer.Exit:
     """Close a session stopped after it opened and before its capture began, say so (the stop
     named by ``why``) as a stop while opening is said, and give the exit a stop by ``signum``
-    asks (the capture's own teardown never ran: the rig is made safe and closed here)."""
-    _print_failures(_close_left_open(opened))
+    asks (the capture's own teardown never ran: the rig is made safe and closed here).
+
+    What the close established about the lights is said, as every other stop says it (this
+    one had said only that nothing was captured, though the close had sent the all-off)."""
+    from rti_rig.app.usecases.safe_state import lights_state
+
+    failed = _print_failures(_close_left_open(opened))
+    lights = lights_state(opened.rig, failed)
     if opened.resumed:
         said = (
-            f"Stopped ({why}) before the session went on: no new image was captured; continue "
-            f"it with {_resume_before_begin(opened)}"
+            f"Stopped ({why}) before the session went on: no new image was captured; {lights}; "
+            f"continue it with {_resume_before_begin(opened)}"
         )
     else:
         said = f"Stopped ({why}) before the first image: nothing was captured"
         if not opened.folder.begun:
             said += f" or written to {opened.out_dir}"
+        said += f"; {lights}"
     err.print(f"[yellow]{escape(said)}.[/]")
     return typer.Exit(code=stop_exit_code(signum))
 

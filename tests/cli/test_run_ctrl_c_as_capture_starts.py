@@ -68,6 +68,8 @@ def test_a_ctrl_c_as_the_capture_starts_switches_the_emulated_dome_off_and_close
     assert "AllOff" in received[seen["before"] :], (received, said)
     assert not seen["opened"].rig.lighting.source.link.port_open, said  # the rig was closed
     assert "Stopped (Ctrl-C) before the first image: nothing was captured" in said, said
+    # what the close established of the lights, as other stops say (it had been unsaid)
+    assert f"written to {out}; all-off sent and acknowledged by the dome: lights are off." in said
     assert "Traceback" not in said, said
     assert r.exit_code == 130, said
     assert not any(out.glob("image_*"))
@@ -101,7 +103,10 @@ def test_a_sigterm_as_the_controller_checks_the_disk_switches_the_held_dome_off_
     assert seen["before"] > 0, said  # metering spoke to the dome
     assert "AllOff" in received[seen["before"] :], (received, said)
     assert not seen["opened"].rig.lighting.source.link.port_open, said
-    assert "Stopped (SIGTERM) before the first image: nothing was captured" in said, said
+    assert (
+        "Stopped (SIGTERM) before the first image: nothing was captured or written to "
+        f"{out}; all-off sent and acknowledged by the dome: lights are off." in said
+    ), said
     assert "teardown problem" not in said and "Traceback" not in said, said
     assert r.exit_code == 143, said
 
