@@ -193,6 +193,10 @@ class DomeFirmware:
         """Opening the port toggles DTR, which resets an Arduino: reboot."""
         return self.boot()
 
+    def on_port_closed(self) -> None:
+        """The host closed the port: this Arduino sketch does nothing on its DTR dropping (only
+        the open's DTR edge resets it, :meth:`on_port_opened`)."""
+
     def take_disconnect(self) -> float | None:
         """Seconds the device stays away, once, after a DISCONNECT fault fired; else None."""
         with self._lock:

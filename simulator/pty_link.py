@@ -122,6 +122,11 @@ class PtyDevice(Protocol):
 
     def take_disconnect(self) -> float | None: ...
 
+    def on_port_closed(self) -> None:
+        """The host closed the port (its DTR dropped): a board that acts on it (an ATmega32u4
+        touched at 1200 baud jumps to its bootloader) says so here; declared, where the server
+        had probed for it with ``getattr`` (a misspelt name went unheard)."""
+
 
 @dataclass
 class PtyLink:
@@ -280,9 +285,7 @@ class _Server:
     def _closed(self) -> None:
         """The host closed the port (DTR dropped): told to a device that acts on it (an
         ATmega32u4 set to 1200 baud jumps to its bootloader)."""
-        closed = getattr(self.device, "on_port_closed", None)
-        if closed is not None:
-            closed()
+        self.device.on_port_closed()
 
     def _reset_by_late_opens(self) -> None:
         """An open of the port the loop had not read when the server was asked to stop still

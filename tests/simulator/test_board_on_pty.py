@@ -165,3 +165,18 @@ def test_closing_the_32u4_port_at_1200_baud_drops_it_into_its_bootloader(
             )
     assert touches(board) == jumps, board.events
     assert heard is not bool(jumps), board.timeline
+
+
+def test_every_device_served_on_a_pty_declares_what_the_server_calls() -> None:
+    """The server calls each member of :class:`PtyDevice` on the device it serves; a port's
+    close (``on_port_closed``) had been probed with ``getattr``, so a device that misspelt it
+    went unheard. Both emulators served on a pty declare every member."""
+    from rti_rig.simulator.dome_firmware import DomeFirmware
+    from rti_rig.simulator.domes.board import Board
+    from rti_rig.simulator.pty_link import PtyDevice
+
+    members = [n for n, v in vars(PtyDevice).items() if callable(v) and not n.startswith("_")]
+    assert "on_port_closed" in members, members
+    for device in (Board, DomeFirmware):
+        missing = [n for n in members if not callable(getattr(device, n, None))]
+        assert not missing, (device, missing)
