@@ -259,6 +259,59 @@ class Camera(Protocol):
 
 
 @runtime_checkable
+class ExposureJudgingCamera(Protocol):
+    """A camera whose driver, once connected, can tell why an exposure cannot be shot on it
+    (a DSLR's fixed list of shutter speeds, a UVC camera's frame period and exposure units):
+    ``exposure_problem`` says why, None when it can.
+
+    Why declared: ``check`` had probed for it with ``getattr``, so a driver that misspelt
+    it passed every exposure unchecked."""
+
+    def exposure_problem(self, exposure_s: float) -> str | None: ...
+
+
+@runtime_checkable
+class ExposureRefusingCamera(Protocol):
+    """A camera that refuses, before anything lights, an exposure it would not shoot as asked
+    (``refuse_exposure`` raises a DeviceError naming ``before``, what was not done)."""
+
+    def refuse_exposure(self, exposure_s: float, before: str) -> None: ...
+
+
+@runtime_checkable
+class ShutterSpeedCamera(Protocol):
+    """A camera that offers its own list of exposures (a DSLR's shutter speeds): metering
+    starts at the one nearest the config's, never between two."""
+
+    def available_exposures_s(self) -> list[float]: ...
+
+
+@runtime_checkable
+class TrialShotCamera(Protocol):
+    """A camera that ``check`` has take one shot and decode it (a tethered DSLR: a body whose
+    RAW the installed LibRaw cannot read fails the check, not the session's first step);
+    ``test_shot`` returns what the shot established, as a phrase."""
+
+    def test_shot(self) -> str: ...
+
+
+@runtime_checkable
+class ConnectNotingCamera(Protocol):
+    """A camera whose connect could not establish everything (a gphoto2 image format whose
+    name does not say whether it gives a RAW): ``connect_notes`` says what, to be said."""
+
+    def connect_notes(self) -> tuple[str, ...]: ...
+
+
+@runtime_checkable
+class CardListingCamera(Protocol):
+    """A camera that shoots to a card and lists it before the session's first shot, so that a
+    picture taken before then is told apart (what it finds said through ``say``)."""
+
+    def list_card(self, say: Callable[[str], None]) -> None: ...
+
+
+@runtime_checkable
 class ExposingCamera(Protocol):
     """A camera whose exposure is over well before its image is in hand, in two calls.
 

@@ -16,7 +16,14 @@ from enum import StrEnum
 from typing import Any, Protocol
 
 from rti_rig.core.deferred_signals import signals_deferred, stop_words
-from rti_rig.core.devices import BusyAwareCamera, ExposingCamera, Frame, FramePacedCamera
+from rti_rig.core.devices import (
+    BusyAwareCamera,
+    CardListingCamera,
+    ExposingCamera,
+    ExposureRefusingCamera,
+    Frame,
+    FramePacedCamera,
+)
 from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
@@ -361,9 +368,9 @@ def check_capture_fits_lit(rig: Rig, exposures_s: Iterable[float], before: str) 
     # a UVC camera exposes at most a frame period however long it is asked (its exposure
     # reads back as set), and only whole exposure units: refused here too, with no lit-time
     # limit, before anything lights (the longest first: the frame period is its to fail)
-    refuse = getattr(camera, "refuse_exposure", None)
-    for exposure in sorted(set(exposures), reverse=True) if refuse is not None else ():
-        refuse(exposure, before)
+    if isinstance(camera, ExposureRefusingCamera):  # declared, where getattr had probed
+        for exposure in sorted(set(exposures), reverse=True):
+            camera.refuse_exposure(exposure, before)
 
 
 def _check_capture_lit_time(
@@ -378,12 +385,11 @@ def _check_capture_lit_time(
         return
     capture_s, said = counted
     t = rig.timing
-    transfer = float(getattr(t, "transfer_s", 0.0))
-    switch = float(getattr(t, "light_switch_s", 0.0))
+    transfer, switch = float(t.transfer_s), float(t.light_switch_s)  # declared: TimingConfig
     total = t.settle_s + capture_s + t.readout_s + transfer + switch
     if total <= limit + 1e-9:
         return
-    where = getattr(getattr(rig, "loaded", None), "path", None)
+    where = rig.loaded.path
     raise DeviceError(
         camera.name,
         f"a capture at {exposure:g} s reads {said} with its LED lit, so each step's LED stays "
@@ -716,10 +722,9 @@ def run_session(
         rig.lighting.off()
         # a card camera lists its card, to tell a picture taken before the first shot (only
         # a capture session does: `check` and `preview` never wait for it)
-        walk = getattr(rig.camera, "list_card", None) if list_card else None
-        if walk is not None:
-            name = str(getattr(rig.camera, "name", "camera"))
-            walk(lambda text: emit(DeviceSays(name, text)))
+        if list_card and isinstance(rig.camera, CardListingCamera):
+            name = str(rig.camera.name)
+            rig.camera.list_card(lambda text: emit(DeviceSays(name, text)))
         planned = [
             *(step_exposure(rig, schedule.steps[i]) for i in todo if source is None),
             *((cam.exposure_s, *(s.exposure_s or 0.0 for s in schedule.steps)) if source else ()),

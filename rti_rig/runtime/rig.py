@@ -82,6 +82,11 @@ class TimingConfig(Protocol):
     settle_s: float
     #: from the end of the exposure until the camera reports the image taken
     readout_s: float
+    #: the image's transfer to the host, with its LED lit where the camera cannot say when
+    #: its exposure is over
+    transfer_s: float
+    #: a light's switching time, counted in the time an LED stays lit
+    light_switch_s: float
 
 
 class RigConfig(Protocol):

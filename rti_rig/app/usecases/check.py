@@ -19,6 +19,12 @@ from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
 from rti_rig.app.usecases.safe_state import lights_state, software_lamp
 from rti_rig.core.acquisition_images import AcquisitionImagesError
+from rti_rig.core.devices import (
+    ConnectNotingCamera,
+    ExposureJudgingCamera,
+    ShutterSpeedCamera,
+    TrialShotCamera,
+)
 from rti_rig.core.errors import DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry
 from rti_rig.runtime.arm_check import arm_self_test
@@ -196,7 +202,7 @@ def _undimmable_reason(loaded: Any, intensity: float) -> str | None:
             "LEDs with the camera's flash pulse, and rti-rig lights none of them, so no LED "
             "can be checked at any level"
         )
-    serial = getattr(dome, "serial", None)
+    serial = dome.serial
     refusal = None if serial is None else serial.dimming_refusal()
     if refusal is not None and intensity < 1.0:  # fully on is the level 1 asks for
         return (
@@ -304,10 +310,10 @@ def camera_line(  # type: ignore[no-untyped-def]
     try:
         rig.camera.connect()
         problem = _exposure_problem(rig, auto_exposure)
-        shoot = getattr(rig.camera, "test_shot", None) if test_shot else None
-        if problem is None and callable(shoot):
+        # declared capabilities (core.devices), where getattr had probed by name
+        if test_shot and problem is None and isinstance(rig.camera, TrialShotCamera):
             try:
-                shot = str(shoot())
+                shot = str(rig.camera.test_shot())
             except RtiRigError as exc:
                 # what the failed shot left unknown or undone (a format it never reached, a
                 # shutter speed it could not put back) is said beside its error: it had
@@ -319,8 +325,8 @@ def camera_line(  # type: ignore[no-untyped-def]
                     False,
                 )
         # after the shot: what it established (a RAW given) is no longer said to be unknown
-        notes = getattr(rig.camera, "connect_notes", None)
-        said = tuple(notes()) if callable(notes) else ()
+        camera = rig.camera
+        said = tuple(camera.connect_notes()) if isinstance(camera, ConnectNotingCamera) else ()
     except RtiRigError as exc:
         return f"camera: FAILED to connect: {exc}", False
     finally:
@@ -347,9 +353,9 @@ def _exposure_problem(rig, auto_exposure: bool = False) -> str | None:  # type: 
     metering's start (:func:`_metering_start_s`). Without, a refusal that run --auto-exposure
     would not make says so: the check had refused an exposure_s (off a UVC camera's units)
     that the run the user meant to start took, naming neither the flag nor why."""
-    judge = getattr(rig.camera, "exposure_problem", None)
-    if not callable(judge):
+    if not isinstance(rig.camera, ExposureJudgingCamera):
         return None
+    judge = rig.camera.exposure_problem
     exposure = float(rig.camera_config.exposure_s)
     try:
         start = _metering_start_s(rig, exposure)
@@ -386,7 +392,7 @@ def _metering_start_s(rig, exposure_s: float) -> float | None:  # type: ignore[n
     from rti_rig.app.usecases.session import metering_range
     from rti_rig.runtime.exposure_policy import metering_start_s
 
-    if callable(getattr(rig.camera, "available_exposures_s", None)):
+    if isinstance(rig.camera, ShutterSpeedCamera):
         return None
     return metering_start_s(rig.camera, exposure_s, metering_range(rig))
 
