@@ -23,6 +23,7 @@ from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.rig_geometry import ArmGeometry
 from rti_rig.runtime.arm_end import PARK_TOLERANCE_DEG, ArmEnd, left_end, park_end
+from rti_rig.runtime.controller import EmergencyStop
 from rti_rig.runtime.lighting import attempt_all
 from rti_rig.runtime.teardown_repeats import failed_as_before
 
@@ -330,7 +331,8 @@ def arm_self_test(
     except BaseException as exc:  # a stop (signal): goes on up, with what the teardown found
         report.aborted = f"stopped ({exc})"
         report.stopped_by_user = True
-        exc.self_test_report = report  # type: ignore[attr-defined]
+        if isinstance(exc, EmergencyStop):  # declared there; check reads it of a stop
+            exc.self_test_report = report
         raise
     finally:
         failures = attempt_all([("lamp off", lambda: carrier.lamp(False)), ("stop", carrier.stop)])

@@ -13,7 +13,7 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from rti_rig.core.deferred_signals import signals_deferred, stop_words
 from rti_rig.core.devices import (
@@ -42,6 +42,9 @@ from rti_rig.runtime.session import (
     steps_to_hold,
 )
 from rti_rig.runtime.teardown_repeats import failed_as_before
+
+if TYPE_CHECKING:
+    from rti_rig.runtime.arm_check import ArmSelfTestReport
 
 
 class FinishReason(StrEnum):
@@ -79,6 +82,11 @@ class EmergencyStop(BaseException):
     (:func:`stop_words`, or ``words`` where the handler names it otherwise: "second Ctrl-C").
     Why typed: the exit code had been decided by comparing those words with "SIGTERM".
     """
+
+    #: The report of an arm's self-test this stop cut short (set by
+    #: :func:`~rti_rig.runtime.arm_check.arm_self_test`: its teardown's failures, where it
+    #: left the arm), None otherwise. Declared: ``check`` had read it with ``getattr``.
+    self_test_report: ArmSelfTestReport | None = None
 
     def __init__(self, signum: signal.Signals, words: str | None = None) -> None:
         self.signum = signal.Signals(signum)

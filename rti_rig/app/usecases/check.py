@@ -147,11 +147,11 @@ def check_rig(
                 return WithCamera(lights, camera, notes)
         except EmergencyStop as exc:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
-            report = getattr(exc, "self_test_report", None)
-            failures = tuple(str(f) for f in getattr(report, "teardown_failures", None) or ())
+            report = exc.self_test_report  # declared on the stop (it had been a getattr)
+            failures = tuple(str(f) for f in report.teardown_failures) if report else ()
             # where the self-test's teardown left the arm, as read back (a stopped check
             # had said "lamp off and stop were requested" and nothing of the arm)
-            lights = lights_state(rig, bool(failures), end=getattr(report, "end", None))
+            lights = lights_state(rig, bool(failures), end=report.end if report else None)
             raise CheckStopped(exc, lights, failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
 
