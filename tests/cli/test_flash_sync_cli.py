@@ -454,7 +454,8 @@ def test_refusals_give_the_run_of_the_config_actually_used(tmp_path: Path, rigs)
     assert "CONFIG" not in text and rigs == []
     out = tmp_path / "s"
     assert runner.invoke(app, ["run", str(cfg), "--out", str(out), "--no-verdict"]).exit_code == 0
-    result = runner.invoke(app, ["run", "--resume", str(out)])
+    # (a plain resume of it is complete, exit 0: refused with --reshoot-lost, naming the run)
+    result = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost"])
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())
     assert f"then {run_it} NEWDIR)" in text and "CONFIG" not in text, text
