@@ -203,11 +203,26 @@ class ArmSelfTestReport:
 def said_once(text: str, detail: str | None, pointer: str) -> str:
     """``text`` with ``detail`` (an error's explanation, said in full elsewhere) shortened to
     its first clause (the fault itself) and ``(pointer)``: a servo fault's paragraph of what to
-    do is said once, not again by every teardown step that met the same fault."""
+    do is said once, not again by every teardown step that met the same fault. The first
+    clause ends at a ``;`` outside parentheses: one inside a quoted system error (a lost port's
+    "No such file or directory; serial ports present now: …") had cut the head there, its
+    parenthesis left open."""
     if not detail or len(detail) < 60 or detail not in text:
         return text
-    head = detail.split(";", 1)[0]
-    return text.replace(detail, f"{head} ({pointer})")
+    return text.replace(detail, f"{_first_clause(detail)} ({pointer})")
+
+
+def _first_clause(text: str) -> str:
+    """``text`` up to its first ``;`` at parenthesis depth 0 (all of it if there is none)."""
+    depth = 0
+    for i, ch in enumerate(text):
+        if ch == "(":
+            depth += 1
+        elif ch == ")":
+            depth = max(0, depth - 1)
+        elif ch == ";" and depth == 0:
+            return text[:i]
+    return text
 
 
 def not_connected_sentence(carrier: object, connected: bool | None = None) -> str | None:
