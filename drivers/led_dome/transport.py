@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import contextlib
 import os
+from errno import ENOENT
 from typing import Protocol
 
 import serial
 
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.deferred_signals import signals_deferred
+from rti_rig.drivers.ports_present import ports_present_note
 from rti_rig.drivers.serial_ports import PORT_ERRORS, TERMIOS_ERROR, finish_close, identity
 
 
@@ -149,6 +151,9 @@ class SerialTransport:
             else:
                 why = str(exc)
             error = PortHeldError if "exclusively lock" in str(exc) else TransportError
+            if errno == ENOENT:  # the device went (or came back under another name)
+                note = ports_present_note(self.port)
+                why += f"; {note}" if note else ""
             raise error(
                 f"cannot open serial port {self.port}: {why}", errno=_system_errno(exc)
             ) from exc
