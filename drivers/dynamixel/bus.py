@@ -18,6 +18,7 @@ Known SDK behaviours handled here:
 
 from __future__ import annotations
 
+import errno
 import logging
 from collections.abc import Iterable, Mapping
 from typing import Any
@@ -34,6 +35,7 @@ from rti_rig.drivers.dynamixel.faults import (
     HardwareFaultError,
     ServoStatusError,
 )
+from rti_rig.drivers.ports_present import ports_present_note
 from rti_rig.drivers.serial_ports import finish_close, identity
 
 log = logging.getLogger("rti_rig.dynamixel.traffic")
@@ -163,9 +165,12 @@ class DxlBus:
             try:
                 ok = self.port.openPort() and self.port.setBaudRate(baudrate)
             except Exception as exc:  # pyserial raises SerialException/OSError
+                # a missing device node: the adapter gone, or back under another name
+                note = ports_present_note(self.port.getPortName()) if _missing(exc) else ""
                 raise CommunicationError(
                     self.device,
-                    f"cannot open port {self.port.getPortName()!r}: {exc}; check that the "
+                    f"cannot open port {self.port.getPortName()!r}: {exc}; "
+                    f"{note + '; ' if note else ''}check that the "
                     "arm's USB adapter (e.g. a U2D2) is plugged in and that the rig config's "
                     "[arm.dynamixel] port names it",
                     "open",
@@ -524,6 +529,12 @@ class DxlBus:
         result, error = self.ph.reboot(self.port, dxl_id)
         log.debug("%s: reboot %d (%d, %d)", self.device, dxl_id, result, error)
         self._check(result, error, dxl_id, "reboot", alert=False)
+
+
+def _missing(exc: BaseException) -> bool:
+    """Whether an open failed because the device node is not there (ENOENT): pyserial's
+    ``SerialException`` carries the system's errno, a plain ``OSError`` its own."""
+    return getattr(exc, "errno", None) == errno.ENOENT
 
 
 def _span_name(address: int, length: int) -> str:
