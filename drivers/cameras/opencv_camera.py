@@ -546,11 +546,26 @@ class OpenCvCamera:
 
     # -- capture ---------------------------------------------------------------------------
     def _ran_out(self) -> str:
-        """For an image sequence: how many files were read, so that a sequence shorter than
-        the session (or a drain that skips files) is told as such, not as a lost device."""
+        """Why the stream ended, as far as it can be told. For an image sequence: how many
+        files were read, so that a sequence shorter than the session (or a drain that skips
+        files) is told as such, not as a lost device. For a V4L2 camera that has delivered
+        frames: OpenCV's grab fails once the device has gone (VIDIOC_DQBUF answers ENODEV), so
+        the camera is said to have dropped off, with what to check and that the session is
+        resumed once it is back (it had said "stream ended while draining frame 1 of 4" alone,
+        which named neither the unplugged camera nor what to do)."""
         s = self.settings
         if s.backend != "images":
-            return ""
+            if s.backend != "v4l2" or self._frames_read == 0:
+                return ""
+            where = f"/dev/video{s.device}" if isinstance(s.device, int) else s.device
+            return (
+                f": the camera on {where} stopped delivering frames after "
+                f"{self._frames_read} read; "
+                "it was unplugged or dropped off the USB bus (a loose cable, a hub, a laptop's "
+                "USB power saving): check its cable and hub, and once it is back (v4l2-ctl "
+                "--list-devices; it may return as another /dev/video number, then set "
+                "[camera.device] device to it) resume the session"
+            )
         how = (
             f" (drain_frames = {self._drain} in [camera.device], then one kept)"
             if s.drain_frames is not None
