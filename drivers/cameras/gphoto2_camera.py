@@ -394,9 +394,7 @@ class Gphoto2Camera:
         if port is not None:
             match = [d for d in detected if d[1] == port]
             if not match:
-                raise DeviceError(
-                    self.name, f"no camera on port {port}; found {detected}", "connect"
-                )
+                raise DeviceError(self.name, _port_gone(port, detected), "connect")
             model = match[0][0]
         elif len(detected) > 1:
             raise DeviceError(
@@ -1619,3 +1617,30 @@ def _number(text: str | None) -> float:
         return float(text) if text is not None else 0.0
     except ValueError:
         return 0.0
+
+
+def _port_gone(port: str, detected: list[tuple[str, str]]) -> str:
+    """The refusal of a configured ``port`` no camera is on, naming the cameras found.
+
+    Why worded so: libgphoto2's ``usb:BUS,DEVICE`` is the USB device number, which the
+    system gives anew at every plugging. A camera that dropped off a hub mid-session and came
+    back is on another one (usb:001,004 → usb:001,005), and the refusal had been "no camera on
+    port usb:001,004; found [('Canon EOS 600D', 'usb:001,005')]": a Python list, and nothing
+    of why nor what to do. rti-rig does not take the other camera by itself (with ``port`` set
+    there may be two bodies, and a resume must not shoot the rest on the wrong one): it names
+    what is there and the line to change; the port is not part of the session's rig identity,
+    so the resume then goes on."""
+    found = "; ".join(f"{model} on {where}" for model, where in detected)
+    usb = (
+        " (a usb: port is the USB device number, which changes each time the camera is "
+        "plugged in again or wakes from its power saving)"
+        if port.startswith("usb:")
+        else ""
+    )
+    fix = (
+        f'set port = "{detected[0][1]}" in [camera.device], or remove the port line to '
+        "use the only camera found"
+        if len(detected) == 1
+        else "set port in [camera.device] to the one to use"
+    )
+    return f"no camera on port {port}{usb}; cameras found now: {found}. If it is yours, {fix}"
