@@ -1,0 +1,82 @@
+"""The arm's USB adapter (a U2D2) unplugged mid-session, then plugged back for the resume.
+
+Through ``rti-rig run`` on the shipped emulated arm (the real driver, SDK and pyserial on a
+pty). The adapter's going is modelled where the system shows it to pyserial: the next write
+fails with EIO ("write failed: [Errno 5] Input/output error", pyserial's words for a tty whose
+device is gone), and the device node is gone until it is plugged back (ENOENT at the open).
+"""
+
+from __future__ import annotations
+
+import errno
+import sys
+from pathlib import Path
+
+import pytest
+import serial
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.simulator import dynamixel_pty
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+
+def test_an_arm_adapter_unplugged_mid_session_stops_keeps_and_resumes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    #: instructions into the session when the adapter goes: after the second image
+    gone: dict[str, int | bool] = {"after": 250, "now": False}
+    handler = dynamixel_pty.EmulatedLinkPortHandler
+    real_write, real_open = handler.writePort, handler.openPort
+
+    def write(self, packet):  # type: ignore[no-untyped-def]
+        if gone["now"] or self._server.emulator.instructions_received >= gone["after"]:
+            gone["now"] = True
+            raise serial.SerialException("write failed: [Errno 5] Input/output error")
+        return real_write(self, packet)
+
+    def open_port(self):  # type: ignore[no-untyped-def]
+        if gone["now"]:
+            raise serial.SerialException(
+                errno.ENOENT, f"could not open port {self.port_name}: No such file or directory"
+            )
+        return real_open(self)
+
+    monkeypatch.setattr(handler, "writePort", write)
+    monkeypatch.setattr(handler, "openPort", open_port)
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text((CONFIGS / "simulated_arm.toml").read_text())
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app,
+        ["run", str(cfg), "--out", str(out), "--lights", "6", "--no-verdict"],
+        terminal_width=400,
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "arm: the port '" in said, said
+    assert "failed (write failed: [Errno 5] Input/output error): check that the arm's USB " in said
+    assert "the arm's park is NOT confirmed" in said, said  # a dead port parks nothing
+    kept = (out / "lights.lp").read_text().split()
+    assert kept[0] == "2", said
+    assert f"2 image(s) kept in {out}, listed in lights.lp" in said, said
+    assert f"Continue with: rti-rig run --resume {out}" in said, said
+    assert "Traceback" not in said
+
+    # a resume while it is still unplugged is refused at the open, the session untouched
+    r = CliRunner().invoke(app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "No such file or directory" in said and "Nothing was commanded" in said, said
+    assert (out / "lights.lp").read_text().split()[0] == "2", said
+
+    gone.update(after=10**9, now=False)  # plugged back in
+    r = CliRunner().invoke(app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert (out / "lights.lp").read_text().split()[0] == "6", said
