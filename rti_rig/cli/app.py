@@ -13,6 +13,7 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
+from rti_rig.core.deferred_signals import as_received
 from rti_rig.core.errors import RtiRigError
 
 app = typer.Typer(
@@ -167,8 +168,9 @@ def parse_az_el(text: str | None, option: str = "--preview-light") -> tuple[floa
 def stop_exit_code(signum: signal.Signals) -> int:
     """The exit code of a command stopped by the signal ``signum``: 128 + its number, as a
     shell reports a process the signal ended (SIGTERM 143, Ctrl-C 130). Decided on the signal
-    itself, not on the words that name it to the user."""
-    return 128 + int(signum)
+    itself, not on the words that name it to the user; a SIGTERM that was a hang-up is
+    SIGHUP's 129 (:func:`~rti_rig.core.deferred_signals.as_received`)."""
+    return 128 + int(as_received(signum))
 
 
 #: Libraries whose log records are not for the user's terminal: a command says in words what

@@ -13,7 +13,7 @@ import typer
 from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, stop_exit_code
-from rti_rig.core.deferred_signals import signal_handlers
+from rti_rig.core.deferred_signals import hangup_as_sigterm, signal_handlers
 from rti_rig.core.errors import RtiRigError
 
 if TYPE_CHECKING:
@@ -39,7 +39,10 @@ def stop_on_signals() -> Iterator[None]:
         phase = "stopping"
         raise EmergencyStop(signal.Signals(signum))
 
-    with signal_handlers({signal.SIGINT: on_signal, signal.SIGTERM: on_signal}):
+    with (
+        signal_handlers({signal.SIGINT: on_signal, signal.SIGTERM: on_signal}),
+        hangup_as_sigterm(),
+    ):
         try:
             yield
         finally:
@@ -96,7 +99,8 @@ def check(
     acquisition's .lp (a replay rig) has no device: its images are checked instead.
 
     Exit codes: 0 passed (or RESULT: SENT, NOT VERIFIED, a dome that cannot answer); 1
-    RESULT: FAIL; 2 refused or an error; 130 / 143 stopped by Ctrl-C / SIGTERM."""
+    RESULT: FAIL; 2 refused or an error; 130 / 143 / 129 stopped by Ctrl-C / SIGTERM / a
+    hang-up (SIGHUP: the terminal or ssh connection closed; torn down as for SIGTERM)."""
     from rti_rig.app.usecases.check import CheckRequest, CheckStopped, check_rig
     from rti_rig.runtime.controller import EmergencyStop
 

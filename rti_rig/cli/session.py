@@ -29,7 +29,14 @@ from rti_rig.cli.app import (
     stop_exit_code,
 )
 from rti_rig.cli.stopping import stop_signal
-from rti_rig.core.deferred_signals import handlers_settable, put_back, signal_handlers
+from rti_rig.core.deferred_signals import (
+    as_received,
+    handlers_settable,
+    hangup_as_sigterm,
+    put_back,
+    signal_handlers,
+    stop_words,
+)
 from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free)
@@ -229,7 +236,8 @@ def run(
     rti-rig did not name; 2 refused (bad input, --out not empty, too little disk, the session
     or the dome's port in use) or an error during the capture (a device fault, a failed
     write: the images so far kept; manifest.json's runner.finish_reason says which); 130 /
-    143 stopped (docs/guide.md, section 11).
+    143 stopped; 129 a hang-up (SIGHUP: the terminal or ssh connection closed), stopped as
+    by SIGTERM (docs/guide.md, section 11).
     """
     from rti_rig.app.usecases.session import (
         NewSessionRequest,
@@ -355,14 +363,15 @@ def run(
             ),
             not_opened=f"Nothing was captured or written to {out_dir}",
         )
-    with _late_pause_ignored(), _late_term_held() as late_term:
+    with hangup_as_sigterm(), _late_pause_ignored(), _late_term_held() as late_term:
         with _sigterm_exit_wins(late_term):
             opened, handover = _open_for_capture(opening)
             unsafe = _execute(opened, handover)
         if late_term:  # the summary is out; the verdict, not computed, is fit's to give
             _refuse_unsafe_end(unsafe, exit_code=None)
             err.print(
-                "[yellow]Stopped (SIGTERM) once the session had ended: it is complete; its QA "
+                f"[yellow]Stopped ({stop_words(signal.SIGTERM)}) once the session had ended: it "
+                "is complete; its QA "
                 "verdict was not computed:[/] rti-rig fit "
                 f"{escape(_arg(opened.out_dir))} --out FOLDER gives it",
                 soft_wrap=True,
@@ -698,8 +707,8 @@ def _late_term_held() -> Iterator[list[int]]:
 
     def late(signum, frame) -> None:  # type: ignore[no-untyped-def]
         if held:  # asked twice: stop now (a summary that hangs must not outlive a stop)
-            signal.signal(signal.SIGTERM, signal.SIG_DFL)
-            signal.raise_signal(signal.SIGTERM)
+            signal.signal(as_received(signum), signal.SIG_DFL)  # a hang-up's: SIGHUP
+            signal.raise_signal(as_received(signum))
         held.append(signum)
 
     with signal_handlers({signal.SIGTERM: late}):
@@ -724,8 +733,9 @@ def _sigterm_exit_wins(late_term: list[int]) -> Iterator[None]:
         if not late_term or exc.exit_code == stop_exit_code(signal.SIGTERM):
             raise
         err.print(
-            "[yellow]SIGTERM while the run's end was being said: what is said above stands; "
-            f"exit {stop_exit_code(signal.SIGTERM)} for the SIGTERM (not {exc.exit_code}).[/]",
+            f"[yellow]{stop_words(signal.SIGTERM)} while the run's end was being said: what is "
+            f"said above stands; exit {stop_exit_code(signal.SIGTERM)} for the "
+            f"{stop_words(signal.SIGTERM)} (not {exc.exit_code}).[/]",
             soft_wrap=True,
         )
         raise typer.Exit(code=stop_exit_code(signal.SIGTERM)) from None
@@ -1970,7 +1980,8 @@ def preview(
         if late_term:  # the preview and its summary are out; the run's word on the stop
             _refuse_unsafe_end(unsafe, exit_code=None)
             err.print(
-                "[yellow]Stopped (SIGTERM) once the preview was taken: it is complete in "
+                f"[yellow]Stopped ({stop_words(signal.SIGTERM)}) once the preview was taken: it "
+                "is complete in "
                 f"{escape(_arg(out_dir))}[/] (plan from it as above)",
                 soft_wrap=True,
             )

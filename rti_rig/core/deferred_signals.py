@@ -23,8 +23,58 @@ from typing import Any
 
 def stop_words(signum: signal.Signals) -> str:
     """How a stop by ``signum`` is named to the user: ``Ctrl-C`` for SIGINT, else the
-    signal's name (``SIGTERM``)."""
-    return "Ctrl-C" if signum == signal.SIGINT else signum.name
+    signal's name (``SIGTERM``; ``SIGHUP`` for a SIGTERM that was a hang-up, see
+    :func:`as_received`)."""
+    return "Ctrl-C" if signum == signal.SIGINT else as_received(signum).name
+
+
+#: A hang-up (SIGHUP) came during a :func:`hangup_as_sigterm` block and was answered as a
+#: SIGTERM: the stop it made is named, recorded and exited as SIGHUP (:func:`as_received`).
+_hung_up = False
+
+
+def as_received(signum: int) -> signal.Signals:
+    """The signal a stop really came as: SIGHUP for a SIGTERM once a hang-up was answered as
+    one (:func:`hangup_as_sigterm`), else ``signum`` itself. What names a stop (the words, the
+    manifest's record, the exit code 128 + its number) goes through it."""
+    sig = signal.Signals(signum)
+    if _hung_up and sig == signal.SIGTERM:
+        return signal.SIGHUP
+    return sig
+
+
+@contextlib.contextmanager
+def hangup_as_sigterm() -> Iterator[None]:
+    """For the block (a whole ``run`` or ``check``), a SIGHUP is answered by whatever answers a
+    SIGTERM at that moment: the stop and teardown (all-off, arm stopped), a hold, a late
+    record; it is named, recorded and exited as itself (SIGHUP, exit 129: :func:`as_received`).
+
+    Why: SIGHUP (the terminal or the ssh connection closing) had no handler: the process died
+    at once with exit 129, no teardown (a dome's LED left lit, an arm holding) and no end in
+    the manifest. One mechanism, SIGTERM's, rather than a second copy of every SIGTERM handler
+    (the opening's, the capture's, the holds', the verdict's). Where SIGTERM's action is the
+    default, SIGHUP's is too (the process ends by SIGHUP). The flag is cleared as the block
+    begins, not as it ends: the exit code is decided on it once the block is left. No SIGHUP
+    (Windows), or SIGHUP ignored as the block begins (``nohup``): nothing is installed."""
+    global _hung_up
+    _hung_up = False
+    sighup = getattr(signal, "SIGHUP", None)
+    if sighup is None or signal.getsignal(sighup) == signal.SIG_IGN:
+        yield  # ignored as the command began (``nohup``): the session is meant to outlive
+        return  # its terminal, and goes on to its end
+
+    def hung_up(signum: int, frame: Any) -> None:
+        global _hung_up
+        _hung_up = True
+        handler = signal.getsignal(signal.SIGTERM)
+        if callable(handler):
+            handler(signal.SIGTERM, frame)
+        elif handler != signal.SIG_IGN:  # the default (or a handler set outside Python)
+            signal.signal(sighup, signal.SIG_DFL)
+            signal.raise_signal(sighup)
+
+    with signal_handlers({sighup: hung_up}):
+        yield
 
 
 #: How many :func:`after_a_stop` blocks are open (in the main thread, where handlers run).

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import TYPE_CHECKING, Any, Protocol
 
-from rti_rig.core.deferred_signals import signals_deferred, stop_words
+from rti_rig.core.deferred_signals import as_received, signals_deferred, stop_words
 from rti_rig.core.devices import (
     BusyAwareCamera,
     CardListingCamera,
@@ -89,7 +89,7 @@ class EmergencyStop(BaseException):
     self_test_report: ArmSelfTestReport | None = None
 
     def __init__(self, signum: signal.Signals, words: str | None = None) -> None:
-        self.signum = signal.Signals(signum)
+        self.signum = as_received(signum)  # a hang-up answered as a SIGTERM is a SIGHUP
         super().__init__(words or stop_words(self.signum))
 
 

@@ -36,7 +36,14 @@ app(sys.argv[1:], prog_name="rti-rig")
 @pytest.mark.slow
 @pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
 @pytest.mark.parametrize(
-    ("sig", "code", "name"), [(signal.SIGTERM, 143, "SIGTERM"), (signal.SIGINT, 130, "Ctrl-C")]
+    ("sig", "code", "name"),
+    [
+        (signal.SIGTERM, 143, "SIGTERM"),
+        (signal.SIGINT, 130, "Ctrl-C"),
+        # a hang-up (the terminal or ssh connection closing) is torn down as SIGTERM is; it had
+        # no handler: the process died at once, LED lit, nothing said
+        (signal.SIGHUP, 129, "SIGHUP"),
+    ],
 )
 def test_a_stopped_check_switches_the_dome_off_and_says_so(sig, code, name) -> None:
     cfg = REPO / "rig_configs" / "emulated_nab_rti_v1.toml"
