@@ -507,6 +507,70 @@ def arm_tablet_12(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+def dome_session_said(root: Path, scene: str, side: int, lights: int) -> Path:
+    """A correct session of :func:`dome_variant` in ``root/s``, shot through the CLI with its
+    verdict, which must end it with exit 0; what it printed, unwrapped, is in ``said.txt``
+    beside it (``root/said.txt``) for tests that assert on the run's verdict."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    out = root / "s"
+    config = dome_variant(root, scene, side)
+    r = CliRunner().invoke(app, ["run", str(config), "--out", str(out), "--lights", str(lights)])
+    assert r.exit_code == 0, r.output
+    (root / "said.txt").write_text(said(r), encoding="utf-8")
+    return out
+
+
+@pytest.fixture(scope="session")
+def dome_coin_1024_12(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The shipped simulated dome's glossy coin at 1024 px, 12 lights, with its verdict
+    (:func:`dome_session_said`; read only: the QA tests copy it to dim, scale or move an
+    image). Why one for the run: four QA test files each shot this same session."""
+    return dome_session_said(tmp_path_factory.mktemp("coin1024"), "coin", 1024, 12)
+
+
+@pytest.fixture(scope="session")
+def dome_coin_512_12(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The shipped simulated dome's glossy coin at 512 px, 12 lights, with its verdict
+    (:func:`dome_session_said`; read only). Why one for the run: two QA test files each shot
+    this same session."""
+    return dome_session_said(tmp_path_factory.mktemp("coin512"), "coin", 512, 12)
+
+
+@pytest.fixture(scope="session")
+def dome_painting_512_12(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The shipped simulated dome's varnished painting at 512 px, 12 lights, with its verdict
+    (:func:`dome_session_said`; read only). Why one for the run: two QA test files each shot
+    this same session."""
+    return dome_session_said(tmp_path_factory.mktemp("painting512"), "painting", 512, 12)
+
+
+@pytest.fixture(scope="session")
+def dome_relief(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A correct session of the shipped simulated dome as it ships (the relief, 512 px, its
+    own lights), shot through the CLI without its verdict (read only: tests copy it to move
+    its images). Why one for the run: two QA test files each shot this same session."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    out = tmp_path_factory.mktemp("relief") / "s"
+    config = CONFIGS / "simulated_dome.toml"
+    r = CliRunner().invoke(app, ["run", str(config), "--out", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    return out
+
+
+@pytest.fixture(scope="session")
+def dome_industrial_512_24(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A correct session of the shipped simulated dome on the industrial part (brushed steel)
+    at 512 px, 24 lights (:func:`dome_session`; read only: tests copy it to change it). Why
+    one for the run: two QA test files each shot this same session."""
+    return dome_session(tmp_path_factory.mktemp("industrial512"), "industrial", 512, 24)
+
+
 def coin_dome(folder: Path, exposure_s: float = 0.05) -> Path:
     """The shipped emulated dome (48 LEDs, real driver over a pty) shooting the polished coin at
     ``exposure_s``, as emulated_dome.toml did until its scene became the matte tablet: at 0.05 s

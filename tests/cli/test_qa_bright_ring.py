@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import dome_session
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -36,8 +35,10 @@ def _fit(session: Path, out: Path) -> tuple[str, dict]:  # type: ignore[type-arg
 
 @pytest.mark.slow
 @pytest.mark.e2e
-def test_a_ring_of_glossy_images_is_not_called_brighter(tmp_path: Path) -> None:
-    session = dome_session(tmp_path, "industrial", 512, 24)
+def test_a_ring_of_glossy_images_is_not_called_brighter(
+    tmp_path: Path, dome_industrial_512_24: Path
+) -> None:
+    session = dome_industrial_512_24  # read only: the bright image is made in a copy
 
     said, qa = _fit(session, tmp_path / "fit")
     by_name = {im["name"]: im for im in qa["images"]}

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -39,18 +38,10 @@ def _dimmed_copy(session: Path, dst: Path, name: str) -> Path:
 
 
 @pytest.mark.slow  # the coin at 1024 px (at 512 px the dim light tilts too little), 12 lights
-def test_only_the_dimmed_light_is_named_on_the_glossy_coin(tmp_path: Path) -> None:
-    text = (CONFIGS / "simulated_dome.toml").read_text()
-    assert 'name = "relief"' in text and "width = 512" in text and "height = 512" in text
-    text = text.replace('name = "relief"', 'name = "coin"')
-    text = text.replace("width = 512", "width = 1024").replace("height = 512", "height = 1024")
-    session = tmp_path / "s"
-    r = runner.invoke(
-        app, ["run", str(write_config(tmp_path, text)), "--out", str(session), "--lights", "12"]
-    )
-    assert r.exit_code == 0, r.output
-
-    dimmed = _dimmed_copy(session, tmp_path / "dimmed", "image_007")
+def test_only_the_dimmed_light_is_named_on_the_glossy_coin(
+    tmp_path: Path, dome_coin_1024_12: Path
+) -> None:
+    dimmed = _dimmed_copy(dome_coin_1024_12, tmp_path / "dimmed", "image_007")
     out = tmp_path / "fit"
     r = runner.invoke(
         app, ["fit", str(dimmed), "--out", str(out), "--no-ptm", "--no-hsh", "--no-normals"]

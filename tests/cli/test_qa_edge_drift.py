@@ -53,10 +53,8 @@ def _grey(session: Path) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def relief(tmp_path_factory: pytest.TempPathFactory) -> np.ndarray:
-    out = tmp_path_factory.mktemp("relief") / "s"
-    _run(out, REPO / "rig_configs" / "simulated_dome.toml", "--no-verdict")
-    return _grey(out)
+def relief(dome_relief: Path) -> np.ndarray:
+    return _grey(dome_relief)
 
 
 @pytest.fixture(scope="module")

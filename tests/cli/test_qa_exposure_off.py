@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -57,19 +56,10 @@ def _exposure_named(qa: dict) -> dict[str, str]:
 
 
 @pytest.fixture(scope="module")
-def coin_session(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The shipped simulated dome with its scene set to the coin at 1024 px, 12 lights."""
-    tmp_path = tmp_path_factory.mktemp("coin")
-    text = (CONFIGS / "simulated_dome.toml").read_text()
-    assert 'name = "relief"' in text and "width = 512" in text and "height = 512" in text
-    text = text.replace('name = "relief"', 'name = "coin"')
-    text = text.replace("width = 512", "width = 1024").replace("height = 512", "height = 1024")
-    session = tmp_path / "s"
-    r = runner.invoke(
-        app, ["run", str(write_config(tmp_path, text)), "--out", str(session), "--lights", "12"]
-    )
-    assert r.exit_code == 0, r.output
-    return session
+def coin_session(dome_coin_1024_12: Path) -> Path:
+    """The shipped simulated dome with its scene set to the coin at 1024 px, 12 lights (read
+    only: the tests scale an image in a copy)."""
+    return dome_coin_1024_12
 
 
 @pytest.mark.slow  # the coin at 1024 px, 12 lights: three fits of the session

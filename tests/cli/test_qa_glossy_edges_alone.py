@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import dome_session
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -26,8 +25,8 @@ runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
-def coin(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return dome_session(tmp_path_factory.mktemp("coin"), "coin", 1024, 12)
+def coin(dome_coin_1024_12: Path) -> Path:
+    return dome_coin_1024_12
 
 
 def _qa(session: Path, out: Path) -> dict:  # type: ignore[type-arg]

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -27,21 +26,11 @@ runner = CliRunner()
 
 
 @pytest.mark.slow  # a 12-light session of the coin at 1024 px, then a fit of a copy of it
-def test_only_the_moved_image_is_called_moved_on_the_coin(tmp_path: Path) -> None:
-    text = (CONFIGS / "simulated_dome.toml").read_text()
-    assert 'name = "relief"' in text and "width = 512\nheight = 512" in text
-    text = text.replace('name = "relief"', 'name = "coin"')
-    text = text.replace("width = 512\nheight = 512", "width = 1024\nheight = 1024")
-    session = tmp_path / "s"
-    r = runner.invoke(
-        app,
-        ["run", str(write_config(tmp_path, text)), "--out", str(session), "--lights", "12"],
-        catch_exceptions=False,
-    )
-    assert r.exit_code == 0, r.output
-
+def test_only_the_moved_image_is_called_moved_on_the_coin(
+    tmp_path: Path, dome_coin_1024_12: Path
+) -> None:
     moved = tmp_path / "moved"
-    shutil.copytree(session, moved)
+    shutil.copytree(dome_coin_1024_12, moved)
     for name in ("journal.jsonl", "manifest.json"):  # a fault injected, not a file changed
         (moved / name).unlink(missing_ok=True)
     tif = moved / "linear" / "image_011.tif"

@@ -26,12 +26,8 @@ runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
-def session(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    out = tmp_path_factory.mktemp("dome") / "s"
-    config = REPO / "rig_configs" / "simulated_dome.toml"
-    r = runner.invoke(app, ["run", str(config), "--out", str(out), "--no-verdict"])
-    assert r.exit_code == 0, r.output
-    return out
+def session(dome_relief: Path) -> Path:
+    return dome_relief  # read only: the tests move a copy
 
 
 def _verdict(session: Path, out: Path) -> dict:  # type: ignore[type-arg]

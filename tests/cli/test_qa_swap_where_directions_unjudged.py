@@ -23,7 +23,6 @@ import shutil
 from pathlib import Path
 
 import pytest
-from conftest import dome_session
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -39,8 +38,8 @@ def _qa(session: Path, out: Path) -> dict:  # type: ignore[type-arg]
 
 
 @pytest.fixture(scope="module")
-def industrial(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return dome_session(tmp_path_factory.mktemp("industrial"), "industrial", 512, 24)
+def industrial(dome_industrial_512_24: Path) -> Path:
+    return dome_industrial_512_24
 
 
 def _wrong(qa: dict) -> dict[str, str]:  # type: ignore[type-arg]
