@@ -51,10 +51,11 @@ def _image(i: int) -> str:
 
 
 @pytest.fixture(scope="module")
-def sessions(tmp_path_factory: pytest.TempPathFactory) -> dict[int, Path]:
+def sessions(tmp_path_factory: pytest.TempPathFactory, dome_coin_512_12: Path) -> dict[int, Path]:
+    assert LIGHTS == 12  # the lights of the shared 512 px session
     return {
-        side: dome_session(tmp_path_factory.mktemp(f"coin{side}"), "coin", side, LIGHTS)
-        for side in (256, 512)
+        256: dome_session(tmp_path_factory.mktemp("coin256"), "coin", 256, LIGHTS),
+        512: dome_coin_512_12,
     }
 
 
