@@ -754,11 +754,13 @@ class Gphoto2Camera:
                 try:
                     self._restore_shutter(own)
                 except Exception as failed:
+                    # what is known: the speed last read back (the shot's); a write
+                    # that failed part-way may have left either, so "is left at" is not said
                     self._restore_note = (
-                        f"the camera is left at shutter speed '{self._shutter_label}' (the "
-                        f"test shot's), not its own '{own}': putting it back failed ("
-                        f"{getattr(failed, 'message', None) or failed}); set it on the camera "
-                        "before shooting with it outside rti-rig"
+                        f"putting the camera's own shutter speed '{own}' back after the test "
+                        f"shot failed ({getattr(failed, 'message', None) or failed}); it was "
+                        f"last read back at '{self._shutter_label}' (the test shot's): check "
+                        "and set it on the camera before shooting with it outside rti-rig"
                     )
             raise
         self.output_dir = bound

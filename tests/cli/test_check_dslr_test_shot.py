@@ -141,8 +141,11 @@ def test_a_shutter_speed_a_failed_test_shot_could_not_put_back_is_said(
     assert "camera: dslr connected, but FAILED its test shot: " in said, said
     assert f"{LIBRAW} cannot read" in said, said  # the shot's own error, first
     assert (
-        "; note: the camera is left at shutter speed '1/250' (the test shot's), not its own "
-        "'1/60': putting it back failed (" in said
+        "; note: putting the camera's own shutter speed '1/60' back after the test shot "
+        "failed (" in said
+    ), said
+    assert (
+        "it was last read back at '1/250' (the test shot's): check and set it on the camera" in said
     ), said
     if how == "no longer offered":
         assert "the camera's own shutter speed '1/60' (as connect found it, put back" in said

@@ -318,8 +318,9 @@ def camera_line(  # type: ignore[no-untyped-def]
                 # what the failed shot left unknown or undone (a format it never reached, a
                 # shutter speed it could not put back) is said beside its error: it had
                 # been left out, the body left at the shot's speed without a word
-                notes = getattr(rig.camera, "connect_notes", None)
-                left = "".join(f"; note: {n}" for n in (notes() if callable(notes) else ()))
+                camera = rig.camera
+                notes = camera.connect_notes() if isinstance(camera, ConnectNotingCamera) else ()
+                left = "".join(f"; note: {n}" for n in notes)
                 return (
                     f"camera: {rig.camera.name} connected, but FAILED its test shot: {exc}{left}",
                     False,
