@@ -59,7 +59,9 @@ def ports_present_note(port: str) -> str:
 
         found = sorted(list_ports.comports(), key=lambda p: p.device)
     except Exception as exc:  # a hint must not replace the error it explains
-        return f"the serial ports present could not be listed ({exc})"
+        # the system's reason, not Python's text of it ("[Errno 13] ...: '/sys/class/tty'")
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        return f"the serial ports present could not be listed ({why or type(exc).__name__})"
     stable = _stable_names()
     kernel_name = not port.startswith(("/dev/serial/by-id/", "/dev/serial/by-path/"))
     advice = (

@@ -175,3 +175,26 @@ def test_a_port_outside_dev_gets_no_listing() -> None:
     """An emulator's pty or a URL is no device a user points a config at: no listing."""
     assert ports_present.ports_present_note("/tmp/rti-rig-pty-x/tty-dome") == ""
     assert ports_present.ports_present_note("loop://") == ""
+
+
+def test_a_listing_that_fails_is_said_in_the_systems_words(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The port listing refused (sysfs not readable) is named as the system says it, not as
+    Python's text of the error (``[Errno 13] Permission denied: '/sys/class/tty'``); a by-id
+    folder that cannot be read only loses the stable names, not the listing."""
+    from serial.tools import list_ports
+
+    def refused() -> list[object]:
+        raise PermissionError(13, "Permission denied", "/sys/class/tty")
+
+    monkeypatch.setattr(list_ports, "comports", refused)
+    note = ports_present.ports_present_note("/dev/ttyACM0")
+    assert note == "the serial ports present could not be listed (Permission denied)", note
+
+    board = SimpleNamespace(device="/dev/ttyACM1", description="n/a", serial_number=None)
+    monkeypatch.setattr(list_ports, "comports", lambda: [board])
+    monkeypatch.setattr(ports_present, "BY_ID", tmp_path / "not-a-folder")
+    (tmp_path / "not-a-folder").write_text("", encoding="utf-8")
+    note = ports_present.ports_present_note("/dev/ttyACM0")
+    assert note.startswith("serial ports present now: /dev/ttyACM1. If the device came"), note
