@@ -557,12 +557,22 @@ class OpenCvCamera:
         if s.backend != "images":
             if s.backend != "v4l2" or self._frames_read == 0:
                 return ""
-            where = f"/dev/video{s.device}" if isinstance(s.device, int) else s.device
+            where = f"/dev/video{s.device}" if isinstance(s.device, int) else str(s.device)
+            if _device_node_present(where):
+                # OpenCV's grab also fails on its select() timeout, the device still there:
+                # the camera hung or its link reset; no unplugging was established
+                why = (
+                    f"{where} is still there, so the camera hung or its USB link reset: unplug "
+                    "it and plug it in again"
+                )
+            else:
+                why = (
+                    f"{where} is gone: it was unplugged or dropped off the USB bus (a loose "
+                    "cable, a hub, a laptop's USB power saving): check its cable and hub"
+                )
             return (
                 f": the camera on {where} stopped delivering frames after "
-                f"{self._frames_read} read; "
-                "it was unplugged or dropped off the USB bus (a loose cable, a hub, a laptop's "
-                "USB power saving): check its cable and hub, and once it is back (v4l2-ctl "
+                f"{self._frames_read} read; {why}, and once it is back (v4l2-ctl "
                 "--list-devices; it may return as another /dev/video number, then set "
                 "[camera.device] device to it) resume the session"
             )
@@ -694,3 +704,11 @@ class OpenCvCamera:
             timestamp_s=started,
             metadata=metadata,
         )
+
+
+def _device_node_present(where: str) -> bool:
+    """Whether a V4L2 camera's device node exists now: a stream that stopped with it gone was
+    unplugged; with it there, OpenCV's grab had timed out on a camera that hung."""
+    import os
+
+    return os.path.exists(where)

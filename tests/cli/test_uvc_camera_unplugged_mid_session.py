@@ -22,6 +22,7 @@ from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.clock import SystemClock
+from rti_rig.drivers.cameras import opencv_camera
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -82,11 +83,13 @@ def test_a_uvc_camera_unplugged_mid_session_stops_keeps_and_resumes(
     cfg = _config(tmp_path)
     out = tmp_path / "s"
     args = ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)]
+    # the world: /dev/video0 went with the camera (not this machine's own /dev, if it has one)
+    monkeypatch.setattr(opencv_camera, "_device_node_present", lambda where: False)
     code, said, lit = _run(monkeypatch, cfg, UnpluggedUvcStream(gone_after=2), args)
     assert code == 2, said
     assert "error: uvc-camera during 'drain'" in said, said
     assert "the camera on /dev/video0 stopped delivering frames after " in said, said
-    assert "unplugged or dropped off the USB bus" in said, said
+    assert "/dev/video0 is gone: it was unplugged or dropped off the USB bus" in said, said
     # the dome is still there: its all-off was acknowledged, and nothing is lit
     assert "All-off sent and acknowledged by the dome: lights are off." in said, said
     assert lit == []
@@ -104,3 +107,19 @@ def test_a_uvc_camera_unplugged_mid_session_stops_keeps_and_resumes(
     images = _images(out)
     assert len(images) == LIGHTS and images[:2] == kept, images
     assert lit == []
+
+
+def test_a_uvc_camera_that_stops_with_its_device_still_there_is_not_said_unplugged(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """OpenCV's grab fails on its select() timeout too, the device node still there (a camera
+    that hung): the stop says the node is there, and claims no unplugging."""
+    cfg = _config(tmp_path)
+    out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)]
+    monkeypatch.setattr(opencv_camera, "_device_node_present", lambda where: True)
+    code, said, _ = _run(monkeypatch, cfg, UnpluggedUvcStream(gone_after=2), args)
+    assert code == 2, said
+    assert "/dev/video0 is still there, so the camera hung or its USB link reset" in said, said
+    assert "unplugged or dropped off" not in said, said
+    assert f"Continue with: rti-rig run --resume {out}" in said, said
