@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import errno
 import logging
+import os
 from collections.abc import Iterable, Mapping
 from typing import Any
 
@@ -166,10 +167,14 @@ class DxlBus:
                 ok = self.port.openPort() and self.port.setBaudRate(baudrate)
             except Exception as exc:  # pyserial raises SerialException/OSError
                 # a missing device node: the adapter gone, or back under another name
-                note = ports_present_note(self.port.getPortName()) if _missing(exc) else ""
+                missing = _missing(exc)
+                note = ports_present_note(self.port.getPortName()) if missing else ""
+                # the system's reason alone: pyserial's text names the port twice, in Python's
+                # words ("[Errno 2] could not open port P: [Errno 2] No such file …: 'P'")
+                why = os.strerror(errno.ENOENT) if missing else str(exc)
                 raise CommunicationError(
                     self.device,
-                    f"cannot open port {self.port.getPortName()!r}: {exc}; "
+                    f"cannot open port {self.port.getPortName()!r}: {why}; "
                     f"{note + '; ' if note else ''}check that the "
                     "arm's USB adapter (e.g. a U2D2) is plugged in and that the rig config's "
                     "[arm.dynamixel] port names it",
