@@ -35,9 +35,12 @@ out = Console()
 def _flags_show_no_type() -> None:
     """Show on/off flags in help without a value type: typer 0.29 labels them ``<bool>``, as if
     ``--force`` took a value (it takes none). Every command's flags at once, in one place."""
-    from typer.core import TyperOption
+    try:  # typer's internals: a release without them loses this polish, not the CLI
+        from typer.core import TyperOption
 
-    original = TyperOption.display_type_rich
+        original = TyperOption.display_type_rich
+    except (ImportError, AttributeError):
+        return
     if getattr(original, "_rti_rig", False):
         return
 
@@ -72,14 +75,20 @@ def _empty_paths_refused() -> None:
     script ran in (or was refused as ". is not empty", naming no empty argument), and
     ``--resume ""`` resumed the current folder. An empty string is never a folder or file a
     user meant; ``.`` is still accepted when written as such."""
-    from typer.core import _TyperParameter
+    try:  # typer's internals: a release without them loses this refusal (its tests say so),
+        # not the whole CLI (an ImportError here had ended every command before it ran)
+        from typer.core import _TyperParameter
 
-    original = _TyperParameter.process_value
+        original = _TyperParameter.process_value
+    except (ImportError, AttributeError):
+        return
     if getattr(original, "_rti_rig", False):
         return
 
     def process_value(self, ctx, value):  # type: ignore[no-untyped-def]
-        if _is_path_annotation(self.type_descriptor.annotation):
+        # getattr: typer's own object; a release that renames it must not fail every option
+        annotation = getattr(getattr(self, "type_descriptor", None), "annotation", None)
+        if _is_path_annotation(annotation):
             given = value if isinstance(value, list | tuple) else [value]
             if any(isinstance(v, str) and v == "" for v in given):
                 raise typer.BadParameter(
