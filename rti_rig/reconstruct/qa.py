@@ -2136,6 +2136,10 @@ def _evidence(
     not_counted = (
         f" ({flat_out} flat frame{'s' if flat_out != 1 else ''} not counted)" if flat_out else ""
     )
+    # whether the images follow their recorded lights' order, told with no fit: measured once
+    # and said whichever branch below the verdict takes (a shuffled .lp of a matte sphere, seed
+    # 1 of 3, went down the judged branch and was said as images "brighter" and "moved" alone)
+    likeness = neighbour_likeness(crop_arr, lt)
     if spread_deg < MIN_NORMAL_SPREAD_DEG:
         note = (
             f"light directions not checked: the fitted normals spread only {spread_deg:.1f}° "
@@ -2162,8 +2166,6 @@ def _evidence(
         # ... or lights that are not these images': a matte sphere's .lp shuffled had been
         # said to be "a glossy, saturated or non-Lambertian surface" (and images "brighter
         # than predicted", "moved"): the lights' order against the images tells the two apart
-        if neighbour_likeness(crop_arr, lt) >= LIKENESS_UNORDERED:
-            note += f"; but {UNORDERED_SAID}"
     else:
         judged = cand.copy()
         agree = cand & (err <= WRONG_LIGHT_DEG)
@@ -2195,7 +2197,6 @@ def _evidence(
             # recorded lights look alike where the lights are this acquisition's (the gilded
             # icon of NeuralRTI's example: 41 of 45 "off", each image's nearest light's
             # image the one most like it); it had been left to the user to guess
-            likeness = neighbour_likeness(crop_arr, lt)
             if likeness <= LIKENESS_ORDERED:
                 note = (
                     f"{head}, yet each image looks most like the images of its nearest "
@@ -2282,6 +2283,11 @@ def _evidence(
                 f"{WRONG_LIGHT_MISFIT_RATIO:g}× the best direction's: on this object gloss, "
                 "shadows or clipping pull the best direction); not called wrong",
             )
+    if likeness >= LIKENESS_UNORDERED and UNORDERED_SAID not in note:
+        # ... or lights that are not these images': a matte sphere's .lp shuffled had been
+        # said to be "a glossy, saturated or non-Lambertian surface" (and images "brighter
+        # than predicted", "moved"): the lights' order against the images tells the two apart
+        note = f"{note}; but {UNORDERED_SAID}" if note else UNORDERED_SAID
     swap_ratio = np.full(n, np.nan)
     if not judged.any() and spread_deg >= MIN_NORMAL_SPREAD_DEG:
         # no direction judged by its angle: a swapped pair may still be plain (swapped_pairs)

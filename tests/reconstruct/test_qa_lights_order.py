@@ -33,7 +33,9 @@ def test_the_images_follow_their_own_lights_order(sphere) -> None:  # type: igno
     assert neighbour_likeness(np.stack(frames), lights) <= LIKENESS_ORDERED
 
 
-@pytest.mark.parametrize("seed", [0, 2])
+# seed 1 takes the branch where the directions are judged (13 of 24 images close to a
+# rendering): it had been said as images "brighter" and "moved" alone, the .lp not doubted
+@pytest.mark.parametrize("seed", [0, 1, 2])
 def test_a_shuffled_lp_is_said_to_be_likely_wrong(sphere, seed: int) -> None:  # type: ignore[no-untyped-def]
     frames, lights = sphere
     recorded = lights[np.random.default_rng(seed).permutation(N)]
