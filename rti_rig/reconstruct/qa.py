@@ -41,7 +41,7 @@ images to reshoot and why, followed by every check that was not made (:attr:`QAR
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
@@ -87,7 +87,9 @@ from rti_rig.reconstruct.qa_exposure import (
 )
 from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
 from rti_rig.reconstruct.qa_unchanging import (
+    FLAT_ADVICE,
     UNCHANGING,
+    UNCHANGING_ADVICE,
     flat_images,
     flat_problem,
     unchanging_problem,
@@ -380,6 +382,15 @@ class ImageCheck:
 
 #: The saturation check's advice (replaced where a session cannot follow it).
 LESS_EXPOSURE = "reshoot with less exposure"
+#: What the all-black check tells a session that can reshoot to do.
+BLACK_ADVICE = "mend that, then reshoot"
+#: Every per-image what-to-do that asks for a new capture. A session that cannot follow them
+#: (an imported acquisition, a replay, an adaptive session) has each replaced by its own words
+#: through :meth:`QAReport.with_advice`, one table per kind of session that must cover every
+#: phrase here. Why one list: "reshoot with less exposure" alone had been replaced, so an
+#: imported acquisition was still told of a flat frame "reshoot it" and of images that never
+#: changed "then reshoot", advice for an object no longer under any dome.
+REDO_ADVICE = (LESS_EXPOSURE, FLAT_ADVICE, UNCHANGING_ADVICE, BLACK_ADVICE)
 
 
 @dataclass(frozen=True)
@@ -610,6 +621,16 @@ class QAReport:
         )
         return replace(self, images=images, light_note=note)
 
+    def with_advice(self, advice: Callable[[str, str], str]) -> QAReport:
+        """This report with each phrase of :data:`REDO_ADVICE` in its images' problems
+        replaced by ``advice(image name, phrase)``: the words of a session that cannot
+        reshoot (the caller's table must answer every phrase)."""
+        images = tuple(
+            replace(c, problems=tuple(_readvised(p, c.name, advice) for p in c.problems))
+            for c in self.images
+        )
+        return replace(self, images=images)
+
     def to_json(self) -> dict[str, Any]:
         return {
             "verdict": self.verdict,
@@ -632,6 +653,14 @@ class QAReport:
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
+
+
+def _readvised(problem: str, name: str, advice: Callable[[str, str], str]) -> str:
+    """``problem`` with each :data:`REDO_ADVICE` phrase in it said as ``advice`` has it."""
+    for phrase in REDO_ADVICE:
+        if phrase in problem:
+            problem = problem.replace(phrase, advice(name, phrase))
+    return problem
 
 
 def _bright(gain: float, saturated_fraction: float) -> bool:
@@ -1642,7 +1671,7 @@ def assess(
     black_throughout = (
         f"{BLACK_THROUGHOUT}: the brightest pixels of every image reach at most "
         f"{float(np.max(peak)):.2%} of full scale (a lens cap left on, lights that never fired, "
-        "or an exposure far too short); mend that, then reshoot"
+        f"or an exposure far too short); {BLACK_ADVICE}"
         if all_black  # judged with a full scale: ``peak`` is finite
         else ""
     )

@@ -76,6 +76,13 @@ def unchanging_spread(
     return spread if spread < UNCHANGING_SPREAD else None
 
 
+#: What :func:`unchanging_problem` tells a session that can reshoot to do (replaced where it
+#: cannot: :data:`rti_rig.reconstruct.qa.REDO_ADVICE`).
+UNCHANGING_ADVICE = "check that each light fires, then reshoot"
+#: What :func:`flat_problem` tells a session that can reshoot to do (likewise replaced).
+FLAT_ADVICE = "reshoot it"
+
+
 def unchanging_problem(spread: float) -> str:
     """What the verdict says of every image of an acquisition that does not change with its
     light, and what to do."""
@@ -83,7 +90,7 @@ def unchanging_problem(spread: float) -> str:
         f"{UNCHANGING} (their median pixel varies {spread:.1%} from image to image, where "
         "these lights would change any surface's shading): the lights never changed (the "
         "dome's LEDs did not fire while another light was on, or one frame was saved under "
-        "every name); check that each light fires, then reshoot"
+        f"every name); {UNCHANGING_ADVICE}"
     )
 
 
@@ -156,5 +163,5 @@ def flat_problem(spread: float, typical: float) -> str:
     return (
         f"{FLAT_FRAME} (one level across the frame: it varies {spread:.1%} across it, where "
         f"the images of the nearest lights vary a median {typical:.0%}); a frame from "
-        "another source, a covered lens or a camera fault; reshoot it"
+        f"another source, a covered lens or a camera fault; {FLAT_ADVICE}"
     )

@@ -77,3 +77,21 @@ def test_a_session_of_this_rig_is_still_told_to_reshoot(shot: Path, tmp_path: Pa
     assert "QA verdict: reshoot: image_005 (saturated" in text, text
     assert "reshoot with less exposure" in text
     assert "an imported acquisition" not in text
+
+
+def test_every_reshoot_advice_has_words_where_none_can_be_followed() -> None:
+    """One table per kind of session that cannot reshoot, covering every advice to reshoot:
+    a phrase added to REDO_ADVICE without its words here would still tell an imported
+    acquisition to reshoot (the flat frame's "reshoot it" and the unchanging images' "then
+    reshoot" had been)."""
+    from rti_rig.app.usecases.session_integrity import (
+        ADAPTIVE_ADVICE,
+        IMPORTED_ADVICE,
+        REPLAYED_ADVICE,
+    )
+    from rti_rig.reconstruct.qa import LESS_EXPOSURE, REDO_ADVICE
+
+    assert set(IMPORTED_ADVICE) == set(REDO_ADVICE)
+    assert not any("reshoot" in v for v in IMPORTED_ADVICE.values())
+    for table in (REPLAYED_ADVICE, ADAPTIVE_ADVICE):  # their clipped image's words name more
+        assert set(table) | {LESS_EXPOSURE} == set(REDO_ADVICE)

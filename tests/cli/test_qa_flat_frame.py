@@ -38,7 +38,9 @@ def _replay(folder: Path, flat: str | None) -> Path:
 def test_a_flat_frame_in_a_real_acquisition_is_named(tmp_path: Path) -> None:
     said, qa = qa_of(_replay(tmp_path / "acq", "image29.jpg"), tmp_path / "f")
     assert f"image29 ({FLAT} (one level across the frame" in said, said
-    assert "reshoot it" in said
+    # an imported acquisition (an .lp and its JPEGs): nobody can reshoot it, and it is not told
+    # to (it had been: "...; reshoot it")
+    assert "reshoot it" not in said and "camera fault; so it is in the acquisition" in said
     named = [c["name"] for c in qa["images"] if any(FLAT in p for p in c["problems"])]
     assert named == ["image29"], named
 

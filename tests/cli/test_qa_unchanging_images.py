@@ -49,7 +49,9 @@ def test_the_same_frame_under_every_light_is_called_so_once(tmp_path: Path, fram
     assert said.count(SAID) == 1, said
     first, last = Path(entries[0].name).stem, Path(entries[-1].name).stem
     assert f"{first} ... {last} ({len(entries)} images: {SAID}" in said
-    assert "check that each light fires, then reshoot" in said
+    # an imported acquisition: told what it is, not to reshoot (it had been "then reshoot")
+    assert "then reshoot" not in said
+    assert "saved under every name); so they are in the acquisition" in said
 
 
 def test_images_that_follow_their_light_are_not_called_unchanging(tmp_path: Path) -> None:

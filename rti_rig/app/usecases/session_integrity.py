@@ -21,7 +21,13 @@ import numpy as np
 from rti_rig.app.usecases.uneven_lights import with_uneven_lights
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import lp_files_in, read_lp
-from rti_rig.reconstruct.qa import LESS_EXPOSURE, QAReport
+from rti_rig.reconstruct.qa import (
+    BLACK_ADVICE,
+    FLAT_ADVICE,
+    LESS_EXPOSURE,
+    UNCHANGING_ADVICE,
+    QAReport,
+)
 from rti_rig.runtime.session import (
     JOURNAL,
     LINEAR_DIR,
@@ -277,20 +283,44 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
     else:
         return qa
 
-    def said(name: str) -> str:
+    table = REPLAYED_ADVICE if word == "flawed" else ADAPTIVE_ADVICE
+
+    def said(name: str, phrase: str) -> str:
+        if phrase != LESS_EXPOSURE:
+            return table[phrase]
         if name not in recorded:
             return advice
         return advice.replace("the recording", f"the recording, {recorded[name]}", 1)
 
-    images = tuple(
-        replace(c, problems=tuple(p.replace(LESS_EXPOSURE, said(c.name)) for p in c.problems))
-        for c in qa.images
-    )
-    return replace(qa, images=images, session_note=note if qa.reshoot else "", verdict_word=word)
+    qa = qa.with_advice(said)
+    return replace(qa, session_note=note if qa.reshoot else "", verdict_word=word)
+
+
+#: What a replayed acquisition is told in place of each reshoot advice but the clipped one's
+#: (that names the recorded file: :func:`_with_session_kind`).
+REPLAYED_ADVICE = {
+    FLAT_ADVICE: "so it was recorded (a replayed acquisition cannot be reshot)",
+    UNCHANGING_ADVICE: "so they were recorded (a replayed acquisition cannot be reshot)",
+    BLACK_ADVICE: "so they were recorded (a replayed acquisition cannot be reshot)",
+}
+#: What an adaptive session is told in their place (it can start again, not reshoot one image).
+ADAPTIVE_ADVICE = {
+    FLAT_ADVICE: "a new session replaces it (an adaptive session cannot reshoot one image)",
+    UNCHANGING_ADVICE: "check that each light fires, then start a new session",
+    BLACK_ADVICE: "mend that, then start a new session",
+}
 
 
 #: What a clipped image of an imported acquisition is said to be (what to do: the note, once).
 IMPORTED_CLIPPED = "clipped in the acquisition"
+#: What an imported acquisition is told in place of each reshoot advice (its images were shot
+#: elsewhere: what it can do is said once, in the note).
+IMPORTED_ADVICE = {
+    LESS_EXPOSURE: IMPORTED_CLIPPED,
+    FLAT_ADVICE: "so it is in the acquisition",
+    UNCHANGING_ADVICE: "so they are in the acquisition: no fit of them can be trusted",
+    BLACK_ADVICE: "so they are in the acquisition: there is nothing to fit",
+}
 
 
 def _with_imported(qa: QAReport) -> QAReport:
@@ -301,17 +331,14 @@ def _with_imported(qa: QAReport) -> QAReport:
     problems are still named, as the acquisition's ("flawed"), with what they cost the fit."""
     if not qa.reshoot:
         return qa
-    images = tuple(
-        replace(c, problems=tuple(p.replace(LESS_EXPOSURE, IMPORTED_CLIPPED) for p in c.problems))
-        for c in qa.images
-    )
     note = (
         "an imported acquisition (an .lp with no rti-rig session record beside it): the "
         "problems named are its images', kept as they are; reshoot only if the object can be "
         "photographed again (a clipped image with less exposure), else leave the images named "
         "out of the .lp (or keep them and accept what they cost the fit)"
     )
-    return replace(_noted(qa, note), images=images, verdict_word="flawed")
+    qa = qa.with_advice(lambda _name, phrase: IMPORTED_ADVICE[phrase])
+    return replace(_noted(qa, note), verdict_word="flawed")
 
 
 def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
