@@ -3,6 +3,13 @@
 Signal scales with exposure; shot (Poisson) and read (Gaussian) noise and saturation are applied
 in electrons, then scaled to a 16-bit linear container. Capturing advances the injected clock by
 exposure + readout + transfer, so a dry run reports the session time the real rig would take.
+
+The exposure starts at the trigger and lasts exactly ``exposure_s`` on the clock, as a real
+camera's does: the light is read at the trigger, and the image is rendered only after the
+exposure, in the time the modelled readout and transfer take. Rendering is the simulator's cost,
+not the camera's; before 2026-12-01 it came first and, on the real clock of a self-timed dome
+(RTIPy), pushed the whole exposure ~0.1 s later into the LED's window, so a capture that fits
+the window on the real dome was refused as outlasting it.
 """
 
 from __future__ import annotations
@@ -64,6 +71,10 @@ class SimulatedCamera:
         self._raw = raw
         self._count = 0
         self._connected = False
+        #: (trigger, exposure end, delivery) of every capture on the camera's clock: the
+        #: interval the light must be on is [trigger, exposure end]; delivery is later by the
+        #: modelled readout and transfer, or by the render if that took longer.
+        self.exposures: list[tuple[float, float, float]] = []
 
     def connect(self) -> None:
         self._connected = True
@@ -71,18 +82,25 @@ class SimulatedCamera:
     def close(self) -> None:
         self._connected = False
 
-    def _noise_key(self, exposure_s: float) -> list[int]:
+    def _noise_key(
+        self,
+        exposure_s: float,
+        d: NDArray[np.float64] | None = None,
+        intensity: float | None = None,
+    ) -> list[int]:
         """Noise depends on the scene seed and what is lit, not on how many frames came before.
 
         A session that is interrupted and resumed therefore yields bit-identical images to an
         uninterrupted one, which is what lets the tests compare the two folders file by file.
+        ``d`` / ``intensity``: the light read at the trigger (without them, the light now).
         """
-        d = self._state.direction
+        if intensity is None:
+            d, intensity = self._state.direction, self._state.intensity
         light = [0, 0, 0] if d is None else [round(c * 1e6) + 2_000_000 for c in d]
         return [
             self._seed,
             *light,
-            round(self._state.intensity * 1e6),
+            round(intensity * 1e6),
             round(exposure_s * 1e9),
         ]
 
@@ -92,10 +110,20 @@ class SimulatedCamera:
         if not exposure_s > 0:
             raise CaptureError(self.name, f"exposure must be positive, got {exposure_s}", "capture")
         t0 = self._clock.now()
-        rng = np.random.default_rng(self._noise_key(exposure_s))
+        # The light as it is at the trigger is what this exposure sees: read it now, since on
+        # a self-timed dome it may be dark by the time the image is rendered.
+        direction, intensity = self._state.direction, self._state.intensity
+        rng = np.random.default_rng(self._noise_key(exposure_s, direction, intensity))
         self._count += 1
-        out = self._expose(exposure_s, rng)
-        self._clock.sleep(exposure_s + self._readout_s + self._transfer_s)
+        # Deadlines, not durations: the time reading the light took (an emulated board's link
+        # is first run up to now) lies inside the exposure, not after it.
+        self._sleep_until(t0 + exposure_s)
+        exposed = self._clock.now()
+        out = self._expose(exposure_s, rng, direction, intensity)
+        # Render time counts towards the readout and transfer; only beyond them does it delay
+        # the frame (on a virtual clock the render takes none, so this is readout + transfer).
+        self._sleep_until(exposed + self._readout_s + self._transfer_s)
+        self.exposures.append((t0, exposed, self._clock.now()))
         if self._raw:
             return self._through_raw(out, exposure_s, t0)
         return Frame(
@@ -107,9 +135,18 @@ class SimulatedCamera:
             metadata={"source": "simulated", "capture_index": self._count - 1},
         )
 
-    def _expose(self, exposure_s: float, rng: np.random.Generator) -> NDArray[np.generic]:
-        """The sensor's output (uint16 codes, or linear float in [0, 1] for ``raw``), a band of
-        rows at a time.
+    def _sleep_until(self, deadline: float) -> None:
+        self._clock.sleep(max(0.0, deadline - self._clock.now()))
+
+    def _expose(
+        self,
+        exposure_s: float,
+        rng: np.random.Generator,
+        direction: NDArray[np.float64] | None,
+        intensity: float,
+    ) -> NDArray[np.generic]:
+        """The sensor's output (uint16 codes, or linear float in [0, 1] for ``raw``) under the
+        light ``direction`` / ``intensity`` read at the trigger, a band of rows at a time.
 
         Why bands: whole-image float64 temporaries of a 24 MP frame are 0.6 GB each, and the
         sensor chain made half a dozen. Every pixel still goes through the same arithmetic,
@@ -121,14 +158,13 @@ class SimulatedCamera:
         """
         band_of = getattr(self._render, "rows", None)
         if band_of is None:
-            whole = self._render(self._state.direction, self._state.intensity)
+            whole = self._render(direction, intensity)
             shape = whole.shape
 
             def band(start: int, stop: int) -> NDArray[np.float64]:
                 return whole[start:stop]
         else:
             shape = tuple(self._render.shape)  # type: ignore[attr-defined]
-            direction, intensity = self._state.direction, self._state.intensity
 
             def band(start: int, stop: int) -> NDArray[np.float64]:
                 return band_of(direction, intensity, start, stop)  # type: ignore[no-any-return]
