@@ -328,6 +328,19 @@ class SessionComplete(SessionError):
         self.next_step = next_step
 
 
+class ImagesLostSinceCapture(SessionError):
+    """A resume refused because the session completed: ``note`` is what the refusal says of
+    its images missing or changed since capture (:func:`_lost_note`; empty when none is).
+
+    Why: a camera-triggered dome's resume is refused by the app with words of its own, and
+    had dropped this refusal, so the image lost was never named; the note lets it say the
+    same words, with no second copy of the listing."""
+
+    def __init__(self, message: str, note: str) -> None:
+        super().__init__(message)
+        self.note = note
+
+
 class NoSpaceError(SessionError):
     """The disk cannot hold the next image(s): checked before the rig starts and before each
     image, so the session stops cleanly rather than on a write that fails half-way.
@@ -1780,10 +1793,9 @@ def _prepare_resume(
                 "checksum)"
             )
         if not lost or manifest.get("adaptive") or not reshoot_lost:
-            raise SessionError(
-                f"{root}: this session already completed all {total} steps"
-                + _lost_note(root, latest, lost, adaptive=bool(manifest.get("adaptive")))
-                + moved
+            note = _lost_note(root, latest, lost, adaptive=bool(manifest.get("adaptive")))
+            raise ImagesLostSinceCapture(
+                f"{root}: this session already completed all {total} steps" + note + moved, note
             )
         # the lost steps are reshot; the others stand as they are, verified or not
         done = {i: _to_record(rec) for i, rec in latest.items() if i not in lost}

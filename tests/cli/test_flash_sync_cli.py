@@ -8,6 +8,7 @@ correctly labelled images.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import shlex
 from pathlib import Path
@@ -354,15 +355,39 @@ def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None
     assert f"Next: rti-rig fit {out} --out FOLDER" in text
     assert "cannot be used" not in text and "error" not in text
     image = out / "image_003.jpg"
-    for extra, change in ((["--reshoot-lost"], False), ([], True)):
-        if change:
+    for extra, change in ((["--reshoot-lost"], False), ([], True), (["--reshoot-lost"], False)):
+        if change:  # one image changed, one missing since capture
             image.write_bytes(image.read_bytes() + b"x")
+            (out / "image_010.jpg").unlink()
+        before = _md5_of_every_file(out)
         result = runner.invoke(app, ["run", "--resume", str(out), *extra])
         assert result.exit_code == 2, result.output
+        assert _md5_of_every_file(out) == before  # nothing in the folder changed
         text = " ".join(result.output.split())
         assert "this session already completed all 60 steps; nothing to resume" in text
-        assert "cannot reshoot single images" in text
         assert "cannot be used" not in text and "Next:" not in text
+        assert "Traceback" not in text
+        if extra:  # --reshoot-lost keeps its refusal, and names no image
+            assert "cannot reshoot single images either" in text, text
+            assert "long-press the dome's start button" in text and "image_0" not in text
+        else:
+            # the images lost are named (the refusal had said only "nothing to resume"),
+            # with what this dome can do: never --reshoot-lost, which it refuses
+            assert "2 of its images are missing or changed since capture" in text, text
+            assert "(image_003, image_010)" in text
+            assert "put the originals back from a copy" in text
+            assert "cannot continue a session or reshoot single images" in text
+            assert "long-press its start button" in text and "--out NEWDIR" in text
+            assert "--reshoot-lost" not in text
+
+
+def _md5_of_every_file(folder: Path) -> dict[str, str]:
+    """Every file under ``folder`` (its path inside it) with the md5 of its bytes."""
+    return {
+        p.relative_to(folder).as_posix(): hashlib.md5(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
 
 
 def test_a_dead_led_is_named_as_such_and_the_dome_said_to_have_stepped_on(  # type: ignore[no-untyped-def]

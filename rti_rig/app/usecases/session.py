@@ -1646,24 +1646,34 @@ def rebuild_finished_session(req: ResumeRequest) -> list[str] | None:
     return rebuild_finished_journal(Path(req.session_dir))
 
 
-def _say_if_complete(session_dir: Path) -> None:
+def _say_if_complete(session_dir: Path) -> str:
     """Raise :class:`~rti_rig.runtime.session.SessionComplete` if the completed session in
     ``session_dir`` has every image as captured (exit 0, the next step named), as any other
-    complete session's resume does; return otherwise (the caller refuses it).
+    complete session's resume does; return otherwise (the caller refuses it) what its resume's
+    refusal says of the images missing or changed since capture ("" when it names none).
 
     Why: a complete, intact camera-triggered session's resume had been exit 2 while every
     other kind's was exit 0 with ``rti-rig fit`` named; nothing flash-specific differs once
     nothing is to be shot (a lab's script runs the same ``--resume`` line either way). The
     check reads and changes nothing more than another session's resume: the completed branch
-    of :func:`~rti_rig.runtime.session.prepare_resume` only reads, then raises."""
-    from rti_rig.runtime.session import SessionComplete, SessionError, prepare_resume
+    of :func:`~rti_rig.runtime.session.prepare_resume` only reads, then raises. The images
+    lost are named in its words (their advice already what this dome can do: put them back,
+    or shoot again into a new folder): the refusal had said only "nothing to resume"."""
+    from rti_rig.runtime.session import (
+        ImagesLostSinceCapture,
+        SessionComplete,
+        SessionError,
+        prepare_resume,
+    )
 
     try:
         prepare_resume(session_dir)
     except SessionComplete:
         raise
+    except ImagesLostSinceCapture as exc:
+        return exc.note  # the flash refusal says them, then why it cannot reshoot
     except SessionError:
-        return  # an image lost or unchecked: the flash refusal says why it cannot reshoot
+        return ""  # unchecked, say: the flash refusal says why it cannot reshoot
     raise RtiRigError(f"{session_dir}: a completed session's resume went on")  # pragma: no cover
 
 
@@ -1710,12 +1720,16 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     if flash_sync_of(loaded) is not None and runner.get("finish_reason") == "completed":
         # a finished session had been told only that a camera-triggered dome cannot resume
         # (so the user looked for what had interrupted it): it is complete, and says so
-        if not req.reshoot_lost:
-            _say_if_complete(Path(req.session_dir))
-        raise RtiRigError(
+        lost = "" if req.reshoot_lost else _say_if_complete(Path(req.session_dir))
+        done = (
             f"{req.session_dir}: this session already completed all "
             f"{runner.get('steps_planned', len(manifest.get('steps') or []))} steps; nothing "
-            "to resume (a camera-triggered dome cannot reshoot single images either: to shoot "
+            "to resume"
+        )
+        if lost:  # named, with what this dome can do (nothing in the folder was changed)
+            raise RtiRigError(done + lost)
+        raise RtiRigError(
+            done + " (a camera-triggered dome cannot reshoot single images either: to shoot "
             "again, long-press the dome's start button, then rti-rig run "
             f"{shlex.quote(str(config_path))} --out NEWDIR)"
         )
