@@ -251,7 +251,9 @@ class Gphoto2Camera:
         #: what connect could not establish of the image format (said by ``rti-rig check``)
         self._format_note: str | None = None
         #: a shutter speed a failed test shot could not put back (said by ``rti-rig check``
-        #: beside the shot's own error: the camera is left at another speed than its own)
+        #: beside the shot's own error: the camera's own speed, the speed last read back, and
+        #: to check it on the camera; never that it "is left at" one: a write that failed
+        #: part-way may have left either)
         self._restore_note: str | None = None
 
     # -- error handling --------------------------------------------------------------------
