@@ -334,6 +334,10 @@ class ArmLighting:
         self._stop_asked: int | None = None
         #: the last :meth:`connect` raised (the arm was never reached): no park, no end
         self.connect_failed = False
+        #: the teardown commands ("lamp off", "stop") the last :meth:`safe` could not send: a
+        #: dead port (an unplugged adapter) had been reported as "lamp off and stop were
+        #: requested", of requests that never left the computer
+        self.not_sent: tuple[str, ...] = ()
 
     def resends(self) -> tuple[dict[str, list[str]], str | None]:
         """The manifest's ``arm_resent`` (each command sent once more after its status packet
@@ -483,6 +487,7 @@ class ArmLighting:
         and the run had then said "Stopped during the arm's park" of an arm left or parked."""
         self.stopped_by = None
         self._stop_asked = None
+        self.not_sent = ()
 
         def stop_asked(signum: int) -> None:
             if self._stop_asked is None:
@@ -503,9 +508,12 @@ class ArmLighting:
         return f"the park was stopped by {who}: held where it stopped, torque on"
 
     def _safe(self, emergency: bool) -> list[str]:
-        failures = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
+        lamp_failed = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
         stop_failed = attempt_all([("stop", self.carrier.stop)])
-        failures += stop_failed
+        failures = lamp_failed + stop_failed
+        self.not_sent = tuple(
+            label for label, failed in (("lamp off", lamp_failed), ("stop", stop_failed)) if failed
+        )
         if self.connect_failed:
             # a connect that failed (a servo reporting an overload as the port opened): no
             # park, and no end to record, as nothing was read back; what may be said of the

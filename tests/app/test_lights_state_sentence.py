@@ -67,3 +67,26 @@ def test_a_dome_that_keeps_no_record_of_its_all_off_is_not_said_to_have_had_none
         said = lights_state(rig)
         assert said == "whether the dome's lights are off is not known: check them", said
         assert safe_state_unsure(rig) is True
+
+
+def test_an_arm_whose_lamp_off_and_stop_could_not_be_sent_is_not_said_to_have_had_them() -> None:
+    """A dead port (an unplugged adapter) fails both teardown writes: "lamp off and stop were
+    requested" had been said of requests that never left the computer."""
+    rig = build_rig(load_rig_config(REPO / "rig_configs" / "virtual_arm.toml"))
+    with rig:
+        carrier = rig.lighting.carrier
+
+        def gone(*_: object) -> None:
+            raise OSError("write failed: [Errno 5] Input/output error")
+
+        carrier.lamp, carrier.stop = gone, gone  # type: ignore[method-assign]
+        failures = rig.lighting.safe()
+        assert [f.split(":")[0] for f in failures] == ["lamp off", "stop"], failures
+        said = lights_state(rig, teardown_failed=True)
+        assert said.startswith(
+            "the lamp-off and the stop could not be sent to the arm: the lamp may still be lit, "
+            "and a servo no command reaches keeps its last goal under torque, so the arm may "
+            "hold there or still be moving to it; switch the arm's power supply off"
+        ), said
+        assert "requested" not in said, said
+        del carrier.lamp, carrier.stop  # the class's own again, for the rig's close

@@ -62,6 +62,13 @@ def test_an_arm_adapter_unplugged_mid_session_stops_keeps_and_resumes(
     assert "arm: the port '" in said, said
     assert "failed (write failed: [Errno 5] Input/output error): check that the arm's USB " in said
     assert "the arm's park is NOT confirmed" in said, said  # a dead port parks nothing
+    # the stop never left the computer: not "requested", and what that leaves is said
+    assert "stop were requested" not in said, said
+    assert (
+        "Lamp off was requested, but the stop could not be sent to every servo: a servo no "
+        "command reaches keeps its last goal under torque, so the arm may hold there or still "
+        "be moving to it; switch the arm's power supply off" in said
+    ), said
     kept = (out / "lights.lp").read_text().split()
     assert kept[0] == "2", said
     assert f"2 image(s) kept in {out}, listed in lights.lp" in said, said

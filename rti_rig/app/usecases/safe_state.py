@@ -56,7 +56,11 @@ def lights_state(  # type: ignore[no-untyped-def]
     if unreached is not None:
         return unreached
     after = " (see the teardown problems above)" if teardown_failed else ""
-    if software_lamp(lighting) and getattr(rig.loaded.config, "backend", None) == "hardware":
+    not_sent = lighting.not_sent if isinstance(lighting, ArmLighting) else ()
+    software = software_lamp(lighting) and getattr(rig.loaded.config, "backend", None) == "hardware"
+    if not_sent:
+        said = not_sent_sentence(not_sent, software)
+    elif software:
         # the lamp's own switch is outside the servo bus: its "off" is a flag in the driver,
         # and "lamp off ... requested" had told a user at a real arm that it was switched
         said = (
@@ -72,6 +76,41 @@ def lights_state(  # type: ignore[no-untyped-def]
     if end is not None:
         said += f"; {end.sentence()}"
     return said + after
+
+
+def not_sent_sentence(not_sent: tuple[str, ...], software_lamp: bool = False) -> str:
+    """What is known of an arm whose teardown lamp-off or stop could not be sent (its port
+    gone: an unplugged adapter; or a servo that did not answer), said in place of "lamp off
+    and stop were requested", which had been printed of requests that never left the computer.
+
+    A Dynamixel servo no host reaches keeps the last goal it was sent, under torque (rti-rig
+    sets no Bus Watchdog), so the arm may hold there or still be moving to it; the lamp keeps
+    its last state. Only removing the arm's power settles both."""
+    lamp_unsent = "lamp off" in not_sent
+    stop_unsent = "stop" in not_sent
+    if lamp_unsent and stop_unsent:
+        said = "the lamp-off and the stop could not be sent to the arm"
+    elif stop_unsent:
+        said = "the stop could not be sent to every servo"
+        if not software_lamp:
+            said = "lamp off was requested, but " + said
+    else:
+        said = "stop was requested, but the lamp-off could not be sent to the arm"
+    known = []
+    if lamp_unsent:
+        known.append("the lamp may still be lit")
+    if stop_unsent:
+        known.append(
+            "a servo no command reaches keeps its last goal under torque, so the arm may hold "
+            "there or still be moving to it"
+        )
+    said += ": " + ", and ".join(known) + "; switch the arm's power supply off"
+    if software_lamp:
+        said += (
+            ' (the lamp is not switched by rti-rig: lamp = "software" in [arm.dynamixel], '
+            "so switch it off yourself too)"
+        )
+    return said
 
 
 def simulated_lights_sentence(known: KnownStateLightSource) -> str:
