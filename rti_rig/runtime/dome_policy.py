@@ -308,6 +308,11 @@ class DomePolicy:
         #: clears it): a port lost now is reopened to send that all-off again, and nothing
         #: goes on after it.
         self._ending = False
+        #: A reconnection during this teardown gave up on a port that did not come back: a
+        #: later teardown all-off (the port close's, after the lighting's) then opens the port
+        #: once more at once instead of waiting the reconnect window again. Both had waited it
+        #: in full (2 × 7 s on the shipped emulated configs) for a port already found gone.
+        self._teardown_gave_up = False
 
     def ending(self) -> None:
         """Mark what follows as a teardown (its all-off, then perhaps :meth:`close`), until the
@@ -371,6 +376,7 @@ class DomePolicy:
 
     def connect(self) -> None:
         self._ending = False
+        self._teardown_gave_up = False
         self._read_ledger()
         if self.settings.intensity_correction is not None and not self.link.can_dim:
             # before the port opens (the Nab sketch boots lit): every corrected level of an
@@ -1126,14 +1132,19 @@ class DomePolicy:
         """Reopen the port a session lost (``drop``, a USB drop during ``command``) and check
         it is the same dome."""
         recovered: list[str] = []
+        # a teardown whose reconnection window already ran out without the port: one more
+        # opening (the port may be back: its all-off is then sent), no second wait
+        once = self._ending and self._teardown_gave_up
         info, last, came_back = self._reopen(
             recovered,
             end_when_back=False,
             drop=drop,
             during=f"'{command}'",
             goes_on=goes_on or self._goes_on(),
+            once=once,
         )
         if info is not None:
+            self._teardown_gave_up = False
             problem = self._check_identity(info)
             if problem:
                 self._quiet_close()
@@ -1152,9 +1163,18 @@ class DomePolicy:
                 f"its port came back but the board did not answer its handshake after "
                 f"{attempts} ({said}); check the USB cable and the dome's power"
             )
+        elif once:
+            window = self.reconnect_window_s()
+            outcome = (
+                f"did not come back: this teardown already gave it {attempts} over "
+                f"{window:.1f} s, and one more opening without waiting found it still gone "
+                f"({said}); check the USB cable, the hub and the dome's power, or "
+                f"{self._window_keys()}"
+            )
         else:
             window = self.reconnect_window_s()
             self._gave_up_after_s = window
+            self._teardown_gave_up = self._ending
             outcome = (
                 f"did not come back within {attempts} over {window:.1f} s ({said}); check the "
                 f"USB cable, the hub and the dome's power, or {self._window_keys()}"
@@ -1188,6 +1208,7 @@ class DomePolicy:
         drop: DomeLinkError,
         during: str,
         goes_on: str,
+        once: bool = False,
     ) -> tuple[DomeInfo | None, DomeLinkError | None, bool]:
         """Close the port and open it again by path, up to ``reconnect_attempts`` times, the
         back-off doubling from ``reconnect_backoff_s`` on the link's clock; each opening
@@ -1205,13 +1226,21 @@ class DomePolicy:
         ``drop`` (the loss that led here, ``during`` a command) is said through
         :meth:`listen`'s ``say`` as the reopening begins, with ``goes_on`` (what follows once
         the dome is back), and the outcome once it is known; each reopening is recorded in
-        ``stats.reconnections``."""
-        n = self.settings.reconnect_attempts
-        self._tell(
-            f"The dome dropped off the USB bus during {during}: reopening its port (up to {n} "
-            f"attempt{'s' if n != 1 else ''} over {self.reconnect_window_s():.1f} s); "
-            f"{goes_on}."
-        )
+        ``stats.reconnections``. ``once``: one opening, at once (a teardown whose window already
+        ran out without the port), said as such."""
+        n = 1 if once else self.settings.reconnect_attempts
+        if once:
+            self._tell(
+                f"The dome's port is still gone at {during}: this teardown already waited "
+                f"{self.reconnect_window_s():.1f} s for it, so it is opened once more without "
+                f"waiting again; {goes_on}."
+            )
+        else:
+            self._tell(
+                f"The dome dropped off the USB bus during {during}: reopening its port (up to "
+                f"{n} attempt{'s' if n != 1 else ''} over {self.reconnect_window_s():.1f} s); "
+                f"{goes_on}."
+            )
         last: DomeLinkError | None = None
         came_back = False
         tries = 0
@@ -1219,7 +1248,8 @@ class DomePolicy:
         for attempt in range(n):
             tries = attempt + 1
             self._quiet_close()
-            self._back_off(self.settings.reconnect_backoff_s * (2**attempt))
+            if not once:
+                self._back_off(self.settings.reconnect_backoff_s * (2**attempt))
             try:
                 info = self._open_and_handshake(recovered)
             except DomeLinkError as exc:

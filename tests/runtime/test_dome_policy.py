@@ -1084,3 +1084,51 @@ def test_a_reopening_said_with_no_listener_is_a_warning_record_not_lost(
     said = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
     assert any("goes on once it is back" in text for text in said), said
     assert dome.stats.reconnects == 1
+
+
+def test_a_teardown_waits_the_reconnect_window_once_for_a_port_gone_for_good():
+    """The lighting's all-off, then the port close's: both had waited the whole reconnect
+    window (2 × 7 s here) for a port the first had already found gone. The close's all-off now
+    opens the port once more at once, and waits for nothing."""
+    dome, _fw, clock = make(
+        "default", [Fault(5, FaultKind.DISCONNECT, delay_s=1000.0)], reconnect_attempts=3
+    )
+    dome.connect()  # commands 1 and 2
+    dome.light(0, 1.0)  # command 3
+    dome.all_off()  # command 4
+    dome.ending()
+    said: list[str] = []
+    dome.listen(said.append)
+    with pytest.raises(DomeLinkError, match="did not come back within 3 reconnection"):
+        dome.all_off()  # command 5: the port goes for good; the window is waited once
+    before = clock.now()
+    dome.close()
+    assert clock.now() == before  # no back-off: the window had already run out
+    assert [r["attempts"] for r in dome.stats.reconnections] == [3, 1]
+    assert said[-2].startswith("The dome's port is still gone at 'all off': this teardown "), said
+    assert (
+        "already waited 7.0 s for it, so it is opened once more without waiting again" in (said[-2])
+    )
+    report = lights_state_sentence(dome)
+    assert report.startswith("all-off could NOT be sent"), report
+    assert "this teardown already gave it 3 reconnection attempts over 7.0 s, and one more " in (
+        report
+    )
+
+
+def test_a_port_back_after_the_teardowns_window_still_gets_its_closing_all_off():
+    """Safety kept: the close's single opening sends the all-off to a port that came back."""
+    dome, fw, clock = make(
+        "default", [Fault(5, FaultKind.DISCONNECT, delay_s=9.0)], reconnect_attempts=3
+    )
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    dome.ending()
+    with pytest.raises(DomeLinkError, match="did not come back within 3 reconnection"):
+        dome.all_off()  # gone 9 s: the 7 s window runs out
+    clock.sleep(3.0)  # the rest of the teardown (the camera's close): the port is back
+    dome.close()
+    assert [r["outcome"] for r in dome.stats.reconnections] == ["did not come back", "reconnected"]
+    assert dome.off_report is not None and dome.off_report.outcome is OffOutcome.ACKNOWLEDGED
+    assert fw.lit is None
