@@ -525,7 +525,7 @@ class DomePolicy:
         if exc.command == "open port" and not self._port_was_open:
             # Nothing was ever sent: say so, not "all-off failed, lights may be on".
             self.off_report = OffReport(
-                OffOutcome.NEVER_OPENED, exc.message, port_held=exc.port_held
+                OffOutcome.NEVER_OPENED, _open_failure_head(exc.message), port_held=exc.port_held
             )
         elif (
             exc.command == "open port"
@@ -1680,6 +1680,24 @@ class DomePolicy:
 
 #: Faults of a board that may not be the one the profile describes (or no board at all).
 _NOT_ITS_BOARD = (LinkFault.TIMEOUT, LinkFault.GARBLED, LinkFault.MISMATCH)
+
+
+def _open_failure_head(message: str) -> str:
+    """The system's reason a port could not be opened, for the lights line: ``message`` up to
+    its first ``;`` outside parentheses, and a pointer to the error for the rest.
+
+    Why: a missing port's error carries the serial ports present now and how to set one
+    (:mod:`rti_rig.drivers.ports_present`), a paragraph the lights line had repeated word for
+    word beside the error that says it (at every ``run`` and ``check`` on a port gone)."""
+    depth = 0
+    for i, ch in enumerate(message):
+        if ch == "(":
+            depth += 1
+        elif ch == ")":
+            depth = max(0, depth - 1)
+        elif ch == ";" and depth == 0:
+            return f"{message[:i]}; the error says which serial ports are present now"
+    return message
 
 
 def _lost_after_opening(exc: DomeLinkError) -> bool:

@@ -151,6 +151,9 @@ def test_a_dome_back_under_another_name_is_named_and_the_session_resumes_on_it(
     code, said = _run(["run", "--resume", str(out)])
     assert code == 2, said
     assert f"serial ports present now: {NEW} (" in said, said
+    # said once, in the error: the lights line had repeated the whole listing beside it
+    assert said.count("serial ports present now") == 1, said
+    assert "the error says which serial ports are present now" in said, said
     assert _images(out) == kept
 
     # the config pointed at NEW: the session goes on where it stopped and completes
