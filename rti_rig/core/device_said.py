@@ -18,3 +18,18 @@ def say_or_log(text: str, say: Callable[[str], None] | None, log: logging.Logger
         say(text)
     else:
         log.warning("%s", text)
+
+
+def first_clause(text: str) -> str:
+    """``text`` up to its first ``;`` at parenthesis depth 0 (all of it if there is none): an
+    error's head, the fault itself, where its advice is said in full elsewhere. A ``;``
+    inside parentheses (a quoted system error) is not an end."""
+    depth = 0
+    for i, ch in enumerate(text):
+        if ch == "(":
+            depth += 1
+        elif ch == ")":
+            depth = max(0, depth - 1)
+        elif ch == ";" and depth == 0:
+            return text[:i]
+    return text

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.clock import Clock
+from rti_rig.core.device_said import first_clause
 from rti_rig.core.devices import LightCarrier, ReadBackCarrier
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
@@ -209,20 +210,7 @@ def said_once(text: str, detail: str | None, pointer: str) -> str:
     parenthesis left open."""
     if not detail or len(detail) < 60 or detail not in text:
         return text
-    return text.replace(detail, f"{_first_clause(detail)} ({pointer})")
-
-
-def _first_clause(text: str) -> str:
-    """``text`` up to its first ``;`` at parenthesis depth 0 (all of it if there is none)."""
-    depth = 0
-    for i, ch in enumerate(text):
-        if ch == "(":
-            depth += 1
-        elif ch == ")":
-            depth = max(0, depth - 1)
-        elif ch == ";" and depth == 0:
-            return text[:i]
-    return text
+    return text.replace(detail, f"{first_clause(detail)} ({pointer})")
 
 
 def not_connected_sentence(carrier: object, connected: bool | None = None) -> str | None:

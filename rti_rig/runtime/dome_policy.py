@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.clock import Clock, VirtualClock
 from rti_rig.core.deferred_signals import after_a_stop, signals_deferred
-from rti_rig.core.device_said import say_or_log
+from rti_rig.core.device_said import first_clause, say_or_log
 from rti_rig.core.devices import DiscreteLightSource
 from rti_rig.core.dome_link import (
     DomeInfo,
@@ -1684,20 +1684,16 @@ _NOT_ITS_BOARD = (LinkFault.TIMEOUT, LinkFault.GARBLED, LinkFault.MISMATCH)
 
 def _open_failure_head(message: str) -> str:
     """The system's reason a port could not be opened, for the lights line: ``message`` up to
-    its first ``;`` outside parentheses, and a pointer to the error for the rest.
+    its first ``;`` outside parentheses, and a pointer to the error for the ports present.
 
     Why: a missing port's error carries the serial ports present now and how to set one
     (:mod:`rti_rig.drivers.ports_present`), a paragraph the lights line had repeated word for
-    word beside the error that says it (at every ``run`` and ``check`` on a port gone)."""
-    depth = 0
-    for i, ch in enumerate(message):
-        if ch == "(":
-            depth += 1
-        elif ch == ")":
-            depth = max(0, depth - 1)
-        elif ch == ";" and depth == 0:
-            return f"{message[:i]}; the error says which serial ports are present now"
-    return message
+    word beside the error that says it (at every ``run`` and ``check`` on a port gone). The
+    pointer only where the error lists them (a listing that failed is not a list)."""
+    head = first_clause(message)
+    if head == message or "serial ports present now" not in message:
+        return message
+    return f"{head}; the error says which serial ports are present now"
 
 
 def _lost_after_opening(exc: DomeLinkError) -> bool:
