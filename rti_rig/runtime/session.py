@@ -330,7 +330,8 @@ class SessionComplete(SessionError):
 
 class ImagesLostSinceCapture(SessionError):
     """A resume refused because the session completed: ``note`` is what the refusal says of
-    its images missing or changed since capture (:func:`_lost_note`; empty when none is).
+    its images missing or changed since capture (:func:`_lost_note`) or renamed (empty when
+    none is).
 
     Why: a camera-triggered dome's resume is refused by the app with words of its own, and
     had dropped this refusal, so the image lost was never named; the note lets it say the
@@ -1795,7 +1796,8 @@ def _prepare_resume(
         if not lost or manifest.get("adaptive") or not reshoot_lost:
             note = _lost_note(root, latest, lost, adaptive=bool(manifest.get("adaptive")))
             raise ImagesLostSinceCapture(
-                f"{root}: this session already completed all {total} steps" + note + moved, note
+                f"{root}: this session already completed all {total} steps" + note + moved,
+                note + moved,  # an image renamed is named too (the flash refusal had not)
             )
         # the lost steps are reshot; the others stand as they are, verified or not
         done = {i: _to_record(rec) for i, rec in latest.items() if i not in lost}
