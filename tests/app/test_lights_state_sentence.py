@@ -84,7 +84,8 @@ def test_an_arm_whose_lamp_off_and_stop_could_not_be_sent_is_not_said_to_have_ha
         assert [f.split(":")[0] for f in failures] == ["lamp off", "stop"], failures
         said = lights_state(rig, teardown_failed=True)
         assert said.startswith(
-            "the lamp-off and the stop could not be sent to the arm: the lamp may still be lit, "
+            "the lamp-off and the stop failed (not sent, or sent and not acknowledged): the lamp "
+            "may still be lit, "
             "and a servo no command reaches keeps its last goal under torque, so the arm may "
             "hold there or still be moving to it; switch the arm's power supply off"
         ), said

@@ -65,7 +65,8 @@ def test_an_arm_adapter_unplugged_mid_session_stops_keeps_and_resumes(
     # the stop never left the computer: not "requested", and what that leaves is said
     assert "stop were requested" not in said, said
     assert (
-        "Lamp off was requested, but the stop could not be sent to every servo: a servo no "
+        "Lamp off was requested, but the stop failed at a servo (not sent, or sent and not "
+        "acknowledged): a servo no "
         "command reaches keeps its last goal under torque, so the arm may hold there or still "
         "be moving to it; switch the arm's power supply off" in said
     ), said

@@ -78,9 +78,14 @@ def lights_state(  # type: ignore[no-untyped-def]
     return said + after
 
 
+#: What a failed teardown write establishes: the failure is any exception (a port gone before
+#: the write, or a status reply that never came after it), so not that the request never left.
+_UNSURE = "(not sent, or sent and not acknowledged)"
+
+
 def not_sent_sentence(not_sent: tuple[str, ...], software_lamp: bool = False) -> str:
-    """What is known of an arm whose teardown lamp-off or stop could not be sent (its port
-    gone: an unplugged adapter; or a servo that did not answer), said in place of "lamp off
+    """What is known of an arm whose teardown lamp-off or stop failed (its port gone: an
+    unplugged adapter; or a servo that did not answer), said in place of "lamp off
     and stop were requested", which had been printed of requests that never left the computer.
 
     A Dynamixel servo no host reaches keeps the last goal it was sent, under torque (rti-rig
@@ -89,13 +94,13 @@ def not_sent_sentence(not_sent: tuple[str, ...], software_lamp: bool = False) ->
     lamp_unsent = "lamp off" in not_sent
     stop_unsent = "stop" in not_sent
     if lamp_unsent and stop_unsent:
-        said = "the lamp-off and the stop could not be sent to the arm"
+        said = f"the lamp-off and the stop failed {_UNSURE}"
     elif stop_unsent:
-        said = "the stop could not be sent to every servo"
+        said = f"the stop failed at a servo {_UNSURE}"
         if not software_lamp:
             said = "lamp off was requested, but " + said
     else:
-        said = "stop was requested, but the lamp-off could not be sent to the arm"
+        said = f"stop was requested, but the lamp-off failed {_UNSURE}"
     known = []
     if lamp_unsent:
         known.append("the lamp may still be lit")
