@@ -309,7 +309,10 @@ def _usage_errors_plain() -> None:
     was not      │`` / ``│ set?) …``), so a log kept the message in pieces between box
     characters. Typer looks its formatter up at each error, so replacing it here is enough;
     a terminal keeps the box."""
-    from typer import rich_utils
+    try:  # typer's internals, as the two patches above: a release without it keeps its box
+        from typer import rich_utils
+    except ImportError:
+        return
 
     def plain(exc) -> None:  # type: ignore[no-untyped-def]
         exc.show()

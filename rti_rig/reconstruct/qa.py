@@ -2192,9 +2192,6 @@ def _evidence(
             f"{needed} are needed to judge the lights; median misfit {spread:.0%}): a glossy, "
             "saturated or non-Lambertian surface"
         )
-        # ... or lights that are not these images': a matte sphere's .lp shuffled had been
-        # said to be "a glossy, saturated or non-Lambertian surface" (and images "brighter
-        # than predicted", "moved"): the lights' order against the images tells the two apart
     else:
         judged = cand.copy()
         agree = cand & (err <= WRONG_LIGHT_DEG)
