@@ -354,6 +354,15 @@ def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None
     assert "this session is complete: all 60 steps were captured" in text
     assert f"Next: rti-rig fit {out} --out FOLDER" in text
     assert "cannot be used" not in text and "error" not in text
+    # an image renamed is named with its fix (the refusal had said only "nothing to resume")
+    (out / "image_020.jpg").rename(out / "photo_x.jpg")
+    before = _md5_of_every_file(out)
+    result = runner.invoke(app, ["run", "--resume", str(out)])
+    assert result.exit_code == 2, result.output
+    assert _md5_of_every_file(out) == before
+    text = " ".join(result.output.split())
+    assert "image_020.jpg as photo_x.jpg is in the folder under another name" in text, text
+    (out / "photo_x.jpg").rename(out / "image_020.jpg")
     image = out / "image_003.jpg"
     for extra, change in ((["--reshoot-lost"], False), ([], True), (["--reshoot-lost"], False)):
         if change:  # one image changed, one missing since capture
