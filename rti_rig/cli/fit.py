@@ -225,7 +225,8 @@ def fit(
     finished earlier, or finished on a Dask worker); 1 every fit is in place but a session
     changed while it was fitted, so its fit is of the session as it was read (a batch: run
     the same command again to refit it; one session: fit it again into a new --out); 2 an
-    error (a batch: a session failed, the others fitted); 130 / 143 stopped by Ctrl-C / SIGTERM."""
+    error (a batch: a session failed, the others fitted); 130 / 143 / 129 stopped by Ctrl-C /
+    SIGTERM / a hang-up (SIGHUP)."""
     from rti_rig.app.usecases.fit_memory import use_one_heap
 
     # One malloc heap for this process, before any decode or reader thread starts: it is

@@ -1946,8 +1946,10 @@ def preview(
         ),
         not_opened=f"Nothing was captured or written to {out_dir}",
     )
-    # a SIGTERM once the capture is over: the summary and the plan hint finish first
-    with _late_term_held() as late_term:
+    # a SIGTERM once the capture is over: the summary and the plan hint finish first. A
+    # hang-up (SIGHUP) is answered as SIGTERM is: the preview lights the dome, and SIGHUP had
+    # ended it at once with the LED lit (no all-off), exit 129 and no word
+    with hangup_as_sigterm(), _late_term_held() as late_term:
         with _sigterm_exit_wins(late_term):
             opened, handover = _open_for_capture(opening)
             unsafe = _execute(opened, handover)

@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from rti_rig.core.deferred_signals import signal_handlers
+from rti_rig.core.deferred_signals import hangup_as_sigterm, signal_handlers
 
 #: A file's identity and content stamp (inode, mtime in ns, size), or None where there is none.
 Stamp = tuple[int, int, int] | None
@@ -33,12 +33,17 @@ class Terminated(BaseException):
 @contextmanager
 def sigterm_stops() -> Iterator[None]:
     """For the block, a SIGTERM raises :class:`Terminated` (the handler before it is put back
-    however the block ends)."""
+    however the block ends), and so does a hang-up (SIGHUP), named and exited as itself (129:
+    :func:`~rti_rig.core.deferred_signals.hangup_as_sigterm`; left ignored under ``nohup``).
+
+    Why the hang-up: ``fit``, ``plan`` and ``calibrate-lights`` had no SIGHUP handler, so the
+    terminal or ssh connection closing ended them at once, mid-write (a hidden temporary file
+    left beside the one asked for) and, for ``calibrate-lights``, with the dome's LED lit."""
 
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
         raise Terminated()
 
-    with signal_handlers({signal.SIGTERM: terminated}):
+    with signal_handlers({signal.SIGTERM: terminated}), hangup_as_sigterm():
         yield
 
 

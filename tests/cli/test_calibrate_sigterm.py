@@ -24,6 +24,7 @@ from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.cli import calibrate as calibrate_cli
+from rti_rig.core.deferred_signals import signal_handlers
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
 
@@ -111,3 +112,41 @@ def test_a_sigterm_once_written_says_the_calibration_and_its_line(
     ) in text, text
     assert 'format = "rti-rig-light-calibration/1"' in target.read_text()
     assert sorted(p.name for p in tmp_path.iterdir()) == [target.name]
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGHUP"), reason="no SIGHUP on this platform")
+def test_a_hangup_mid_write_leaves_no_temporary_file_and_exits_129(
+    card: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A hang-up (SIGHUP: the terminal or ssh connection closing) is answered as SIGTERM is,
+    and named as itself: it had no handler, and ended the command at once mid-write."""
+    rig, session = card
+    before = sorted(p.name for p in session.iterdir())
+    real = Path.write_text
+    cut: list[Path] = []
+
+    def write_text(self: Path, data: str, *args: Any, **kwargs: Any) -> int:
+        if self.name == ".light_calibration.toml.tmp":
+            real(self, data[: len(data) // 2], *args, **kwargs)  # as far as it got
+            cut.append(self)
+            os.kill(os.getpid(), signal.SIGHUP)  # handled at the next bytecode
+        return real(self, data, *args, **kwargs)
+
+    def unhandled(signum: int, frame: Any) -> None:
+        raise Unhandled("SIGHUP reached the test's handler: calibrate-lights installed none")
+
+    argv = ["calibrate-lights", str(session), "--rig", str(rig)]
+    with monkeypatch.context() as m, signal_handlers({signal.SIGHUP: unhandled}):
+        m.setattr(Path, "write_text", write_text)
+        r = runner.invoke(app, argv)
+
+    text = said(r)
+    assert len(cut) == 1, text
+    assert not isinstance(r.exception, Unhandled), text
+    assert r.exit_code == 129, text  # 128 + SIGHUP, as the shell reports a hang-up
+    assert "Traceback" not in text and "SIGTERM" not in text, text
+    assert (
+        f"Stopped (SIGHUP) before the calibration was written: nothing was written to "
+        f"{session / 'light_calibration.toml'}"
+    ) in text, text
+    assert sorted(p.name for p in session.iterdir()) == before  # no .light_calibration.toml.tmp
