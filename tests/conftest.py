@@ -202,7 +202,11 @@ def refused_and_waited(monkeypatch: pytest.MonkeyPatch) -> threading.Event:
 #: The handlers a test must leave as it found them: a command run in the pytest process
 #: (CliRunner) that left SIGINT ignored made every later subprocess a test started inherit an
 #: ignored Ctrl-C (red in CI only, far from the test that leaked it).
-_WATCHED_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+# SIGHUP too where there is one: run, preview, check, probe, fit, plan and calibrate-lights
+# answer a hang-up (hangup_as_sigterm), and a handler they leave set is a leak as SIGTERM's is
+_WATCHED_SIGNALS = (signal.SIGINT, signal.SIGTERM) + (
+    (signal.SIGHUP,) if hasattr(signal, "SIGHUP") else ()
+)
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -286,7 +290,7 @@ def _dome_leds_cold(
 
 @pytest.fixture(autouse=True)
 def _signal_handlers_left_as_found() -> Iterator[None]:
-    """Fail the test that changes a SIGINT/SIGTERM handler and does not put it back.
+    """Fail the test that changes a SIGINT/SIGTERM/SIGHUP handler and does not put it back.
 
     Why: a leaked handler shows up tests later, in whichever test next relies on it (a child
     process inheriting an ignored Ctrl-C); caught here, the failure names the test that leaked
