@@ -212,6 +212,8 @@ def swapped_pairs(
 
 #: Pixels of each image :func:`neighbour_likeness` compares (a strided sample).
 LIKENESS_SAMPLE = 6000
+#: Sample columns :func:`neighbour_likeness` makes float64 at a time.
+_LIKENESS_BAND = 512
 #: Images :func:`neighbour_likeness` needs.
 LIKENESS_MIN_IMAGES = 8
 
@@ -231,12 +233,18 @@ def neighbour_likeness(stack: NDArray, lights: NDArray) -> float:
     n = stack.shape[0]
     if n < LIKENESS_MIN_IMAGES:
         return float("nan")
-    flat = stack.reshape(n, -1)
-    step = max(1, flat.shape[1] // LIKENESS_SAMPLE)
-    x = flat[:, ::step].astype(np.float64)
-    x = x - x.mean(axis=1, keepdims=True)
-    x /= np.maximum(np.linalg.norm(x, axis=1, keepdims=True), 1e-12)
-    like = x @ x.T
+    sample = stack.reshape(n, -1)[:, :: max(1, stack[0].size // LIKENESS_SAMPLE)]
+    mean = sample.mean(axis=1, dtype=np.float64)
+    # the images' Gram matrix summed over bands of the sample, each band made float64 and
+    # centred alone: the whole sample in float64 had been a copy of every image's crop where
+    # the crop is small (8 bytes a pixel at 96 px: the QA's memory test caught it)
+    gram = np.zeros((n, n))
+    for start in range(0, sample.shape[1], _LIKENESS_BAND):
+        band = sample[:, start : start + _LIKENESS_BAND].astype(np.float64)
+        band -= mean[:, None]
+        gram += band @ band.T
+    norm = np.maximum(np.sqrt(np.diag(gram)), 1e-12)
+    like = gram / np.outer(norm, norm)
     u = np.asarray(lights, dtype=np.float64)
     u = u / np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-12)
     near = u @ u.T
