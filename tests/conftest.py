@@ -817,3 +817,49 @@ def eventually(predicate: Callable[[], object], timeout_s: float = 10.0) -> bool
             return False
         time.sleep(0.005)
     return True
+
+
+class SighupUnhandled(Exception):
+    """A SIGHUP nothing in rti-rig answered (its default action would have ended pytest)."""
+
+
+@pytest.fixture
+def hangup_guarded() -> Iterator[None]:
+    """For the test, a SIGHUP nothing in rti-rig answers raises :class:`SighupUnhandled`."""
+    from rti_rig.core.deferred_signals import signal_handlers
+
+    def unhandled(signum: int, frame: Any) -> None:
+        raise SighupUnhandled("SIGHUP was not handled by rti-rig (the default ends the process)")
+
+    with signal_handlers({signal.SIGHUP: unhandled}):
+        yield
+
+
+def sighup_at_lit_led(monkeypatch: pytest.MonkeyPatch, nth: int) -> list[Any]:
+    """SIGHUP raised in the command's own process once the ``nth`` LED of the first emulated
+    firmware is lit (the firmware has acknowledged it); returns the firmwares built from here
+    on, to read their truth from. One helper for the hang-up tests of run, check and preview."""
+    import rti_rig.simulator.dome_firmware as dome_firmware
+    from rti_rig.runtime.dome_policy import DomePolicy
+
+    firmwares: list[Any] = []
+    real_firmware_for = dome_firmware.firmware_for
+
+    def firmware_for(*args: Any, **kwargs: Any) -> Any:
+        firmware = real_firmware_for(*args, **kwargs)
+        firmwares.append(firmware)
+        return firmware
+
+    real_light = DomePolicy.light
+    lit_steps: list[int] = []
+
+    def light(self: Any, index: int, intensity: float = 1.0) -> None:
+        real_light(self, index, intensity)
+        if len(firmwares) == 1 and len(lit_steps) < nth and firmwares[0].lit is not None:
+            lit_steps.append(index)
+            if len(lit_steps) == nth:
+                signal.raise_signal(signal.SIGHUP)
+
+    monkeypatch.setattr(dome_firmware, "firmware_for", firmware_for)
+    monkeypatch.setattr(DomePolicy, "light", light)
+    return firmwares

@@ -13,12 +13,10 @@ from __future__ import annotations
 
 import signal
 import sys
-from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
 
 import pytest
-from conftest import CONFIGS, manifest, said
+from conftest import CONFIGS, SighupUnhandled, manifest, said, sighup_at_lit_led
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -29,60 +27,17 @@ pytestmark = pytest.mark.skipif(
 )
 
 
-class Unhandled(Exception):
-    """Raised by the test's own SIGHUP handler: the command installed none."""
-
-
-@pytest.fixture
-def hangup_guarded() -> Iterator[None]:
-    """A SIGHUP nothing in rti-rig answers fails the test (its default would end pytest)."""
-
-    def unhandled(signum: int, frame: Any) -> None:
-        raise Unhandled("SIGHUP was not handled by rti-rig (the default ends the process)")
-
-    with signal_handlers({signal.SIGHUP: unhandled}):
-        yield
-
-
-def _hangup_once_lit(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
-    """SIGHUP raised in the command's process once its first LED is lit (the emulated
-    firmware has acknowledged it); the firmwares built from here on, to read their truth."""
-    import rti_rig.simulator.dome_firmware as dome_firmware
-    from rti_rig.runtime.dome_policy import DomePolicy
-
-    firmwares: list[Any] = []
-    real_firmware_for = dome_firmware.firmware_for
-
-    def firmware_for(*args: Any, **kwargs: Any) -> Any:
-        firmware = real_firmware_for(*args, **kwargs)
-        firmwares.append(firmware)
-        return firmware
-
-    real_light = DomePolicy.light
-    raised: list[int] = []
-
-    def light(self: Any, index: int, intensity: float = 1.0) -> None:
-        real_light(self, index, intensity)
-        if len(firmwares) == 1 and not raised and firmwares[0].lit is not None:
-            raised.append(index)
-            signal.raise_signal(signal.SIGHUP)
-
-    monkeypatch.setattr(dome_firmware, "firmware_for", firmware_for)
-    monkeypatch.setattr(DomePolicy, "light", light)
-    return firmwares
-
-
 def test_a_hangup_during_preview_switches_the_lit_led_off_and_exits_129(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, hangup_guarded: None
 ) -> None:
     out = tmp_path / "p"
     with monkeypatch.context() as patched:
-        firmwares = _hangup_once_lit(patched)
+        firmwares = sighup_at_lit_led(patched, 1)
         r = CliRunner().invoke(
             app, ["preview", str(CONFIGS / "emulated_dome.toml"), "--out", str(out)]
         )
     text = said(r)
-    assert not isinstance(r.exception, Unhandled), text
+    assert not isinstance(r.exception, SighupUnhandled), text
     assert r.exit_code == 129, text  # 128 + SIGHUP, as the shell reports a hang-up
     assert "Traceback" not in text and "SIGTERM" not in text, text
     assert "SIGHUP" in text, text
@@ -100,7 +55,7 @@ def test_a_preview_started_with_the_hangup_ignored_goes_on_to_its_image(
     """``nohup rti-rig preview …``: SIGHUP ignored as the command begins stays ignored."""
     out = tmp_path / "p"
     with monkeypatch.context() as patched, signal_handlers({signal.SIGHUP: signal.SIG_IGN}):
-        _hangup_once_lit(patched)
+        sighup_at_lit_led(patched, 1)
         r = CliRunner().invoke(
             app, ["preview", str(CONFIGS / "emulated_dome.toml"), "--out", str(out)]
         )

@@ -12,12 +12,10 @@ from __future__ import annotations
 
 import signal
 import sys
-from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
 
 import pytest
-from conftest import CONFIGS, manifest
+from conftest import CONFIGS, manifest, sighup_at_lit_led
 from conftest import said as unwrapped
 from typer.testing import CliRunner
 
@@ -29,57 +27,13 @@ pytestmark = pytest.mark.skipif(
 )
 
 
-@pytest.fixture
-def hangup_guarded() -> Iterator[None]:
-    """A SIGHUP nothing in rti-rig answers fails the test (its default would end pytest)."""
-
-    def unhandled(signum: int, frame: Any) -> None:
-        raise AssertionError("SIGHUP was not handled by rti-rig (the default ends the process)")
-
-    with signal_handlers({signal.SIGHUP: unhandled}):
-        yield
-    # put back by the block: the command left it as it found it
-    assert signal.getsignal(signal.SIGHUP) is not unhandled
-
-
-def _hangup_at_third_led(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
-    """SIGHUP raised in the run's process once its third LED is lit (the firmware has
-    acknowledged it); the emulated firmwares built from here on, to read their truth from."""
-    import rti_rig.simulator.dome_firmware as dome_firmware
-    from rti_rig.runtime.dome_policy import DomePolicy
-
-    firmwares: list[Any] = []
-    real_firmware_for = dome_firmware.firmware_for
-
-    def firmware_for(*args: Any, **kwargs: Any) -> Any:
-        firmware = real_firmware_for(*args, **kwargs)
-        firmwares.append(firmware)
-        return firmware
-
-    real_light = DomePolicy.light
-    raised: list[int] = []
-
-    def light(self: Any, index: int, intensity: float = 1.0) -> None:
-        real_light(self, index, intensity)
-        if len(firmwares) == 1 and not raised and firmwares[0].lit is not None:
-            lit_steps.append(index)
-            if len(lit_steps) == 3:
-                raised.append(index)
-                signal.raise_signal(signal.SIGHUP)
-
-    lit_steps: list[int] = []
-    monkeypatch.setattr(dome_firmware, "firmware_for", firmware_for)
-    monkeypatch.setattr(DomePolicy, "light", light)
-    return firmwares
-
-
 def test_a_hangup_mid_run_switches_the_dome_off_records_the_end_and_resumes(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, hangup_guarded: None
 ) -> None:
     out = tmp_path / "s"
     runner = CliRunner()
     with monkeypatch.context() as patched:
-        firmwares = _hangup_at_third_led(patched)
+        firmwares = sighup_at_lit_led(patched, 3)
         argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
         r = runner.invoke(app, [*argv, "--no-verdict"], terminal_width=400)
     said = unwrapped(r)
@@ -111,7 +65,7 @@ def test_a_run_started_with_the_hangup_ignored_goes_on_to_its_end(
     is meant to outlive its terminal); the hang-up stops nothing and the session completes."""
     out = tmp_path / "s"
     with monkeypatch.context() as patched, signal_handlers({signal.SIGHUP: signal.SIG_IGN}):
-        _hangup_at_third_led(patched)
+        sighup_at_lit_led(patched, 3)
         argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
         r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
         assert signal.getsignal(signal.SIGHUP) == signal.SIG_IGN
