@@ -92,6 +92,11 @@ class ArmSelfTestReport:
     #: had never said so, nor that the servo took the writes
     lamp_servo: int | None = None
     lamp_flashes: int = 0
+    #: which of the teardown's "lamp off" and "stop" failed (not sent, or not acknowledged):
+    #: a stopped check's lights line says what that leaves (:func:`not_sent_sentence`), as
+    #: ``run``'s does from ``ArmLighting.not_sent``; it had said "lamp off and stop were
+    #: requested" of a lamp-off that had failed
+    not_sent: tuple[str, ...] = ()
 
     @property
     def park_confirmed(self) -> bool:
@@ -340,6 +345,11 @@ def arm_self_test(
     finally:
         failures = attempt_all([("lamp off", lambda: carrier.lamp(False)), ("stop", carrier.stop)])
         report.stopped = not any(f.startswith("stop: ") for f in failures)
+        report.not_sent = tuple(
+            label
+            for label in ("lamp off", "stop")
+            if any(f.startswith(f"{label}: ") for f in failures)
+        )
         # read back before the close releases the port (and, by its torque policy, the joints)
         report.end = _check_end(carrier, report, connected)
         failures += attempt_all([("close", carrier.close)])

@@ -102,11 +102,20 @@ def test_a_stopped_arm_check_says_what_its_teardown_could_not_do(
 
     monkeypatch.setattr(SimulatedArm, "move_to", move_to)
     monkeypatch.setattr(SimulatedArm, "lamp", lamp)
-    r = CliRunner().invoke(app, ["check", str(REPO / "rig_configs" / "virtual_arm.toml")])
+    r = CliRunner().invoke(
+        app, ["check", str(REPO / "rig_configs" / "virtual_arm.toml")], terminal_width=400
+    )
     said = " ".join(r.output.split())
     assert r.exit_code == 143, said
     assert "teardown problem: lamp off" in said and "no answer to lamp off" in said, said
     assert said.index("teardown problem") < said.index("Check stopped (SIGTERM)")
+    # the lights line does not claim the lamp-off that failed ("lamp off and stop were
+    # requested" had been said of it), and says what that leaves
+    assert "lamp off and stop were requested" not in said, said
+    assert (
+        "Check stopped (SIGTERM): stop was requested, but the lamp-off failed (not sent, or "
+        "sent and not acknowledged): the lamp may still be lit" in said
+    ), said
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")

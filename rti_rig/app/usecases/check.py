@@ -151,7 +151,14 @@ def check_rig(
             failures = tuple(str(f) for f in report.teardown_failures) if report else ()
             # where the self-test's teardown left the arm, as read back (a stopped check
             # had said "lamp off and stop were requested" and nothing of the arm)
-            lights = lights_state(rig, bool(failures), end=report.end if report else None)
+            # and which of its lamp-off and stop failed: a failed lamp-off had been said
+            # "lamp off and stop were requested", the lamp perhaps still lit
+            lights = lights_state(
+                rig,
+                bool(failures),
+                end=report.end if report else None,
+                not_sent=report.not_sent if report else None,
+            )
             raise CheckStopped(exc, lights, failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
 

@@ -30,12 +30,17 @@ def software_lamp(lighting: object) -> bool:
 
 
 def lights_state(  # type: ignore[no-untyped-def]
-    rig, teardown_failed: bool = False, *, end: ArmEnd | None = None
+    rig,
+    teardown_failed: bool = False,
+    *,
+    end: ArmEnd | None = None,
+    not_sent: tuple[str, ...] | None = None,
 ) -> str:
     """One sentence on the lights of ``rig`` after its teardown (``teardown_failed``: the
-    teardown's failures were printed just before, and the sentence points at them; ``end``:
-    where a teardown other than the session's left an arm, as read back — a stopped check's
-    self-test, whose record the rig's lighting does not hold)."""
+    teardown's failures were printed just before, and the sentence points at them; ``end`` and
+    ``not_sent``: where a teardown other than the session's left an arm, as read back, and
+    which of its lamp-off and stop failed — a stopped check's self-test, whose record the rig's
+    lighting does not hold; None: the lighting's own)."""
     lighting = rig.lighting
     if getattr(rig.loaded.config, "backend", None) == "replay":
         return "a replayed acquisition has no lights to switch off"
@@ -56,7 +61,8 @@ def lights_state(  # type: ignore[no-untyped-def]
     if unreached is not None:
         return unreached
     after = " (see the teardown problems above)" if teardown_failed else ""
-    not_sent = lighting.not_sent if isinstance(lighting, ArmLighting) else ()
+    if not_sent is None:
+        not_sent = lighting.not_sent if isinstance(lighting, ArmLighting) else ()
     software = software_lamp(lighting) and getattr(rig.loaded.config, "backend", None) == "hardware"
     if not_sent:
         said = not_sent_sentence(not_sent, software)
