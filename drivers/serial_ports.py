@@ -56,3 +56,28 @@ def finish_close(ser: serial.SerialBase, opened_as: tuple[int, int] | None) -> N
         return
     with contextlib.suppress(*PORT_ERRORS):
         ser.close()
+
+
+def permission_denied_why(port: str) -> str:
+    """Why a serial port that exists would not open for this user (EACCES), and what to do:
+    the dome's transport and the arm's bus say it in these same words.
+
+    Why: the system's "Permission denied" alone (the dome) or pyserial's "[Errno 13] could not
+    open port P: [Errno 13] Permission denied: 'P'" (the arm) left a user to guess; on Linux a
+    serial device belongs to a group (``dialout`` on Debian/Ubuntu/Fedora, ``uucp`` on Arch),
+    and a user joins it once, the new group counting only from the next login. The group is
+    the device's own where the system says (never "root", which no user should join)."""
+    group = "dialout"
+    try:
+        import grp
+
+        owner = grp.getgrgid(os.stat(port).st_gid).gr_name
+        if owner != "root":
+            group = owner
+    except (ImportError, OSError, KeyError):  # not POSIX, the node gone, a group with no name
+        pass
+    return (
+        "permission denied: this user may not open it; on Linux, add the user to the "
+        f"'{group}' group (sudo usermod -aG {group} $USER), then log out and in again (a "
+        "new group counts only from the next login)"
+    )

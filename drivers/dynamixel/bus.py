@@ -37,7 +37,7 @@ from rti_rig.drivers.dynamixel.faults import (
     ServoStatusError,
 )
 from rti_rig.drivers.ports_present import ports_present_note
-from rti_rig.drivers.serial_ports import finish_close, identity
+from rti_rig.drivers.serial_ports import finish_close, identity, permission_denied_why
 
 log = logging.getLogger("rti_rig.dynamixel.traffic")
 
@@ -172,6 +172,16 @@ class DxlBus:
                 # the system's reason alone: pyserial's text names the port twice, in Python's
                 # words ("[Errno 2] could not open port P: [Errno 2] No such file …: 'P'")
                 why = os.strerror(errno.ENOENT) if missing else str(exc)
+                if getattr(exc, "errno", None) == errno.EACCES:
+                    # there, but not this user's: the dome's words for it (pyserial's raw
+                    # "[Errno 13] could not open port …" had been said, then "check that the
+                    # adapter is plugged in", which it is)
+                    raise CommunicationError(
+                        self.device,
+                        f"cannot open port {self.port.getPortName()!r}: "
+                        f"{permission_denied_why(self.port.getPortName())}",
+                        "open",
+                    ) from exc
                 raise CommunicationError(
                     self.device,
                     f"cannot open port {self.port.getPortName()!r}: {why}; "

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-from errno import ENOENT
+from errno import EACCES, ENOENT
 from typing import Protocol
 
 import serial
@@ -21,7 +21,13 @@ import serial
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.drivers.ports_present import ports_present_note
-from rti_rig.drivers.serial_ports import PORT_ERRORS, TERMIOS_ERROR, finish_close, identity
+from rti_rig.drivers.serial_ports import (
+    PORT_ERRORS,
+    TERMIOS_ERROR,
+    finish_close,
+    identity,
+    permission_denied_why,
+)
 
 
 class TransportError(Exception):
@@ -154,6 +160,8 @@ class SerialTransport:
             if errno == ENOENT:  # the device went (or came back under another name)
                 note = ports_present_note(self.port)
                 why += f"; {note}" if note else ""
+            elif errno == EACCES:  # there, but not this user's to open: say what to do
+                why = permission_denied_why(self.port)
             raise error(
                 f"cannot open serial port {self.port}: {why}", errno=_system_errno(exc)
             ) from exc
