@@ -550,6 +550,16 @@ class ArmLighting:
                 if stop_failed
                 else "it was left where it stopped"
             )
+            # what to do, in the order it is done: after a failed stop the power goes off
+            # first (as the stop's error and the lights line say); "park it with rti-rig
+            # check" had followed "switch the power off" with no word of the power coming back
+            todo = (
+                "Support the lamp and switch the arm's power off first (a joint the stop did "
+                "not hold may still be moving, or sag); then clear the fault (its error says "
+                "how), switch the power back on and park it with 'rti-rig check'"
+                if stop_failed
+                else "Clear the fault (its error says how), then park it with 'rti-rig check'"
+            )
             # said once, as where the arm was left: it had also been listed as a teardown
             # failure ("park: not attempted because …"), and the arm's sentence repeated it
             self.end = ArmEnd(
@@ -557,8 +567,7 @@ class ArmLighting:
                 None,
                 None,
                 f"not attempted because the arm's {why}: parking is a move of both joints, and "
-                f"a faulty or blocked arm must not be driven near the object; {left}. Clear the "
-                "fault (its error says how), then park it with 'rti-rig check'",
+                f"a faulty or blocked arm must not be driven near the object; {left}. {todo}",
             )
             return failures
         if self._stop_asked is not None:  # a stop came as the lamp went off: no park begun

@@ -179,6 +179,14 @@ def test_a_fault_that_blocks_the_park_is_said_once(tmp_path: Path) -> None:
         "the arm's park is NOT confirmed: not attempted because the arm's own move failed: "
         "parking is a move of both joints" in said
     ), said
+    # what to do, in order: the stop did not hold servo 2, so the power goes off first (as
+    # the lights line says), and comes back on before the park ("then park it with 'rti-rig
+    # check'" had followed "switch the arm's power supply off")
+    assert (
+        "Support the lamp and switch the arm's power off first (a joint the stop did not hold "
+        "may still be moving, or sag); then clear the fault (its error says how), switch the "
+        "power back on and park it with 'rti-rig check'" in said
+    ), said
     assert said.count("clear the obstruction") == 1, said  # in the error, said last
     assert said.rindex("clear the obstruction") > said.index("(as in the error below)"), said
     assert _arm_end(out)["outcome"] == "park-unconfirmed"
