@@ -94,9 +94,23 @@ def not_sent_sentence(not_sent: tuple[str, ...], software_lamp: bool = False) ->
     unplugged adapter; or a servo that did not answer), said in place of "lamp off
     and stop were requested", which had been printed of requests that never left the computer.
 
-    A Dynamixel servo no host reaches keeps the last goal it was sent, under torque (rti-rig
-    sets no Bus Watchdog), so the arm may hold there or still be moving to it; the lamp keeps
-    its last state. Only removing the arm's power settles both."""
+    A Dynamixel servo no host reaches keeps the last goal it was sent, under torque, so the arm
+    may hold there or still be moving to it; the lamp keeps its last state. Only removing the
+    arm's power settles both.
+
+    rti-rig sets no Bus Watchdog (address 98), and one would not settle them. The ROBOTIS
+    e-manual's X-series control table ("Bus Watchdog(98)", e.g.
+    https://emanual.robotis.com/docs/en/dxl/x/xl430-w250/, from ROBOTIS-GIT/emanual
+    ``_includes/en/dxl/control_table_buswatchdog.md``) has it watch the time between
+    instruction packets whenever Torque Enable is 1 and limits it to no operating mode (Goal
+    Position is among the goals its error makes read-only; its one example is in velocity
+    mode): past 1..127 x 20 ms without a packet "the DYNAMIXEL will stop". In position mode
+    that stops a move short of its goal, torque still on: the arm holds where it stopped
+    instead of at a goal that was a pose checked safe before it was sent, and neither torque
+    nor the lamp goes off. Setting it would also have a session send a packet at least every
+    2.54 s through each exposure and wait, or find its servos stopped and their goals refused
+    (Data Range Error) until the error is cleared. With or without it the servo stays under
+    torque, which is why the sentence says to switch the arm's power off."""
     lamp_unsent = "lamp off" in not_sent
     stop_unsent = "stop" in not_sent
     if lamp_unsent and stop_unsent:
