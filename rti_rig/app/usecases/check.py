@@ -314,6 +314,7 @@ def camera_line(  # type: ignore[no-untyped-def]
     exposure is known to be one it takes. Why: a body whose RAW the installed LibRaw cannot
     read passed the check and was refused at the session's first shot, its LED lit."""
     shot: str | None = None
+    failed: RtiRigError | None = None
     try:
         rig.camera.connect()
         problem = _exposure_problem(rig, auto_exposure)
@@ -322,19 +323,19 @@ def camera_line(  # type: ignore[no-untyped-def]
             try:
                 shot = str(rig.camera.test_shot())
             except RtiRigError as exc:
-                # what the failed shot left unknown or undone (a format it never reached, a
-                # shutter speed it could not put back) is said beside its error: it had
-                # been left out, the body left at the shot's speed without a word
-                camera = rig.camera
-                notes = camera.connect_notes() if isinstance(camera, ConnectNotingCamera) else ()
-                left = "".join(f"; note: {n}" for n in notes)
-                return (
-                    f"camera: {rig.camera.name} connected, but FAILED its test shot: {exc}{left}",
-                    False,
-                )
-        # after the shot: what it established (a RAW given) is no longer said to be unknown
+                failed = exc
+        # read once, after the shot: what it established (a RAW given) is no longer said to be
+        # unknown; what a failed shot left unknown or undone (a format it never reached, a
+        # shutter speed it could not put back) is said beside its error (it had been left out,
+        # the body left at the shot's speed without a word)
         camera = rig.camera
         said = tuple(camera.connect_notes()) if isinstance(camera, ConnectNotingCamera) else ()
+        if failed is not None:
+            left = "".join(f"; note: {n}" for n in said)
+            return (
+                f"camera: {rig.camera.name} connected, but FAILED its test shot: {failed}{left}",
+                False,
+            )
     except RtiRigError as exc:
         return f"camera: FAILED to connect: {exc}", False
     finally:
