@@ -111,20 +111,15 @@ class LatchedErrors:
             str(k): int(bytes.fromhex(v["table"])[ct.HARDWARE_ERROR_STATUS.address])
             for k, v in sorted(states.items())
         }
-        body = json.dumps(
-            {
-                "config": str(self.config_path),
-                "hardware_error_status": {k: v for k, v in errors.items() if v},
-                "servos": {str(k): v for k, v in sorted(states.items())},
-                "note": "emulated servos kept powered between rti-rig commands; "
-                "delete this file to power-cycle them",
-            },
-            indent=1,
+        self._save(
+            self.path,
+            states,
+            "emulated servos kept powered between rti-rig commands; "
+            "delete this file to power-cycle them",
+            "powered state (torque, pose, latched errors)",
+            "the next command on this rig meets them as if power-cycled",
+            hardware_error_status={k: v for k, v in errors.items() if v},
         )
-        try:
-            replace_text(self.path, body)
-        except OSError as exc:
-            self._unkept(exc)
 
     def load_eeprom(self) -> dict[int, dict[str, Any]]:
         """Each servo's EEPROM and rest pose as kept through a power cycle
@@ -138,19 +133,39 @@ class LatchedErrors:
     def save_eeprom(self, states: dict[int, dict[str, Any]]) -> None:
         """Record what each servo keeps through a power cycle (atomically); a file that
         cannot be written is a warning, as :meth:`_unkept` says."""
+        self._save(
+            self.eeprom_path,
+            states,
+            "emulated servos' EEPROM and rest pose, kept through a power cycle "
+            "(deleting the other file); delete this one too for factory-fresh servos",
+            "EEPROM area and rest pose",
+            "after a power cycle (deleting the other file) they are met factory-fresh",
+        )
+
+    def _save(
+        self,
+        path: Path,
+        states: dict[int, dict[str, Any]],
+        note: str,
+        what: str,
+        lost: str,
+        **extra: Any,
+    ) -> None:
+        """Write one of the two state files (``extra``: its fields beside the servos'). One
+        writer for both: :meth:`save_state` and :meth:`save_eeprom` had been two copies."""
         body = json.dumps(
             {
                 "config": str(self.config_path),
+                **extra,
                 "servos": {str(k): v for k, v in sorted(states.items())},
-                "note": "emulated servos' EEPROM and rest pose, kept through a power cycle "
-                "(deleting the other file); delete this one too for factory-fresh servos",
+                "note": note,
             },
             indent=1,
         )
         try:
-            replace_text(self.eeprom_path, body)
+            replace_text(path, body)
         except OSError as exc:
-            self._unkept(exc)
+            self._unkept(path, what, lost, exc)
 
     def load(self) -> dict[int, int]:
         """The errors the chain still has from an earlier command; {} if none or unreadable.
@@ -164,8 +179,10 @@ class LatchedErrors:
         except (OSError, ValueError, KeyError, TypeError, AttributeError):
             return {}
 
-    def _unkept(self, exc: OSError) -> None:
-        """The warning of a state file that could not be written.
+    def _unkept(self, path: Path, what: str, lost: str, exc: OSError) -> None:
+        """The warning of a state file (``path``, holding the servos' ``what``; ``lost``: what
+        follows) that could not be written, naming that file (the EEPROM file's had been said
+        to be the powered state's, the other file).
 
         Why a warning, not an error: the state is saved from inside the emulated bus as a
         status packet goes out, so an OSError here (a full disk, a state folder another user
@@ -174,9 +191,8 @@ class LatchedErrors:
         unsaid. Unkept, the chain is met by the next command as if power-cycled, which the
         warning says (the console prints it as a note)."""
         warnings.warn(
-            f"the emulated servos' powered state (torque, pose, latched errors) could not be "
-            f"kept in {self.path} ({exc}): the next command on this rig meets them as if "
-            f"power-cycled; set {STATE_DIR_ENV} to a writable folder to keep it",
+            f"the emulated servos' {what} could not be kept in {path} ({exc}): {lost}; "
+            f"set {STATE_DIR_ENV} to a writable folder to keep it",
             RuntimeWarning,
-            stacklevel=3,
+            stacklevel=4,  # the caller of save_state / save_eeprom
         )

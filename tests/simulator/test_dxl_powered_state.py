@@ -7,10 +7,16 @@ motion; a record that is not that servo's is met as a power-cycled servo, never 
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
+import pytest
+
 from rti_rig.core.clock import VirtualClock
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.simulator.dynamixel_emulator import EmulatedServo
+from rti_rig.simulator.servo_latch import STATE_DIR_ENV, LatchedErrors
 
 
 def _moving(clock: VirtualClock) -> EmulatedServo:
@@ -51,3 +57,23 @@ def test_a_record_of_another_servo_leaves_it_as_at_power_on() -> None:
     assert not damaged.restore_powered({"table": state["table"]})
     for servo in (other_model, other_id, damaged):
         assert servo.get(ct.TORQUE_ENABLE) == 0
+
+
+def test_an_eeprom_file_that_cannot_be_written_is_named_in_its_warning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each of the two state files is written by one writer, and a failure names the file that
+    failed and what it held: the EEPROM file's had been said to be the powered state's file,
+    which was written."""
+    monkeypatch.setenv(STATE_DIR_ENV, str(tmp_path))
+    latch = LatchedErrors(tmp_path / "arm.toml")
+    latch.eeprom_path.mkdir(parents=True)  # a folder where the file goes: it cannot replace it
+    states = {1: EmulatedServo(1, 1060, VirtualClock()).powered_state()}
+    latch.save_state(states)
+    with pytest.warns(RuntimeWarning) as caught:
+        latch.save_eeprom(states)
+    said = str(caught[0].message)
+    assert f"EEPROM area and rest pose could not be kept in {latch.eeprom_path} (" in said, said
+    assert str(latch.path) not in said, said
+    assert latch.load_state() == states  # the powered state's file, written as before
+    assert json.loads(latch.path.read_text())["hardware_error_status"] == {}
