@@ -34,10 +34,11 @@ import termios
 import threading
 import time
 import tty
+from abc import abstractmethod
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 #: inotify event bits (``<sys/inotify.h>``).
 _IN_CLOSE_WRITE, _IN_CLOSE_NOWRITE, _IN_OPEN = 0x08, 0x10, 0x20
@@ -126,6 +127,31 @@ class PtyDevice(Protocol):
         """The host closed the port (its DTR dropped): a board that acts on it (an ATmega32u4
         touched at 1200 baud jumps to its bootloader) says so here; declared, where the server
         had probed for it with ``getattr`` (a misspelt name went unheard)."""
+
+
+@runtime_checkable
+class HostBaudDevice(Protocol):
+    """A :class:`PtyDevice` that sees the speed the host set its UART to (``host_baud``, set
+    by the server on each pass; None until then): behind a USB-serial chip two UARTs at
+    different rates read garbage, and a native-USB board is touched at 1200 baud.
+
+    Declared by the concrete class (``class Board(HostBaudDevice, TickingDevice)``), where
+    the server had probed for the name with ``hasattr``: a device that misspelt it was never
+    told the host's rate."""
+
+    host_baud: int | None
+
+
+@runtime_checkable
+class TickingDevice(Protocol):
+    """A :class:`PtyDevice` that acts on its own time (a sketch's timers, a watchdog, a
+    self-timed LED going dark): ``tick`` is called on each pass while the port is open and
+    returns what it sent meanwhile. Abstract: a class that declares it and renames the method
+    cannot be built (the server had probed for it with ``getattr``, a misspelt one never
+    ran)."""
+
+    @abstractmethod
+    def tick(self) -> list[TimedOutput]: ...
 
 
 @dataclass
@@ -271,11 +297,10 @@ class _Server:
                     data = b""
                 if data:
                     self.pending += self.device.receive(data)
-            if hasattr(self.device, "host_baud"):  # the host's UART speed, as the board sees it
+            if isinstance(self.device, HostBaudDevice):  # the host's UART speed, as it sees it
                 self.device.host_baud = host_baud(self.master)
-            tick = getattr(self.device, "tick", None)  # devices that act on their own time
-            if tick is not None and self.opened:
-                self.pending += tick()
+            if isinstance(self.device, TickingDevice) and self.opened:
+                self.pending += self.device.tick()
             down = self.device.take_disconnect()
             if down is not None:
                 self._unplug(down)

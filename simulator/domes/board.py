@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan, Output, garble
+from rti_rig.simulator.pty_link import HostBaudDevice, TickingDevice
 
 RX_BUFFER = 64
 
@@ -58,8 +59,9 @@ class Read:
 Firmware = Generator[Sleep | Read, int | None, None]
 
 
-class Board:
-    """A board with LEDs running :meth:`firmware`; serve it with ``serve_on_pty``."""
+class Board(HostBaudDevice, TickingDevice):
+    """A board with LEDs running :meth:`firmware`; serve it with ``serve_on_pty``, which tells
+    it the host's UART rate and ticks its clock (the two capabilities it declares)."""
 
     name = "board"
     led_count = 0

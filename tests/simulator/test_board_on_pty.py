@@ -180,3 +180,18 @@ def test_every_device_served_on_a_pty_declares_what_the_server_calls() -> None:
     for device in (Board, DomeFirmware):
         missing = [n for n in members if not callable(getattr(device, n, None))]
         assert not missing, (device, missing)
+
+
+def test_a_board_declares_the_host_s_rate_and_its_own_time_which_the_server_serves() -> None:
+    """The server tells a device the host's UART rate and ticks its clock only where the
+    device declares them (:class:`HostBaudDevice`, :class:`TickingDevice`): it had probed by
+    name, so a board whose ``tick`` was misspelt would have sat unticked, unsaid. Every board
+    declares both (``tick`` abstract: a board without it cannot be built); the scripted
+    firmware, which keeps no time of its own and reads any rate, declares neither."""
+    from rti_rig.simulator.dome_firmware import DomeFirmware
+    from rti_rig.simulator.domes.board import Board
+    from rti_rig.simulator.pty_link import HostBaudDevice, TickingDevice
+
+    for declared in (HostBaudDevice, TickingDevice):
+        assert declared in Board.__mro__ and declared not in DomeFirmware.__mro__, declared
+    assert "tick" in TickingDevice.__abstractmethods__
