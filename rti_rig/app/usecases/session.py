@@ -452,6 +452,7 @@ def fix_exposure(
     the emulated card dome clipped 56–100 %. There up to ``PROBE_LIGHTS`` of the highest-ranked
     planned lights are checked, at one test shot each at least, with a note saying so and what
     it costs before the lights come on."""
+    from rti_rig.core.devices import ShutterSpeedCamera
     from rti_rig.drivers.cameras.exposure import meter_exposure, recheck_exposure
     from rti_rig.drivers.cameras.settings import ExposureRule
     from rti_rig.runtime.exposure_policy import (
@@ -531,11 +532,17 @@ def fix_exposure(
         high_s = max(update.get("max_exposure_s", rule.max_exposure_s), low_s)
         return rule.model_copy(update={"min_exposure_s": low_s, "max_exposure_s": high_s})
 
+    def shutter_speeds() -> list[float] | None:
+        # a camera with its own list of exposures (a DSLR's shutter speeds) is metered on it:
+        # asked of the rig's camera, which the metering's camera wraps, by its declared
+        # capability (core.devices), where getattr had probed the wrapper by name
+        camera = rig.camera
+        return camera.available_exposures_s() if isinstance(camera, ShutterSpeedCamera) else None
+
     # a camera taking exposures in steps (a UVC camera's exposure_unit_s) is asked for those
     def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
-        shutter = getattr(camera, "available_exposures_s", None)
         ruled = camera_rule(camera)
-        if not callable(shutter):
+        if not isinstance(rig.camera, ShutterSpeedCamera):
             # a start moved into the camera's range is said (it had been refused above it)
             moved = metering_start(camera, cam.exposure_s, within)[1]
             if moved is not None:
@@ -547,17 +554,16 @@ def fix_exposure(
             # ranges and in the camera's units (metering_start): clamped again here it had
             # left the camera's units (0.00125 s on a 0.0001 s camera, judged 0.0012 s)
             start_s,
-            shutter() if shutter else None,
+            shutter_speeds(),
             quantise=exposure_steps(camera),
         )
 
     def recheck(camera, exposure_s: float) -> Recheck:  # type: ignore[no-untyped-def]
-        shutter = getattr(camera, "available_exposures_s", None)
         choice, tested = recheck_exposure(
             camera,
             camera_rule(camera),
             exposure_s,
-            shutter() if shutter else None,
+            shutter_speeds(),
             quantise=exposure_steps(camera),
         )
         return Recheck(tested, choice)
@@ -738,8 +744,11 @@ def _held_after_s(rig: Rig) -> float:
 def _next_shorter_s(rig: Rig, longest: float) -> float:
     """The longest shutter speed the camera offers at or under ``longest`` (``longest`` for a
     camera without a list): the metering chose the cap when it chose that one."""
-    offered = getattr(rig.camera, "available_exposures_s", None)
-    speeds = [t for t in (offered() if offered is not None else []) if t <= longest + 1e-9]
+    from rti_rig.core.devices import ShutterSpeedCamera
+
+    camera = rig.camera
+    offered = camera.available_exposures_s() if isinstance(camera, ShutterSpeedCamera) else []
+    speeds = [t for t in offered if t <= longest + 1e-9]
     return max(speeds) if speeds else longest
 
 
