@@ -541,9 +541,10 @@ def _print_metering_failures(exc: BaseException) -> None:
     (said as it happened, by the dome's own line) as being in no record, which it is: the
     session's record is written only once the capture begins (it had been said as a teardown
     problem, or not kept at all)."""
+    from rti_rig.runtime.exposure_policy import teardown_failures_of
     from rti_rig.runtime.lighting import unsafe_failures
 
-    failures = list(getattr(exc, "teardown_failures", None) or ())
+    failures = teardown_failures_of(exc)
     unsafe = unsafe_failures(failures)
     # those the error names itself (metering that could not make the rig safe) said once
     _print_failures([f for f in unsafe if str(f) not in str(exc)])

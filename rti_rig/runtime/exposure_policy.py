@@ -312,6 +312,31 @@ class _LitForEachShot:
         return getattr(self._rig.camera, name)
 
 
+#: The attribute of the error or stop that ended metering which carries what its teardown
+#: could not do: named once, here, for :func:`carry_teardown_failures` and
+#: :func:`teardown_failures_of` alone.
+_CARRIED = "teardown_failures"
+
+
+def carry_teardown_failures(exc: BaseException, failures: list[str]) -> None:
+    """Attach to ``exc``, the error or stop (Ctrl-C, SIGTERM, a fault no part of rti-rig
+    named) that ended metering, what metering's teardown could not do.
+
+    Why an attribute set here, not one each error type declares: a KeyboardInterrupt or a
+    camera driver's TypeError is raised on as it is (wrapped, it would be said otherwise and
+    stop otherwise), and their types cannot declare it. Its writer and readers had each
+    spelt the name (a ``# type: ignore`` and a ``getattr``), so a misspelt one was read as
+    "nothing failed"."""
+    setattr(exc, _CARRIED, failures)
+
+
+def teardown_failures_of(exc: BaseException) -> list[str]:
+    """What metering's teardown could not do, as :func:`carry_teardown_failures` attached it
+    to ``exc`` (empty: ``exc`` did not end metering, or its teardown did all); each as it
+    was (a port's close a :class:`~rti_rig.runtime.lighting.PortCloseFailure`, told by type)."""
+    return list(getattr(exc, _CARRIED, None) or ())
+
+
 def fix_session_exposure(
     rig: Rig,
     schedule: LightSchedule,
@@ -421,7 +446,7 @@ def fix_session_exposure(
     except BaseException as exc:
         # a Ctrl-C or an error while metering: what the teardown could not do travels with it
         # (it had been dropped, and the user told an all-off was sent)
-        exc.teardown_failures = teardown()  # type: ignore[attr-defined]
+        carry_teardown_failures(exc, teardown())
         raise
     failures = teardown(keep_lights=True)
     rig_time_s, wall_time_s = rig.clock.now() - started, time.perf_counter() - wall_started
@@ -438,7 +463,7 @@ def fix_session_exposure(
             "the lights before anything else",
             "meter",
         )
-        error.teardown_failures = failures  # type: ignore[attr-defined]
+        carry_teardown_failures(error, failures)
         raise error
     steps_fixed = tuple(replace(s, exposure_s=float(choice.exposure_s)) for s in schedule.steps)
     evidence = {

@@ -591,10 +591,11 @@ def fix_exposure(
         # dome whose all-off metering had sent and seen acknowledged); a state that cannot be
         # told leaves the fault to be said as it is
         from rti_rig.app.usecases.safe_state import lights_state
+        from rti_rig.runtime.exposure_policy import teardown_failures_of
         from rti_rig.runtime.lighting import unsafe_failures
 
         # (a port that did not close cleanly is no doubt about the lights: the all-off says)
-        failures = unsafe_failures(getattr(exc, "teardown_failures", None))
+        failures = unsafe_failures(teardown_failures_of(exc))
         with contextlib.suppress(Exception):  # never said in place of the fault raised
             exc.lights_state = lights_state(rig, bool(failures))  # type: ignore[attr-defined]
         raise
