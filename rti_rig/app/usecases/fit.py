@@ -1510,7 +1510,7 @@ def qa_without_normals(lights: np.ndarray, session: Path | None = None) -> str |
 
 def _read_pixels(frame: Any) -> str | None:
     """The pixel checksum a TIFF frame took as the fit read it through, or None."""
-    got = getattr(frame, "pixel_digest", None) if isinstance(frame, TiffRows) else None
+    got = frame.pixel_digest if isinstance(frame, TiffRows) else None
     return None if got is None else str(got[1])
 
 
@@ -1518,6 +1518,6 @@ def _remember_pixels(frames: list[Any]) -> None:
     """Hand the integrity check the pixel checksums the TIFFs of ``frames`` took as they were
     read through (:attr:`TiffRows.pixel_digest`): it then reads none of them again."""
     for frame in frames:
-        got = getattr(frame, "pixel_digest", None) if isinstance(frame, TiffRows) else None
+        got = frame.pixel_digest if isinstance(frame, TiffRows) else None
         if got is not None:
             remember_pixel_digest(frame.path, *got)
