@@ -6,6 +6,7 @@ message (file, line or key, and what to do) with exit status 2, never a tracebac
 
 from __future__ import annotations
 
+import io
 import math
 import signal
 
@@ -315,7 +316,9 @@ def _usage_errors_plain() -> None:
         return
 
     def plain(exc) -> None:  # type: ignore[no-untyped-def]
-        exc.show()
+        # through err's stream: a stderr that cannot be written (2>/dev/full) loses the words,
+        # not the usage error's exit 2 (click's own stderr raised, and the command exited 1)
+        exc.show(file=err.file)
 
     rich_utils.rich_format_error = plain  # type: ignore[assignment]
 
@@ -380,13 +383,78 @@ class ReaderGoneTolerant:
         return getattr(self._stream, name)
 
 
+class WritableWaited(io.RawIOBase):
+    """A descriptor opened non-blocking (``O_NONBLOCK``), written as a blocking one is: a write
+    the pipe has no room for waits until the reader makes room, then writes what is left.
+
+    Why: a parent that set ``O_NONBLOCK`` on the pipe it reads (node's ``child_process``, some
+    CI runners; the flag is on the pipe, shared with the child) made a write to a full pipe
+    raise ``BlockingIOError``: taken as output that cannot be written, every word after it was
+    dropped. Retrying above Python's text stream cannot work: its buffer forgets how much of
+    a failed write went out. Here, below the buffer, the count written is exact."""
+
+    def __init__(self, fd: int) -> None:
+        super().__init__()
+        self._fd = fd
+
+    def writable(self) -> bool:
+        return True
+
+    def fileno(self) -> int:
+        return self._fd
+
+    def write(self, data) -> int:  # type: ignore[no-untyped-def,override]
+        import os
+        import select
+
+        while True:
+            try:
+                return os.write(self._fd, data)  # a short count: the buffer writes the rest
+            except BlockingIOError:
+                select.select([], [self._fd], [])  # the reader made room (or left: EPIPE next)
+
+    def close(self) -> None:
+        """Leave the descriptor open: it is the process's stdout or stderr, not ours."""
+        super().close()
+
+
+def waiting_when_nonblocking(stream):  # type: ignore[no-untyped-def]
+    """``stream`` itself, or, where its descriptor is non-blocking, a text stream of the same
+    encoding and buffering that writes through :class:`WritableWaited`."""
+    import os
+
+    try:
+        fd = stream.fileno()
+        if os.get_blocking(fd):
+            return stream
+        stream.flush()  # nothing written yet, as a rule: if something is, in order
+    except (AttributeError, OSError, ValueError):  # not a descriptor's stream: as it is
+        return stream
+    return io.TextIOWrapper(
+        io.BufferedWriter(WritableWaited(fd)),
+        encoding=stream.encoding,
+        errors=stream.errors,
+        line_buffering=stream.line_buffering,
+        write_through=getattr(stream, "write_through", False),
+    )
+
+
 def reader_gone_tolerated() -> None:
-    """Give :data:`out` and :data:`err` the process's stdout and stderr through
-    :class:`ReaderGoneTolerant` (the console entry only, as :func:`unwrapped_when_piped`)."""
+    """Give :data:`out` and :data:`err`, and ``sys.stdout`` and ``sys.stderr`` for everything
+    else that writes (click's usage errors, typer's help, the launcher's last line), the
+    process's stdout and stderr through :class:`ReaderGoneTolerant`, each waiting for room
+    where its pipe is non-blocking (:func:`waiting_when_nonblocking`). The console entry only,
+    as :func:`unwrapped_when_piped`.
+
+    Why ``sys.stdout`` and ``sys.stderr`` too: a word written past the consoles to a stream
+    that failed raised from wherever it was written: ``run --nope 2>/dev/full`` exited 1 (a
+    fault rti-rig did not name), not the usage error's 2."""
     import sys
 
-    out.file = ReaderGoneTolerant(sys.stdout, said_on=sys.stderr)
-    err.file = ReaderGoneTolerant(sys.stderr)
+    stdout = waiting_when_nonblocking(sys.stdout)
+    stderr = waiting_when_nonblocking(sys.stderr)
+    sys.stdout = out.file = ReaderGoneTolerant(stdout, said_on=stderr)  # type: ignore[assignment]
+    sys.stderr = err.file = ReaderGoneTolerant(stderr)  # type: ignore[assignment]
 
 
 def main() -> None:

@@ -94,3 +94,21 @@ def test_a_write_failing_mid_way_drops_the_rest_and_is_said_once(tmp_path: Path)
     finally:
         target.close()
     assert said.getvalue().count("output could not be written (Input/output error)") == 1
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+def test_a_usage_error_exits_2_when_stderr_cannot_be_written() -> None:
+    """Click said the usage error on its own stderr, whose failed write ended the command with
+    exit 1 (a fault rti-rig did not name), not a usage error's 2."""
+    r = _rti_rig_closed("2>/dev/full", "run", "--nope")
+    assert r.returncode == 2, r.stdout
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+def test_help_on_a_full_disk_is_said_once_and_exits_0() -> None:
+    """Typer's help is printed past rti-rig's consoles, to ``sys.stdout``: its failed write
+    had ended ``--help > log`` with a traceback and exit 1."""
+    r = _rti_rig_closed(">/dev/full", "run", "--help")
+    assert "Traceback" not in r.stderr, r.stderr
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.count("output could not be written (No space left on device)") == 1, r.stderr

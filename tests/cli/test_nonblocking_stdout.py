@@ -1,0 +1,111 @@
+"""A command whose stdout is a pipe its reader made non-blocking (``O_NONBLOCK``: node's
+``child_process``, some CI runners) waits for room in the pipe, as with any other pipe, and
+says every word.
+
+A write to the full pipe raised ``BlockingIOError``: taken as output that could not be written,
+the rest of the words were dropped (a ``--help`` read by such a parent stopped at 3 kB of its
+13). Through ``python -m rti_rig`` on a real pipe, made small and filled before the command
+starts, so that its first write finds no room.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import REPO
+
+#: Linux's fcntl to resize a pipe (``F_SETPIPE_SZ``); Python names it from 3.10 on Linux only.
+F_SETPIPE_SZ = 1031
+
+
+def _full_nonblocking_pipe() -> tuple[int, int, bytes]:
+    """A pipe of one page, its write end non-blocking, filled to the last byte it takes."""
+    import fcntl
+
+    read_end, write_end = os.pipe()
+    fcntl.fcntl(write_end, F_SETPIPE_SZ, 4096)
+    os.set_blocking(write_end, False)
+    filler = b""
+    try:
+        while True:
+            filler += b"x" * os.write(write_end, b"x" * 512)
+    except BlockingIOError:
+        pass
+    return read_end, write_end, filler
+
+
+def _read_all(fd: int) -> bytes:
+    with os.fdopen(fd, "rb") as stream:
+        return stream.read()
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="needs Linux's F_SETPIPE_SZ")
+def test_help_on_a_full_non_blocking_pipe_is_said_whole(tmp_path: Path) -> None:
+    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "80"}
+    whole = subprocess.run(
+        [sys.executable, "-m", "rti_rig", "run", "--help"],
+        capture_output=True,
+        env=env,
+        timeout=600,
+    ).stdout
+    assert len(whole) > 4096, whole  # more than the pipe holds: the command must wait for room
+
+    read_end, write_end, filler = _full_nonblocking_pipe()
+    with open(tmp_path / "stderr.txt", "wb") as stderr:
+        command = subprocess.Popen(
+            [sys.executable, "-m", "rti_rig", "run", "--help"],
+            stdout=write_end,
+            stderr=stderr,
+            env=env,
+        )
+    os.close(write_end)
+    try:
+        # The time a command that drops its words takes to start, find the pipe full and end;
+        # a command that waits for room is still waiting when it passes, however loaded the
+        # machine (it cannot end before the pipe is read), so this bounds how sure the test
+        # is, never whether the right behaviour passes.
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            command.wait(timeout=5)
+        said = _read_all(read_end)
+        code = command.wait(timeout=600)
+    finally:
+        if command.poll() is None:
+            command.kill()
+            command.wait()
+    errors = (tmp_path / "stderr.txt").read_text()
+    assert code == 0, errors
+    assert "could not be written" not in errors and "Traceback" not in errors, errors
+    assert said == filler + whole, (len(said), len(filler) + len(whole))
+
+
+def test_a_descriptor_with_no_room_is_written_once_the_reader_makes_room() -> None:
+    """Below the text stream, the count is exact: what one write could not take goes out with
+    the next, nothing twice, nothing lost (the wait itself is the pipe's: a thread reads)."""
+    import threading
+
+    from rti_rig.cli.app import waiting_when_nonblocking
+
+    read_end, write_end = os.pipe()
+    os.set_blocking(write_end, False)
+    with open(write_end, "w", encoding="utf-8", closefd=False) as plain:
+        stream = waiting_when_nonblocking(plain)
+        assert stream is not plain
+        got: list[bytes] = []
+        reader = threading.Thread(target=lambda: got.append(_read_all(read_end)))
+        reader.start()
+        text = "".join(f"line {i} → é\n" for i in range(40_000))  # far more than a pipe holds
+        stream.write(text)
+        stream.flush()
+        stream.close()
+    os.close(write_end)
+    reader.join(timeout=600)
+    assert not reader.is_alive()
+    assert got[0] == text.encode("utf-8")
+    # and a blocking descriptor's stream is left as it is
+    with open(os.devnull, "w") as blocking:
+        assert waiting_when_nonblocking(blocking) is blocking
