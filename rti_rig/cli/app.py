@@ -323,6 +323,22 @@ def _usage_errors_plain() -> None:
     rich_utils.rich_format_error = plain  # type: ignore[assignment]
 
 
+def help_styled_as_the_consoles() -> None:
+    """Style typer's help and usage errors as :data:`out` and :data:`err` are: no escape codes
+    where the stream is not a terminal, unless ``FORCE_COLOR`` or ``TTY_COMPATIBLE=1`` asks
+    for them (rich reads both itself), and no colour under ``NO_COLOR`` (rich again).
+
+    Why: typer forces its consoles to be terminals under ``GITHUB_ACTIONS`` or ``PY_COLORS``,
+    so ``rti-rig run --help > help.txt`` in a CI job wrote bold, dim and colour codes into the
+    file, where every other word of rti-rig is plain text when piped."""
+    try:  # typer's internals, as the patches above: a release without them keeps its rule
+        from typer import rich_utils
+    except ImportError:
+        return
+    if getattr(rich_utils, "FORCE_TERMINAL", None) is True:
+        rich_utils.FORCE_TERMINAL = None
+
+
 class ReaderGoneTolerant:
     """A console's stream whose reader closing the pipe (``| head -1``, a script that read the
     line it wanted) sends the rest of the command's words to ``/dev/null`` instead of ending
@@ -462,5 +478,6 @@ def main() -> None:
     records_as_notes()
     warnings_as_notes()
     unwrapped_when_piped()
+    help_styled_as_the_consoles()
     reader_gone_tolerated()
     app()
