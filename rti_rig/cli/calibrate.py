@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out, print_notes, stop_exit_code
+from rti_rig.cli.app import app, err, fail, out, print_notes, shown_path, stop_exit_code
 from rti_rig.cli.stopping import Terminated, sigterm_stops, stamp, stop_signal, written_since
 from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
@@ -249,7 +249,7 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
         "level it with care."
     )
     rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
-    out.print(f"Calibration → {escape(str(target))}")
+    out.print(f"Calibration → {escape(shown_path(target))}")
     if in_force and cal.shot_spread < even_enough:
         out.print(
             "The correction in force is good: no new calibration is needed. To use this "

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Annotated, NoReturn
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out, stop_exit_code
+from rti_rig.cli.app import app, err, fail, out, shown_path, stop_exit_code
 from rti_rig.core.deferred_signals import hangup_as_sigterm, signal_handlers
 from rti_rig.core.errors import RtiRigError
 
@@ -109,7 +109,7 @@ def check(
         return
 
     def announce() -> None:
-        out.print(f"Checking {escape(str(rig_config))} (Ctrl-C stops the check at once)…")
+        out.print(f"Checking {escape(shown_path(rig_config))} (Ctrl-C stops the check at once)…")
 
     try:
         with stop_on_signals():
@@ -141,7 +141,8 @@ def _reboot_faulted(rig_config: Path) -> None:
     from rti_rig.app.usecases.check import reboot_faulted
 
     def looking() -> None:
-        out.print(f"Looking for faulted servos on {escape(str(rig_config))}'s arm (nothing moves)…")
+        shown = escape(shown_path(rig_config))
+        out.print(f"Looking for faulted servos on {shown}'s arm (nothing moves)…")
 
     try:
         report = reboot_faulted(rig_config, on_start=looking)

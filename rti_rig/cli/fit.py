@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shlex
 import signal
 import warnings
 from pathlib import Path
@@ -11,7 +10,7 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out, print_notes, stop_exit_code
+from rti_rig.cli.app import app, err, fail, out, print_notes, shell_word, shown_path, stop_exit_code
 from rti_rig.cli.stopping import Terminated, sigterm_stops, stop_signal
 from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
@@ -66,7 +65,7 @@ def print_verdict(session: Path | None) -> None:
         signum = signal.SIGTERM if isinstance(exc, VerdictTerminated) else signal.SIGINT
         err.print(
             f"[yellow]QA verdict skipped ({stop_words(signum)}):[/] the session is complete; "
-            f"rti-rig fit {escape(shlex.quote(str(session)))} --out FOLDER gives the verdict"
+            f"rti-rig fit {escape(shell_word(session))} --out FOLDER gives the verdict"
         )
         raise typer.Exit(code=stop_exit_code(signum)) from None
 
@@ -357,7 +356,8 @@ def _fit_command(  # type: ignore[no-untyped-def]
     for text in result.warnings:
         err.print(f"[yellow]warning:[/] {escape(text)}")
     out.print(
-        f"Wrote {len(result.files)} files to {escape(str(out_dir))} in {result.seconds:.1f} s"
+        f"Wrote {len(result.files)} files to {escape(shown_path(out_dir))} "
+        f"in {result.seconds:.1f} s"
     )
     if result.qa is not None:
         out.print(f"QA verdict: {escape(result.qa.verdict)}")

@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
+from rich.markup import escape
 
 from rti_rig.cli.app import (
     app,
@@ -15,6 +16,7 @@ from rti_rig.cli.app import (
     out,
     parse_az_el,
     print_notes,
+    shown_path,
     stop_exit_code,
 )
 from rti_rig.cli.stopping import Stamp, Terminated, sigterm_stops, stamp, stop_signal, written_since
@@ -253,7 +255,7 @@ def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:
         except RtiRigError as exc:
             raise fail(exc) from None
         done["drawn"] = True
-        out.print(f"Map of the plan → {request.figure}")
+        out.print(f"Map of the plan → {escape(shown_path(request.figure))}")
 
 
 def _stopped(why: str, request: PlanLightsRequest, before: Stamp, done: dict[str, Any]) -> str:

@@ -6,7 +6,6 @@ handlers (Ctrl-C, SIGTERM, SIGUSR1), the progress bar and the closing messages.
 
 from __future__ import annotations
 
-import shlex
 import signal
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -26,6 +25,8 @@ from rti_rig.cli.app import (
     out,
     parse_az_el,
     print_note,
+    shell_word,
+    shown_path,
     stop_exit_code,
 )
 from rti_rig.cli.stopping import stop_signal
@@ -817,7 +818,7 @@ def _arg(path: Path | str) -> str:
     """``path`` as one shell word, for a command the user is told to run: a session folder
     with a space in its name ("Object 12 recto") had been printed bare, so the resume hint
     pasted into a shell ran ``--resume Object`` with "12" and "recto" as other arguments."""
-    return shlex.quote(str(path))
+    return shell_word(path)  # and as $'...' where a stream cannot print it (shell_word)
 
 
 def _sentence(text: str) -> str:
@@ -1585,7 +1586,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     # the noun agrees with the total it follows: "1 of 4 light left" had been said
     noun = "light" if total == 1 else "lights"
     count = f"{todo} {noun}" if todo == total else f"{todo} of {total} {noun} left"
-    out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {escape(str(out_dir))}")
+    shown = escape(shown_path(out_dir))
+    out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {shown}")
 
     def resume_hint() -> str:  # said once the run stopped: what it wrote decides the command
         return _cannot_resume(rig) or f"Continue with: {_continue_command(opened)}"
@@ -1964,8 +1966,8 @@ def preview(
             if given
         )
         out.print(
-            f"Plan from it: rti-rig plan {shlex.quote(str(out_dir))} --rig "
-            f"{shlex.quote(str(rig_config))} --lights N{band} --out plan.lp",
+            f"Plan from it: rti-rig plan {_arg(out_dir)} --rig "
+            f"{_arg(rig_config)} --lights N{band} --out plan.lp",
             highlight=False,
             markup=False,
             soft_wrap=True,
@@ -1973,7 +1975,7 @@ def preview(
         metered = _metered_apart(opened) if auto_exposure else None
         if metered is not None:
             out.print(
-                f"Then: rti-rig run {shlex.quote(str(rig_config))} --plan plan.lp --out SESSION "
+                f"Then: rti-rig run {_arg(rig_config)} --plan plan.lp --out SESSION "
                 f"--auto-exposure (this preview was metered at {metered[0]:.4g} s; without "
                 f"--auto-exposure the run uses the config's exposure_s = {metered[1]:g} s)",
                 highlight=False,
@@ -2085,4 +2087,4 @@ def export_lp(
     # escaped: a file in a folder named 'coin [draft]' had been said as 'coin .lp' (rich read
     # '[draft]' as markup)
     n = len(done.entries)
-    out.print(f"{n} light{'' if n == 1 else 's'} → {escape(str(out_file))}")
+    out.print(f"{n} light{'' if n == 1 else 's'} → {escape(shown_path(out_file))}")
