@@ -86,22 +86,36 @@ def _main() -> None:
     try:
         from rti_rig.cli import main as run_cli
     except KeyboardInterrupt:
-        sys.stderr.write("rti-rig: stopped while starting (Ctrl-C); nothing was done\n")
+        _say("rti-rig: stopped while starting (Ctrl-C); nothing was done\n")
         raise SystemExit(INTERRUPTED_EXIT) from None
     try:
         run_cli()
     except KeyboardInterrupt:
         # a Ctrl-C no command handled: one line, not Python's traceback
-        sys.stderr.write("rti-rig: stopped (Ctrl-C)\n")
+        _say("rti-rig: stopped (Ctrl-C)\n")
         raise SystemExit(INTERRUPTED_EXIT) from None
     except SystemExit as exc:
         if _from_keyboard_interrupt(exc):
             # typer turns a Ctrl-C no command handled (its options still being parsed, a
             # command with nothing to make safe) into exit 130 without a word (older typer:
             # "Aborted!" and exit 1): said, and the shell's code for a Ctrl-C either way
-            sys.stderr.write("rti-rig: stopped (Ctrl-C)\n")
+            _say("rti-rig: stopped (Ctrl-C)\n")
             raise SystemExit(INTERRUPTED_EXIT) from None
         raise
+
+
+def _say(text: str) -> None:
+    """Write ``text`` on stderr, or nothing where stderr cannot be written (``2>/dev/full``, a
+    terminal gone): the exit status is what says how the command ended.
+
+    Why: before the command line has put its tolerant streams in place (a Ctrl-C while it is
+    imported) a failed write raised here and the process exited 1, not 130; once they are in
+    place, ``sys.stderr`` is one of them and this guard is not needed, but costs nothing."""
+    try:
+        sys.stderr.write(text)
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
 
 
 def _from_keyboard_interrupt(exc: BaseException) -> bool:

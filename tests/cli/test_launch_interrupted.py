@@ -101,3 +101,20 @@ def test_ctrl_c_while_the_rig_opens_says_nothing_was_captured(tmp_path: Path) ->
         f"Stopped (Ctrl-C) before the first image: nothing was captured or written to {out}" in text
     )
     assert not out.exists()
+
+
+def test_ctrl_c_during_the_import_exits_130_when_stderr_cannot_be_written() -> None:
+    """Its one line's failed write (``2>/dev/full``) had raised, and the process exited 1."""
+    import pytest
+
+    if not Path("/dev/full").exists():
+        pytest.skip("needs Linux's /dev/full")
+    with open("/dev/full", "w") as full:
+        done = subprocess.run(
+            [sys.executable, "-c", _INTERRUPTED_RUN, "rti_rig.cli", "--help"],
+            stdout=subprocess.PIPE,
+            stderr=full,
+            text=True,
+            timeout=120,
+        )
+    assert done.returncode == 130, done.stdout
