@@ -471,6 +471,12 @@ class WritableWaited(io.RawIOBase):
     def fileno(self) -> int:
         return self._fd
 
+    def isatty(self) -> bool:
+        """A terminal still: a non-blocking terminal keeps its colour and progress bar."""
+        import os
+
+        return os.isatty(self._fd)
+
     def write(self, data) -> int:  # type: ignore[no-untyped-def,override]
         import os
         import select

@@ -106,6 +106,17 @@ def test_a_descriptor_with_no_room_is_written_once_the_reader_makes_room() -> No
     reader.join(timeout=600)
     assert not reader.is_alive()
     assert got[0] == text.encode("utf-8")
+    # a non-blocking terminal is a terminal still (its colour and progress bar kept)
+    import pty
+
+    leader, follower = pty.openpty()
+    try:
+        os.set_blocking(follower, False)
+        with open(follower, "w", closefd=False) as terminal:
+            assert waiting_when_nonblocking(terminal).isatty()
+    finally:
+        os.close(leader)
+        os.close(follower)
     # and a blocking descriptor's stream is left as it is
     with open(os.devnull, "w") as blocking:
         assert waiting_when_nonblocking(blocking) is blocking
