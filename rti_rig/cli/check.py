@@ -180,6 +180,13 @@ def probe(
     from rti_rig.runtime.controller import EmergencyStop
 
     result = ProbeResult(port)  # filled by the probe: what it established, whenever a stop lands
+
+    def trying(what: str, tries: str) -> None:
+        # on stderr as it goes: a port where nothing answers takes over 20 s, which the
+        # command had spent in silence
+        err.print(f"Trying {tries or what} ({what})…", highlight=False, markup=False)
+
+    result.on_try = trying
     try:
         with stop_on_signals():
             run_probe(ProbeRequest(port), result=result)

@@ -27,6 +27,7 @@ import os
 import re
 import stat
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum, auto
 
@@ -34,6 +35,7 @@ from rti_rig.drivers.led_dome.codec_binary import BinaryCodec
 from rti_rig.drivers.led_dome.codec_default import DefaultCodec
 from rti_rig.drivers.led_dome.codec_framed import FramedCodec, FramedSpec
 from rti_rig.drivers.led_dome.dome_profiles import nab_rti_v1 as nab
+from rti_rig.drivers.led_dome.dome_profiles import rtipy
 from rti_rig.drivers.led_dome.messages import Banner
 from rti_rig.drivers.led_dome.transport import SerialTransport, TransportError
 from rti_rig.runtime.controller import EmergencyStop
@@ -152,6 +154,11 @@ class ProbeResult:
     #: Config lines the firmware's answer showed beyond ``[dome.serial]`` (a default-profile
     #: board without checksums).
     extra_lines: list[str] = field(default_factory=list)
+    #: Told each probe as it begins: its label ("listen at 9600 baud" …) and the firmwares it
+    #: is for ("the Nab sketch, nichlock, rti-rig's own"), so that a caller can say which is
+    #: being tried: a port where nothing answers takes over 20 s, and the command had said
+    #: nothing meanwhile. Not told of a stop's teardown's openings, nor of the Nab sketch's.
+    on_try: Callable[[str, str], None] | None = field(default=None, repr=False, compare=False)
 
     def config_lines(self) -> list[str]:
         if self.profile is None:
@@ -277,10 +284,21 @@ STOPPED_UNANSWERED = (
 
 
 def _exchange(
-    result: ProbeResult, what: str, baud: int, wait_s: float, send: bytes, listen_s: float
+    result: ProbeResult,
+    what: str,
+    baud: int,
+    wait_s: float,
+    send: bytes,
+    listen_s: float,
 ) -> str:
     """Open at ``baud``, wait ``wait_s`` (collecting the banner), send, listen; all text heard,
     also added to ``result.heard`` under ``what``.
+
+    Each wait and listen ends as soon as what was heard is an answer that names a firmware
+    completely (:func:`_answered`: a whole banner, a whole reply), and nothing is sent after
+    a banner that already did: every listen had run its whole window, 2.6 s after a Nab
+    banner over in 2 s. Silence, garbage at another rate or a banner still arriving is listened
+    to for the whole window, which covers the firmwares' bootloaders and banners.
 
     A probe met by silence is sent once more on the same open port (every probe is harmless
     to the firmwares known, and none resets a board when it is repeated): one reply lost on
@@ -288,6 +306,8 @@ def _exchange(
     known firmware answered, where a session's driver resends the same command. Stopped
     (:class:`EmergencyStop`) with the port open, the stop's teardown runs on it
     (:func:`_stopped_on_open_port`), then :class:`ProbeStopped` is raised."""
+    if result.on_try is not None:
+        result.on_try(what, _TRIES.get(what, ""))
     t = SerialTransport(result.port, baud)
     result.openings += 1
     held: EmergencyStop | None = None
@@ -315,14 +335,18 @@ def _exchange(
     try:
         if held is not None:
             raise held  # its teardown, below, on the port open at ``baud``
-        _listen(t, wait_s, into=heard)
-        if send:
+        _listen(t, wait_s, into=heard, done=_answered)
+        if send and not _answered(heard.decode("latin-1")):
             t.write(send)
             asked = len(heard)
-            _listen(t, listen_s, into=heard)
+
+            def replied(text: str) -> bool:
+                return _answered(text, text[asked:])
+
+            _listen(t, listen_s, into=heard, done=replied)
             if len(heard) == asked:
                 t.write(send)
-                _listen(t, listen_s, into=heard)
+                _listen(t, listen_s, into=heard, done=replied)
         text = heard.decode("latin-1")
         result.heard.append(Heard(what, baud, text))
     except EmergencyStop as exc:
@@ -455,11 +479,13 @@ def _listen(
     seconds: float,
     until: re.Pattern[str] | None = None,
     into: bytearray | None = None,
+    done: Callable[[str], bool] | None = None,
 ) -> bytes:
     """All ``t`` sends for ``seconds``, or until what it sent matches ``until`` (an
     acknowledgement: no use listening on, and a stop would only find the probe still
     listening). ``until`` is matched against ``into`` when it is given (the caller's whole
-    text: a ready line that a stop cut in two is still seen), else against this listen's bytes.
+    text: a ready line that a stop cut in two is still seen), else against this listen's bytes;
+    ``done`` is asked of the same text, and ends the listen when it says True.
 
     Each read is also appended to ``into`` as it comes, so that a caller stopped inside the
     listen (:class:`EmergencyStop` raised from a read) still has what was heard: returned only
@@ -471,8 +497,12 @@ def _listen(
         out += data
         if into is not None:
             into += data
-        seen = out if into is None else into
-        if until is not None and until.search(seen.decode("latin-1")):
+        if until is None and done is None:
+            continue
+        seen = (out if into is None else into).decode("latin-1")
+        if until is not None and until.search(seen):
+            break
+        if done is not None and done(seen):
             break
     return bytes(out)
 
@@ -722,6 +752,42 @@ _OWN_UNHEARD = {
 }
 
 
+#: The last words of nichlock's boot, each of which nothing more of it follows until a key
+#: comes: its prompt, and its touch-screen calibration (which holds the boot in it).
+_NICHLOCK_BOOT_ENDS = ("For help, press 'h'", "Starting Calibration")
+
+#: How long RTIPy's board takes to boot, by its profile: the wait before ``T,0,0,0``. Its
+#: sketch prints nothing at boot, so the rest of a probe's 2.6 s (the bootloader and a banner)
+#: was waited for nothing; a slower board's banner (the Nab sketch's, up to the 4 s its
+#: profile allows) is still heard by the listens after the sends, 5.6 s from the opening.
+_RTIPY_BOOT_S = float(rtipy.SPEC["boot_wait_s"])
+
+#: RTIPy's whole answer to the probe's ``T,0,0,0`` (printed with no line ending).
+_RTIPY_SAYS = "I received: T,0,0,0 the instructionByte was: T"
+
+
+def _answered(text: str, reply: str | None = None) -> bool:
+    """``text`` (all a probe heard since the port opened; ``reply``, its part since the probe's
+    bytes were sent, if they were) holds an answer that names a firmware completely, so that
+    listening on can change nothing the probe decides: the Nab sketch's banner to its last
+    line (``ready_pattern``) or its whole answer to an unknown code, nichlock's banner to its
+    prompt or its calibration (whose note depends on which comes), a whole line of nichlock's
+    answer to a key, the Elexol board's ``USB I/O 24R1``, minirti's acknowledgement (the one
+    byte ``0x01``, all the reply), RTIPy's whole answer, or a whole boot banner of rti-rig's own
+    protocols. Anything else (silence, bytes at another rate, a banner still arriving) is no
+    answer yet: the listen runs on to its end."""
+    if _NAB_READY.search(text) or _NAB_UNKNOWN_CODE.search(text):
+        return True
+    if "Reflectance Transformation Imager Serial Interface" in text:
+        return any(words in text for words in _NICHLOCK_BOOT_ENDS)
+    lines = text.split("\n")[:-1]  # the lines that ended
+    if any(words in line for line in lines for words in _NICHLOCK_SAYS):
+        return True
+    if _ELEXOL_SAYS in text or _RTIPY_SAYS in text or reply == "\x01":
+        return True
+    return _own_protocol(text) is not None
+
+
 def _own_protocol(text: str) -> str | None:
     """The first boot banner of one of rti-rig's own protocols in ``text``, or None."""
     found = [(m.start(), m.group()) for _, pattern in _OWN_BANNERS if (m := pattern.search(text))]
@@ -826,6 +892,21 @@ def _heard_another_firmware(result: ProbeResult) -> bool:
     return any(_another_firmware_found(result, heard.text, heard.baud) for heard in result.heard)
 
 
+#: The firmwares each probe is for, as :attr:`ProbeResult.on_try` is told them (said only).
+#: Keyed by each probe's label (the label is not passed along: tests stand in for
+#: :func:`_exchange` with its positional arguments).
+_TRIES: dict[str, str] = {
+    "listen at 9600 baud": "the Nab sketch (RTI v1.0), nichlock, rti-rig's own protocols",
+    "listen at 115200 baud": "nichlock, rti-rig's own protocols",
+    **{f"listen at {rate} baud": "nichlock" for rate in (19200, 2400)},
+    "'?' at 38400 baud": "Elexol 24R1",
+    "'m' (free RAM) at 115200 baud": "nichlock",
+    "'<9>' (an unknown code) at 9600 baud": "the Nab sketch (RTI v1.0)",
+    "0x42 + empty mask at 9600 baud": "minirti",
+    "'T,0,0,0' at 9600 baud": "RTIPy",
+}
+
+
 def _probe(result: ProbeResult, wait: float) -> ProbeResult:
     """:func:`probe`'s sequence of probes."""
     try:
@@ -874,8 +955,10 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             result.profile, result.baudrate = "minirti", 9600
             _say_lights(result, LightsState.MASK_ACKNOWLEDGED)
             return result
-        text = _exchange(result, "'T,0,0,0' at 9600 baud", 9600, wait, b"T,0,0,0", 1.8)
-        if "I received: T,0,0,0 the instructionByte was: T" in text:
+        text = _exchange(
+            result, "'T,0,0,0' at 9600 baud", 9600, min(wait, _RTIPY_BOOT_S), b"T,0,0,0", 1.8
+        )
+        if _RTIPY_SAYS in text:
             result.profile, result.baudrate = "rtipy", 9600
             _say_lights(result, LightsState.ZERO_SECONDS)
             return result
