@@ -384,13 +384,19 @@ class ImageCheck:
 LESS_EXPOSURE = "reshoot with less exposure"
 #: What the all-black check tells a session that can reshoot to do.
 BLACK_ADVICE = "mend that, then reshoot"
+#: What a move part-way through (:data:`MOVED_FROM`, and an image that may have moved) tells a
+#: session to do. It ends its problem, and what follows it there (the alternatives, where to
+#: reshoot from) is its own: :meth:`QAReport.with_advice` replaces it with all that follows.
+#: Why in :data:`REDO_ADVICE`: an imported acquisition moved part-way had been told "reshoot the
+#: whole session", of an object no longer under any dome.
+MOVED_ADVICE = "reshoot the whole session"
 #: Every per-image what-to-do that asks for a new capture. A session that cannot follow them
 #: (an imported acquisition, a replay, an adaptive session) has each replaced by its own words
 #: through :meth:`QAReport.with_advice`, one table per kind of session that must cover every
 #: phrase here. Why one list: "reshoot with less exposure" alone had been replaced, so an
 #: imported acquisition was still told of a flat frame "reshoot it" and of images that never
 #: changed "then reshoot", advice for an object no longer under any dome.
-REDO_ADVICE = (LESS_EXPOSURE, FLAT_ADVICE, UNCHANGING_ADVICE, BLACK_ADVICE)
+REDO_ADVICE = (LESS_EXPOSURE, FLAT_ADVICE, UNCHANGING_ADVICE, BLACK_ADVICE, MOVED_ADVICE)
 
 
 @dataclass(frozen=True)
@@ -656,10 +662,14 @@ class QAReport:
 
 
 def _readvised(problem: str, name: str, advice: Callable[[str, str], str]) -> str:
-    """``problem`` with each :data:`REDO_ADVICE` phrase in it said as ``advice`` has it."""
+    """``problem`` with each :data:`REDO_ADVICE` phrase in it said as ``advice`` has it
+    (:data:`MOVED_ADVICE` with the rest of the problem after it: its alternatives)."""
     for phrase in REDO_ADVICE:
         if phrase in problem:
-            problem = problem.replace(phrase, advice(name, phrase))
+            if phrase == MOVED_ADVICE:
+                problem = problem[: problem.index(phrase)] + advice(name, phrase)
+            else:
+                problem = problem.replace(phrase, advice(name, phrase))
     return problem
 
 
@@ -1116,7 +1126,7 @@ def _may_have_moved(step: Step, names: Sequence[str]) -> str:
     return (
         f"may have moved: the object or camera moved between {lo} and {hi}, and the edges "
         "cannot tell whether before or after this image (the fit explains this object too "
-        "poorly to tell); reshoot the whole session"
+        f"poorly to tell); {MOVED_ADVICE}"
     )
 
 
@@ -1763,7 +1773,7 @@ def assess(
             )
             problems.append(
                 f"{MOVED_FROM} {first} on{unsure}: shifted ({dx:+.1f}, {dy:+.1f}) px "
-                "against the images before it; reshoot the whole session (reshooting from "
+                f"against the images before it; {MOVED_ADVICE} (reshooting from "
                 f"{first} on keeps two positions unless the object is put back exactly), or "
                 "align those images to the earlier ones before fitting"
             )

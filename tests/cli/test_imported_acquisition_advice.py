@@ -16,7 +16,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from conftest import qa_of
+from conftest import moved_session_copy, qa_of
 
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
@@ -41,19 +41,24 @@ def shot(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return session
 
 
-@pytest.fixture(scope="module")
-def imported(shot: Path) -> Path:
-    """The same images as an archive acquisition: JPEGs and a dirs.lp, nothing else."""
-    acq = shot.parent / "acquisition"
+def as_imported(session: Path, acq: Path) -> Path:
+    """A session's images as an archive acquisition in ``acq``: JPEGs and a dirs.lp, nothing
+    else (its ``dirs.lp``)."""
     acq.mkdir()
     entries = []
-    for k, e in enumerate(read_lp(shot / "lights.lp")):
-        px = read_linear_tiff(shot / "linear" / f"{Path(e.name).stem}.tif") / 65535.0
+    for k, e in enumerate(read_lp(session / "lights.lp")):
+        px = read_linear_tiff(session / "linear" / f"{Path(e.name).stem}.tif") / 65535.0
         name = f"image{k + 1:02d}.jpg"
         cv2.imwrite(str(acq / name), _srgb8(px), [cv2.IMWRITE_JPEG_QUALITY, 95])
         entries.append(LpEntry(name, e.direction))
     write_lp(acq / "dirs.lp", entries)
     return acq / "dirs.lp"
+
+
+@pytest.fixture(scope="module")
+def imported(shot: Path) -> Path:
+    """The same images as an archive acquisition: JPEGs and a dirs.lp, nothing else."""
+    return as_imported(shot, shot.parent / "acquisition")
 
 
 def test_an_imported_acquisition_is_told_what_it_can_do(imported: Path, tmp_path: Path) -> None:
@@ -95,3 +100,20 @@ def test_every_reshoot_advice_has_words_where_none_can_be_followed() -> None:
     assert not any("reshoot" in v for v in IMPORTED_ADVICE.values())
     for table in (REPLAYED_ADVICE, ADAPTIVE_ADVICE):  # their clipped image's words name more
         assert set(table) | {LESS_EXPOSURE} == set(REDO_ADVICE)
+
+
+def test_an_imported_acquisition_moved_part_way_is_not_told_to_reshoot(
+    dome_relief: Path, tmp_path: Path
+) -> None:
+    """A move part-way through, found in an imported acquisition, is named as the
+    acquisition's with what can be done about it (it had been told "reshoot the whole
+    session"); a session of this rig moved the same way keeps that advice
+    (test_qa_move_part_way)."""
+    moved = moved_session_copy(dome_relief, tmp_path / "moved", 25, 1, 2)
+    text, qa = qa_of(as_imported(moved, tmp_path / "acquisition"), tmp_path / "fit")
+    assert "QA verdict: flawed: image25 ... image48 (24 images: object or camera moved" in text
+    assert "reshoot the whole session" not in text and "reshooting from" not in text, text
+    assert "align the images from the move on to the earlier ones" in text, text
+    assert qa["reshoot"] == [f"image{i:02d}" for i in range(25, 49)], qa["verdict"]
+    for c in qa["images"]:
+        assert not any("reshoot" in p for p in c["problems"]), c["problems"]

@@ -25,6 +25,7 @@ from rti_rig.reconstruct.qa import (
     BLACK_ADVICE,
     FLAT_ADVICE,
     LESS_EXPOSURE,
+    MOVED_ADVICE,
     UNCHANGING_ADVICE,
     QAReport,
 )
@@ -302,12 +303,20 @@ REPLAYED_ADVICE = {
     FLAT_ADVICE: "so it was recorded (a replayed acquisition cannot be reshot)",
     UNCHANGING_ADVICE: "so they were recorded (a replayed acquisition cannot be reshot)",
     BLACK_ADVICE: "so they were recorded (a replayed acquisition cannot be reshot)",
+    MOVED_ADVICE: (
+        "so it was recorded (a replayed acquisition cannot be reshot): align the images from "
+        "the move on to the earlier ones before fitting, or fit one position's images alone"
+    ),
 }
 #: What an adaptive session is told in their place (it can start again, not reshoot one image).
 ADAPTIVE_ADVICE = {
     FLAT_ADVICE: "a new session replaces it (an adaptive session cannot reshoot one image)",
     UNCHANGING_ADVICE: "check that each light fires, then start a new session",
     BLACK_ADVICE: "mend that, then start a new session",
+    MOVED_ADVICE: (
+        "start a new session (an adaptive session cannot reshoot part of one), or align the "
+        "images from the move on to the earlier ones before fitting"
+    ),
 }
 
 
@@ -320,6 +329,12 @@ IMPORTED_ADVICE = {
     FLAT_ADVICE: "so it is in the acquisition",
     UNCHANGING_ADVICE: "so they are in the acquisition: no fit of them can be trusted",
     BLACK_ADVICE: "so they are in the acquisition: there is nothing to fit",
+    # a move part-way through: the acquisition holds two positions of the object, which no
+    # reshoot here mends (it had been told "reshoot the whole session")
+    MOVED_ADVICE: (
+        "so it is in the acquisition: align the images from the move on to the earlier ones "
+        "before fitting, or leave one position's images out of the .lp"
+    ),
 }
 
 
