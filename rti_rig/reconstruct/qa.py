@@ -88,6 +88,7 @@ from rti_rig.reconstruct.qa_exposure import (
 from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
 from rti_rig.reconstruct.qa_unchanging import (
     FLAT_ADVICE,
+    FLAT_FRAME,
     UNCHANGING,
     UNCHANGING_ADVICE,
     flat_images,
@@ -459,6 +460,11 @@ class QAReport:
     #: From how many degrees above the object's mean surface a light that reaches it only at
     #: n . l < 0.2 has its black frame told (:func:`qa_surface.faint_black_frame`).
     faint_floor_deg: float = 0.0
+    #: The images under neighbouring recorded lights do not look alike
+    #: (:data:`LIKENESS_UNORDERED`): most recorded lights are likely wrong, so the verdict leads
+    #: with that (:data:`UNORDERED_SAID`) and does not name images one by one for what only a
+    #: right light could tell (:func:`lights_independent`).
+    lights_likely_wrong: bool = False
 
     @property
     def caveats(self) -> list[str]:
@@ -558,7 +564,20 @@ class QAReport:
 
     @property
     def good(self) -> bool:
-        return not self.reshoot and not self.lost_unfitted
+        return not self.reshoot and not self.lost_unfitted and not self.lights_likely_wrong
+
+    @property
+    def named(self) -> list[ImageCheck]:
+        """The images the verdict names: :attr:`reshoot`, or where the lights are likely
+        wrong only those with a problem their lights cannot have caused, with those problems
+        alone (:func:`lights_independent`)."""
+        if not self.lights_likely_wrong:
+            return self.reshoot
+        kept = (
+            replace(c, problems=tuple(p for p in c.problems if lights_independent(p)))
+            for c in self.reshoot
+        )
+        return [c for c in kept if c.problems]
 
     @property
     def verdict(self) -> str:
@@ -566,6 +585,35 @@ class QAReport:
         tail = "".join(f"; {c}" for c in self.caveats)
         # an image lost and not fitted is named with the others, its what-to-do in the caveats
         lost = [f"{n} (lost since capture, not fitted)" for n in self.lost_unfitted]
+        if self.lights_likely_wrong:
+            # said first, and once: a wrong .lp makes every check against the lights (wrong
+            # light, brighter, dimmer, moved) point at images one by one; the shuffled .lp of
+            # a matte sphere led with "reshoot: image_012 (...)" before the likely cause
+            tail = "".join(f"; {c}" for c in self.caveats if c != UNORDERED_SAID)
+            for said in (f", and {UNORDERED_SAID}", f"; but {UNORDERED_SAID}"):
+                tail = tail.replace(said, "")
+            head = f"lights likely wrong: {UNORDERED_SAID}"
+            named = self.named
+            held = len(self.reshoot) - sum(
+                1 for c in self.reshoot if all(lights_independent(p) for p in c.problems)
+            )
+            if held:
+                who = (
+                    f"{held} images disagree with their recorded lights"
+                    if held > 1
+                    else "1 image disagrees with its recorded light"
+                )
+                head += (
+                    f"; {who} "
+                    "(wrong light, brightness, shift against a fit of those "
+                    "lights): not named one by one, since wrong lights alone explain that"
+                )
+            if named or self.lost_unfitted:
+                lost = [f"{n} (lost since capture, not fitted)" for n in self.lost_unfitted]
+                whatever = [f"{c.name} ({'; '.join(c.problems)})" for c in named]
+                head += f"; {self.verdict_word} whatever the lights: " + ", ".join(whatever + lost)
+            light = f"; {self.light_note}" if self.light_note else ""
+            return head + light + tail
         if self.good:
             head = (
                 f"no image to {self.verdict_word}, but {self.light_note}"
@@ -641,7 +689,8 @@ class QAReport:
         return {
             "verdict": self.verdict,
             "good": self.good,
-            "reshoot": [c.name for c in self.reshoot] + list(self.lost_unfitted),
+            "reshoot": [c.name for c in self.named] + list(self.lost_unfitted),
+            "lights_likely_wrong": self.lights_likely_wrong,
             "session_complete": self.session_complete,
             "expected_normal_error_deg": self.expected_normal_error_deg,
             "noise_sigma": self.noise_sigma,
@@ -659,6 +708,14 @@ class QAReport:
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
+
+
+def lights_independent(problem: str) -> bool:
+    """Whether an image's problem stands whatever its recorded light (clipped, a flat frame,
+    images that do not change, black throughout), where the others (wrong light, brighter or
+    dimmer than predicted, exposure against its elevation, moved) are found against a fit of
+    the recorded lights and follow from a wrong ``.lp`` alone."""
+    return problem.startswith(("saturated", FLAT_FRAME, UNCHANGING, BLACK_THROUGHOUT))
 
 
 def _readvised(problem: str, name: str, advice: Callable[[str, str], str]) -> str:
@@ -1867,6 +1924,7 @@ def assess(
         surface_margin_deg=ev.surface_margin_deg,
         faint_floor_deg=ev.faint_floor_deg,
         crop=(rs.start, cs.start, rs.stop - rs.start, cs.stop - cs.start),
+        lights_likely_wrong=bool(ev.likeness >= LIKENESS_UNORDERED),
     )
 
 
@@ -1979,6 +2037,8 @@ class _Evidence:
     faint: NDArray = field(default_factory=lambda: np.zeros(0, bool))
     #: From how many degrees above the mean surface a faint light's black frame is told.
     faint_floor_deg: float = GRAZING_DIM_MIN_DEG
+    #: :func:`~rti_rig.reconstruct.qa_directions.neighbour_likeness` (NaN where not measured).
+    likeness: float = float("nan")
 
 
 def _evidence(
@@ -2385,6 +2445,7 @@ def _evidence(
         margin,
         faint,
         faint_floor,
+        likeness,
     )
 
 
