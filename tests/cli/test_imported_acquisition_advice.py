@@ -117,3 +117,38 @@ def test_an_imported_acquisition_moved_part_way_is_not_told_to_reshoot(
     assert qa["reshoot"] == [f"image{i:02d}" for i in range(25, 49)], qa["verdict"]
     for c in qa["images"]:
         assert not any("reshoot" in p for p in c["problems"]), c["problems"]
+
+
+def _record_lost(shot: Path, dst: Path) -> Path:
+    """``shot`` as a session folder is left when its manifest, journal and linear/ are lost:
+    its JPEGs (made from the linear TIFFs, as a run writes them) and its lights.lp."""
+    shutil.copytree(shot, dst)
+    for e in read_lp(dst / "lights.lp"):
+        px = read_linear_tiff(dst / "linear" / f"{Path(e.name).stem}.tif") / 65535.0
+        cv2.imwrite(str(dst / e.name), _srgb8(px), [cv2.IMWRITE_JPEG_QUALITY, 95])
+    shutil.rmtree(dst / "linear")
+    return dst
+
+
+def test_a_session_that_lost_its_record_is_not_called_imported(shot: Path, tmp_path: Path) -> None:
+    """Manifest, journal and linear/ lost, lights.lp and rti-rig's image names left: said to be
+    a session whose record is missing (it had been "an imported acquisition", its clipped
+    image "clipped in the acquisition"), with the advice to reshoot, as the object may still be
+    under the dome."""
+    text, _ = qa_of(_record_lost(shot, tmp_path / "s"), tmp_path / "fit")
+    assert "QA verdict: reshoot: image_005 (saturated" in text, text
+    assert "reshoot with less exposure" in text
+    assert "an imported acquisition" not in text, text
+    assert "the session record is missing" in text, text
+    assert "lights.lp lists image_001.jpg … image_036.jpg" in text, text
+
+
+def test_a_records_folder_left_is_a_trace_too(imported: Path, tmp_path: Path) -> None:
+    """Images renamed, yet the step records rti-rig keeps beside them still there."""
+    acq = tmp_path / "acquisition"
+    shutil.copytree(imported.parent, acq)
+    (acq / "records").mkdir()
+    (acq / "records" / "image_001.json").write_text("{}", encoding="utf-8")
+    text, _ = qa_of(acq / imported.name, tmp_path / "fit")
+    assert "the session record is missing" in text and "a records/ folder" in text, text
+    assert "an imported acquisition" not in text, text

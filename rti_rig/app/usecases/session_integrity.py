@@ -34,7 +34,10 @@ from rti_rig.runtime.session import (
     LINEAR_DIR,
     LP_NAME,
     MANIFEST,
+    RAW_DIR,
+    RECORDS_DIR,
     RUN_ENDED,
+    STRAY_DIR,
     files_lost_since_capture,
     image_names,
     journal_mend_note,
@@ -83,8 +86,10 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         manifest = None
     if manifest is None and not any((source / n).exists() for n in (MANIFEST, JOURNAL, LINEAR_DIR)):
         # no session record, nor a session's layout (a session that lost its manifest is
-        # still rti-rig's, and may be reshot): an acquisition rti-rig did not shoot here
-        qa = _with_imported(qa)
+        # still rti-rig's, and may be reshot): an acquisition rti-rig did not shoot here,
+        # unless what rti-rig writes beside them is still there
+        traces = session_traces(source, lp)
+        qa = _with_record_missing(qa, traces) if traces else _with_imported(qa)
     if manifest is not None:
         qa = _with_relabelled(qa, lp, source, manifest)
     if manifest is not None:
@@ -354,6 +359,53 @@ def _with_imported(qa: QAReport) -> QAReport:
     )
     qa = qa.with_advice(lambda _name, phrase: IMPORTED_ADVICE[phrase])
     return replace(_noted(qa, note), verdict_word="flawed")
+
+
+def session_traces(source: Path, lp: Path) -> list[str]:
+    """What in folder ``source`` (fitted by ``lp``) rti-rig writes into a session, where its
+    record (manifest, journal, linear TIFFs) is gone; [] where nothing is.
+
+    Why: such a folder was called "an imported acquisition (an .lp with no rti-rig session
+    record beside it)", its images "kept as they are", where it is a session of this rig whose
+    record was lost: the object may still be under the dome, and what was lost is what
+    vouches for the images. rti-rig writes no comment into ``lights.lp`` nor any tag into its
+    JPEGs (:func:`~rti_rig.core.lp_format.format_lp`,
+    :func:`~rti_rig.core.image_files.write_srgb_jpeg`): its traces are the names it gives and
+    the folders it keeps beside them."""
+    found = []
+    if lp.name == LP_NAME:
+        try:
+            names = [e.name for e in read_lp(lp)]
+        except (RtiRigError, OSError):
+            names = []
+        if names and names == [f"{n}.jpg" for n in image_names(len(names))]:
+            found.append(
+                f"{LP_NAME} lists {names[0]}{f' … {names[-1]}' if len(names) > 1 else ''}, "
+                "rti-rig's names for a session's images"
+            )
+    for folder, what in (
+        (RECORDS_DIR, "step records"),
+        (RAW_DIR, "RAW originals"),
+        (STRAY_DIR, "a camera's stray pictures"),
+        ("recovered", "files set aside on resume"),
+    ):
+        if (source / folder).is_dir():
+            found.append(f"a {folder}/ folder ({what})")
+    return found
+
+
+def _with_record_missing(qa: QAReport, traces: list[str]) -> QAReport:
+    """``qa`` with a note that the folder is a session of this rig whose record is lost
+    (:func:`session_traces`); its advice (reshoot) stands, since the object may still be under
+    the dome."""
+    note = (
+        f"the session record is missing: this folder holds what rti-rig writes into a session "
+        f"({'; '.join(traces)}) but not its {MANIFEST}, {JOURNAL} or {LINEAR_DIR}/ (deleted, "
+        "or not copied with it?): the fit read its 8-bit JPEGs, not the linear TIFFs, and no "
+        "image could be checked against its capture; restore the session folder from a backup "
+        "if there is one and fit it again"
+    )
+    return _noted(qa, note)
 
 
 def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
