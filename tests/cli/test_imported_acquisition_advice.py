@@ -16,7 +16,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from conftest import moved_session_copy, qa_of
+from conftest import qa_of
 
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
@@ -102,19 +102,17 @@ def test_every_reshoot_advice_has_words_where_none_can_be_followed() -> None:
         assert set(table) | {LESS_EXPOSURE} == set(REDO_ADVICE)
 
 
-def test_an_imported_acquisition_moved_part_way_is_not_told_to_reshoot(
-    dome_relief: Path, tmp_path: Path
-) -> None:
+def test_an_imported_acquisition_moved_part_way_is_not_told_to_reshoot(tmp_path: Path) -> None:
     """A move part-way through, found in an imported acquisition, is named as the
     acquisition's with what can be done about it (it had been told "reshoot the whole
     session"); a session of this rig moved the same way keeps that advice
     (test_qa_move_part_way)."""
-    moved = moved_session_copy(dome_relief, tmp_path / "moved", 25, 1, 2)
+    moved, _, _ = make_session(tmp_path / "moved", size=(96, 112), move=(18, 2, 1))
     text, qa = qa_of(as_imported(moved, tmp_path / "acquisition"), tmp_path / "fit")
-    assert "QA verdict: flawed: image25 ... image48 (24 images: object or camera moved" in text
+    assert "QA verdict: flawed: image19 ... image36 (18 images: object or camera moved" in text
     assert "reshoot the whole session" not in text and "reshooting from" not in text, text
     assert "align the images from the move on to the earlier ones" in text, text
-    assert qa["reshoot"] == [f"image{i:02d}" for i in range(25, 49)], qa["verdict"]
+    assert qa["reshoot"] == [f"image{i:02d}" for i in range(19, 37)], qa["verdict"]
     for c in qa["images"]:
         assert not any("reshoot" in p for p in c["problems"]), c["problems"]
 
