@@ -55,6 +55,7 @@ from rti_rig.reconstruct.qa_bands import median_by_rows, row_bands
 from rti_rig.reconstruct.qa_directions import (
     MISFIT_LIMIT,
     consensus_images,
+    mirror_ratio,
     neighbour_likeness,
     recorded_misfit,
     relative_misfit,
@@ -158,6 +159,21 @@ CLIPPED_DIRECTION_LIMIT = 0.5
 #: shuffled reads 0.40-0.55).
 LIKENESS_ORDERED = 0.1
 LIKENESS_UNORDERED = 0.3
+#: The recorded lights are said to be mirrored where the fitted surface's curl as recorded is
+#: at least this many times its curl with one light axis flipped
+#: (:func:`~rti_rig.reconstruct.qa_directions.mirror_ratio` at most its inverse). Measured
+#: (96×112 px, 36 lights; sphere 64 px, 24): right lights read 16-92 on the matte sphere,
+#: tablet, tilted plane and varnished painting, 2.0-2.4 on the glossy coin and brushed steel,
+#: 1.0 on the flat plate and on NeuralRTI's gilded icon (18 real images); x or y flipped read
+#: 0.01-0.06 on the first four, 0.42-0.50 on the coin and steel (not told), 1.0 on the last two.
+MIRROR_RATIO = 5.0
+#: Said where the recorded lights look mirrored (:data:`MIRROR_RATIO`).
+MIRRORED_SAID = (
+    "the recorded lights look mirrored: the fitted surface holds together only with the x or "
+    "the y of every light flipped (a .lp made for images whose y points down?): flip the y "
+    "(or the x) of every light in the .lp and fit again; the images cannot tell which of the "
+    "two (flipping both turns the surface inside out)"
+)
 #: Said where the images do not follow their recorded lights' order.
 UNORDERED_SAID = (
     "images under neighbouring recorded lights do not look alike (as they do wherever the "
@@ -465,6 +481,11 @@ class QAReport:
     #: with that (:data:`UNORDERED_SAID`) and does not name images one by one for what only a
     #: right light could tell (:func:`lights_independent`).
     lights_likely_wrong: bool = False
+    #: The fitted surface holds together only with the recorded lights mirrored
+    #: (:data:`MIRROR_RATIO`): said first in the verdict (:data:`MIRRORED_SAID`), never good.
+    lights_mirrored: bool = False
+    #: :func:`~rti_rig.reconstruct.qa_directions.mirror_ratio` of the fit (NaN: not measured).
+    mirror_ratio: float = float("nan")
 
     @property
     def caveats(self) -> list[str]:
@@ -564,7 +585,12 @@ class QAReport:
 
     @property
     def good(self) -> bool:
-        return not self.reshoot and not self.lost_unfitted and not self.lights_likely_wrong
+        return (
+            not self.reshoot
+            and not self.lost_unfitted
+            and not self.lights_likely_wrong
+            and not self.lights_mirrored
+        )
 
     @property
     def named(self) -> list[ImageCheck]:
@@ -614,6 +640,10 @@ class QAReport:
                 head += f"; {self.verdict_word} whatever the lights: " + ", ".join(whatever + lost)
             light = f"; {self.light_note}" if self.light_note else ""
             return head + light + tail
+        if self.lights_mirrored and not self.reshoot and not self.lost_unfitted:
+            # every image agrees with the fit: the mirror is the one finding, said first
+            light = f"; {self.light_note}" if self.light_note else ""
+            return MIRRORED_SAID + light + tail
         if self.good:
             head = (
                 f"no image to {self.verdict_word}, but {self.light_note}"
@@ -643,7 +673,8 @@ class QAReport:
             if rest:
                 parts.append(f"{c.name} ({'; '.join(rest)})")
         light = f"; {self.light_note}" if self.light_note else ""
-        return f"{self.verdict_word}: " + ", ".join(parts + lost) + light + tail
+        mirrored = f"{MIRRORED_SAID}; " if self.lights_mirrored else ""
+        return mirrored + f"{self.verdict_word}: " + ", ".join(parts + lost) + light + tail
 
     def bright_within_light_scatter(self) -> list[ImageCheck]:
         """The images called brighter than predicted whose light's own output can explain it
@@ -691,6 +722,8 @@ class QAReport:
             "good": self.good,
             "reshoot": [c.name for c in self.named] + list(self.lost_unfitted),
             "lights_likely_wrong": self.lights_likely_wrong,
+            "lights_mirrored": self.lights_mirrored,
+            "mirror_ratio": self.mirror_ratio,
             "session_complete": self.session_complete,
             "expected_normal_error_deg": self.expected_normal_error_deg,
             "noise_sigma": self.noise_sigma,
@@ -1903,7 +1936,9 @@ def assess(
         "exposure_off": EXPOSURE_OFF,
         "exposure_scatter_z": EXPOSURE_SCATTER_Z,
         "exposure_mate_deg": EXPOSURE_MATE_DEG,
+        "mirror_ratio": MIRROR_RATIO,
     }
+    mirrored = mirror_ratio(ps.normals, ps.valid)
     return QAReport(
         tuple(checks),
         coverage,
@@ -1925,6 +1960,11 @@ def assess(
         faint_floor_deg=ev.faint_floor_deg,
         crop=(rs.start, cs.start, rs.stop - rs.start, cs.stop - cs.start),
         lights_likely_wrong=bool(ev.likeness >= LIKENESS_UNORDERED),
+        # where the lights are likely wrong altogether, that is said, not a mirror of them
+        lights_mirrored=bool(
+            not ev.likeness >= LIKENESS_UNORDERED and mirrored <= 1.0 / MIRROR_RATIO
+        ),
+        mirror_ratio=mirrored,
     )
 
 
@@ -2238,7 +2278,12 @@ def _evidence(
     # whether the images follow their recorded lights' order, told with no fit: measured once
     # and said whichever branch below the verdict takes (a shuffled .lp of a matte sphere, seed
     # 1 of 3, went down the judged branch and was said as images "brighter" and "moved" alone)
-    likeness = neighbour_likeness(crop_arr, lt)
+    # (not on a near-flat object: its images differ by their level alone, so which look alike
+    # is noise; the simulated flat plate, every light right, read 0.53-0.60 and was told its
+    # lights were likely wrong)
+    likeness = (
+        neighbour_likeness(crop_arr, lt) if spread_deg >= MIN_NORMAL_SPREAD_DEG else float("nan")
+    )
     if spread_deg < MIN_NORMAL_SPREAD_DEG:
         note = (
             f"light directions not checked: the fitted normals spread only {spread_deg:.1f}° "

@@ -253,3 +253,40 @@ def neighbour_likeness(stack: NDArray, lights: NDArray) -> float:
     mate = np.argmax(near, axis=1)
     above = np.sum(like > like[np.arange(n), mate][:, None], axis=1)
     return float(np.median(above) / (n - 2))
+
+
+def mirror_ratio(normals: NDArray, valid: NDArray[np.bool_]) -> float:
+    """How much better the fitted surface holds together with its lights mirrored than as
+    recorded: the summed curl of its gradient field, over the summed curl of that field with
+    one component negated (pure; smoothed over 1.5 px, on pixels whose normal is at least 0.2
+    towards the camera). Above 1 the recorded frame is right; far below 1 the lights are
+    mirrored in x or in y; about 1 where the surface tells nothing (a flat plate, a surface
+    without cross-slopes, a fit that cannot place the lights).
+
+    Why: a mirrored ``.lp`` (x flipped, or y flipped between tools with y-down and y-up image
+    conventions) keeps every angle between the lights, so the likeness of neighbouring lights'
+    images (:func:`neighbour_likeness`) cannot see it, and the fit explains every image as well
+    as with the right lights (its normals mirrored with them), so no image points away from its
+    light. But the mirrored normals are those of no surface: their gradient field has a curl.
+    Flipping x and flipping y give the same curl (flipping both is the surface turned inside
+    out, as integrable as the right one), so which of the two is not told."""
+    n = np.asarray(normals, dtype=np.float64)
+    nz = n[..., 2]
+    ok = np.asarray(valid, bool) & (nz > 0.2)
+    if ok.sum() < 100:
+        return float("nan")
+    import cv2  # on use, as the QA's other OpenCV calls
+
+    safe = np.maximum(nz, 1e-6)
+    along_cols = cv2.GaussianBlur(np.where(ok, -n[..., 0] / safe, 0.0), (0, 0), 1.5)  # dz/dcol
+    along_rows = cv2.GaussianBlur(np.where(ok, n[..., 1] / safe, 0.0), (0, 0), 1.5)  # dz/drow
+    a = np.gradient(along_cols, axis=0)
+    b = np.gradient(along_rows, axis=1)
+    inner = cv2.erode(ok.astype(np.uint8), np.ones((7, 7), np.uint8)).astype(bool)
+    if inner.sum() < 100:
+        return float("nan")
+    as_recorded = float(np.abs(a - b)[inner].sum())
+    mirrored = float(np.abs(a + b)[inner].sum())
+    if as_recorded == 0.0 and mirrored == 0.0:
+        return float("nan")
+    return mirrored / max(as_recorded, 1e-300)

@@ -17,7 +17,7 @@ import numpy as np
 from conftest import qa_of
 
 from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
-from rti_rig.reconstruct.qa import UNORDERED_SAID
+from rti_rig.reconstruct.qa import MIRRORED_SAID, UNORDERED_SAID
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from fit_sessions import make_session
@@ -44,3 +44,25 @@ def test_a_shuffled_lp_is_said_first_and_its_images_not_blamed(tmp_path: Path) -
     assert "image_" not in head, verdict  # no image blamed before it (caveats may name some)
     assert qa["lights_likely_wrong"] is True and qa["good"] is False
     assert qa["reshoot"] == ["image_005"], qa["reshoot"]
+
+
+def test_a_y_flipped_lp_is_said_to_be_mirrored(tmp_path: Path) -> None:
+    """An .lp whose y is flipped (a tool with y-down image axes) keeps every angle between the
+    lights: the fit explained every image and the verdict was "good". The fitted surface, whose
+    gradient then curls, tells it."""
+    session, _, _ = make_session(tmp_path / "s", size=(64, 80))
+    entries = read_lp(session / "lights.lp")
+    flipped = [LpEntry(e.name, (e.direction[0], -e.direction[1], e.direction[2])) for e in entries]
+    write_lp(session / "lights.lp", flipped)
+    text, qa = qa_of(session, tmp_path / "fit")
+    assert f"QA verdict: {MIRRORED_SAID}" in text, text
+    assert qa["lights_mirrored"] is True and qa["good"] is False, qa["verdict"]
+
+
+def test_a_flat_plate_with_its_lights_right_is_not_doubted(tmp_path: Path) -> None:
+    """A flat plate's images differ by their level alone, so which look alike is noise: with
+    every light right it was told "most recorded lights are likely wrong" (likeness 0.53-0.60)."""
+    session, _, _ = make_session(tmp_path / "s", scene="flat", size=(64, 80))
+    text, qa = qa_of(session, tmp_path / "fit")
+    assert "likely wrong" not in text and "mirrored" not in text, text
+    assert qa["good"] is True, qa["verdict"]

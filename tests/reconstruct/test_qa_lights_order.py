@@ -12,7 +12,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rti_rig.reconstruct.qa import LIKENESS_ORDERED, LIKENESS_UNORDERED, assess
+from rti_rig.reconstruct.qa import (
+    LIKENESS_ORDERED,
+    LIKENESS_UNORDERED,
+    MIRROR_RATIO,
+    MIRRORED_SAID,
+    assess,
+)
 from rti_rig.reconstruct.qa_directions import neighbour_likeness
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 
@@ -57,3 +63,20 @@ def test_a_mirrored_frame_is_not_claimed_to_be_seen(sphere) -> None:  # type: ig
     frames, lights = sphere
     flipped = lights * np.array([1.0, -1.0, 1.0])
     assert neighbour_likeness(np.stack(frames), flipped) <= LIKENESS_ORDERED
+
+
+@pytest.mark.parametrize("flip", [(-1.0, 1.0, 1.0), (1.0, -1.0, 1.0)], ids=["x", "y"])
+def test_a_mirrored_lp_is_said_by_the_surface_it_fits(sphere, flip) -> None:  # type: ignore[no-untyped-def]
+    """The fit explains every image under mirrored lights (its normals mirrored with them), so
+    no direction check sees it; the mirrored normals are no surface's (their gradient curls)."""
+    frames, lights = sphere
+    qa = assess(frames, lights * np.array(flip), [f"image{k:02d}.tif" for k in range(N)])
+    assert qa.lights_mirrored and not qa.good, qa.verdict
+    assert qa.verdict.startswith(MIRRORED_SAID), qa.verdict
+    assert qa.mirror_ratio <= 1.0 / MIRROR_RATIO
+
+
+def test_the_right_lights_are_not_mirrored(sphere) -> None:  # type: ignore[no-untyped-def]
+    frames, lights = sphere
+    qa = assess(frames, lights, [f"image{k:02d}.tif" for k in range(N)])
+    assert not qa.lights_mirrored and qa.mirror_ratio >= MIRROR_RATIO, qa.mirror_ratio
