@@ -166,6 +166,10 @@ LIKENESS_UNORDERED = 0.3
 #: tablet, tilted plane and varnished painting, 2.0-2.4 on the glossy coin and brushed steel,
 #: 1.0 on the flat plate and on NeuralRTI's gilded icon (18 real images); x or y flipped read
 #: 0.01-0.06 on the first four, 0.42-0.50 on the coin and steel (not told), 1.0 on the last two.
+#: The emulated dome's sessions (256 px, 24 lights, through ``run`` and ``fit``): right lights
+#: 20-42 (painting, tablet, tilted), 6.6 steel, 5.0 coin, 1.0 flat; flipped 0.02-0.05, 0.15
+#: steel (told), 0.20 coin (not told: its right and mirrored lights lie either side of 5 by a
+#: hair), 1.0 flat.
 MIRROR_RATIO = 5.0
 #: Said where the recorded lights look mirrored (:data:`MIRROR_RATIO`).
 MIRRORED_SAID = (
