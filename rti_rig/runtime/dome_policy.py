@@ -41,7 +41,7 @@ from numpy.typing import NDArray
 from rti_rig.core.clock import Clock, VirtualClock
 from rti_rig.core.deferred_signals import after_a_stop, signals_deferred
 from rti_rig.core.device_said import first_clause, say_or_log
-from rti_rig.core.devices import DiscreteLightSource
+from rti_rig.core.devices import DiscreteLightSource, KnownStateLightSource
 from rti_rig.core.dome_link import (
     DomeInfo,
     DomeLedError,
@@ -1786,6 +1786,12 @@ class SelfTestReport:
     #: slow bootloader and the ``boot_wait_s`` to set), said in the report: it had reached
     #: stderr alone, beside a "RESULT: PASS" that a user reads as nothing to change.
     slow_boot: str | None = None
+    #: A simulated dome (its state the simulation's): no firmware to name and no command to
+    #: time. Why: ``check rig_configs/simulated_dome.toml`` said "unknown firmware, 48 LEDs"
+    #: and "light command round trip: median 0.00 ms (wall clock)", as if a board had not
+    #: been identified and had answered instantly, beside a walk timed on the simulation's
+    #: clock (the arm's check says its clock, the dome's did not).
+    simulated: bool = False
 
     @property
     def failed(self) -> list[LedCheck]:
@@ -1809,6 +1815,8 @@ class SelfTestReport:
         fw = (
             f"{self.firmware.firmware_id} {self.firmware.version}"
             if self.firmware
+            else "no firmware (a simulation)"
+            if self.simulated
             else "unknown firmware"
         )
         if self.foreign_firmware is not None:
@@ -1854,7 +1862,7 @@ class SelfTestReport:
             passed = sum(c.ok for c in self.checks)
             out.append(
                 f"LEDs stepped: {len(self.checks)}, {self._passed_as()}: {passed}"
-                + f", failed: {len(self.failed)} in {self.elapsed_s:.2f} s"
+                + f", failed: {len(self.failed)} in {self.elapsed_s:.2f} s on the rig's clock"
             )
             if self.light_confirmed and not self.senses_current and passed:
                 out.append(
@@ -1864,7 +1872,7 @@ class SelfTestReport:
                     "--no-ptm --no-hsh --no-normals`, whose QA names a dark image"
                 )
         out += [f"  LED {c.index}: {c.message}" for c in self.failed]
-        if self.light_latency_s and self.foreign_firmware is None:
+        if self.light_latency_s and self.foreign_firmware is None and not self.simulated:
             lat = np.asarray(self.light_latency_s) * 1000
             out.append(
                 f"light command round trip: median {np.median(lat):.2f} ms, "
@@ -1989,6 +1997,7 @@ def self_test(
     # a source with no link (no firmware to answer) is reported as before: its steps passed
     report.light_confirmed = True if link is None else link.light_confirmed
     report.senses_current = True if link is None else link.senses_led_current
+    report.simulated = isinstance(source, KnownStateLightSource)
     if isinstance(source, DomePolicy):
         source.lights_images = False  # an LED lost to a reboot spoils no image here
     try:
