@@ -151,6 +151,22 @@ def test_each_probe_is_announced_with_the_firmwares_it_is_for(
     assert "Trying" not in r.stdout and "No known dome firmware answered" in r.stdout
 
 
+def test_t000_is_sent_after_rtipys_own_boot_wait(monkeypatch: pytest.MonkeyPatch) -> None:
+    """RTIPy's sketch prints nothing at boot, and its own host (``rti_py.py``) writes 2 s after
+    opening the port: ``T,0,0,0`` is sent after the profile's ``boot_wait_s`` (2 s), not the
+    2.6 s other probes wait for a bootloader and a banner. On a silent port its probe is that
+    wait and two unanswered listens of 1.8 s (virtual time)."""
+    from rti_rig.drivers.led_dome.dome_profiles import rtipy
+
+    r, openings = _probe(monkeypatch, 9600, [])
+    assert r.exit_code == 1, r.output
+    (_, t000), (end, ended) = openings[-2:]
+    assert end == "end", openings
+    boot = float(rtipy.SPEC["boot_wait_s"])
+    assert boot == 2.0
+    assert ended - t000 == pytest.approx(boot + 1.8 + 1.8, abs=0.11), openings
+
+
 @pytest.mark.parametrize(
     ("text", "reply", "answered"),
     [
