@@ -11,6 +11,7 @@ stop inside the opening while the other had been left out.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from errno import EACCES
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.dome_link import DomeLinkError
@@ -112,6 +113,7 @@ class PortOpening(ABC):
             self.open_cut_short = False  # the system refused it: nothing was opened or reset
             error = self._refused(exc)
             error.port_held = isinstance(exc, PortHeldError)
+            error.permission_denied = exc.errno == EACCES
             raise error from exc
         self._open = True
         self._rx.clear()

@@ -51,6 +51,7 @@ class DomeLinkError(DeviceError):
         retryable: bool,
         code: int | None = None,
         port_held: bool = False,
+        permission_denied: bool = False,
         sent: bool = True,
         slow_boot: bool = False,
     ) -> None:
@@ -68,6 +69,10 @@ class DomeLinkError(DeviceError):
         #: The port could not be opened because another program holds its lock (another
         #: rti-rig check or run on this dome): nothing about the board is known or wrong.
         self.port_held = port_held
+        #: The port is there but this user may not open it (EACCES): its error says what to
+        #: do (join the device's group), and "check that the board is plugged in" beside it
+        #: would send the user to a cable that is plugged in.
+        self.permission_denied = permission_denied
         #: Whether the command's bytes may have been written before it failed. False when it
         #: failed before the write (a reboot banner found waiting, the port not open): an
         #: all-off that failed so was never sent, and must not be said "sent but not

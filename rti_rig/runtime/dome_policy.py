@@ -429,10 +429,17 @@ class DomePolicy:
                     exc.command,
                 ) from exc
             if exc.command == "open port":
+                # a port this user may not open is there: its error says what to do, and "check
+                # that the board is plugged in" had followed it (the arm's bus says it alone)
+                advice = (
+                    ""
+                    if exc.permission_denied
+                    else "; check that the board is plugged in and that the rig config's port "
+                    "names it"
+                )
                 raise DeviceError(
                     self.name,
-                    f"the dome's port could not be opened ({exc.message}); check that the board "
-                    "is plugged in and that the rig config's port names it",
+                    f"the dome's port could not be opened ({exc.message}){advice}",
                     exc.command,
                 ) from exc
             if exc.fault is LinkFault.FOREIGN:

@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import errno
 import grp
+import os
 import sys
 from pathlib import Path
 
 import pytest
 import serial
-from conftest import CONFIGS, said
+from conftest import CONFIGS, emulated_dome_as_hardware, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -88,3 +89,34 @@ def test_the_group_named_is_the_device_s_own(
     monkeypatch.setattr(grp, "getgrgid", lambda n: grp.struct_group(("root", "x", n, [])))
     assert "the 'dialout' group" in permission_denied_why(str(port))
     assert "the 'dialout' group" in permission_denied_why(str(tmp_path / "gone"))
+
+
+def test_a_dome_port_not_this_user_s_to_open_is_not_said_unplugged(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A user's dome config through check, and probe on a device node: the refusal's advice
+    stands alone, as the arm's does. The dome's check had gone on "check that the board is
+    plugged in", and probe "Check ... that the dome is plugged in and powered", of a port
+    that is there."""
+    port = tmp_path / "ttyACM0"
+    port.write_text("")
+    cfg = emulated_dome_as_hardware(tmp_path, "emulated_nab_rti_v1.toml", str(port))
+
+    def serial_for_url(url, *args, **kwargs):  # type: ignore[no-untyped-def]
+        raise _refused(url)
+
+    monkeypatch.setattr(serial, "serial_for_url", serial_for_url)
+    r = CliRunner().invoke(app, ["check", str(cfg)])
+    text = said(r)
+    assert r.exit_code == 1, text
+    opened = f"'open port': the dome's port could not be opened (cannot open serial port {port}: "
+    assert opened + ADVICE in text, text
+    assert ADVICE in text and RELOGIN in text, text
+    assert "plugged in" not in text and "Traceback" not in text, text
+    # a character device (no regular file, which probe says is no serial port)
+    r = CliRunner().invoke(app, ["probe", os.devnull])
+    text = said(r)
+    assert r.exit_code == 1, text
+    assert f"error: cannot open serial port {os.devnull}: {ADVICE}" in text, text
+    assert "The port is there but this user may not open it, so no firmware was asked" in text
+    assert "plugged in" not in text and "Traceback" not in text, text

@@ -151,6 +151,9 @@ class ProbeResult:
     #: What the port's path is when it is no serial port ("is a regular file" …; None: it
     #: may be one), said in place of advice to check the dome's cable and power.
     not_serial: str | None = None
+    #: The port is there but this user may not open it (EACCES): its error says what to do,
+    #: and advice to check the dome's cable and power is not given beside it.
+    permission_denied: bool = False
     #: Config lines the firmware's answer showed beyond ``[dome.serial]`` (a default-profile
     #: board without checksums).
     extra_lines: list[str] = field(default_factory=list)
@@ -207,6 +210,14 @@ class ProbeResult:
                 "The port opened but failed before any firmware answered, so no firmware was "
                 "identified. Check that the dome's cable is plugged in and that no other "
                 "program uses the port, then probe again."
+            )
+        elif not_opened and self.permission_denied:
+            # there, but not this user's: "check that the dome is plugged in" had followed the
+            # error's advice to join the device's group
+            out.append(
+                "The port is there but this user may not open it, so no firmware was asked. "
+                "Do as the error says (join the device's group, log out and in again), then "
+                "probe again."
             )
         elif not_opened:
             # the port never opened: nothing was asked, so nothing can be concluded about a
@@ -999,6 +1010,7 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             )
             # what the path is, from its opening's failure (a read's failure says nothing of it)
             result.not_serial = _not_a_serial_port(result.port, exc) if opening else None
+            result.permission_denied = opening and exc.errno == errno.EACCES
     return result
 
 
