@@ -120,15 +120,18 @@ def test_a_stop_during_the_nab_all_off_finishes_it_without_resetting_the_board()
     assert code == 130, said
     assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
     assert "acknowledged" in said and "Traceback" not in said, said
-    assert _boots(board) == 2, board.events  # the listen, then the all-off's opening: no third
+    # switched off on the port its banner was heard on: reset once (it had been reset twice, its
+    # all-off sent on a second opening, and a stop there had led to a third)
+    assert _boots(board) == 1, board.events
     assert board.lit_once_booted() == frozenset()
 
 
 def test_a_stop_then_a_port_failure_in_the_nab_all_off_is_a_stop_not_a_success() -> None:
-    """A Ctrl-C while the found Nab board boots, then the port fails as the all-off is sent (a
-    USB drop): it had ended as a probe that succeeded (exit 0, "Found: nab-rti-v1")."""
+    """A Ctrl-C while the Nab board boots, then the port fails as the all-off is sent (a USB
+    drop): it had ended as a probe that succeeded (exit 0, "Found: nab-rti-v1"), and then as
+    "the dome's state is not known" of a sketch that boots lit."""
     board = board_for("nab-rti-v1", faults=FaultPlan((Fault(1, FaultKind.DISCONNECT),)))
-    code, said = _probe(board, "nab-rti-v1", signal.SIGINT, lambda: _boots(board) >= 2)
+    code, said = _probe(board, "nab-rti-v1", signal.SIGINT, lambda: _boots(board) >= 1)
     assert code == 130, said
     assert "Probe stopped (Ctrl-C): the sketch boots with every LED on and the all-off " in said
     assert "could NOT be sent" in said and "may be fully lit" in said, said
@@ -181,24 +184,23 @@ def test_a_stop_once_the_nab_banner_was_heard_but_not_yet_named_switches_the_dom
     """A Ctrl-C after the first listen heard the Nab sketch's banner, before the probe named
     it: it said "stopped before a firmware answered" with the banner among the lines heard,
     and left the dome lit. The stop is raised where the signal lands, as the switching-off
-    begins (no timing can aim a real signal into that gap)."""
-    real_found = probe_usecase._nab_found
+    begins on the port the banner was heard on (no timing can aim a real signal into that
+    gap): the teardown switches it off on that same port, not reset again."""
     calls: list[str | None] = []
 
-    def stopped_first(result: probe_usecase.ProbeResult, wait: float) -> Any:
+    def stopped(result: probe_usecase.ProbeResult, *args: Any) -> None:
         calls.append(result.profile)
-        if len(calls) == 1:
-            raise EmergencyStop(signal.SIGINT)
-        return real_found(result, wait)
+        raise EmergencyStop(signal.SIGINT)
 
-    monkeypatch.setattr(probe_usecase, "_nab_found", stopped_first)
+    monkeypatch.setattr(probe_usecase, "_nab_off_on_open_port", stopped)
     board = board_for("nab-rti-v1")
     with serve_on_pty(board, "nab-rti-v1") as link:
         r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
     said = " ".join(r.output.split())
-    assert r.exit_code == 130, said
+    assert r.exit_code == 130 and calls == [None], said
     assert "before a firmware answered" not in said, said
     assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
+    assert _boots(board) == 1, board.events
     assert board.lit_once_booted() == frozenset()
 
 
@@ -207,7 +209,8 @@ def test_a_stop_as_the_port_closes_after_an_acknowledged_all_off_does_not_reopen
 ) -> None:
     """A Ctrl-C as the probe closes the port after the Nab board acknowledged its all-off: the
     teardown reopened the port (a reset: every LED lit again) to send the all-off once more.
-    The stop is raised where the signal lands, in the closing (too short to aim a signal)."""
+    The stop is raised where the signal lands, in the closing (too short to aim a signal).
+    Reset once: the all-off goes on the port its banner was heard on."""
     board = board_for("nab-rti-v1")
     real_close = SerialTransport.close
     stops: list[str] = []
@@ -224,7 +227,7 @@ def test_a_stop_as_the_port_closes_after_an_acknowledged_all_off_does_not_reopen
     said = " ".join(r.output.split())
     assert r.exit_code == 130 and stops, said
     assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
-    assert _boots(board) == 2, board.events
+    assert _boots(board) == 1, board.events  # its banner's port: no second
     assert board.lit_once_booted() == frozenset()
 
 
@@ -304,7 +307,7 @@ def test_a_stop_after_the_probe_returned_says_the_acknowledged_all_off(
     assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
     assert "look at the dome" not in said, said
     assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
-    assert _boots(board) == 2, board.events  # no third opening to switch it off again
+    assert _boots(board) == 1, board.events  # no second opening to switch it off again
     assert board.lit_once_booted() == frozenset()
 
 
@@ -362,9 +365,8 @@ def test_a_stop_as_the_first_port_closes_leaves_it_unlocked_for_the_all_off(
     assert board.lit_once_booted() == frozenset()
 
 
-@pytest.mark.parametrize(("opening", "boots"), [(1, 1), (2, 2)], ids=["listen", "nab-found"])
 def test_a_stop_held_over_an_opening_is_torn_down_on_the_open_port(
-    monkeypatch: pytest.MonkeyPatch, opening: int, boots: int
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """A SIGTERM as the system opens the port (the board resets), held by the transport over
     pyserial's open and raised once the port is the transport's: open and locked. The probe
@@ -373,15 +375,17 @@ def test_a_stop_held_over_an_opening_is_torn_down_on_the_open_port(
     left lit. A real signal sent as the emulator sees the port open lands there whenever the
     probe is descheduled within pyserial's open (the SIGTERM case of the first test failed so
     on a loaded machine); here the signal is raised inside that hold, every time. The stop is
-    finished on the port already open: no further opening (``boots``), the dome switched off.
-    ``opening`` 1 is the first listen's, 2 the Nab sketch's own once its banner was heard."""
+    finished on the port already open: no further opening, the dome switched off. (A second
+    case stopped the Nab sketch's own opening once its banner was heard: the sketch is now
+    switched off on the port its banner came on, and that opening is not made; its hold is
+    tested below.)"""
     real_open = serial.serial_for_url
     openings: list[str] = []
 
     def opened_then_stopped(url: str, *args: Any, **kwargs: Any) -> Any:
         port = real_open(url, *args, **kwargs)
         openings.append(url)
-        if len(openings) == opening:
+        if len(openings) == 1:
             signal.raise_signal(signal.SIGTERM)  # inside the transport's hold over the opening
         return port
 
@@ -391,9 +395,35 @@ def test_a_stop_held_over_an_opening_is_torn_down_on_the_open_port(
         r = CliRunner().invoke(app, ["probe", link.port])
     said = " ".join(r.output.split())
     assert r.exit_code == 143, said
-    assert len(openings) == boots, openings
+    assert len(openings) == 1, openings
     assert "could not be locked" not in said, said
     assert "Probe stopped (SIGTERM): the sketch boots with every LED on; all-off sent and " in said
     assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
-    assert _boots(board) == boots, board.events
+    assert _boots(board) == 1, board.events
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_held_over_the_nab_sketchs_own_opening_is_finished_on_that_port(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The sketch's own opening (a stop's teardown, or its banner heard at another rate than
+    its own) with a stop held over it, raised once the port is open and locked, as the
+    transport's hold raises it: its boot is listened out and its all-off sent on that port,
+    then the stop is raised; the port is not opened again. Called directly: through the
+    command, that stop would be a second signal, which its handler does not raise."""
+    real_open = SerialTransport.open
+
+    def opened_then_stopped(self: SerialTransport) -> None:
+        real_open(self)
+        raise EmergencyStop(signal.SIGTERM)  # the port is the transport's: open, locked
+
+    monkeypatch.setattr(SerialTransport, "open", opened_then_stopped)
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        result = probe_usecase.ProbeResult(link.port)
+        with pytest.raises(probe_usecase.ProbeStopped) as stopped:
+            probe_usecase._nab_found(result, 2.6)
+    assert stopped.value.signum == signal.SIGTERM
+    assert result.lights_state is probe_usecase.LightsState.OFF_ACKNOWLEDGED, result.lines()
+    assert result.openings == 1 and _boots(board) == 1, board.events
     assert board.lit_once_booted() == frozenset()

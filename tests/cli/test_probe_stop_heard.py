@@ -123,23 +123,22 @@ def test_a_nab_board_slow_to_boot_is_switched_off_once_its_banner_is_over() -> N
 def test_a_slow_nab_board_stopped_before_it_is_named_is_switched_off(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    """The same slow board, the stop landing as the probe begins to switch it off: the
-    teardown's own all-off (the port opened again, the board reset) waits for its banner too."""
-    real_found = probe_usecase._nab_found
-    calls: list[str | None] = []
+    """The same slow board, the stop landing as the probe begins to switch it off on the port
+    its banner (begun) was heard on: the teardown's all-off, on that same port (the board not
+    reset again), waits for the rest of its banner too."""
+    stops: list[tuple[str | None, int]] = []
 
-    def stopped_first(result: probe_usecase.ProbeResult, wait: float) -> Any:
-        calls.append(result.profile)
-        if len(calls) == 1:
-            raise EmergencyStop(signal.SIGINT)
-        return real_found(result, wait)
+    def stopped(result: probe_usecase.ProbeResult, *args: Any) -> None:
+        stops.append((result.profile, _boots(board)))
+        raise EmergencyStop(signal.SIGINT)
 
-    monkeypatch.setattr(probe_usecase, "_nab_found", stopped_first)
+    monkeypatch.setattr(probe_usecase, "_nab_off_on_open_port", stopped)
     board = board_for("nab-rti-v1")
     board.boot_s = SLOW_BOOT_S
     code, said = _probe(board, "nab-rti-v1")
-    assert code == 130 and len(calls) == 2, said
+    assert code == 130 and len(stops) == 1 and stops[0][0] is None, (stops, said)
     assert f"Probe stopped (Ctrl-C): {SWITCHED_OFF}" in said, said
+    assert _boots(board) == stops[0][1], board.events  # no opening after the stop
     assert board.lit_once_booted() == frozenset()
 
 

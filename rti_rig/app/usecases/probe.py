@@ -4,7 +4,9 @@ Least intrusive first: listen to what the board prints when the port opens (the 
 nichlock's firmware print banners), then ask questions that light nothing (the Elexol board's
 ``?``), then commands that switch everything off (minirti's all-zero mask), and last RTIPy's
 ``T,0,0,0`` (LED 0 for zero seconds). A firmware identified with its LEDs possibly on (the Nab
-sketch boots fully lit) is sent its all-off before the probe returns. A dome that never answers
+sketch boots fully lit) is sent its all-off before the probe returns: the Nab sketch on the
+port it was heard on, still open (opening it again reset the board a second time, lit again,
+its boot waited out twice). A dome that never answers
 (hadrian2/RTI_Dome) cannot be identified; the result says so, with what was heard.
 
 Ctrl-C or SIGTERM (raised as :class:`EmergencyStop` by the command's handler) stops the probe
@@ -316,7 +318,12 @@ def _exchange(
     the line, an Elexol board's ``USB I/O 24R1`` to ``?``, had made the probe say that no
     known firmware answered, where a session's driver resends the same command. Stopped
     (:class:`EmergencyStop`) with the port open, the stop's teardown runs on it
-    (:func:`_stopped_on_open_port`), then :class:`ProbeStopped` is raised."""
+    (:func:`_stopped_on_open_port`), then :class:`ProbeStopped` is raised.
+
+    At the Nab sketch's rate, a text that shows the sketch (its banner, its all-on, its answer
+    to an unknown code) names it and has its all-off sent on this port before it is closed
+    (:func:`_nab_off_on_open_port`): the board booted lit, and reopening the port for the
+    all-off reset it once more."""
     if result.on_try is not None:
         result.on_try(what, _TRIES.get(what, ""))
     t = SerialTransport(result.port, baud)
@@ -360,13 +367,20 @@ def _exchange(
                 _listen(t, listen_s, into=heard, done=replied)
         text = heard.decode("latin-1")
         result.heard.append(Heard(what, baud, text))
+        if baud == _NAB_BAUD and any(says.search(text) for says in _NAB_SAYS):
+            # the sketch, heard at its rate, booted lit: switched off on this port, which is
+            # open; the probe had closed it and opened it again for the all-off, a second
+            # reset (every LED lit once more, its boot waited out again, ~2 s)
+            _nab_off_on_open_port(result, t, opened + _nab_boot_s(wait_s), bytearray(heard))
     except EmergencyStop as exc:
         result.heard.append(Heard(f"{what} (stopped)", baud, heard.decode("latin-1")))
         try:
-            _stopped_on_open_port(result, t, baud, opened, wait_s, heard.decode("latin-1"))
+            if result.lights_state is not LightsState.OFF_ACKNOWLEDGED:
+                # (acknowledged: on this very port, the probe returning once it is, and no
+                # opening since to light it again)
+                _stopped_on_open_port(result, t, baud, opened, wait_s, heard.decode("latin-1"))
         except TransportError as failed:
-            result.error = ProbeError(ProbeFailure.PORT_FAILED, str(failed))
-            _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
+            _teardown_failed(result, failed)
         finally:
             t.close()  # its all-off sent on it (closing resets no board; opening does)
         raise ProbeStopped(exc, result) from None
@@ -479,10 +493,21 @@ def _reopened_at_nab_rate(result: ProbeResult, wait_s: float) -> None:
         t.open()
         _stopped_on_open_port(result, t, _NAB_BAUD, time.monotonic(), wait_s)
     except TransportError as failed:
-        result.error = ProbeError(ProbeFailure.PORT_FAILED, str(failed))
-        _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
+        _teardown_failed(result, failed)
     finally:
         t.close()
+
+
+def _teardown_failed(result: ProbeResult, failed: TransportError) -> None:
+    """Say a port that failed during a stop's teardown: a board named as the Nab sketch
+    booted lit and its all-off could not be sent (it may be fully lit); else the dome's state
+    is not known. The sketch's case had been told "the dome's state is not known" once its
+    all-off was sent on the port the stop found open."""
+    result.error = ProbeError(ProbeFailure.PORT_FAILED, str(failed))
+    if result.profile == _NAB_NAME and result.lights_state is not LightsState.OFF_ACKNOWLEDGED:
+        _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(failed))
+    else:
+        _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
 
 
 def _listen(
@@ -519,19 +544,14 @@ def _listen(
 
 
 def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
-    """The Nab sketch answered: it boots with every LED on, so switch them off before leaving.
+    """The Nab sketch was heard but not switched off on the port it was heard on (a stop's
+    teardown with no port open, or the sketch heard at another rate than its own): open the
+    port at its rate (a reset: it boots lit again) and switch it off there
+    (:func:`_nab_off_on_open_port`).
 
-    A stop (:class:`EmergencyStop`) meanwhile, in the boot listen or in the all-off itself, is
-    held until the all-off is through on this same open port, then raised as
-    :class:`ProbeStopped`: a stop mid all-off had escaped to the probe's teardown, which opened
-    the port again (a reset: every LED lit once more) to send the all-off a second time. A
-    port that fails after such a stop is said, with the lights, in :class:`ProbeStopped` (it had
-    ended as a probe that succeeded, exit 0, "Found: nab-rti-v1").
-
-    The all-off is sent once the sketch's banner is over (its ready line, ``ready_pattern``),
-    listened for up to the boot time its profile allows (:func:`_nab_boot_s`): after a fixed
-    ``wait`` it had reached a board slower to boot (3.3 to 4 s) still in its bootloader, which
-    drops what it receives, and the dome was left lit."""
+    A stop held over the opening (the transport's hold) is finished on this port, as a stop in
+    the boot listen is: left open, it had been reopened by the caller's teardown while still
+    locked, and the dome left lit."""
     result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
     t = SerialTransport(result.port, _NAB_BAUD)
     result.openings += 1
@@ -541,27 +561,57 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
     except EmergencyStop as exc:
         if not t.is_open:
             raise  # cut short inside pyserial's open (the port closed): the caller reopens it
-        # held over the opening and raised once the port was open: finished on this port, as
-        # a stop in the boot listen is (left open, it had been reopened by the caller's
-        # teardown while still locked, and the dome left lit)
         stop = exc
-    opened = time.monotonic()
-    deadline = opened + _nab_boot_s(wait)
-    booted = bytearray()
+    try:
+        _nab_off_on_open_port(result, t, time.monotonic() + _nab_boot_s(wait), bytearray(), stop)
+    finally:
+        t.close()
+    return result
+
+
+def _nab_off_on_open_port(
+    result: ProbeResult,
+    t: SerialTransport,
+    deadline: float,
+    booted: bytearray,
+    stop: EmergencyStop | None = None,
+) -> None:
+    """Switch off the Nab sketch on ``t``, open at its rate: it boots with every LED on.
+    ``booted`` holds what this opening has heard so far; the rest of the sketch's boot is
+    listened to first, until its banner is over (its ready line, ``ready_pattern``) or an
+    answer to a code shows it running, up to ``deadline`` (monotonic: the opening plus the boot
+    time its profile allows, :func:`_nab_boot_s`); after a fixed wait the all-off had reached
+    a board slower to boot (3.3 to 4 s) still in its bootloader, which drops what it receives,
+    and the dome was left lit. The port is left open: its owner closes it.
+
+    A stop (:class:`EmergencyStop`; ``stop``, one already held over the opening), in the boot
+    listen or in the all-off itself, is held until the all-off is through on this same open
+    port, then raised as :class:`ProbeStopped`: a stop mid all-off had escaped to the probe's
+    teardown, which opened the port again (a reset: every LED lit once more) to send the
+    all-off a second time. A port that fails after such a stop is said, with the lights, in
+    :class:`ProbeStopped` (it had ended as a probe that succeeded, exit 0, "Found:
+    nab-rti-v1"); one that fails with no stop is raised (the probe's own handler says it: the
+    dome may be lit, exit 1)."""
+    result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
+    before = len(booted)
+    listened = False
     try:
         try:
             if stop is not None:
                 raise stop  # the teardown below: the rest of the boot, then the all-off
-            # the board resets as the port opens: its bootloader, then its banner
-            _listen(t, deadline - time.monotonic(), until=_NAB_READY, into=booted)
+            if not _nab_running(booted.decode("latin-1")):
+                # the board resets as the port opens: its bootloader, then its banner
+                listened = True
+                _listen(t, deadline - time.monotonic(), until=_NAB_READY, into=booted)
         except EmergencyStop as exc:
             # the teardown: the rest of the boot, so that the all-off reaches a booted board
-            stop = exc
-            if not _NAB_READY.search(booted.decode("latin-1")):
+            stop, listened = exc, True
+            if not _nab_running(booted.decode("latin-1")):
                 left = max(0.0, deadline - time.monotonic())
                 _listen(t, left, until=_NAB_READY, into=booted)
-        booted_text = booted.decode("latin-1")
-        result.heard.append(Heard(f"the board's boot at {_NAB_BAUD} baud", _NAB_BAUD, booted_text))
+        if listened:
+            rest = booted[before:].decode("latin-1")
+            result.heard.append(Heard(f"the board's boot at {_NAB_BAUD} baud", _NAB_BAUD, rest))
         try:
             _nab_off(result, t)
         except EmergencyStop as exc:
@@ -575,11 +625,14 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
         result.error = ProbeError(ProbeFailure.PORT_FAILED, str(exc))
         _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(exc))
         raise ProbeStopped(stop, result) from None
-    finally:
-        t.close()
     if stop is not None:
         raise ProbeStopped(stop, result) from None
-    return result
+
+
+def _nab_running(text: str) -> bool:
+    """``text``, heard since an opening, shows the Nab sketch past its boot: its banner over
+    (its ready line) or its answer to a code it does not know (printed from ``loop()``)."""
+    return bool(_NAB_READY.search(text) or _NAB_UNKNOWN_CODE.search(text))
 
 
 def _nab_not_off(exc: TransportError) -> str:
@@ -922,6 +975,8 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
     """:func:`probe`'s sequence of probes."""
     try:
         text = _exchange(result, _LISTEN_SAID.format(baud=9600), 9600, wait, b"", 0)
+        if result.profile == _NAB_NAME:
+            return result  # heard at its rate, and switched off on that port (_exchange)
         if _NAB_BANNER.search(text) or _NAB_ALL_ON.search(text):
             return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
@@ -953,6 +1008,8 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
         text = _exchange(
             result, f"'<9>' (an unknown code) at {_NAB_BAUD} baud", _NAB_BAUD, wait, b"<9>", 0.6
         )
+        if result.profile == _NAB_NAME:
+            return result
         if _NAB_UNKNOWN_CODE.search(text) or _NAB_BANNER.search(text):
             return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
@@ -960,6 +1017,8 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
         text = _exchange(
             result, "0x42 + empty mask at 9600 baud", 9600, 1.6, b"\x42" + bytes(8), 0.5
         )
+        if result.profile == _NAB_NAME:
+            return result  # a slow Nab board's banner heard here: not reset once more
         if _nichlock_found(result, text, 9600):
             return result
         if text.endswith("\x01"):
@@ -969,15 +1028,17 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
         text = _exchange(
             result, "'T,0,0,0' at 9600 baud", 9600, min(wait, _RTIPY_BOOT_S), b"T,0,0,0", 1.8
         )
+        if result.profile == _NAB_NAME:
+            return result
         if _RTIPY_SAYS in text:
             result.profile, result.baudrate = "rtipy", 9600
             _say_lights(result, LightsState.ZERO_SECONDS)
             return result
         if _nab_heard(result):
             # a Nab board slower to boot than a probe's listen (up to the 4 s its profile
-            # allows) is first heard by a later probe's longer listen, T,0,0,0's: its banner
-            # had been shown among the lines heard under "No known dome firmware answered",
-            # the dome left lit
+            # allows) is first heard by a later probe's longer listen (switched off there when
+            # at its rate): its banner had been shown among the lines heard under "No known
+            # dome firmware answered", the dome left lit
             return _nab_found(result, wait)
         _say_lights(result, LightsState.UNANSWERED, _unanswered_lights(wait))
     except TransportError as exc:

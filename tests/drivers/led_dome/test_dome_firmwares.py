@@ -103,6 +103,9 @@ def test_probe_sends_the_nab_all_off_again_when_its_reply_is_lost() -> None:
     text = said(r)
     assert "all-off sent and acknowledged" in text and "NOT acknowledged" not in text, text
     assert board.commands == 2
+    # on the port its banner was heard on: it had been opened again for the all-off, a second
+    # reset that lit every LED again and waited out the boot once more (~2 s)
+    assert sum(what == "boot" for _, what in board.events) == 1, board.events
 
 
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
