@@ -65,6 +65,7 @@ from rti_rig.reconstruct.qa_drift import (
     CHANGE_MIN_BLOCK,
     MAX_SHIFT_PX,
     TRUSTED_SPREAD_PX,
+    EdgeImages,
     Step,
     change_point,
     edge_agreement,
@@ -1032,6 +1033,7 @@ def _confirmed_step(
     lit: NDArray[np.bool_],
     saturation: float | None,
     refused: list[Step] | None = None,
+    edge_set: EdgeImages | None = None,
 ) -> tuple[Step, NDArray, Any] | None:
     """A move part-way through the session (the first of
     :func:`~rti_rig.reconstruct.qa_drift.step_candidates` the fit confirms), with the images
@@ -1051,7 +1053,8 @@ def _confirmed_step(
     capture order is the order of rising elevation, and a still brushed-steel part's shadow
     edges split low lights from high ones by up to 5 px (emulated Nab dome, uneven LEDs, seeds
     2 and 8: "moved part-way through", reshoot the whole session). Such steps are appended to
-    ``refused`` for the verdict to say, not claimed."""
+    ``refused`` for the verdict to say, not claimed. ``edge_set``: the edge images of
+    ``crop_arr`` already made (:class:`~rti_rig.reconstruct.qa_drift.EdgeImages`)."""
     n = len(crop_arr)
     # The fit-confirmed candidate that, undone, explains its images best: the first one the
     # fit confirms can be a blend. The still tablet of 12 lights moved (2, 0) px from image 7
@@ -1066,7 +1069,7 @@ def _confirmed_step(
     # read "moved" by 0.138 against 0.134) and then the split at image 7 (12 of 12); the
     # verdict had said "moved from image_005 on", two images too early.
     unjudged: list[Step] = []
-    for step in step_candidates(crop_arr, lit):  # the next when the fit refuses one
+    for step in step_candidates(crop_arr, lit, edge_set):  # the next when the fit refuses one
         pad = int(np.ceil(max(abs(v) for v in step.shift))) + 1
         # Both hypotheses judged on equally interpolated images (:func:`_half_moved`): a
         # sub-pixel move back is a blur, which lowers the noise the residual measures.
@@ -1487,7 +1490,10 @@ def assess(
     # first, from the two sides' own edges, and confirmed by the fit; its images are moved
     # back before anything else is measured, and the images from it on are the ones moved.
     refused_steps: list[Step] = []
-    found = _confirmed_step(crop_arr, lt, lit_images, sat_level, refused_steps)
+    # the edge images of the crop as read, for the step's search and the drift's alike (the
+    # same values, made once): let go where a step moves images back
+    edge_set: EdgeImages | None = EdgeImages(crop_arr, lit_images)
+    found = _confirmed_step(crop_arr, lt, lit_images, sat_level, refused_steps, edge_set)
     step: Step | None = None
     step_fit: Any = None  # the fit of crop_arr as it now is (the step undone)
     step_moved = np.zeros(n, bool)
@@ -1496,7 +1502,9 @@ def assess(
         step, crop_arr, step_fit = found
         step_moved[step.first :] = True
         step_shift = np.array(step.shift)
-    edge_shift, _ = measure_drift(crop_arr, lit_images)
+        edge_set = None  # of the crop as read, not as moved back
+    edge_shift, _ = measure_drift(crop_arr, lit_images, edge_set)
+    del edge_set
     edges_trusted, edge_dev = edge_shifts_trusted(edge_shift)
     # only the part of an image's edge shift that does not follow its light is a move
     # (shading edges lean towards the light: :func:`light_trend`); edges whose spread is

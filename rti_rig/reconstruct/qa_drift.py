@@ -82,6 +82,32 @@ def edge_image(img: NDArray[np.float32]) -> NDArray[np.float32] | None:
     return np.minimum(m / scale, 2.0)
 
 
+class EdgeImages:
+    """The edge images of one crop stack (:func:`edge_image` of each usable image; None for
+    the others) and the median of all of them, made once for :func:`step_candidates` and
+    :func:`measure_drift` alike.
+
+    Why: the QA ran both on the same stack when no step was found (every still session), and
+    each made the 48 edge images (a blur, two Sobels and a percentile apiece) and their median
+    over again: the same values, computed twice. Valid only for the stack it was made of: a
+    caller that moves images back makes a new one."""
+
+    def __init__(self, crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> None:
+        self.shape = crops.shape
+        self.edges = [edge_image(c) if usable[i] else None for i, c in enumerate(crops)]
+        self.have = [i for i in range(crops.shape[0]) if self.edges[i] is not None]
+        self._median_all: NDArray[np.float32] | None = None
+
+    def median_of(self, images: list[int]) -> NDArray[np.float64]:
+        """``median_of_images`` of those edge images, float64 (the median of every usable
+        one kept, as both callers take it first)."""
+        if images == self.have:
+            if self._median_all is None:
+                self._median_all = median_of_images([self.edges[i] for i in images])
+            return self._median_all.astype(np.float64)
+        return median_of_images([self.edges[i] for i in images]).astype(np.float64)
+
+
 def _move(img: NDArray, dx: float, dy: float) -> NDArray:
     m = np.float32([[1, 0, dx], [0, 1, dy]])
     return cv2.warpAffine(
@@ -138,9 +164,18 @@ def _correlation(
     ref_spectrum: NDArray[np.complex128], img: NDArray[np.float64], window: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """The phase correlation surface of ``img`` against the reference, no shift at its centre."""
-    cross = np.conj(ref_spectrum) * _spectrum(img, window)
+    return _cross_correlation(ref_spectrum, _spectrum(img, window), img.shape)
+
+
+def _cross_correlation(
+    ref_spectrum: NDArray[np.complex128],
+    spectrum: NDArray[np.complex128],
+    shape: tuple[int, ...],
+) -> NDArray[np.float64]:
+    """:func:`_correlation` from the image's spectrum (made once for several references)."""
+    cross = np.conj(ref_spectrum) * spectrum
     cross /= np.maximum(np.abs(cross), 1e-30)
-    return np.fft.fftshift(np.fft.irfft2(cross, s=img.shape))
+    return np.fft.fftshift(np.fft.irfft2(cross, s=shape))
 
 
 def _peak_near_zero(
@@ -170,17 +205,21 @@ def _peak_near_zero(
 
 
 def measure_drift(
-    crops: NDArray[np.float32], usable: NDArray[np.bool_]
+    crops: NDArray[np.float32],
+    usable: NDArray[np.bool_],
+    edge_set: EdgeImages | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Per image ``(dx, dy)`` (image axes, x right, y down) against the session's median edge
     image, and the correlation response. ``usable`` False (a dark or misfired frame), a
-    featureless image or a shift not confirmed gives NaN: not measured."""
+    featureless image or a shift not confirmed gives NaN: not measured. ``edge_set``: the
+    :class:`EdgeImages` of these ``crops`` and ``usable`` already made (else made here)."""
     n = crops.shape[0]
-    edges = [edge_image(c) if usable[i] else None for i, c in enumerate(crops)]
+    if edge_set is None:
+        edge_set = EdgeImages(crops, usable)
+    edges, have = edge_set.edges, edge_set.have
     shifts = np.zeros((n, 2))
     measured = np.zeros(n, bool)
     response = np.zeros(n)
-    have = [i for i in range(n) if edges[i] is not None]
     if len(have) < 3:
         return np.full((n, 2), np.nan), response
     window = cv2.createHanningWindow((crops.shape[2], crops.shape[1]), cv2.CV_64F)
@@ -188,11 +227,15 @@ def measure_drift(
         # only measured shifts move an image back: a wrong one would drag the reference
         # (an image not moved is itself, not a warped copy: the identity warp gives the same
         # values, and a copy of every edge image had set the QA's peak at many lights)
-        back = [
-            _move(edges[i], -shifts[i, 0], -shifts[i, 1]) if shifts[i].any() else edges[i]
-            for i in have
-        ]
-        ref = median_of_images(back).astype(np.float64)
+        if not shifts.any():  # none moved back: the median of the edge images as they are
+            ref = edge_set.median_of(have)
+        else:
+            back = [
+                _move(edges[i], -shifts[i, 0], -shifts[i, 1]) if shifts[i].any() else edges[i]
+                for i in have
+            ]
+            ref = median_of_images(back).astype(np.float64)
+            del back
         ref_spectrum = _spectrum(ref, window)
         for i in have:
             e = edges[i].astype(np.float64)
@@ -247,7 +290,9 @@ def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | N
     return next(step_candidates(crops, usable), None)
 
 
-def step_candidates(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Iterator[Step]:
+def step_candidates(
+    crops: NDArray[np.float32], usable: NDArray[np.bool_], edge_set: EdgeImages | None = None
+) -> Iterator[Step]:
     """Moves part-way through the session (a step in the per-image shifts) the edges bear
     out, most likely first, each with a different first image (none: none found).
 
@@ -277,33 +322,39 @@ def step_candidates(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> It
     holds that position alone, and the other side's peaks stand off it by the move. A caller
     that confirms a candidate another way (:func:`~rti_rig.reconstruct.qa._confirmed_step`)
     takes the next when one is refused.
+
+    ``edge_set``: the :class:`EdgeImages` of these ``crops`` and ``usable`` already made (else
+    made here).
     """
     n = crops.shape[0]
-    edges = [edge_image(c) if usable[i] else None for i, c in enumerate(crops)]
-    have = [i for i in range(n) if edges[i] is not None]
+    if edge_set is None:
+        edge_set = EdgeImages(crops, usable)
+    edges, have = edge_set.edges, edge_set.have
     if len(have) < 2 * STEP_MIN_IMAGES:
         return
     window = cv2.createHanningWindow((crops.shape[2], crops.shape[1]), cv2.CV_64F)
+    median_of = edge_set.median_of
 
-    def median_of(images: list[int]) -> NDArray[np.float64]:
-        return median_of_images([edges[i] for i in images]).astype(np.float64)
-
-    def peaks_against(ref: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Each image's whole-pixel peak against ``ref`` (NaN: none within the search)."""
-        out = np.full((n, 2), np.nan)
-        ref_spectrum = _spectrum(ref, window)
-        h, w = ref.shape
+    def peaks_against(refs: list[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
+        """Each image's whole-pixel peak against each of ``refs`` (NaN: none within the
+        search). All references at once: each image's spectrum is made once for all of them
+        (one a reference, it had been made three times over for the three seeds below)."""
+        outs = [np.full((n, 2), np.nan) for _ in refs]
+        h, w = refs[0].shape
         cy, cx = h // 2, w // 2
         r = min(MAX_SHIFT_PX, cy - 3, cx - 3)
         if r < 2:
-            return out
+            return outs
+        ref_spectra = [_spectrum(ref, window) for ref in refs]
         for i in have:
-            corr = _correlation(ref_spectrum, edges[i].astype(np.float64), window)
-            near = corr[cy - r : cy + r + 1, cx - r : cx + r + 1]
-            iy, ix = np.unravel_index(int(np.argmax(near)), near.shape)
-            if near[iy, ix] >= MIN_RESPONSE and 0 < iy < 2 * r and 0 < ix < 2 * r:
-                out[i] = (ix - r, iy - r)
-        return out
+            spectrum = _spectrum(edges[i].astype(np.float64), window)
+            for out, ref_spectrum in zip(outs, ref_spectra, strict=True):
+                corr = _cross_correlation(ref_spectrum, spectrum, edges[i].shape)
+                near = corr[cy - r : cy + r + 1, cx - r : cx + r + 1]
+                iy, ix = np.unravel_index(int(np.argmax(near)), near.shape)
+                if near[iy, ix] >= MIN_RESPONSE and 0 < iy < 2 * r and 0 < ix < 2 * r:
+                    out[i] = (ix - r, iy - r)
+        return outs
 
     def best_split(peaks: NDArray[np.float64]) -> int | None:
         """The first image after the split of the capture order that separates the placed
@@ -394,10 +445,11 @@ def step_candidates(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> It
     # leaves one half at one position, whose median holds that position's edges alone.
     half = len(have) // 2
     seen: set[int] = set()
-    for seed in (have, have[:half], have[half:]):
-        if len(seed) < STEP_MIN_IMAGES:
-            continue
-        step = judged(best_split(peaks_against(median_of(seed))))
+    seeds = [seed for seed in (have, have[:half], have[half:]) if len(seed) >= STEP_MIN_IMAGES]
+    # every seed's peaks are taken (the QA judges every candidate): in one pass over the images
+    peaks = peaks_against([median_of(seed) for seed in seeds])
+    for seed_peaks in peaks:
+        step = judged(best_split(seed_peaks))
         if step is not None and step.first not in seen:
             seen.add(step.first)
             yield step
