@@ -37,12 +37,20 @@ def median_by_rows(stack: NDArray[np.floating]) -> NDArray[np.floating]:
 def median_of_images(images: Sequence[NDArray[np.floating]]) -> NDArray[np.floating]:
     """``np.median(np.stack(images), axis=0)`` of equal-shaped images, a band of rows at a
     time: the same values without the stack (a copy of every image) and the median's
-    partitioned copy of it."""
+    partitioned copy of it.
+
+    Each band is stacked with the images on its last axis and partitioned in place: each
+    pixel's values lie side by side, where numpy's median along the first axis copied every
+    pixel's strided values out and partitioned a copy of the band besides (the same values: a
+    median is of the values alone, whatever their order; 48 edge images of 384 px, 0.18 s of
+    CPU a median, the QA's step search and drift took six)."""
     n = len(images)
     h, w = images[0].shape[:2]
     out: NDArray[np.floating] | None = None
     for band in row_bands(n, h, w):
-        part = np.median(np.stack([im[band] for im in images]), axis=0)
+        part = np.median(
+            np.stack([im[band] for im in images], axis=-1), axis=-1, overwrite_input=True
+        )
         if out is None:
             out = np.empty((h, *part.shape[1:]), part.dtype)
         out[band] = part
