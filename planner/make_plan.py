@@ -10,7 +10,7 @@ Pipeline (each step a pure function in its own module):
    ``optimal`` (exchange search on an objective, :mod:`rti_rig.planner.optimal`);
 3. the rig's constraints (usable LEDs without repeats / reachable arm band) and its order
    (ascending LED index on a dome; on an arm the ``arm_order`` passed in — the CLI passes the
-   servos' move-time order, :func:`rti_rig.planner.arm_order.order_for_arm` — else nearest neighbour
+   arm's move-time order, :func:`rti_rig.planner.arm_order.order_for_arm` — else nearest neighbour
    from the park pose).
 
 The evidence behind a plan is a :class:`rti_rig.planner.plan_report.PlanReport`. The default
@@ -188,7 +188,7 @@ class PlanRequest:
     the ``normals`` objective — an uncalibrated dome's LED spread and 8-bit JPEG captures
     (:data:`rti_rig.planner.objectives.SIGNAL_NOISE_JPEG_DOME`); 0 models additive noise only.
 
-    ``arm_order`` orders an arm's lights (the composition root passes the servos' move-time
+    ``arm_order`` orders an arm's lights (the composition root passes the arm's move-time
     order, :func:`rti_rig.planner.arm_order.order_for_arm`); without it, nearest neighbour from
     the park pose.
     """

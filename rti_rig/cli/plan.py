@@ -178,8 +178,9 @@ def plan(
     well as with a preview).
 
     The plan's lights are the rig's own (a dome's LEDs, used once each; an arm's reachable
-    directions, ordered for the least move time of its servos when the config has
-    \\[arm.dynamixel], else nearest neighbour first); `rti-rig run RIG --plan PLAN.lp` runs it.
+    directions, ordered for the least move time: of its servos when the config has
+    \\[arm.dynamixel], of the simulated arm's \\[arm] speed and limits otherwise, never wrapping
+    the azimuth past its stop); `rti-rig run RIG --plan PLAN.lp` runs it.
     """
     # the arm's order as rti_rig.app.compose.arm_order_for gives it (tests/cli/test_plan_help.py)
     from rti_rig.app.config import default_config_path

@@ -19,12 +19,40 @@ the azimuth range is under 360 deg and an approximation otherwise.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core.geometry import az_el_from_direction
+
+
+@dataclass(frozen=True)
+class JointMotion:
+    """One joint's travel limits and trapezoid, in joint degrees (what the model reads)."""
+
+    min_deg: float
+    max_deg: float
+    joint_velocity_deg_s: float
+    joint_acceleration_deg_s2: float
+
+
+@dataclass(frozen=True)
+class ArmMotion:
+    """An arm's move-time model for a rig that declares no servo settings.
+
+    Why: the simulated arm (``[arm]`` speed, acceleration and elevation limits, no
+    ``[arm.dynamixel]``) also cannot wrap its azimuth past ±180°; ordering its stops by angle
+    alone sent it the long way round (a 6 s move from -170° to 157.6° in a 12-light plan).
+    The composition root fills this from the config, so the planner orders those stops by the
+    same model as a Dynamixel arm's."""
+
+    azimuth: JointMotion
+    elevation: JointMotion
+    park_azimuth_deg: float
+    park_elevation_deg: float
+    settle_time_s: float = 0.0
 
 
 def joint_move_time_s(distance_deg: float, velocity_deg_s: float, accel_deg_s2: float) -> float:
