@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from rti_rig.core.clock import Clock
 from rti_rig.core.device_said import say_or_log
 from rti_rig.core.devices import ReadBackCarrier, TorqueAtClose
-from rti_rig.core.errors import MoveCancelled
+from rti_rig.core.errors import MoveCancelled, UnheldJoint
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
@@ -40,6 +40,7 @@ from rti_rig.drivers.dynamixel.faults import (
     HardwareFaultError,
     MoveTimeoutError,
     SafetyViolation,
+    StopIncompleteError,
     UnreachableError,
 )
 from rti_rig.drivers.dynamixel.kinematics import (
@@ -977,7 +978,18 @@ class DynamixelArm(ReadBackCarrier):
                 for sid, exc in failed
             ]
         )
-        raise DynamixelError(self.name, f"stop incomplete: {said}", "stop") from failed[0][1]
+        # what was read of each joint not held, for the lights line: a servo that shut itself
+        # off after a fault (torque read off) is limp, not holding its last goal
+        unheld = tuple(
+            UnheldJoint(
+                roles[sid],
+                sid,
+                isinstance(exc, HardwareFaultError),
+                exc.torque_on if isinstance(exc, HardwareFaultError) else None,
+            )
+            for sid, exc in failed
+        )
+        raise StopIncompleteError(self.name, f"stop incomplete: {said}", unheld) from failed[0][1]
 
     def emergency_stop(self) -> str:
         """Torque off on every servo now (one broadcast packet, no reply to wait for), then

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from rti_rig.core.errors import DeviceError, ScheduleError
+from rti_rig.core.errors import DeviceError, ScheduleError, StopIncomplete, UnheldJoint
 from rti_rig.drivers.dynamixel import control_table as ct
 
 
@@ -15,6 +15,15 @@ class DynamixelError(DeviceError):
         self.servo_id = servo_id
         where = f"servo {servo_id}: " if servo_id is not None else ""
         super().__init__(device, where + message, command)
+
+
+class StopIncompleteError(DynamixelError, StopIncomplete):
+    """The arm's stop held some joints and not others (:meth:`DynamixelArm.stop`), with what
+    was read of each it did not hold (its fault, and the torque read after it)."""
+
+    def __init__(self, device: str, message: str, unheld: tuple[UnheldJoint, ...]) -> None:
+        super().__init__(device, message, "stop")
+        self.unheld = unheld
 
 
 class CommunicationError(DynamixelError):

@@ -6,6 +6,7 @@ Every error a user can meet says *where* (file and line, config key, device, LED
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 
@@ -60,6 +61,30 @@ class MoveCancelled(DeviceError):
     by a hold where it stood (torque on): raised only once that hold was written to every
     joint, so whoever catches it may say the arm is held there (a stop that did not hold
     every joint raises its own error instead)."""
+
+
+@dataclass(frozen=True)
+class UnheldJoint:
+    """A joint a stop could not hold, and what was read of its servo when it tried.
+
+    ``fault``: the servo answered with a hardware fault (an overload, overheating…), for which
+    a servo may shut itself down, torque off; ``torque_on``: its Torque Enable as read after
+    that fault (None: not read, or no fault was read: a servo that did not answer)."""
+
+    joint: str
+    servo_id: int
+    fault: bool
+    torque_on: bool | None = None
+
+
+class StopIncomplete(DeviceError):
+    """A stop that did not hold every joint; :attr:`unheld` says what was read of each joint
+    it did not hold. Why: the lights line said of every such stop that the servo "keeps its
+    last goal under torque", also of a servo that had shut itself off after an overload,
+    torque read off: a limp joint, the arm free to sag."""
+
+    #: the joints not held, as read (set by the driver that raises it)
+    unheld: tuple[UnheldJoint, ...] = ()
 
 
 class CaptureError(DeviceError):

@@ -20,12 +20,12 @@ from numpy.typing import NDArray
 from rti_rig.core.clock import Clock
 from rti_rig.core.device_said import first_clause
 from rti_rig.core.devices import LightCarrier, ReadBackCarrier
-from rti_rig.core.errors import RtiRigError
+from rti_rig.core.errors import RtiRigError, UnheldJoint
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.rig_geometry import ArmGeometry
 from rti_rig.runtime.arm_end import PARK_TOLERANCE_DEG, ArmEnd, left_end, park_end
 from rti_rig.runtime.controller import EmergencyStop
-from rti_rig.runtime.lighting import attempt_all
+from rti_rig.runtime.lighting import attempt_all, stop_reading_unheld
 from rti_rig.runtime.teardown_repeats import failed_as_before
 
 #: Largest angle between the asked and the reached direction that passes (degrees).
@@ -97,6 +97,9 @@ class ArmSelfTestReport:
     #: ``run``'s does from ``ArmLighting.not_sent``; it had said "lamp off and stop were
     #: requested" of a lamp-off that had failed
     not_sent: tuple[str, ...] = ()
+    #: the joints the teardown's failed stop did not hold, as read (its servo's fault and the
+    #: torque read after it), for the same lights line
+    unheld: tuple[UnheldJoint, ...] = ()
 
     @property
     def park_confirmed(self) -> bool:
@@ -343,7 +346,14 @@ def arm_self_test(
             exc.self_test_report = report
         raise
     finally:
-        failures = attempt_all([("lamp off", lambda: carrier.lamp(False)), ("stop", carrier.stop)])
+        unheld: list[UnheldJoint] = []
+        failures = attempt_all(
+            [
+                ("lamp off", lambda: carrier.lamp(False)),
+                ("stop", lambda: stop_reading_unheld(carrier, unheld)),
+            ]
+        )
+        report.unheld = tuple(unheld)
         report.stopped = not any(f.startswith("stop: ") for f in failures)
         report.not_sent = tuple(
             label

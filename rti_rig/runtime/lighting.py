@@ -22,7 +22,7 @@ from rti_rig.core.devices import (
     LightCarrier,
     ReadBackCarrier,
 )
-from rti_rig.core.errors import DeviceError, MoveCancelled
+from rti_rig.core.errors import DeviceError, MoveCancelled, StopIncomplete, UnheldJoint
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.schedule import LightStep
@@ -338,6 +338,9 @@ class ArmLighting:
         #: dead port (an unplugged adapter) had been reported as "lamp off and stop were
         #: requested", of requests that never left the computer
         self.not_sent: tuple[str, ...] = ()
+        #: the joints the last :meth:`safe`'s failed stop did not hold, as read (a servo that
+        #: shut itself off after an overload is limp: the lights line had said it held its goal)
+        self.unheld: tuple[UnheldJoint, ...] = ()
 
     def resends(self) -> tuple[dict[str, list[str]], str | None]:
         """The manifest's ``arm_resent`` (each command sent once more after its status packet
@@ -488,6 +491,7 @@ class ArmLighting:
         self.stopped_by = None
         self._stop_asked = None
         self.not_sent = ()
+        self.unheld = ()
 
         def stop_asked(signum: int) -> None:
             if self._stop_asked is None:
@@ -509,7 +513,9 @@ class ArmLighting:
 
     def _safe(self, emergency: bool) -> list[str]:
         lamp_failed = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
-        stop_failed = attempt_all([("stop", self.carrier.stop)])
+        unheld: list[UnheldJoint] = []
+        stop_failed = attempt_all([("stop", lambda: stop_reading_unheld(self.carrier, unheld))])
+        self.unheld = tuple(unheld)
         failures = lamp_failed + stop_failed
         self.not_sent = tuple(
             label for label, failed in (("lamp off", lamp_failed), ("stop", stop_failed)) if failed
@@ -630,6 +636,16 @@ def unsafe_failures(failures: Iterable[str] | None) -> list[str]:
     what it established). Told by type, never by wording: a plain text that reads like a port's
     close is kept as unsafe."""
     return [f for f in failures or () if not isinstance(f, PortCloseFailure)]
+
+
+def stop_reading_unheld(carrier: LightCarrier, unheld: list[UnheldJoint]) -> None:
+    """``carrier.stop()``; a stop that did not hold every joint adds to ``unheld`` what was
+    read of each joint it did not hold, then raises on (for :func:`attempt_all`)."""
+    try:
+        carrier.stop()
+    except StopIncomplete as exc:
+        unheld.extend(exc.unheld)
+        raise
 
 
 def attempt_all(actions: list[tuple[str, object]]) -> list[str]:

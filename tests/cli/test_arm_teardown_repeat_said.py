@@ -21,3 +21,12 @@ def test_the_close_failing_as_the_stop_did_is_said_plainly(tmp_path: Path) -> No
         "more was established of the lights or the arm than the 'stop' line says"
     ) in said, said
     assert "failed as 'stop' above" not in said, said
+    # the lights line says what the overload left of servo 1's torque, as read (off): it had
+    # said "a servo no command reaches keeps its last goal under torque" of a limp joint
+    # (tests/app/test_unheld_joint_said.py); asserted here, on the same run, to spare CI one
+    lights = said.split("the stop failed at a servo", 1)[1].split("; the arm's park", 1)[0]
+    assert (
+        "the azimuth servo (id 1) shut itself off after its fault (torque read off): that "
+        "joint is limp, so the arm may sag; support the arm and switch its power supply off"
+    ) in lights, said
+    assert "keeps its last goal under torque" not in said, said

@@ -158,6 +158,7 @@ def check_rig(
                 bool(failures),
                 end=report.end if report else None,
                 not_sent=report.not_sent if report else None,
+                unheld=report.unheld if report else None,
             )
             raise CheckStopped(exc, lights, failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")

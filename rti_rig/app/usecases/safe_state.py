@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from rti_rig.core.devices import KnownStateLightSource
 from rti_rig.core.dome_link import OffOutcome
+from rti_rig.core.errors import UnheldJoint
 from rti_rig.runtime.arm_check import not_connected_sentence
 from rti_rig.runtime.arm_end import ArmEnd
 from rti_rig.runtime.dome_policy import lights_state_sentence
@@ -35,12 +36,14 @@ def lights_state(  # type: ignore[no-untyped-def]
     *,
     end: ArmEnd | None = None,
     not_sent: tuple[str, ...] | None = None,
+    unheld: tuple[UnheldJoint, ...] | None = None,
 ) -> str:
     """One sentence on the lights of ``rig`` after its teardown (``teardown_failed``: the
     teardown's failures were printed just before, and the sentence points at them; ``end`` and
     ``not_sent``: where a teardown other than the session's left an arm, as read back, and
-    which of its lamp-off and stop failed — a stopped check's self-test, whose record the rig's
-    lighting does not hold; None: the lighting's own)."""
+    which of its lamp-off and stop failed, and ``unheld`` what was read of each joint that
+    stop did not hold — a stopped check's self-test, whose record the rig's lighting does not
+    hold; None: the lighting's own)."""
     lighting = rig.lighting
     if getattr(rig.loaded.config, "backend", None) == "replay":
         return "a replayed acquisition has no lights to switch off"
@@ -64,8 +67,10 @@ def lights_state(  # type: ignore[no-untyped-def]
     if not_sent is None:
         not_sent = lighting.not_sent if isinstance(lighting, ArmLighting) else ()
     software = software_lamp(lighting) and getattr(rig.loaded.config, "backend", None) == "hardware"
+    if unheld is None:
+        unheld = lighting.unheld if isinstance(lighting, ArmLighting) else ()
     if not_sent:
-        said = not_sent_sentence(not_sent, software)
+        said = not_sent_sentence(not_sent, software, unheld)
     elif software:
         # the lamp's own switch is outside the servo bus: its "off" is a flag in the driver,
         # and "lamp off ... requested" had told a user at a real arm that it was switched
@@ -89,7 +94,9 @@ def lights_state(  # type: ignore[no-untyped-def]
 _UNSURE = "(not sent, or sent and not acknowledged)"
 
 
-def not_sent_sentence(not_sent: tuple[str, ...], software_lamp: bool = False) -> str:
+def not_sent_sentence(
+    not_sent: tuple[str, ...], software_lamp: bool = False, unheld: tuple[UnheldJoint, ...] = ()
+) -> str:
     """What is known of an arm whose teardown lamp-off or stop failed (its port gone: an
     unplugged adapter; or a servo that did not answer), said in place of "lamp off
     and stop were requested", which had been printed of requests that never left the computer.
@@ -110,7 +117,15 @@ def not_sent_sentence(not_sent: tuple[str, ...], software_lamp: bool = False) ->
     nor the lamp goes off. Setting it would also have a session send a packet at least every
     2.54 s through each exposure and wait, or find its servos stopped and their goals refused
     (Data Range Error) until the error is cleared. With or without it the servo stays under
-    torque, which is why the sentence says to switch the arm's power off."""
+    torque, which is why the sentence says to switch the arm's power off.
+
+    Unless the servo shut itself off: a stop that failed because a servo reported a hardware
+    fault its Shutdown register selects (an overload, on an XL430) met a servo whose torque
+    is off, its joint limp, and the arm may sag. ``unheld`` (what the stop read of each joint
+    it did not hold) says which: torque read off, read on, or not read (then both are said).
+    Why: "keeps its last goal under torque" had been said after an overload that had switched
+    the torque off. A stop whose failure read nothing of a fault (a servo that did not answer,
+    a port gone) is said as before."""
     lamp_unsent = "lamp off" in not_sent
     stop_unsent = "stop" in not_sent
     if lamp_unsent and stop_unsent:
@@ -124,18 +139,49 @@ def not_sent_sentence(not_sent: tuple[str, ...], software_lamp: bool = False) ->
     known = []
     if lamp_unsent:
         known.append("the lamp may still be lit")
+    may_sag = False
     if stop_unsent:
-        known.append(
-            "a servo no command reaches keeps its last goal under torque, so the arm may hold "
-            "there or still be moving to it"
-        )
-    said += ": " + ", and ".join(known) + "; switch the arm's power supply off"
+        faulted = [j for j in unheld if j.fault]
+        for joint in faulted:
+            known.append(_faulted_joint_said(joint))
+            may_sag = may_sag or joint.torque_on is not True
+        if not faulted or any(not j.fault for j in unheld):
+            known.append(
+                "a servo no command reaches keeps its last goal under torque, so the arm may "
+                "hold there or still be moving to it"
+            )
+    power_off = (
+        "support the arm and switch its power supply off"
+        if may_sag
+        else "switch the arm's power supply off"
+    )
+    said += ": " + ", and ".join(known) + "; " + power_off
     if software_lamp:
         said += (
             ' (the lamp is not switched by rti-rig: lamp = "software" in [arm.dynamixel], '
             "so switch it off yourself too)"
         )
     return said
+
+
+def _faulted_joint_said(joint: UnheldJoint) -> str:
+    """What a servo that reported a fault as the stop read it was left doing, as read."""
+    servo = f"the {joint.joint} servo (id {joint.servo_id})"
+    if joint.torque_on is False:
+        return (
+            f"{servo} shut itself off after its fault (torque read off): that joint is limp, "
+            "so the arm may sag"
+        )
+    if joint.torque_on is True:
+        return (
+            f"{servo} kept its torque after its fault (read on): it keeps its last goal, so the "
+            "arm may hold there or still be moving to it"
+        )
+    return (
+        f"{servo} reported a fault and its torque could not be read: it may have shut itself "
+        "off (that joint limp, so the arm may sag) or keep its last goal under torque (so the "
+        "arm may hold there or still be moving to it)"
+    )
 
 
 def simulated_lights_sentence(known: KnownStateLightSource) -> str:
