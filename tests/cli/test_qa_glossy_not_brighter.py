@@ -6,7 +6,8 @@ Lambertian rendering of the fit has (the QA itself said no image was close to on
 gives the same image. The brightness check is now made on images a rendering explains and said
 "not judged" elsewhere; the saturated image it names is still named (a reshoot with less
 exposure does change it). A stray flash on a matte object stays named:
-tests/app/test_uneven_lights.py.
+tests/app/test_uneven_lights.py. (That highlight's light is image_009 since the arm's lights are
+ordered by its move time.)
 """
 
 from __future__ import annotations
@@ -29,5 +30,5 @@ def test_a_glossy_coins_highlight_is_not_called_too_bright(tmp_path: Path) -> No
     assert "QA verdict: reshoot: image_002 (saturated:" in said, said
     assert "brighter than the other images predict" not in said, said
     # the check not made is said, with why
-    assert "brighter than predicted, not judged on image_007" in said, said
+    assert "brighter than predicted, not judged on image_009" in said, said
     assert "(gloss)" in said
