@@ -977,8 +977,6 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
         text = _exchange(result, _LISTEN_SAID.format(baud=9600), 9600, wait, b"", 0)
         if result.profile == _NAB_NAME:
             return result  # heard at its rate, and switched off on that port (_exchange)
-        if _NAB_BANNER.search(text) or _NAB_ALL_ON.search(text):
-            return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
             return result
         own_at_9600 = _own_protocol(text)
@@ -1009,9 +1007,7 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             result, f"'<9>' (an unknown code) at {_NAB_BAUD} baud", _NAB_BAUD, wait, b"<9>", 0.6
         )
         if result.profile == _NAB_NAME:
-            return result
-        if _NAB_UNKNOWN_CODE.search(text) or _NAB_BANNER.search(text):
-            return _nab_found(result, wait)
+            return result  # its answer or banner heard at its rate, switched off there (_exchange)
         if _nichlock_found(result, text, 9600):
             return result
         text = _exchange(
