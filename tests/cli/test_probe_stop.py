@@ -24,7 +24,7 @@ from typer.testing import CliRunner
 
 from rti_rig.app.usecases import probe as probe_usecase
 from rti_rig.cli import app
-from rti_rig.drivers.led_dome.transport import SerialTransport
+from rti_rig.drivers.led_dome.transport import SerialTransport, TransportError
 from rti_rig.runtime.controller import EmergencyStop
 from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan
 from rti_rig.simulator.domes import board_for
@@ -126,26 +126,57 @@ def test_a_stop_during_the_nab_all_off_finishes_it_without_resetting_the_board()
     assert board.lit_once_booted() == frozenset()
 
 
+#: What a Nab board whose port failed after its ``<0>`` was written is said to be (it had been
+#: told "could NOT be sent" of an all-off its board received).
+_SENT_PORT_FAILED = "the all-off was sent, but not acknowledged (the port failed"
+
+
 def test_a_stop_then_a_port_failure_in_the_nab_all_off_is_a_stop_not_a_success() -> None:
-    """A Ctrl-C while the Nab board boots, then the port fails as the all-off is sent (a USB
-    drop): it had ended as a probe that succeeded (exit 0, "Found: nab-rti-v1"), and then as
-    "the dome's state is not known" of a sketch that boots lit."""
+    """A Ctrl-C while the Nab board boots, then the port fails as the all-off arrives (a USB
+    drop as the board receives ``<0>``: written, the failure in the listen after it): it had
+    ended as a probe that succeeded (exit 0, "Found: nab-rti-v1"), then as "the dome's state is
+    not known" of a sketch that boots lit, then as "could NOT be sent" of a ``<0>`` written."""
     board = board_for("nab-rti-v1", faults=FaultPlan((Fault(1, FaultKind.DISCONNECT),)))
     code, said = _probe(board, "nab-rti-v1", signal.SIGINT, lambda: _boots(board) >= 1)
     assert code == 130, said
-    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on and the all-off " in said
-    assert "could NOT be sent" in said and "may be fully lit" in said, said
-    assert "Traceback" not in said, said
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on and " in said, said
+    assert _SENT_PORT_FAILED in said and "the dome may still be lit" in said, said
+    assert "could NOT be sent" not in said and "Traceback" not in said, said
 
 
-def test_a_nab_board_whose_all_off_could_not_be_sent_does_not_exit_0() -> None:
-    """No stop: the port fails as the found Nab board is sent its all-off, so the dome may be
-    fully lit; the probe had exited 0 under "Found: nab-rti-v1"."""
+def test_a_nab_board_whose_port_failed_after_its_all_off_does_not_exit_0() -> None:
+    """No stop: the port fails as the found Nab board receives its all-off (written, the
+    failure in the listen after it), so the dome may be lit; the probe had exited 0 under
+    "Found: nab-rti-v1", then said "could NOT be sent" of a ``<0>`` written."""
     board = board_for("nab-rti-v1", faults=FaultPlan((Fault(1, FaultKind.DISCONNECT),)))
     code, said = _probe(board, "nab-rti-v1", None)
     assert code == 1, said
+    assert _SENT_PORT_FAILED in said and "the dome may still be lit" in said, said
+    assert "could NOT be sent" not in said and "Traceback" not in said, said
+
+
+def test_a_nab_board_whose_all_off_write_failed_says_it_could_not_be_sent(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The port fails in the write of ``<0>`` itself (it never left): "could NOT be sent", not
+    "sent, but not acknowledged"; exit 1. The failure is raised where the write would fail."""
+    real_write = SerialTransport.write
+    failed: list[bytes] = []
+
+    def write_fails_on_all_off(self: SerialTransport, data: bytes) -> None:
+        if data == b"<0>":
+            failed.append(data)
+            raise TransportError(f"write to {self.port} failed: [Errno 5] Input/output error")
+        real_write(self, data)
+
+    monkeypatch.setattr(SerialTransport, "write", write_fails_on_all_off)
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and failed == [b"<0>"], said
     assert "the all-off could NOT be sent" in said and "may be fully lit" in said, said
-    assert "Traceback" not in said, said
+    assert "not acknowledged" not in said and "Traceback" not in said, said
 
 
 def test_a_stop_inside_the_opening_at_9600_reopens_the_port_and_switches_the_nab_dome_off(
@@ -427,3 +458,17 @@ def test_a_stop_held_over_the_nab_sketchs_own_opening_is_finished_on_that_port(
     assert result.lights_state is probe_usecase.LightsState.OFF_ACKNOWLEDGED, result.lines()
     assert result.openings == 1 and _boots(board) == 1, board.events
     assert board.lit_once_booted() == frozenset()
+
+
+def test_an_all_off_written_before_a_later_opening_is_not_said_sent() -> None:
+    """A ``<0>`` written on an earlier opening, the port failing after a later one (a stop's
+    teardown reopening it: a reset, every LED lit again): "could NOT be sent", not "sent"."""
+    result = probe_usecase.ProbeResult("/dev/ttyNAB", profile="nab-rti-v1", openings=1)
+    result.off_written_at_opening = 1
+    probe_usecase._nab_not_off(result, TransportError("read failed"))
+    assert result.lights_state is probe_usecase.LightsState.OFF_SENT_PORT_FAILED, result.lights
+    assert _SENT_PORT_FAILED + " (read failed))" in result.lights, result.lights
+    result.openings = 2
+    probe_usecase._nab_not_off(result, TransportError("open failed"))
+    assert result.lights_state is probe_usecase.LightsState.OFF_NOT_SENT, result.lights
+    assert "the all-off could NOT be sent (open failed)" in result.lights, result.lights

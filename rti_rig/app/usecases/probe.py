@@ -99,6 +99,9 @@ class LightsState(Enum):
     OFF_NOT_ACKNOWLEDGED = auto()
     #: The Nab sketch, lit at boot: its all-off could not be sent (the port failed).
     OFF_NOT_SENT = auto()
+    #: The Nab sketch, lit at boot: its all-off was written, then the port failed before an
+    #: acknowledgement (said "could NOT be sent", of an all-off the board may have obeyed).
+    OFF_SENT_PORT_FAILED = auto()
 
 
 class ProbeFailure(Enum):
@@ -150,6 +153,10 @@ class ProbeResult:
     note: str | None = None
     #: How many times a port opening was attempted (each resets a board like an Arduino).
     openings: int = 0
+    #: The opening (its number in :attr:`openings`) on which the Nab sketch's all-off was last
+    #: written (0: never): a port failing after it says "sent, but not acknowledged" only while
+    #: no opening since has reset the board, lit again.
+    off_written_at_opening: int = 0
     #: What the port's path is when it is no serial port ("is a regular file" …; None: it
     #: may be one), said in place of advice to check the dome's cable and power.
     not_serial: str | None = None
@@ -500,12 +507,12 @@ def _reopened_at_nab_rate(result: ProbeResult, wait_s: float) -> None:
 
 def _teardown_failed(result: ProbeResult, failed: TransportError) -> None:
     """Say a port that failed during a stop's teardown: a board named as the Nab sketch
-    booted lit and its all-off could not be sent (it may be fully lit); else the dome's state
-    is not known. The sketch's case had been told "the dome's state is not known" once its
-    all-off was sent on the port the stop found open."""
+    booted lit and its all-off was not acknowledged, sent or not (:func:`_nab_not_off`: it may
+    be lit); else the dome's state is not known. The sketch's case had been told "the dome's
+    state is not known" once its all-off was sent on the port the stop found open."""
     result.error = ProbeError(ProbeFailure.PORT_FAILED, str(failed))
     if result.profile == _NAB_NAME and result.lights_state is not LightsState.OFF_ACKNOWLEDGED:
-        _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(failed))
+        _nab_not_off(result, failed)
     else:
         _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
 
@@ -623,7 +630,7 @@ def _nab_off_on_open_port(
         if stop is None:
             raise  # the probe's own handler says it (the dome may be lit; exit 1)
         result.error = ProbeError(ProbeFailure.PORT_FAILED, str(exc))
-        _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(exc))
+        _nab_not_off(result, exc)
         raise ProbeStopped(stop, result) from None
     if stop is not None:
         raise ProbeStopped(stop, result) from None
@@ -635,11 +642,26 @@ def _nab_running(text: str) -> bool:
     return bool(_NAB_READY.search(text) or _NAB_UNKNOWN_CODE.search(text))
 
 
-def _nab_not_off(exc: TransportError) -> str:
-    """The lights of a Nab board whose all-off could not be sent (it booted, lit)."""
-    return (
-        f"the sketch boots with every LED on and the all-off could NOT be sent ({exc}): the "
-        "dome may be fully lit; switch it off at its power supply"
+def _nab_not_off(result: ProbeResult, exc: TransportError | None = None) -> None:
+    """Say the lights of a Nab board (it booted, lit) whose port failed (``exc``) before its
+    all-off was acknowledged: "sent, but not acknowledged" if ``<0>`` was written since the
+    last opening (:attr:`ProbeResult.off_written_at_opening`), else "could NOT be sent". A
+    port that failed in the listen after the write had been told "could NOT be sent"."""
+    why = "" if exc is None else f" ({exc})"
+    if result.off_written_at_opening and result.off_written_at_opening == result.openings:
+        _say_lights(
+            result,
+            LightsState.OFF_SENT_PORT_FAILED,
+            f"the sketch boots with every LED on and the all-off was sent, but not "
+            f"acknowledged (the port failed{why}): the dome may still be lit; look at it, and "
+            "switch it off at its power supply if it is",
+        )
+        return
+    _say_lights(
+        result,
+        LightsState.OFF_NOT_SENT,
+        f"the sketch boots with every LED on and the all-off could NOT be sent{why}: the "
+        "dome may be fully lit; switch it off at its power supply",
     )
 
 
@@ -659,6 +681,7 @@ def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
         (_ALL_OFF_AGAIN_SAID.format(command=command), 1.2),
     ):
         t.write(_NAB_ALL_OFF)
+        result.off_written_at_opening = result.openings
         off = _listen(t, listen_s, until=_NAB_OFF_SAYS).decode("latin-1")
         result.heard.append(Heard(what, t.baudrate, off))
         if _NAB_OFF_SAYS.search(off):
@@ -929,7 +952,7 @@ def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
             _nab_found(result, wait)
         except TransportError as exc:
             result.error = ProbeError(ProbeFailure.PORT_FAILED, str(exc))
-            _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(exc))
+            _nab_not_off(result, exc)
     elif result.profile is not None or result.error is not None:
         # the probe had concluded (another firmware found, or the port failed), the stop coming
         # as it returned: its lights stand ("stopped before a firmware answered … look at the
@@ -1044,12 +1067,7 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
         )
         if result.profile == _NAB_NAME:
             # it answered, so it booted, and it boots with every LED on
-            _say_lights(
-                result,
-                LightsState.OFF_NOT_SENT,
-                "the sketch boots with every LED on and the all-off could NOT be sent: the dome "
-                "may be fully lit; switch it off at its power supply",
-            )
+            _nab_not_off(result)
         elif result.heard:
             sent = ", ".join(heard.label for heard in result.heard)
             _say_lights(
