@@ -640,7 +640,6 @@ class QAReport:
                     "lights): not named one by one, since wrong lights alone explain that"
                 )
             if named or self.lost_unfitted:
-                lost = [f"{n} (lost since capture, not fitted)" for n in self.lost_unfitted]
                 whatever = [f"{c.name} ({'; '.join(c.problems)})" for c in named]
                 head += f"; {self.verdict_word} whatever the lights: " + ", ".join(whatever + lost)
             light = f"; {self.light_note}" if self.light_note else ""

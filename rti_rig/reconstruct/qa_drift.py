@@ -93,7 +93,6 @@ class EdgeImages:
     caller that moves images back makes a new one."""
 
     def __init__(self, crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> None:
-        self.shape = crops.shape
         self.edges = [edge_image(c) if usable[i] else None for i, c in enumerate(crops)]
         self.have = [i for i in range(crops.shape[0]) if self.edges[i] is not None]
         self._median_all: NDArray[np.float32] | None = None
