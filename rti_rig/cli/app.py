@@ -11,6 +11,7 @@ import math
 import os
 import shlex
 import signal
+import sys
 
 import typer
 from rich.console import Console
@@ -162,8 +163,6 @@ def shell_word(path: object) -> str:
 
 def _printable_as_is(text: str) -> bool:
     """Whether both standard streams' encodings hold every character of ``text``."""
-    import sys
-
     for stream in (sys.stdout, sys.stderr):
         try:
             text.encode(getattr(stream, "encoding", None) or "utf-8")
@@ -428,8 +427,6 @@ class ReaderGoneTolerant:
             self._reader_gone(exc)
 
     def _reader_gone(self, exc: OSError | None = None) -> None:
-        import os
-
         if exc is not None and not isinstance(exc, BrokenPipeError) and self._said_on:
             said_on, self._said_on = self._said_on, None  # said once
             try:
@@ -459,7 +456,9 @@ class WritableWaited(io.RawIOBase):
     CI runners; the flag is on the pipe, shared with the child) made a write to a full pipe
     raise ``BlockingIOError``: taken as output that cannot be written, every word after it was
     dropped. Retrying above Python's text stream cannot work: its buffer forgets how much of
-    a failed write went out. Here, below the buffer, the count written is exact."""
+    a failed write went out. Here, below the buffer, the count written is exact. Closing it
+    leaves the descriptor open (``RawIOBase.close`` closes none): it is the process's stdout or
+    stderr, not ours."""
 
     def __init__(self, fd: int) -> None:
         super().__init__()
@@ -473,12 +472,9 @@ class WritableWaited(io.RawIOBase):
 
     def isatty(self) -> bool:
         """A terminal still: a non-blocking terminal keeps its colour and progress bar."""
-        import os
-
         return os.isatty(self._fd)
 
     def write(self, data) -> int:  # type: ignore[no-untyped-def,override]
-        import os
         import select
 
         while True:
@@ -487,16 +483,10 @@ class WritableWaited(io.RawIOBase):
             except BlockingIOError:
                 select.select([], [self._fd], [])  # the reader made room (or left: EPIPE next)
 
-    def close(self) -> None:
-        """Leave the descriptor open: it is the process's stdout or stderr, not ours."""
-        super().close()
-
 
 def waiting_when_nonblocking(stream):  # type: ignore[no-untyped-def]
     """``stream`` itself, or, where its descriptor is non-blocking, a text stream of the same
     encoding and buffering that writes through :class:`WritableWaited`."""
-    import os
-
     try:
         fd = stream.fileno()
         if os.get_blocking(fd):
@@ -523,8 +513,6 @@ def reader_gone_tolerated() -> None:
     Why ``sys.stdout`` and ``sys.stderr`` too: a word written past the consoles to a stream
     that failed raised from wherever it was written: ``run --nope 2>/dev/full`` exited 1 (a
     fault rti-rig did not name), not the usage error's 2."""
-    import sys
-
     stdout = waiting_when_nonblocking(sys.stdout)
     stderr = waiting_when_nonblocking(sys.stderr)
     sys.stdout = out.file = ReaderGoneTolerant(stdout, said_on=stderr)  # type: ignore[assignment]
