@@ -209,8 +209,10 @@ class _Server:
     def __init__(self, device: PtyDevice, link_path: Path, stop: threading.Event) -> None:
         self.device = device
         # what the device declares, decided once: a runtime-checkable protocol's isinstance
-        # walks its members each time (about 50 us on Python 3.11, against 0.3 us for the
-        # hasattr it replaced), and the loop below passes every 10 ms or sooner
+        # walks its members each time; measured on a Board (timeit, Python 3.11, a loaded
+        # 2-core machine), the two checks took 36-52 us a pass together (one 11-28 us),
+        # against 0.3-0.5 us for the hasattr + getattr pair they replaced, and the loop below
+        # passes every 10 ms or sooner
         self.host_baud_device = device if isinstance(device, HostBaudDevice) else None
         self.ticking_device = device if isinstance(device, TickingDevice) else None
         self.link_path = link_path
