@@ -19,7 +19,7 @@ from rti_rig.reconstruct.qa import (
     MIRRORED_SAID,
     assess,
 )
-from rti_rig.reconstruct.qa_directions import neighbour_likeness
+from rti_rig.reconstruct.qa_directions import LIKENESS_MAX_NEIGHBOUR_DEG, neighbour_likeness
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 
 N = 24
@@ -80,3 +80,20 @@ def test_the_right_lights_are_not_mirrored(sphere) -> None:  # type: ignore[no-u
     frames, lights = sphere
     qa = assess(frames, lights, [f"image{k:02d}.tif" for k in range(N)])
     assert not qa.lights_mirrored and qa.mirror_ratio >= MIRROR_RATIO, qa.mirror_ratio
+
+
+def test_lights_far_apart_are_not_judged_by_likeness() -> None:
+    """Images under lights 40° apart need not look alike (a real gilded icon's 9 replayed
+    lights, every one right, read as a shuffled .lp): the likeness is not measured there."""
+    rng = np.random.default_rng(3)
+    stack = rng.random((9, 32, 32)).astype(np.float32)
+    el = np.radians(10.0)  # low: 40° of azimuth is about 39° between neighbours
+    az = np.radians(np.arange(9) * 40.0)
+    sparse = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.full(9, np.sin(el))], 1)
+    assert np.isnan(neighbour_likeness(stack, sparse))
+    dense_az = np.radians(np.arange(9) * 8.0)
+    dense = np.stack(
+        [np.cos(el) * np.cos(dense_az), np.cos(el) * np.sin(dense_az), np.full(9, np.sin(el))], 1
+    )
+    assert LIKENESS_MAX_NEIGHBOUR_DEG > 8.0
+    assert not np.isnan(neighbour_likeness(stack, dense))
