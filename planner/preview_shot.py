@@ -45,6 +45,7 @@ def preview_schedule(
     geometry: DomeGeometry | ArmGeometry,
     az_el_deg: tuple[float, float] | None = None,
     band: tuple[float, float] = FULL_BAND_DEG,
+    shot_as: str = "",
 ) -> tuple[LightSchedule, list[str]]:
     """A one-step schedule lighting from ``az_el_deg`` on this rig, and notes for the user.
 
@@ -59,6 +60,12 @@ def preview_schedule(
     then takes its nearest LED in the band, preferring the paper's band only where the two
     overlap by more than an edge); a light asked for outside the band is refused, naming the
     option; a dome fires only an LED in the band, the nearest to the light asked for.
+
+    A note names a dome's LED by its number (as ``check`` and the dome's errors count them,
+    from 0) and where it lights from, and ``shot_as``, the file the preview writes under it,
+    where given. Why not by its name in the dome's ``.lp``: that is the image name of another
+    acquisition ("led_036.jpg"), and the preview's image was ``image_001.jpg``: a user looked
+    for a file the preview never wrote.
     """
     lo_band, hi_band = band
     if isinstance(geometry, ArmGeometry):
@@ -108,9 +115,10 @@ def preview_schedule(
         d = geometry.directions[led]
         if off > SNAP_TOLERANCE_DEG:
             got_az, got_el = (float(v) for v in az_el_from_direction(d))
+            shot = f"; the preview's {shot_as} is shot under it" if shot_as else ""
             notes.append(
-                f"no LED at az {az:g}°, el {el:g}°: {which}, {geometry.names[led]} "
-                f"(az {got_az:.1f}°, el {got_el:.1f}°), is {off:.1f}° away"
+                f"no LED at az {az:g}°, el {el:g}°: {which}, LED {led} "
+                f"(az {got_az:.1f}°, el {got_el:.1f}°), is {off:.1f}° away{shot}"
             )
         schedule = LightSchedule.from_directions(
             [d], leds=[led], labels=[geometry.names[led]], method="preview", provenance=prov

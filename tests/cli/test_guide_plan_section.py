@@ -29,8 +29,8 @@ def test_the_guides_preview_and_plan_claims_are_what_the_shipped_dome_prints(
     tmp_path: Path,
 ) -> None:
     guide = _section_5()
-    nearest = re.search(r"here `(led_\d+)`, ([\d.]+)° away", guide)
-    banded = re.search(r"chosen within it \(here `(led_\d+)`, at ([\d.]+)°\)", guide)
+    nearest = re.search(r"here `(LED \d+)`, ([\d.]+)° away", guide)
+    banded = re.search(r"chosen within it \(here `(LED \d+)`, at ([\d.]+)°\)", guide)
     first_line = re.search(r"prints what it assumed and what it expects, e\.g\. `([^`]+)`", guide)
     assert nearest and banded and first_line, guide
 

@@ -41,7 +41,7 @@ def test_dome_preview_uses_the_nearest_led_and_says_how_far_it_is() -> None:
     assert notes == []
     schedule, notes = preview_schedule(dome, (135.0, 80.0))
     assert schedule.steps[0].led == 3
-    assert any("nearest, d" in n and "5.0° away" in n for n in notes)
+    assert any("nearest, LED 3 (" in n and "5.0° away" in n for n in notes)
     assert any("85° elevation: outside 30–70°" in n for n in notes)
     assert schedule.provenance["wanted_az_el_deg"] == [135.0, 80.0]
 
@@ -60,7 +60,7 @@ def test_default_dome_preview_stays_in_the_paper_s_band_when_it_can() -> None:
     # a dome with no LED in the band falls back to its nearest LED
     schedule, notes = preview_schedule(DomeGeometry(dome.directions[[0, 3]], ("low", "far")))
     assert schedule.steps[0].label == "low"
-    assert any("the nearest, low" in n for n in notes)
+    assert any("the nearest, LED 0 (" in n for n in notes)
 
 
 def test_arm_preview_goes_where_asked_or_names_the_limit() -> None:
@@ -87,7 +87,7 @@ def test_a_preview_keeps_to_the_elevation_band_it_is_given() -> None:
     assert schedule.steps[0].label == "low"
     assert schedule.provenance["wanted_az_el_deg"] == [135.0, 45.0]
     assert schedule.provenance["elevation_band_deg"] == [0.0, 45.0]
-    assert any("el 45°: the nearest in the band, low" in n for n in notes), notes
+    assert any("el 45°: the nearest in the band, LED 1 " in n for n in notes), notes
     # the paper's band is preferred where it is part of the band, not where it is its edge
     # ("far", at 45° across the dome, is not taken under the 45° ceiling)
     assert preview_schedule(dome, band=(45.0, 90.0))[0].steps[0].label == "paper"
@@ -97,13 +97,13 @@ def test_a_preview_keeps_to_the_elevation_band_it_is_given() -> None:
     assert schedule.steps[0].label == "at 54"
     assert notes == [
         "no LED at az 135°, el 50°: the nearest at 45–55° (the paper's band within yours), "
-        "at 54 (az 150.0°, el 54.0°), is 10.0° away"
+        "LED 0 (az 150.0°, el 54.0°), is 10.0° away"
     ]
     assert preview_schedule(dome, band=(30.0, 45.0))[0].steps[0].label == "low"
     # a light asked for in the band: the nearest LED in the band, not the nearest overall
     schedule, notes = preview_schedule(dome, (135.0, 46.0), band=(0.0, 46.0))
     assert schedule.steps[0].label == "low"  # "paper" (50°) is nearer, above the band
-    assert any("the nearest in the band, low" in n for n in notes), notes
+    assert any("the nearest in the band, LED 1 " in n for n in notes), notes
     with pytest.raises(ScheduleError) as exc:
         preview_schedule(dome, (135.0, 50.0), band=(0.0, 45.0))
     assert "--light 135,50: its elevation 50° is above --max-elevation-deg 45 (the band 0–45°)" in (

@@ -1874,6 +1874,7 @@ def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> Op
         rig_geometry(loaded),
         req.light_az_el_deg,
         (req.min_elevation_deg, req.max_elevation_deg),
+        shot_as=f"{image_names(1)[0]}.jpg",  # the file its one step writes
     )
     for note in notes:
         on_note(Note(note, "warning"))
