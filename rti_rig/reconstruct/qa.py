@@ -2466,7 +2466,10 @@ def _evidence(
                 if mv:
                     mv = _confirmed_shift(pred, crop_arr[a], dx, dy, valid & ~crop_sat[a])[0]
                 moved[a], drift[a] = mv, (dx, -dy)
-        if pairs:
+        # said only where the pair is named: under lights likely wrong (likeness) the verdict
+        # names no image for its light (QAReport.named), and "a swapped pair is still named"
+        # had been said beside it of a pair it did not name
+        if pairs and not likeness >= LIKENESS_UNORDERED:
             note = _and_note(
                 note,
                 "a swapped pair is still named where each image is rendered clearly closer "

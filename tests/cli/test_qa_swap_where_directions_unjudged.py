@@ -72,3 +72,33 @@ def test_the_correct_session_has_no_swap(industrial: Path, tmp_path: Path) -> No
     qa = _qa(industrial, tmp_path / "f")
     assert not _wrong(qa), qa["verdict"]
     assert "swapped" not in qa["verdict"], qa["verdict"]
+
+
+def test_a_shuffled_lp_names_no_swapped_pair_nor_says_one_is(
+    industrial: Path, tmp_path: Path
+) -> None:
+    """Its lights.lp shuffled (seed 2), the verdict leads with lights likely wrong and names no
+    image for its light; it had still said "a swapped pair is still named where each image is
+    rendered clearly closer …" of a pair it did not name."""
+    import numpy as np
+
+    from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
+    session = tmp_path / "shuffled"
+    shutil.copytree(industrial, session)
+    entries = read_lp(session / "lights.lp")
+    order = np.random.default_rng(2).permutation(len(entries))
+    write_lp(
+        session / "lights.lp",
+        [LpEntry(e.name, entries[k].direction) for e, k in zip(entries, order, strict=True)],
+    )
+    r = runner.invoke(
+        app,
+        ["fit", str(session), "--out", str(tmp_path / "f"), "--no-ptm", "--no-hsh", "--no-normals"],
+    )
+    assert r.exit_code == 0, r.output
+    qa = json.loads((tmp_path / "f" / "qa.json").read_text())
+    assert qa["lights_likely_wrong"] is True, qa["verdict"]
+    assert not _wrong({"images": [c for c in qa["images"] if c["name"] in qa["reshoot"]]})
+    assert "swapped pair" not in " ".join(r.output.split()), r.output
+    assert not any("swapped pair" in c for c in qa["caveats"]), qa["caveats"]
