@@ -150,3 +150,45 @@ def test_a_records_folder_left_is_a_trace_too(imported: Path, tmp_path: Path) ->
     text, _ = qa_of(acq / imported.name, tmp_path / "fit")
     assert "the session record is missing" in text and "a records/ folder" in text, text
     assert "an imported acquisition" not in text, text
+
+
+def _shuffled(session: Path) -> Path:
+    """``session`` with its lights.lp's directions shuffled among its images (seed 1)."""
+    entries = read_lp(session / "lights.lp")
+    order = np.random.default_rng(1).permutation(len(entries))
+    write_lp(
+        session / "lights.lp",
+        [LpEntry(e.name, entries[k].direction) for e, k in zip(entries, order, strict=True)],
+    )
+    return session
+
+
+def test_an_imported_acquisition_with_a_shuffled_lp_is_told_of_no_images_named(
+    tmp_path: Path,
+) -> None:
+    """Its lights likely wrong, the verdict names no image for what its lights explain, yet
+    the imported acquisition's note ("the problems named are its images' … leave the images
+    named out of the .lp") was said beside it; its images' problems in qa.json still carry no
+    advice to reshoot."""
+    session, _, _ = make_session(tmp_path / "s", size=(64, 80))
+    lp = as_imported(_shuffled(session), tmp_path / "acquisition")
+    text, qa = qa_of(lp, tmp_path / "fit")
+    assert "QA verdict: lights likely wrong: " in text, text
+    assert qa["reshoot"] == [], qa["verdict"]
+    assert "an imported acquisition" not in text and "images named" not in text, text
+    assert any(c["problems"] for c in qa["images"]), qa["verdict"]  # checked, not named
+    for c in qa["images"]:
+        assert not any("reshoot" in p for p in c["problems"]), c["problems"]
+
+
+def test_a_clipped_image_of_a_shuffled_imported_acquisition_keeps_the_note(
+    shot: Path, tmp_path: Path
+) -> None:
+    """Whatever the lights, a clipped image is named: the note and its word stay."""
+    session = tmp_path / "s"
+    shutil.copytree(shot, session)
+    lp = as_imported(_shuffled(session), tmp_path / "acquisition")
+    text, qa = qa_of(lp, tmp_path / "fit")
+    assert "; flawed whatever the lights: image05 (saturated" in text, text
+    assert "an imported acquisition" in text, text
+    assert qa["reshoot"] == ["image05"], qa["verdict"]

@@ -299,7 +299,10 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
         return advice.replace("the recording", f"the recording, {recorded[name]}", 1)
 
     qa = qa.with_advice(said)
-    return replace(qa, session_note=note if qa.reshoot else "", verdict_word=word)
+    # the note speaks of the images named: none under lights likely wrong, where problems
+    # remain that the lights explain (QAReport.named)
+    named = bool(qa.named or qa.lost_unfitted)
+    return replace(qa, session_note=note if named else "", verdict_word=word)
 
 
 #: What a replayed acquisition is told in place of each reshoot advice but the clipped one's
@@ -348,8 +351,17 @@ def _with_imported(qa: QAReport) -> QAReport:
     session record beside them) can follow. Why: its images were shot elsewhere, often long
     ago, of an object no longer under any dome; "reshoot: image01 (... reshoot with less
     exposure)" of a published archive acquisition told its user to do what nobody can. The
-    problems are still named, as the acquisition's ("flawed"), with what they cost the fit."""
+    problems are still named, as the acquisition's ("flawed"), with what they cost the fit.
+
+    Every image's advice is replaced (``qa.json`` lists each image's problems, named in the
+    verdict or not), the note and the verdict's word only where the verdict names an image
+    (:attr:`QAReport.named`): under lights likely wrong it names none for what its lights
+    explain, and the note of "the images named" had been said of a shuffled ``.lp`` that
+    named none."""
     if not qa.reshoot:
+        return qa
+    qa = qa.with_advice(lambda _name, phrase: IMPORTED_ADVICE[phrase])
+    if not qa.named and not qa.lost_unfitted:
         return qa
     note = (
         "an imported acquisition (an .lp with no rti-rig session record beside it): the "
@@ -357,7 +369,6 @@ def _with_imported(qa: QAReport) -> QAReport:
         "photographed again (a clipped image with less exposure), else leave the images named "
         "out of the .lp (or keep them and accept what they cost the fit)"
     )
-    qa = qa.with_advice(lambda _name, phrase: IMPORTED_ADVICE[phrase])
     return replace(_noted(qa, note), verdict_word="flawed")
 
 
