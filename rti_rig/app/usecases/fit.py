@@ -346,6 +346,30 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     return frames
 
 
+def _resume_words(source: Path) -> str:
+    """How to continue ``source`` (a session folder or an ``.lp`` in one) where it is an
+    rti-rig session that did not finish (its manifest records no completed end); "" otherwise.
+
+    Why: a session stopped after 2 of 12 images was told by ``fit`` "shoot more lights", and
+    not that ``run --resume`` shoots the rest of the lights it planned (or, where no resume
+    can continue it, what to do instead: :func:`unresumable`)."""
+    folder = source if source.is_dir() else source.parent
+    try:
+        manifest = read_manifest(folder)
+    except RtiRigError:
+        return ""
+    runner = manifest.get("runner") or {}
+    if not isinstance(runner, dict) or runner.get("finish_reason") == "completed":
+        return ""
+    instead = unresumable(folder)
+    if instead is not None:
+        return f"the session is not finished: {instead}"
+    return (
+        "the session is not finished: continue it with rti-rig run --resume "
+        f"{shlex.quote(str(folder))}"
+    )
+
+
 def _layout_words(shape: tuple[int, ...]) -> str:
     """An image's size and kind as a user reads them (``402x395 colour``), not a numpy shape."""
     return f"{shape[1]}x{shape[0]} {'colour' if len(shape) == 3 else 'greyscale'}"
@@ -999,10 +1023,14 @@ def _fit_all(
                 stack, lights, max_pixels=sample_size(stack), candidates=candidates
             )
         except ReconstructionError as exc:
+            resume = _resume_words(Path(req.source))
             if n < FIT_MINIMUMS.normal:  # no normal either: the choice's refusal stands
-                raise
+                if not resume:
+                    raise
+                raise FitInputError(f"{exc}; {resume}") from None
             raise FitInputError(
                 f"--model auto: {exc}. "
+                + (f"{resume[0].upper()}{resume[1:]}. " if resume else "")
                 + (
                     f"Nor can photometric stereo be fitted: {undetermined}; "
                     + auto_way_out(AutoFit(n, normals_determined=False))
