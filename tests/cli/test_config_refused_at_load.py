@@ -130,6 +130,7 @@ def test_auto_exposure_meters_no_longer_than_the_window_holds(
         def __init__(self) -> None:
             self.loaded = loaded
             self.camera_config = loaded.config.camera
+            self.camera = object()  # a camera with no shutter-speed list of its own
             self.lighting = UnlimitedLighting()
 
     def planned():  # type: ignore[no-untyped-def]

@@ -255,12 +255,19 @@ def test_a_missing_manifest_is_said_by_fit(session: Path, tmp_path: Path) -> Non
     assert r.exit_code == 2, r.output
     assert f"{s} is a session folder without its manifest.json" in said(r), said(r)
     assert "restore manifest.json from a backup copy" in said(r)
-    # a folder of images and an .lp that never was a session (no journal) gets no such note
+    # a folder of images and an .lp that never was a session (no journal, and none of the
+    # image_NNN names rti-rig gives, which are said as a session whose record is lost) gets
+    # no such note
     plain = tmp_path / "plain"
     plain.mkdir()
-    for f in s.glob("image_*.jpg"):
-        shutil.copy(f, plain / f.name)
-    shutil.copy(s / "lights.lp", plain / "lights.lp")
+    from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
+    renamed = []
+    for e in read_lp(s / "lights.lp"):
+        name = "photo_" + e.name.removeprefix("image_")
+        shutil.copy(s / e.name, plain / name)
+        renamed.append(LpEntry(name, e.direction))
+    write_lp(plain / "lights.lp", renamed)
     r = runner.invoke(app, ["fit", str(plain), "--out", str(tmp_path / "fit2")])
     assert r.exit_code == 0, r.output
     assert "manifest.json" not in said(r)
