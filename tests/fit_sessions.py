@@ -50,6 +50,8 @@ def make_session(
     swap: tuple[int, int] | None = None,
     move: tuple[int, int, int] | None = None,  # (from image, dx, dy) pixels
     saturate: int | None = None,
+    saturate_gain: float = 6.0,
+    saturate_channel: int | None = None,  # that channel only (a red object under a warm LED)
     black: int | None = None,  # a misfire that left a black frame (constant 2 of 65535)
     swaps: tuple[tuple[int, int], ...] = (),  # more swapped pairs
     lights: np.ndarray | None = None,
@@ -70,8 +72,10 @@ def make_session(
         value = img / peak * 0.8
         if misfire == k:
             value = value * 0.03
-        if saturate == k:
-            value = value * 6.0
+        if saturate == k and saturate_channel is None:
+            value = value * saturate_gain
+        elif saturate == k:
+            value[..., saturate_channel] *= saturate_gain
         if move is not None and k >= move[0]:
             value = np.roll(value, shift=(-move[2], move[1]), axis=(0, 1))
         value = value + rng.normal(0.0, 0.002, value.shape)

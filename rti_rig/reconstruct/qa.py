@@ -854,22 +854,34 @@ def _reduced(
 
 def _crop_stack(
     frames: Sequence[ArrayLike], rs: slice, cs: slice, saturation: float
-) -> NDArray[np.float32]:
-    """The crop ``rs``, ``cs`` of every frame, grey, as a fraction of ``saturation`` (N, h, w).
+) -> tuple[NDArray[np.float32], NDArray[np.bool_]]:
+    """The crop ``rs``, ``cs`` of every frame, grey, as a fraction of ``saturation`` (N, h, w),
+    and which of its pixels are clipped: any channel at ``saturation`` (N, h, w).
 
-    Filled in place and scaled in place: a list of the crops, its stack and the scaled stack
-    had held three copies of every image's crop at once (the same values: each is one
-    float32 division by the same float32 scale)."""
+    The clipped mask is taken per channel, in the same pass: a red object under a warm LED
+    clips its red channel while its grey mean stays well below full scale, and a mask taken
+    on the grey crop (as it had been) called such an image unclipped, judged its light
+    direction on the clipped pixels and named it a "wrong light". Filled in place and scaled
+    in place: a list of the crops, its stack and the scaled stack had held three copies of
+    every image's crop at once (the same values: each is one float32 division by the same
+    float32 scale)."""
     n = len(frames)
     out: NDArray[np.float32] | None = None
+    clipped: NDArray[np.bool_] | None = None
     for i, f in enumerate(frames):
-        g = _grey(np.asarray(f[rs])[:, cs])
+        a = np.asarray(f[rs])[:, cs]
+        g = _grey(a)
         if out is None:
             out = np.empty((n, *g.shape), np.float32)
+            clipped = np.zeros((n, *g.shape), bool)
         out[i] = g
-    assert out is not None  # validate_lights refused an empty acquisition
+        if np.isfinite(saturation):
+            top = a if a.ndim == 2 else np.fmax.reduce(a.reshape(*a.shape[:2], -1), axis=-1)
+            assert clipped is not None
+            clipped[i] = top >= saturation
+    assert out is not None and clipped is not None  # validate_lights refused an empty one
     out /= np.float32(saturation if np.isfinite(saturation) else 1.0)
-    return out
+    return out, clipped
 
 
 #: The crop moves off the centre only when its window holds this many times the centre's lit
@@ -1477,9 +1489,9 @@ def assess(
     # go before the crop is read, so the two stacks are never held at once
     level = small.reshape(n, -1).mean(axis=1, dtype=np.float64)
     del small, small_sat
-    crop_arr = _crop_stack(frames, rs, cs, saturation)
+    # clipped where any channel is (a red object under a warm LED), as the first pass judges
+    crop_arr, crop_sat = _crop_stack(frames, rs, cs, saturation)
     sat_level = 1.0 if np.isfinite(saturation) else None
-    crop_sat = crop_arr >= 1.0 if sat_level is not None else np.zeros_like(crop_arr, bool)
     dark_level = dark / saturation if np.isfinite(saturation) else dark
     # Image-to-image drift from edges, where the object holds its edges still under changing
     # light (texture): it needs no fit, so a fit made from moved images cannot hide a move.
