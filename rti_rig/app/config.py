@@ -31,6 +31,7 @@ from rti_rig.core.rig_geometry import (
     ArmGeometry,
     DomeGeometry,
     coincident_leds,
+    default_led_name,
 )
 from rti_rig.core.validation_text import error_text as _error_text
 from rti_rig.core.validation_text import key_of as _key_of
@@ -1427,7 +1428,7 @@ def dome_led_directions(
             f"{az:.1f}°, elevation {el:.1f}°: two LEDs cannot share a direction (a ring at 90° "
             "elevation holds one LED; rings at one elevation need different azimuth offsets)",
         )
-    return dirs, [f"led_{i:03d}" for i in range(len(dirs))]
+    return dirs, [default_led_name(i) for i in range(len(dirs))]
 
 
 def _led_name(dome: DomeConfig, i: int) -> str:

@@ -61,6 +61,13 @@ def repeated_directions(directions: ArrayLike) -> list[list[int]]:
     return groups
 
 
+def default_led_name(index: int) -> str:
+    """The name a dome config without an ``lp_file`` gives LED ``index`` (``led_036``): a
+    machine-readable id kept in plans and manifests (a step's ``label``), never what a user
+    is told (they are told "LED 36", as ``check`` and the dome's errors count LEDs)."""
+    return f"led_{index:03d}"
+
+
 @dataclass(frozen=True, eq=False)
 class DomeGeometry:
     """A dome: LED ``i`` lights from ``directions[i]`` and is called ``names[i]``."""

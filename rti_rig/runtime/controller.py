@@ -26,7 +26,9 @@ from rti_rig.core.devices import (
 )
 from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
+from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.lp_format import MAX_LIGHTS
+from rti_rig.core.rig_geometry import default_led_name
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.runtime.lighting import ArmLighting, Lighting, port_close_failures
 from rti_rig.runtime.rig import Rig
@@ -498,8 +500,7 @@ def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
         if reason is None and not cam.min_exposure_s <= exp <= cam.max_exposure_s:
             reason = f"exposure {exp} s outside [{cam.min_exposure_s}, {cam.max_exposure_s}] s"
         if reason:
-            label = f" ({step.label})" if step.label else ""
-            problems.append(f"step {i + 1}{label}: {reason}")
+            problems.append(f"step {i + 1}{_step_named(step)}: {reason}")
     if problems:
         shown = "\n  ".join(problems[:10])
         more = f"\n  ... and {len(problems) - 10} more" if len(problems) > 10 else ""
@@ -507,6 +508,19 @@ def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
             f"the schedule cannot run on rig '{rig.name}' "
             f"({len(problems)} problem(s)); nothing has moved:\n  {shown}{more}"
         )
+
+
+def _step_named(step: LightStep) -> str:
+    """How a refused step is named to the user: a dome's LED by its number and where it lights
+    from, as the preview's note and ``check`` name it. The step's ``label`` is the dome's
+    machine-readable name for the LED (``led_036``, kept in the manifest), and the refusal had
+    read "step 1 (led_036): ..." beside a note that said "LED 36 (az 112.5°, el 55.0°)"; a
+    name the user gave (a dome ``.lp``'s image name) is still said beside the number."""
+    if step.led is None:
+        return f" ({step.label})" if step.label else ""
+    az, el = (float(v) for v in az_el_from_direction(step.direction))
+    given = f", {step.label}" if step.label and step.label != default_led_name(step.led) else ""
+    return f" (LED {step.led}{given}, az {az:.1f}°, el {el:.1f}°)"
 
 
 def frame_layout(frame: Frame) -> tuple[int, int, bool]:
