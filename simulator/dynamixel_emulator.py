@@ -45,6 +45,7 @@ from rti_rig.core.clock import Clock
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.simulator import dynamixel_models as models
+from rti_rig.simulator.pty_link import HostBaudDevice
 
 #: The registers a servo leaves the factory with, and the field of
 #: :class:`~rti_rig.simulator.dynamixel_models.FactoryTable` that holds each one's value.
@@ -626,8 +627,12 @@ class EmulatedServo:
         return 0
 
 
-class DynamixelBusEmulator:
+class DynamixelBusEmulator(HostBaudDevice):
     """Several servos on one bus: bytes in, status bytes out (thread-safe).
+
+    Declares :class:`~rti_rig.simulator.pty_link.HostBaudDevice`: it hears the host's line
+    speed (``host_baud``), which the pty server sets only on a device that declares it (the
+    server had set the attribute undeclared, unseen by the protocol check).
 
     Fault injection: ``silent_ids`` never answer nor act (a disconnected servo);
     ``corrupt_next_replies`` damages the CRC of that many upcoming status packets;

@@ -46,7 +46,7 @@ import dynamixel_sdk
 from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
-from rti_rig.simulator.pty_link import host_baud
+from rti_rig.simulator.pty_link import HostBaudDevice, host_baud
 
 #: Wall-time bound on a reply wait that is still *not* causally over (bytes lost in the kernel,
 #: a wedged emulator thread): a broken link fails a test in bounded time instead of hanging it.
@@ -140,6 +140,9 @@ class PtyServoServer:
         self, emulator: DynamixelBusEmulator, poll_s: float = 0.02, real_time: bool = True
     ) -> None:
         self.emulator = emulator
+        # told the host's line speed where it declares it (decided once, as pty_link's
+        # server decides: a runtime protocol's isinstance walks its members each time)
+        self.host_baud_device = emulator if isinstance(emulator, HostBaudDevice) else None
         self.poll_s = poll_s
         self.real_time = real_time
         self.device_path: str | None = None
@@ -188,7 +191,8 @@ class PtyServoServer:
                 continue
             # the line speed the host set on its end (a pty pair shares its termios), as the
             # servos hear it: one at another Baud Rate answers nothing
-            self.emulator.host_baud = host_baud(master)
+            if self.host_baud_device is not None:
+                self.host_baud_device.host_baud = host_baud(master)
             reply = self.emulator.receive(data)
             ledger = self.ledger
             if ledger is not None:
