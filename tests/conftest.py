@@ -687,6 +687,19 @@ def line_within(process: subprocess.Popen[AnyStr], seconds: float, what: str) ->
     return line
 
 
+@contextlib.contextmanager
+def ended_on_exit(process: subprocess.Popen[Any]) -> Iterator[subprocess.Popen[Any]]:
+    """``process`` (a command this test started), killed by its own handle and reaped if it
+    is still running when the block is left (a failed assertion, a timeout): no test leaves
+    a child behind. Two subprocess tests had each written this ``finally`` out."""
+    try:
+        yield process
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+
+
 def said(result) -> str:  # type: ignore[no-untyped-def]
     """A CLI result's output with its line wrapping undone (rich wraps to the terminal)."""
     return " ".join(result.output.split())

@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import REPO
+from conftest import REPO, ended_on_exit
 
 #: Linux's fcntl to resize a pipe (``F_SETPIPE_SZ``); Python names it from 3.10 on Linux only.
 F_SETPIPE_SZ = 1031
@@ -64,7 +64,7 @@ def test_help_on_a_full_non_blocking_pipe_is_said_whole(tmp_path: Path) -> None:
             env=env,
         )
     os.close(write_end)
-    try:
+    with ended_on_exit(command):
         # The time a command that drops its words takes to start, find the pipe full and end;
         # a command that waits for room is still waiting when it passes, however loaded the
         # machine (it cannot end before the pipe is read), so this bounds how sure the test
@@ -73,10 +73,6 @@ def test_help_on_a_full_non_blocking_pipe_is_said_whole(tmp_path: Path) -> None:
             command.wait(timeout=5)
         said = _read_all(read_end)
         code = command.wait(timeout=600)
-    finally:
-        if command.poll() is None:
-            command.kill()
-            command.wait()
     errors = (tmp_path / "stderr.txt").read_text()
     assert code == 0, errors
     assert "could not be written" not in errors and "Traceback" not in errors, errors

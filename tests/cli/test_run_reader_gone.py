@@ -15,7 +15,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from conftest import CONFIGS, REPO, line_within
+from conftest import CONFIGS, REPO, ended_on_exit, line_within
 
 
 def test_a_run_piped_into_head_completes_and_exits_0(tmp_path: Path) -> None:
@@ -39,15 +39,11 @@ def test_a_run_piped_into_head_completes_and_exits_0(tmp_path: Path) -> None:
             env=env,
             text=True,
         )
-        try:
+        with ended_on_exit(run):
             # the first line is said before the rig opens: the rest is written to a closed pipe
             assert line_within(run, 300, "the run's first line").startswith("Rig ")
             run.stdout.close()  # type: ignore[union-attr]
             code = run.wait(timeout=600)
-        finally:
-            if run.poll() is None:
-                run.kill()
-                run.wait()
     said = (tmp_path / "stderr.txt").read_text()
     assert code == 0, said
     assert "Traceback" not in said and "BrokenPipe" not in said and "Exception" not in said, said
