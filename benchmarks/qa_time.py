@@ -25,19 +25,12 @@ import numpy as np
 from rti_rig.app.usecases.fit import load_acquisition
 from rti_rig.reconstruct.qa import assess
 from rti_rig.reconstruct.robust_ps import warm_up
-from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
+from rti_rig.reconstruct.synthetic import sphere_frames
 
 
 def rendered(n: int = 48, side: int = 512) -> tuple[list[Any], np.ndarray, list[str]]:
     """A still, correctly lit sphere of ``n`` lights (uint16 RGB, a little noise)."""
-    lights = fibonacci_lights(n, 15.0)
-    normals, _ = sphere_normals(side, side, 0.4)
-    albedo = np.full((side, side, 3), 0.5)
-    rng = np.random.default_rng(0)
-    frames = []
-    for d in lights:
-        img = render(normals, albedo, d[None])[0] * 0.7 + rng.normal(0, 0.002, (side, side, 3))
-        frames.append(np.clip(np.round(img * 65535), 0, 65535).astype(np.uint16))
+    frames, lights = sphere_frames(n, side)
     return frames, lights, [f"image_{i + 1:03d}" for i in range(n)]
 
 

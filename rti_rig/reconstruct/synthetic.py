@@ -60,3 +60,22 @@ def render(
         spec *= shade > 0
         img = img + specular * (spec[..., None] if alb.ndim == 3 else spec)
     return img.astype(np.float32)
+
+
+def sphere_frames(
+    n: int, side: int, specular: float = 0.0, shininess: float = 50.0
+) -> tuple[list[NDArray[np.uint16]], NDArray[np.float64]]:
+    """A still, correctly lit grey sphere under ``n`` :func:`fibonacci_lights` (from 15°):
+    ``n`` uint16 RGB frames of ``side`` px at 70 % of full scale, a little noise (seeded), and
+    the lights. The QA's CPU benchmark (``benchmarks/qa_time.py``) and its memory test time
+    and measure the same frames; each had written its own copy of this loop."""
+    lights = fibonacci_lights(n, 15.0)
+    normals, _ = sphere_normals(side, side, 0.4)
+    albedo = np.full((side, side, 3), 0.5)
+    rng = np.random.default_rng(0)
+    frames = []
+    for d in lights:
+        img = render(normals, albedo, d[None], specular=specular, shininess=shininess)[0] * 0.7
+        img = img + rng.normal(0, 0.002, img.shape)
+        frames.append(np.clip(np.round(img * 65535), 0, 65535).astype(np.uint16))
+    return frames, lights

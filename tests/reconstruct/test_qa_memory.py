@@ -18,7 +18,7 @@ import tracemalloc
 import numpy as np
 
 from rti_rig.reconstruct.qa import assess
-from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
+from rti_rig.reconstruct.synthetic import sphere_frames
 
 SIDE = 96
 #: Bytes per added image pixel the QA's peak may grow by (measured: 20.3 now; 28 with a float64
@@ -28,16 +28,7 @@ BYTES_PER_ADDED_PIXEL = 25
 
 
 def _frames(n: int) -> tuple[list[np.ndarray], np.ndarray]:
-    lights = fibonacci_lights(n, 15.0)
-    normals, _ = sphere_normals(SIDE, SIDE, 0.4)
-    albedo = np.full((SIDE, SIDE, 3), 0.5)
-    rng = np.random.default_rng(0)
-    frames = []
-    for d in lights:
-        img = render(normals, albedo, d[None], specular=0.3, shininess=40.0)[0] * 0.7
-        img = img + rng.normal(0, 0.002, img.shape)
-        frames.append(np.clip(np.round(img * 65535), 0, 65535).astype(np.uint16))
-    return frames, lights
+    return sphere_frames(n, SIDE, specular=0.3, shininess=40.0)
 
 
 def _qa_peak(n: int) -> int:
