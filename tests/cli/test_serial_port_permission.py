@@ -39,6 +39,20 @@ def _refused(port: str) -> serial.SerialException:
     )
 
 
+def _said_refused(monkeypatch: pytest.MonkeyPatch, *args: str) -> str:
+    """What ``rti-rig ARGS`` says where the system refuses every serial port pyserial opens
+    (EACCES, raised where pyserial raises it), its exit status 1 checked."""
+
+    def serial_for_url(url, *args, **kwargs):  # type: ignore[no-untyped-def]
+        raise _refused(url)
+
+    monkeypatch.setattr(serial, "serial_for_url", serial_for_url)
+    r = CliRunner().invoke(app, list(args))
+    text = said(r)
+    assert r.exit_code == 1, text
+    return text
+
+
 def test_an_arm_port_not_this_user_s_to_open_is_said_so(monkeypatch: pytest.MonkeyPatch) -> None:
     def open_port(self):  # type: ignore[no-untyped-def]
         raise _refused(self.port_name)
@@ -59,14 +73,7 @@ def test_a_dome_port_not_this_user_s_to_open_is_said_in_the_same_words(
 ) -> None:
     port = tmp_path / "ttyACM0"
     port.write_text("")
-
-    def serial_for_url(url, *args, **kwargs):  # type: ignore[no-untyped-def]
-        raise _refused(url)
-
-    monkeypatch.setattr(serial, "serial_for_url", serial_for_url)
-    r = CliRunner().invoke(app, ["probe", str(port)])
-    text = said(r)
-    assert r.exit_code == 1, text
+    text = _said_refused(monkeypatch, "probe", str(port))
     assert f"error: cannot open serial port {port}: {ADVICE}" in text, text
     assert RELOGIN in text and "Errno" not in text and "Traceback" not in text, text
 
@@ -101,22 +108,13 @@ def test_a_dome_port_not_this_user_s_to_open_is_not_said_unplugged(
     port = tmp_path / "ttyACM0"
     port.write_text("")
     cfg = emulated_dome_as_hardware(tmp_path, "emulated_nab_rti_v1.toml", str(port))
-
-    def serial_for_url(url, *args, **kwargs):  # type: ignore[no-untyped-def]
-        raise _refused(url)
-
-    monkeypatch.setattr(serial, "serial_for_url", serial_for_url)
-    r = CliRunner().invoke(app, ["check", str(cfg)])
-    text = said(r)
-    assert r.exit_code == 1, text
+    text = _said_refused(monkeypatch, "check", str(cfg))
     opened = f"'open port': the dome's port could not be opened (cannot open serial port {port}: "
     assert opened + ADVICE in text, text
     assert ADVICE in text and RELOGIN in text, text
     assert "plugged in" not in text and "Traceback" not in text, text
     # a character device (no regular file, which probe says is no serial port)
-    r = CliRunner().invoke(app, ["probe", os.devnull])
-    text = said(r)
-    assert r.exit_code == 1, text
+    text = _said_refused(monkeypatch, "probe", os.devnull)
     assert f"error: cannot open serial port {os.devnull}: {ADVICE}" in text, text
     assert "The port is there but this user may not open it, so no firmware was asked" in text
     assert "plugged in" not in text and "Traceback" not in text, text
