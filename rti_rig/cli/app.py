@@ -526,4 +526,10 @@ def main() -> None:
     unwrapped_when_piped()
     help_styled_as_the_consoles()
     reader_gone_tolerated()
-    app()
+    from rti_rig.cli.unwaited_words import words_unwaited, words_written
+
+    words_unwaited((out, err))  # no print waits on the reader while the rig works
+    try:
+        app()
+    finally:
+        words_written()

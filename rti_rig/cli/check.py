@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import signal
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -26,6 +25,7 @@ def stop_on_signals() -> Iterator[None]:
     stopped): without a handler SIGTERM killed the process with an LED lit and said nothing.
     A further signal while the first is handled only says so: the teardown it would cut short
     is what switches the lights off (``kill -9`` still ends the process)."""
+    from rti_rig.cli.unwaited_words import say_unwaited
     from rti_rig.runtime.controller import EmergencyStop
 
     phase = "checking"  # then "stopping" (first signal), "done" (handlers being restored)
@@ -33,7 +33,8 @@ def stop_on_signals() -> Iterator[None]:
     def on_signal(signum, frame):  # type: ignore[no-untyped-def]
         nonlocal phase
         if phase == "stopping":
-            os.write(2, b"Still stopping: making the rig safe first (lights, lamp, arm)...\n")
+            # never waiting on stderr's reader: this interrupts the teardown it describes
+            say_unwaited("Still stopping: making the rig safe first (lights, lamp, arm)...\n")
         if phase != "checking":
             return  # never raised mid-teardown, nor mid-restore
         phase = "stopping"

@@ -1,0 +1,173 @@
+"""The console entry's words written by a thread of their own, so that no print waits on the
+reader of rti-rig's output while a lamp is lit or an arm moves.
+
+Why: stdout and stderr wait when their pipe is full (a blocking pipe always did; a non-blocking
+one does since :class:`rti_rig.cli.app.WritableWaited`). A reader that stops reading (a paused
+``| less``, a wedged CI runner, a node ``child_process`` nobody drains, a terminal stopped by
+Ctrl-S) then blocked the print, and a print made between "light on" and "light off" (a
+device's word, a warning, a signal handler's "Stopping after this image", the progress bar on a
+terminal) kept the LED lit, or the arm where it was, for as long as the reader stalled: a
+thermal risk for the dome and light dose on the object. The teardown's all-off could wait on a
+word too (a dome reopening its port says so as it happens).
+
+Why a queue rather than a bounded wait: any wait with the lamp lit is dose on the object, and a
+wait of a few seconds repeated at each print is minutes; a word queued costs nothing. The queue
+is bounded (:data:`HELD_LIMIT` characters): beyond it the words are dropped, counted, and said
+to be on stderr once the reader reads again, so a reader stalled for hours (a stopped terminal
+under a progress bar's redraws) cannot fill the memory. Nothing captured depends on the words:
+the images, journal and manifest are written as before. At the command's end the process waits
+for the reader to take what is queued (as it did before for each print), the rig then safe.
+"""
+
+from __future__ import annotations
+
+import atexit
+import collections
+import contextlib
+import os
+import sys
+import threading
+from typing import Any
+
+#: How many characters may wait for a stalled reader before further words are dropped.
+HELD_LIMIT = 1 << 20
+
+_FLUSH = object()
+
+
+class WordsWriter:
+    """One thread writing, in the order they were said, the words of both standard streams.
+
+    The saying side (any thread, and signal handlers in the main thread) only appends to a
+    deque and writes a byte to a non-blocking wake-up pipe: no lock is taken there, so a
+    handler that speaks while the main thread was speaking cannot deadlock, and nothing there
+    can block. One queue for both streams keeps their order (``2>&1``) as it was said."""
+
+    def __init__(self, notes_to: Any, limit: int = HELD_LIMIT) -> None:
+        self._items: collections.deque[Any] = collections.deque()
+        self._limit = limit
+        self._held = 0  # characters queued (approximate: a count, not a lock)
+        self._dropped = 0
+        self._notes_to = notes_to
+        self._wake_r, self._wake_w = os.pipe()
+        os.set_blocking(self._wake_w, False)
+        self._thread = threading.Thread(target=self._run, name="rti-rig words", daemon=True)
+        self._thread.start()
+
+    def write(self, stream: Any, text: str) -> None:
+        if not self._thread.is_alive():  # a forked child, or a writer that ended: as before
+            stream.write(text)
+            return
+        if self._held + len(text) > self._limit:
+            self._dropped += len(text)
+            return
+        self._held += len(text)
+        self._items.append((stream, text))
+        self._wake()
+
+    def flush(self, stream: Any) -> None:
+        if not self._thread.is_alive():
+            stream.flush()
+            return
+        self._items.append((stream, _FLUSH))
+        self._wake()
+
+    def drain(self) -> None:
+        """Wait until every word said so far is written (or dropped by a gone reader)."""
+        if not self._thread.is_alive() or threading.current_thread() is self._thread:
+            return
+        done = threading.Event()
+        self._items.append(done)
+        self._wake()
+        done.wait()
+
+    def _wake(self) -> None:
+        with contextlib.suppress(OSError):  # full: the thread is awake already
+            os.write(self._wake_w, b"\0")
+
+    def _run(self) -> None:
+        while True:
+            os.read(self._wake_r, 4096)
+            while self._items:
+                item = self._items.popleft()
+                if isinstance(item, threading.Event):  # a drain: the note before its end
+                    if self._dropped:
+                        self._say_dropped()
+                    item.set()
+                    continue
+                stream, text = item
+                try:
+                    if text is _FLUSH:
+                        stream.flush()
+                    else:
+                        self._held -= len(text)
+                        stream.write(text)
+                except Exception:  # a word lost, never the writer
+                    pass
+                if not self._items and self._dropped:
+                    self._say_dropped()
+
+    def _say_dropped(self) -> None:
+        dropped, self._dropped = self._dropped, 0
+        with contextlib.suppress(Exception):
+            self._notes_to.write(
+                f"note: {dropped} characters of output were dropped: its reader did not read "
+                f"for so long that over {self._limit} waited for it (rti-rig does not wait on "
+                "its reader while the rig works); the session's files hold what happened\n"
+            )
+            self._notes_to.flush()
+
+
+class UnwaitedStream:
+    """A standard stream whose writes and flushes go through a :class:`WordsWriter`."""
+
+    def __init__(self, stream: Any, writer: WordsWriter) -> None:
+        self._stream = stream
+        self._writer = writer
+
+    def write(self, text: str) -> int:
+        self._writer.write(self._stream, text)
+        return len(text)
+
+    def flush(self) -> None:
+        self._writer.flush(self._stream)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
+_writer: WordsWriter | None = None
+
+
+def words_unwaited(consoles: tuple[Any, Any]) -> None:
+    """Give ``sys.stdout``/``sys.stderr`` and the consoles (``out``, ``err``) their streams
+    through one :class:`WordsWriter`; the console entry only (as the tolerant streams)."""
+    global _writer
+    if _writer is not None:
+        return
+    out, err = consoles
+    stdout, stderr = sys.stdout, sys.stderr
+    _writer = WordsWriter(notes_to=stderr)
+    sys.stdout = out.file = UnwaitedStream(stdout, _writer)  # type: ignore[assignment]
+    sys.stderr = err.file = UnwaitedStream(stderr, _writer)  # type: ignore[assignment]
+    atexit.register(words_written)
+
+
+def words_written() -> None:
+    """Wait for the reader to take every word said (the command's end: the rig is safe)."""
+    if _writer is not None:
+        with contextlib.suppress(KeyboardInterrupt):  # a Ctrl-C on the wait: the words go
+            _writer.drain()
+
+
+def say_unwaited(text: str) -> None:
+    """Say ``text`` on stderr from a signal handler, never waiting on the reader where the
+    words are queued (the console entry); else written to descriptor 2 as before, a write that
+    fails (a full non-blocking pipe: ``BlockingIOError``) dropped rather than raised into the
+    teardown the handler interrupted."""
+    if _writer is not None:
+        sys.stderr.write(text)
+        sys.stderr.flush()
+        return
+    with contextlib.suppress(OSError):
+        os.write(2, text.encode("utf-8", "replace"))
