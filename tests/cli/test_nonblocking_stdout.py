@@ -5,15 +5,17 @@ says every word.
 A write to the full pipe raised ``BlockingIOError``: taken as output that could not be written,
 the rest of the words were dropped (a ``--help`` read by such a parent stopped at 3 kB of its
 13). Through ``python -m rti_rig`` on a real pipe, made small and filled before the command
-starts, so that its first write finds no room.
+starts, so that its first write finds no room. The pipe is read once the command has met it
+full (ended, or waiting for room), never after a guessed time: read after 5 s, as it had been,
+a loaded machine's command had not yet written, and one that drops its words passed.
 """
 
 from __future__ import annotations
 
-import contextlib
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -37,6 +39,34 @@ def _full_nonblocking_pipe() -> tuple[int, int, bytes]:
     except BlockingIOError:
         pass
     return read_end, write_end, filler
+
+
+def _waits_for_room(pid: int) -> bool:
+    """Whether a thread of process ``pid`` is blocked in select/poll (the kernel's
+    ``poll_schedule_timeout``, ``do_select``): where a non-blocking write that found no room
+    waits for the reader. Nothing else in ``--help`` selects."""
+    try:
+        tasks = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return False
+    for task in tasks:
+        try:
+            with open(f"/proc/{pid}/task/{task}/wchan") as wchan:
+                where = wchan.read()
+        except OSError:
+            continue
+        if "poll" in where or "select" in where:
+            return True
+    return False
+
+
+def _unread(fd: int) -> int:
+    """How many bytes wait in the pipe for its reader (``FIONREAD``)."""
+    import fcntl
+    import termios
+
+    got = fcntl.ioctl(fd, termios.FIONREAD, b"\0\0\0\0")
+    return int.from_bytes(got, sys.byteorder)
 
 
 def _read_all(fd: int) -> bytes:
@@ -65,12 +95,15 @@ def test_help_on_a_full_non_blocking_pipe_is_said_whole(tmp_path: Path) -> None:
         )
     os.close(write_end)
     with ended_on_exit(command):
-        # The time a command that drops its words takes to start, find the pipe full and end;
-        # a command that waits for room is still waiting when it passes, however loaded the
-        # machine (it cannot end before the pipe is read), so this bounds how sure the test
-        # is, never whether the right behaviour passes.
-        with contextlib.suppress(subprocess.TimeoutExpired):
-            command.wait(timeout=5)
+        # The pipe is read only once the command has met it full: it ended (a command that
+        # drops its words) or one of its threads waits for room in it (select/poll). Read
+        # sooner (the 5 s this had waited, on a loaded machine), the room made let a command
+        # that drops its words pass.
+        deadline = time.monotonic() + 600
+        while command.poll() is None and not _waits_for_room(command.pid):
+            assert time.monotonic() < deadline, "the command neither ended nor waited in 600 s"
+            time.sleep(0.05)
+        assert _unread(read_end) == len(filler)  # nothing was read before it met the pipe
         said = _read_all(read_end)
         code = command.wait(timeout=600)
     errors = (tmp_path / "stderr.txt").read_text()
