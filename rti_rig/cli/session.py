@@ -29,7 +29,7 @@ from rti_rig.cli.app import (
     shown_path,
     stop_exit_code,
 )
-from rti_rig.cli.stopping import stop_signal
+from rti_rig.cli.stopping import Terminated, sigterm_stops, stamp, stop_signal, written_since
 from rti_rig.core.deferred_signals import (
     as_received,
     handlers_settable,
@@ -2040,10 +2040,25 @@ def export_lp(
     from rti_rig.app.usecases.export import export_lp as write_session_lp
     from rti_rig.runtime.session import JOURNAL
 
+    before = stamp(out_file)  # a file there already (--force) is not one this export wrote
     try:
-        done = write_session_lp(ExportLpRequest(session_dir, out_file, linear, force))
+        # SIGTERM (and a hang-up) as Ctrl-C: without a handler one ended the export at once,
+        # mid-write, leaving its hidden temporary file beside the .lp asked for, and said
+        # nothing; raised, the writer removes it (the .lp itself is only ever renamed whole)
+        with sigterm_stops():
+            done = write_session_lp(ExportLpRequest(session_dir, out_file, linear, force))
     except RtiRigError as exc:
         raise fail(exc) from None
+    except (KeyboardInterrupt, Terminated) as exc:
+        signum = stop_signal(exc)
+        state = (
+            f"{out_file} is written whole"
+            if written_since(out_file, before)
+            else f"no .lp was written to {out_file}"
+            + ("" if before is None else " (the file already there is as it was)")
+        )
+        err.print(f"Stopped ({stop_words(signum)}): {state}.", markup=False, soft_wrap=True)
+        raise typer.Exit(code=stop_exit_code(signum)) from None
     if done.left_out:
         err.print(
             f"[yellow]note:[/] left out, missing or changed since they were captured: "
