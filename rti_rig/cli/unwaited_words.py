@@ -48,7 +48,7 @@ class WordsWriter:
         self._limit = limit
         self._held = 0  # characters queued (approximate: a count, not a lock)
         self._dropped = 0
-        self._notes_to = notes_to
+        self.notes_to = notes_to
         self._wake_r, self._wake_w = os.pipe()
         os.set_blocking(self._wake_w, False)
         self._thread = threading.Thread(target=self._run, name="rti-rig words", daemon=True)
@@ -110,12 +110,12 @@ class WordsWriter:
     def _say_dropped(self) -> None:
         dropped, self._dropped = self._dropped, 0
         with contextlib.suppress(Exception):
-            self._notes_to.write(
+            self.notes_to.write(
                 f"note: {dropped} characters of output were dropped: its reader did not read "
                 f"for so long that over {self._limit} waited for it (rti-rig does not wait on "
                 "its reader while the rig works); the session's files hold what happened\n"
             )
-            self._notes_to.flush()
+            self.notes_to.flush()
 
 
 class UnwaitedStream:
@@ -143,14 +143,14 @@ def words_unwaited(consoles: tuple[Any, Any]) -> None:
     """Give ``sys.stdout``/``sys.stderr`` and the consoles (``out``, ``err``) their streams
     through one :class:`WordsWriter`; the console entry only (as the tolerant streams)."""
     global _writer
-    if _writer is not None:
-        return
     out, err = consoles
     stdout, stderr = sys.stdout, sys.stderr
-    _writer = WordsWriter(notes_to=stderr)
+    if _writer is None:  # one thread a process; each entry's streams are its own
+        _writer = WordsWriter(notes_to=stderr)
+        atexit.register(words_written)
+    _writer.notes_to = stderr
     sys.stdout = out.file = UnwaitedStream(stdout, _writer)  # type: ignore[assignment]
     sys.stderr = err.file = UnwaitedStream(stderr, _writer)  # type: ignore[assignment]
-    atexit.register(words_written)
 
 
 def words_written() -> None:
