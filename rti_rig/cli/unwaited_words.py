@@ -154,10 +154,21 @@ def words_unwaited(consoles: tuple[Any, Any]) -> None:
 
 
 def words_written() -> None:
-    """Wait for the reader to take every word said (the command's end: the rig is safe)."""
-    if _writer is not None:
-        with contextlib.suppress(KeyboardInterrupt):  # a Ctrl-C on the wait: the words go
-            _writer.drain()
+    """Wait for the reader to take every word said (the command's end: the rig is safe).
+
+    A Ctrl-C during the wait ends it, and every later one (the exit's): the user chose to
+    leave the words a stalled reader never took."""
+    global _given_up
+    if _writer is None or _given_up:
+        return
+    try:
+        _writer.drain()
+    except KeyboardInterrupt:
+        _given_up = True
+
+
+#: A Ctrl-C ended a wait for the reader: the process no longer waits for it.
+_given_up = False
 
 
 def say_unwaited(text: str) -> None:
