@@ -123,3 +123,25 @@ def test_an_export_into_its_own_session_says_so_and_never_replaces_its_lights_lp
     r = wide.invoke(app, ["export-lp", str(a), "--out", str(tmp_path / "outside.lp")])
     assert r.exit_code == 0, r.output
     assert "inside the session" not in said(r), said(r)
+
+
+def test_an_export_into_its_own_session_says_which_lp_relight_cli_reads_there(
+    tmp_path: Path,
+) -> None:
+    """relight-cli given a folder reads the first .lp there by name, case ignored (relight's
+    ImageSet: QDir::entryList({"*.lp"})[0]). An export named before lights.lp (the guide's
+    demo_linear.lp) became the .lp relight-cli read for the session without a word."""
+    a = _session(tmp_path, "séance a", "6")
+    wide = CliRunner(env={"COLUMNS": "400"})
+
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(a / "mine.lp")])
+    assert r.exit_code == 0, r.output
+    assert f"relight-cli given {a} reads the first .lp there by name, still lights.lp" in said(r)
+
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(a / "Demo_linear.lp"), "--linear"])
+    assert r.exit_code == 0, r.output
+    assert (
+        f"relight-cli given {a} reads the first .lp there by name, now Demo_linear.lp, not "
+        "lights.lp: move Demo_linear.lp out of the folder before giving the folder to relight-cli"
+    ) in said(r), said(r)
+    assert (a / "Demo_linear.lp").is_file() and (a / "lights.lp").is_file()

@@ -145,11 +145,33 @@ def _in_session_said(out_file: Path, root: Path) -> str:
         return (
             f"{out_file} is written inside the session {root}, beside its own {LP_NAME}, "
             f"which is left as captured (a session's files are never replaced); rti-rig fit "
-            f"{root} reads {LP_NAME}: give {out_file} itself to use this one"
+            f"{root} reads {LP_NAME}: give {out_file} itself to use this one; "
+            + _relight_reads(root, out_file.name)
         )
     return (
         f"{out_file} is written inside the session {root}, which has no {LP_NAME}: rti-rig "
         f"export-lp {root} --out {own} writes the session's own {LP_NAME} again"
+    )
+
+
+def _relight_reads(root: Path, new: str) -> str:
+    """Which ``.lp`` relight-cli takes when given the session folder: the first by name, case
+    ignored (relight's ``ImageSet`` takes ``QDir::entryList({"*.lp"})[0]``, whose default sort
+    is ``Name | IgnoreCase``), ``new`` among them (said before it is written).
+
+    Why: an export named before lights.lp (``demo_linear.lp``, ``export.lp``) became the .lp
+    relight-cli read for the session without a word. relight-cli pairs the folder's JPEGs with
+    its lines by order and checks only their count, so one exported before a resume (the
+    images taken by then) or with images left out stops it with "Lp number of lights (…)
+    different from the number of images found", naming neither file."""
+    names = {p.name for p in root.iterdir() if p.suffix.lower() == ".lp" and p.is_file()}
+    names.add(new)
+    first = min(names, key=lambda n: (n.casefold(), n))
+    if first == LP_NAME:
+        return f"relight-cli given {root} reads the first .lp there by name, still {LP_NAME}"
+    return (
+        f"relight-cli given {root} reads the first .lp there by name, now {first}, not "
+        f"{LP_NAME}: move {first} out of the folder before giving the folder to relight-cli"
     )
 
 
