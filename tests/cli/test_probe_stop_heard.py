@@ -12,6 +12,7 @@ ports), which no timing could aim a real signal at.
 from __future__ import annotations
 
 import signal
+import time
 from typing import Any
 
 import pytest
@@ -339,3 +340,38 @@ def test_a_stop_after_an_acknowledged_all_off_does_not_reopen_whatever_was_print
     probe_usecase._stopped_between_ports(result, 0.1)
     assert result.lights_state is probe_usecase.LightsState.OFF_ACKNOWLEDGED
     assert result.lights == "the sketch boots with every LED on; all-off sent and acknowledged"
+
+
+def test_a_stop_after_the_sketchs_answer_to_a_code_sends_its_all_off_without_waiting() -> None:
+    """A stop's teardown on a port where the sketch has answered ``<9>`` (its banner over, or
+    lost): the sketch is running, so its all-off goes at once. The teardown listened for the
+    banner's last line only, and so waited out the rest of the 4 s its profile allows a boot,
+    the dome lit, for a line that had come or never would. Counted in reads of the port
+    before the all-off (none: nothing is waited for)."""
+
+    class Line(_NabLine):
+        reads_before_the_off = 0
+        written = False
+
+        def write(self, data: bytes) -> None:
+            self.written = True
+            super().write(data)
+
+        def read(self, timeout: float) -> bytes:
+            self.reads_before_the_off += not self.written
+            return super().read(timeout)
+
+    line = Line(_OFF_REPLY)
+    result = probe_usecase.ProbeResult("/dev/ttyACM9")
+    heard = "<INCORRECT FUNCTION CALL: 9>\r\n"
+    probe_usecase._stopped_on_open_port(
+        result,
+        line,  # type: ignore[arg-type]
+        9600,
+        time.monotonic(),
+        2.6,
+        heard,
+    )
+    assert line.reads_before_the_off == 0
+    assert result.profile == "nab-rti-v1"
+    assert result.lights_state is probe_usecase.LightsState.OFF_ACKNOWLEDGED

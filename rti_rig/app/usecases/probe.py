@@ -443,9 +443,7 @@ def _stopped_on_open_port(
         return
     if baud == _NAB_BAUD:
         boot = bytearray(heard.encode("latin-1"))
-        if not _NAB_READY.search(heard):
-            left = opened + _nab_boot_s(wait_s) - time.monotonic()
-            _listen(t, max(0.0, left), until=_NAB_READY, into=boot)
+        _listen_out_nab_boot(t, opened + _nab_boot_s(wait_s), boot)
         text = boot[len(heard) :].decode("latin-1")
         result.heard.append(Heard("listening out the board's boot", baud, text))
         whole = boot.decode("latin-1")  # a banner cut in two by the stop is still one banner
@@ -606,16 +604,13 @@ def _nab_off_on_open_port(
         try:
             if stop is not None:
                 raise stop  # the teardown below: the rest of the boot, then the all-off
-            if not _nab_running(booted.decode("latin-1")):
-                # the board resets as the port opens: its bootloader, then its banner
-                listened = True
-                _listen(t, deadline - time.monotonic(), until=_NAB_READY, into=booted)
+            # the board resets as the port opens: its bootloader, then its banner
+            listened = not _nab_running(booted.decode("latin-1"))
+            _listen_out_nab_boot(t, deadline, booted)
         except EmergencyStop as exc:
             # the teardown: the rest of the boot, so that the all-off reaches a booted board
             stop, listened = exc, True
-            if not _nab_running(booted.decode("latin-1")):
-                left = max(0.0, deadline - time.monotonic())
-                _listen(t, left, until=_NAB_READY, into=booted)
+            _listen_out_nab_boot(t, deadline, booted)
         if listened:
             rest = booted[before:].decode("latin-1")
             result.heard.append(Heard(f"the board's boot at {_NAB_BAUD} baud", _NAB_BAUD, rest))
@@ -634,6 +629,21 @@ def _nab_off_on_open_port(
         raise ProbeStopped(stop, result) from None
     if stop is not None:
         raise ProbeStopped(stop, result) from None
+
+
+def _listen_out_nab_boot(t: SerialTransport, deadline: float, booted: bytearray) -> None:
+    """Listen on ``t`` (open at the Nab sketch's rate) into ``booted`` (all this opening heard)
+    until it shows the sketch past its boot (:func:`_nab_running`: its banner's last line, or
+    its answer to a code) or ``deadline`` (monotonic) passes; at once if it already does.
+
+    The one listen both the switching-off (:func:`_nab_off_on_open_port`) and a stop's
+    teardown (:func:`_stopped_on_open_port`) do before the sketch's all-off. The teardown's
+    own copy waited for the banner's last line only: after the sketch's answer to ``<9>``
+    (its banner over, or lost), it listened out the rest of the 4 s the profile allows a boot,
+    for a line that had come or never would."""
+    if _nab_running(booted.decode("latin-1")):
+        return
+    _listen(t, max(0.0, deadline - time.monotonic()), into=booted, done=_nab_running)
 
 
 def _nab_running(text: str) -> bool:
