@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import signal
 import time
+from types import SimpleNamespace
 from typing import Any
 
 import pytest
@@ -340,6 +341,39 @@ def test_a_stop_after_an_acknowledged_all_off_does_not_reopen_whatever_was_print
     probe_usecase._stopped_between_ports(result, 0.1)
     assert result.lights_state is probe_usecase.LightsState.OFF_ACKNOWLEDGED
     assert result.lights == "the sketch boots with every LED on; all-off sent and acknowledged"
+
+
+def test_a_stop_as_the_port_has_just_opened_is_torn_down_on_that_port(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C landing once the port had opened, as the probe read the opening's time (before
+    the try whose handler tears a stop down on the open port): the stop escaped with the port
+    still open and locked, the teardown opened it again ("another program holds it") and the
+    Nab dome, reset by the opening, was left lit. Injected at that very point: the first read
+    of the clock after an opening."""
+    real_open = SerialTransport.open
+    opened: list[str] = []
+    stops: list[str] = []
+
+    def open_then_flag(self: SerialTransport) -> None:
+        real_open(self)
+        opened.append(self.port)
+
+    def monotonic() -> float:
+        if opened and not stops:
+            stops.append("stopped")
+            raise EmergencyStop(signal.SIGINT)
+        return time.monotonic()
+
+    monkeypatch.setattr(SerialTransport, "open", open_then_flag)
+    monkeypatch.setattr(probe_usecase, "time", SimpleNamespace(monotonic=monotonic))
+    board = board_for("nab-rti-v1")
+    code, said = _probe(board, "nab-rti-v1")
+    assert code == 130 and stops, said
+    assert f"Probe stopped (Ctrl-C): {SWITCHED_OFF}" in said, said
+    assert "another program" not in said and "Traceback" not in said, said
+    assert _boots(board) == 1, board.events  # torn down on the port it opened, not reopened
+    assert board.lit_once_booted() == frozenset()
 
 
 def test_a_stop_after_the_sketchs_answer_to_a_code_sends_its_all_off_without_waiting() -> None:

@@ -335,31 +335,33 @@ def _exchange(
         result.on_try(what, _TRIES.get(what, ""))
     t = SerialTransport(result.port, baud)
     result.openings += 1
-    held: EmergencyStop | None = None
-    try:
-        t.open()
-    except TransportError as exc:
-        raise _PortNotOpened(str(exc), errno=exc.errno) from exc
-    except EmergencyStop as exc:
-        if not t.is_open:
-            # inside pyserial's open, which closes the port as the stop goes through: the
-            # opening may have reset the board all the same (the Nab sketch then boots lit)
-            _stopped_inside_opening(result, t, wait_s)
-            raise ProbeStopped(exc, result) from None
-        # held over the opening (the transport's hold) and raised once the port was open: the
-        # port is ours, at ``baud``, as for a stop at the start of the listen below. Taken for
-        # a stop inside the opening, the port was opened again while this one still held its
-        # lock ("another program holds it"), and the Nab dome was left lit (a SIGTERM sent as
-        # the board reset, on a loaded machine, lands there)
-        held = exc
-    opened = time.monotonic()
     # the bytes are collected here as they come, not when a listen returns: a stop inside a
     # listen had lost all it heard (a Nab banner already in, then "stopped before a firmware
     # answered" and no all-off, the dome left lit)
     heard = bytearray()
+    opened = time.monotonic()
+    # the opening is inside the try whose handler tears a stop down on the open port: a stop
+    # landing once the port had opened, before that try began (as the opening's time was
+    # read), escaped with the port still open and locked; the teardown then opened it again,
+    # "another program holds it", and a Nab dome was left lit
     try:
-        if held is not None:
-            raise held  # its teardown, below, on the port open at ``baud``
+        try:
+            t.open()
+        except TransportError as exc:
+            raise _PortNotOpened(str(exc), errno=exc.errno) from exc
+        except EmergencyStop as exc:
+            if not t.is_open:
+                # inside pyserial's open, which closes the port as the stop goes through: the
+                # opening may have reset the board all the same (the Nab sketch then boots lit)
+                _stopped_inside_opening(result, t, wait_s)
+                raise ProbeStopped(exc, result) from None
+            # held over the opening (the transport's hold) and raised once the port was open:
+            # the port is ours, at ``baud``; its teardown is below, as for a stop in the
+            # listen. Taken for a stop inside the opening, the port was opened again while
+            # this one still held its lock ("another program holds it"), and the Nab dome was
+            # left lit (a SIGTERM sent as the board reset, on a loaded machine, lands there)
+            raise
+        opened = time.monotonic()
         _listen(t, wait_s, into=heard, done=_answered)
         if send and not _answered(heard.decode("latin-1")):
             t.write(send)
@@ -379,6 +381,10 @@ def _exchange(
             # open; the probe had closed it and opened it again for the all-off, a second
             # reset (every LED lit once more, its boot waited out again, ~2 s)
             _nab_off_on_open_port(result, t, opened + _nab_boot_s(wait_s), bytearray(heard))
+    except (ProbeStopped, _PortNotOpened):
+        # its teardown done (or none due: the port never opened), on this port or another
+        t.close()
+        raise
     except EmergencyStop as exc:
         result.heard.append(Heard(f"{what} (stopped)", baud, heard.decode("latin-1")))
         try:
