@@ -143,28 +143,29 @@ def test_each_probe_is_announced_with_the_firmwares_it_is_for(
         "Trying nichlock (listen at 2400 baud)…",
         "Trying Elexol 24R1 ('?' at 38400 baud)…",
         "Trying nichlock ('m' (free RAM) at 115200 baud)…",
-        "Trying the Nab sketch (RTI v1.0) ('<9>' (an unknown code) at 9600 baud)…",
         "Trying minirti (0x42 + empty mask at 9600 baud)…",
+        "Trying the Nab sketch (RTI v1.0) ('<9>' (an unknown code) at 9600 baud)…",
         "Trying RTIPy ('T,0,0,0' at 9600 baud)…",
     ], r.stderr
-    assert len(openings) == 10, openings  # one opening each, then the end
+    # one opening each, the last three on one (each opening resets an Arduino), then the end
+    assert len(openings) == 8, openings
     assert "Trying" not in r.stdout and "No known dome firmware answered" in r.stdout
 
 
-def test_t000_is_sent_after_rtipys_own_boot_wait(monkeypatch: pytest.MonkeyPatch) -> None:
-    """RTIPy's sketch prints nothing at boot, and its own host (``rti_py.py``) writes 2 s after
-    opening the port: ``T,0,0,0`` is sent after the profile's ``boot_wait_s`` (2 s), not the
-    2.6 s other probes wait for a bootloader and a banner. On a silent port its probe is that
-    wait and two unanswered listens of 1.8 s (virtual time)."""
-    from rti_rig.drivers.led_dome.dome_profiles import rtipy
-
+def test_mask_unknown_code_and_t000_share_one_opening(monkeypatch: pytest.MonkeyPatch) -> None:
+    """minirti's mask (1.6 s after the opening, as its host waits 1.5 s), the Nab sketch's
+    ``<9>`` (once a probe's 2.6 s for a bootloader and banner are over) and RTIPy's
+    ``T,0,0,0`` are sent on one opening at 9600, where each had its own (a reset, its boot
+    waited out, each time). ``T,0,0,0`` waits for 1.5 s of the probe's silence, past the 1 s
+    that ends a command on RTIPy's sketch (sooner, it was part of the ``<9>``'s command). On a
+    silent port: the mask's two listens of 0.5 s, ``<9>``'s two of 0.6 s from 2.6 s, the
+    silence, then T's two listens of 1.8 s (virtual time)."""
     r, openings = _probe(monkeypatch, 9600, [])
     assert r.exit_code == 1, r.output
-    (_, t000), (end, ended) = openings[-2:]
-    assert end == "end", openings
-    boot = float(rtipy.SPEC["boot_wait_s"])
-    assert boot == 2.0
-    assert ended - t000 == pytest.approx(boot + 1.8 + 1.8, abs=0.11), openings
+    (rate, opened), (end, ended) = openings[-2:]
+    assert (rate, end) == ("9600", "end"), openings
+    second_nine = 2.6 + 0.6
+    assert ended - opened == pytest.approx(second_nine + 1.5 + 1.8 + 1.8, abs=0.11), openings
 
 
 @pytest.mark.parametrize(

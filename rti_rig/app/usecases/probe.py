@@ -310,9 +310,14 @@ def _exchange(
     wait_s: float,
     send: bytes,
     listen_s: float,
+    tries: _For | None = None,
+    more: tuple[_Then, ...] = (),
 ) -> str:
     """Open at ``baud``, wait ``wait_s`` (collecting the banner), send, listen; all text heard,
-    also added to ``result.heard`` under ``what``.
+    also added to ``result.heard`` under ``what``. ``tries`` is told to
+    :attr:`ProbeResult.on_try` with ``what``. Each of ``more`` is then sent on the same open
+    port (no reset between), told as it begins and heard under its own label, unless an
+    answer came first (:func:`_settled`).
 
     Each wait and listen ends as soon as what was heard is an answer that names a firmware
     completely (:func:`_answered`: a whole banner, a whole reply), and nothing is sent after
@@ -332,13 +337,15 @@ def _exchange(
     (:func:`_nab_off_on_open_port`): the board booted lit, and reopening the port for the
     all-off reset it once more."""
     if result.on_try is not None:
-        result.on_try(what, _TRIES.get(what, ""))
+        result.on_try(what, "" if tries is None else tries.value)
     t = SerialTransport(result.port, baud)
     result.openings += 1
     # the bytes are collected here as they come, not when a listen returns: a stop inside a
     # listen had lost all it heard (a Nab banner already in, then "stopped before a firmware
     # answered" and no all-off, the dome left lit)
     heard = bytearray()
+    #: the label of the probe now on the port, and where its part of ``heard`` begins
+    saying, said_from = what, 0
     opened = time.monotonic()
     # the opening is inside the try whose handler tears a stop down on the open port: a stop
     # landing once the port had opened, before that try began (as the opening's time was
@@ -363,19 +370,39 @@ def _exchange(
             raise
         opened = time.monotonic()
         _listen(t, wait_s, into=heard, done=_answered)
-        if send and not _answered(heard.decode("latin-1")):
-            t.write(send)
-            asked = len(heard)
+        reply: str | None = None  # the last probe's reply, once one was sent
+        wrote = opened
+        steps = [_Then(what, send, listen_s), *more]  # the first's ``tries`` told above
+        for n, step in enumerate(steps):
+            if not step.send or _settled(heard.decode("latin-1"), reply):
+                break  # an answer came (or a banner began): nothing more is sent
+            if n:
+                # the next probe on this open port: what the one before heard is said under
+                # its label, this one told as it begins (the telling never waits on output:
+                # a board may be lit meanwhile, see the CLI's ``trying``)
+                result.heard.append(Heard(saying, baud, heard[said_from:].decode("latin-1")))
+                saying, said_from = step.what, len(heard)
+                if result.on_try is not None:
+                    result.on_try(step.what, "" if step.tries is None else step.tries.value)
+                left = max(opened + step.not_before_s, wrote + step.quiet_s) - time.monotonic()
+                if left > 0:
+                    _listen(t, left, into=heard, done=_answered)
+                if _settled(heard.decode("latin-1"), reply):
+                    break
+            t.write(step.send)
+            wrote, asked = time.monotonic(), len(heard)
 
-            def replied(text: str) -> bool:
+            def replied(text: str, asked: int = asked) -> bool:
                 return _answered(text, text[asked:])
 
-            _listen(t, listen_s, into=heard, done=replied)
+            _listen(t, step.listen_s, into=heard, done=replied)
             if len(heard) == asked:
-                t.write(send)
-                _listen(t, listen_s, into=heard, done=replied)
+                t.write(step.send)
+                wrote = time.monotonic()
+                _listen(t, step.listen_s, into=heard, done=replied)
+            reply = heard[asked:].decode("latin-1")
         text = heard.decode("latin-1")
-        result.heard.append(Heard(what, baud, text))
+        result.heard.append(Heard(saying, baud, heard[said_from:].decode("latin-1")))
         if baud == _NAB_BAUD and any(says.search(text) for says in _NAB_SAYS):
             # the sketch, heard at its rate, booted lit: switched off on this port, which is
             # open; the probe had closed it and opened it again for the all-off, a second
@@ -386,7 +413,8 @@ def _exchange(
         t.close()
         raise
     except EmergencyStop as exc:
-        result.heard.append(Heard(f"{what} (stopped)", baud, heard.decode("latin-1")))
+        stopped_in = heard[said_from:].decode("latin-1")
+        result.heard.append(Heard(f"{saying} (stopped)", baud, stopped_in))
         try:
             if result.lights_state is not LightsState.OFF_ACKNOWLEDGED:
                 # (acknowledged: on this very port, the probe returning once it is, and no
@@ -891,6 +919,24 @@ def _answered(text: str, reply: str | None = None) -> bool:
     return _own_protocol(text) is not None
 
 
+def _acknowledged_mask(result: ProbeResult, mask_at: int) -> bool:
+    """minirti's acknowledgement ``0x01`` ends what its mask's probe heard (``mask_at``: its
+    place in ``result.heard``; the probes sent after it on the same opening are said apart)."""
+    return len(result.heard) > mask_at and result.heard[mask_at].text.endswith("\x01")
+
+
+def _settled(text: str, reply: str | None) -> bool:
+    """No further probe is sent on this opening: ``text`` (all heard since it opened; ``reply``,
+    what the last probe sent on it heard) is an answer (:func:`_answered`), or shows the Nab
+    sketch (a banner begun: its board booted lit, its all-off comes next, once its boot is
+    over) or nichlock's firmware (whose keys the next probe's bytes would be)."""
+    if _answered(text, reply):
+        return True
+    return any(says.search(text) for says in _NAB_SAYS) or any(
+        words in text for words in _NICHLOCK_SAYS
+    )
+
+
 def _own_protocol(text: str) -> str | None:
     """The first boot banner of one of rti-rig's own protocols in ``text``, or None."""
     found = [(m.start(), m.group()) for _, pattern in _OWN_BANNERS if (m := pattern.search(text))]
@@ -995,31 +1041,64 @@ def _heard_another_firmware(result: ProbeResult) -> bool:
     return any(_another_firmware_found(result, heard.text, heard.baud) for heard in result.heard)
 
 
-#: The firmwares each probe is for, as :attr:`ProbeResult.on_try` is told them (said only).
-#: Keyed by each probe's label (the label is not passed along: tests stand in for
-#: :func:`_exchange` with its positional arguments).
-_TRIES: dict[str, str] = {
-    "listen at 9600 baud": "the Nab sketch (RTI v1.0), nichlock, rti-rig's own protocols",
-    "listen at 115200 baud": "nichlock, rti-rig's own protocols",
-    **{f"listen at {rate} baud": "nichlock" for rate in (19200, 2400)},
-    "'?' at 38400 baud": "Elexol 24R1",
-    "'m' (free RAM) at 115200 baud": "nichlock",
-    "'<9>' (an unknown code) at 9600 baud": "the Nab sketch (RTI v1.0)",
-    "0x42 + empty mask at 9600 baud": "minirti",
-    "'T,0,0,0' at 9600 baud": "RTIPy",
-}
+class _For(Enum):
+    """The firmwares a probe is for, as :attr:`ProbeResult.on_try` is told them (said only).
+    Each probe passes its own to :func:`_exchange`: the words had been looked up by the probe's
+    label, so rewording a label (or a rate) silently said no firmware at all."""
+
+    NAB_NICHLOCK_OWN = "the Nab sketch (RTI v1.0), nichlock, rti-rig's own protocols"
+    NICHLOCK_OWN = "nichlock, rti-rig's own protocols"
+    NICHLOCK = "nichlock"
+    ELEXOL = "Elexol 24R1"
+    NAB = "the Nab sketch (RTI v1.0)"
+    MINIRTI = "minirti"
+    RTIPY = "RTIPy"
+
+
+@dataclass(frozen=True)
+class _Then:
+    """A further probe sent on the port an exchange opened, after its first (:func:`_exchange`):
+    no reopening between them, so no reset and no bootloader waited out again (each opening of
+    an Arduino-style board had cost its boot, ~2 s, three times at 9600)."""
+
+    #: What it is, as printed ("'<9>' (an unknown code) at 9600 baud").
+    what: str
+    send: bytes
+    #: How long its reply is listened for (twice if met by silence: it is sent once more).
+    listen_s: float
+    #: The firmwares it is for (told as it begins; None: the first, told by its caller).
+    tries: _For | None = None
+    #: It is not sent before this many seconds since the opening (a bootloader, a banner).
+    not_before_s: float = 0.0
+    #: Seconds of silence from the probe before it is sent: RTIPy takes what arrives before
+    #: 1 s of silence as one command, so ``T,0,0,0`` sent sooner after the probes before it
+    #: would be part of their command, not a ``T``.
+    quiet_s: float = 0.0
+
+
+#: How long minirti's host waits after opening the port before its first mask.
+_MINIRTI_BOOT_S = 1.6
+
+#: The label of the Nab sketch's unknown-code probe (said only).
+_UNKNOWN_CODE_SAID = f"'<9>' (an unknown code) at {_NAB_BAUD} baud"
+
+#: The silence RTIPy's sketch needs to end a command (``Serial.readString``'s 1 s), with room
+#: for a loaded machine's or a USB link's delay: ``T,0,0,0`` after other probes on one open.
+_RTIPY_FRAME_S = 1.5
 
 
 def _probe(result: ProbeResult, wait: float) -> ProbeResult:
     """:func:`probe`'s sequence of probes."""
     try:
-        text = _exchange(result, _LISTEN_SAID.format(baud=9600), 9600, wait, b"", 0)
+        said = _LISTEN_SAID.format(baud=9600)
+        text = _exchange(result, said, 9600, wait, b"", 0, _For.NAB_NICHLOCK_OWN)
         if result.profile == _NAB_NAME:
             return result  # heard at its rate, and switched off on that port (_exchange)
         if _nichlock_found(result, text, 9600):
             return result
         own_at_9600 = _own_protocol(text)
-        text = _exchange(result, _LISTEN_SAID.format(baud=115200), 115200, wait, b"", 0)
+        said = _LISTEN_SAID.format(baud=115200)
+        text = _exchange(result, said, 115200, wait, b"", 0, _For.NICHLOCK_OWN)
         if _nichlock_found(result, text, 115200):
             return result
         # rti-rig's own protocols announce themselves at boot: heard at both rates, the link
@@ -1032,38 +1111,52 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
         # boot: listened for before anything is sent, since bytes at another rate reach such a
         # board as keys of its menus (a board set so had been "No known dome firmware")
         for rate in NICHLOCK_OTHER_RATES:
-            text = _exchange(result, _LISTEN_SAID.format(baud=rate), rate, wait, b"", 0)
+            said = _LISTEN_SAID.format(baud=rate)
+            text = _exchange(result, said, rate, wait, b"", 0, _For.NICHLOCK)
             if _nichlock_found(result, text, rate) or _own_protocol_found(result, text, rate):
                 return result
-        text = _exchange(result, "'?' at 38400 baud", 38400, 0.2, b"?", 0.5)
+        text = _exchange(result, "'?' at 38400 baud", 38400, 0.2, b"?", 0.5, _For.ELEXOL)
         if _ELEXOL_SAYS in text:
             result.profile, result.baudrate = "elexol-24r1", 38400
             return result
-        text = _exchange(result, "'m' (free RAM) at 115200 baud", 115200, wait, b"m", 0.5)
+        said = "'m' (free RAM) at 115200 baud"
+        text = _exchange(result, said, 115200, wait, b"m", 0.5, _For.NICHLOCK)
         if _nichlock_found(result, text, 115200):
             return result
+        # minirti's mask, the Nab sketch's unknown code and RTIPy's T,0,0,0, on one opening
+        # at 9600 (each had its own: three resets, each boot waited out): the mask first, a
+        # minirti board's only published command, 1.6 s after the opening (its host waits
+        # 1.5 s), so that it is sent nothing else before it; bytes outside <...> are nothing
+        # to the Nab sketch, and the probe's bytes are all one harmless command to RTIPy,
+        # whose T,0,0,0 goes last, after the silence that ends a command there
+        mask_at = len(result.heard)
         text = _exchange(
-            result, f"'<9>' (an unknown code) at {_NAB_BAUD} baud", _NAB_BAUD, wait, b"<9>", 0.6
+            result,
+            "0x42 + empty mask at 9600 baud",
+            9600,
+            min(wait, _MINIRTI_BOOT_S),
+            b"\x42" + bytes(8),
+            0.5,
+            _For.MINIRTI,
+            (
+                _Then(_UNKNOWN_CODE_SAID, b"<9>", 0.6, _For.NAB, not_before_s=wait),
+                _Then(
+                    "'T,0,0,0' at 9600 baud",
+                    b"T,0,0,0",
+                    1.8,
+                    _For.RTIPY,
+                    not_before_s=_RTIPY_BOOT_S,
+                    quiet_s=_RTIPY_FRAME_S,
+                ),
+            ),
         )
         if result.profile == _NAB_NAME:
-            return result  # its answer or banner heard at its rate, switched off there (_exchange)
+            return result  # its banner or answer heard at its rate, switched off there
         if _nichlock_found(result, text, 9600):
             return result
-        text = _exchange(
-            result, "0x42 + empty mask at 9600 baud", 9600, 1.6, b"\x42" + bytes(8), 0.5
-        )
-        if result.profile == _NAB_NAME:
-            return result  # a slow Nab board's banner heard here: not reset once more
-        if _nichlock_found(result, text, 9600):
-            return result
-        if text.endswith("\x01"):
+        if _acknowledged_mask(result, mask_at):
             result.profile, result.baudrate = "minirti", 9600
             _say_lights(result, LightsState.MASK_ACKNOWLEDGED)
-            return result
-        text = _exchange(
-            result, "'T,0,0,0' at 9600 baud", 9600, min(wait, _RTIPY_BOOT_S), b"T,0,0,0", 1.8
-        )
-        if result.profile == _NAB_NAME:
             return result
         if _RTIPY_SAYS in text:
             result.profile, result.baudrate = "rtipy", 9600
