@@ -9,7 +9,6 @@ from __future__ import annotations
 import io
 import math
 import os
-import shlex
 import signal
 import sys
 
@@ -19,6 +18,8 @@ from rich.markup import escape
 
 from rti_rig.core.deferred_signals import as_received
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.shell_words import shell_word as shell_word  # re-exported for the commands
+from rti_rig.core.shell_words import shown_path as shown_path  # re-exported for the commands
 
 app = typer.Typer(
     help=(
@@ -135,54 +136,6 @@ def fail(exc: RtiRigError) -> typer.Exit:
     # the message is plain text: "[camera]" or "[dome.serial]" in it must not be read as markup
     err.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
     return typer.Exit(code=2)
-
-
-def shown_path(path: object) -> str:
-    """``path`` as printed for a user to copy: as it is, or, where stdout or stderr cannot
-    encode it (an ASCII or Latin-1 locale, a name whose bytes are not UTF-8), as the word a
-    shell reads back as the same name (:func:`shell_word`'s ``$'...'``).
-
-    Why: the streams print a character they cannot hold as ``?`` (stdout) or ``\\xe9``
-    (stderr), fine for an arrow, not for a name: ``--out é`` was said as ``→ ?``, and neither
-    ``?`` (a glob) nor ``\\xe9`` pasted into a shell names the folder."""
-    text = str(path)
-    return text if _printable_as_is(text) else _ansi_c_quoted(os.fsencode(text))
-
-
-def shell_word(path: object) -> str:
-    """``path`` as one shell word naming it, for a command the user is told to run: quoted
-    where it holds a space or a shell's special character (``shlex.quote``), and as ``$'...'``
-    (bash, zsh, ksh, BusyBox and POSIX.1-2024 sh) where stdout or stderr cannot print it, each
-    byte of the name outside printable ASCII written ``\\xHH``: the bytes the file system holds,
-    whatever the terminal's encoding, so the word pasted back names the same folder."""
-    text = str(path)
-    if _printable_as_is(text):
-        return shlex.quote(text)
-    return _ansi_c_quoted(os.fsencode(text))
-
-
-def _printable_as_is(text: str) -> bool:
-    """Whether both standard streams' encodings hold every character of ``text``."""
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            text.encode(getattr(stream, "encoding", None) or "utf-8")
-        except (UnicodeEncodeError, LookupError):
-            return False
-    return True
-
-
-def _ansi_c_quoted(name: bytes) -> str:
-    """``name``'s bytes as a shell's ANSI-C quoted word: printable ASCII as itself (``'`` and
-    ``\\`` escaped), any other byte as two hex digits."""
-    chars = []
-    for byte in name:
-        if byte in b"'\\":
-            chars.append("\\" + chr(byte))
-        elif 0x20 <= byte < 0x7F:
-            chars.append(chr(byte))
-        else:
-            chars.append(f"\\x{byte:02x}")
-    return "$'" + "".join(chars) + "'"
 
 
 def print_notes(notes) -> None:  # type: ignore[no-untyped-def]
