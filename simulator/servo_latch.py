@@ -40,12 +40,12 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import shlex
 import tempfile
 import warnings
 from pathlib import Path
 from typing import Any
 
+from rti_rig.core.shell_words import shell_word
 from rti_rig.core.state_files import replace_text
 from rti_rig.drivers.dynamixel import control_table as ct
 
@@ -89,7 +89,7 @@ class LatchedErrors:
         has no switch for; its errors outlive the command in this file, and deleting it is
         what clears them (as ``rti-rig check RIG.toml --reboot-faulted`` does)."""
         return (
-            f"delete {shlex.quote(str(self.path))} (where the emulated servos' powered state "
+            f"delete {shell_word(str(self.path))} (where the emulated servos' powered state "
             "and latched errors are kept: their power off and on)"
         )
 

@@ -8,9 +8,10 @@ MODEL_NAMES; factory values are not (per model, cited: rti_rig.simulator.dynamix
 
 from __future__ import annotations
 
-import shlex
 from dataclasses import dataclass
 from enum import IntEnum
+
+from rti_rig.core.shell_words import shell_word
 
 
 @dataclass(frozen=True)
@@ -180,7 +181,7 @@ def reboot_how(
     XL430 too, whose torque stays on (its Shutdown 0x34 does not select it): the check then
     refused to reboot it, and nothing had said that a reboot before the cause is fixed
     leaves the fault set."""
-    rig = shlex.quote(config) if config else "RIG.toml"
+    rig = shell_word(config) if config else "RIG.toml"
     cause_first = (
         "a reboot clears the fault only once its cause is gone, else the servo reports it again"
     )

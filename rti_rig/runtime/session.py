@@ -43,7 +43,6 @@ import json
 import math
 import os
 import platform
-import shlex
 import shutil
 import sys
 import threading
@@ -68,6 +67,7 @@ from rti_rig.core.image_files import (
 )
 from rti_rig.core.lp_format import LpEntry, format_lp, lp_files_in
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
+from rti_rig.core.shell_words import shell_word
 from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
 from rti_rig.runtime.unrecorded_end import CAUSES, unrecorded_end
 from rti_rig.runtime.unrecorded_end import UNRECORDED as RUN_UNRECORDED
@@ -515,7 +515,7 @@ def lock_session(root: Path) -> None:
         raise SessionError(
             f"{root} is in use by another rti-rig process (a session is being captured or "
             "resumed in it): let it finish, or stop it (Ctrl-C in its terminal), then "
-            f"continue with: rti-rig run --resume {shlex.quote(str(root))}"
+            f"continue with: rti-rig run --resume {shell_word(str(root))}"
         ) from None
     except OSError:  # a filesystem without flock (some network mounts): no lock, as before
         os.close(fd)
@@ -531,10 +531,10 @@ def _finished_hint(root: Path, manifest: dict[str, Any]) -> str:
     Why: a preview folder given twice to ``preview --out`` had been told "fit it with rti-rig
     fit", which cannot fit one image; the command that uses a preview is ``plan``, given its
     rig (the config the preview recorded, as ``preview`` itself advises)."""
-    folder = shlex.quote(str(root))
+    folder = shell_word(str(root))
     if (manifest.get("schedule") or {}).get("method") == "preview":
         rig = (manifest.get("rig") or {}).get("config_path")
-        shown = shlex.quote(str(rig)) if isinstance(rig, str) and rig else "RIG.toml"
+        shown = shell_word(str(rig)) if isinstance(rig, str) and rig else "RIG.toml"
         return (
             f" (it holds a finished preview: plan from it with rti-rig plan {folder} --rig "
             f"{shown} --lights N --out plan.lp)"
@@ -643,7 +643,7 @@ class SessionFolder:
                 finished = (read_manifest(outer).get("runner") or {}).get(
                     "finish_reason"
                 ) == "completed"
-                resume = f"rti-rig run --resume {shlex.quote(str(outer))}"
+                resume = f"rti-rig run --resume {shell_word(str(outer))}"
                 what = (
                     "a finished session"
                     if finished
@@ -669,7 +669,7 @@ class SessionFolder:
                     _finished_hint(root, manifest)
                     if finished
                     else ", or continue the interrupted session in it with "
-                    f"rti-rig run --resume {shlex.quote(str(root))}"
+                    f"rti-rig run --resume {shell_word(str(root))}"
                 )
                 if not finished and in_use_by_another(root):  # running, not interrupted
                     resume = " (another rti-rig process is capturing a session in it right now)"
@@ -1745,7 +1745,7 @@ def _prepare_resume(
         raise SessionError(
             f"{root}: this session completed: nothing is captured to rebuild its journal, "
             "which rebuild_finished_journal does without the rig (rti-rig run --resume "
-            f"{shlex.quote(str(root))} --rebuild-journal)"
+            f"{shell_word(str(root))} --rebuild-journal)"
         )
     rebuilt: dict[int, dict[str, Any]] | None = None  # the records taken back
     lost_now: list[str] = []  # a session not finished: committed images lost since capture
@@ -1810,7 +1810,7 @@ def _prepare_resume(
                 f"({_ended_as(runner.get('finish_reason'), root, scan.records)}), "
                 "and its resume sets aside and shoots again whatever it cannot verify anyway "
                 "(nothing in this folder was changed): continue it with rti-rig run --resume "
-                f"{shlex.quote(str(root))}"
+                f"{shell_word(str(root))}"
             )
         unjournaled = _unjournaled_steps(root, manifest, scan, names)
         if rebuild_journal and (unjournaled or scan.missing):
@@ -1906,7 +1906,7 @@ def _prepare_resume(
 def _refuse_complete(root: Path, manifest: dict[str, Any], total: int, finished: int) -> None:
     """Raise :class:`SessionComplete` for ``root``, a session that completed with every image
     as captured (checked by the caller), naming its next step: ``rti-rig fit``."""
-    folder = shlex.quote(str(root))
+    folder = shell_word(str(root))
     if manifest.get("adaptive") and finished < total:
         stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
         done = (
@@ -1924,7 +1924,7 @@ def _refuse_complete(root: Path, manifest: dict[str, Any], total: int, finished:
         # fit refuses a session folder without it (naming export-lp): the next step had been
         # named as fit alone, which then failed
         said += f"; only its {LP_NAME} is missing"
-        own = shlex.quote(str(root / LP_NAME))
+        own = shell_word(str(root / LP_NAME))
         fit = f"rti-rig export-lp {folder} --out {own} writes it from the journal, then {fit}"
     raise SessionComplete(said, fit)
 
@@ -2088,7 +2088,7 @@ def rebuild_finished_journal(root: Path) -> list[str]:
         names = image_names(planned_steps(manifest))
         scan = scan_journal(root, names)
         taken, unproven, lost = _finished_rebuild(root, manifest, names, scan)
-        folder = shlex.quote(str(root))
+        folder = shell_word(str(root))
         if unproven is None:
             # what is lost, named with what gets it back: the user who reached for the rebuild
             # had been sent to a fit to find out
@@ -2143,7 +2143,7 @@ def rebuild_advice(root: Path, scan: JournalScan | None = None) -> str:
     the journal lost before it shoots exactly those (the backup alone had been advised), beside
     the rebuild, which records them as lost without the rig. ``scan``: the caller's scan of
     the journal with the schedule's image names, if it holds one."""
-    folder = shlex.quote(str(root))
+    folder = shell_word(str(root))
     lost = _lost_beside_a_lost_journal(Path(root), scan)
     if lost:
         return (
@@ -2205,7 +2205,7 @@ def _refuse_unjournaled(
             parts.append("its last line cut short")
         what = f"{JOURNAL} is damaged ({', '.join(parts) or 'records missing'})"
     shown = ", ".join(names[i] for i in unjournaled[:8]) + (" …" if len(unjournaled) > 8 else "")
-    folder = shlex.quote(str(root))
+    folder = shell_word(str(root))
     raise SessionError(
         f"{root}: {what}: it holds no record of {len(unjournaled)} image(s) that {MANIFEST} "
         f"lists as captured, with files on disk as its checksums say ({shown}); a resume "
@@ -2527,9 +2527,9 @@ def _refuse_lost_journal(root: Path, names: list[str], scan: JournalScan) -> Non
             f"{len(scan.records)} image(s) as captured, but not {shown}, whose record files "
             "are gone or no longer match them: restore "
             f"{JOURNAL} (or {RECORDS_DIR}/) from a backup copy of the folder, then run "
-            f"rti-rig run --resume {shlex.quote(str(root))} again; if it is lost for good, "
+            f"rti-rig run --resume {shell_word(str(root))} again; if it is lost for good, "
             "rti-rig run --resume "
-            f"{shlex.quote(str(root))} --rebuild-journal sets them aside in recovered/ (never "
+            f"{shell_word(str(root))} --rebuild-journal sets them aside in recovered/ (never "
             "deleted) and shoots them again (nothing in this folder was changed)"
         )
     first = names[0] if names else ""
@@ -2538,7 +2538,7 @@ def _refuse_lost_journal(root: Path, names: list[str], scan: JournalScan) -> Non
         f"{root}: {JOURNAL} is missing, so none of the images on disk (about {count} steps) "
         "can be verified as captured with its light: restore "
         f"{JOURNAL} from a backup copy of the folder (or from where it was moved), then run "
-        f"rti-rig run --resume {shlex.quote(str(root))} again; if it is lost for good, shoot "
+        f"rti-rig run --resume {shell_word(str(root))} again; if it is lost for good, shoot "
         "the session again with another --out (nothing in this folder was changed; "
         f"--rebuild-journal cannot help either: {MANIFEST} vouches for none of these images, "
         "as a session killed before any run of it ended records none)"
@@ -2644,7 +2644,7 @@ def unresumable(root: Path) -> str | None:
     config_of = (rig.get("config") or {}) if isinstance(rig, dict) else {}
     dome = config_of.get("dome")
     sync = dome.get("flash_sync") if isinstance(dome, dict) else None
-    config = shlex.quote(str(rig.get("config_path") or "CONFIG"))
+    config = shell_word(str(rig.get("config_path") or "CONFIG"))
     if not isinstance(sync, dict):
         camera = config_of.get("camera")
         device = camera.get("device") if isinstance(camera, dict) else None
@@ -2711,11 +2711,11 @@ def lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None = Non
         return (
             f"put the originals back{where}, or let its resume set them aside and shoot "
             f"them again, with the object where it was: rti-rig run --resume "
-            f"{shlex.quote(str(root))}"
+            f"{shell_word(str(root))}"
         )
     return (
         "put the originals back from a copy, or reshoot exactly those, with the object where "
-        f"it was: rti-rig run --resume {shlex.quote(str(root))} --reshoot-lost"
+        f"it was: rti-rig run --resume {shell_word(str(root))} --reshoot-lost"
     )
 
 
@@ -2795,7 +2795,7 @@ _JSON_KIND = {
 def _acquisition_lp_use(lp: Path) -> str:
     """What to do with an `.lp` outside any session (a recorded acquisition's, its images
     beside it): it is fitted and replayed as it is, with no session to export or resume."""
-    q = shlex.quote(str(lp))
+    q = shell_word(str(lp))
     return (
         "if that is a recorded acquisition's .lp (its images beside it), use it as it is: "
         f"rti-rig fit {q} --out DIR, or replay it as a rig: rti-rig run {q} --out DIR"
@@ -2831,7 +2831,7 @@ def read_manifest(root: Path) -> dict[str, Any]:
             # a session that lost its manifest (deleted, or left out of a copy): "not an rti-rig
             # session folder" had been said of a folder of its images and journal
             fit = (
-                f", but its images can still be fitted: rti-rig fit {shlex.quote(str(root))} "
+                f", but its images can still be fitted: rti-rig fit {shell_word(str(root))} "
                 "--out DIR"
                 if (Path(root) / LP_NAME).is_file()
                 else ""
@@ -3113,7 +3113,7 @@ def journal_mend_note(root: Path) -> str | None:
     why = ", ".join(parts) or "records missing"
     state = "is missing, so it" if scan.missing else f"is damaged ({why}) and"
     completed = (manifest.get("runner") or {}).get("finish_reason") == "completed"
-    mend = f"rti-rig run --resume {shlex.quote(str(root))}" + (
+    mend = f"rti-rig run --resume {shell_word(str(root))}" + (
         " --rebuild-journal" if completed else ""
     )
     one = len(stems) == 1
@@ -3148,7 +3148,7 @@ def _unwritten_line_note(root: Path, stem: str) -> str:
     fitted = "" if listed else f" (kept, but not yet in {LP_NAME}, so not fitted)"
     return (
         f"the run stopped after {stem}'s record file, before its journal line{fitted}; "
-        f"rti-rig run --resume {shlex.quote(str(root))} writes it back"
+        f"rti-rig run --resume {shell_word(str(root))} writes it back"
     )
 
 
@@ -3233,7 +3233,7 @@ def list_unwritten_step(root: Path, scan: JournalScan | None = None) -> str | No
             return (
                 f"the run stopped after {stem}'s record file, before its journal line and "
                 f"before {LP_NAME} listed it; {LP_NAME} could not be rewritten to list it ({exc}) "
-                f"and still lacks {stem}; rti-rig run --resume {shlex.quote(str(root))} lists "
+                f"and still lacks {stem}; rti-rig run --resume {shell_word(str(root))} lists "
                 "it, once the folder can be written"
             )
     finally:
@@ -3437,7 +3437,7 @@ def session_lp_report(
                 + (
                     instead
                     if instead is not None
-                    else f"continue it with rti-rig run --resume {shlex.quote(str(root))} (a "
+                    else f"continue it with rti-rig run --resume {shell_word(str(root))} (a "
                     "first image's files left on disk without its record file are set aside in "
                     "recovered/ and shot again)"
                 )
