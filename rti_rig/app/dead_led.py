@@ -11,12 +11,12 @@ without its line, or for a session of some LEDs a plan written beside it
 
 from __future__ import annotations
 
-import shlex
 from pathlib import Path
 from typing import Any
 
 from rti_rig.core.dome_link import DomeLedError, DomeLinkError, LinkFault
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.shell_words import shell_word
 from rti_rig.drivers.led_dome.messages import ERR_LED_FAULT
 
 
@@ -63,13 +63,13 @@ def dead_led_advice(
     is one it chose later), had been written as "the session's N other lights" (N one short),
     a plan of a few lights offered in the session's place."""
     dome = loaded.config.dome
-    cfg = shlex.quote(str(loaded.path))
+    cfg = shell_word(str(loaded.path))
     names = _led_names(loaded)
     which = f"LED {led} ({names[led]})" if 0 <= led < len(names) else f"LED {led}"
     leds = {s.led for s in schedule.steps}
     repaired = (
         f"that LED or its wiring is repaired, continue with: rti-rig run --resume "
-        f"{shlex.quote(str(out_dir))}"
+        f"{shell_word(str(out_dir))}"
     )
     resume, resume_sentence = f"once {repaired}", f"Once {repaired}"
     rig_lp = (
@@ -103,7 +103,7 @@ def dead_led_advice(
                 f"A resume lights {which} first and stops there again. The session's "
                 f"{len(leds - {led})} other lights, in its order, {how} beside it "
                 f"as {written.name}; to shoot them now: rti-rig run {cfg} --plan "
-                f"{shlex.quote(str(written))} --out NEW_DIR. {resume_sentence}"
+                f"{shell_word(str(written))} --out NEW_DIR. {resume_sentence}"
             )
         step = next((s for s in schedule.steps if s.led == led), None)
         where = "" if step is None else " ({:.6f} {:.6f} {:.6f})".format(*step.direction)

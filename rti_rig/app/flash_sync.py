@@ -20,7 +20,6 @@ Everything that would fire the camera outside the sequence steps the dome too, s
 from __future__ import annotations
 
 import json
-import shlex
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Literal
@@ -31,6 +30,7 @@ from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import ConfigError, DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.core.shell_words import shell_word
 from rti_rig.runtime.disowned import MARKER as DISOWN_MARKER
 from rti_rig.runtime.disowned import disown
 from rti_rig.runtime.flash_sync import CameraTriggeredLighting, LightSlipError
@@ -463,7 +463,7 @@ def refuse_options(loaded, **given: bool) -> None:  # type: ignore[no-untyped-de
             raise RtiRigError(
                 f"{loaded.path}: {option} cannot be used with a camera-triggered dome "
                 f"({fs.firmware}): {why[option]}. Long-press the dome's start button to rewind "
-                f"it, then run the whole sequence: rti-rig run {shlex.quote(str(loaded.path))} "
+                f"it, then run the whole sequence: rti-rig run {shell_word(str(loaded.path))} "
                 "--out DIR"
             )
 

@@ -20,7 +20,6 @@ times the exposure it needed under the median LED), which is reported.
 from __future__ import annotations
 
 import math
-import shlex
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -34,6 +33,7 @@ from rti_rig.app.config import CALIBRATION_FORMAT as FORMAT
 from rti_rig.app.dead_led import dead_led_recorded
 from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.shell_words import shell_word
 from rti_rig.planner.topography import downsample
 from rti_rig.reconstruct import ReconstructionError, estimate_light_gains
 from rti_rig.runtime.session import (
@@ -209,7 +209,7 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
         raise SessionError(
             f"{root}: the card session did not finish ({finish or 'no finish recorded'}, "
             f"{max(taken, len(steps))} of {len(planned)} images): continue it with rti-rig run "
-            f"--resume {shlex.quote(str(root))}, or shoot the card again"
+            f"--resume {shell_word(str(root))}, or shoot the card again"
         )
     shot_with = {run.get("config_sha256") for run in manifest.get("runs") or []}
     shot_with.discard(None)

@@ -20,7 +20,6 @@ a session's) or belong to another acquisition. Two records that disagree are an 
 
 from __future__ import annotations
 
-import shlex
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +34,7 @@ from rti_rig.core.geometry import (
     direction_from_az_el,
 )
 from rti_rig.core.lp_format import LpEntry, image_path
+from rti_rig.core.shell_words import shell_word
 from rti_rig.runtime.session import (
     JOURNAL,
     LINEAR_DIR,
@@ -113,7 +113,7 @@ def _recorded_steps(
     steps.update((i, r) for i, r in journaled.items() if i not in steps)
     if steps:
         return [steps[i] for i in sorted(steps)], journaled
-    resume = f"rti-rig run --resume {shlex.quote(str(root))}"
+    resume = f"rti-rig run --resume {shell_word(str(root))}"
     if light_given:  # the light is given: only an image is missing
         raise ScheduleError(
             f"{root}: the session has no finished images; if it was interrupted, finish it "

@@ -20,7 +20,6 @@ uninterrupted session would have.
 
 from __future__ import annotations
 
-import shlex
 import time
 import warnings
 from collections.abc import Callable, Iterator
@@ -49,6 +48,7 @@ from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.core.shell_words import shell_word
 from rti_rig.planner import adaptive_until
 from rti_rig.planner.adaptive import (
     ESTIMATE_SCALE,
@@ -1479,7 +1479,7 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
     _, el = az_el_from_direction(rig_geometry(loaded).directions)
     facts = _nothing_to_choose(el, offered, lights, until_error_deg, band, min_lights)
     if facts is not None:
-        config = shlex.quote(str(loaded.path))
+        config = shell_word(str(loaded.path))
         raise RtiRigError(_nothing_to_choose_words(facts, config, until_error_deg, objective))
 
 
@@ -1550,7 +1550,7 @@ def _arm_widen_to_hold(  # type: ignore[no-untyped-def]
             continue
         if held >= need:
             return f" (or widen the band to hold {need}:{band_options(wider)})"
-    config = shlex.quote(str(loaded.path))
+    config = shell_word(str(loaded.path))
     widening = "; a wider band holds no more on this arm" if tuple(band) != _FULL_BAND else ""
     return (
         f"{widening} (an arm's lights are its {ARM_CANDIDATES} candidate directions spread over "

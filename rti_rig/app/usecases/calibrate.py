@@ -9,7 +9,6 @@ input and the output are checked, and a card session's own calibration file is n
 
 from __future__ import annotations
 
-import shlex
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +31,7 @@ from rti_rig.app.light_calibration import (
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.shell_words import shell_word
 from rti_rig.drivers.led_dome.settings import DIMMING_LINK, IMAGE_GAINS_REMEDY
 from rti_rig.reconstruct.light_gains import DeadLightError
 
@@ -107,14 +107,14 @@ def _dead_led_advice(
     led = int(card.leds[exc.light])
     image = card.image_of.get(led, f"image {exc.light + 1}")
     name = names[led] if 0 <= led < len(names) else f"LED {led}"
-    session = shlex.quote(str(req.card_session))
+    session = shell_word(str(req.card_session))
     return (
         f"{req.card_session}: LED {led} ({name}, session image {image}) gave {exc.gain:.3f} "
         "of the median LED's light: a dead LED (or a black frame), which no correction can "
         "even out. Check that LED and its wiring, then shoot the card again; to calibrate "
         f"the other LEDs meanwhile, shoot the card under all but it: copy {session}/lights.lp "
         f"without the line of {image} (the count on its first line one less) as PLAN.lp, "
-        f"run rti-rig run {shlex.quote(str(req.rig_config))} --plan PLAN.lp --out NEW_CARD "
+        f"run rti-rig run {shell_word(str(req.rig_config))} --plan PLAN.lp --out NEW_CARD "
         "and calibrate NEW_CARD"
     )
 
@@ -131,7 +131,7 @@ def _without_led(req: CalibrateRequest, loaded: LoadedRig, which: str) -> str:
     return (
         f"Repair {which} or its wiring and shoot the card again; to calibrate the other LEDs "
         f"meanwhile, copy {lp} without the line of {which} (the count on its first line one "
-        f"less) as PLAN.lp, run rti-rig run {shlex.quote(str(req.rig_config))} --plan PLAN.lp "
+        f"less) as PLAN.lp, run rti-rig run {shell_word(str(req.rig_config))} --plan PLAN.lp "
         "--out NEW_CARD and calibrate NEW_CARD"
     )
 

@@ -16,7 +16,6 @@ import html
 import json
 import math
 import os
-import shlex
 import threading
 import time
 import warnings
@@ -64,6 +63,7 @@ from rti_rig.core.out_folders import (
     refuse_a_file_in_the_way,
 )
 from rti_rig.core.raw_rows import DecodedStore, RawRows
+from rti_rig.core.shell_words import shell_word
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters, signal_check
 from rti_rig.reconstruct.errors import ReconstructionError
@@ -138,11 +138,9 @@ def _output_error(exc: OSError, req: FitRequest, out: Path, created: bool) -> Fi
     }.get(exc.errno or 0, "free space on that disk, or choose an --out on another")
     if out.name.startswith(".") and out.name.endswith(".partial"):
         # a batch's hidden attempt folder is no --out to give: the batch is run again
-        again = f"run the batch again with --out {shlex.quote(str(out.parent))}"
+        again = f"run the batch again with --out {shell_word(str(out.parent))}"
     else:
-        again = (
-            f"run again: rti-rig fit {shlex.quote(str(req.source))} --out {shlex.quote(str(out))}"
-        )
+        again = f"run again: rti-rig fit {shell_word(str(req.source))} --out {shell_word(str(out))}"
     return FitOutputError(
         f"{req.source}: the fit could not write its outputs in {out}{where}: {reason}; "
         f"nothing of it was kept ({out} {left}) and the session is unchanged: {remedy}, "
@@ -366,7 +364,7 @@ def _resume_words(source: Path) -> str:
         return f"the session is not finished: {instead}"
     return (
         "the session is not finished: continue it with rti-rig run --resume "
-        f"{shlex.quote(str(folder))}"
+        f"{shell_word(str(folder))}"
     )
 
 
@@ -387,8 +385,8 @@ def acquisition_files(
             if (source / JOURNAL).is_file():  # a session that lost its lights.lp
                 raise FitInputError(
                     f"{source} is a session folder without its {LP_NAME}; rebuild it from the "
-                    f"session's journal with: rti-rig export-lp {shlex.quote(str(source))} "
-                    f"--out {shlex.quote(str(source / LP_NAME))}"
+                    f"session's journal with: rti-rig export-lp {shell_word(str(source))} "
+                    f"--out {shell_word(str(source / LP_NAME))}"
                 )
             first = stopped_before_first_journal(source)
             if first is not None:
@@ -407,7 +405,7 @@ def acquisition_files(
                     + (
                         instead
                         if instead is not None
-                        else f"continue it with rti-rig run --resume {shlex.quote(str(source))}"
+                        else f"continue it with rti-rig run --resume {shell_word(str(source))}"
                     )
                 )
             if (source / MANIFEST).is_file():  # its journal and lights.lp both gone
@@ -423,15 +421,15 @@ def acquisition_files(
             shown = ", ".join(p.name for p in lps[:6]) + (" …" if len(lps) > 6 else "")
             rebuild = (
                 f"; or rebuild the session's own {LP_NAME} from its journal with: rti-rig "
-                f"export-lp {shlex.quote(str(source))} --out "
-                f"{shlex.quote(str(source / LP_NAME))}"
+                f"export-lp {shell_word(str(source))} --out "
+                f"{shell_word(str(source / LP_NAME))}"
                 if (source / JOURNAL).is_file()
                 else ""
             )
             raise FitInputError(
                 f"{source} holds {len(lps)} .lp files and no {LP_NAME} ({shown}): which one "
                 "lists its lights cannot be told; fit the one you mean, e.g. rti-rig fit "
-                f"{shlex.quote(str(lps[0]))} --out DIR{rebuild}"
+                f"{shell_word(str(lps[0]))} --out DIR{rebuild}"
             )
         lp = source / LP_NAME if (source / LP_NAME).is_file() else lps[0]
         if notes is not None and lp.name != LP_NAME and (source / JOURNAL).is_file():
@@ -440,8 +438,8 @@ def acquisition_files(
             notes.append(
                 f"{source} is a session folder without its {LP_NAME}: fitted from its "
                 f"{lp.name}; rebuild {LP_NAME} from the session's journal with: rti-rig "
-                f"export-lp {shlex.quote(str(source))} --out "
-                f"{shlex.quote(str(source / LP_NAME))}"
+                f"export-lp {shell_word(str(source))} --out "
+                f"{shell_word(str(source / LP_NAME))}"
             )
         if notes is not None and (source / JOURNAL).is_file() and not (source / MANIFEST).is_file():
             # a session (it has a journal) that lost its manifest had been fitted, and judged
@@ -553,8 +551,8 @@ def _refuse_lost_images(lp: Path, damaged: list[tuple[Path, str]]) -> None:
             f"{root}: {len(damaged)} image(s) its {lp.name} lists are not under their session "
             f"names: {renamed_note(renamed)}; then run this again"
         )
-    folder = shlex.quote(str(root))
-    rest = shlex.quote(str(root / "rest.lp"))
+    folder = shell_word(str(root))
+    rest = shell_word(str(root / "rest.lp"))
     raise FitInputError(
         f"{root}: {len(damaged)} image(s) its {lp.name} lists cannot be read as captured "
         f"({shown}){moved}: {lost_image_advice(root, adaptive)}; or fit the images that "
@@ -1526,7 +1524,7 @@ def qa_without_normals(lights: np.ndarray, session: Path | None = None) -> str |
     fit = (
         ""
         if session is None
-        else f"; `rti-rig fit {shlex.quote(str(session))} --out FOLDER` still writes the "
+        else f"; `rti-rig fit {shell_word(str(session))} --out FOLDER` still writes the "
         "relighting files"
     )
     return (

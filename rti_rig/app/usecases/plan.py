@@ -9,7 +9,6 @@ meaning "a dome with exactly these lights".
 
 from __future__ import annotations
 
-import shlex
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -36,6 +35,7 @@ from rti_rig.core.image_files import png_alpha_note
 from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 from rti_rig.core.schedule import LightSchedule
+from rti_rig.core.shell_words import shell_word
 from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.make_plan import (
     DEFAULT_OBJECTIVE,
@@ -360,7 +360,7 @@ def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: li
 def _config_shown(rig: Path) -> str:
     """The rig config ``plan`` was given, as a ``run`` command line names it: a bare ``.lp``
     rig is no config, and ``RIG.toml`` stands for the one whose lights it lists."""
-    return "RIG.toml" if Path(rig).suffix.lower() == ".lp" else shlex.quote(str(rig))
+    return "RIG.toml" if Path(rig).suffix.lower() == ".lp" else shell_word(str(rig))
 
 
 def run_plan_command(rig: Path, plan_file: Path) -> str:
@@ -370,7 +370,7 @@ def run_plan_command(rig: Path, plan_file: Path) -> str:
 
     Why: the advice had been ``rti-rig run --plan PLAN.lp --allow-no-normals``, which ``run``
     refuses ("give a RIG_CONFIG and --out DIR")."""
-    plan = shlex.quote(str(plan_file))
+    plan = shell_word(str(plan_file))
     return f"rti-rig run {_config_shown(rig)} --plan {plan} --out DIR --allow-no-normals"
 
 

@@ -11,11 +11,11 @@ records what the session was asked for; the command repeats it.
 
 from __future__ import annotations
 
-import shlex
 from pathlib import Path
 from typing import Any
 
 from rti_rig.app.usecases.run_options import adaptive_options, band_options
+from rti_rig.core.shell_words import shell_word
 
 
 def new_session_dir(session_dir: Path | str) -> Path:
@@ -59,9 +59,9 @@ def new_session_command(
     where it was relative to is unknown)."""
     words = [
         "rti-rig run",
-        shlex.quote(str(config_path)),
+        shell_word(str(config_path)),
         "--out",
-        shlex.quote(str(new_session_dir(session_dir))),
+        shell_word(str(new_session_dir(session_dir))),
     ]
     return " ".join(words) + session_options(manifest)
 
@@ -83,12 +83,12 @@ def session_options(manifest: dict[str, Any]) -> str:
                 float(until) if until is not None else None,
                 int(lights) if lights is not None else None,  # --lights was given
                 int(floor) if floor is not None else None,
-                shlex.quote(str(adaptive.get("objective") or "normals")),
+                shell_word(str(adaptive.get("objective") or "normals")),
             )
         )
         band = adaptive
     elif provenance.get("plan_file"):
-        words.append(f"--plan {shlex.quote(str(provenance['plan_file']))}")
+        words.append(f"--plan {shell_word(str(provenance['plan_file']))}")
     elif provenance.get("n") is not None:
         words.append(f"--lights {int(provenance['n'])}")
         band = provenance

@@ -12,13 +12,13 @@ anything on disk is touched, naming what differs and what to do.
 from __future__ import annotations
 
 import math
-import shlex
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
+from rti_rig.core.shell_words import shell_word
 
 #: Two lights of a plan are the same light within this angle (°): an .lp carries six decimals
 #: (or fewer, rewritten by another program), which moves a direction by far less than this.
@@ -71,7 +71,7 @@ def check_same_start(
         limit = _recorded_max_saturated(manifest)
         if limit is not None and not _same_number(limit, NewSessionRequest.max_saturated):
             began += f" --max-saturated {limit:g}"
-    folder = shlex.quote(str(root))
+    folder = shell_word(str(root))
     raise RtiRigError(
         f"{root}: this resume asks for another session than the one in it ("
         + "; ".join(diffs)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import contextlib
 import math
-import shlex
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -18,6 +17,7 @@ from typing import Any
 from rti_rig.app.usecases.replay_advice import new_session_command
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.schedule import LightSchedule
+from rti_rig.core.shell_words import shell_word
 from rti_rig.runtime.controller import (
     CancelToken,
     EmergencyStop,
@@ -982,7 +982,7 @@ def _refuse_rig_config_as_plan(plan: Path, rig_config: Path) -> None:
     if data.get("kind") not in ("dome", "arm"):
         return
     name = f" ({data['name']})" if isinstance(data.get("name"), str) and data["name"] else ""
-    rig = shlex.quote(str(rig_config))
+    rig = shell_word(str(rig_config))
     raise RtiRigError(
         f"--plan {plan} is a rig config{name}, not a plan: --plan takes a plan file, the .lp "
         "light list (a count line, then 'name x y z' per image) that rti-rig plan writes; "
@@ -1206,7 +1206,7 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
         raise RtiRigError(
             f"{req.adaptive_option} cannot meter the exposure: its lights are chosen as the images "
             "arrive, so there is no brightest planned light to meter at. Meter once with a "
-            f"planned run (rti-rig run {shlex.quote(str(req.rig_config))} --out TEST "
+            f"planned run (rti-rig run {shell_word(str(req.rig_config))} --out TEST "
             f"{_metering_options(req, loaded)} --auto-exposure prints 'Exposure fixed at T s'), "
             "set camera.exposure_s = T in the rig config, then run this command again without "
             "--auto-exposure"
@@ -1415,7 +1415,7 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             f"the images of {config_path} are not the ones this session began with (one was "
             "edited, replaced or re-exported since): the session's first images and the ones "
             "a resume would take would come from two different acquisitions. Put the original "
-            f"files back to continue (rti-rig run --resume {shlex.quote(str(session_dir))}), "
+            f"files back to continue (rti-rig run --resume {shell_word(str(session_dir))}), "
             "or start a new session from the acquisition as it is now ("
             + new_session_command(config_path, manifest, session_dir)
             + ")"
@@ -1445,7 +1445,7 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             "or gain reads as a brighter or darker light, another size or decoding as another "
             "picture), and fit, relight and RTIBuilder take a session's images as one set. "
             "That cannot be accepted into this session, even with --accept-rig-change: set it "
-            f"back to continue (rti-rig run --resume {shlex.quote(str(session_dir))} with the "
+            f"back to continue (rti-rig run --resume {shell_word(str(session_dir))} with the "
             "session's own "
             "config), or start a new session with the new settings"
         )
@@ -1599,7 +1599,7 @@ def _back_to_own_config(
         )
     return (
         "Resume with the session's own config (rti-rig run --resume "
-        f"{shlex.quote(str(session_dir))})"
+        f"{shell_word(str(session_dir))})"
     )
 
 
@@ -1741,7 +1741,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         raise RtiRigError(
             done + " (a camera-triggered dome cannot reshoot single images either: to shoot "
             "again, long-press the dome's start button, then rti-rig run "
-            f"{shlex.quote(str(config_path))} --out NEWDIR)"
+            f"{shell_word(str(config_path))} --out NEWDIR)"
         )
     refuse_options(loaded, **{"--resume": True})
     _refuse_image_sequence_resume(loaded, Path(req.session_dir))
@@ -1784,7 +1784,7 @@ def _refuse_image_sequence_resume(loaded: Any, root: Path) -> None:
     an image sequence (:func:`rti_rig.runtime.session.image_sequence_restarts`)."""
     from rti_rig.runtime.session import holds_no_image, image_sequence_restarts
 
-    why = image_sequence_restarts(loaded.config.camera.device, shlex.quote(str(loaded.path)))
+    why = image_sequence_restarts(loaded.config.camera.device, shell_word(str(loaded.path)))
     if why is None or holds_no_image(root):
         return  # nothing shot yet: the sequence's first file is the first image's
     raise RtiRigError(f"{root}: this session cannot be resumed (nothing was changed): {why}")

@@ -11,7 +11,6 @@ JPEGs in order) gave every later image the wrong light. The journal says what wa
 from __future__ import annotations
 
 import math
-import shlex
 from dataclasses import replace
 from pathlib import Path
 from typing import TypeVar
@@ -21,6 +20,7 @@ import numpy as np
 from rti_rig.app.usecases.uneven_lights import with_uneven_lights
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import lp_files_in, read_lp
+from rti_rig.core.shell_words import shell_word
 from rti_rig.reconstruct.qa import (
     BLACK_ADVICE,
     FLAT_ADVICE,
@@ -224,10 +224,10 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
         unlisted = sorted(n for n in candidates if n not in lost)
     if not differ and not reordered and not unlisted:
         return qa
-    folder = shlex.quote(str(source))
+    folder = shell_word(str(source))
     again = (
         f"move {lp.name} aside and write it again from the journal: rti-rig export-lp {folder} "
-        f"--out {shlex.quote(str(source / lp.name))}"
+        f"--out {shell_word(str(source / lp.name))}"
         + (" --linear" if any(e.name.startswith(f"{LINEAR_DIR}/") for e in entries) else "")
     )
     if differ:
@@ -499,7 +499,7 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
         + (
             instead  # its resume is refused: not named
             if instead is not None
-            else f"continue it with rti-rig run --resume {shlex.quote(str(source))}"
+            else f"continue it with rti-rig run --resume {shell_word(str(source))}"
             # a plain resume of a journal that lost records the manifest holds is refused
             + (
                 " --rebuild-journal (or once its journal is restored)"
@@ -520,7 +520,7 @@ def _with_stopped_while_committing(qa: QAReport, source: Path) -> QAReport:
     stopped = stopped_while_committing(source)
     if stopped is None:
         return qa
-    folder = shlex.quote(str(source))
+    folder = shell_word(str(source))
     instead = unresumable(source)  # a resume is refused: not named
     if stopped in {c.name for c in qa.images}:  # an .lp of the user's own listed it
         note = (
