@@ -200,7 +200,7 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
         return f"LED {i}, {names[i]}" + (f", session image {shot}" if shot else "")
 
     out.print(
-        f"Card session {escape(str(card_session))}: {len(card.leds)} images of rig "
+        f"Card session {escape(shown_path(card_session))}: {len(card.leds)} images of rig "
         f"'{escape(loaded.config.name)}'; {len(measured)} of {geometry.count} LEDs measured "
         f"(lowest {lowest:.1f}° above the card)."
     )
@@ -253,13 +253,14 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
     if in_force and cal.shot_spread < even_enough:
         out.print(
             "The correction in force is good: no new calibration is needed. To use this "
-            f"one instead, set under {escape('[dome.serial]')} in {escape(str(rig_config))}:",
+            f"one instead, set under {escape('[dome.serial]')} in "
+            f"{escape(shown_path(rig_config))}:",
             highlight=False,
         )
     else:
         out.print(
             f"To use it, {_how_to_set(loaded.raw)} {escape('[dome.serial]')} in "
-            f"{escape(str(rig_config))}:",
+            f"{escape(shown_path(rig_config))}:",
             highlight=False,
         )
     # the line to paste, on its own and never wrapped (a wrapped line pastes as two)

@@ -363,10 +363,10 @@ def _fit_command(  # type: ignore[no-untyped-def]
         out.print(f"QA verdict: {escape(result.qa.verdict)}")
     if moved_on is not None:
         err.print(
-            f"[yellow]warning:[/] {escape(str(request.source))} changed while it was being "
-            f"fitted ({escape(moved_on)}): the fit in {escape(str(out_dir))} is of the session "
-            "as it was read, not as it is now; once the session is no longer being changed, "
-            "fit it again into a new --out (exit 1)",
+            f"[yellow]warning:[/] {escape(shown_path(request.source))} changed while it was "
+            f"being fitted ({escape(moved_on)}): the fit in {escape(shown_path(out_dir))} is of "
+            "the session as it was read, not as it is now; once the session is no longer being "
+            "changed, fit it again into a new --out (exit 1)",
             soft_wrap=True,
         )
         raise typer.Exit(code=1)

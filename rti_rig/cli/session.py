@@ -2090,7 +2090,7 @@ def export_lp(
         )
     if done.outside_session:
         err.print(
-            f"[yellow]note:[/] its image names are relative to {escape(str(session_dir))}, "
+            f"[yellow]note:[/] its image names are relative to {escape(shown_path(session_dir))}, "
             "and tools (relight, RTIBuilder, rti-rig fit) read them beside the .lp: move "
             f"{escape(_arg(out_file))} into {escape(_arg(session_dir))} to use it; for "
             "relight-cli, which reads the first .lp of a folder, move that folder's lights.lp "
