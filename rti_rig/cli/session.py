@@ -510,7 +510,7 @@ def refuse_unmetered_limit(
 def _opening_failed(exc: RtiRigError, out_dir: Path | None) -> typer.Exit:
     """The exit for an error while the rig opened (before any image): where metering had lit
     the rig, the lights' state is said first, with nothing captured or written."""
-    state = getattr(exc, "lights_state", None)
+    state = exc.lights_state
     if state is not None:
         err.print(
             f"{_sentence(state)}; nothing was captured or written to {out_dir}.", markup=False
@@ -523,8 +523,10 @@ def _stopped_while_opening(
 ) -> typer.Exit:
     """Say a stop (Ctrl-C, SIGTERM) that came while the session opened, and what metering's
     teardown established of the lights if it was metering; the exit a stop by ``why`` asks."""
+    from rti_rig.app.usecases.safe_state import lights_state_of
+
     _print_metering_failures(exc)
-    state = getattr(exc, "lights_state", None)
+    state = lights_state_of(exc)
     if state is not None:  # stopped while metering: what its teardown established
         said += f"; metering was stopped, and then: {state}"
     elif auto_exposure:
@@ -583,6 +585,7 @@ def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
     One place for ``run`` and ``preview``: they had two copies of this, and the preview's
     lacked two of the run's answers (an unnamed fault while it opened reached the user as a
     traceback, and metering's teardown failures went unsaid on an error)."""
+    from rti_rig.app.usecases.safe_state import lights_state_of
     from rti_rig.runtime.controller import EmergencyStop
     from rti_rig.runtime.session import SessionComplete
 
@@ -608,7 +611,7 @@ def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
     except Exception as exc:  # no part of rti-rig named it: said, not a traceback
         _print_metering_failures(exc)
         said = opening.not_opened
-        state = getattr(exc, "lights_state", None)
+        state = lights_state_of(exc)
         if state is not None:  # metering failed: what its teardown established
             said += f"; metering failed, and then: {state}"
         elif opening.auto_exposure:

@@ -13,6 +13,11 @@ from pathlib import Path
 class RtiRigError(Exception):
     """Base class of every error rti-rig raises on purpose."""
 
+    #: What metering's teardown established of the lights, where this error ended metering
+    #: (set by the session use case, said by the CLI before the error), None otherwise.
+    #: Declared: it had been set with a ``# type: ignore`` and read with ``getattr``.
+    lights_state: str | None = None
+
 
 class ConfigError(RtiRigError):
     """A rig config is unreadable or invalid; names the file and the key."""

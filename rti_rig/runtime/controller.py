@@ -89,6 +89,9 @@ class EmergencyStop(BaseException):
     #: :func:`~rti_rig.runtime.arm_check.arm_self_test`: its teardown's failures, where it
     #: left the arm), None otherwise. Declared: ``check`` had read it with ``getattr``.
     self_test_report: ArmSelfTestReport | None = None
+    #: What metering's teardown established of the lights, where this stop ended metering
+    #: (as :attr:`~rti_rig.core.errors.RtiRigError.lights_state`), None otherwise.
+    lights_state: str | None = None
 
     def __init__(self, signum: signal.Signals, words: str | None = None) -> None:
         self.signum = as_received(signum)  # a hang-up answered as a SIGTERM is a SIGHUP

@@ -10,12 +10,34 @@ from __future__ import annotations
 
 from rti_rig.core.devices import KnownStateLightSource
 from rti_rig.core.dome_link import OffOutcome
-from rti_rig.core.errors import UnheldJoint
+from rti_rig.core.errors import RtiRigError, UnheldJoint
 from rti_rig.runtime.arm_check import not_connected_sentence
 from rti_rig.runtime.arm_end import ArmEnd
+from rti_rig.runtime.controller import EmergencyStop
 from rti_rig.runtime.dome_policy import lights_state_sentence
 from rti_rig.runtime.flash_sync import CameraTriggeredLighting
 from rti_rig.runtime.lighting import ArmLighting, DomeLighting
+
+
+def carry_lights_state(exc: BaseException, state: str) -> None:
+    """Attach to ``exc``, the error or stop that ended metering, what metering's teardown
+    established of the lights (:func:`lights_state`), for the CLI to say before the error.
+
+    :class:`~rti_rig.core.errors.RtiRigError` and
+    :class:`~rti_rig.runtime.controller.EmergencyStop` declare ``lights_state`` and are read
+    plainly; a Ctrl-C's KeyboardInterrupt or a camera driver's TypeError is raised on as it
+    is (wrapped, it would be said and stop otherwise) and its type cannot declare it: this
+    and :func:`lights_state_of` alone spell the name for those."""
+    exc.lights_state = state  # type: ignore[attr-defined]  # declared where the type can
+
+
+def lights_state_of(exc: BaseException) -> str | None:
+    """What :func:`carry_lights_state` attached to ``exc`` (None: ``exc`` did not end
+    metering, or the lights' state could not be told)."""
+    if isinstance(exc, (RtiRigError, EmergencyStop)):
+        return exc.lights_state
+    state = getattr(exc, "lights_state", None)
+    return state if isinstance(state, str) else None
 
 
 def software_lamp(lighting: object) -> bool:

@@ -590,14 +590,14 @@ def fix_exposure(
         # only the error, and of a camera driver's TypeError "check the rig's lights" of a
         # dome whose all-off metering had sent and seen acknowledged); a state that cannot be
         # told leaves the fault to be said as it is
-        from rti_rig.app.usecases.safe_state import lights_state
+        from rti_rig.app.usecases.safe_state import carry_lights_state, lights_state
         from rti_rig.runtime.exposure_policy import teardown_failures_of
         from rti_rig.runtime.lighting import unsafe_failures
 
         # (a port that did not close cleanly is no doubt about the lights: the all-off says)
         failures = unsafe_failures(teardown_failures_of(exc))
         with contextlib.suppress(Exception):  # never said in place of the fault raised
-            exc.lights_state = lights_state(rig, bool(failures))  # type: ignore[attr-defined]
+            carry_lights_state(exc, lights_state(rig, bool(failures)))
         raise
     chosen = fixed.provenance["exposure"]
     where = ""
