@@ -67,7 +67,7 @@ from rti_rig.core.image_files import (
 )
 from rti_rig.core.lp_format import LpEntry, format_lp, lp_files_in
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
 from rti_rig.runtime.unrecorded_end import CAUSES, unrecorded_end
 from rti_rig.runtime.unrecorded_end import UNRECORDED as RUN_UNRECORDED
@@ -654,8 +654,8 @@ class SessionFolder:
             except SessionError:  # a journal without a manifest, or a damaged manifest
                 what = f"a session folder (it holds rti-rig's {MANIFEST} or {JOURNAL})"
             raise SessionError(
-                f"--out {root} is inside {outer}, {what}: give an --out outside it, so that "
-                "each session stays a folder of its own"
+                f"--out {shown_path(root)} is inside {shown_path(outer)}, {what}: give an --out "
+                "outside it, so that each session stays a folder of its own"
             )
         if root.exists() and any(root.iterdir()) and not holds_no_image(root):
             resume = ""  # not a session: no resume to offer
@@ -674,8 +674,8 @@ class SessionFolder:
                 if not finished and in_use_by_another(root):  # running, not interrupted
                     resume = " (another rti-rig process is capturing a session in it right now)"
             raise SessionError(
-                f"{root} is not empty: refusing to write a session over existing files; "
-                f"choose a new --out folder{resume}"
+                f"{shown_path(root)} is not empty: refusing to write a session over existing "
+                f"files; choose a new --out folder{resume}"
             )
         # where the session's folder would be made: found unwritable only at the first image,
         # a session had lit the rig (and on an arm, moved it) for nothing
