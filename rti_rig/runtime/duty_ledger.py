@@ -105,7 +105,9 @@ class DutyLedger:
     def __init__(self, key: str, *, wall: Callable[[], float] = time.time) -> None:
         self.key = key
         self.wall = wall
-        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+        # surrogateescape: a config in a folder whose name is not UTF-8 (its path holds
+        # '\udce9') had ended every command on its emulated dome with a UnicodeEncodeError
+        digest = hashlib.sha256(key.encode("utf-8", "surrogateescape")).hexdigest()[:16]
         stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", Path(key.split(":", 1)[-1]).name)[:40] or "dome"
         self.path = ledger_dir() / f"{stem}-{digest}.json"
         #: The folder was swept of stale ledgers by this object's first write: once a command

@@ -108,7 +108,9 @@ def test_a_fit_of_a_session_without_its_lp_gives_an_export_lp_that_runs_as_paste
 def test_a_calibration_of_an_unfinished_card_session_gives_its_resume_as_a_word_that_pastes_back(
     tmp_path: Path,
 ) -> None:
-    cfg = card_rig(tmp_path)
+    # its rig config in such a folder too: its emulated dome's duty ledger is keyed by its path
+    (tmp_path / os.fsdecode(b"rig \xe9")).mkdir()
+    cfg = card_rig(tmp_path / os.fsdecode(b"rig \xe9"))
     card = tmp_path / os.fsdecode(b"card \xe9") / "C"
     r = rti_rig("run", cfg, "--lights", "6", "--out", card, "--no-verdict")
     assert r.returncode == 0, r.stderr
