@@ -360,9 +360,9 @@ def run(
             auto_exposure,
             stopped=lambda why, _exc: (
                 f"Stopped ({why}) before the first image: nothing was captured or written to "
-                f"{out_dir}"
+                f"{shown_path(out_dir)}"
             ),
-            not_opened=f"Nothing was captured or written to {out_dir}",
+            not_opened=f"Nothing was captured or written to {shown_path(out_dir)}",
         )
     with hangup_as_sigterm(), _late_pause_ignored(), _late_term_held() as late_term:
         with _sigterm_exit_wins(late_term):
@@ -513,7 +513,8 @@ def _opening_failed(exc: RtiRigError, out_dir: Path | None) -> typer.Exit:
     state = exc.lights_state
     if state is not None:
         err.print(
-            f"{_sentence(state)}; nothing was captured or written to {out_dir}.", markup=False
+            f"{_sentence(state)}; nothing was captured or written to {shown_path(out_dir)}.",
+            markup=False,
         )
     return fail(exc)
 
@@ -1124,7 +1125,7 @@ _STOP_SAID: tuple[tuple[Callable[[_Stop], object], Callable[[_Stop], str]], ...]
     (lambda s: s.resumed, lambda s: f"No new image was captured. {s.resume_hint}"),
     (
         lambda s: not s.ending.begun,
-        lambda s: f"Nothing was captured and nothing was written to {s.out_dir}.",
+        lambda s: f"Nothing was captured and nothing was written to {shown_path(s.out_dir)}.",
     ),
     (
         lambda s: s.ending.holds_no_image,
@@ -1430,7 +1431,7 @@ def _stopped_before_capture(  # type: ignore[no-untyped-def]
     else:
         said = f"Stopped ({why}) before the first image: nothing was captured"
         if not opened.folder.begun:
-            said += f" or written to {opened.out_dir}"
+            said += f" or written to {shown_path(opened.out_dir)}"
         said += f"; {lights}"
     err.print(f"[yellow]{escape(said)}.[/]")
     return typer.Exit(code=stop_exit_code(signum))
@@ -1948,9 +1949,9 @@ def preview(
         auto_exposure,
         stopped=lambda why, _exc: (
             f"Stopped ({why}) before the preview image: nothing was captured or written to "
-            f"{out_dir}"
+            f"{shown_path(out_dir)}"
         ),
-        not_opened=f"Nothing was captured or written to {out_dir}",
+        not_opened=f"Nothing was captured or written to {shown_path(out_dir)}",
     )
     # a SIGTERM once the capture is over: the summary and the plan hint finish first. A
     # hang-up (SIGHUP) is answered as SIGTERM is: the preview lights the dome, and SIGHUP had
