@@ -33,7 +33,7 @@ from rti_rig.app.config import CALIBRATION_FORMAT as FORMAT
 from rti_rig.app.dead_led import dead_led_recorded
 from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import read_linear_tiff
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.planner.topography import downsample
 from rti_rig.reconstruct import ReconstructionError, estimate_light_gains
 from rti_rig.runtime.session import (
@@ -207,8 +207,9 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
                 led,
             )
         raise SessionError(
-            f"{root}: the card session did not finish ({finish or 'no finish recorded'}, "
-            f"{max(taken, len(steps))} of {len(planned)} images): continue it with rti-rig run "
+            f"{shown_path(root)}: the card session did not finish "
+            f"({finish or 'no finish recorded'}, {max(taken, len(steps))} of {len(planned)} "
+            "images): continue it with rti-rig run "
             f"--resume {shell_word(str(root))}, or shoot the card again"
         )
     shot_with = {run.get("config_sha256") for run in manifest.get("runs") or []}

@@ -1916,8 +1916,8 @@ def _refuse_complete(root: Path, manifest: dict[str, Any], total: int, finished:
     else:
         done = f"this session is complete: all {finished} steps were captured"
     said = (
-        f"{root}: {done}, and every image is as captured (each JPEG and linear TIFF matches "
-        "its journaled checksum); nothing to resume, nothing was changed"
+        f"{shown_path(root)}: {done}, and every image is as captured (each JPEG and linear "
+        "TIFF matches its journaled checksum); nothing to resume, nothing was changed"
     )
     fit = f"rti-rig fit {folder} --out FOLDER (FOLDER new or empty, outside the session)"
     if not (root / LP_NAME).is_file():

@@ -80,6 +80,9 @@ def test_a_resume_of_a_complete_session_gives_its_fit_as_a_word_that_pastes_back
     r = rti_rig("run", "--resume", session)
     assert r.returncode == 0, r.stderr
     assert words_after(r.stdout, b"Next: rti-rig fit ") == [os.fsencode(session)], r.stdout
+    assert words_after(r.stdout, b": this session is complete") == [os.fsencode(session)]
+    assert r.stdout.startswith(b"$'"), r.stdout  # and the session it names, as said first
+    assert [pasted(w) for w in WORD.findall(r.stdout)] == [os.fsencode(session)] * 2, r.stdout
     assert b"udce9" not in r.stdout, r.stdout
 
 
@@ -94,6 +97,8 @@ def test_a_fit_of_a_session_without_its_lp_gives_an_export_lp_that_runs_as_paste
     said = r.stderr.decode("ascii")
     command = said.split("with: ", 1)[1].split("\n", 1)[0].strip()
     assert command.startswith("rti-rig export-lp $'"), said
+    folder, lp = os.fsencode(copy), os.fsencode(copy / "lights.lp")
+    assert words_after(r.stderr, b"error: ") == [folder, folder, lp], said
     # the command as printed, run by bash: it writes the .lp back into the same folder
     done = subprocess.run(
         ["bash", "-c", command.replace("rti-rig", '"$PY" -m rti_rig', 1)],
@@ -123,3 +128,4 @@ def test_a_calibration_of_an_unfinished_card_session_gives_its_resume_as_a_word_
     assert b"did not finish" in r.stderr, r.stderr
     said = words_after(r.stderr, b"continue it with rti-rig run --resume ")
     assert said == [os.fsencode(card)], r.stderr
+    assert words_after(r.stderr, b"error: ") == [os.fsencode(card)] * 2, r.stderr

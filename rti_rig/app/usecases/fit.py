@@ -63,7 +63,7 @@ from rti_rig.core.out_folders import (
     refuse_a_file_in_the_way,
 )
 from rti_rig.core.raw_rows import DecodedStore, RawRows
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters, signal_check
 from rti_rig.reconstruct.errors import ReconstructionError
@@ -384,8 +384,8 @@ def acquisition_files(
         if not lps:
             if (source / JOURNAL).is_file():  # a session that lost its lights.lp
                 raise FitInputError(
-                    f"{source} is a session folder without its {LP_NAME}; rebuild it from the "
-                    f"session's journal with: rti-rig export-lp {shell_word(str(source))} "
+                    f"{shown_path(source)} is a session folder without its {LP_NAME}; rebuild it "
+                    f"from the session's journal with: rti-rig export-lp {shell_word(str(source))} "
                     f"--out {shell_word(str(source / LP_NAME))}"
                 )
             first = stopped_before_first_journal(source)
@@ -410,9 +410,9 @@ def acquisition_files(
                 )
             if (source / MANIFEST).is_file():  # its journal and lights.lp both gone
                 raise FitInputError(
-                    f"{source} is a session folder without its {LP_NAME} and {JOURNAL}: its "
-                    "images cannot be paired with their lights or verified as captured; restore "
-                    "both from a backup copy of the folder"
+                    f"{shown_path(source)} is a session folder without its {LP_NAME} and "
+                    f"{JOURNAL}: its images cannot be paired with their lights or verified as "
+                    "captured; restore both from a backup copy of the folder"
                 )
             raise FitInputError(f"{source} holds no .lp file: not a session folder")
         if not (source / LP_NAME).is_file() and len(lps) > 1:
@@ -436,7 +436,7 @@ def acquisition_files(
             # a session that lost its lights.lp had been fitted from another .lp in it (one
             # the user exported: a subset, say) without a word
             notes.append(
-                f"{source} is a session folder without its {LP_NAME}: fitted from its "
+                f"{shown_path(source)} is a session folder without its {LP_NAME}: fitted from its "
                 f"{lp.name}; rebuild {LP_NAME} from the session's journal with: rti-rig "
                 f"export-lp {shell_word(str(source))} --out "
                 f"{shell_word(str(source / LP_NAME))}"
