@@ -174,26 +174,33 @@ class SimulatedCamera:
         bands = row_bands(shape[0], shape[1] if len(shape) > 1 else 1)
         counts = np.empty(shape, dtype=np.float32) if self._noise else None
         for a, b in bands:
-            electrons = (band(a, b) + self._ambient) * scale
+            # in place, on the band's own new array (the renderer's is only read): one
+            # temporary a band where there were four, the same arithmetic
+            electrons = np.add(band(a, b), self._ambient)
+            electrons *= scale
             if counts is None:
                 self._finish(electrons, out[a:b])
             else:
-                drawn = rng.poisson(np.clip(electrons, 0.0, None))
-                counts[a:b] = np.minimum(drawn, _COUNT_CAP)
+                np.clip(electrons, 0.0, None, out=electrons)
+                drawn = rng.poisson(electrons)
+                np.minimum(drawn, _COUNT_CAP, out=counts[a:b], casting="unsafe")
         if counts is not None:
             for a, b in bands:
-                electrons = counts[a:b].astype(np.float64)
-                electrons += rng.normal(0.0, self._read_noise, electrons.shape)
+                electrons = rng.normal(0.0, self._read_noise, counts[a:b].shape)
+                electrons += counts[a:b]  # count + noise: the same sum, in either order
                 self._finish(electrons, out[a:b])
         return out
 
     def _finish(self, electrons: NDArray[np.float64], out: NDArray[np.generic]) -> None:
-        """Clip ``electrons`` to the well and write the band's output codes into ``out``."""
-        electrons = np.clip(electrons, 0.0, self._full_well)
+        """Clip ``electrons`` (the band's own array: it is overwritten) to the well and write
+        the band's output codes into ``out``."""
+        np.clip(electrons, 0.0, self._full_well, out=electrons)
         if self._raw:
-            out[...] = electrons / self._full_well
+            np.divide(electrons, self._full_well, out=out)
         else:
-            out[...] = np.round(electrons * (_WHITE / self._full_well)).astype(np.uint16)
+            electrons *= _WHITE / self._full_well
+            np.rint(electrons, out=electrons)  # np.round to 0 decimals, without its copy
+            out[...] = electrons  # whole codes in [0, 65535]: the cast is exact
 
     def _through_raw(self, linear: NDArray[np.float64], exposure_s: float, t0: float) -> Frame:
         """Deliver the frame as a DSLR would: Bayer mosaic → DNG → the real rawpy decode path."""

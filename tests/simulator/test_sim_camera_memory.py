@@ -31,6 +31,17 @@ def _small_bands(monkeypatch: pytest.MonkeyPatch) -> None:
     """Bands of 40 rows: many bands in a small test image, so a band's own temporaries are a
     small part of it, as in a 24 MP frame (~90 bands of 43 rows)."""
     monkeypatch.setattr(sim_scene, "BAND_PIXELS", 40 * W, raising=False)
+    # and no whole-image planes kept: the test's small image stands for a 24 MP one
+    monkeypatch.setattr(sim_scene, "CACHED_PIXELS", 0, raising=False)
+
+
+@pytest.fixture(params=["banded planes", "kept planes"])
+def planes(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
+    """A small image keeps its normals and albedo (``CACHED_PIXELS``); a large one makes them
+    band by band. Both must give the whole-image formula's pixels."""
+    if request.param == "kept planes":
+        monkeypatch.setattr(sim_scene, "CACHED_PIXELS", H * W)
+    return str(request.param)
 
 
 def _peak_while(fn):  # type: ignore[no-untyped-def]
@@ -72,8 +83,9 @@ def test_a_capture_holds_less_than_one_and_a_half_radiance_images():
     assert frame.pixels.shape == (H, W, 3)
 
 
-def test_the_banded_relief_renders_the_whole_image_formula_bit_for_bit():
+def test_the_banded_relief_renders_the_whole_image_formula_bit_for_bit(planes):
     render = renderer_for("relief", H, W, seed=2)
+    assert (render._planes is not None) == (planes == "kept planes")  # the case is the one named
     scene = relief_scene(H, W, seed=2)
     for direction in (LIGHT, np.array([0.0, 0.0, 1.0]), np.array([-0.97, 0.0, 0.243])):
         np.testing.assert_array_equal(
