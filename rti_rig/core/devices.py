@@ -46,14 +46,24 @@ class Frame:
     @property
     def saturated_fraction(self) -> float:
         """Fraction of pixels (any channel) at or above the white level."""
-        px = self.pixels if self.pixels.ndim == 2 else self.pixels.max(axis=-1)
-        return float(np.mean(px >= self.white_level))
+        return float(np.mean(_channel_max(self.pixels) >= self.white_level))
 
     @property
     def black_fraction(self) -> float:
         """Fraction of pixels (all channels) at zero: underexposed or in full shadow."""
-        px = self.pixels if self.pixels.ndim == 2 else self.pixels.max(axis=-1)
-        return float(np.mean(px == 0))
+        return float(np.mean(_channel_max(self.pixels) == 0))
+
+
+def _channel_max(pixels: NDArray[Any]) -> NDArray[Any]:
+    """Each pixel's largest channel (the pixels themselves when grey): ``pixels.max(axis=-1)``,
+    value for value, channel against channel. Why: a reduction over a last axis of 3 runs its
+    inner loop 3 elements long; this is ~10x faster, and a session asks it twice an image."""
+    if pixels.ndim == 2:
+        return pixels
+    out = np.array(pixels[..., 0])
+    for c in range(1, pixels.shape[-1]):
+        np.maximum(out, pixels[..., c], out=out)
+    return out
 
 
 @runtime_checkable
