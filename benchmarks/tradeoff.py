@@ -252,12 +252,18 @@ def session_times(
 ) -> tuple[float, float]:
     """Session time of a plan on the simulated dome and on the simulated arm (seconds).
 
-    The dome takes the same time for every light. The arm visits the lights in the order it
-    would execute them (greedy nearest neighbour from the park pose; move-time-optimal ordering
-    is the arm planner's job) and pays each move under its trapezoidal velocity profile.
+    The dome takes the same time for every light. The arm visits the lights in the order
+    ``rti-rig run`` gives a simulated arm (the move-time order of
+    :func:`rti_rig.app.compose.arm_order_for`, from the park pose, by the model
+    :func:`rti_rig.app.compose.simulated_arm_motion` makes of the arm's ``[arm]`` settings)
+    and pays each move under its trapezoidal velocity profile. Before 2026-12-02 the arm went
+    in nearest-neighbour order by angle, which ``run`` no longer uses for a simulated arm.
     Lights the arm cannot reach (inside its keep-out cone) are clamped to its band for timing.
     """
-    from rti_rig.planner.uniform import order_nearest_neighbour
+    from types import SimpleNamespace
+
+    from rti_rig.app.compose import simulated_arm_motion
+    from rti_rig.planner.arm_order import order_for_arm
     from rti_rig.simulator.sim_lights import LightState, SimulatedArm
 
     dome_s = len(directions) * per_light_s
@@ -265,7 +271,20 @@ def session_times(
     carrier = SimulatedArm(arm, LightState(), clock, speed, accel, 360.0 / 4096, 0.02)
     carrier.connect()
     reachable = np.array([_clamp_to_band(d, arm) for d in directions])
-    for i in order_nearest_neighbour(reachable, arm.park_direction):
+    # the [arm] table simulated_arm_motion reads, as a simulated rig's config holds it
+    config = SimpleNamespace(
+        backend="simulated",
+        arm=SimpleNamespace(
+            speed_deg_s=speed,
+            acceleration_deg_s2=accel,
+            min_elevation_deg=arm.min_elevation_deg,
+            max_elevation_deg=arm.max_elevation_deg,
+            park_azimuth_deg=arm.park_azimuth_deg,
+            park_elevation_deg=arm.park_elevation_deg,
+        ),
+    )
+    motion = simulated_arm_motion(SimpleNamespace(config=config))
+    for i in order_for_arm(reachable, arm.park_direction, motion):  # as plan_uniform gives it
         carrier.move_to(reachable[i])
         clock.sleep(per_light_s)
     carrier.park()

@@ -183,3 +183,29 @@ def test_a_verdict_with_nothing_to_compare_says_so() -> None:
     text = "\n".join(_verdicts("painting", {}, [6, 8]))
     assert "never" not in text
     assert "was not compared with naive uniform" in text and "not compared (no N with both)" in text
+
+
+def test_the_arm_is_timed_in_the_order_run_gives_a_simulated_arm() -> None:
+    """``rti-rig run`` orders a simulated arm's stops by move time (compose.arm_order_for),
+    not by angle: the benchmark's arm time must be that order's, never the nearest-neighbour
+    order's when that one is slower (stops either side of ±180°, which the azimuth cannot
+    cross: nearest by angle, a whole turn apart for the arm)."""
+    from benchmarks.tradeoff import BENCH_ARM, session_times
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.core.geometry import direction_from_az_el
+    from rti_rig.planner.uniform import order_nearest_neighbour
+    from rti_rig.simulator.sim_lights import LightState, SimulatedArm
+
+    dirs = np.array(
+        [direction_from_az_el(az, 30.0) for az in (170.0, -170.0, 100.0, -100.0, 30.0, -30.0)]
+    )
+    clock = VirtualClock()
+    arm = SimulatedArm(BENCH_ARM, LightState(), clock, 60.0, 120.0, 360.0 / 4096, 0.02)
+    arm.connect()
+    for i in order_nearest_neighbour(dirs, BENCH_ARM.park_direction):
+        arm.move_to(dirs[i])
+        clock.sleep(PER_LIGHT_S)
+    arm.park()
+    _, timed = session_times(dirs, PER_LIGHT_S, BENCH_ARM, 60.0, 120.0)
+    # nearest by angle: 30, -30, -100, -170, then 170 a whole turn away (22.9 s in all)
+    assert timed < clock.now() - 0.5, (timed, clock.now())
