@@ -86,6 +86,7 @@ def main(argv: list[str] | None = None) -> str:
     args = ap.parse_args(argv)
     if args.runs < 3:
         ap.error("--runs: at least 3 (the figures are medians)")
+    load_before = os.getloadavg()[0]
     runs = []
     with tempfile.TemporaryDirectory(prefix="dry_run_time_") as tmp:
         for i in range(args.runs):
@@ -97,6 +98,7 @@ def main(argv: list[str] | None = None) -> str:
         wall = statistics.median(r[stage][0] for r in runs)
         cpu = statistics.median(r[stage][1] for r in runs)
         rows.append(f"| {stage} | {wall:.1f} | {cpu:.1f} |")
+    load = f"load average (1 min) {load_before:.1f} before, {os.getloadavg()[0]:.1f} after"
     kernel = "compiled in every run (--cold)" if args.cold else "loaded from numba's cache"
     from benchmarks.report import machine_line, write_section
 
@@ -107,7 +109,8 @@ def main(argv: list[str] | None = None) -> str:
             machine_line(),
             "",
             f"`rti-rig run rig_configs/simulated_dome.toml` (48 lights, 512 px), each run a new "
-            f"process; median of {args.runs} runs; the robust kernel {kernel}. *Wall* is what "
+            f"process; median of {args.runs} runs; the robust kernel {kernel}; {load}, on "
+            f"{os.cpu_count()} cores shared with other jobs. *Wall* is what "
             "the user waits (a loaded machine stretches it); *CPU* is `process_time`. *Total* "
             "includes the imports and the session summary.",
             "",
