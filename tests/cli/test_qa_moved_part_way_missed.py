@@ -14,7 +14,11 @@ Found by an injection sweep over correct simulated sessions (every case below wa
   the right image, and refused by the fit, which explains neither object well enough to
   confirm anything (qa.STEP_FIT_NO_EVIDENCE);
 * the virtual arm's 256 px industrial part, 48 lights, moved (1, 2) px from image 25: found
-  and confirmed, but named from image 24, which never moved (now placed by the fit).
+  and confirmed, but named from image 24, which never moved (now placed by the fit); in the
+  arm's own move-time order (``run --lights``, no plan) still not found (see ``case``);
+  that session held still is tested below.
+
+The other arm sessions are shot in the arm's default order, as a user's `run --lights` is.
 """
 
 from __future__ import annotations
@@ -61,11 +65,14 @@ def case(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactor
     config = virtual_arm_variant(root, scene, side) if rig == "arm" else _dome_variant(root, scene)
     out = root / "s"
     args = ["run", str(config), "--out", str(out), "--lights", str(lights), "--no-verdict"]
-    if rig == "arm":
-        # the arm's uniform lights in the order these moves were found in (nearest neighbour
-        # by angle, the planner's order without an arm's); `run --lights` now takes the arm's
-        # move-time order, in which the industrial part's (1, 2) px move from image 25 (other
-        # lights from there on) is not found: a limit of the QA, not looked into here
+    if request.param == "industrial_arm_48":
+        # still pinned to the order this move was found in (nearest neighbour by angle): in
+        # the arm's own move-time order (`run --lights`) it is not found. The two sides'
+        # 5 x 5 centroid lies over a pixel off their clear (1, 2) peak and is refused (no
+        # step; benchmarks/qa_step_margin.py measures an upsampled peak there, (1.0, 1.9) px,
+        # not adopted: it adds a false step elsewhere), and even the exact (1, 2) px step is
+        # not confirmed by the fit: undone, the residual is 0.81 of the captured one against
+        # qa.DRIFT_CONFIRM = 0.8
         args[-3:-1] = ["--plan", str(_nearest_neighbour_plan(root, config, lights))]
     r = runner.invoke(app, args)
     assert r.exit_code == 0, r.output
@@ -116,3 +123,45 @@ def test_the_session_held_still_is_not_called_moved(case, tmp_path: Path) -> Non
     session = case[0]
     qa = _qa(session, tmp_path / "f")
     assert "moved" not in qa["verdict"], qa["verdict"]
+
+
+@pytest.fixture(scope="module")
+def arm_industrial_48(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The virtual arm's 256 px industrial part, 48 lights in the arm's own (move-time)
+    order, as `run --lights` shoots it (read only)."""
+    root = tmp_path_factory.mktemp("arm_industrial_48")
+    config = virtual_arm_variant(root, "industrial", 256)
+    out = root / "s"
+    r = runner.invoke(
+        app, ["run", str(config), "--out", str(out), "--lights", "48", "--no-verdict"]
+    )
+    assert r.exit_code == 0, r.output
+    return out
+
+
+def _steps_seen(session: Path, out: Path, monkeypatch: pytest.MonkeyPatch) -> tuple[list, dict]:  # type: ignore[type-arg]
+    """The edges' steps the QA's search yields while `fit` runs on ``session``, and qa.json."""
+    import rti_rig.reconstruct.qa as qa_module
+
+    seen = []
+    search = qa_module.step_candidates
+
+    def recorded(*args, **kwargs):  # type: ignore[no-untyped-def]
+        for step in search(*args, **kwargs):
+            seen.append(step)
+            yield step
+
+    monkeypatch.setattr(qa_module, "step_candidates", recorded)
+    return seen, _qa(session, out)
+
+
+def test_the_arm_order_session_held_still_has_no_step(
+    arm_industrial_48: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The session held still, in the arm's own order: no step, nothing called moved (its
+    sides' 5 x 5 centroids read up to 0.97 px apart, against qa_drift.STEP_PX 1.0: a thin
+    margin any change to the sides' estimate must keep)."""
+    seen, qa = _steps_seen(arm_industrial_48, tmp_path / "f", monkeypatch)
+    assert seen == []
+    assert "moved" not in qa["verdict"], qa["verdict"]
+    assert not [c["name"] for c in qa["images"] if any("moved" in p for p in c["problems"])]
