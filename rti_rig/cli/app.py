@@ -82,6 +82,7 @@ def _empty_paths_refused() -> None:
     user meant; ``.`` is still accepted when written as such."""
     try:  # typer's internals: a release without them loses this refusal (its tests say so),
         # not the whole CLI (an ImportError here had ended every command before it ran)
+        from typer._click.exceptions import UsageError
         from typer.core import _TyperParameter
 
         original = _TyperParameter.process_value
@@ -102,10 +103,56 @@ def _empty_paths_refused() -> None:
                     ctx=ctx,
                     param=self,
                 )
-        return original(self, ctx, value)
+        try:
+            return original(self, ctx, value)
+        except typer.BadParameter:
+            refusal = _not_a_number(self, annotation, value)
+            if refusal is None:
+                raise
+            raise UsageError(refusal, ctx=ctx) from None
 
     process_value._rti_rig = True  # type: ignore[attr-defined]
     _TyperParameter.process_value = process_value  # type: ignore[method-assign]
+
+
+def _number_kind(annotation: object) -> type | None:
+    """``int`` or ``float`` for an option typed so (or ``... | None``), else ``None``."""
+    import typing
+
+    kinds = [a for a in typing.get_args(annotation) if a is not type(None)] or [annotation]
+    if len(kinds) == 1 and kinds[0] in (int, float):
+        return kinds[0]  # type: ignore[no-any-return]
+    return None
+
+
+def _not_a_number(param: object, annotation: object, value: object) -> str | None:
+    """The refusal of ``value`` given to a whole-number or number option that is not one:
+    "--lights: 'N' is not a whole number: give one in digits, e.g. --lights 12", or ``None``
+    when the value is a number (a range refusal keeps its own words).
+
+    Why: typer's pydantic said "Invalid value for '--lights': Input should be a valid
+    integer, unable to parse string as an integer", which is not what a user pasting a
+    hint's ``--lights N`` needs: the value given and what to give instead."""
+    kind = _number_kind(annotation)
+    if kind is None or not isinstance(value, str):
+        return None
+    try:
+        kind(value)
+    except ValueError:
+        pass
+    else:
+        return None
+    opts = [o for o in getattr(param, "opts", ()) if o.startswith("--")]
+    name = opts[0] if opts else str(getattr(param, "name", "the value"))
+    default = getattr(param, "default", None)
+    example = (
+        f", e.g. {name} {default:g}"
+        if isinstance(default, int | float) and not isinstance(default, bool) and opts
+        else ""
+    )
+    if kind is int:
+        return f"{name}: {value!r} is not a whole number: give one in digits{example}"
+    return f"{name}: {value!r} is not a number: give one in digits (a point for decimals){example}"
 
 
 _empty_paths_refused()

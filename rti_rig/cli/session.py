@@ -1969,9 +1969,11 @@ def preview(
             )
             if given
         )
+        plan_lp = _free_name(Path("plan.lp"))
+        lights = _plan_light_count(opened, min_elevation_deg, max_elevation_deg)
         out.print(
             f"Plan from it: rti-rig plan {_arg(out_dir)} --rig "
-            f"{_arg(rig_config)} --lights N{band} --out plan.lp",
+            f"{_arg(rig_config)} --lights {lights}{band} --out {_arg(plan_lp)}",
             highlight=False,
             markup=False,
             soft_wrap=True,
@@ -1979,7 +1981,8 @@ def preview(
         metered = _metered_apart(opened) if auto_exposure else None
         if metered is not None:
             out.print(
-                f"Then: rti-rig run {_arg(rig_config)} --plan plan.lp --out SESSION "
+                f"Then: rti-rig run {_arg(rig_config)} --plan {_arg(plan_lp)} --out "
+                f"{_arg(_free_name(out_dir.parent / 'planned'))} "
                 f"--auto-exposure (this preview was metered at {metered[0]:.4g} s; without "
                 f"--auto-exposure the run uses the config's exposure_s = {metered[1]:g} s)",
                 highlight=False,
@@ -2003,6 +2006,40 @@ def preview(
             " (plan from it as above)",
         )
         _refuse_unsafe_end(unsafe)
+
+
+#: The lights a preview's closing line suggests planning: ``plan``'s own default (``--lights``).
+PLAN_HINT_LIGHTS = 12
+
+
+def _plan_light_count(opened, low_deg: float, high_deg: float) -> int:  # type: ignore[no-untyped-def]
+    """How many lights the preview's closing ``plan`` command asks for: ``plan``'s default,
+    or fewer on a dome with fewer LEDs in the band (at least 3, what a plan needs).
+
+    Why: the line said ``--lights N``, which pasted as printed was refused as not a whole
+    number; a count the dome cannot give would be refused too."""
+    import math
+
+    from rti_rig.runtime.lighting import DomeLighting
+
+    lighting = opened.rig.lighting
+    if not isinstance(lighting, DomeLighting):
+        return PLAN_HINT_LIGHTS
+    z = lighting.geometry.directions[:, 2].clip(-1.0, 1.0)
+    elevations = [math.degrees(math.asin(float(v))) for v in z]
+    in_band = sum(1 for e in elevations if low_deg - 1e-6 <= e <= high_deg + 1e-6)
+    return max(3, min(PLAN_HINT_LIGHTS, in_band))
+
+
+def _free_name(path: Path) -> Path:
+    """``path``, or ``path`` with ``-2``, ``-3``… before its suffix if that is taken: the name a
+    closing hint gives for a file or folder the next command writes (``plan`` refuses an
+    existing ``--out`` without ``--force``, ``run`` a non-empty folder)."""
+    candidate, n = path, 2
+    while candidate.exists() or candidate.is_symlink():
+        candidate = path.with_name(f"{path.stem}-{n}{path.suffix}")
+        n += 1
+    return candidate
 
 
 def _metered_apart(opened) -> tuple[float, float] | None:  # type: ignore[no-untyped-def]

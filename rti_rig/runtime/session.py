@@ -537,7 +537,7 @@ def _finished_hint(root: Path, manifest: dict[str, Any]) -> str:
         shown = shell_word(str(rig)) if isinstance(rig, str) and rig else "RIG.toml"
         return (
             f" (it holds a finished preview: plan from it with rti-rig plan {folder} --rig "
-            f"{shown} --lights N --out plan.lp)"
+            f"{shown} --lights 12 --out plan.lp)"  # plan's default count: N pasted was refused
         )
     return f" (it holds a finished session: fit it with rti-rig fit {folder} --out DIR)"
 

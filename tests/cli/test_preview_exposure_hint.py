@@ -29,8 +29,8 @@ def test_a_metered_preview_says_the_run_meters_again(tmp_path: Path) -> None:
     assert abs(metered - 0.05) > 0.0005  # this dome meters away from its config's 0.05 s
     text = said(r)
     assert (
-        f"--plan plan.lp --out SESSION --auto-exposure (this preview was metered at {metered:.4g} s"
-        in text
+        f"--plan plan.lp --out {tmp_path / 'planned'} --auto-exposure (this preview was metered "
+        f"at {metered:.4g} s" in text
     )
     assert "the run uses the config's exposure_s = 0.05 s" in text
 

@@ -33,8 +33,8 @@ def test_a_preview_folder_not_empty_points_to_plan(tmp_path: Path) -> None:
         hint = re.search(r"a finished preview: plan from it with (rti-rig plan .*?)\)", text)
         assert hint is not None, text
     assert sorted(p.name for p in pv.rglob("*")) == before  # nothing overwritten
-    # the command offered works as given (N chosen)
-    args = shlex.split(hint.group(1).replace("--lights N", "--lights 6"))[1:]
+    # the command offered works as given (its --lights a count: "N" was refused when pasted)
+    args = shlex.split(hint.group(1))[1:]
     args = [str(tmp_path / a) if a == "plan.lp" else a for a in args]
     r = runner.invoke(app, args)
     assert r.exit_code == 0 and (tmp_path / "plan.lp").is_file(), r.output
