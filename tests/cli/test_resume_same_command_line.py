@@ -334,3 +334,20 @@ def test_a_completed_sessions_journal_rebuild_refuses_the_options_it_cannot_chec
     r = runner.invoke(app, line)
     assert r.exit_code == 0, r.output
     assert (out / "journal.jsonl").is_file()
+
+
+def test_a_session_begun_without_lights_is_said_to_have_every_light(
+    tmp_path_factory: pytest.TempPathFactory,
+) -> None:
+    """Begun with no --lights, the refusal had said "It began with --lights 48", an option
+    never given: it says what chose the 48, and that the resume continues it without it."""
+    out = tmp_path_factory.mktemp("every") / "s"
+    run = cut_new_session(NewSessionRequest(DOME, out), after_step=1)
+    assert run.finish_reason is FinishReason.CANCELLED
+    before = tree(out)
+    for options in (["--lights", "12"], ["--auto-exposure"]):
+        r = runner.invoke(app, ["run", str(DOME), "--resume", str(out), *options])
+        assert r.exit_code == 2, r.output
+        assert "It began with every light of the dome (48) (nothing" in said(r), said(r)
+        assert "--lights 48" not in said(r) and "drop those options" in said(r)
+    assert tree(out) == before

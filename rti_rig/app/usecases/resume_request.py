@@ -72,13 +72,69 @@ def check_same_start(
         if limit is not None and not _same_number(limit, NewSessionRequest.max_saturated):
             began += f" --max-saturated {limit:g}"
     folder = shell_word(str(root))
+    give = "give those options or none"
+    by_default = _default_count_said(began, manifest, loaded)
+    if by_default is not None:
+        said, rest = by_default
+        began = f"{said} and {rest}" if rest else said
+        give = "give those options without --lights, or none" if rest else "drop those options"
     raise RtiRigError(
         f"{root}: this resume asks for another session than the one in it ("
         + "; ".join(diffs)
         + f"). It began with {began or 'the defaults'} (nothing in the folder was changed): "
-        f"to continue it as it began, give those options or none (rti-rig run --resume "
+        f"to continue it as it began, {give} (rti-rig run --resume "
         f"{folder}); to shoot this request, start a new session in a new --out"
     )
+
+
+def _default_count_said(
+    began: str, manifest: dict[str, Any], loaded: Any
+) -> tuple[str, str] | None:
+    """When ``began``'s ``--lights N`` is the count the rig runs without ``--lights`` (its
+    lights the same): what chose it, "every light of the dome (48)" or "the rig's default of
+    24 lights" (a config's ``default_lights``), and the options after it; else ``None``.
+
+    Why: a session begun with no ``--lights`` was refused with "It began with --lights 48",
+    an option never given (the manifest records the count, not whether it was typed); both
+    lines begin the same session, so the count is said by what chose it."""
+    from rti_rig.app.usecases.session import NewSessionRequest, new_session_schedule
+    from rti_rig.core.schedule import LightSchedule
+
+    schedule = manifest.get("schedule") or {}
+    provenance = schedule.get("provenance") or {}
+    n = provenance.get("n")
+    words = f"--lights {n}"
+    if isinstance(manifest.get("adaptive"), dict) or provenance.get("plan_file") or n is None:
+        return None
+    if not (began == words or began.startswith(words + " ")):
+        return None
+    low, high = provenance.get("min_elevation_deg"), provenance.get("max_elevation_deg")
+    try:
+        recorded = LightSchedule.from_dict(schedule)
+        default = new_session_schedule(
+            NewSessionRequest(
+                Path(loaded.path),
+                Path("."),
+                min_elevation_deg=float(low) if low is not None else 0.0,
+                max_elevation_deg=float(high) if high is not None else 90.0,
+                allow_no_normals=bool(provenance.get("allow_no_normals", False)),
+            ),
+            loaded,
+        )
+    except (RtiRigError, KeyError, TypeError, ValueError):  # said as recorded, as before
+        return None
+    if len(default) != len(recorded) or any(
+        (a.led, b.led) != (None, None) and a.led != b.led
+        for a, b in zip(default.steps, recorded.steps, strict=True)
+    ):
+        return None
+    dome = getattr(loaded.config, "dome", None)
+    if dome is not None and not dome.default_lights:
+        banded = low not in (None, 0.0) or high not in (None, 90.0)
+        said = f"every light of the dome{' in its band' if banded else ''} ({len(recorded)})"
+    else:
+        said = f"the rig's default of {len(recorded)} lights (no --lights)"
+    return said, began[len(words) :].strip()
 
 
 def _differences(asked: StartOptions, manifest: dict[str, Any], loaded: Any) -> list[str]:
