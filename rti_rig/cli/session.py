@@ -2077,7 +2077,7 @@ def export_lp(
     """Write the .lp of a session from its verified journal: the lights that actually fired,
     for every image on disk as captured (an interrupted session's too). A session whose run
     stopped before adding its last committed image to lights.lp has it added there too."""
-    from rti_rig.app.usecases.export import ExportLpRequest
+    from rti_rig.app.usecases.export import ExportLpRequest, relight_move_advice
     from rti_rig.app.usecases.export import export_lp as write_session_lp
     from rti_rig.runtime.session import JOURNAL
 
@@ -2133,11 +2133,8 @@ def export_lp(
         err.print(
             f"[yellow]note:[/] its image names are relative to {escape(shown_path(session_dir))}, "
             "and tools (relight, RTIBuilder, rti-rig fit) read them beside the .lp: move "
-            f"{escape(_arg(out_file))} into {escape(_arg(session_dir))} to use it; for "
-            "relight-cli, which reads the first .lp of a folder, move that folder's lights.lp "
-            "out too ("
-            f"`rti-rig export-lp {escape(_arg(session_dir))} --out "
-            f"{escape(_arg(session_dir / 'lights.lp'))}` writes it again)",
+            f"{escape(_arg(out_file))} into {escape(_arg(session_dir))} to use it; "
+            + escape(relight_move_advice(session_dir, out_file.name)),
             soft_wrap=True,
         )
     # escaped: a file in a folder named 'coin [draft]' had been said as 'coin .lp' (rich read

@@ -145,3 +145,29 @@ def test_an_export_into_its_own_session_says_which_lp_relight_cli_reads_there(
         "lights.lp: move Demo_linear.lp out of the folder before giving the folder to relight-cli"
     ) in said(r), said(r)
     assert (a / "Demo_linear.lp").is_file() and (a / "lights.lp").is_file()
+
+
+def test_an_export_outside_its_session_says_what_relight_cli_needs_moved(tmp_path: Path) -> None:
+    """An export written elsewhere was always told to move the session's lights.lp out for
+    relight-cli, also when its own name sorts first (the guide's demo_linear.lp): relight-cli
+    reads that one first anyway, so the session lost its lights.lp for nothing."""
+    a = _session(tmp_path, "séance a", "6")
+    wide = CliRunner(env={"COLUMNS": "400"})
+    lead = "relight-cli, which reads the first .lp of a folder by name (case ignored)"
+
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(tmp_path / "Demo_linear.lp")])
+    assert r.exit_code == 0, r.output
+    assert f"{lead}, then reads Demo_linear.lp there: nothing else needs moving" in said(r)
+    assert "lights.lp out" not in said(r), said(r)
+
+    (a / "archive.lp").write_text("")  # another .lp before lights.lp and session.lp
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(tmp_path / "session.lp")])
+    assert r.exit_code == 0, r.output
+    assert (
+        f"for {lead}, move that folder's archive.lp and lights.lp out too (`rti-rig export-lp"
+    ) in said(r), said(r)
+
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(tmp_path / "lights.lp")])
+    assert r.exit_code == 0, r.output
+    assert "move that folder's archive.lp and lights.lp out too" in said(r)
+    assert "lights.lp there would be replaced by the move" in said(r), said(r)

@@ -272,8 +272,13 @@ def test_export_lp_outside_the_session_says_where_its_names_resolve(tmp_path: Pa
     assert r.exit_code == 0, r.output
     said = " ".join(r.output.split())
     assert "move" in said and "relative to" in said
-    # the advice for relight-cli (the first .lp of a folder) is not to keep two there, and how
-    # to get lights.lp back: it had said "move it into the session … keep one there"
+    # relight-cli reads the first .lp of a folder by name: demo_linear.lp, moved in, is it
+    assert "then reads demo_linear.lp there: nothing else needs moving" in said, said
+    # one named after lights.lp: not to keep two there, and how to get lights.lp back (it had
+    # said "move it into the session … keep one there")
+    r = runner.invoke(app, ["export-lp", str(session), "--out", str(tmp_path / "session.lp")])
+    assert r.exit_code == 0, r.output
+    said = " ".join(r.output.split())
     assert "move that folder's lights.lp out too" in said
     assert f"rti-rig export-lp {session} --out {session / 'lights.lp'}` writes it again" in said
     r = runner.invoke(app, ["fit", str(outside), "--out", str(tmp_path / "f"), "--no-qa"])

@@ -164,15 +164,51 @@ def _relight_reads(root: Path, new: str) -> str:
     its lines by order and checks only their count, so one exported before a resume (the
     images taken by then) or with images left out stops it with "Lp number of lights (…)
     different from the number of images found", naming neither file."""
-    names = {p.name for p in root.iterdir() if p.suffix.lower() == ".lp" and p.is_file()}
-    names.add(new)
-    first = min(names, key=lambda n: (n.casefold(), n))
+    first = _relight_order(root, new)[0]
     if first == LP_NAME:
         return f"relight-cli given {root} reads the first .lp there by name, still {LP_NAME}"
     return (
         f"relight-cli given {root} reads the first .lp there by name, now {first}, not "
         f"{LP_NAME}: move {first} out of the folder before giving the folder to relight-cli"
     )
+
+
+def _relight_order(root: Path, new: str) -> list[str]:
+    """The ``.lp`` files at the top of ``root``, ``new`` among them, in the order relight-cli
+    lists them (by name, case ignored: :func:`_relight_reads`); the first is the one it reads."""
+    names = {p.name for p in root.iterdir() if p.suffix.lower() == ".lp" and p.is_file()}
+    names.add(new)
+    return sorted(names, key=lambda n: (n.casefold(), n))
+
+
+def relight_move_advice(root: Path, new: str) -> str:
+    """What else to move for relight-cli given session ``root`` once an export named ``new``,
+    written outside it, is moved in: the ``.lp`` files listed before it (relight-cli reads the
+    first, :func:`_relight_order`), and one of its very name, which the move would replace.
+
+    Why: the note of an export written outside its session always said to move the session's
+    lights.lp out for relight-cli, also for a name that sorts before it (the guide's
+    ``demo_linear.lp``), which relight-cli reads first anyway: the session left without its
+    own lights.lp for nothing."""
+    from rti_rig.core.shell_words import shell_word
+
+    try:
+        order = _relight_order(root, new)
+    except OSError:  # a folder that cannot be listed: the moves are the user's to judge
+        order = [new]
+    ahead = order[: order.index(new)] + ([new] if (root / new).is_file() else [])
+    said = "relight-cli, which reads the first .lp of a folder by name (case ignored)"
+    if not ahead:
+        return f"{said}, then reads {new} there: nothing else needs moving"
+    listed = " and ".join(ahead)
+    again = (
+        f" (`rti-rig export-lp {shell_word(str(root))} --out "
+        f"{shell_word(str(root / LP_NAME))}` writes it again)"
+        if LP_NAME in ahead
+        else ""
+    )
+    replaced = f"; {new} there would be replaced by the move" if new in ahead else ""
+    return f"for {said}, move that folder's {listed} out too{again}{replaced}"
 
 
 def _refuse_another_session(out_file: Path, root: Path, first: str | None) -> None:
