@@ -317,6 +317,9 @@ LIGHT_SCATTER_Z = 3.5
 MOVED_FROM = "object or camera moved from"
 #: The bright-image check's words, found by :meth:`QAReport.explain_bright_by_lights`.
 BRIGHTER = "brighter than the other images predict"
+#: The caveat of the light directions of images that do not change with their light (said
+#: once: the verdict names the fault itself).
+UNCHANGING_DIRECTIONS = "light directions not checked: with every image alike, none tells its light"
 #: The exposure check's words (:mod:`~rti_rig.reconstruct.qa_exposure`): "about N× too bright
 #: for its light" is a bright image too, which a dome's uneven LEDs can explain.
 TOO_BRIGHT = "too bright for its light"
@@ -1866,7 +1869,11 @@ def assess(
                 bright_claim = None
             problems.append(black_throughout)
         if unchanged is not None:
+            # images that do not change with their light admit no fit to compare one with:
+            # "3.0x brighter than the other images predict", said beside it, was noise
+            problems = [p for p in problems if p.startswith("saturated")]
             problems.append(unchanging_problem(unchanged))
+            bright_claim = None
         if i in flat:
             # its level against the fit (dim, too bright, exposure off) says nothing of a
             # frame with no picture of the object in it
@@ -1974,7 +1981,13 @@ def assess(
         # its rendering, not its angle, and had made qa.json say "checked" beside a null
         # median and a note saying no direction was
         directions_checked=bool((ev.direction_judged & ~np.isfinite(ev.swap_ratio)).any()),
-        direction_note=ev.direction_note,
+        # images that do not change with their light tell no light: "on a near-flat object"
+        # (a fit of one picture) had been said of them
+        direction_note=(
+            ev.direction_note
+            if unchanged is None or not ev.direction_note
+            else UNCHANGING_DIRECTIONS
+        ),
         drift_note=drift_note,
         shift_note=shift_note,
         step_note=_elevation_step_note(refused_steps, names) if step is None else "",

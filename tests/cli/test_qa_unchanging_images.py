@@ -81,3 +81,30 @@ def test_a_ring_of_lights_over_a_level_object_may_give_one_picture(tmp_path: Pat
         cv2.imwrite(str(tmp_path / e.name), texture)
     said = _fit(tmp_path, entries)
     assert SAID not in said, said
+
+
+def test_no_image_is_judged_against_a_fit_of_unchanging_images(
+    tmp_path_factory: pytest.TempPathFactory,
+) -> None:
+    """The shipped dome's first image saved under every light's name (a camera that ignores
+    the lights): the verdict had said "image_001 (3.0× brighter than the other images
+    predict)" and "on a near-flat object" beside it, claims of a fit no such images allow.
+    The one true thing is said, and nothing of any image against the fit."""
+    import shutil
+
+    from conftest import dome_session
+
+    root = tmp_path_factory.mktemp("same")
+    session = dome_session(root, "relief", 128, 12)
+    acq = root / "acq"
+    acq.mkdir()
+    shutil.copy(session / "lights.lp", acq / "lights.lp")
+    for image in sorted(session.glob("image_*.jpg")):
+        shutil.copy(session / "image_001.jpg", acq / image.name)
+    r = CliRunner().invoke(app, ["fit", str(acq / "lights.lp"), "--out", str(root / "f")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    assert f"QA verdict: reshoot: image_001 ... image_012 (12 images: {SAID}" in said, said
+    assert "brighter than" not in said and "dimmer than" not in said, said
+    assert "near-flat object" not in said and said.count(SAID) == 1
+    assert "light directions not checked: with every image alike, none tells its light" in said
