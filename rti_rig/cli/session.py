@@ -2020,12 +2020,12 @@ def _plan_light_count(opened, low_deg: float, high_deg: float) -> int:  # type: 
     number; a count the dome cannot give would be refused too."""
     import math
 
-    from rti_rig.runtime.lighting import DomeLighting
+    from rti_rig.core.rig_geometry import DomeGeometry
 
-    lighting = opened.rig.lighting
-    if not isinstance(lighting, DomeLighting):
+    geometry = opened.rig.geometry  # a flash-synced dome's and a replayed .lp's too
+    if not isinstance(geometry, DomeGeometry):
         return PLAN_HINT_LIGHTS
-    z = lighting.geometry.directions[:, 2].clip(-1.0, 1.0)
+    z = geometry.directions[:, 2].clip(-1.0, 1.0)
     elevations = [math.degrees(math.asin(float(v))) for v in z]
     in_band = sum(1 for e in elevations if low_deg - 1e-6 <= e <= high_deg + 1e-6)
     return max(3, min(PLAN_HINT_LIGHTS, in_band))

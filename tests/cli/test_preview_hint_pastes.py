@@ -53,6 +53,24 @@ def test_the_preview_plan_line_runs_as_printed(
     assert (tmp_path / "plan-2.lp").is_file() and (tmp_path / "plan.lp").read_text() == "taken\n"
 
 
+def test_a_band_with_fewer_leds_than_the_default_count_is_planned_as_printed(
+    small_dome: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Above 60° the shipped dome has 6 LEDs: the line asks for those 6, not for 12 (which
+    plan would refuse), and carries the band."""
+    monkeypatch.chdir(tmp_path)
+    preview = tmp_path / "preview"
+    argv = ["preview", str(small_dome), "--out", str(preview), "--min-elevation-deg", "60"]
+    r = runner.invoke(app, argv)
+    assert r.exit_code == 0, r.output
+    words = _line(r.output, "Plan from it: ")
+    assert words[words.index("--lights") + 1] == "6", words
+    assert words[words.index("--min-elevation-deg") + 1] == "60", words
+    r = runner.invoke(app, words)
+    assert r.exit_code == 0, r.output
+    assert "Planned 6 lights" in " ".join(r.output.split())
+
+
 def test_a_word_for_a_count_names_the_option_and_the_value(tmp_path: Path) -> None:
     r = runner.invoke(app, ["plan", "--lights", "N", "--out", str(tmp_path / "p.lp")])
     assert r.exit_code == 2
