@@ -254,9 +254,14 @@ def write_linear_tiff(
     pixels: NDArray[np.uint16],
     description: str | None = None,
     compression: str | None = LINEAR_TIFF_COMPRESSION,
+    iccprofile: bytes | None = None,
 ) -> str:
     """Write a linear 16-bit TIFF (``description`` goes into ImageDescription); returns its
-    SHA-256. ``compression``: None (default, see :data:`LINEAR_TIFF_COMPRESSION`) or "zlib"."""
+    SHA-256. ``compression``: None (default, see :data:`LINEAR_TIFF_COMPRESSION`) or "zlib".
+    ``iccprofile``: an RGB ICC profile for the InterColorProfile tag of a colour image (a
+    session's linear-sRGB TIFFs carry :func:`~rti_rig.core.image_colour.icc_profile`
+    ``("linear")``, so that colour-managed viewers do not take them as sRGB-encoded and show
+    them dark)."""
     import io
 
     import tifffile  # imported by the writer only: reading a config or planning never needs it
@@ -266,12 +271,32 @@ def write_linear_tiff(
     extra: dict[str, object] = {"description": description, "metadata": None} if description else {}
     if compression is None:
         extra["rowsperstrip"] = LINEAR_TIFF_ROWS_PER_STRIP
+    if iccprofile is not None and pixels.ndim == 3:  # an RGB profile: colour images only
+        extra["iccprofile"] = iccprofile
     tifffile.imwrite(buf, pixels, photometric=photometric, compression=compression, **extra)
     return _atomic_write(path, buf.getvalue())
 
 
 def write_srgb_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> str:
-    """Write an 8-bit sRGB JPEG (RGB order in, as OpenCV wants BGR on disk); returns SHA-256."""
+    """Write an 8-bit sRGB JPEG (RGB order in, as OpenCV wants BGR on disk), marked sRGB when
+    colour (Exif ColorSpace 1 and an sRGB ICC profile,
+    :func:`~rti_rig.core.image_colour.tag_jpeg_srgb`; a grey one has no RGB colour space);
+    returns its SHA-256. Still a plain baseline JFIF, as relight and RTIBuilder read it."""
+    from rti_rig.core.image_colour import tag_jpeg_srgb
+
+    data = _encode_jpeg(path, srgb8, quality)
+    return _atomic_write(path, tag_jpeg_srgb(data) if srgb8.ndim == 3 else data)
+
+
+def write_untagged_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> str:
+    """:func:`write_srgb_jpeg` with no colour-space tag: for pixels through the sRGB curve
+    that are not sRGB colours (camera RGB from a RAW with no colour matrix, a CFA mosaic),
+    which viewers must not be told are sRGB; returns its SHA-256."""
+    return _atomic_write(path, _encode_jpeg(path, srgb8, quality))
+
+
+def _encode_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int) -> bytes:
+    """The baseline JPEG of ``srgb8`` (RGB order in), 4:4:4 where colour."""
     import cv2  # on use: importing the controller must not load a device library
 
     img = srgb8[..., ::-1] if srgb8.ndim == 3 else srgb8
@@ -283,7 +308,7 @@ def write_srgb_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> 
     ok, enc = cv2.imencode(".jpg", np.ascontiguousarray(img), params)
     if not ok:
         raise SessionError(f"could not encode {path.name} as JPEG")
-    return _atomic_write(path, enc.tobytes())
+    return enc.tobytes()
 
 
 def pixels_sha256(pixels: NDArray[Any]) -> str:
