@@ -364,7 +364,13 @@ def keep_unlabelled(
 ) -> str:
     """Write a slipped (or proof) image under ``unlabelled/`` (linear TIFF, sRGB JPEG, the
     verdict)."""
-    from rti_rig.core.image_files import linear_to_srgb8, write_linear_tiff, write_srgb_jpeg
+    from rti_rig.core.image_colour import decode_colour
+    from rti_rig.core.image_files import (
+        linear_to_srgb8,
+        write_linear_tiff,
+        write_srgb_jpeg,
+        write_untagged_jpeg,
+    )
 
     folder = root / UNLABELLED_DIR
     folder.mkdir(parents=True, exist_ok=True)
@@ -375,7 +381,10 @@ def keep_unlabelled(
         base = f"{stem}_{index + 1:03d}_{n}"
         tif, n = folder / f"{base}.tif", n + 1
     write_linear_tiff(tif, frame.pixels)
-    write_srgb_jpeg(folder / f"{base}.jpg", linear_to_srgb8(frame.pixels, frame.white_level))
+    # tagged sRGB only where it is: a RAW with no colour matrix gives camera RGB
+    srgb = decode_colour(frame.metadata.get("decode") or {}) == "srgb"
+    writer = write_srgb_jpeg if srgb else write_untagged_jpeg
+    writer(folder / f"{base}.jpg", linear_to_srgb8(frame.pixels, frame.white_level))
     (folder / f"{base}.json").write_text(json.dumps(verdict, indent=1) + "\n", encoding="utf-8")
     return f"{UNLABELLED_DIR}/{base}.tif"
 

@@ -57,6 +57,14 @@ from typing import Any
 from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import SessionError
+from rti_rig.core.image_colour import (
+    JPEG_COLOUR_WORDS,
+    LINEAR_CAMERA_RGB,
+    LINEAR_COLOUR_WORDS,
+    LINEAR_SRGB,
+    decode_colour,
+    icc_profile,
+)
 from rti_rig.core.image_files import (
     MOSAIC_TIFF_LABEL,
     linear_to_srgb8,
@@ -64,6 +72,7 @@ from rti_rig.core.image_files import (
     tiff_pixels_sha256,
     write_linear_tiff,
     write_srgb_jpeg,
+    write_untagged_jpeg,
 )
 from rti_rig.core.lp_format import LpEntry, format_lp, lp_files_in
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
@@ -934,15 +943,21 @@ class SessionFolder:
                     decode["camera_file"] = originals[rel][1]
             sha = {name: digest for name, (digest, _) in originals.items()}
             current = self.root / tif
-            description = _tiff_description(decode)
+            description = _tiff_description(decode, frame.white_level)
+            colour = decode_colour(decode)
+            # only sRGB pixels are said to be sRGB: camera RGB or a mosaic carries no tag
+            icc = icc_profile("linear") if colour == "srgb" else None
+            jpeg_writer = write_srgb_jpeg if colour == "srgb" else write_untagged_jpeg
             # the pixels' checksum is taken while the files are encoded and written (hashing
             # releases the GIL): about 0.4 s of CPU for a 24 MP frame, overlapped, not added
             pixel_digest = _hash_pool().submit(pixels_sha256, frame.pixels)
             try:
-                sha[tif] = write_linear_tiff(current, frame.pixels, description=description)
+                sha[tif] = write_linear_tiff(
+                    current, frame.pixels, description=description, iccprofile=icc
+                )
                 current = self.root / jpg
                 srgb8 = linear_to_srgb8(frame.pixels, frame.white_level)
-                sha[jpg] = write_srgb_jpeg(current, srgb8)
+                sha[jpg] = jpeg_writer(current, srgb8)
             finally:
                 wait((pixel_digest,))  # the frame's hash ends before the step does
             pixel_sums = {tif: pixel_digest.result()}
@@ -1168,11 +1183,39 @@ class SessionFolder:
                 "lp_file": LP_NAME if ordered and lp_error is None else None,
                 "steps": [asdict(r) for r in ordered],
                 "notices": session_notices(ordered),
+                "image_colour": image_colour(ordered),
             }
         )
         _write_json_atomic(self.root / MANIFEST, self.manifest)
         if lp_error is not None:
             raise lp_error
+
+
+#: said once of a session whose RAWs were decoded with no colour matrix (or with
+#: ``output_color = "raw"``): its colours are the sensor's, which the guide had called sRGB
+CAMERA_RGB_NOTICE = (
+    "the images are in camera RGB, not sRGB: the RAW holds no colour matrix "
+    "(or [camera.device.decode] output_color = 'raw'), so the sensor's colours were kept; "
+    "the JPEGs are untagged and their colours may look off, while relighting and fitting are "
+    "unaffected. For sRGB colours shoot a RAW (or DNG) that carries the camera's colour "
+    "matrix, with output_color = 'srgb'"
+)
+
+
+def image_colour(records: list[StepRecord]) -> dict[str, str]:
+    """What the manifest says of the colour of the session's JPEGs and linear TIFFs, as their
+    tags and ImageDescriptions say it (one colour for a session whose images all share it,
+    else each colour with the images in it)."""
+    by: dict[str, list[str]] = {}
+    for r in records:
+        by.setdefault(decode_colour(r.decode), []).append(Path(r.image).stem)
+    if len(by) <= 1:
+        colour = next(iter(by), "srgb")
+        return {"jpeg": JPEG_COLOUR_WORDS[colour], "linear": LINEAR_COLOUR_WORDS[colour]}
+    return {
+        "jpeg": "; ".join(f"{JPEG_COLOUR_WORDS[c]}: {', '.join(n)}" for c, n in by.items()),
+        "linear": "; ".join(f"{LINEAR_COLOUR_WORDS[c]}: {', '.join(n)}" for c, n in by.items()),
+    }
 
 
 def session_notices(records: list[StepRecord]) -> list[str]:
@@ -1198,6 +1241,8 @@ def session_notices(records: list[StepRecord]) -> list[str]:
                 "not demosaiced; the JPEGs are grey checkerboards, not pictures"
             )
             counts[n] = counts.get(n, 0) + 1
+        elif r.decode and decode_colour(r.decode) == "camera":
+            counts[CAMERA_RGB_NOTICE] = counts.get(CAMERA_RGB_NOTICE, 0) + 1
     total = len(records)
     return [f"{n} [{c} of {total} images]" for n, c in counts.items()]
 
@@ -1456,17 +1501,24 @@ def _fsync_sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _tiff_description(decode: dict[str, Any]) -> str | None:
-    """A label inside the linear TIFF saying what its pixels are, for RAW-derived images."""
+def _tiff_description(decode: dict[str, Any], white_level: int | None = None) -> str:
+    """A label inside the linear TIFF saying what its pixels are: linear (not sRGB-encoded),
+    in which colours, and for a RAW-derived image how it was decoded.
+
+    Why for every image: a TIFF not from a RAW had held only tifffile's ``{"shape": ...}``,
+    nothing saying it is linear, and viewers took it as sRGB and showed it dark. The mosaic
+    label begins :data:`MOSAIC_TIFF_LABEL` (``rti-rig fit`` refuses a file by it)."""
     if not decode:
-        return None
+        white = f", white level {white_level}" if white_level else ""
+        return f"rti-rig: {LINEAR_SRGB}, 16-bit{white} (the camera's own colours, not a RAW's)"
     if decode.get("mode") == "mosaic":
         return (
             f"{MOSAIC_TIFF_LABEL} ({decode.get('cfa_pattern')}), black level removed per "
             "photosite, NOT demosaiced, no white balance: one colour per pixel"
         )
+    colours = LINEAR_SRGB if decode_colour(decode) == "srgb" else LINEAR_CAMERA_RGB
     return (
-        f"rti-rig: linear {decode.get('color_space')} RGB from RAW ({decode.get('mode')}), "
+        f"rti-rig: {colours} from RAW ({decode.get('mode')}), "
         f"white balance {decode.get('white_balance')}, sensor orientation"
     )
 
