@@ -133,10 +133,17 @@ def tag_jpeg_srgb(jpeg: bytes) -> bytes:
     """``jpeg`` with :func:`srgb_jpeg_segments` after its JFIF APP0 (which must come first),
     or straight after its start-of-image marker when it has none; the compressed data is
     untouched, so the pixels are the same."""
+    return b"".join(tagged_jpeg_parts(jpeg))
+
+
+def tagged_jpeg_parts(jpeg: bytes) -> list[memoryview | bytes]:
+    """:func:`tag_jpeg_srgb` in three parts, the JPEG's own as views, not copies (written one
+    after the other: a 24 MP JPEG is copied no more to be tagged)."""
     at = 2
     if jpeg[2:4] == b"\xff\xe0" and jpeg[6:11] == b"JFIF\0":
         at = 4 + int.from_bytes(jpeg[4:6], "big")
-    return jpeg[:at] + srgb_jpeg_segments() + jpeg[at:]
+    view = memoryview(jpeg)
+    return [view[:at], srgb_jpeg_segments(), view[at:]]
 
 
 def jpeg_colour_tags(jpeg: bytes) -> dict[str, Any]:

@@ -221,14 +221,19 @@ def linear_to_srgb8(pixels: NDArray[np.uint16], white_level: int) -> NDArray[np.
     return _srgb8_formula(pixels, white_level)
 
 
-def _atomic_write(path: Path, data: bytes) -> str:
-    """Write bytes to a new file atomically; return its SHA-256."""
+def _atomic_write(path: Path, data: bytes | Sequence[bytes | memoryview]) -> str:
+    """Write bytes (or parts, one after the other) to a new file atomically; return its
+    SHA-256."""
     if path.exists():
         raise SessionError(f"{path} already exists: refusing to overwrite a captured file")
+    parts = [data] if isinstance(data, bytes) else list(data)
     tmp = path.with_name(f".{path.name}.partial")
+    digest = hashlib.sha256()
     try:
         with open(tmp, "wb") as fh:
-            fh.write(data)
+            for part in parts:
+                fh.write(part)
+                digest.update(part)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
@@ -237,7 +242,7 @@ def _atomic_write(path: Path, data: bytes) -> str:
         with contextlib.suppress(OSError):
             tmp.unlink(missing_ok=True)
         raise
-    return hashlib.sha256(data).hexdigest()
+    return digest.hexdigest()
 
 
 #: Compression of the linear TIFFs a session writes. None (uncompressed) since 2026-11-24:
@@ -282,10 +287,10 @@ def write_srgb_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> 
     colour (Exif ColorSpace 1 and an sRGB ICC profile,
     :func:`~rti_rig.core.image_colour.tag_jpeg_srgb`; a grey one has no RGB colour space);
     returns its SHA-256. Still a plain baseline JFIF, as relight and RTIBuilder read it."""
-    from rti_rig.core.image_colour import tag_jpeg_srgb
+    from rti_rig.core.image_colour import tagged_jpeg_parts
 
     data = _encode_jpeg(path, srgb8, quality)
-    return _atomic_write(path, tag_jpeg_srgb(data) if srgb8.ndim == 3 else data)
+    return _atomic_write(path, tagged_jpeg_parts(data) if srgb8.ndim == 3 else data)
 
 
 def write_untagged_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> str:
