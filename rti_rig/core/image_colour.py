@@ -205,13 +205,15 @@ def decode_colour(decode: dict[str, Any]) -> ImageColour:
 
 #: what the manifest's ``image_colour`` says of the JPEGs and the linear TIFFs, by colour
 JPEG_COLOUR_WORDS: dict[str, str] = {
-    "srgb": "sRGB (tagged: Exif ColorSpace 1 and an sRGB ICC profile)",
+    "srgb": "sRGB (tagged: Exif ColorSpace 1 and an sRGB ICC profile; a grey image carries "
+    "no colour tag)",
     "camera": "camera RGB through the sRGB curve, NOT sRGB (untagged: the RAW has no colour "
     "matrix)",
     "mosaic": "CFA mosaic through the sRGB curve: grey checkerboards, not pictures (untagged)",
 }
 LINEAR_COLOUR_WORDS: dict[str, str] = {
-    "srgb": f"{LINEAR_SRGB} (tagged: a linear-sRGB ICC profile and the ImageDescription)",
+    "srgb": f"{LINEAR_SRGB} (tagged: the ImageDescription, and a linear-sRGB ICC profile on "
+    "a colour image)",
     "camera": f"{LINEAR_CAMERA_RGB} (no ICC profile; said in the ImageDescription)",
     "mosaic": "CFA mosaic, linear, one colour per pixel (no ICC profile; said in the "
     "ImageDescription)",
