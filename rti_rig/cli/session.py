@@ -371,13 +371,13 @@ def run(
         if late_term:  # the summary is out; the verdict, not computed, is fit's to give
             _refuse_unsafe_end(unsafe, exit_code=None)
             err.print(
-                f"[yellow]Stopped ({stop_words(signal.SIGTERM)}) once the session had ended: it "
+                f"[yellow]Stopped ({stop_words(late_term[0])}) once the session had ended: it "
                 "is complete; its QA "
                 "verdict was not computed:[/] rti-rig fit "
                 f"{escape(_arg(opened.out_dir))} --out FOLDER gives it",
                 soft_wrap=True,
             )
-            raise typer.Exit(code=stop_exit_code(signal.SIGTERM))
+            raise typer.Exit(code=stop_exit_code(late_term[0]))
         # the verdict is not computed: the stop asked for no more
         _exit_if_park_stopped(
             opened,
@@ -675,13 +675,15 @@ class HandOver:
         if not handlers_settable():
             return
         for sig in (signal.SIGINT, signal.SIGTERM):
-            before = signal.signal(sig, lambda signum, frame: self.held.append(signum))
+            # as received: a hang-up answered as a SIGTERM is kept as SIGHUP, named so later
+            before = signal.signal(sig, lambda signum, frame: self.held.append(as_received(signum)))
             self.originals.setdefault(sig, before)
         self.holding = True
 
     def stop(self) -> signal.Signals:
-        """The held stop's signal: SIGTERM if one came, else SIGINT (called once one came)."""
-        return signal.SIGTERM if signal.SIGTERM in self.held else signal.SIGINT
+        """The held stop's signal: the first SIGTERM or hang-up (SIGHUP) that came, else
+        SIGINT (called once one came)."""
+        return next((signal.Signals(s) for s in self.held if s != signal.SIGINT), signal.SIGINT)
 
 
 @contextmanager
@@ -699,9 +701,11 @@ def _verdict_terminable() -> Iterator[None]:
 
 
 @contextmanager
-def _late_term_held() -> Iterator[list[int]]:
+def _late_term_held() -> Iterator[list[signal.Signals]]:
     """A SIGTERM once the capture is over, while its summary prints, recorded (in the list
-    yielded) rather than acted on at once; a second one ends the process as the default would.
+    yielded, as received: SIGHUP for a hang-up answered as one, so that a real SIGTERM after a
+    hang-up is named SIGTERM) rather than acted on at once; a second one ends the process as
+    the default would.
 
     Why: the capture's handlers were undone before its summary printed, and a SIGTERM then (a
     scheduler's ``timeout``) met the default action: exit 143 with no word of the images kept,
@@ -709,20 +713,21 @@ def _late_term_held() -> Iterator[list[int]]:
     completed. The summary takes milliseconds; ``run`` then says the verdict was not computed
     and which command gives it, and exits 143. This is the handler every later restore puts
     back (installed before the opening's), so it holds from the capture's end to the run's."""
-    held: list[int] = []
+    held: list[signal.Signals] = []
 
     def late(signum, frame) -> None:  # type: ignore[no-untyped-def]
+        received = as_received(signum)  # a hang-up's: SIGHUP
         if held:  # asked twice: stop now (a summary that hangs must not outlive a stop)
-            signal.signal(as_received(signum), signal.SIG_DFL)  # a hang-up's: SIGHUP
-            signal.raise_signal(as_received(signum))
-        held.append(signum)
+            signal.signal(received, signal.SIG_DFL)
+            signal.raise_signal(received)
+        held.append(received)
 
     with signal_handlers({signal.SIGTERM: late}):
         yield held
 
 
 @contextmanager
-def _sigterm_exit_wins(late_term: list[int]) -> Iterator[None]:
+def _sigterm_exit_wins(late_term: list[signal.Signals]) -> Iterator[None]:
     """A run that ends with its own exit (a Ctrl-C stop's 130, an error's 2, an unsafe end's
     1) after a SIGTERM was held while that end was said (``late_term``, from
     :func:`_late_term_held`) exits 143 instead, once what it was saying is out, and says so.
@@ -736,15 +741,16 @@ def _sigterm_exit_wins(late_term: list[int]) -> Iterator[None]:
     try:
         yield
     except typer.Exit as exc:
-        if not late_term or exc.exit_code == stop_exit_code(signal.SIGTERM):
+        late = late_term[0] if late_term else signal.SIGTERM  # SIGTERM, or a hang-up's SIGHUP
+        if not late_term or exc.exit_code == stop_exit_code(late):
             raise
         err.print(
-            f"[yellow]{stop_words(signal.SIGTERM)} while the run's end was being said: what is "
-            f"said above stands; exit {stop_exit_code(signal.SIGTERM)} for the "
-            f"{stop_words(signal.SIGTERM)} (not {exc.exit_code}).[/]",
+            f"[yellow]{stop_words(late)} while the run's end was being said: what is "
+            f"said above stands; exit {stop_exit_code(late)} for the "
+            f"{stop_words(late)} (not {exc.exit_code}).[/]",
             soft_wrap=True,
         )
-        raise typer.Exit(code=stop_exit_code(signal.SIGTERM)) from None
+        raise typer.Exit(code=stop_exit_code(late)) from None
 
 
 @contextmanager
@@ -1992,12 +1998,12 @@ def preview(
         if late_term:  # the preview and its summary are out; the run's word on the stop
             _refuse_unsafe_end(unsafe, exit_code=None)
             err.print(
-                f"[yellow]Stopped ({stop_words(signal.SIGTERM)}) once the preview was taken: it "
+                f"[yellow]Stopped ({stop_words(late_term[0])}) once the preview was taken: it "
                 "is complete in "
                 f"{escape(_arg(out_dir))}[/] (plan from it as above)",
                 soft_wrap=True,
             )
-            raise typer.Exit(code=stop_exit_code(signal.SIGTERM))
+            raise typer.Exit(code=stop_exit_code(late_term[0]))
         _exit_if_park_stopped(
             opened,
             unsafe,

@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from rti_rig.core.deferred_signals import hangup_as_sigterm, signal_handlers
+from rti_rig.core.deferred_signals import as_received, hangup_as_sigterm, signal_handlers
 
 #: A file's identity and content stamp (inode, mtime in ns, size), or None where there is none.
 Stamp = tuple[int, int, int] | None
@@ -27,7 +27,13 @@ Stamp = tuple[int, int, int] | None
 class Terminated(BaseException):
     """A SIGTERM during a command that uses :func:`sigterm_stops` (raised by its handler): a
     BaseException so that no ``except Exception`` on the way swallows it and every ``finally``
-    (a temporary file removed) runs."""
+    (a temporary file removed) runs. ``signum``: the signal as received (SIGHUP for a hang-up
+    answered as a SIGTERM), kept as the handler ran: named after it, a hang-up had been
+    named SIGTERM, or a SIGTERM SIGHUP."""
+
+    def __init__(self, signum: signal.Signals = signal.SIGTERM) -> None:
+        super().__init__(signum)
+        self.signum = signum
 
 
 @contextmanager
@@ -41,7 +47,7 @@ def sigterm_stops() -> Iterator[None]:
     left beside the one asked for) and, for ``calibrate-lights``, with the dome's LED lit."""
 
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
-        raise Terminated()
+        raise Terminated(as_received(signum))
 
     with signal_handlers({signal.SIGTERM: terminated}), hangup_as_sigterm():
         yield
@@ -79,4 +85,4 @@ def stop_signal(exc: BaseException) -> signal.Signals:
     controller = sys.modules.get("rti_rig.runtime.controller")
     if controller is not None and isinstance(exc, controller.EmergencyStop):
         return exc.signum
-    return signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT
+    return exc.signum if isinstance(exc, Terminated) else signal.SIGINT

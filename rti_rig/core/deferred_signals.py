@@ -28,19 +28,38 @@ def stop_words(signum: signal.Signals) -> str:
     return "Ctrl-C" if signum == signal.SIGINT else as_received(signum).name
 
 
-#: A hang-up (SIGHUP) came during a :func:`hangup_as_sigterm` block and was answered as a
-#: SIGTERM: the stop it made is named, recorded and exited as SIGHUP (:func:`as_received`).
+#: A hang-up (SIGHUP) is being answered as a SIGTERM right now: the SIGTERM handler that
+#: :func:`hangup_as_sigterm` called for it (or a hold delivering one it held) is running, and
+#: the stop it makes is named, recorded and exited as SIGHUP (:func:`as_received`).
+#:
+#: Set only for that delivery, not for the rest of the block: it had stayed set from the
+#: hang-up to the block's end, so a real SIGTERM after it (a supervisor's ``kill`` once the
+#: terminal had closed) was named, recorded and exited as SIGHUP too, and one before it was
+#: renamed SIGHUP by a hang-up that came during its teardown. Whatever keeps a stop's signal
+#: for later (an exception, a list of held signals) keeps :func:`as_received`'s answer.
 _hung_up = False
 
 
 def as_received(signum: int) -> signal.Signals:
-    """The signal a stop really came as: SIGHUP for a SIGTERM once a hang-up was answered as
-    one (:func:`hangup_as_sigterm`), else ``signum`` itself. What names a stop (the words, the
-    manifest's record, the exit code 128 + its number) goes through it."""
+    """The signal a stop really came as: SIGHUP for a SIGTERM while a hang-up answered as one
+    is being delivered (:func:`hangup_as_sigterm`), else ``signum`` itself. What names a stop
+    (the words, the manifest's record, the exit code 128 + its number) goes through it, and
+    a handler that keeps the signal for later keeps this, not its ``signum``."""
     sig = signal.Signals(signum)
     if _hung_up and sig == signal.SIGTERM:
         return signal.SIGHUP
     return sig
+
+
+def _deliver(handler: Callable[[int, Any], Any], received: int, frame: Any) -> None:
+    """Call SIGTERM's ``handler`` for a stop that came as ``received`` (SIGTERM, or a hang-up
+    answered as one): for a hang-up, :func:`as_received` names it SIGHUP for that call only."""
+    global _hung_up
+    before, _hung_up = _hung_up, received == getattr(signal, "SIGHUP", None)
+    try:
+        handler(signal.SIGTERM if _hung_up else received, frame)
+    finally:
+        _hung_up = before
 
 
 @contextlib.contextmanager
@@ -54,7 +73,9 @@ def hangup_as_sigterm() -> Iterator[None]:
     the manifest. One mechanism, SIGTERM's, rather than a second copy of every SIGTERM handler
     (the opening's, the capture's, the holds', the verdict's). Where SIGTERM's action is the
     default, SIGHUP's is too (the process ends by SIGHUP). The flag is cleared as the block
-    begins, not as it ends: the exit code is decided on it once the block is left. No SIGHUP
+    begins; it is set only while the hang-up's SIGTERM handler runs (what it names then is
+    kept: an exception's signal, a held signal), so a real SIGTERM before or after the hang-up
+    is named SIGTERM. No SIGHUP
     (Windows), or SIGHUP ignored as the block begins (``nohup``): nothing is installed."""
     global _hung_up
     _hung_up = False
@@ -64,11 +85,9 @@ def hangup_as_sigterm() -> Iterator[None]:
         return  # its terminal, and goes on to its end
 
     def hung_up(signum: int, frame: Any) -> None:
-        global _hung_up
-        _hung_up = True
         handler = signal.getsignal(signal.SIGTERM)
         if callable(handler):
-            handler(signal.SIGTERM, frame)
+            _deliver(handler, sighup, frame)
         elif handler != signal.SIG_IGN:  # the default (or a handler set outside Python)
             signal.signal(sighup, signal.SIG_DFL)
             signal.raise_signal(sighup)
@@ -107,7 +126,8 @@ def signals_deferred(
     """Hold SIGINT/SIGTERM while devices are put in their safe state, or while a captured
     image is committed (its files and journal line).
 
-    ``on_held`` (called with the signal's number, in the main thread, as each is held) lets
+    ``on_held`` (called with the signal's number, as received: SIGHUP for a hang-up answered
+    as a SIGTERM; in the main thread, as each is held) lets
     the block cut short a long wait of its own that a stop must not sit through (the arm's
     final park, which lasts up to ``move_timeout_s``): it should only record the request (set
     a flag), never raise; the signal is still delivered once the block is done.
@@ -133,7 +153,7 @@ def signals_deferred(
     if second_stops and _after_a_stop:
         yield  # a stop was already acted on: a further one acts at once (see after_a_stop)
         return
-    pending: list[tuple[int, Any]] = []
+    pending: list[tuple[int, Any, int]] = []  # signal, frame, as received
     raised: list[BaseException] = []  # by a pending signal's handler as a handler was swapped
 
     released = False  # the hold was ended early by a second stop (``second_stops``)
@@ -146,22 +166,23 @@ def signals_deferred(
         for sig, handler in installed.items():
             _swap_handler(sig, handler, raised)
         held, pending[:] = list(pending), []
-        for signum, frame in held:
+        for signum, frame, received in held:
             handler = installed.get(signum)
             if handler is None:
                 continue
             if callable(handler):
-                try:
-                    handler(signum, frame)
+                try:  # a held hang-up is delivered as one: named SIGHUP, not SIGTERM
+                    _deliver(handler, received, frame)
                 except BaseException as exc:
                     raised.append(exc)
             elif handler != signal.SIG_IGN:  # the default action: raised again, now unheld
-                signal.raise_signal(signum)
+                signal.raise_signal(received)  # a hang-up's: SIGHUP (exit 129)
 
     def hold(signum: int, frame: Any) -> None:
-        pending.append((signum, frame))
+        received = as_received(signum)  # SIGHUP for a hang-up's: delivered later as one
+        pending.append((signum, frame, received))
         if on_held is not None:
-            on_held(signum)
+            on_held(received)
         if second_stops and len(pending) > 1 and not released:
             release()  # the user insists: acted on here, in the block, as if never held
             if raised:
