@@ -136,9 +136,30 @@ def libraw_printed(name: str, into: list[str]) -> Iterator[None]:
                         else:
                             other.append(line)
                     if other:
-                        os.write(2, "".join(other).encode("utf-8", "replace"))
+                        _said_again("".join(other))
         finally:
             os.close(saved)
+
+
+def _said_again(text: str) -> None:
+    """Write lines caught on fd 2 during a decode, not LibRaw's about the file, back through
+    ``sys.stderr``: where the console entry queues its words for a thread of their own, they
+    join that queue instead of waiting on the reader.
+
+    Why not ``os.write(2, ...)``, as before: the decode runs in the main thread during a
+    capture, a DSLR's frame taken with the light on; a write to a full stderr pipe whose reader
+    stalled waited there, the LED lit, for as long as the reader did. Where there is no
+    ``sys.stderr`` (``pythonw``), or it fails, fd 2 as before, a failure dropped."""
+    stream = sys.stderr
+    if stream is not None:
+        try:
+            stream.write(text)
+            stream.flush()
+            return
+        except (AttributeError, OSError, ValueError):
+            pass
+    with suppress(OSError):
+        os.write(2, text.encode("utf-8", "replace"))
 
 
 def _reported(printed: list[str]) -> str:

@@ -25,6 +25,7 @@ import atexit
 import collections
 import contextlib
 import os
+import select
 import sys
 import threading
 from typing import Any
@@ -119,38 +120,95 @@ class WordsWriter:
 
 
 class UnwaitedStream:
-    """A standard stream whose writes and flushes go through a :class:`WordsWriter`."""
+    """A standard stream whose writes and flushes go through a :class:`WordsWriter`, to
+    ``target`` (the stream itself unless given: stderr's :class:`Fd2Copy`)."""
 
-    def __init__(self, stream: Any, writer: WordsWriter) -> None:
+    def __init__(self, stream: Any, writer: WordsWriter, target: Any = None) -> None:
         self._stream = stream
         self._writer = writer
+        self._target = stream if target is None else target
 
     def write(self, text: str) -> int:
-        self._writer.write(self._stream, text)
+        self._writer.write(self._target, text)
         return len(text)
 
     def flush(self) -> None:
-        self._writer.flush(self._stream)
+        self._writer.flush(self._target)
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._stream, name)
 
 
+class Fd2Copy:
+    """Where the writer thread writes stderr's words: a copy (``os.dup``) of descriptor 2
+    taken as the console entry began, in the encoding and error handling of the stream it
+    stands for; a full non-blocking pipe is waited on (the writer thread may wait: that is
+    what it is for), a failed write raised to the writer, which drops the word.
+
+    Why: descriptor 2 is pointed elsewhere for a moment by code that captures what C
+    libraries print there (the RAW decoder holds LibRaw's lines off the terminal while it
+    reads a file); the writer thread's words written to fd 2 meanwhile went into that capture
+    and came out later, out of order, or were taken for the library's own. The copy still
+    names the terminal or pipe the command was given."""
+
+    def __init__(self, stream: Any, fd: int) -> None:
+        self.fd = fd
+        self._encoding = getattr(stream, "encoding", None) or "utf-8"
+        self._errors = getattr(stream, "errors", None) or "backslashreplace"
+
+    def write(self, text: str) -> int:
+        data = memoryview(text.encode(self._encoding, self._errors))
+        while data:
+            try:
+                written = os.write(self.fd, data)
+            except BlockingIOError:  # a pipe its reader set non-blocking: wait for room
+                select.select([], [self.fd], [])
+                continue
+            except InterruptedError:
+                continue
+            data = data[written:]
+        return len(text)
+
+    def flush(self) -> None:
+        """Nothing is buffered: each word is written as it comes."""
+
+
+def _fd2_copy(stderr: Any) -> Fd2Copy | None:
+    """A :class:`Fd2Copy` for ``stderr`` where it writes to descriptor 2 (after a flush of
+    what it holds, so that the order is kept), else None (a stream of no descriptor, or of
+    another one: nothing swaps it)."""
+    try:
+        if stderr.fileno() != 2:
+            return None
+        stderr.flush()
+        return Fd2Copy(stderr, os.dup(2))
+    except (AttributeError, OSError, ValueError):
+        return None
+
+
 _writer: WordsWriter | None = None
+#: the descriptor 2 copy the current entry's stderr words are written to (closed once a later
+#: entry takes its own and no word is left queued for it)
+_copy: Fd2Copy | None = None
 
 
 def words_unwaited(consoles: tuple[Any, Any]) -> None:
     """Give ``sys.stdout``/``sys.stderr`` and the consoles (``out``, ``err``) their streams
     through one :class:`WordsWriter`; the console entry only (as the tolerant streams)."""
-    global _writer
+    global _writer, _copy
     out, err = consoles
     stdout, stderr = sys.stdout, sys.stderr
     if _writer is None:  # one thread a process; each entry's streams are its own
         _writer = WordsWriter(notes_to=stderr)
         atexit.register(words_written)
-    _writer.notes_to = stderr
+    copy = _fd2_copy(stderr)  # stderr's words never land where fd 2 is pointed for a moment
+    if _copy is not None and not _writer._items:  # nothing left queued for the last entry's
+        with contextlib.suppress(OSError):
+            os.close(_copy.fd)
+    _copy = copy
+    _writer.notes_to = stderr if copy is None else copy
     sys.stdout = out.file = UnwaitedStream(stdout, _writer)  # type: ignore[assignment]
-    sys.stderr = err.file = UnwaitedStream(stderr, _writer)  # type: ignore[assignment]
+    sys.stderr = err.file = UnwaitedStream(stderr, _writer, copy)  # type: ignore[assignment]
 
 
 def words_written() -> None:
