@@ -887,10 +887,13 @@ _OWN_UNHEARD = {
 #: comes: its prompt, and its touch-screen calibration (which holds the boot in it).
 _NICHLOCK_BOOT_ENDS = ("For help, press 'h'", "Starting Calibration")
 
-#: How long RTIPy's board takes to boot, by its profile: the wait before ``T,0,0,0``. Its
-#: sketch prints nothing at boot, so the rest of a probe's 2.6 s (the bootloader and a banner)
-#: was waited for nothing; a slower board's banner (the Nab sketch's, up to the 4 s its
-#: profile allows) is still heard by the listens after the sends, 5.6 s from the opening.
+#: How long RTIPy's board takes to boot, by its profile: ``T,0,0,0`` is never sent sooner
+#: after the opening. On the opening it shares with minirti's mask and the Nab sketch's
+#: ``<9>`` it comes later all the same, after 1.5 s of the probe's silence
+#: (:data:`_RTIPY_FRAME_S`): on a silent port the mask at 1.6 s (again at 2.1 s), ``<9>`` at
+#: 2.6 s (again at 3.2 s), ``T,0,0,0`` at 4.7 s (again at 6.5 s), the last listen ending 8.3 s
+#: from the opening. A slower board's banner (the Nab sketch's, up to the 4 s its profile
+#: allows) is heard by those listens, and the whole text of the opening is what decides.
 _RTIPY_BOOT_S = float(rtipy.SPEC["boot_wait_s"])
 
 #: RTIPy's whole answer to the probe's ``T,0,0,0`` (printed with no line ending).
