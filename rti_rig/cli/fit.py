@@ -62,7 +62,7 @@ def print_verdict(session: Path | None) -> None:
         # said, then the exit the stop has everywhere else (Ctrl-C 130, SIGTERM 143): a
         # Ctrl-C here had exited 0, so ``run && fit`` went on to fit after the user asked to
         # stop, and the two stops of the same moment disagreed
-        signum = signal.SIGTERM if isinstance(exc, VerdictTerminated) else signal.SIGINT
+        signum = exc.signum if isinstance(exc, VerdictTerminated) else signal.SIGINT
         err.print(
             f"[yellow]QA verdict skipped ({stop_words(signum)}):[/] the session is complete; "
             f"rti-rig fit {escape(shell_word(session))} --out FOLDER gives the verdict"
@@ -109,7 +109,13 @@ class VerdictTerminated(BaseException):
     """A SIGTERM while ``run`` computes its QA verdict (raised by the run's handler for that
     phase): the session is complete, so it is said like a Ctrl-C there; it had ended the
     process silently (exit 143), which read like a failed session. A BaseException, as
-    KeyboardInterrupt is, so that no ``except Exception`` on the way swallows it."""
+    KeyboardInterrupt is, so that no ``except Exception`` on the way swallows it.
+    ``signum``: the signal as received (SIGHUP for a hang-up answered as a SIGTERM), kept as
+    the handler ran: a hang-up is named and exited as itself, a SIGTERM after one as SIGTERM."""
+
+    def __init__(self, signum: signal.Signals = signal.SIGTERM) -> None:
+        super().__init__(signum)
+        self.signum = signum
 
 
 def _stopped(

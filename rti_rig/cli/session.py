@@ -694,7 +694,7 @@ def _verdict_terminable() -> Iterator[None]:
     from rti_rig.cli.fit import VerdictTerminated
 
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
-        raise VerdictTerminated
+        raise VerdictTerminated(as_received(signum))  # a hang-up's: SIGHUP
 
     with signal_handlers({signal.SIGTERM: terminated}):
         yield
@@ -1740,8 +1740,9 @@ def _as_before(handler: Any, signum: int, frame: Any) -> None:
     if callable(handler):
         handler(signum, frame)
     elif handler != signal.SIG_IGN:  # the default action (or one set outside Python)
-        signal.signal(signum, signal.SIG_DFL)
-        signal.raise_signal(signum)
+        received = as_received(signum)  # a hang-up answered as a SIGTERM ends as SIGHUP
+        signal.signal(received, signal.SIG_DFL)
+        signal.raise_signal(received)
 
 
 @contextmanager
