@@ -30,6 +30,7 @@ from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.rig_geometry import default_led_name
 from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.core.shell_words import shown_path
 from rti_rig.runtime.lighting import ArmLighting, Lighting, port_close_failures
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
@@ -409,9 +410,9 @@ def _check_capture_lit_time(
         f"lit timing.settle_s {t.settle_s:g} + {capture_s:.3g} s + timing.readout_s "
         f"{t.readout_s:g} + timing.transfer_s {transfer:g} + timing.light_switch_s {switch:g} "
         f"= {total:.3g} s, beyond {lit_limit_said(rig)}"
-        f"{f' ({where})' if where else ''}: every capture would stop at the thermal limit with "
-        f"the object lit; {before}. Give the camera a higher frame rate, let its driver queue "
-        "fewer buffers (buffer_size in [camera.device]; drain_frames if the sensor latches a "
+        f"{f' ({shown_path(where)})' if where else ''}: every capture would stop at the thermal "
+        f"limit with the object lit; {before}. Give the camera a higher frame rate, let its driver "
+        "queue fewer buffers (buffer_size in [camera.device]; drain_frames if the sensor latches a "
         "new exposure at once), or raise max_on_s if the LEDs allow it",
         "check lit time",
     )

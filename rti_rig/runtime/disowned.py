@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from rti_rig.core.errors import SessionError
+from rti_rig.core.shell_words import shown_path
 
 #: The marker, at the session's root, beside ``lights.lp``; it holds the reason as text.
 MARKER = "LABELS_NOT_VERIFIED.txt"
@@ -37,7 +38,8 @@ def refuse_if_disowned(root: Path) -> None:
         reasons = marker.read_text(encoding="utf-8").strip().splitlines()
         last = reasons[-1] if reasons else "(no reason recorded)"  # the most specific one
         raise DisownedSessionError(
-            f"{root}: the images of this session may be labelled with the wrong lights, so it "
-            f"is not used: {marker} says: {last} — reshoot the object (the images are kept; "
-            f"delete {marker.name} only if you have checked every label by hand)"
+            f"{shown_path(root)}: the images of this session may be labelled with the wrong "
+            f"lights, so it is not used: {shown_path(marker)} says: {last} — reshoot the object "
+            f"(the images are kept; delete {marker.name} only if you have checked every label by "
+            "hand)"
         )

@@ -50,6 +50,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from rti_rig.core.shell_words import shown_path
 from rti_rig.core.state_files import replace_text
 
 #: Overrides where the ledgers are kept (a test's own folder, say).
@@ -209,7 +210,9 @@ class DutyLedger:
     def _warn(self, what: str, advice: str) -> None:
         """One line, said by the console as a note: the command goes on."""
         warnings.warn(
-            f"the dome's duty ledger {self.path} {what}{advice}", RuntimeWarning, stacklevel=3
+            f"the dome's duty ledger {shown_path(self.path)} {what}{advice}",
+            RuntimeWarning,
+            stacklevel=3,
         )
 
 

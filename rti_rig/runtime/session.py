@@ -195,7 +195,7 @@ class SessionWriteError(SessionError):
         self.errno_name = _errno.errorcode.get(exc.errno or 0, "") if exc.errno else ""
         reason = exc.strerror or str(exc)
         code = f" ({self.errno_name})" if self.errno_name else ""
-        super().__init__(f"cannot write {self.path}: {reason}{code}")
+        super().__init__(f"cannot write {shown_path(self.path)}: {reason}{code}")
 
 
 def _write_bytes_atomic(path: Path, data: bytes) -> None:
@@ -522,8 +522,8 @@ def lock_session(root: Path) -> None:
     except BlockingIOError:
         os.close(fd)
         raise SessionError(
-            f"{root} is in use by another rti-rig process (a session is being captured or "
-            "resumed in it): let it finish, or stop it (Ctrl-C in its terminal), then "
+            f"{shown_path(root)} is in use by another rti-rig process (a session is being captured "
+            "or resumed in it): let it finish, or stop it (Ctrl-C in its terminal), then "
             f"continue with: rti-rig run --resume {shell_word(str(root))}"
         ) from None
     except OSError:  # a filesystem without flock (some network mounts): no lock, as before
@@ -564,9 +564,9 @@ def refuse_if_in_use(root: Path, what: str) -> None:
     mounts) is read as before."""
     if in_use_by_another(root):
         raise SessionError(
-            f"{root} is being captured by another rti-rig process right now (its images and "
-            f"{LP_NAME} change as it goes): {what} once that run has ended (or stop it with "
-            "Ctrl-C in its terminal)"
+            f"{shown_path(root)} is being captured by another rti-rig process right now (its "
+            f"images and {LP_NAME} change as it goes): {what} once that run has ended (or stop it "
+            "with Ctrl-C in its terminal)"
         )
 
 
@@ -693,8 +693,8 @@ class SessionFolder:
             nearest = nearest.parent
         if nearest.is_dir() and not os.access(nearest, os.W_OK | os.X_OK):
             raise SessionError(
-                f"{root}: cannot write there ({nearest} is read-only or not writable by you); "
-                "choose an --out folder you can write to"
+                f"{shown_path(root)}: cannot write there ({shown_path(nearest)} is read-only or "
+                "not writable by you); choose an --out folder you can write to"
             )
 
     @classmethod
@@ -812,8 +812,8 @@ class SessionFolder:
         if self.resume is not None:
             if header["schedule"] != self.manifest["schedule"]:
                 raise SessionError(
-                    f"{self.root}: the schedule to resume differs from the one the session began "
-                    "with; a resumed session must run the same steps"
+                    f"{shown_path(self.root)}: the schedule to resume differs from the one the "
+                    "session began with; a resumed session must run the same steps"
                 )
             runs = self.manifest.setdefault("runs", [])
             for old in runs:
@@ -1054,7 +1054,9 @@ class SessionFolder:
                 n += 1
             dest = self.root / rel
             if dest.exists():
-                raise SessionError(f"{dest} already exists: refusing to overwrite a captured file")
+                raise SessionError(
+                    f"{shown_path(dest)} already exists: refusing to overwrite a captured file"
+                )
             kept[rel] = (_take_whole(src, dest, root), str(item.get("name") or src.name))
         return kept
 
@@ -1376,7 +1378,7 @@ def scan_journal(root: Path, names: list[str] | None = None) -> JournalScan:
         _mend_from_step_records(Path(root), names, scan)
         return scan
     except OSError as exc:
-        raise SessionError(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise SessionError(f"cannot read {shown_path(path)}: {exc.strerror or exc}") from None
     *lines, scan.torn = data.split(b"\n")
     for i, raw in enumerate(lines):
         if not raw.strip():
@@ -1783,20 +1785,22 @@ def _prepare_resume(
     manifest = read_manifest(root)
     total = planned_steps(manifest)
     if total == 0:
-        raise SessionError(f"{root}: the manifest holds no schedule, so there is nothing to resume")
+        raise SessionError(
+            f"{shown_path(root)}: the manifest holds no schedule, so there is nothing to resume"
+        )
     runner = manifest.get("runner") or {}
     names = image_names(total)
     scan = scan_journal(root, names)
     if rebuild_journal and reshoot_lost:
         raise SessionError(
-            f"{root}: --rebuild-journal and --reshoot-lost go one at a time: rebuild the "
-            "journal first, then reshoot what the rebuilt journal finds lost (--reshoot-lost "
+            f"{shown_path(root)}: --rebuild-journal and --reshoot-lost go one at a time: rebuild "
+            "the journal first, then reshoot what the rebuilt journal finds lost (--reshoot-lost "
             "needs a journal to know what was captured): drop --reshoot-lost"
         )
     if rebuild_journal and runner.get("finish_reason") == "completed":
         raise SessionError(
-            f"{root}: this session completed: nothing is captured to rebuild its journal, "
-            "which rebuild_finished_journal does without the rig (rti-rig run --resume "
+            f"{shown_path(root)}: this session completed: nothing is captured to rebuild its "
+            "journal, which rebuild_finished_journal does without the rig (rti-rig run --resume "
             f"{shell_word(str(root))} --rebuild-journal)"
         )
     rebuilt: dict[int, dict[str, Any]] | None = None  # the records taken back
@@ -1821,7 +1825,7 @@ def _prepare_resume(
         if manifest.get("adaptive") and finished < total:  # an adaptive session that stopped
             stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
             raise SessionError(
-                f"{root}: this adaptive session already completed: it stopped after "
+                f"{shown_path(root)}: this adaptive session already completed: it stopped after "
                 f"{finished} of at most {total} lights ({stop.get('reason', 'its stopping rule')})"
                 + _lost_note(root, latest, lost, adaptive=True)
             )
@@ -1829,26 +1833,30 @@ def _prepare_resume(
             unchecked, why = unchecked_images(root)
             if unchecked:  # nothing found lost is not nothing lost
                 raise SessionError(
-                    f"{root}: --reshoot-lost finds nothing lost among the images it can check, "
-                    f"but {', '.join(unchecked[:8])}{' …' if len(unchecked) > 8 else ''} cannot "
-                    f"be checked ({why}): restore {MANIFEST if MANIFEST in why else JOURNAL} "
-                    "from a backup copy of the folder"
+                    f"{shown_path(root)}: --reshoot-lost finds nothing lost among the images it "
+                    "can check, but "
+                    f"{', '.join(unchecked[:8])}{' …' if len(unchecked) > 8 else ''} cannot be "
+                    f"checked ({why}): restore {MANIFEST if MANIFEST in why else JOURNAL} from a "
+                    "backup copy of the folder"
                     + ("" if MANIFEST in why else rebuild_advice(root))
                     + ", then run this again"
                 )
             if renamed:
                 raise SessionError(
-                    f"{root}: nothing to reshoot: this session completed all {total} steps" + moved
+                    f"{shown_path(root)}: nothing to reshoot: this session completed all {total} "
+                    "steps" + moved
                 )
             raise SessionError(
-                f"{root}: nothing to reshoot: this session completed all {total} steps and "
-                "every image is as captured (each JPEG and linear TIFF matches its journaled "
+                f"{shown_path(root)}: nothing to reshoot: this session completed all {total} steps "
+                "and every image is as captured (each JPEG and linear TIFF matches its journaled "
                 "checksum)"
             )
         if not lost or manifest.get("adaptive") or not reshoot_lost:
             note = _lost_note(root, latest, lost, adaptive=bool(manifest.get("adaptive")))
             raise ImagesLostSinceCapture(
-                f"{root}: this session already completed all {total} steps" + note + moved,
+                f"{shown_path(root)}: this session already completed all {total} steps"
+                + note
+                + moved,
                 note + moved,  # an image renamed is named too (the flash refusal had not)
             )
         # the lost steps are reshot; the others stand as they are, verified or not
@@ -1858,8 +1866,8 @@ def _prepare_resume(
             # the command named: after a --reshoot-lost stopped part-way, the user's next try
             # is the same command again, and "drop --reshoot-lost" left the rest to guess
             raise SessionError(
-                f"{root}: --reshoot-lost is for a session that completed; this one did not "
-                f"({_ended_as(runner.get('finish_reason'), root, scan.records)}), "
+                f"{shown_path(root)}: --reshoot-lost is for a session that completed; this one did "
+                f"not ({_ended_as(runner.get('finish_reason'), root, scan.records)}), "
                 "and its resume sets aside and shoots again whatever it cannot verify anyway "
                 "(nothing in this folder was changed): continue it with rti-rig run --resume "
                 f"{shell_word(str(root))}"
@@ -2136,7 +2144,9 @@ def rebuild_finished_journal(root: Path) -> list[str]:
         manifest = read_manifest(root)
         runner = manifest.get("runner") or {}
         if runner.get("finish_reason") != "completed":
-            raise SessionError(f"{root}: this session did not complete: resume it instead")
+            raise SessionError(
+                f"{shown_path(root)}: this session did not complete: resume it instead"
+            )
         names = image_names(planned_steps(manifest))
         scan = scan_journal(root, names)
         taken, unproven, lost = _finished_rebuild(root, manifest, names, scan)
@@ -2146,8 +2156,8 @@ def rebuild_finished_journal(root: Path) -> list[str]:
             # had been sent to a fit to find out
             gone = lost_since_capture_said(root, manifest)
             raise SessionError(
-                f"{root}: this session completed and its {JOURNAL} holds a record of every "
-                "image it captured: nothing to rebuild; drop --rebuild-journal"
+                f"{shown_path(root)}: this session completed and its {JOURNAL} holds a record of "
+                "every image it captured: nothing to rebuild; drop --rebuild-journal"
                 + (
                     f"; but {gone}"
                     if gone
@@ -2158,10 +2168,10 @@ def rebuild_finished_journal(root: Path) -> list[str]:
         if len(lost) < len(unproven):
             shown = "; ".join(unproven[:8]) + (" …" if len(unproven) > 8 else "")
             raise SessionError(
-                f"{root}: {JOURNAL} cannot be rebuilt: {len(unproven)} of the session's images "
-                f"cannot be proven as captured: {shown}; nothing in this folder was changed: "
-                f"restore {JOURNAL} (or those files) from a backup copy of the folder, then run "
-                f"this again; meanwhile rti-rig fit {folder} --out DIR fits the "
+                f"{shown_path(root)}: {JOURNAL} cannot be rebuilt: {len(unproven)} of the "
+                f"session's images cannot be proven as captured: {shown}; nothing in this folder "
+                f"was changed: restore {JOURNAL} (or those files) from a backup copy of the "
+                f"folder, then run this again; meanwhile rti-rig fit {folder} --out DIR fits the "
                 "session as it is, its verdict naming the images it cannot check"
             )
         notes: list[str] = []
@@ -2259,9 +2269,9 @@ def _refuse_unjournaled(
     shown = ", ".join(names[i] for i in unjournaled[:8]) + (" …" if len(unjournaled) > 8 else "")
     folder = shell_word(str(root))
     raise SessionError(
-        f"{root}: {what}: it holds no record of {len(unjournaled)} image(s) that {MANIFEST} "
-        f"lists as captured, with files on disk as its checksums say ({shown}); a resume "
-        "would set them aside and shoot them again (nothing in this folder was changed): "
+        f"{shown_path(root)}: {what}: it holds no record of {len(unjournaled)} image(s) that "
+        f"{MANIFEST} lists as captured, with files on disk as its checksums say ({shown}); a "
+        "resume would set them aside and shoot them again (nothing in this folder was changed): "
         f"restore {JOURNAL} from a backup copy of the folder and resume again, or rebuild it "
         f"from the manifest: rti-rig run --resume {folder} --rebuild-journal (it takes back "
         "only the images whose files match the checksums and light the manifest or an intact "
@@ -2291,8 +2301,8 @@ def _restorable(
     unproven = sorted(i for i in listed if i not in journaled and i not in restored)
     if unproven:
         raise SessionError(
-            f"{root}: {JOURNAL} holds no record of {_shown(names, unproven)}, and the light "
-            f"{MANIFEST} records for {'it' if len(unproven) == 1 else 'them'} is not the one "
+            f"{shown_path(root)}: {JOURNAL} holds no record of {_shown(names, unproven)}, and the "
+            f"light {MANIFEST} records for {'it' if len(unproven) == 1 else 'them'} is not the one "
             "its step was given: --reshoot-lost would set them aside and shoot them again with "
             "the images lost (nothing in this folder was changed): restore "
             f"{JOURNAL} from a backup copy of the folder, then run this again"
@@ -2354,8 +2364,8 @@ def _provable_steps(
         ]
         if undecided:
             raise SessionError(
-                f"{root}: {MANIFEST} records {', '.join(undecided[:8])} without the adaptive "
-                "decision that chose its light, so a rebuilt journal could not prove the "
+                f"{shown_path(root)}: {MANIFEST} records {', '.join(undecided[:8])} without the "
+                "adaptive decision that chose its light, so a rebuilt journal could not prove the "
                 "session continues as it began; nothing in this folder was changed: restore "
                 f"{JOURNAL} from a backup copy of the folder, or start a new session with "
                 "another --out"
@@ -2575,8 +2585,8 @@ def _refuse_lost_journal(root: Path, names: list[str], scan: JournalScan) -> Non
         )
         shown = ", ".join(bases[:8]) + (" …" if len(bases) > 8 else "")
         raise SessionError(
-            f"{root}: {JOURNAL} is missing; the step record files in {RECORDS_DIR}/ prove "
-            f"{len(scan.records)} image(s) as captured, but not {shown}, whose record files "
+            f"{shown_path(root)}: {JOURNAL} is missing; the step record files in {RECORDS_DIR}/ "
+            f"prove {len(scan.records)} image(s) as captured, but not {shown}, whose record files "
             "are gone or no longer match them: restore "
             f"{JOURNAL} (or {RECORDS_DIR}/) from a backup copy of the folder, then run "
             f"rti-rig run --resume {shell_word(str(root))} again; if it is lost for good, "
@@ -2587,8 +2597,8 @@ def _refuse_lost_journal(root: Path, names: list[str], scan: JournalScan) -> Non
     first = names[0] if names else ""
     count = len({stem.split("_")[1] for stem in later} | {first.split("_")[1]})
     raise SessionError(
-        f"{root}: {JOURNAL} is missing, so none of the images on disk (about {count} steps) "
-        "can be verified as captured with its light: restore "
+        f"{shown_path(root)}: {JOURNAL} is missing, so none of the images on disk (about {count} "
+        "steps) can be verified as captured with its light: restore "
         f"{JOURNAL} from a backup copy of the folder (or from where it was moved), then run "
         f"rti-rig run --resume {shell_word(str(root))} again; if it is lost for good, shoot "
         "the session again with another --out (nothing in this folder was changed; "
@@ -2858,17 +2868,20 @@ def read_manifest(root: Path) -> dict[str, Any]:
     """The manifest of a session folder, with a clear error if it is not one."""
     path = Path(root) / MANIFEST
     if not Path(root).exists():
-        raise SessionError(f"{root} does not exist: give a session folder written by 'rti-rig run'")
+        raise SessionError(
+            f"{shown_path(root)} does not exist: give a session folder written by 'rti-rig run'"
+        )
     if not Path(root).is_dir():
         if Path(root).suffix.lower() == ".lp" and not (Path(root).parent / MANIFEST).is_file():
             # a recorded acquisition's .lp had been told to give "the session folder that
             # holds it", which was then refused as "not an rti-rig session folder"
             raise SessionError(
-                f"{root} is an .lp, not a session folder, and its folder is no session either "
-                f"(no {MANIFEST}): {_acquisition_lp_use(Path(root))}"
+                f"{shown_path(root)} is an .lp, not a session folder, and its folder is no session "
+                f"either (no {MANIFEST}): {_acquisition_lp_use(Path(root))}"
             )
         raise SessionError(
-            f"{root} is a file: give the session folder that holds it (the one with {MANIFEST})"
+            f"{shown_path(root)} is a file: give the session folder that holds it (the one with "
+            f"{MANIFEST})"
         )
     # rti-rig writes the manifest atomically, so a damaged one was damaged outside it (a disk,
     # a sync tool, an editor): say what is still intact and what to do, never a traceback
@@ -2889,9 +2902,9 @@ def read_manifest(root: Path) -> dict[str, Any]:
                 else ""
             )
             raise SessionError(
-                f"{root} is a session folder without its {MANIFEST} (its {JOURNAL} is there): "
-                f"restore {MANIFEST} from a backup copy of the folder; without it the session "
-                f"cannot be resumed (its schedule and rig are recorded there){fit}"
+                f"{shown_path(root)} is a session folder without its {MANIFEST} (its {JOURNAL} is "
+                f"there): restore {MANIFEST} from a backup copy of the folder; without it the "
+                f"session cannot be resumed (its schedule and rig are recorded there){fit}"
             ) from None
         lps = lp_files_in(Path(root))
         held = (
@@ -2901,21 +2914,24 @@ def read_manifest(root: Path) -> dict[str, Any]:
             else ""
         )
         raise SessionError(
-            f"{root} has no {MANIFEST}: it is not an rti-rig session folder{held}"
+            f"{shown_path(root)} has no {MANIFEST}: it is not an rti-rig session folder{held}"
         ) from None
     except IsADirectoryError:
-        raise SessionError(f"{path} is a folder, not the session's manifest{damaged}") from None
+        raise SessionError(
+            f"{shown_path(path)} is a folder, not the session's manifest{damaged}"
+        ) from None
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise SessionError(f"{path} is not valid JSON ({exc}){damaged}") from None
+        raise SessionError(f"{shown_path(path)} is not valid JSON ({exc}){damaged}") from None
     except OSError as exc:
-        raise SessionError(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise SessionError(f"cannot read {shown_path(path)}: {exc.strerror or exc}") from None
     if not isinstance(data, dict):
         kind = _JSON_KIND.get(type(data), "value")
         raise SessionError(
-            f"{path} is not a session manifest (it holds a JSON {kind}, not an object){damaged}"
+            f"{shown_path(path)} is not a session manifest (it holds a JSON {kind}, not an "
+            f"object){damaged}"
         )
     if data.get("format") != FORMAT:
-        raise SessionError(f"{path}: unknown session format {data.get('format')!r}")
+        raise SessionError(f"{shown_path(path)}: unknown session format {data.get('format')!r}")
     return data
 
 
@@ -3484,8 +3500,8 @@ def session_lp_report(
         if stopped_before_first_journal(root, scan) == UNRECORDED:
             instead = unresumable(root)
             raise SessionError(
-                f"{root}: the session stopped before its first image was recorded in its "
-                f"{JOURNAL}, so there is no .lp to export; "
+                f"{shown_path(root)}: the session stopped before its first image was recorded in "
+                f"its {JOURNAL}, so there is no .lp to export; "
                 + (
                     instead
                     if instead is not None
@@ -3496,17 +3512,19 @@ def session_lp_report(
             )
         if not (Path(root) / JOURNAL).is_file():
             raise SessionError(
-                f"{root}: {JOURNAL} is missing, so no image can be verified as captured with "
-                f"its light: restore {JOURNAL} from a backup copy of the folder"
+                f"{shown_path(root)}: {JOURNAL} is missing, so no image can be verified as "
+                f"captured with its light: restore {JOURNAL} from a backup copy of the folder"
                 + rebuild_advice(root, scan)
             )
-        raise SessionError(f"{root}: the session recorded no images, so there is no .lp to export")
+        raise SessionError(
+            f"{shown_path(root)}: the session recorded no images, so there is no .lp to export"
+        )
     left_out = sorted({r[key] for r in records if r["index"] not in done})
     if not done:
         renamed = renamed_jpegs(root, records, only=key)  # of the kind of file the .lp lists
         raise SessionError(
-            f"{root}: none of the {len(left_out)} journaled image(s) is on disk as captured "
-            "(missing or changed), so there is no .lp to export"
+            f"{shown_path(root)}: none of the {len(left_out)} journaled image(s) is on disk as "
+            "captured (missing or changed), so there is no .lp to export"
             + (f"; {renamed_note(renamed)}" if renamed else "")
         )
     entries = [LpEntry(getattr(done[i], key), done[i].actual_direction) for i in sorted(done)]
