@@ -9,6 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from rti_rig.core.shell_words import shown_path
+
 
 class RtiRigError(Exception):
     """Base class of every error rti-rig raises on purpose."""
@@ -26,7 +28,7 @@ class ConfigError(RtiRigError):
         self.path = str(path)
         self.key = key
         self.message = message
-        where = f"{self.path}: key '{key}'" if key else self.path
+        where = f"{shown_path(self.path)}: key '{key}'" if key else shown_path(self.path)
         super().__init__(f"{where}: {message}")
 
 
@@ -37,7 +39,9 @@ class LpFormatError(RtiRigError):
         self.path = str(path)
         self.line = line
         self.message = message
-        where = f"{self.path}, line {line}" if line is not None else self.path
+        where = (
+            f"{shown_path(self.path)}, line {line}" if line is not None else shown_path(self.path)
+        )
         super().__init__(f"{where}: {message}")
 
 
