@@ -33,6 +33,7 @@ from rti_rig.core.rig_geometry import (
     coincident_leds,
     default_led_name,
 )
+from rti_rig.core.shell_words import shown_path
 from rti_rig.core.validation_text import error_text as _error_text
 from rti_rig.core.validation_text import key_of as _key_of
 from rti_rig.drivers.dynamixel.settings import ArmSettings
@@ -668,13 +669,13 @@ def read_calibration_file(path: Path) -> tuple[dict[str, Any], bytes]:
     try:
         raw = path.read_bytes()
     except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise ValueError(f"cannot read {shown_path(path)}: {exc.strerror or exc}") from None
     try:
         return tomllib.loads(_config_text(path, raw, _CALIBRATION_FILE)), raw
     except ConfigError as exc:  # an image, a binary file, another encoding: said as such
         raise ValueError(str(exc)) from None
     except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{path} is not valid TOML: {exc}") from None
+        raise ValueError(f"{shown_path(path)} is not valid TOML: {exc}") from None
 
 
 def correction_factors(data: dict[str, Any], path: Path, rig_name: str) -> list[float]:
@@ -685,22 +686,25 @@ def correction_factors(data: dict[str, Any], path: Path, rig_name: str) -> list[
     """
     if data.get("format") != CALIBRATION_FORMAT:
         raise ValueError(
-            f"{path} is not an rti-rig light calibration (format {CALIBRATION_FORMAT!r})"
+            f"{shown_path(path)} is not an rti-rig light calibration (format "
+            f"{CALIBRATION_FORMAT!r})"
         )
     if data.get("rig") != rig_name:
         raise ValueError(
-            f"{path} calibrates the dome '{data.get('rig')}', not '{rig_name}'; calibrate this "
-            "dome (rti-rig calibrate-lights)"
+            f"{shown_path(path)} calibrates the dome '{data.get('rig')}', not '{rig_name}'; "
+            "calibrate this dome (rti-rig calibrate-lights)"
         )
     corr = data.get("intensity_correction")
     if not isinstance(corr, list) or not corr:
-        raise ValueError(f"{path}: intensity_correction must be a list of factors, one per LED")
+        raise ValueError(
+            f"{shown_path(path)}: intensity_correction must be a list of factors, one per LED"
+        )
     for i, v in enumerate(corr):
         ok = isinstance(v, int | float) and not isinstance(v, bool)
         if not (ok and math.isfinite(v) and 0 < v <= 1):
             raise ValueError(
-                f"{path}: intensity_correction[{i}] is {v!r}; factors must be numbers in (0, 1] "
-                "(calibrate again with rti-rig calibrate-lights)"
+                f"{shown_path(path)}: intensity_correction[{i}] is {v!r}; factors must be numbers "
+                "in (0, 1] (calibrate again with rti-rig calibrate-lights)"
             )
     return [float(v) for v in corr]
 
@@ -1160,8 +1164,8 @@ def _untriggered_wait_note(rig: LoadedRig, cam: Any) -> str:
     if cam.timeout_s <= lit_for:
         return ""
     return (
-        f"{rig.path}: camera.device.timeout_s = {cam.timeout_s:g} s is longer than an LED may "
-        f"stay lit ([dome.serial.thermal] max_on_s = {serial.thermal.max_on_s:g} s, less "
+        f"{shown_path(rig.path)}: camera.device.timeout_s = {cam.timeout_s:g} s is longer than an "
+        f"LED may stay lit ([dome.serial.thermal] max_on_s = {serial.thermal.max_on_s:g} s, less "
         f"settle_s): with trigger = 'none' the LED stays on until the file comes, so a file "
         f"later than {lit_for:g} s stops the session at the thermal limit. Lower timeout_s, or "
         "let the dome fire the camera (trigger = 'dome_shutter': its LED goes off after the "
@@ -1191,8 +1195,8 @@ def _resume_check_note(rig: LoadedRig, cam: Any) -> str:
     if cam.timeout_s > 2 * allowance:
         return ""
     return (
-        f"{rig.path}: camera.device.timeout_s = {cam.timeout_s:g} s is not over twice the "
-        f"allowance of the capture-time check ({allowance:g} s: 1 s of EXIF times, "
+        f"{shown_path(rig.path)}: camera.device.timeout_s = {cam.timeout_s:g} s is not over twice "
+        f"the allowance of the capture-time check ({allowance:g} s: 1 s of EXIF times, "
         f"camera.device.shutter_lag_s = {cam.shutter_lag_s:g} s and two shutter pulses): a "
         "late file of a run stopped at timeout_s and quickly resumed may not be told from the "
         f"resumed light's own and be taken as its image. Raise timeout_s over "
@@ -1397,7 +1401,8 @@ def dome_led_directions(
             raise ConfigError(
                 rig.path,
                 "dome.lp_file",
-                f"file {lp_path} does not exist (paths are relative to the config file's folder)",
+                f"file {shown_path(lp_path)} does not exist (paths are relative to the config "
+                "file's folder)",
             )
         try:
             entries = read_lp(lp_path, upper_hemisphere=True, notes=notes, wanted=DOME_LP_WANTED)
@@ -1410,9 +1415,9 @@ def dome_led_directions(
             raise ConfigError(
                 rig.path,
                 "dome.lp_file",
-                f"{lp_path}: lights {i + 1} ({entries[i].name}) and {j + 1} ({entries[j].name}) "
-                "give the same direction; a dome's calibration lists each LED once (an "
-                "acquisition's .lp may repeat a light: remove the repeats)",
+                f"{shown_path(lp_path)}: lights {i + 1} ({entries[i].name}) and {j + 1} "
+                f"({entries[j].name}) give the same direction; a dome's calibration lists each LED "
+                "once (an acquisition's .lp may repeat a light: remove the repeats)",
             )
         return dirs, [e.name for e in entries]  # read_lp refused lights below the plane
     if len(dirs) > 1000:

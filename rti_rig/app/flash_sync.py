@@ -30,7 +30,7 @@ from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import ConfigError, DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import DomeGeometry
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import MARKER as DISOWN_MARKER
 from rti_rig.runtime.disowned import disown
 from rti_rig.runtime.flash_sync import CameraTriggeredLighting, LightSlipError
@@ -346,9 +346,9 @@ def _keep(
         return keep_unlabelled(root, index, frame, verdict, stem)
     except OSError as exc:
         raise SessionWriteError(
-            f"could not keep the unlabelled {stem} {index + 1} under {root / UNLABELLED_DIR}: "
-            f"{exc}. The session is marked {DISOWN_MARKER} (its labels are not used); free "
-            "disk space and start a new session"
+            f"could not keep the unlabelled {stem} {index + 1} under "
+            f"{shown_path(root / UNLABELLED_DIR)}: {exc}. The session is marked {DISOWN_MARKER} "
+            "(its labels are not used); free disk space and start a new session"
         ) from None
 
 
@@ -470,7 +470,7 @@ def refuse_options(loaded, **given: bool) -> None:  # type: ignore[no-untyped-de
     for option, present in given.items():
         if present:
             raise RtiRigError(
-                f"{loaded.path}: {option} cannot be used with a camera-triggered dome "
+                f"{shown_path(loaded.path)}: {option} cannot be used with a camera-triggered dome "
                 f"({fs.firmware}): {why[option]}. Long-press the dome's start button to rewind "
                 f"it, then run the whole sequence: rti-rig run {shell_word(str(loaded.path))} "
                 "--out DIR"

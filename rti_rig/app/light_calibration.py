@@ -159,7 +159,7 @@ def read_card_session(root: Path | str, rig_name: str | None = None) -> CardSess
         return _read_card_session(root, manifest, rig_name)
     except (KeyError, IndexError, TypeError, ValueError, AttributeError) as exc:
         raise SessionError(
-            f"{root}/manifest.json does not describe a card session rti-rig can read "
+            f"{shown_path(root)}/manifest.json does not describe a card session rti-rig can read "
             f"({type(exc).__name__}: {exc}); shoot the card again with 'rti-rig run'"
         ) from None
 
@@ -168,21 +168,21 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
     rig = manifest["rig"]
     if rig_name is not None and rig.get("name") != rig_name:
         raise SessionError(
-            f"{root} was shot on rig '{rig.get('name')}', not '{rig_name}': calibrate a dome "
-            "from its own card session"
+            f"{shown_path(root)} was shot on rig '{rig.get('name')}', not '{rig_name}': calibrate "
+            "a dome from its own card session"
         )
     steps = manifest.get("steps") or []
     if rig.get("kind") != "dome":
         raise SessionError(
-            f"{root}: a session of the {rig.get('kind')!r} rig '{rig.get('name')}'; light "
-            "calibration is for domes (an arm carries one lamp, which every image shares)"
+            f"{shown_path(root)}: a session of the {rig.get('kind')!r} rig '{rig.get('name')}'; "
+            "light calibration is for domes (an arm carries one lamp, which every image shares)"
         )
     serial = _serial_table(manifest)
     if not serial:
         raise SessionError(
-            f"{root}: shot on rig '{rig.get('name')}' without a [dome.serial] table (backend "
-            f"{rig.get('backend')!r}): only a serial dome can dim its LEDs; shoot the card on "
-            "the hardware (or emulated) rig"
+            f"{shown_path(root)}: shot on rig '{rig.get('name')}' without a [dome.serial] table "
+            f"(backend {rig.get('backend')!r}): only a serial dome can dim its LEDs; shoot the "
+            "card on the hardware (or emulated) rig"
         )
     planned = manifest["schedule"]["steps"]
     finish = (manifest.get("runner") or {}).get("finish_reason")
@@ -201,9 +201,10 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
             # a resume lights the same LED first, and a new card session lights it too: "continue
             # it with --resume, or shoot the card again" led back to the same stop
             raise CardStoppedAtLedError(
-                f"{root}: the card session stopped at an LED after {max(taken, len(steps))} of "
-                f"{len(planned)} images ({error.removeprefix(LED_ERROR)}); a resume, or the card "
-                "shot again, lights that LED again",
+                f"{shown_path(root)}: the card session stopped at an LED after "
+                f"{max(taken, len(steps))} of {len(planned)} images "
+                f"({error.removeprefix(LED_ERROR)}); a resume, or the card shot again, lights "
+                "that LED again",
                 led,
             )
         raise SessionError(
@@ -216,14 +217,14 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
     shot_with.discard(None)
     if len(shot_with | {rig.get("config_sha256")}) > 1:
         raise SessionError(
-            f"{root}: the card session was resumed with a changed rig config or light "
+            f"{shown_path(root)}: the card session was resumed with a changed rig config or light "
             "calibration, so its images were not all shot with the same LED correction; shoot "
             "the card again"
         )
     if len(steps) < 4:
         raise SessionError(
-            f"{root}: {len(steps)} image(s); shoot the card under every LED of the dome "
-            "(rti-rig run RIG --out CARD_SESSION, with no --lights)"
+            f"{shown_path(root)}: {len(steps)} image(s); shoot the card under every LED of the "
+            "dome (rti-rig run RIG --out CARD_SESSION, with no --lights)"
         )
     directions = _step_directions(root, steps)
     _refuse_unverified(root, steps, len(planned))
@@ -237,18 +238,20 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
     for s, exposure in zip(steps, exposures, strict=True):
         led, name = s["led"], s["linear_image"]
         if isinstance(led, bool) or not isinstance(led, int) or led < 0:
-            raise SessionError(f"{root}: step {s['index'] + 1} ({name}) records LED {led!r}")
+            raise SessionError(
+                f"{shown_path(root)}: step {s['index'] + 1} ({name}) records LED {led!r}"
+            )
         if led in seen:
             raise SessionError(
-                f"{root}: LED {led} lit both {seen[led]} and {name}; a card session shoots each "
-                "LED once"
+                f"{shown_path(root)}: LED {led} lit both {seen[led]} and {name}; a card session "
+                "shoots each LED once"
             )
         seen[led] = name
         path = root / name
         try:
             pixels = read_linear_tiff(path)
         except (OSError, ValueError) as exc:
-            raise SessionError(f"{path} (LED {led}) cannot be read: {exc}") from None
+            raise SessionError(f"{shown_path(path)} (LED {led}) cannot be read: {exc}") from None
         images.append(_work_image(pixels))
         intensity = float(planned[s["index"]].get("intensity", 1.0))
         factor = 1.0 if correction is None or led >= len(correction) else float(correction[led])
@@ -304,11 +307,11 @@ def _step_directions(root: Path, steps: list[dict[str, Any]]) -> NDArray[np.floa
             image = step.get("image") or step.get("linear_image") or "its image"
             what = "no light" if direction is None else f"the light {direction!r}, not a direction"
             raise SessionError(
-                f"{root}/{MANIFEST}: {which} ({image}, LED {step.get('led')!r}) records {what} "
-                f"('actual_direction' is {'missing' if direction is None else 'unreadable'}), so "
-                f"the direction that lit it is not known and the card cannot be read at it: "
-                f"restore {MANIFEST} from a backup copy of the folder, or shoot the card again "
-                "with rti-rig run"
+                f"{shown_path(root)}/{MANIFEST}: {which} ({image}, LED {step.get('led')!r}) "
+                f"records {what} ('actual_direction' is "
+                f"{'missing' if direction is None else 'unreadable'}), so the direction that lit "
+                f"it is not known and the card cannot be read at it: restore {MANIFEST} from a "
+                "backup copy of the folder, or shoot the card again with rti-rig run"
             )
         out.append(light)
     return np.array(out, dtype=np.float64)
@@ -346,7 +349,7 @@ def _refuse_saturated(
             f"differ by tens of percent, so {other} clipped the card: "
         )
     raise SessionError(
-        f"{root}/{worst['linear_image']} (LED {worst['led']}): "
+        f"{shown_path(root)}/{worst['linear_image']} (LED {worst['led']}): "
         f"{100 * float(worst['saturated_fraction']):.1f} % of its pixels are saturated "
         f"({len(clipped)} of {len(steps)} images clipped over {100 * MAX_SATURATED:g} %: "
         f"{listed}); {why}shoot the card again with a shorter fixed exposure, e.g. "
@@ -376,8 +379,8 @@ def _refuse_unverified(root: Path, steps: list[dict[str, Any]], total: int) -> N
     if bad:
         shown = "; ".join(bad[:6]) + (f"; and {len(bad) - 6} more" if len(bad) > 6 else "")
         raise SessionError(
-            f"{root}: {len(bad)} card image(s) not as captured ({shown}): a calibration "
-            "measured from them would misjudge those LEDs, or all of them; restore the "
+            f"{shown_path(root)}: {len(bad)} card image(s) not as captured ({shown}): a "
+            "calibration measured from them would misjudge those LEDs, or all of them; restore the "
             "originals from a backup copy of the folder, or shoot the card again"
         )
 
@@ -423,7 +426,7 @@ def _check_enough_above(
     usable = int((above >= min_elevation_deg - 1e-9).sum())
     if usable < MIN_MEASURED_LEDS:
         raise ReconstructionError(
-            f"{card.root}: only {usable} of its {len(above)} LEDs are at or above "
+            f"{shown_path(card.root)}: only {usable} of its {len(above)} LEDs are at or above "
             f"--min-elevation-deg {min_elevation_deg:g} above the card (the highest at "
             f"{float(above.max()):.1f}°), and measuring needs at least {MIN_MEASURED_LEDS}: "
             "lower --min-elevation-deg (default 5)"
@@ -450,8 +453,8 @@ def calibrate_dome(
     if outside.any():
         bad = int(card.leds[outside][0])
         raise SessionError(
-            f"{card.root}: LED {bad} is outside a dome of {led_count} LEDs; was the card shot "
-            "on another rig?"
+            f"{shown_path(card.root)}: LED {bad} is outside a dome of {led_count} LEDs; was the "
+            "card shot on another rig?"
         )
     if not 0.0 < min_elevation_deg < 90.0:
         raise ReconstructionError(f"min_elevation_deg must be in (0, 90), got {min_elevation_deg}")
@@ -465,8 +468,8 @@ def calibrate_dome(
     previous = np.ones(led_count) if card.correction is None else np.array(card.correction)
     if len(previous) != led_count:
         raise SessionError(
-            f"{card.root}: shot with {len(previous)} correction factors, but the dome has "
-            f"{led_count} LEDs; was the card shot on another rig?"
+            f"{shown_path(card.root)}: shot with {len(previous)} correction factors, but the dome "
+            f"has {led_count} LEDs; was the card shot on another rig?"
         )
     est = gains.estimated
     power = gains.gains / card.drive  # each measured LED's own output, up to a common scale

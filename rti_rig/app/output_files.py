@@ -9,6 +9,7 @@ from rti_rig.app.config import LoadedRig
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import image_paths, read_lp
 from rti_rig.core.out_folders import ensure_file_writable
+from rti_rig.core.shell_words import shown_path
 from rti_rig.runtime.session import LP_NAME, MANIFEST
 
 
@@ -69,25 +70,28 @@ def check_output_file(
         raise RtiRigError(f"{option} {out_file} is a folder: give the name of the file to write")
     parent = out_file.parent
     if not parent.is_dir():
-        raise RtiRigError(f"{option} {out_file}: folder {parent} does not exist; create it first")
+        raise RtiRigError(
+            f"{option} {shown_path(out_file)}: folder {shown_path(parent)} does not exist; create "
+            "it first"
+        )
     if not out_file.exists():
         ensure_file_writable(out_file, option)
         return
     for what, path in inputs.items():
         if path is not None and path.exists() and out_file.samefile(path):
             raise RtiRigError(
-                f"{option} {out_file} is the {what} this command reads; choose another"
+                f"{option} {shown_path(out_file)} is the {what} this command reads; choose another"
             )
     for folder in out_file.resolve().parents:
         if (folder / MANIFEST).is_file():
             if _own_lp(out_file, folder):
                 break  # the user's own .lp beside the images (no capture): --force replaces it
             raise RtiRigError(
-                f"{option} {out_file} would replace a file of the session in {folder}; a "
-                "session's files are never overwritten: write it elsewhere"
+                f"{option} {shown_path(out_file)} would replace a file of the session in "
+                f"{shown_path(folder)}; a session's files are never overwritten: write it elsewhere"
             )
     if not force:
-        raise RtiRigError(f"{option} {out_file} exists; use --force to replace it")
+        raise RtiRigError(f"{option} {shown_path(out_file)} exists; use --force to replace it")
     ensure_file_writable(out_file, option)
 
 
@@ -126,7 +130,7 @@ def lp_name_note(out_file: Path, *, run_reads_it: bool = False) -> str | None:
         else ""
     )
     return (
-        f"{out_file} holds light positions in the .lp format but is not named .lp: {run}relight, "
-        f"RTIBuilder and rti-rig fit find an .lp by its name; name it {named} to use it "
-        f"there{taken}"
+        f"{shown_path(out_file)} holds light positions in the .lp format but is not named .lp: "
+        f"{run}relight, RTIBuilder and rti-rig fit find an .lp by its name; name it {named} to use "
+        f"it there{taken}"
     )

@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.shell_words import shown_path
 
 #: File types the map can be written as (by the file name's suffix).
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
@@ -161,8 +162,8 @@ def check_figure_path(path: Path) -> None:
     """Refuse a map file type that cannot be written, before any planning is done."""
     if path.suffix.lower() not in FIGURE_SUFFIXES:
         raise RtiRigError(
-            f"--figure {path}: give a file ending in {', '.join(FIGURE_SUFFIXES)} (the map's "
-            "format follows the name)"
+            f"--figure {shown_path(path)}: give a file ending in {', '.join(FIGURE_SUFFIXES)} (the "
+            "map's format follows the name)"
         )
 
 

@@ -34,7 +34,7 @@ from rti_rig.core.geometry import (
     direction_from_az_el,
 )
 from rti_rig.core.lp_format import LpEntry, image_path
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.session import (
     JOURNAL,
     LINEAR_DIR,
@@ -116,13 +116,13 @@ def _recorded_steps(
     resume = f"rti-rig run --resume {shell_word(str(root))}"
     if light_given:  # the light is given: only an image is missing
         raise ScheduleError(
-            f"{root}: the session has no finished images; if it was interrupted, finish it "
-            f"with {resume} (or shoot the preview again)"
+            f"{shown_path(root)}: the session has no finished images; if it was interrupted, "
+            f"finish it with {resume} (or shoot the preview again)"
         )
     raise ScheduleError(
-        f"{root}: the session has no finished images, so its lights are not recorded yet; "
-        f"if it was interrupted, finish it with {resume} (or shoot the preview again), or give "
-        "the light with --preview-light AZ,EL"
+        f"{shown_path(root)}: the session has no finished images, so its lights are not recorded "
+        f"yet; if it was interrupted, finish it with {resume} (or shoot the preview again), or "
+        "give the light with --preview-light AZ,EL"
     )
 
 
@@ -146,8 +146,8 @@ def _manifest_light(
     index = step.get("index")
     which = f"step {index + 1}" if isinstance(index, int) else "the step"
     raise ScheduleError(
-        f"{root / MANIFEST}: {which} ({image.name}) records {what} ('actual_direction' is "
-        f"{'missing' if direction is None else 'unreadable'}), and {journal}, so the light "
+        f"{shown_path(root / MANIFEST)}: {which} ({image.name}) records {what} ('actual_direction' "
+        f"is {'missing' if direction is None else 'unreadable'}), and {journal}, so the light "
         "that lit the preview is not known: give it with --preview-light AZ,EL"
     )
 
@@ -174,9 +174,9 @@ def _step_light(
         journal = f"{JOURNAL}'s record of it does not match the image on disk"
         return _manifest_light(root, step, image, journal)
     raise ScheduleError(
-        f"{image}: the image is not as the session {root} captured it (changed or replaced "
-        "since; its checksum differs from its journal's), so the light recorded for it may not "
-        "be the one that lit it: give the light with --preview-light AZ,EL"
+        f"{shown_path(image)}: the image is not as the session {shown_path(root)} captured it "
+        "(changed or replaced since; its checksum differs from its journal's), so the light "
+        "recorded for it may not be the one that lit it: give the light with --preview-light AZ,EL"
     )
 
 
@@ -195,8 +195,8 @@ def _linear_image(root: Path, step: dict[str, Any]) -> str:
         else "give the preview's image file itself as PREVIEW"
     )
     raise ScheduleError(
-        f"{root / MANIFEST}: its step records no linear image ('linear_image' is missing): "
-        f"{instead}"
+        f"{shown_path(root / MANIFEST)}: its step records no linear image ('linear_image' is "
+        f"missing): {instead}"
     )
 
 
@@ -240,14 +240,15 @@ def _refuse_a_rig_as_preview(path: Path) -> None:
     suffix = path.suffix.lower()
     if suffix == ".toml":
         raise ScheduleError(
-            f"{path} is a rig config, not a preview image: give it as --rig {path} "
-            "(rti-rig plan [PREVIEW] --rig RIG.toml; without a preview, uniform, or optimal "
-            "for a level surface)"
+            f"{shown_path(path)} is a rig config, not a preview image: give it as --rig "
+            f"{shell_word(path)} (rti-rig plan [PREVIEW] --rig RIG.toml; without a preview, "
+            "uniform, or optimal for a level surface)"
         )
     if suffix == ".lp":
         raise ScheduleError(
-            f"{path} is an .lp light list, not a preview image: give it as --rig {path} (a "
-            "dome with exactly those lights), and as PREVIEW one of the images it lists"
+            f"{shown_path(path)} is an .lp light list, not a preview image: give it as --rig "
+            f"{shell_word(path)} (a dome with exactly those lights), and as PREVIEW one of the "
+            "images it lists"
         )
 
 
@@ -281,14 +282,14 @@ def resolve_preview(
     if path.is_dir():
         if not (path / MANIFEST).is_file():
             raise ScheduleError(
-                f"{path} is a folder: give one preview image file, or a session folder from "
-                "'rti-rig preview'"
+                f"{shown_path(path)} is a folder: give one preview image file, or a session folder "
+                "from 'rti-rig preview'"
             )
         steps, journaled = _recorded_steps(path, light_given)
         if len(steps) != 1:
             raise ScheduleError(
-                f"{path} is a session of {len(steps)} images: give the one to plan from, e.g. "
-                f"{path / (steps[0].get('linear_image') or 'linear/image_001.tif')}"
+                f"{shown_path(path)} is a session of {len(steps)} images: give the one to plan "
+                f"from, e.g. {path / (steps[0].get('linear_image') or 'linear/image_001.tif')}"
             )
         image = path / _linear_image(path, steps[0])
         if light_given:  # the user's light stands: the session's record of it is not read

@@ -48,7 +48,7 @@ from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.planner import adaptive_until
 from rti_rig.planner.adaptive import (
     ESTIMATE_SCALE,
@@ -1021,17 +1021,17 @@ class AdaptiveSteps:
                 timing = self._timing_differences(folder)
                 if timing:  # the config's times changed: restoring them continues the session
                     raise RtiRigError(
-                        f"{folder.root}: step {i + 1} is not decided as it was: an adaptive "
-                        "session weighs each light by the time it costs (the capture and, on an "
-                        "arm, the move to it), and the rig config now gives other times ("
+                        f"{shown_path(folder.root)}: step {i + 1} is not decided as it was: an "
+                        "adaptive session weighs each light by the time it costs (the capture and, "
+                        "on an arm, the move to it), and the rig config now gives other times ("
                         + "; ".join(timing)
                         + "). Nothing was recorded or captured. Put those settings back as the "
                         "session began to continue it, or start a new session"
                     )
                 raise RtiRigError(
-                    f"{folder.root}: step {i + 1} was decided differently when the session "
-                    "began (another rig config, software version or image on disk); it cannot "
-                    "be continued deterministically: start a new session"
+                    f"{shown_path(folder.root)}: step {i + 1} was decided differently when the "
+                    "session began (another rig config, software version or image on disk); it "
+                    "cannot be continued deterministically: start a new session"
                 )
             pixels = read_linear_tiff(Path(folder.root) / rec.linear_image)
             self.chooser.observe(candidate, np.asarray(rec.actual_direction), small_grey(pixels))
@@ -1058,8 +1058,8 @@ class AdaptiveSteps:
         where = np.flatnonzero(self.plan.leds == rec.led)
         if where.size == 0:
             raise RtiRigError(
-                f"{folder.root}: step {i + 1} was shot with LED index {rec.led}, which the "
-                "changed rig accepted with --accept-rig-change no longer offers this session "
+                f"{shown_path(folder.root)}: step {i + 1} was shot with LED index {rec.led}, which "
+                "the changed rig accepted with --accept-rig-change no longer offers this session "
                 "(outside its elevation band, or gone). Nothing was recorded or captured. "
                 f"Resume with the session's own config (rti-rig run --resume {folder.root}), "
                 "or start a new session on the changed rig"
@@ -1074,8 +1074,8 @@ class AdaptiveSteps:
         twice = sorted(set(rest) & set(self.chooser.used))
         if twice:
             raise RtiRigError(
-                f"{folder.root}: on the changed rig accepted with --accept-rig-change the "
-                "starting layout is other LEDs, and one of its remaining lights was already "
+                f"{shown_path(folder.root)}: on the changed rig accepted with --accept-rig-change "
+                "the starting layout is other LEDs, and one of its remaining lights was already "
                 "shot (LED index "
                 + ", ".join(str(self._step(c).led) for c in twice)
                 + "). Nothing was recorded or captured. Resume with the session's own config "
@@ -1667,7 +1667,7 @@ def refuse_other_format(header: dict, root: Path) -> None:
     what to do — from the manifest alone, before the folder or the rig is touched."""
     if header.get("format") not in (FORMAT, FORMAT_MIN_LIGHTS):
         raise RtiRigError(
-            f"{root}: this adaptive session was begun with format "
+            f"{shown_path(root)}: this adaptive session was begun with format "
             f"{header.get('format')!r}, and this version of rti-rig continues only {FORMAT!r} "
             f"and {FORMAT_MIN_LIGHTS!r} "
             "(its choices would differ from the ones already made). The images are kept: "
@@ -1683,15 +1683,15 @@ def refuse_other_constants(header: dict, root: Path) -> None:
     recorded = header.get("constants")
     if not isinstance(recorded, dict):  # every session of this format records them
         raise RtiRigError(
-            f"{root}: this adaptive session's settings do not record its decision constants "
-            "(a development build of this format wrote it): this build cannot tell whether it "
-            "would repeat its choices. The images are kept: `rti-rig export-lp` and `rti-rig "
-            "fit` use them as they are; start a new session to shoot more"
+            f"{shown_path(root)}: this adaptive session's settings do not record its decision "
+            "constants (a development build of this format wrote it): this build cannot tell "
+            "whether it would repeat its choices. The images are kept: `rti-rig export-lp` and "
+            "`rti-rig fit` use them as they are; start a new session to shoot more"
         )
     differ = constant_differences(recorded, decision_constants())
     if differ:
         raise RtiRigError(
-            f"{root}: this adaptive session was begun with other decision constants "
+            f"{shown_path(root)}: this adaptive session was begun with other decision constants "
             f"({describe_differences(differ)}): this build would not repeat its choices. The "
             "images are kept: `rti-rig export-lp` and `rti-rig fit` use them as they are; "
             "continue it with the build that began it, or start a new session to shoot more"
@@ -1706,23 +1706,23 @@ def check_resume_objective(manifest: dict, root: Path, objective: str | None) ->
         if objective is None:
             return "normals"
         raise RtiRigError(
-            f"{root}: --objective goes with an adaptive session, and this one is not: drop "
-            f"--objective {objective}"
+            f"{shown_path(root)}: --objective goes with an adaptive session, and this one is not: "
+            f"drop --objective {objective}"
         )
     refuse_other_format(header, root)
     refuse_other_constants(header, root)
     began = header.get("objective")
     if began not in OBJECTIVES:
         raise RtiRigError(
-            f"{root}: the manifest's adaptive settings do not say which objective the session "
-            f"was chosen for ({began!r}); it cannot continue as it began"
+            f"{shown_path(root)}: the manifest's adaptive settings do not say which objective the "
+            f"session was chosen for ({began!r}); it cannot continue as it began"
         )
     if objective is not None and objective != began:
         raise RtiRigError(
-            f"{root}: this adaptive session was begun with --objective {began}; its lights so "
-            f"far were chosen for {began}, and a resume repeats and continues those decisions. "
-            f"Drop --objective {objective} to continue it for {began}, or start a new session "
-            f"for {objective}"
+            f"{shown_path(root)}: this adaptive session was begun with --objective {began}; its "
+            f"lights so far were chosen for {began}, and a resume repeats and continues those "
+            f"decisions. Drop --objective {objective} to continue it for {began}, or start a new "
+            f"session for {objective}"
         )
     return str(began)
 
@@ -1748,7 +1748,7 @@ def refuse_broken_run(root: Path, total_steps: int) -> Callable[[dict[int, Any]]
             "from their journaled checksums"
         )
         raise RtiRigError(
-            f"{root}: {which}, but later steps are on disk. The lights "
+            f"{shown_path(root)}: {which}, but later steps are on disk. The lights "
             "after a step were chosen from its image, so an adaptive session cannot reshoot it "
             "in place; nothing in the folder was changed. Put the step's original files back "
             "(its JPEG, linear/ TIFF and any raw/ original, as the journal lists them with "
@@ -1796,10 +1796,10 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
         # what to do, not only what is wrong (it had ended "it cannot continue as it began",
         # after a note that the rig change was accepted)
         raise RtiRigError(
-            f"{folder.root}: the rig now offers {len(plan.candidates)} candidate lights, the "
-            f"session began with {header['candidates']}: an adaptive session chooses among the "
-            "rig's lights, and a resume re-decides every step already taken among them, so it "
-            "cannot continue as it began. Nothing was recorded or captured. Resume with the "
+            f"{shown_path(folder.root)}: the rig now offers {len(plan.candidates)} candidate "
+            f"lights, the session began with {header['candidates']}: an adaptive session chooses "
+            "among the rig's lights, and a resume re-decides every step already taken among them, "
+            "so it cannot continue as it began. Nothing was recorded or captured. Resume with the "
             f"session's own config (rti-rig run --resume {folder.root}), or start a new session "
             "on the changed rig"
         )

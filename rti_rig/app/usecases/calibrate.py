@@ -31,7 +31,7 @@ from rti_rig.app.light_calibration import (
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.drivers.led_dome.settings import DIMMING_LINK, IMAGE_GAINS_REMEDY
 from rti_rig.reconstruct.light_gains import DeadLightError
 
@@ -70,7 +70,7 @@ def _check_dome_can_dim(req: CalibrateRequest, loaded: LoadedRig) -> None:
     if serial is None:
         # why it has none, said as it is: an arm's or a camera-triggered dome's had been told
         # "the simulated backend's are exact", true only of a simulated dome
-        rig = f"{req.rig_config}: rig '{loaded.config.name}'"
+        rig = f"{shown_path(req.rig_config)}: rig '{loaded.config.name}'"
         if loaded.config.kind != "dome":
             raise RtiRigError(
                 f"{rig} is an arm: calibrate-lights evens out the LEDs of a dome driven over a "
@@ -88,8 +88,8 @@ def _check_dome_can_dim(req: CalibrateRequest, loaded: LoadedRig) -> None:
     why = serial.dimming_refusal()
     if why is not None:
         raise RtiRigError(
-            f"{req.rig_config}: {why}, so a light correction could not be applied to it. A "
-            f"correction needs {DIMMING_LINK}; on this dome, divide the gains out of the "
+            f"{shown_path(req.rig_config)}: {why}, so a light correction could not be applied to "
+            f"it. A correction needs {DIMMING_LINK}; on this dome, divide the gains out of the "
             f"images instead ({IMAGE_GAINS_REMEDY})"
         )
 
@@ -109,13 +109,13 @@ def _dead_led_advice(
     name = names[led] if 0 <= led < len(names) else f"LED {led}"
     session = shell_word(str(req.card_session))
     return (
-        f"{req.card_session}: LED {led} ({name}, session image {image}) gave {exc.gain:.3f} "
-        "of the median LED's light: a dead LED (or a black frame), which no correction can "
-        "even out. Check that LED and its wiring, then shoot the card again; to calibrate "
-        f"the other LEDs meanwhile, shoot the card under all but it: copy {session}/lights.lp "
-        f"without the line of {image} (the count on its first line one less) as PLAN.lp, "
-        f"run rti-rig run {shell_word(str(req.rig_config))} --plan PLAN.lp --out NEW_CARD "
-        "and calibrate NEW_CARD"
+        f"{shown_path(req.card_session)}: LED {led} ({name}, session image {image}) gave "
+        f"{exc.gain:.3f} of the median LED's light: a dead LED (or a black frame), which no "
+        "correction can even out. Check that LED and its wiring, then shoot the card again; to "
+        "calibrate the other LEDs meanwhile, shoot the card under all but it: copy "
+        f"{session}/lights.lp without the line of {image} (the count on its first line one less) "
+        f"as PLAN.lp, run rti-rig run {shell_word(str(req.rig_config))} --plan PLAN.lp --out "
+        "NEW_CARD and calibrate NEW_CARD"
     )
 
 
@@ -178,15 +178,15 @@ def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> str | None:
             else " (as its steps record them: its rig identity holds a digest of them alone)"
         )
         return (
-            f"{req.card_session} recorded the dome's LEDs elsewhere than {req.rig_config} "
-            f"places them now ({'; '.join(diffs)}), each still nearest its own recorded "
-            f"position{seen}: taken as the same LEDs re-measured (the correction is by LED "
-            "number, and the card is read at the positions it recorded)"
+            f"{shown_path(req.card_session)} recorded the dome's LEDs elsewhere than "
+            f"{shown_path(req.rig_config)} places them now ({'; '.join(diffs)}), each still "
+            f"nearest its own recorded position{seen}: taken as the same LEDs re-measured (the "
+            "correction is by LED number, and the card is read at the positions it recorded)"
         )
     raise RtiRigError(
-        f"{req.card_session} was shot when the dome's LEDs were others than "
-        f"{req.rig_config} gives now ({'; '.join(diffs)}): the correction is a list by LED "
-        "number, so it would dim other LEDs than the ones the card measured. Calibrate "
+        f"{shown_path(req.card_session)} was shot when the dome's LEDs were others than "
+        f"{shown_path(req.rig_config)} gives now ({'; '.join(diffs)}): the correction is a list by "
+        "LED number, so it would dim other LEDs than the ones the card measured. Calibrate "
         "with the rig config the card was shot with, or shoot the card again on the rig "
         "as it is now"
     )
@@ -272,8 +272,8 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     target = req.target
     if req.out_file is None and target.exists():
         raise RtiRigError(
-            f"{target} exists: this card session was calibrated already (its file is never "
-            "replaced, even with --force, which replaces only a file named by --out); give "
+            f"{shown_path(target)} exists: this card session was calibrated already (its file is "
+            "never replaced, even with --force, which replaces only a file named by --out); give "
             "--out to write the calibration elsewhere"
         )
     check_output_file(target, req.force, rig_inputs(req.rig_config, loaded))
@@ -282,10 +282,10 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
         # an object's session had been "calibrated" into a correction the user was told to
         # install: its relief read as the LEDs' differences
         raise RtiRigError(
-            f"{req.card_session}: these images are not of a flat card: their fitted normals "
-            f"spread {spread:.0f}° (90th percentile from their mean; a level card gives about "
-            f"1°, the limit is {MAX_CARD_SPREAD_DEG:g}°), so what differs between them is the "
-            "object's relief, not the LEDs. Shoot a level matte white card under every LED; "
+            f"{shown_path(req.card_session)}: these images are not of a flat card: their fitted "
+            f"normals spread {spread:.0f}° (90th percentile from their mean; a level card gives "
+            f"about 1°, the limit is {MAX_CARD_SPREAD_DEG:g}°), so what differs between them is "
+            "the object's relief, not the LEDs. Shoot a level matte white card under every LED; "
             "if this is one (a card large for its dome), give --not-flat-ok"
         )
     try:
@@ -307,7 +307,7 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
         tmp.replace(target)
     except OSError as exc:
         raise RtiRigError(
-            f"cannot write {target}: {exc.strerror or exc}; nothing was written there"
+            f"cannot write {shown_path(target)}: {exc.strerror or exc}; nothing was written there"
         ) from None
     finally:
         tmp.unlink(missing_ok=True)

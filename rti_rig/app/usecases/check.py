@@ -27,6 +27,7 @@ from rti_rig.core.devices import (
 )
 from rti_rig.core.errors import DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry
+from rti_rig.core.shell_words import shown_path
 from rti_rig.runtime.arm_check import arm_self_test
 from rti_rig.runtime.controller import EmergencyStop
 from rti_rig.runtime.dome_policy import self_test
@@ -161,7 +162,7 @@ def check_rig(
                 unheld=report.unheld if report else None,
             )
             raise CheckStopped(exc, lights, failures) from None
-        raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
+        raise RtiRigError(f"{shown_path(req.rig_config)}: no self-test for this kind of lighting")
 
 
 def _refuse_undimmable(loaded: Any, intensity: float) -> None:
@@ -255,8 +256,8 @@ def reboot_faulted(rig_config: Path, on_start: Callable[[], None] | None = None)
     loaded = load_rig_config(rig_config)
     if loaded.config.arm is None or loaded.config.backend not in ("emulated", "hardware"):
         raise RtiRigError(
-            f"{rig_config}: --reboot-faulted reboots a Dynamixel arm's faulted servos; this rig "
-            "config has none (a dome, a simulated or a replay rig)"
+            f"{shown_path(rig_config)}: --reboot-faulted reboots a Dynamixel arm's faulted servos; "
+            "this rig config has none (a dome, a simulated or a replay rig)"
         )
     if on_start is not None:
         on_start()
@@ -268,8 +269,8 @@ def reboot_faulted(rig_config: Path, on_start: Callable[[], None] | None = None)
         carrier = rig.lighting.carrier if isinstance(rig.lighting, ArmLighting) else None
         if not isinstance(carrier, DynamixelArm):
             raise RtiRigError(
-                f"{rig_config}: --reboot-faulted needs an arm on Dynamixel servos; this rig's "
-                "arm has none"
+                f"{shown_path(rig_config)}: --reboot-faulted needs an arm on Dynamixel servos; "
+                "this rig's arm has none"
             )
         return RebootReport(tuple(carrier.reboot_faulted()), rig_config)
 

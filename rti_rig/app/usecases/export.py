@@ -14,6 +14,7 @@ from pathlib import Path
 from rti_rig.app.output_files import check_output_file, lp_name_note
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import LpEntry, write_lp
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
     LP_NAME,
@@ -138,19 +139,19 @@ def _in_session_said(out_file: Path, root: Path) -> str:
     own = root / LP_NAME
     if out_file.name == LP_NAME:  # refused if it existed: so the session had lost it
         return (
-            f"{out_file} is the session's own {LP_NAME}, which was missing: written again from "
-            "its journal"
+            f"{shown_path(out_file)} is the session's own {LP_NAME}, which was missing: written "
+            "again from its journal"
         )
     if own.is_file():
         return (
-            f"{out_file} is written inside the session {root}, beside its own {LP_NAME}, "
-            f"which is left as captured (a session's files are never replaced); rti-rig fit "
-            f"{root} reads {LP_NAME}: give {out_file} itself to use this one; "
-            + _relight_reads(root, out_file.name)
+            f"{shown_path(out_file)} is written inside the session {shown_path(root)}, beside its "
+            f"own {LP_NAME}, which is left as captured (a session's files are never replaced); "
+            f"rti-rig fit {shell_word(str(root))} reads {LP_NAME}: give {shown_path(out_file)} "
+            "itself to use this one; " + _relight_reads(root, out_file.name)
         )
     return (
-        f"{out_file} is written inside the session {root}, which has no {LP_NAME}: rti-rig "
-        f"export-lp {root} --out {own} writes the session's own {LP_NAME} again"
+        f"{shown_path(out_file)} is written inside the session {shown_path(root)}, which has no "
+        f"{LP_NAME}: rti-rig export-lp {root} --out {own} writes the session's own {LP_NAME} again"
     )
 
 
@@ -166,9 +167,12 @@ def _relight_reads(root: Path, new: str) -> str:
     different from the number of images found", naming neither file."""
     first = _relight_order(root, new)[0]
     if first == LP_NAME:
-        return f"relight-cli given {root} reads the first .lp there by name, still {LP_NAME}"
+        return (
+            f"relight-cli given {shown_path(root)} reads the first .lp there by name, still "
+            f"{LP_NAME}"
+        )
     return (
-        f"relight-cli given {root} reads the first .lp there by name, now {first}, not "
+        f"relight-cli given {shown_path(root)} reads the first .lp there by name, now {first}, not "
         f"{LP_NAME}: move {first} out of the folder before giving the folder to relight-cli"
     )
 
@@ -242,8 +246,9 @@ def _refuse_another_session(out_file: Path, root: Path, first: str | None) -> No
                     "own"
                 )
             raise RtiRigError(
-                f"--out {out_file} is in another session ({f}): this .lp names {root}'s "
-                f"images ({name}, ...), and {why}; write it into {root} or outside any session"
+                f"--out {shown_path(out_file)} is in another session ({f}): this .lp names "
+                f"{shown_path(root)}'s images ({name}, ...), and {why}; write it into "
+                f"{shown_path(root)} or outside any session"
             )
 
 

@@ -142,9 +142,9 @@ def _output_error(exc: OSError, req: FitRequest, out: Path, created: bool) -> Fi
     else:
         again = f"run again: rti-rig fit {shell_word(str(req.source))} --out {shell_word(str(out))}"
     return FitOutputError(
-        f"{req.source}: the fit could not write its outputs in {out}{where}: {reason}; "
-        f"nothing of it was kept ({out} {left}) and the session is unchanged: {remedy}, "
-        f"then {again}"
+        f"{shown_path(req.source)}: the fit could not write its outputs in "
+        f"{shown_path(out)}{where}: {reason}; nothing of it was kept ({shown_path(out)} {left}) "
+        f"and the session is unchanged: {remedy}, then {again}"
     )
 
 
@@ -198,7 +198,9 @@ def read_image(path: Path) -> Any:
     taken as sRGB and linearised on read). The lazy Dask stack reads its chunks through this,
     in the process that computes them."""
     if not path.is_file():
-        raise FitInputError(f"image {path} listed in the .lp is missing{case_hint([path])}")
+        raise FitInputError(
+            f"image {shown_path(path)} listed in the .lp is missing{case_hint([path])}"
+        )
     if path.suffix.lower() in (".tif", ".tiff"):
         rows = TiffRows(path)  # read a band at a time, never whole
         _check_tiff_type(path, rows)
@@ -215,11 +217,13 @@ def _check_tiff_type(path: Path, rows: TiffRows) -> None:
     range, not 65535) that no viewer or check would question."""
     if rows.dtype not in (np.uint16, np.uint8):
         raise FitInputError(
-            f"{path}: a {rows.dtype} TIFF; give 16-bit linear or 8-bit sRGB TIFFs (or JPEG/PNG)"
+            f"{shown_path(path)}: a {rows.dtype} TIFF; give 16-bit linear or 8-bit sRGB TIFFs (or "
+            "JPEG/PNG)"
         )
     if rows.description.startswith(MOSAIC_TIFF_LABEL):
         raise FitInputError(
-            f'{path} is a CFA mosaic (the session was shot with decode.mode = "mosaic"): one '
+            f"{shown_path(path)} is a CFA mosaic (the session was shot with decode.mode = "
+            '"mosaic"): one '
             "colour per pixel, not a picture, so it cannot be fitted; decode the camera's RAW "
             "files kept in the session's raw/ folder to linear RGB (demosaiced) TIFFs with "
             "your RAW converter, list them in an .lp and fit that, and set decode.mode = "
@@ -248,17 +252,18 @@ def _decode(path: Path, into: np.ndarray | None = None) -> np.ndarray:
             # (a PNG cut short had been told only "cannot read image", after libpng's own line)
             kind = "PNG" if path.suffix.lower() == ".png" else "JPEG"
             raise FitInputError(
-                f"image {path} is a damaged {kind}: {why}; copy it again from the camera or card"
+                f"image {shown_path(path)} is a damaged {kind}: {why}; copy it again from the "
+                "camera or card"
             )
         decoded = imread_rgb(path, into)
         if decoded is None:
             raise FitInputError(
-                f"cannot read image {path} (not a JPEG or PNG OpenCV decodes); save it again "
-                "as JPEG, PNG or TIFF, or leave it out of the .lp"
+                f"cannot read image {shown_path(path)} (not a JPEG or PNG OpenCV decodes); save it "
+                "again as JPEG, PNG or TIFF, or leave it out of the .lp"
             )
         img = decoded
     if img.dtype not in (np.uint8, np.uint16):
-        raise FitInputError(f"{path}: expected 8- or 16-bit images, got {img.dtype}")
+        raise FitInputError(f"{shown_path(path)}: expected 8- or 16-bit images, got {img.dtype}")
     return np.ascontiguousarray(img)
 
 
@@ -281,8 +286,8 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     for i, path in enumerate(paths):
         if not path.is_file():
             raise FitInputError(
-                f"image {path} listed in {label} is missing (an .lp's image names are read "
-                f"relative to its own folder){case_hint([path])}"
+                f"image {shown_path(path)} listed in {label} is missing (an .lp's image names are "
+                f"read relative to its own folder){case_hint([path])}"
             )
         if path.suffix.lower() in (".tif", ".tiff"):
             rows = TiffRows(path)
@@ -401,7 +406,7 @@ def acquisition_files(
                     "to fit"
                 )
                 raise FitInputError(
-                    f"{source} is a session that {what}; "
+                    f"{shown_path(source)} is a session that {what}; "
                     + (
                         instead
                         if instead is not None
@@ -414,7 +419,7 @@ def acquisition_files(
                     f"{JOURNAL}: its images cannot be paired with their lights or verified as "
                     "captured; restore both from a backup copy of the folder"
                 )
-            raise FitInputError(f"{source} holds no .lp file: not a session folder")
+            raise FitInputError(f"{shown_path(source)} holds no .lp file: not a session folder")
         if not (source / LP_NAME).is_file() and len(lps) > 1:
             # the first in name order had been fitted, said only of a session: a folder with
             # dirs.lp and a_subset.lp was fitted from the 4 lights of the subset, "good"
@@ -427,8 +432,8 @@ def acquisition_files(
                 else ""
             )
             raise FitInputError(
-                f"{source} holds {len(lps)} .lp files and no {LP_NAME} ({shown}): which one "
-                "lists its lights cannot be told; fit the one you mean, e.g. rti-rig fit "
+                f"{shown_path(source)} holds {len(lps)} .lp files and no {LP_NAME} ({shown}): "
+                "which one lists its lights cannot be told; fit the one you mean, e.g. rti-rig fit "
                 f"{shell_word(str(lps[0]))} --out DIR{rebuild}"
             )
         lp = source / LP_NAME if (source / LP_NAME).is_file() else lps[0]
@@ -446,16 +451,18 @@ def acquisition_files(
             # "good", without a word: what it records (the rig, the plan, the exposure, the
             # lights' calibration) is gone, and run --resume refuses the folder
             notes.append(
-                f"{source} is a session folder without its {MANIFEST}: fitted from its "
+                f"{shown_path(source)} is a session folder without its {MANIFEST}: fitted from its "
                 f"{lp.name}, but its record of the rig, plan and exposure is missing and it "
                 "cannot be resumed; restore the manifest from a copy of the session"
             )
     elif source.suffix.lower() == ".lp" and source.is_file():
         lp = source
     elif not source.exists():  # a typo had been told to "give a session folder or an .lp"
-        raise FitInputError(f"{source} does not exist: give a session folder or an .lp file")
+        raise FitInputError(
+            f"{shown_path(source)} does not exist: give a session folder or an .lp file"
+        )
     else:
-        raise FitInputError(f"{source}: give a session folder or an .lp file")
+        raise FitInputError(f"{shown_path(source)}: give a session folder or an .lp file")
     refuse_if_disowned(lp.parent)  # a session whose labels a late slip check disowned
     entries = _listed_entries(lp, notes)
     lights = directions_of(entries)
@@ -548,14 +555,14 @@ def _refuse_lost_images(lp: Path, damaged: list[tuple[Path, str]]) -> None:
     there = {Path(name).stem for name in renamed}
     if all(why == "gone" and path.stem in there for path, why in damaged):
         raise FitInputError(  # all there, under other names: nothing to restore or reshoot
-            f"{root}: {len(damaged)} image(s) its {lp.name} lists are not under their session "
-            f"names: {renamed_note(renamed)}; then run this again"
+            f"{shown_path(root)}: {len(damaged)} image(s) its {lp.name} lists are not under their "
+            f"session names: {renamed_note(renamed)}; then run this again"
         )
     folder = shell_word(str(root))
     rest = shell_word(str(root / "rest.lp"))
     raise FitInputError(
-        f"{root}: {len(damaged)} image(s) its {lp.name} lists cannot be read as captured "
-        f"({shown}){moved}: {lost_image_advice(root, adaptive)}; or fit the images that "
+        f"{shown_path(root)}: {len(damaged)} image(s) its {lp.name} lists cannot be read as "
+        f"captured ({shown}){moved}: {lost_image_advice(root, adaptive)}; or fit the images that "
         "remain, listed from the session's journal: rti-rig export-lp "
         f"{folder} --linear --out {rest}, then rti-rig fit {rest} --out DIR"
     )
@@ -635,7 +642,7 @@ def load_acquisition(
     frames = _open_frames(paths, str(lp))
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
-        raise FitInputError(f"images of {lp} differ in shape: {sorted(shapes)}")
+        raise FitInputError(f"images of {shown_path(lp)} differ in shape: {sorted(shapes)}")
     if notes is not None and not any(p.parent.name == "linear" for p in paths):
         # (a session's linear/ with stand-ins is said by acquisition_files)
         notes.extend(_mixed_depth_note(lp, frames, paths))
@@ -656,8 +663,8 @@ def _mixed_depth_note(lp: Path, frames: list[Any], paths: list[Path]) -> list[st
     sixteen = [p.name for f, p in zip(frames, paths, strict=True) if not _stored_8_bit(f)]
     shown = ", ".join(sixteen[:3]) + (" ..." if len(sixteen) > 3 else "")
     return [
-        f"{lp} mixes {len(eight)} 8-bit image(s), decoded as sRGB, with {len(sixteen)} 16-bit "
-        f"one(s), taken as linear ({shown}): if the 16-bit files are gamma-encoded exports, "
+        f"{shown_path(lp)} mixes {len(eight)} 8-bit image(s), decoded as sRGB, with {len(sixteen)} "
+        f"16-bit one(s), taken as linear ({shown}): if the 16-bit files are gamma-encoded exports, "
         "not linear data, they are fitted wrongly; export every image of the acquisition alike"
     ]
 
@@ -676,20 +683,26 @@ BandRunner = Callable[[ImageStack, BandPlan, list[slice]], Iterator[tuple[slice,
 def prepare_out_dir(out: Path) -> None:
     """Create ``out`` (new or empty), or refuse clearly: never write over earlier outputs."""
     if out.exists() and not out.is_dir():
-        raise FitInputError(f"--out {out} exists and is not a folder: choose another --out")
+        raise FitInputError(
+            f"--out {shown_path(out)} exists and is not a folder: choose another --out"
+        )
     try:
         if out.exists() and any(out.iterdir()):
             unfinished = _unfinished_fit(out)
             if unfinished:
                 raise FitInputError(
-                    f"{out} holds the outputs of a fit that did not finish ({unfinished}; its "
-                    "fit.json, written last, is missing): the fit was killed, or the machine "
-                    "stopped (out of memory?); delete that folder, or those files, and run this "
-                    "again, or choose another --out"
+                    f"{shown_path(out)} holds the outputs of a fit that did not finish "
+                    f"({unfinished}; its fit.json, written last, is missing): the fit was killed, "
+                    "or the machine stopped (out of memory?); delete that folder, or those files, "
+                    "and run this again, or choose another --out"
                 )
-            raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
+            raise FitInputError(
+                f"{shown_path(out)} is not empty: fit writes into a new or empty folder"
+            )
     except OSError as exc:
-        raise FitInputError(f"--out {out}: cannot read it ({exc.strerror or exc})") from None
+        raise FitInputError(
+            f"--out {shown_path(out)}: cannot read it ({exc.strerror or exc})"
+        ) from None
     try:
         ensure_writable_folder(out)
     except RtiRigError as exc:
@@ -742,8 +755,8 @@ def refuse_out_inside_a_session(out: Path) -> None:
     outer = enclosing_session(out)
     if outer is not None:
         raise RtiRigError(
-            f"--out {out} is inside {outer}, a session folder: give an --out outside it, so "
-            "that each session stays a folder of its own"
+            f"--out {shown_path(out)} is inside {shown_path(outer)}, a session folder: give an "
+            "--out outside it, so that each session stays a folder of its own"
         )
 
 
@@ -997,8 +1010,8 @@ def _fit_all(
     if req.hsh_order and req.write_hsh and n < (req.hsh_order + 1) ** 2:  # asked: refused
         raise FitInputError(
             f"--hsh-order {req.hsh_order} has {(req.hsh_order + 1) ** 2} coefficients per pixel "
-            f"and needs at least {(req.hsh_order + 1) ** 2} lights; {req.source} has {n}: "
-            "choose a lower order, or leave --hsh-order out"
+            f"and needs at least {(req.hsh_order + 1) ** 2} lights; {shown_path(req.source)} has "
+            f"{n}: choose a lower order, or leave --hsh-order out"
         )
     if name == AUTO:
         candidates, undetermined = auto_candidates(lights)
@@ -1050,8 +1063,8 @@ def _fit_all(
         if n < spec.n_coefficients:  # asked for by name: refused, never silently not fitted
             raise FitInputError(
                 f"--model {name} has {spec.n_coefficients} coefficients per pixel and needs at "
-                f"least {spec.n_coefficients} lights; {req.source} has {n}: choose a smaller "
-                "model, or --model auto"
+                f"least {spec.n_coefficients} lights; {shown_path(req.source)} has {n}: choose a "
+                "smaller model, or --model auto"
             )
         reason_line = f"{model_name}: chosen by --model"
     normal_source = _normal_source(model_name)

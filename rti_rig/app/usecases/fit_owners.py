@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.app.usecases.fit_attempts import AttemptFolder
+from rti_rig.core.shell_words import shown_path
 
 #: The suffix of an attempt's owner record, after ``.OUTPUT.ATTEMPT``.
 OWNER_SUFFIX = "owner"
@@ -125,9 +126,13 @@ def owner_of(folder: Path, *, mine_too: bool = False) -> Owner:
     except FileNotFoundError:
         return Owner(gone=_gone_here(pid, None, mine_too), unrecorded=True, pid=pid)
     except (OSError, ValueError):
-        return Owner(gone=False, elsewhere=f"an unknown host (its record {path} is unreadable)")
+        return Owner(
+            gone=False, elsewhere=f"an unknown host (its record {shown_path(path)} is unreadable)"
+        )
     if not isinstance(record, dict):
-        return Owner(gone=False, elsewhere=f"an unknown host (its record {path} is unreadable)")
+        return Owner(
+            gone=False, elsewhere=f"an unknown host (its record {shown_path(path)} is unreadable)"
+        )
     here = this_process()
     host = str(record.get("host"))
     pid = record.get("pid") if isinstance(record.get("pid"), int) else pid

@@ -35,7 +35,7 @@ from rti_rig.core.image_files import png_alpha_note
 from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 from rti_rig.core.schedule import LightSchedule
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.make_plan import (
     DEFAULT_OBJECTIVE,
@@ -127,8 +127,8 @@ def _signal_noise(req: PlanLightsRequest, loaded: LoadedRig | None, objective: s
     noise = loaded.config.camera.signal_noise
     if objective != "normals":
         raise RtiRigError(
-            f"{req.rig}: [camera] signal_noise = {noise:g} is modelled by the normals objective "
-            f"only; give --signal-noise 0 to plan for --objective {objective}"
+            f"{shown_path(req.rig)}: [camera] signal_noise = {noise:g} is modelled by the normals "
+            f"objective only; give --signal-noise 0 to plan for --objective {objective}"
         )
     return noise
 
@@ -199,8 +199,9 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         and MIN_PLAN_LIGHTS <= geometry.count < req.lights
     ):
         raise RtiRigError(
-            f"{req.rig}: the dome has {geometry.count} LEDs, fewer than the {req.lights} lights "
-            f"plan plans when --lights is not given: give --lights {geometry.count} or fewer"
+            f"{shown_path(req.rig)}: the dome has {geometry.count} LEDs, fewer than the "
+            f"{req.lights} lights plan plans when --lights is not given: give --lights "
+            f"{geometry.count} or fewer"
         )
     signal_noise = _signal_noise(req, loaded, objective)
     az_el, light_note, image, unrecorded = req.preview_light, None, None, None
@@ -340,7 +341,7 @@ def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: li
         refuse_undetermined(
             lights,
             "planned lights",
-            f"the lights of {req.rig} between {req.min_elevation_deg:g}°.."
+            f"the lights of {shown_path(req.rig)} between {req.min_elevation_deg:g}°.."
             f"{req.max_elevation_deg:g}° elevation leave no other choice: "
             + band_advice(req.min_elevation_deg, req.max_elevation_deg)
             + "; or, to plan them all the same (relighting only, no normal maps wanted), add "

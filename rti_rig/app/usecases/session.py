@@ -17,7 +17,7 @@ from typing import Any
 from rti_rig.app.usecases.replay_advice import new_session_command
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.schedule import LightSchedule
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.controller import (
     CancelToken,
     EmergencyStop,
@@ -427,9 +427,9 @@ def _check_steps_fit_lit(  # type: ignore[no-untyped-def]
     steps = ", ".join(str(j + 1) for j, _ in over[:10]) + (" ..." if len(over) > 10 else "")
     raise ScheduleError(
         f"{len(over)} step(s) to shoot expose too long for an LED that may stay lit at most "
-        f"[dome.serial.thermal] max_on_s = {max_on:g} s ({loaded.path}): step {i + 1}{led}, "
-        f"{said}, would run into the thermal limit (step(s) {steps}); nothing has moved. A "
-        "step's exposure_s is the schedule's own (fixed when the session began, by "
+        f"[dome.serial.thermal] max_on_s = {max_on:g} s ({shown_path(loaded.path)}): step "
+        f"{i + 1}{led}, {said}, would run into the thermal limit (step(s) {steps}); nothing has "
+        "moved. A step's exposure_s is the schedule's own (fixed when the session began, by "
         "--auto-exposure), which the session's images share: raise max_on_s to at least "
         f"{need:g} s if the LEDs allow it, or shorten the [timing] keys"
     )
@@ -868,8 +868,8 @@ def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  
             "them; each is checked for room as it comes)"
         )
         raise NoSpaceError(
-            f"not enough free disk space to go on with {root}: the {exc.steps} image(s) "
-            f"{still} need about {exc.need / 1e6:.0f} MB on the disk holding {exc.where}, "
+            f"not enough free disk space to go on with {shown_path(root)}: the {exc.steps} "
+            f"image(s) {still} need about {exc.need / 1e6:.0f} MB on the disk holding {exc.where}, "
             f"{exc.free / 1e6:.0f} MB free; free at least {math.ceil(exc.shortfall / 1e6)} MB "
             f"there. {kept}",
             exc.where,
@@ -1036,9 +1036,9 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         check_light_count(n)
     else:
         every = (
-            f"every image of the acquisition {loaded.path}"
+            f"every image of the acquisition {shown_path(loaded.path)}"
             if loaded.config.backend == "replay"
-            else f"the rig's default, from {loaded.path}"
+            else f"the rig's default, from {shown_path(loaded.path)}"
         )
         check_light_count(
             n,
@@ -1061,8 +1061,8 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
                 fewer.append("widen --min-elevation-deg / --max-elevation-deg")
             asked = f"--lights {n}" if req.lights is not None else f"{n} lights (every image)"
             raise RtiRigError(
-                f"{asked}: the acquisition {loaded.path} has only {inside} images{band}; "
-                + " or ".join(fewer)
+                f"{asked}: the acquisition {shown_path(loaded.path)} has only {inside} "
+                f"images{band}; " + " or ".join(fewer)
             )
     schedule = plan_uniform(
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
@@ -1412,9 +1412,9 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     if only_images_other:
         # a replayed acquisition is a rig whose camera returns its files: they are its images
         raise RigChangedError(
-            f"the images of {config_path} are not the ones this session began with (one was "
-            "edited, replaced or re-exported since): the session's first images and the ones "
-            "a resume would take would come from two different acquisitions. Put the original "
+            f"the images of {shown_path(config_path)} are not the ones this session began with "
+            "(one was edited, replaced or re-exported since): the session's first images and the "
+            "ones a resume would take would come from two different acquisitions. Put the original "
             f"files back to continue (rti-rig run --resume {shell_word(str(session_dir))}), "
             "or start a new session from the acquisition as it is now ("
             + new_session_command(config_path, manifest, session_dir)
@@ -1439,7 +1439,7 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         # accepted, a new exposure had gone into the fit as a brighter light: normals 5.5° off
         # on average, with a "good" verdict; nothing downstream corrects for it
         raise RigChangedError(
-            f"{config_path} changes what this session's images are ("
+            f"{shown_path(config_path)} changes what this session's images are ("
             + "; ".join(image_diffs)
             + "): images shot now would not match the ones already taken (another exposure "
             "or gain reads as a brighter or darker light, another size or decoding as another "
@@ -1451,14 +1451,14 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         )
     if recorded.get("kind") != identity.get("kind"):
         raise RigChangedError(
-            f"{config_path} is a rig of kind '{identity.get('kind')}', and this session was "
-            f"begun on a '{recorded.get('kind')}': a session cannot change kind of rig, even "
-            f"with --accept-rig-change. Resume with its own config (rti-rig run --resume "
+            f"{shown_path(config_path)} is a rig of kind '{identity.get('kind')}', and this "
+            f"session was begun on a '{recorded.get('kind')}': a session cannot change kind of "
+            f"rig, even with --accept-rig-change. Resume with its own config (rti-rig run --resume "
             f"{session_dir}) or start a new session"
         )
     if diffs and not accept_change:
         raise RigChangedError(
-            f"{config_path} does not describe the rig this session began on ("
+            f"{shown_path(config_path)} does not describe the rig this session began on ("
             + "; ".join(diffs)
             + "): its images would not match the ones already taken. "
             + (
@@ -1503,8 +1503,8 @@ def _replay_images_changed(
     DIR with the session's own config)": the .lp is the session's own, untouched, and there is
     no setting to set back; it is the images that changed."""
     return (
-        f"the images of {config_path} are not the ones this session began with, and are other "
-        "images now (" + "; ".join(image_diffs) + "): replaced or re-exported since. A "
+        f"the images of {shown_path(config_path)} are not the ones this session began with, and "
+        "are other images now (" + "; ".join(image_diffs) + "): replaced or re-exported since. A "
         "replay's camera takes its size and settings from the recorded images themselves, "
         "and a session's images are one set for fit, relight and RTIBuilder, so this session "
         "cannot be continued on them (not even with --accept-rig-change; only the original "
@@ -1523,7 +1523,7 @@ def _replay_images_unknown(
     files re-exported at another size since; it had been told they were "the same recorded
     images" (:func:`_replay_read_otherwise`), which nothing established."""
     return (
-        f"the images of {config_path} now read otherwise than this session's ("
+        f"the images of {shown_path(config_path)} now read otherwise than this session's ("
         + "; ".join(image_diffs)
         + "): re-exported since, or the same files read otherwise (an rti-rig before "
         "2026-11-30 replayed a TIFF whose thumbnail comes first at the thumbnail's size); "
@@ -1548,8 +1548,8 @@ def _replay_read_otherwise(
     comes first at the thumbnail's size (before 2026-11-30) recorded 16×12 images of a 64×48
     acquisition; its resume was told to "set it back to continue", which nothing can."""
     return (
-        f"{config_path} replays the same recorded images this session began with, but they "
-        "are now read as other images (" + "; ".join(image_diffs) + "): a replay's camera "
+        f"{shown_path(config_path)} replays the same recorded images this session began with, but "
+        "they are now read as other images (" + "; ".join(image_diffs) + "): a replay's camera "
         "takes its size and settings from the recorded images themselves, so nothing can be "
         "set back, and images taken now would not match the ones already taken. (An rti-rig "
         "before 2026-11-30 replayed a TIFF whose thumbnail comes first at the thumbnail's "
@@ -1614,10 +1614,10 @@ def _config_differs(config_path: Path, manifest: dict[str, Any]) -> str:
     last = (manifest.get("rig") or {}).get("config_path")
     if last and not _same_file(Path(config_path), Path(last)):
         return (
-            f"{config_path} is not the rig config this session last ran with ({last}), and "
-            "differs from the one it began with"
+            f"{shown_path(config_path)} is not the rig config this session last ran with ({last}), "
+            "and differs from the one it began with"
         )
-    return f"{config_path} has been edited since the session began"
+    return f"{shown_path(config_path)} has been edited since the session began"
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -1648,8 +1648,8 @@ def rebuild_finished_session(req: ResumeRequest) -> list[str] | None:
         # no rig is read here to compare them with (the session's own or not): refused, as
         # before they could be given again with --resume (they had gone unchecked, unsaid)
         raise RtiRigError(
-            f"{req.session_dir}: --rebuild-journal of a session that completed opens no rig "
-            f"and shoots nothing, so {', '.join(req.start.given)} would change nothing "
+            f"{shown_path(req.session_dir)}: --rebuild-journal of a session that completed opens "
+            f"no rig and shoots nothing, so {', '.join(req.start.given)} would change nothing "
             "(nothing in the folder was changed): drop "
             + ("it" if len(req.start.given) == 1 else "them")
         )
@@ -1684,7 +1684,9 @@ def _say_if_complete(session_dir: Path) -> str:
         return exc.note  # the flash refusal says them, then why it cannot reshoot
     except SessionError:
         return ""  # unchecked, say: the flash refusal says why it cannot reshoot
-    raise RtiRigError(f"{session_dir}: a completed session's resume went on")  # pragma: no cover
+    raise RtiRigError(
+        f"{shown_path(session_dir)}: a completed session's resume went on"
+    )  # pragma: no cover
 
 
 def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
@@ -1706,8 +1708,8 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     rig_entry = manifest.get("rig") or {}
     if req.rig_config is None and not rig_entry.get("config_path"):
         raise RtiRigError(
-            f"{req.session_dir}: the manifest does not say which rig config it was shot with; "
-            "give it: rti-rig run RIG.toml --resume DIR"
+            f"{shown_path(req.session_dir)}: the manifest does not say which rig config it was "
+            "shot with; give it: rti-rig run RIG.toml --resume DIR"
         )
     config_path = req.rig_config or Path(rig_entry["config_path"])
     if req.rig_config is None and not config_path.is_file():
@@ -1716,10 +1718,10 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         what = "recorded acquisition it replayed" if replay else "rig config it was shot with"
         give = f"ACQ/{config_path.name}" if replay else "RIG.toml"
         raise RtiRigError(
-            f"{req.session_dir}: the {what}, {config_path}, is not there any more (moved or "
-            f"renamed?); give it: rti-rig run {give} --resume {req.session_dir} (the "
-            "session's manifest keeps a copy of the rig it began with, and a resume checks "
-            "the rig against it)"
+            f"{shown_path(req.session_dir)}: the {what}, {shown_path(config_path)}, is not there "
+            f"any more (moved or renamed?); give it: rti-rig run {give} --resume "
+            f"{shell_word(str(req.session_dir))} (the session's manifest keeps a copy of the rig "
+            "it began with, and a resume checks the rig against it)"
         )
     loaded = load_rig_config(config_path)
     for note in loaded.notes:
@@ -1732,7 +1734,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         # (so the user looked for what had interrupted it): it is complete, and says so
         lost = "" if req.reshoot_lost else _say_if_complete(Path(req.session_dir))
         done = (
-            f"{req.session_dir}: this session already completed all "
+            f"{shown_path(req.session_dir)}: this session already completed all "
             f"{runner.get('steps_planned', len(manifest.get('steps') or []))} steps; nothing "
             "to resume"
         )
@@ -1787,7 +1789,9 @@ def _refuse_image_sequence_resume(loaded: Any, root: Path) -> None:
     why = image_sequence_restarts(loaded.config.camera.device, shell_word(str(loaded.path)))
     if why is None or holds_no_image(root):
         return  # nothing shot yet: the sequence's first file is the first image's
-    raise RtiRigError(f"{root}: this session cannot be resumed (nothing was changed): {why}")
+    raise RtiRigError(
+        f"{shown_path(root)}: this session cannot be resumed (nothing was changed): {why}"
+    )
 
 
 def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: ignore[no-untyped-def]
@@ -1814,8 +1818,8 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     )
     on_note(
         Note(
-            f"Resuming {req.session_dir}: {done} of {folder.total_steps} images verified on disk"
-            + (moved if recovered else "")
+            f"Resuming {shown_path(req.session_dir)}: {done} of {folder.total_steps} images "
+            "verified on disk" + (moved if recovered else "")
         )
     )
     for note in resume.journal_repair if resume else []:
