@@ -14,6 +14,8 @@ from rti_rig.cli.app import app, err, fail, out, print_notes, shown_path, stop_e
 from rti_rig.cli.stopping import Terminated, sigterm_stops, stamp, stop_signal, written_since
 from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.shell_words import shell_word
+from rti_rig.core.toml_strings import NotTomlText, toml_basic_string
 
 if TYPE_CHECKING:
     from rti_rig.app.usecases.calibrate import CalibrateRequest
@@ -134,6 +136,14 @@ def calibrate_lights(
     except RtiRigError as exc:
         raise fail(exc) from None
     target = request.target
+    if out_file is not None and _setting_line(target, rig_config) is None:
+        # refused before anything is measured or written: the line to paste cannot be said
+        raise fail(
+            RtiRigError(
+                f"{_not_toml_text(target, rig_config)}: give --out a file whose path from the "
+                "config's folder is UTF-8 (nothing was measured or written)"
+            )
+        )
     before = stamp(target)  # a file there already (--force) is not one this run wrote
     reported: list[bool] = []  # set once the file is written and its report begun
     try:
@@ -145,19 +155,50 @@ def calibrate_lights(
         signum = stop_signal(exc)
         why = stop_words(signum)
         if reported or written_since(target, before):
-            rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
+            line = _setting_line(target, rig_config) or _copy_to_use(target, rig_config)
             said = (
-                f"Stopped ({why}): the calibration {target} is written; to use it, set "
-                f'intensity_correction_file = "{rel}" under [dome.serial] in {rig_config}'
+                f"Stopped ({why}): the calibration {shown_path(target)} is written; to use it, "
+                f"set {line} under [dome.serial] in {shown_path(rig_config)}"
             )
         else:
             kept = "" if before is None else " (the file already there is as it was)"
             said = (
                 f"Stopped ({why}) before the calibration was written: nothing was written to "
-                f"{target}{kept}"
+                f"{shown_path(target)}{kept}"
             )
         err.print(said, markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(code=stop_exit_code(signum)) from None
+
+
+def _setting_line(target: Path, rig_config: Path) -> str | None:
+    """The ``intensity_correction_file = "..."`` line naming ``target`` relative to the rig
+    config's folder, as a TOML basic string (a quote or backslash in the name escaped), for the
+    user to paste under ``[dome.serial]``; None where the name is not UTF-8 (no TOML file can
+    hold it: :func:`_not_toml_text` says so).
+
+    Why: it was printed as ``"{rel}"`` unquoted, a line TOML refused or read as another name."""
+    rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
+    try:
+        return f"intensity_correction_file = {toml_basic_string(rel)}"
+    except NotTomlText:
+        return None
+
+
+def _not_toml_text(target: Path, rig_config: Path) -> str:
+    """Why ``target`` cannot be named in ``rig_config``: its path from the config's folder."""
+    rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
+    return (
+        f"{shown_path(target)}: its name as the rig config {shown_path(rig_config)} would give "
+        f"it ({shown_path(rel)}) is not UTF-8 text, which a TOML file cannot hold"
+    )
+
+
+def _copy_to_use(target: Path, rig_config: Path) -> str:
+    """What to do with a calibration whose name no TOML file can hold."""
+    return (
+        f"copy it to a file whose name is UTF-8 (cp {shell_word(target)} NEW.toml, beside "
+        f'{shown_path(rig_config)}) and set intensity_correction_file = "NEW.toml"'
+    )
 
 
 def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> None:
@@ -248,7 +289,6 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
         f"A card tilted by 1° would move the lowest LEDs' figures by up to {tilt_pct:.0f} %: "
         "level it with care."
     )
-    rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
     out.print(f"Calibration → {escape(shown_path(target))}")
     if in_force and cal.shot_spread < even_enough:
         out.print(
@@ -264,7 +304,16 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
             highlight=False,
         )
     # the line to paste, on its own and never wrapped (a wrapped line pastes as two)
-    out.print(f'intensity_correction_file = "{rel}"', markup=False, highlight=False, soft_wrap=True)
+    line = _setting_line(target, rig_config)
+    if line is None:
+        err.print(
+            f"[yellow]warning:[/] {escape(_not_toml_text(target, rig_config))}; "
+            f"{escape(_copy_to_use(target, rig_config))}",
+            highlight=False,
+            soft_wrap=True,
+        )
+    else:
+        out.print(line, markup=False, highlight=False, soft_wrap=True)
     if not (in_force and cal.shot_spread < even_enough):
         out.print(
             "Then shoot the card again and calibrate that session: its spread is what is left."
