@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out, print_notes
+from rti_rig.cli.app import app, err, fail, out, print_notes, shown_path
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import ensure_writable_folder, refuse_a_file_in_the_way
 
@@ -163,22 +163,22 @@ def _check_out_folder(out_dir: Path, force: bool, acquisition: Sequence[Path] = 
     for folder in (out_dir.resolve(), *out_dir.resolve().parents):
         if (folder / MANIFEST).is_file():
             raise RtiRigError(
-                f"--out {out_dir} is inside the session in {folder}; a session's folder is "
-                "never written into: choose another folder"
+                f"--out {shown_path(out_dir)} is inside the session in {shown_path(folder)}; a "
+                "session's folder is never written into: choose another folder"
             )
     # the folder an image is listed in, and the one its file is in when it is a link (images
     # linked into a project's jpeg-exports/ from a card's copy resolve to the card's folder)
     held = {p.parent.resolve() for p in acquisition} | {p.resolve().parent for p in acquisition}
     if out_dir.resolve() in held:
         raise RtiRigError(
-            f"--out {out_dir} holds the acquisition --from reads (its .lp or images): its "
-            "folder is never written into, even with --force; choose another folder (a new "
+            f"--out {shown_path(out_dir)} holds the acquisition --from reads (its .lp or images): "
+            "its folder is never written into, even with --force; choose another folder (a new "
             "one inside it will do)"
         )
     if out_dir.is_dir() and any(out_dir.iterdir()) and not force:
         raise RtiRigError(
-            f"--out {out_dir} is not empty: its results.csv, summary.md and plots would be "
-            "replaced; choose an empty or new folder, or give --force"
+            f"--out {shown_path(out_dir)} is not empty: its results.csv, summary.md and plots "
+            "would be replaced; choose an empty or new folder, or give --force"
         )
     ensure_writable_folder(out_dir)
 

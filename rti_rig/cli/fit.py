@@ -128,28 +128,28 @@ def _stopped(
 
     why = stop_words(signum)
     if written:
-        said = f"Stopped ({why}) after the fit had written its outputs to {out_dir}"
+        said = f"Stopped ({why}) after the fit had written its outputs to {shown_path(out_dir)}"
     elif batch and cluster:
         # Dask cannot interrupt a task a worker is running: a session already started goes on
         # there and is renamed into place when it finishes. "The one being fitted was
         # discarded" had been said, and the sessions appeared in --out minutes later.
         said = (
-            f"Stopped ({why}): the sessions finished are kept in {out_dir}; those already "
-            "running on the Dask workers cannot be stopped from here and go on there, each "
-            f"appearing in {out_dir} when it finishes (the ones not yet started were "
+            f"Stopped ({why}): the sessions finished are kept in {shown_path(out_dir)}; those "
+            "already running on the Dask workers cannot be stopped from here and go on there, each "
+            f"appearing in {shown_path(out_dir)} when it finishes (the ones not yet started were "
             "cancelled); run the same command again to fit the rest (finished ones are "
             "skipped)"
         )
     elif batch:
         said = (
-            f"Stopped ({why}): the sessions finished are kept in {out_dir}, the one being "
-            "fitted was discarded; run the same command again to fit the rest (finished ones "
+            f"Stopped ({why}): the sessions finished are kept in {shown_path(out_dir)}, the one "
+            "being fitted was discarded; run the same command again to fit the rest (finished ones "
             "are skipped)"
         )
     else:
         said = (
-            f"Stopped ({why}) before the fit finished: nothing it wrote was left in {out_dir}; "
-            "run the same command again"
+            f"Stopped ({why}) before the fit finished: nothing it wrote was left in "
+            f"{shown_path(out_dir)}; run the same command again"
         )
     err.print(f"[yellow]{escape(said)}.[/]")
     return typer.Exit(code=stop_exit_code(signum))
@@ -318,7 +318,7 @@ def _fit_command(  # type: ignore[no-untyped-def]
                 items = run_batch_dask(sources, out_dir, request, scheduler)
             written.append(True)
             for item in items:
-                line = f"{item.source}: {item.status}"
+                line = f"{shown_path(item.source)}: {item.status}"
                 if item.verdict:
                     line += f"; QA verdict: {item.verdict}"
                 out.print(escape(line))

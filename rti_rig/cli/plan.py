@@ -245,7 +245,7 @@ def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:
         out.print(line, highlight=False, markup=False)
     out.print(  # the path as it is: a folder named "coin [draft]" is no markup
         f"Planned {len(planned.schedule)} lights ({planned.method}, {planned.objective}) → "
-        f"{request.out_file}",
+        f"{shown_path(request.out_file)}",
         markup=False,
         highlight=False,
     )
@@ -270,13 +270,15 @@ def _stopped(why: str, request: PlanLightsRequest, before: Stamp, done: dict[str
     planned = done.get("planned")
     if planned is None and not written_since(out_file, before):
         kept = "" if before is None else " (the file already there is as it was)"
-        return f"Stopped ({why}) while planning: no plan was written to {out_file}{kept}"
+        return (
+            f"Stopped ({why}) while planning: no plan was written to {shown_path(out_file)}{kept}"
+        )
     count = "" if planned is None else f" ({len(planned.schedule)} lights)"
     map_said = (
         ""
         if figure is None
-        else f"; the map {figure} is written"
+        else f"; the map {shown_path(figure)} is written"
         if done.get("drawn")
-        else f"; the map {figure} was not drawn"
+        else f"; the map {shown_path(figure)} was not drawn"
     )
-    return f"Stopped ({why}): the plan {out_file} is written{count}{map_said}"
+    return f"Stopped ({why}): the plan {shown_path(out_file)} is written{count}{map_said}"

@@ -252,8 +252,9 @@ def run(
         if out_dir is not None and not _same_folder(out_dir, resume):
             raise fail(
                 RtiRigError(
-                    f"--out {out_dir} and --resume {resume} are two folders: a resume "
-                    f"continues the session in --resume's; drop --out (or give the same folder)"
+                    f"--out {shown_path(out_dir)} and --resume {shown_path(resume)} are two "
+                    "folders: a resume continues the session in --resume's; drop --out (or give "
+                    "the same folder)"
                 )
             )
         given = [
@@ -464,17 +465,17 @@ def _rebuilt_finished(req: Any) -> bool:
     lost = lost_since_capture_said(req.session_dir)
     if lost is not None:  # recorded as lost: said with the command that reshoots it
         out.print(
-            f"{req.session_dir}: {JOURNAL} rebuilt from every image it could prove (no rig "
-            f"was opened, nothing was shot), but the session is not whole: {lost}; meanwhile "
+            f"{shown_path(req.session_dir)}: {JOURNAL} rebuilt from every image it could prove (no "
+            f"rig was opened, nothing was shot), but the session is not whole: {lost}; meanwhile "
             f"rti-rig fit {folder} --out FOLDER fits it, its QA verdict naming what is lost",
             highlight=False,
             markup=False,
         )
         return True
     out.print(
-        f"{req.session_dir}: {JOURNAL} rebuilt; the session is complete and whole again (no "
-        f"rig was opened, nothing was shot). Next: rti-rig fit {folder} --out FOLDER fits it "
-        "and gives its QA verdict",
+        f"{shown_path(req.session_dir)}: {JOURNAL} rebuilt; the session is complete and whole "
+        f"again (no rig was opened, nothing was shot). Next: rti-rig fit {folder} --out FOLDER "
+        "fits it and gives its QA verdict",
         highlight=False,
         markup=False,
     )
@@ -1022,7 +1023,7 @@ class _Stop:
     def kept(self) -> str:
         """The images kept and where: every stop's wording begins with them, so the user
         knows what is on disk before being told what to do with it."""
-        return f"{self.ending.images_kept} image(s) kept in {self.out_dir}"
+        return f"{self.ending.images_kept} image(s) kept in {shown_path(self.out_dir)}"
 
     @property
     def lp(self) -> str:
@@ -1135,13 +1136,16 @@ _STOP_SAID: tuple[tuple[Callable[[_Stop], object], Callable[[_Stop], str]], ...]
     ),
     (
         lambda s: s.ending.holds_no_image,
-        lambda s: f"Nothing was captured: {s.out_dir} holds no image and may be used again.",
+        lambda s: (
+            f"Nothing was captured: {shown_path(s.out_dir)} holds no image and may be used again."
+        ),
     ),
     # e.g. a camera's file downloaded for a step that then failed: kept, never deleted
     (
         lambda s: True,
         lambda s: (
-            f"No image was completed, but {s.out_dir} holds files of the camera. {s.resume_hint}"
+            f"No image was completed, but {shown_path(s.out_dir)} holds files of the camera. "
+            f"{s.resume_hint}"
         ),
     ),
 )
@@ -1693,7 +1697,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
 
         state = lights_state(rig, _print_stop_failures(opened))
         err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint())}", markup=False)
-        raise _unexpected(exc, f"{out_dir}/manifest.json") from None
+        raise _unexpected(exc, f"{shown_path(out_dir)}/manifest.json") from None
     finally:
         if over and settable and previous.get(signal.SIGINT) is not None:
             # the session is over (stopped or done): a late Ctrl-C must not cut the summary.
@@ -2100,9 +2104,9 @@ def export_lp(
     except (KeyboardInterrupt, Terminated) as exc:
         signum = stop_signal(exc)
         state = (
-            f"{out_file} is written whole"
+            f"{shown_path(out_file)} is written whole"
             if written_since(out_file, before)
-            else f"no .lp was written to {out_file}"
+            else f"no .lp was written to {shown_path(out_file)}"
             + ("" if before is None else " (the file already there is as it was)")
         )
         err.print(f"Stopped ({stop_words(signum)}): {state}.", markup=False, soft_wrap=True)
