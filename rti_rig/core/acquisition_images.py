@@ -24,6 +24,7 @@ from rti_rig.core.image_files import (
     tiff_several_images,
 )
 from rti_rig.core.lp_format import LpEntry, image_paths, missing_images_advice
+from rti_rig.core.shell_words import shown_path
 
 
 @dataclass(frozen=True)
@@ -239,8 +240,8 @@ def mixed_depth_note(lp_path: Path, names: Sequence[str], paths: Sequence[Path],
         return ""
     shown = ", ".join(sixteen[:3]) + (" ..." if len(sixteen) > 3 else "")
     return (
-        f"{lp_path} mixes {len(eight)} 8-bit image(s), decoded as sRGB, with {len(sixteen)} "
-        f"16-bit one(s), taken as linear ({shown}): if the 16-bit files are gamma-encoded "
-        f"exports, not linear data, they are {use} wrongly; export every image of the "
-        "acquisition alike"
+        f"{shown_path(lp_path)} mixes {len(eight)} 8-bit image(s), decoded as sRGB, with "
+        f"{len(sixteen)} 16-bit one(s), taken as linear ({shown}): if the 16-bit files are "
+        f"gamma-encoded exports, not linear data, they are {use} wrongly; export every image of "
+        "the acquisition alike"
     )

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import SessionError
+from rti_rig.core.shell_words import shown_path
 
 #: The first bytes of the image files an acquisition holds: JPEG, PNG, TIFF (either byte
 #: order; DNG and most camera RAW are TIFF too). One list for the header reads here and for
@@ -225,7 +226,9 @@ def _atomic_write(path: Path, data: bytes | Sequence[bytes | memoryview]) -> str
     """Write bytes (or parts, one after the other) to a new file atomically; return its
     SHA-256."""
     if path.exists():
-        raise SessionError(f"{path} already exists: refusing to overwrite a captured file")
+        raise SessionError(
+            f"{shown_path(path)} already exists: refusing to overwrite a captured file"
+        )
     parts = [data] if isinstance(data, bytes) else list(data)
     tmp = path.with_name(f".{path.name}.partial")
     digest = hashlib.sha256()
@@ -622,8 +625,8 @@ def refuse_truncated_jpeg(path: Path) -> None:
     why = jpeg_truncation(path)
     if why is not None:
         raise SessionError(
-            f"image {path} is a damaged JPEG: {why}; copy it again from the camera or card "
-            "(a truncated image would be read with its missing part grey)"
+            f"image {shown_path(path)} is a damaged JPEG: {why}; copy it again from the camera or "
+            "card (a truncated image would be read with its missing part grey)"
         )
 
 
@@ -634,7 +637,7 @@ def read_jpeg_rgb(path: Path) -> NDArray[np.uint8]:
         refuse_truncated_jpeg(path)  # before OpenCV, which decodes it with a grey part
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
-        raise SessionError(f"cannot read image {path}")
+        raise SessionError(f"cannot read image {shown_path(path)}")
     return img[..., ::-1] if img.ndim == 3 else img
 
 
@@ -665,8 +668,8 @@ def colour_or_grey(pixels: NDArray[Any]) -> NDArray[Any]:
 def _not_8_or_16_bit(path: Path, dtype: Any, shape: tuple[int, ...]) -> str:
     """The refusal of an image whose pixels no frame holds, with what to give instead."""
     return (
-        f"image {path}: {np.dtype(dtype)} {tuple(shape)} is not 8/16-bit grey or RGB; save it "
-        "again as an 8-bit (sRGB) or 16-bit (linear) TIFF of one image"
+        f"image {shown_path(path)}: {np.dtype(dtype)} {tuple(shape)} is not 8/16-bit grey or RGB; "
+        "save it again as an 8-bit (sRGB) or 16-bit (linear) TIFF of one image"
     )
 
 
@@ -708,18 +711,20 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
             with tifffile.TiffFile(p) as tif:
                 img = tiff_main_pixels(tif)  # not a thumbnail in IFD0
         except Exception as exc:  # tifffile raises many kinds; the user needs the file's name
-            raise SessionError(f"cannot read image {p}: {exc}") from None
+            raise SessionError(f"cannot read image {shown_path(p)}: {exc}") from None
         if img.dtype not in (np.uint8, np.uint16) or img.ndim not in (2, 3):
             raise SessionError(_not_8_or_16_bit(p, img.dtype, img.shape))
         return colour_or_grey(img)
     import cv2
 
     if not p.is_file():  # said here, before OpenCV prints its own warning line about it
-        raise SessionError(f"cannot read image {p}: there is no such file")
+        raise SessionError(f"cannot read image {shown_path(p)}: there is no such file")
     refuse_truncated_jpeg(p)  # before OpenCV, which decodes it with a grey part
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
     if img is None:
-        raise SessionError(f"cannot read image {p} (missing, or not an image OpenCV decodes)")
+        raise SessionError(
+            f"cannot read image {shown_path(p)} (missing, or not an image OpenCV decodes)"
+        )
     if img.dtype not in (np.uint8, np.uint16):
-        raise SessionError(f"image {p}: {img.dtype} is not 8- or 16-bit")
+        raise SessionError(f"image {shown_path(p)}: {img.dtype} is not 8- or 16-bit")
     return np.ascontiguousarray(opencv_as_stored(img, p))

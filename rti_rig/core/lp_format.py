@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.errors import LpFormatError
 from rti_rig.core.image_files import looks_like_image
+from rti_rig.core.shell_words import shown_path
 
 #: relight refuses files with more lights than this.
 MAX_LIGHTS = 1000
@@ -253,8 +254,8 @@ def image_paths(lp_path: Path, entries: Sequence[LpEntry]) -> list[Path]:
             raise LpFormatError(
                 lp_path,
                 None,
-                f"{first[p]!r} and {e.name!r} are both read from {p}: two lights cannot share "
-                "an image (their names differ only in folders the .lp's machine had)",
+                f"{first[p]!r} and {e.name!r} are both read from {shown_path(p)}: two lights "
+                "cannot share an image (their names differ only in folders the .lp's machine had)",
             )
         first[p] = e.name
     return paths
@@ -380,16 +381,17 @@ def missing_images_advice(
         return (
             f"; {which} at the path the .lp names, but an .lp's images are read beside it: "
             f"{where}; "
-            f"copy them into {lp_dir}, or write an .lp whose names are relative to its folder"
+            f"copy them into {shown_path(lp_dir)}, or write an .lp whose names are relative to its "
+            "folder"
         )
     if not absolute:
         copy = "copy them where their names point"
     elif len(absolute) == len(names):
-        copy = f"copy them into {lp_dir}"
+        copy = f"copy them into {shown_path(lp_dir)}"
     else:  # a relative name may name a subfolder; an absolute one is read by its file name
         copy = (
             "copy them where their names point, an absolute name's file by its file name "
-            f"into {lp_dir}"
+            f"into {shown_path(lp_dir)}"
         )
     others = f", or remove their lines from the .lp to {use} the others"
     plain = f"; {copy}{others if len(names) < total else ''}"

@@ -7,6 +7,7 @@ import tempfile
 from pathlib import Path
 
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.shell_words import shown_path
 
 #: How the file written and removed to prove the folder writable (permissions, read-only
 #: mounts) is named: this, then a part unique to each probe (:func:`tempfile.mkstemp`).
@@ -19,8 +20,8 @@ def _cannot_write_there(folder: Path, exc: OSError, option: str = "--out") -> Rt
     ``stat``, a ``mkdir`` and a probe file that fail)."""
     where = f": {exc.filename}" if exc.filename else ""
     return RtiRigError(
-        f"{option} {folder}: cannot write there ({exc.strerror or exc}{where}); choose a "
-        "folder you can write to"
+        f"{option} {shown_path(folder)}: cannot write there ({exc.strerror or exc}{where}); choose "
+        "a folder you can write to"
     )
 
 
@@ -31,7 +32,8 @@ def _probe_refused(shown: Path, option: str, what: str) -> RtiRigError:
     directory: /proc)", as if /proc were missing, when it was the new file in it that was
     refused."""
     return RtiRigError(
-        f"{option} {shown}: cannot write there ({what}); choose a folder you can write to"
+        f"{option} {shown_path(shown)}: cannot write there ({what}); choose a folder you can write "
+        "to"
     )
 
 
@@ -43,7 +45,7 @@ def _probe(folder: Path, shown: Path, option: str) -> None:
     except OSError as exc:
         reason = exc.strerror or str(exc)
         raise _probe_refused(
-            shown, option, f"the system refused a new file in {folder}: {reason}"
+            shown, option, f"the system refused a new file in {shown_path(folder)}: {reason}"
         ) from None
     os.close(handle)
     try:
@@ -53,8 +55,8 @@ def _probe(folder: Path, shown: Path, option: str) -> None:
         raise _probe_refused(
             shown,
             option,
-            f"the system refused to remove the test file {probe} it let us create in {folder}: "
-            f"{reason}; remove it yourself",
+            f"the system refused to remove the test file {shown_path(probe)} it let us create in "
+            f"{shown_path(folder)}: {reason}; remove it yourself",
         ) from None
 
 
@@ -85,8 +87,12 @@ def refuse_a_file_in_the_way(folder: Path) -> None:
     except OSError as exc:
         raise _cannot_write_there(folder, exc) from None
     if is_file:
-        what = " is a file" if existing == folder else f": {existing} is a file, not a folder"
-        raise RtiRigError(f"--out {folder}{what}: give a folder")
+        what = (
+            " is a file"
+            if existing == folder
+            else f": {shown_path(existing)} is a file, not a folder"
+        )
+        raise RtiRigError(f"--out {shown_path(folder)}{what}: give a folder")
 
 
 def ensure_writable_folder(folder: Path) -> None:

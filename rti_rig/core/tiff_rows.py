@@ -31,6 +31,7 @@ from rti_rig.core.image_files import (
     tiff_main_image,
     tiff_main_pixels,
 )
+from rti_rig.core.shell_words import shown_path
 
 #: TIFF compression codes decoded strip by strip here: none, Adobe deflate, deflate.
 _STRIPPED = {1: "none", 8: "zlib", 32946: "zlib"}
@@ -122,8 +123,8 @@ class TiffRows:
             data = zlib.decompress(raw) if self._compressed else raw
         except zlib.error as exc:
             raise ImageFileError(
-                f"{self.path}: strip {k} cannot be decompressed ({exc}): the file is truncated "
-                "or damaged; copy it again from the original, or leave it out of the .lp"
+                f"{shown_path(self.path)}: strip {k} cannot be decompressed ({exc}): the file is "
+                "truncated or damaged; copy it again from the original, or leave it out of the .lp"
             ) from None
         rows = len(data) // (int(np.prod(self._row_shape)) * self.dtype.itemsize)
         arr = np.frombuffer(data, dtype=self.dtype).reshape((rows, *self._row_shape))
@@ -147,9 +148,9 @@ class TiffRows:
                 got = os.preadv(fd, [view[pos : pos + want]], at)
                 if got != want:
                     raise ImageFileError(
-                        f"{self.path}: short read in strip {k} ({got} of {want} bytes): the file "
-                        "is truncated or was changed while being read; copy it again from the "
-                        "original, or leave it out of the .lp"
+                        f"{shown_path(self.path)}: short read in strip {k} ({got} of {want} "
+                        "bytes): the file is truncated or was changed while being read; copy it "
+                        "again from the original, or leave it out of the .lp"
                     )
                 pos += want
         finally:
@@ -230,9 +231,9 @@ def _unreadable(path: Path, exc: BaseException) -> ImageFileError:
     reached the user as a traceback). A whole TIFF of several full-size images is said as
     that: copying it again gives the same images back."""
     if isinstance(exc, SeveralFullSizeImages):
-        return ImageFileError(f"{path}: {exc}, or leave it out of the .lp")
+        return ImageFileError(f"{shown_path(path)}: {exc}, or leave it out of the .lp")
     return ImageFileError(
-        f"{path}: cannot be read as a TIFF ({type(exc).__name__}: {exc}); copy it again from "
-        "the original, save it again as an uncompressed or zlib/LZW 8- or 16-bit TIFF, or "
-        "leave it out of the .lp"
+        f"{shown_path(path)}: cannot be read as a TIFF ({type(exc).__name__}: {exc}); copy it "
+        "again from the original, save it again as an uncompressed or zlib/LZW 8- or 16-bit TIFF, "
+        "or leave it out of the .lp"
     )
