@@ -81,6 +81,7 @@ from rti_rig.core.image_files import (
     png_colour_type,
     tiff_extent,
 )
+from rti_rig.core.shell_words import shown_path
 from rti_rig.drivers.cameras.dng_tags import IfdState, ifd_state
 from rti_rig.drivers.cameras.image_io import (
     ImageReadError,
@@ -491,7 +492,7 @@ class FolderWatchCamera:
         if not folder.is_dir():
             raise DeviceError(
                 self.name,
-                f"watched folder {folder} does not exist or is not a "
+                f"watched folder {shown_path(folder)} does not exist or is not a "
                 "folder; create it or fix 'folder' in the rig config",
                 "connect",
             )
@@ -1052,7 +1053,9 @@ class FolderWatchCamera:
         way_out = ""
         clock_file = self._clock_file()
         if clock_file is not None:
-            way_out = f", delete {clock_file} and resume (its first image is then unchecked)"
+            way_out = (
+                f", delete {shown_path(clock_file)} and resume (its first image is then unchecked)"
+            )
         base = CAPTURE_TIME_RESOLUTION_S + self.settings.shutter_lag_s + pending.pulse_window_s
         pulses = self._pulse_times[:-1]  # those before this light's
         for name in names:
@@ -1119,7 +1122,7 @@ class FolderWatchCamera:
         without_clock = self._without_clock_said(pending.before_first_taken)
         clock_file = self._clock_file()
         way_out = (
-            f"delete {clock_file} and resume (its first image is then unchecked)"
+            f"delete {shown_path(clock_file)} and resume (its first image is then unchecked)"
             if clock_file is not None
             else "run again"
         )
@@ -1385,7 +1388,7 @@ class FolderWatchCamera:
                 if isinstance(exc, ImageReadError):
                     # worded here from its fields: the folder's file, not the copy read
                     detail = f" ({exc.reason})" if exc.reason else ""
-                    message = f"cannot read image file {path}{detail}"
+                    message = f"cannot read image file {shown_path(path)}{detail}"
                 elif isinstance(exc, RawDecodeError):
                     # worded here from its fields too: LibRaw's own words are left as said
                     message = exc.about(path)
@@ -1575,14 +1578,17 @@ class FolderWatchCamera:
         it is the copy that went)."""
         folder = self.settings.folder
         left = (
-            f"{path.name} is left in {folder}"
+            f"{path.name} is left in {shown_path(folder)}"
             if _identity(path) is not None
-            else f"{path.name} is gone from {folder} too (moved or deleted by another program)"
+            else (
+                f"{path.name} is gone from {shown_path(folder)} too (moved or deleted by another "
+                "program)"
+            )
         )
         return CaptureError(
             self.name,
-            f"{path} was taken as this light's image and copied into the session "
-            f"({held.parent}), but that copy was removed or renamed before it could be "
+            f"{shown_path(path)} was taken as this light's image and copied into the session "
+            f"({shown_path(held.parent)}), but that copy was removed or renamed before it could be "
             "decoded: keep other programs out of the session's folder. "
             f"{left}, and no image was recorded for this light",
             "decode",
@@ -1640,9 +1646,9 @@ class FolderWatchCamera:
         return CaptureError(
             self.name,
             f"{head}, but the disk refused the copy ({why}) into the session's "
-            f"{self.output_dir}; no image was recorded for this light. {path.name} is still in "
-            f"{self.settings.folder}, but a resume will not use it (a file already in the "
-            "folder when a run starts is never taken as a light's image): "
+            f"{shown_path(self.output_dir)}; no image was recorded for this light. {path.name} is "
+            f"still in {shown_path(self.settings.folder)}, but a resume will not use it (a file "
+            "already in the folder when a run starts is never taken as a light's image): "
             f"{fix}, then resume, which shoots this light again",
             "copy",
         )

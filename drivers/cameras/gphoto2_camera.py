@@ -31,6 +31,7 @@ from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError
 from rti_rig.core.image_files import is_camera_raw
+from rti_rig.core.shell_words import shown_path
 from rti_rig.drivers.cameras.gphoto2_formats import gives_raw, raw_choices
 from rti_rig.drivers.cameras.raw_decode import (
     RawDecodeError,
@@ -1166,10 +1167,10 @@ class Gphoto2Camera:
         where = raw_path.parent
         return CaptureError(
             self.name,
-            f"the camera reported {on_camera} and it was downloaded into {where} as "
+            f"the camera reported {on_camera} and it was downloaded into {shown_path(where)} as "
             f"{raw_path.name}, but it was gone from there before it could be decoded (moved or "
             "deleted by another program: a sync, backup or antivirus tool, or a clean-up of "
-            f"that folder); {copy}. Keep other programs out of {where} (exclude it "
+            f"that folder); {copy}. Keep other programs out of {shown_path(where)} (exclude it "
             "from them), then run again (a resumed session shoots this image again)",
             "decode",
         )
@@ -1201,8 +1202,8 @@ class Gphoto2Camera:
             where += " (a resume moves it to the session's recovered/ folder, never deleting it)"
         return CaptureError(
             self.name,
-            f"the camera's file {camera_name} would not decode; it is kept at {where}, the "
-            f"camera's copy {self._copy_said(camera_name)}. "
+            f"the camera's file {camera_name} would not decode; it is kept at {shown_path(where)}, "
+            f"the camera's copy {self._copy_said(camera_name)}. "
             + (exc.problem if isinstance(exc, RawDecodeError) else exc.message)
             + (
                 ". `rti-rig check` finds a RAW this LibRaw cannot read with a test shot, "

@@ -25,6 +25,7 @@ from rti_rig.core.image_files import (
     tiff_one_image,
     tiff_samples_last,
 )
+from rti_rig.core.shell_words import shown_path
 from rti_rig.drivers.cameras.tiff_ifd import header_size
 from rti_rig.drivers.cameras.tiff_structure import (
     COMPLETE_TIFF_ADVICE,
@@ -135,7 +136,9 @@ class ImageReadError(CaptureError):
             else ""
         )
         detail = f" ({reason})" if reason else ""
-        super().__init__(device, f"cannot read image file {path}{detail}{advice}", "read")
+        super().__init__(
+            device, f"cannot read image file {shown_path(path)}{detail}{advice}", "read"
+        )
 
 
 def _cut_within_header(path: Path) -> str | None:

@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
+from rti_rig.core.shell_words import shown_path
 from rti_rig.drivers.cameras.dng_tags import dng_refusal, read_blind
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
@@ -67,7 +68,7 @@ class RawDecodeError(CaptureError):
 
     def about(self, file: Path | str) -> str:
         """The refusal naming ``file`` as the one that would not decode."""
-        return f"{file}: {self.problem}"
+        return f"{shown_path(file)}: {self.problem}"
 
 
 def libraw_named() -> str:
