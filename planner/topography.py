@@ -45,6 +45,7 @@ from rti_rig.core.image_files import (
     tiff_one_image,
     tiff_samples_last,
 )
+from rti_rig.core.shell_words import shown_path
 
 #: Long side, in pixels, of the image the planner works on.
 PLANNING_SIDE_PX = 256
@@ -97,18 +98,22 @@ def read_preview(path: Path) -> NDArray:
     """
     p = Path(path)
     if p.is_dir():
-        raise ScheduleError(f"{p} is a folder: give one preview image file")
+        raise ScheduleError(f"{shown_path(p)} is a folder: give one preview image file")
     if not p.is_file():
-        raise ScheduleError(f"{p}: preview image not found")
+        raise ScheduleError(f"{shown_path(p)}: preview image not found")
     why = jpeg_truncation(p)  # OpenCV decodes a cut-short JPEG, its missing part grey
     if why is not None:
-        raise ScheduleError(f"{p}: damaged JPEG: {why}; copy it again from the camera or card")
+        raise ScheduleError(
+            f"{shown_path(p)}: damaged JPEG: {why}; copy it again from the camera or card"
+        )
     tiff = _read_tiff_preview(p)
     if tiff is not None:
         return tiff
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
     if img is None:
-        raise ScheduleError(f"{p}: cannot read this file as an image (JPEG, PNG or TIFF)")
+        raise ScheduleError(
+            f"{shown_path(p)}: cannot read this file as an image (JPEG, PNG or TIFF)"
+        )
     # grey + alpha is grey, an alpha dropped, as the replay rig and the fit read it: a grey
     # camera's grey + alpha PNG had been read as colour
     return opencv_as_stored(img, p)
@@ -131,7 +136,7 @@ def _read_tiff_preview(p: Path) -> NDArray | None:
             image = tiff_one_image(tif)  # not a thumbnail, nor one page of a stack
             pixels = tiff_samples_last(image.asarray(), tiff_is_planar(image.keyframe))
     except SeveralFullSizeImages as exc:
-        raise ScheduleError(f"preview {p}: {exc}") from None
+        raise ScheduleError(f"preview {shown_path(p)}: {exc}") from None
     except Exception:  # tifffile raises many kinds for a damaged file; OpenCV's turn
         return None
     return np.ascontiguousarray(colour_or_grey(pixels))

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from rti_rig.core.clock import Clock
+from rti_rig.core.shell_words import shown_path
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.simulator import dynamixel_models as models
@@ -1059,16 +1060,20 @@ def arm_settings_of(config: str | None) -> tuple[Any, str]:
     try:
         table = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise ValueError(f"{path}: cannot read it as a rig config: {exc}") from None
+        raise ValueError(f"{shown_path(path)}: cannot read it as a rig config: {exc}") from None
     arm = table.get("arm", {}).get("dynamixel")
     if not isinstance(arm, dict):
-        raise ValueError(f"{path}: no [arm.dynamixel] table: give a servo-arm rig config")
+        raise ValueError(
+            f"{shown_path(path)}: no [arm.dynamixel] table: give a servo-arm rig config"
+        )
     try:
         return ArmSettings.model_validate(arm), str(path)
     except ValidationError as exc:
         first = exc.errors()[0]
         where = ".".join(str(p) for p in first["loc"])
-        raise ValueError(f"{path}: key 'arm.dynamixel.{where}': {first['msg']}") from None
+        raise ValueError(
+            f"{shown_path(path)}: key 'arm.dynamixel.{where}': {first['msg']}"
+        ) from None
 
 
 @contextlib.contextmanager

@@ -30,6 +30,7 @@ from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
 from rti_rig.core.image_files import linear_to_srgb8, read_image_any
+from rti_rig.core.shell_words import shown_path
 
 WHITE = 65535
 
@@ -111,8 +112,9 @@ class ReplayCamera:
             if pixels.shape[:2] != self._shape[:2]:
                 raise CaptureError(
                     self.name,
-                    f"{path} is {pixels.shape[1]}x{pixels.shape[0]} but the acquisition's first "
-                    f"image is {self._shape[1]}x{self._shape[0]}: one acquisition, one size",
+                    f"{shown_path(path)} is {pixels.shape[1]}x{pixels.shape[0]} but the "
+                    f"acquisition's first image is {self._shape[1]}x{self._shape[0]}: one "
+                    "acquisition, one size",
                     "capture",
                 )
             source = str(path)

@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.shell_words import shown_path
 
 #: Render passes a scene may ask for. Diffuse (Lambertian) shading is always rendered.
 KNOWN_PASSES = frozenset({"shadows", "specular"})
@@ -577,7 +578,7 @@ def make_scene(
 
 def _read_map(path: Path) -> NDArray:
     if not path.is_file():
-        raise SceneError(f"{path}: no such file")
+        raise SceneError(f"{shown_path(path)}: no such file")
     suffix = path.suffix.lower()
     try:
         if suffix == ".npy":
@@ -589,13 +590,15 @@ def _read_map(path: Path) -> NDArray:
         else:
             data = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
             if data is None:
-                raise SceneError(f"{path}: not an image OpenCV can read (try .npy, .tif, .png)")
+                raise SceneError(
+                    f"{shown_path(path)}: not an image OpenCV can read (try .npy, .tif, .png)"
+                )
             if data.ndim == 3:
                 data = data[..., 2::-1] if data.shape[2] >= 3 else data  # BGR(A) -> RGB
     except SceneError:
         raise
     except Exception as exc:  # unreadable file: say which and why
-        raise SceneError(f"{path}: cannot read map ({exc})") from exc
+        raise SceneError(f"{shown_path(path)}: cannot read map ({exc})") from exc
     return np.asarray(data)
 
 
@@ -634,10 +637,10 @@ def scene_from_depth_file(
     if raw.ndim == 3:
         raw = raw[..., 0]
     if raw.ndim != 2 or raw.shape[0] < 2 or raw.shape[1] < 2:
-        raise SceneError(f"{p}: expected a 2-D height map, got shape {raw.shape}")
+        raise SceneError(f"{shown_path(p)}: expected a 2-D height map, got shape {raw.shape}")
     h = raw.astype(np.float64)
     if not np.all(np.isfinite(h)):
-        raise SceneError(f"{p}: height map contains NaN or infinity")
+        raise SceneError(f"{shown_path(p)}: height map contains NaN or infinity")
     if is_depth:
         h = -h
     if relief_px is not None:
@@ -677,14 +680,16 @@ def scene_from_normal_file(
     p = Path(path)
     raw = _read_map(p)
     if raw.ndim != 3 or raw.shape[2] < 3:
-        raise SceneError(f"{p}: expected an RGB normal map (H, W, 3), got shape {raw.shape}")
+        raise SceneError(
+            f"{shown_path(p)}: expected an RGB normal map (H, W, 3), got shape {raw.shape}"
+        )
     raw = raw[..., :3]
     if np.issubdtype(raw.dtype, np.integer):
         n = 2.0 * raw.astype(np.float64) / float(np.iinfo(raw.dtype).max) - 1.0
     else:
         n = raw.astype(np.float64)
     if not np.all(np.isfinite(n)):
-        raise SceneError(f"{p}: normal map contains NaN or infinity")
+        raise SceneError(f"{shown_path(p)}: normal map contains NaN or infinity")
     if not green_up:
         n[..., 1] = -n[..., 1]
     n[..., 2] = np.maximum(n[..., 2], 1e-3)

@@ -45,7 +45,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.core.state_files import replace_text
 from rti_rig.drivers.dynamixel import control_table as ct
 
@@ -191,7 +191,7 @@ class LatchedErrors:
         unsaid. Unkept, the chain is met by the next command as if power-cycled, which the
         warning says (the console prints it as a note)."""
         warnings.warn(
-            f"the emulated servos' {what} could not be kept in {path} ({exc}): {lost}; "
+            f"the emulated servos' {what} could not be kept in {shown_path(path)} ({exc}): {lost}; "
             f"set {STATE_DIR_ENV} to a writable folder to keep it",
             RuntimeWarning,
             stacklevel=4,  # the caller of save_state / save_eeprom

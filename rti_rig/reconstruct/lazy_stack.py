@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.shell_words import shown_path
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.stack import ImageStack
@@ -133,12 +134,13 @@ class StackSource:
                 frame = self.opener(Path(path))
             except (OSError, ValueError, RtiRigError) as exc:  # RtiRigError: the opener's own
                 raise ImageReadError(
-                    f"cannot read {path} on host {socket.gethostname()}: {exc}"
+                    f"cannot read {shown_path(path)} on host {socket.gethostname()}: {exc}"
                 ) from None
             if tuple(frame.shape) != tuple(expected):
                 raise ImageReadError(
-                    f"{path} on host {socket.gethostname()} has shape {tuple(frame.shape)}, "
-                    f"expected {tuple(expected)}: not the file the fit was planned on"
+                    f"{shown_path(path)} on host {socket.gethostname()} has shape "
+                    f"{tuple(frame.shape)}, expected {tuple(expected)}: not the file the fit was "
+                    "planned on"
                 )
             frames.append(frame)
         stack = ImageStack(frames, scale=self.scale, saturation_level=self.saturation_level)
