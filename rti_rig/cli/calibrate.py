@@ -176,7 +176,7 @@ def _setting_line(target: Path, rig_config: Path) -> str | None:
     user to paste under ``[dome.serial]``; None where the name is not UTF-8 (no TOML file can
     hold it: :func:`_not_toml_text` says so).
 
-    Why: it was printed as ``"{rel}"`` unquoted, a line TOML refused or read as another name."""
+    Why: it was printed as ``"{rel}"``, the name unescaped: a line TOML refused or misread."""
     rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
     try:
         return f"intensity_correction_file = {toml_basic_string(rel)}"

@@ -4,7 +4,7 @@ file's name.
 
 Why: the errors began with the raw path (``f"{root}: ..."``): in a C locale with an ASCII stdout,
 a folder whose name is not UTF-8 was said as ``caf?`` or ``caf\\udce9``, neither of which names
-it; and ``intensity_correction_file = "{rel}"`` was printed unquoted, a line TOML refuses (a
+it; and ``intensity_correction_file = "{rel}"`` was printed unescaped, a line TOML refuses (a
 quote, a backslash) or cannot hold (bytes that are not UTF-8). Through ``python -m rti_rig``,
 each word given to bash as the user would paste it.
 """
