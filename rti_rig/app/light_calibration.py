@@ -20,6 +20,7 @@ times the exposure it needed under the median LED), which is reported.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -34,6 +35,7 @@ from rti_rig.app.dead_led import dead_led_recorded
 from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.shell_words import shell_word, shown_path
+from rti_rig.core.toml_strings import toml_basic_string
 from rti_rig.planner.topography import downsample
 from rti_rig.reconstruct import ReconstructionError, estimate_light_gains
 from rti_rig.runtime.session import (
@@ -537,7 +539,8 @@ def calibration_toml(
         return listing([f"{v:.4f}" for v in values])
 
     lines = [
-        f"# Light calibration of dome '{rig_name}' from the card session {session}.",
+        f"# Light calibration of dome '{rig_name}' from the card session "
+        f"{_toml_string(_as_text(session))}.",
         "# Use it from the rig config, under [dome.serial]:",
         '#   intensity_correction_file = "<path of this file, relative to the config>"',
         "# then shoot the card again and calibrate that session: its spread is what is left.",
@@ -548,7 +551,7 @@ def calibration_toml(
         f"# {evened_sentence(cal, 3)}.",
         f'format = "{FORMAT}"',
         f"rig = {_toml_string(rig_name)}",
-        f"session = {_toml_string(str(session))}",
+        f"session = {_toml_string(_as_text(session))}",
         f'created = "{created}"',
         f"measured = {listing(['true' if m else 'false' for m in cal.measured])}",
         "# each LED's output at full drive relative to the median measured LED, LED order",
@@ -561,4 +564,14 @@ def calibration_toml(
 
 
 def _toml_string(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return toml_basic_string(text)
+
+
+def _as_text(path: Path) -> str:
+    """``path`` as text a TOML file (UTF-8) can hold: a byte of its name that is not UTF-8 is
+    written ``\\xHH``, as Python shows it.
+
+    Why: a card session in a folder whose name is not UTF-8 ended calibrate-lights with a
+    traceback (UnicodeEncodeError) as the file was written, after the whole measurement; its
+    name is only a record here (nothing reads it back as a path)."""
+    return os.fsencode(path).decode("utf-8", "backslashreplace")
