@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tomllib
@@ -41,12 +42,17 @@ def rti_rig(*args: str | Path) -> subprocess.CompletedProcess[bytes]:
     return r
 
 
+def pasted(word: bytes) -> bytes:
+    """What bash makes of ``word`` pasted into a command line."""
+    return subprocess.run(["bash", "-c", b"printf %s " + word], capture_output=True).stdout
+
+
 def first_word_after_error(said: bytes) -> bytes:
     """The ``$'...'`` word that opens the error, as bash reads it back pasted."""
     assert said.startswith(b"error: $'"), said
     word = WORD.match(said, len(b"error: "))
     assert word is not None, said
-    return subprocess.run(["bash", "-c", b"printf %s " + word[0]], capture_output=True).stdout
+    return pasted(word[0])
 
 
 @pytest.fixture
@@ -129,3 +135,24 @@ def test_the_line_to_paste_names_a_quote_and_backslash_as_toml_reads_them(
     named = tomllib.loads(line)["intensity_correction_file"]
     assert (cfg.parent / named).resolve() == target.resolve(), line
     assert target.is_file()
+
+
+def test_a_calibration_written_into_such_a_card_session_says_how_to_give_it_to_toml(
+    card: tuple[Path, Path], odd: Path
+) -> None:
+    session, cfg = card
+    copy = odd / "card"
+    shutil.copytree(session, copy)
+    r = rti_rig("calibrate-lights", copy, "--rig", cfg)
+    assert r.returncode == 0, r.stderr  # measured and written: nothing to refuse
+    target = copy / "light_calibration.toml"
+    # written whole, and TOML: the session's name recorded in it as text (it had ended in a
+    # traceback, UnicodeEncodeError, as the file was written)
+    written = tomllib.loads(target.read_text(encoding="utf-8"))
+    assert len(written["intensity_correction"]) == 48
+    assert written["session"].endswith("caf\\xe9 it's/card"), written["session"]
+    assert b"intensity_correction_file = " not in r.stdout, r.stdout  # no line TOML holds
+    said = r.stderr.split(b"warning: ", 1)[1]
+    assert b"not UTF-8 text, which a TOML file cannot hold" in said, r.stderr
+    assert pasted(WORD.match(said)[0]) == os.fsencode(target), r.stderr
+    assert pasted(WORD.match(said.split(b"(cp ", 1)[1])[0]) == os.fsencode(target), r.stderr
