@@ -14,7 +14,7 @@ from pathlib import Path
 from rti_rig.app.output_files import check_output_file, lp_name_note
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import LpEntry, write_lp
-from rti_rig.core.shell_words import shell_word, shown_path
+from rti_rig.core.shell_words import shown_path
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
     LP_NAME,
@@ -146,7 +146,7 @@ def _in_session_said(out_file: Path, root: Path) -> str:
         return (
             f"{shown_path(out_file)} is written inside the session {shown_path(root)}, beside its "
             f"own {LP_NAME}, which is left as captured (a session's files are never replaced); "
-            f"rti-rig fit {shell_word(str(root))} reads {LP_NAME}: give {shown_path(out_file)} "
+            f"rti-rig fit {shown_path(root)} reads {LP_NAME}: give {shown_path(out_file)} "
             "itself to use this one; " + _relight_reads(root, out_file.name)
         )
     return (
