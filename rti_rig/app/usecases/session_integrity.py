@@ -379,10 +379,11 @@ def session_traces(source: Path, lp: Path) -> list[str]:
     Why: such a folder was called "an imported acquisition (an .lp with no rti-rig session
     record beside it)", its images "kept as they are", where it is a session of this rig whose
     record was lost: the object may still be under the dome, and what was lost is what
-    vouches for the images. rti-rig writes no comment into ``lights.lp`` nor any tag into its
-    JPEGs (:func:`~rti_rig.core.lp_format.format_lp`,
-    :func:`~rti_rig.core.image_files.write_srgb_jpeg`): its traces are the names it gives and
-    the folders it keeps beside them."""
+    vouches for the images. rti-rig writes no comment into ``lights.lp``
+    (:func:`~rti_rig.core.lp_format.format_lp`), and its JPEGs' colour tags (Exif ColorSpace
+    and an sRGB ICC profile, :func:`~rti_rig.core.image_files.write_srgb_jpeg`; none on a
+    camera-RGB or grey JPEG) are not read here as a trace: its traces are the names it gives
+    and the folders it keeps beside them."""
     found = []
     if lp.name == LP_NAME:
         try:
