@@ -24,6 +24,7 @@ from __future__ import annotations
 import atexit
 import collections
 import contextlib
+import errno
 import os
 import select
 import sys
@@ -157,6 +158,8 @@ class Fd2Copy:
         self._errors = getattr(stream, "errors", None) or "backslashreplace"
 
     def write(self, text: str) -> int:
+        if self.fd < 0:  # closed: never a write to a number a later open() may have taken
+            raise OSError(errno.EBADF, "the copy of descriptor 2 is closed")
         data = memoryview(text.encode(self._encoding, self._errors))
         while data:
             try:
@@ -171,6 +174,30 @@ class Fd2Copy:
 
     def flush(self) -> None:
         """Nothing is buffered: each word is written as it comes."""
+
+    def close(self) -> None:
+        """Close the copy; a later write through it fails (the writer drops that word)."""
+        fd, self.fd = self.fd, -1
+        if fd >= 0:
+            with contextlib.suppress(OSError):
+                os.close(fd)
+
+
+class _ClosedInTurn:
+    """A :class:`Fd2Copy` closed by the writer thread once the words queued before this
+    (``flush`` of it queued as any flush is) are written.
+
+    Why: closed by the next console entry as soon as the queue looked empty, the copy could
+    be closed while the thread wrote its last word (taken off the queue, waiting in
+    ``select`` for a full pipe's room): the word was lost, or written to whatever a later
+    ``open()`` got that descriptor number for; and with words still queued it was never
+    closed."""
+
+    def __init__(self, copy: Fd2Copy) -> None:
+        self._copy = copy
+
+    def flush(self) -> None:
+        self._copy.close()
 
 
 def _fd2_copy(stderr: Any) -> Fd2Copy | None:
@@ -202,9 +229,8 @@ def words_unwaited(consoles: tuple[Any, Any]) -> None:
         _writer = WordsWriter(notes_to=stderr)
         atexit.register(words_written)
     copy = _fd2_copy(stderr)  # stderr's words never land where fd 2 is pointed for a moment
-    if _copy is not None and not _writer._items:  # nothing left queued for the last entry's
-        with contextlib.suppress(OSError):
-            os.close(_copy.fd)
+    if _copy is not None:  # the last entry's: closed by the thread after its queued words
+        _writer.flush(_ClosedInTurn(_copy))
     _copy = copy
     _writer.notes_to = stderr if copy is None else copy
     sys.stdout = out.file = UnwaitedStream(stdout, _writer)  # type: ignore[assignment]

@@ -10,8 +10,10 @@ a full pipe whose reader stalled held it (a DSLR's frame is decoded with the lig
 
 from __future__ import annotations
 
+import contextlib
 import io
 import os
+import select
 import sys
 
 import pytest
@@ -56,3 +58,52 @@ def test_lines_the_decoder_gives_back_go_through_sys_stderr(
     assert printed == ["data corrupted at 1024"]
     assert words.getvalue() == "another library's warning\n"
     assert capfd.readouterr().err == ""  # nothing written to fd 2 from the main thread
+
+
+def test_a_later_entry_closes_the_last_copy_only_after_the_word_being_written(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The thread has taken the last entry's word off the queue and waits for room in a full
+    pipe: a second entry (a second ``main()`` in one process, as tests run it) must not close
+    that copy under it (the word was lost, or written to a descriptor number a later
+    ``open()`` took); it is closed once the word is out."""
+    import fcntl
+    import types
+
+    from rti_rig.cli import unwaited_words
+    from rti_rig.cli.unwaited_words import Fd2Copy, words_unwaited
+
+    r, w = os.pipe()
+    try:
+        os.set_blocking(w, False)
+        os.set_blocking(r, False)
+        room = fcntl.fcntl(w, fcntl.F_GETPIPE_SZ)
+        os.write(w, b"x" * room)  # full: the word must wait for the reader
+        copy = Fd2Copy(io.StringIO(), os.dup(w))
+        writer = WordsWriter(notes_to=io.StringIO())
+        monkeypatch.setattr(unwaited_words, "_writer", writer)
+        monkeypatch.setattr(unwaited_words, "_copy", copy)
+        monkeypatch.setattr(sys, "stdout", io.StringIO())
+        monkeypatch.setattr(sys, "stderr", io.StringIO())  # no descriptor: no copy of its own
+        writer.write(copy, "the last word\n")
+        for _ in range(60_000):  # taken off the queue by the thread (bounded, not timed)
+            if not writer._items:
+                break
+            os.sched_yield()
+        consoles = (types.SimpleNamespace(file=None), types.SimpleNamespace(file=None))
+        words_unwaited(consoles)  # the next entry
+        got = b""
+        while len(got) < room:  # the reader comes back: the filler, then room for the word
+            try:
+                got += os.read(r, room)
+            except BlockingIOError:
+                select.select([r], [], [])
+        writer.drain()  # the word written (or dropped), then the copy closed
+        tail = b""
+        with contextlib.suppress(BlockingIOError):
+            tail = os.read(r, 4096)
+        assert got[room:] + tail == b"the last word\n"
+        assert copy.fd == -1  # closed, not left open
+    finally:
+        os.close(r)
+        os.close(w)
