@@ -315,6 +315,10 @@ def plan(request: PlanRequest) -> tuple[LightSchedule, PlanReport]:
         # s; an arm's plan, or one of every LED, never loads it): loaded here so that the
         # report's "planned in" times the planning, not an import
         import scipy.optimize  # noqa: F401
+    if method.name == "kmeans":
+        # k-means clusters with scikit-learn, whose first import (sklearn.cluster, ~5 s on a busy
+        # machine) dwarfs the planning: loaded here for the same reason, and only for k-means
+        import sklearn.cluster  # noqa: F401
     with threadpool_limits(limits=1):
         return _plan(request, method)
 

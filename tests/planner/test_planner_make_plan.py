@@ -368,3 +368,25 @@ def test_signal_noise_is_reported_only_where_it_was_modelled() -> None:
     via_report, _ = plan_with_report(None, REAL_DOME, 12, "optimal", signal_noise=0.05)
     assert [s.led for s in via_make.steps] == [s.led for s in via_report.steps]
     assert via_make.provenance["report"]["signal_noise"] == 0.05
+
+
+@pytest.mark.parametrize(("method", "loaded"), [("kmeans", True), ("uniform", False)])
+def test_kmeans_imports_sklearn_before_the_planning_clock_starts(
+    method: str, loaded: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The "planned in" figure times the planning: k-means' sklearn import (seconds) happens
+    before the timed ``_plan``, and a uniform plan never pays for it."""
+    import sys
+
+    import rti_rig.planner.make_plan as mp
+
+    monkeypatch.delitem(sys.modules, "sklearn.cluster", raising=False)
+    seen: list[bool] = []
+
+    def spy(req, m):
+        seen.append("sklearn.cluster" in sys.modules)
+        return "planned"
+
+    monkeypatch.setattr(mp, "_plan", spy)
+    assert plan_with_report(PREVIEW, DOME, 6, method) == "planned"
+    assert seen == [loaded]
