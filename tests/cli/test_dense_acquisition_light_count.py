@@ -45,7 +45,8 @@ def test_a_dense_acquisition_replayed_without_lights_says_so_and_what_to_do(
     assert "--lights 1001" not in text, text
     assert f"1001 lights (every image of the acquisition {lp})" in text, text
     assert "at most 1000 lights per session" in text, text
-    assert "give --lights N, at most 1000" in text, text
+    assert "give --lights with a count of at most 1000" in text, text
+    assert "(e.g. --lights 1000)" in text, text
     assert not out.exists()
     # and the way out it names works
     r = CliRunner().invoke(

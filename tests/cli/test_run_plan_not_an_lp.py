@@ -64,7 +64,8 @@ def test_a_rig_config_given_as_the_plan_is_said_to_be_one_with_the_commands_to_m
             "), not a plan: --plan takes a plan file, the .lp light list (a count line, then "
             "'name x y z' per image) that rti-rig plan writes; make one with: rti-rig plan "
             f"--rig {rig} --out plan.lp, then run it with: rti-rig run {rig} --plan plan.lp "
-            "--out SESSION"
+            f"--out {out} (or run a homogeneous layout without a plan: rti-rig run {rig} "
+            f"--lights 12 --out {out})"
         ) in text, text
         assert "a rig config?" not in text
         assert not out.exists()

@@ -963,14 +963,16 @@ PLAN_WANTED = (
 )
 
 
-def _refuse_rig_config_as_plan(plan: Path, rig_config: Path) -> None:
+def _refuse_rig_config_as_plan(plan: Path, rig_config: Path, out_dir: Path) -> None:
     """Refuse a rig config given as ``--plan``, saying that it is one, what ``--plan`` takes
     and the commands that make and run a plan.
 
     Why: it had been told "this is a TOML file (a rig config?), not an .lp", a guess that left
     the user to work out that a plan is another file and where one comes from. Told by its
     content (a TOML table with a rig's ``kind``), not its name alone; any other file is left to
-    the .lp reader, which says what it is."""
+    the .lp reader, which says what it is. The commands name the run's own ``--out`` (nothing
+    was written to it) and a real count: ``--out SESSION`` and ``--lights N`` had been printed,
+    which pasted as printed ran into a folder named SESSION or were refused."""
     import tomllib
 
     if plan.suffix.lower() != ".toml" or not plan.is_file():
@@ -982,13 +984,13 @@ def _refuse_rig_config_as_plan(plan: Path, rig_config: Path) -> None:
     if data.get("kind") not in ("dome", "arm"):
         return
     name = f" ({data['name']})" if isinstance(data.get("name"), str) and data["name"] else ""
-    rig = shell_word(str(rig_config))
+    rig, out = shell_word(str(rig_config)), shell_word(str(out_dir))
     raise RtiRigError(
         f"--plan {plan} is a rig config{name}, not a plan: --plan takes a plan file, the .lp "
         "light list (a count line, then 'name x y z' per image) that rti-rig plan writes; "
         f"make one with: rti-rig plan --rig {rig} --out plan.lp, then run it with: rti-rig run "
-        f"{rig} --plan plan.lp --out SESSION (or give --lights N for a homogeneous layout "
-        "without a plan)"
+        f"{rig} --plan plan.lp --out {out} (or run a homogeneous layout without a plan: "
+        f"rti-rig run {rig} --lights 12 --out {out})"
     )
 
 
@@ -1010,7 +1012,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     if req.plan is not None:
         if req.lights is not None:
             raise RtiRigError("give either --plan or --lights, not both")
-        _refuse_rig_config_as_plan(Path(req.plan), Path(req.rig_config))
+        _refuse_rig_config_as_plan(Path(req.plan), Path(req.rig_config), Path(req.out_dir))
         plan_notes: list[str] = []
         entries = read_lp(req.plan, upper_hemisphere=True, notes=plan_notes, wanted=PLAN_WANTED)
         for note in plan_notes:
@@ -1043,7 +1045,8 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         check_light_count(
             n,
             f"{n} lights ({every})",
-            f"give --lights N, at most {MAX_LIGHTS}, to run N of them spread over the directions",
+            f"give --lights with a count of at most {MAX_LIGHTS} to run that many spread over "
+            f"the directions (e.g. --lights {MAX_LIGHTS})",
         )
     if loaded.config.backend == "replay":  # its "LEDs" are images, in the band or not
         # (with --min/--max-elevation-deg the planner's refusal had said "the dome has only
