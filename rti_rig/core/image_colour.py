@@ -33,6 +33,8 @@ EXIF_COLORSPACE_SRGB = 1
 #: "rti-rig: " (kept as the RAW-derived description always began: "rti-rig: linear ...")
 LINEAR_SRGB = "linear sRGB (IEC 61966-2-1 primaries, D65 white, gamma 1.0: NOT sRGB-encoded)"
 LINEAR_CAMERA_RGB = "linear camera RGB (no colour matrix: neither sRGB primaries nor curve)"
+#: what a grey (one-channel) linear TIFF not from a RAW holds: no primaries to name
+LINEAR_GREY = "linear grey (one channel, gamma 1.0: NOT sRGB-encoded)"
 
 
 def _s15f16(v: float) -> bytes:

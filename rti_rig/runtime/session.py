@@ -61,6 +61,7 @@ from rti_rig.core.image_colour import (
     JPEG_COLOUR_WORDS,
     LINEAR_CAMERA_RGB,
     LINEAR_COLOUR_WORDS,
+    LINEAR_GREY,
     LINEAR_SRGB,
     decode_colour,
     icc_profile,
@@ -943,7 +944,7 @@ class SessionFolder:
                     decode["camera_file"] = originals[rel][1]
             sha = {name: digest for name, (digest, _) in originals.items()}
             current = self.root / tif
-            description = _tiff_description(decode, frame.white_level)
+            description = _tiff_description(decode, frame.white_level, grey=frame.pixels.ndim == 2)
             colour = decode_colour(decode)
             # only sRGB pixels are said to be sRGB: camera RGB or a mosaic carries no tag
             icc = icc_profile("linear") if colour == "srgb" else None
@@ -1503,15 +1504,21 @@ def _fsync_sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _tiff_description(decode: dict[str, Any], white_level: int | None = None) -> str:
+def _tiff_description(
+    decode: dict[str, Any], white_level: int | None = None, grey: bool = False
+) -> str:
     """A label inside the linear TIFF saying what its pixels are: linear (not sRGB-encoded),
     in which colours, and for a RAW-derived image how it was decoded.
 
     Why for every image: a TIFF not from a RAW had held only tifffile's ``{"shape": ...}``,
     nothing saying it is linear, and viewers took it as sRGB and showed it dark. The mosaic
-    label begins :data:`MOSAIC_TIFF_LABEL` (``rti-rig fit`` refuses a file by it)."""
+    label begins :data:`MOSAIC_TIFF_LABEL` (``rti-rig fit`` refuses a file by it). ``grey``:
+    one channel, said to be linear grey (it had been called linear sRGB, colours it has none
+    of)."""
     if not decode:
         white = f", white level {white_level}" if white_level else ""
+        if grey:
+            return f"rti-rig: {LINEAR_GREY}, 16-bit{white} (the camera's own, not a RAW's)"
         return f"rti-rig: {LINEAR_SRGB}, 16-bit{white} (the camera's own colours, not a RAW's)"
     if decode.get("mode") == "mosaic":
         return (
