@@ -37,6 +37,7 @@ from rti_rig.core.deferred_signals import (
     put_back,
     signal_handlers,
     stop_words,
+    within_after_a_stop,
 )
 from rti_rig.core.errors import RtiRigError
 
@@ -1527,9 +1528,12 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     #: the stop's line of what the teardown did (the lights) is out: a Ctrl-C after it is
     #: pointed above, not below
     teardown_said = False
+    #: the signal of the emergency stop a handler here raised (SIGTERM, SIGHUP for a hang-up,
+    #: SIGINT for a second Ctrl-C), None before one
+    stopping: signal.Signals | None = None
 
     def on_sigint(signum, frame):  # type: ignore[no-untyped-def]
-        nonlocal ended, late_said
+        nonlocal ended, late_said, stopping
         if ended:
             # a second Ctrl-C meant as "stop at once", landing as the session's end is
             # reported (its except or finally clauses, before the ignore is set) had raised
@@ -1542,6 +1546,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             return
         if cancel.cancelled:
             ended = not started  # stopped before the capture began: it never will
+            stopping = signal.SIGINT  # a SIGTERM in its teardown is said, not raised
             raise EmergencyStop(signal.SIGINT, "second Ctrl-C")
         cancel.cancel()
         if _park_stopped_by(opened.rig) is not None:  # delivered after the teardown it stopped:
@@ -1561,9 +1566,22 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         err.print("[yellow]Stopping after this image (Ctrl-C again to stop at once)…[/]")
 
     def on_sigterm(signum, frame):  # type: ignore[no-untyped-def]
+        nonlocal stopping
         if ended:  # as for Ctrl-C: nothing left to stop; the handler from before answers it
             _as_before(previous.get(signal.SIGTERM), signum, frame)
             return
+        if stopping is not None and not within_after_a_stop():
+            # a stop is under way (its teardown, or the except clauses before it): a second
+            # EmergencyStop raised there had replaced the first (said and exited as itself,
+            # recorded as neither) or cut the teardown; said in one line, the first one goes
+            # on. Not while the teardown reopens a port (after_a_stop): there a further stop
+            # still ends an opening that may hang
+            err.print(
+                f"[yellow]{stop_words(as_received(signum))} also arrived: the stop "
+                f"({stop_words(stopping)}) is already under way (lights off, records).[/]"
+            )
+            return
+        stopping = as_received(signum)
         raise EmergencyStop(signal.SIGTERM)
 
     def on_sigusr1(signum, frame):  # type: ignore[no-untyped-def]

@@ -119,6 +119,13 @@ def after_a_stop() -> Iterator[None]:
         _after_a_stop -= 1
 
 
+def within_after_a_stop() -> bool:
+    """Whether an :func:`after_a_stop` block is open: a stop's teardown reopening a port, where
+    a further stop is the user insisting that a hung opening be ended (the CLI raises it there
+    rather than only saying it)."""
+    return _after_a_stop > 0
+
+
 @contextlib.contextmanager
 def signals_deferred(
     on_held: Callable[[int], None] | None = None, *, second_stops: bool = False

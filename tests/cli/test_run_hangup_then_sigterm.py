@@ -17,7 +17,11 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, ended_on_exit, eventually
+from conftest import CONFIGS, ended_on_exit, eventually, manifest, said, sighup_at_lit_led
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.deferred_signals import signal_handlers
 
 pytestmark = pytest.mark.skipif(
     sys.platform != "linux" or not hasattr(signal, "SIGHUP"), reason="signals tested on Linux"
@@ -48,7 +52,9 @@ def test_a_hangup_then_a_sigterm_is_said_recorded_and_exited_as_the_hangup(
     assert process.returncode == 129, words  # 128 + SIGHUP
     assert "Traceback" not in words, words
     assert "Emergency stop (SIGHUP): lights were switched off." in words, words
-    assert "SIGTERM" not in words, words
+    # said once, as a signal that came during the stop, never as the stop's name
+    also = "SIGTERM also arrived: the stop (SIGHUP) is already under way"
+    assert words.count(also) == 1 and words.count("SIGTERM") == 1, words
     runner = json.loads((out / "manifest.json").read_text())["runner"]
     assert runner["finish_reason"] == "emergency-stop", runner
     assert runner["error"] == "emergency stop: SIGHUP", runner
@@ -57,3 +63,48 @@ def test_a_hangup_then_a_sigterm_is_said_recorded_and_exited_as_the_hangup(
     assert len(journal) == len(kept) >= 2, (journal, kept)
     listed = (out / "lights.lp").read_text()
     assert all(name in listed for name in kept), listed
+
+
+class SigtermUnhandled(Exception):
+    """A SIGTERM nothing in rti-rig answered (the default would end pytest)."""
+
+
+def test_a_sigterm_during_a_hangups_teardown_is_said_and_the_teardown_finishes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, hangup_guarded: None
+) -> None:
+    """The SIGTERM is raised in the run's own process as the hang-up's teardown switches the
+    dome off (no timing): it had raised a second emergency stop as the teardown's hold ended,
+    which replaced the hang-up's (said "Emergency stop (SIGTERM)", exit 143, while the manifest
+    recorded SIGHUP)."""
+    from rti_rig.runtime.lighting import DomeLighting
+
+    out = tmp_path / "s"
+    real_safe = DomeLighting.safe
+    sent: list[bool] = []
+
+    def safe(self, emergency: bool = False) -> list[str]:  # type: ignore[no-untyped-def]
+        if emergency and not sent:
+            sent.append(True)
+            signal.raise_signal(signal.SIGTERM)  # held by the teardown, delivered after it
+        return real_safe(self, emergency)
+
+    def unhandled(signum: int, frame: object) -> None:
+        raise SigtermUnhandled("SIGTERM was not handled by rti-rig")
+
+    with monkeypatch.context() as patched, signal_handlers({signal.SIGTERM: unhandled}):
+        firmwares = sighup_at_lit_led(patched, 3)
+        patched.setattr(DomeLighting, "safe", safe)
+        argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
+        r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
+    words = said(r)
+    assert sent == [True]
+    assert r.exit_code == 129, words  # the hang-up's stop, not the SIGTERM's (143)
+    assert "Traceback" not in words and not isinstance(r.exception, SigtermUnhandled), words
+    assert "SIGTERM also arrived: the stop (SIGHUP) is already under way" in words, words
+    assert words.count("SIGTERM") == 1, words
+    assert "Emergency stop (SIGHUP): all-off sent and acknowledged by the dome" in words, words
+    (firmware,) = firmwares
+    assert firmware.lit is None and firmware.history[-1].what == "off"
+    runner = manifest(out)["runner"]
+    assert runner["finish_reason"] == "emergency-stop", runner
+    assert runner["error"] == "emergency stop: SIGHUP", runner
