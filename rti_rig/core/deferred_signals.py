@@ -193,7 +193,7 @@ def signals_deferred(
         if second_stops and len(pending) > 1 and not released:
             release()  # the user insists: acted on here, in the block, as if never held
             if raised:
-                first = raised[0]
+                first = _first_of(raised)
                 raised.clear()
                 raise first
 
@@ -212,7 +212,23 @@ def signals_deferred(
                 if signal.getsignal(sig) is hold:
                     _swap_handler(sig, handler, raised)
         if raised:
-            raise raised[0]
+            raise _first_of(raised)
+
+
+def _first_of(raised: list[BaseException]) -> BaseException:
+    """The first of the exceptions the handlers of the signals a hold delivered raised, with
+    each later one added to its notes ("also raised as the hold ended: …").
+
+    Why: one hold can deliver several stops (a SIGTERM and a second Ctrl-C landing in the same
+    commit); only the first can be raised, and it keeps the first stop's teardown, but the
+    rest had been dropped without a trace. A handler that must be heard when a stop is under
+    way says it as it runs (the CLI's "Ctrl-C also arrived" line); the notes keep what it
+    raised for a traceback or a log."""
+    first = raised[0]
+    for later in raised[1:]:
+        if later is not first:
+            first.add_note(f"also raised as the hold ended: {type(later).__name__}: {later}")
+    return first
 
 
 def handlers_settable() -> bool:

@@ -79,3 +79,28 @@ def test_inside_the_teardowns_hold_a_second_stop_stays_held() -> None:
             reached.append("opened")
         reached.append("all-off sent")
     assert reached == ["opened", "all-off sent"]
+
+
+class Named(BaseException):
+    pass
+
+
+@pytest.mark.parametrize("second_stops", [False, True], ids=["held", "second-stops"])
+def test_stops_one_hold_delivers_are_raised_first_and_the_rest_kept_in_its_notes(
+    second_stops: bool,
+) -> None:
+    """Only the first exception can be raised (it keeps the first stop's teardown); the later
+    one had been dropped without a trace."""
+
+    def named(signum: int, frame: Any) -> None:
+        raise Named(signal.Signals(signum).name)
+
+    wanted = {signal.SIGINT: named, signal.SIGTERM: named}
+    held = signals_deferred(second_stops=second_stops)
+    with signal_handlers(wanted), pytest.raises(Named) as caught, held:
+        signal.raise_signal(signal.SIGTERM)
+        signal.raise_signal(signal.SIGINT)
+    assert str(caught.value) == "SIGTERM"
+    assert getattr(caught.value, "__notes__", []) == [
+        "also raised as the hold ended: Named: SIGINT"
+    ]
