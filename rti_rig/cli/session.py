@@ -1544,6 +1544,24 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
                 late = _LATE_CTRL_C_SAID_ABOVE if teardown_said else _LATE_CTRL_C
                 err.print(f"[yellow]{late if started else closing}[/]")
             return
+        if stopping is not None:
+            # a stop is under way (a SIGTERM's, a hang-up's, a second Ctrl-C's): a Ctrl-C now
+            # had raised "second Ctrl-C" as the teardown's hold ended, which replaced the stop
+            # (said, recorded and exited as a Ctrl-C's, 130, not the SIGTERM's 143), or was
+            # dropped unsaid when the same hold delivered another stop first; and a first
+            # Ctrl-C there had been told "Stopping after this image". The teardown is already
+            # the "stop at once" a Ctrl-C asks for (all-off, a park cut short as it is held):
+            # said in one line, the first stop goes on. While the teardown reopens a port
+            # (after_a_stop) the Ctrl-C escalates: it ends an opening that may hang, and its
+            # words name both (the exit code stays the first stop's)
+            began = stop_words(stopping)
+            if within_after_a_stop():
+                raise EmergencyStop(stopping, f"{began}, then Ctrl-C to stop at once")
+            err.print(
+                f"[yellow]Ctrl-C also arrived: the stop ({began}) is already under way "
+                "(lights off, records).[/]"
+            )
+            return
         if cancel.cancelled:
             ended = not started  # stopped before the capture began: it never will
             stopping = signal.SIGINT  # a SIGTERM in its teardown is said, not raised
@@ -1587,6 +1605,13 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     def on_sigusr1(signum, frame):  # type: ignore[no-untyped-def]
         if ended:  # as the session's end is reported: "Pausing after this image" had been said
             err.print("[yellow]SIGUSR1 ignored: a session pauses only while it captures.[/]")
+            return
+        if stopping is not None:  # not held as stops are: "Pausing after this image" had
+            # been said in a stop's teardown, of a run that was ending
+            err.print(
+                f"[yellow]SIGUSR1 ignored: the stop ({stop_words(stopping)}) is under way "
+                "(lights off, records).[/]"
+            )
             return
         if cancel.paused:
             cancel.resume()
