@@ -1554,9 +1554,10 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             # said in one line, the first stop goes on. While the teardown reopens a port
             # (after_a_stop) the Ctrl-C escalates: it ends an opening that may hang, and its
             # words name both (the exit code stays the first stop's)
-            began = stop_words(stopping)
+            began = "second Ctrl-C" if stopping == signal.SIGINT else stop_words(stopping)
             if within_after_a_stop():
-                raise EmergencyStop(stopping, f"{began}, then Ctrl-C to stop at once")
+                escalated = began if stopping == signal.SIGINT else f"{began}, then Ctrl-C"
+                raise EmergencyStop(stopping, escalated)
             err.print(
                 f"[yellow]Ctrl-C also arrived: the stop ({began}) is already under way "
                 "(lights off, records).[/]"
