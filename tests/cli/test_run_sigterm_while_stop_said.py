@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import signal
 import sys
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -41,18 +42,27 @@ def _sigterm_as_the_end_is_said(monkeypatch: pytest.MonkeyPatch, wording: str) -
     return sent
 
 
-def _stopped_by_ctrl_c(monkeypatch: pytest.MonkeyPatch, times: int) -> None:
-    """Ctrl-C ``times`` times (twice: stop at once) once the second image is committed."""
+def _stopped_by_ctrl_c(monkeypatch: pytest.MonkeyPatch, times: int) -> list[bool]:
+    """Ctrl-C ``times`` times (twice: stop at once) once the second image is committed.
+
+    No race with the 4 images left: the signals are raised in the main thread, inside the
+    commit's hold, which delivers them as it ends, before the next image. Returns whether the
+    commit ran in the main thread (asserted: off it, the handler would run whenever the main
+    thread next checks, possibly after the capture, and the test would race as a subprocess's
+    did, see 1fcd3d88)."""
     real = SessionFolder.write_step
+    in_main: list[bool] = []
 
     def write_step(self, index, *args, **kwargs):  # type: ignore[no-untyped-def]
         record = real(self, index, *args, **kwargs)
         if index == 1:
+            in_main.append(threading.current_thread() is threading.main_thread())
             for _ in range(times):
                 signal.raise_signal(signal.SIGINT)
         return record
 
     monkeypatch.setattr(SessionFolder, "write_step", write_step)
+    return in_main
 
 
 def _camera_fails_at_third(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -79,16 +89,18 @@ def _camera_fails_at_third(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_a_sigterm_while_the_end_of_the_capture_is_said_exits_143(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, ending: str, wording: str, said_first: str
 ) -> None:
+    in_main = [True]
     if ending == "error":
         _camera_fails_at_third(monkeypatch)
     else:
-        _stopped_by_ctrl_c(monkeypatch, 2 if ending == "two ctrl-c" else 1)
+        in_main = _stopped_by_ctrl_c(monkeypatch, 2 if ending == "two ctrl-c" else 1)
     sent = _sigterm_as_the_end_is_said(monkeypatch, wording)
     out = tmp_path / "s"
     argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--lights", "6", "--out", str(out)]
     r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
     said = " ".join(r.output.split())
     assert sent == [signal.SIGTERM], said
+    assert in_main == [True], said  # raised where the commit's hold delivers them at once
     assert "Traceback" not in said, said
     assert said_first in said, said  # what the run was saying is out
     assert "2 image(s)" in said and "Continue with: rti-rig run --resume" in said, said
