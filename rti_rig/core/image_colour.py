@@ -213,10 +213,13 @@ JPEG_COLOUR_WORDS: dict[str, str] = {
     "matrix)",
     "mosaic": "CFA mosaic through the sRGB curve: grey checkerboards, not pictures (untagged)",
 }
+#: (one sentence each: what the pixels are, then where the file says it; ``"grey"`` is a
+#: one-channel linear TIFF not from a RAW, whose ImageDescription says linear grey)
 LINEAR_COLOUR_WORDS: dict[str, str] = {
-    "srgb": f"{LINEAR_SRGB} (tagged: the ImageDescription, and a linear-sRGB ICC profile on "
-    "a colour image)",
-    "camera": f"{LINEAR_CAMERA_RGB} (no ICC profile; said in the ImageDescription)",
-    "mosaic": "CFA mosaic, linear, one colour per pixel (no ICC profile; said in the "
-    "ImageDescription)",
+    "srgb": f"{LINEAR_SRGB}, said in the ImageDescription and tagged with a linear-sRGB ICC "
+    "profile",
+    "grey": f"{LINEAR_GREY}, said in the ImageDescription, with no ICC profile (no colours)",
+    "camera": f"{LINEAR_CAMERA_RGB}, said in the ImageDescription, with no ICC profile",
+    "mosaic": "CFA mosaic, linear, one colour per pixel, said in the ImageDescription, with no "
+    "ICC profile",
 }

@@ -1186,7 +1186,7 @@ class SessionFolder:
                 "lp_file": LP_NAME if ordered and lp_error is None else None,
                 "steps": [asdict(r) for r in ordered],
                 "notices": session_notices(ordered),
-                "image_colour": image_colour(ordered),
+                "image_colour": image_colour(ordered, self.root),
             }
         )
         _write_json_atomic(self.root / MANIFEST, self.manifest)
@@ -1205,20 +1205,43 @@ CAMERA_RGB_NOTICE = (
 )
 
 
-def image_colour(records: list[StepRecord]) -> dict[str, str]:
+def image_colour(records: list[StepRecord], root: Path | None = None) -> dict[str, str]:
     """What the manifest says of the colour of the session's JPEGs and linear TIFFs, as their
     tags and ImageDescriptions say it (one colour for a session whose images all share it,
-    else each colour with the images in it)."""
-    by: dict[str, list[str]] = {}
+    else each colour with the images in it). ``root``: the session folder, whose one-channel
+    linear TIFFs not from a RAW are said to be linear grey, as their ImageDescription says
+    (the manifest had called them linear sRGB, tagged, while the file said linear grey)."""
+    jpeg: dict[str, list[str]] = {}
+    linear: dict[str, list[str]] = {}
     for r in records:
-        by.setdefault(decode_colour(r.decode), []).append(Path(r.image).stem)
-    if len(by) <= 1:
-        colour = next(iter(by), "srgb")
-        return {"jpeg": JPEG_COLOUR_WORDS[colour], "linear": LINEAR_COLOUR_WORDS[colour]}
+        colour = decode_colour(r.decode)
+        jpeg.setdefault(colour, []).append(Path(r.image).stem)
+        if colour == "srgb" and not r.decode and root is not None and _grey_tiff(root, r):
+            colour = "grey"
+        linear.setdefault(colour, []).append(Path(r.image).stem)
     return {
-        "jpeg": "; ".join(f"{JPEG_COLOUR_WORDS[c]}: {', '.join(n)}" for c, n in by.items()),
-        "linear": "; ".join(f"{LINEAR_COLOUR_WORDS[c]}: {', '.join(n)}" for c, n in by.items()),
+        "jpeg": _colour_words(JPEG_COLOUR_WORDS, jpeg),
+        "linear": _colour_words(LINEAR_COLOUR_WORDS, linear),
     }
+
+
+def _colour_words(words: Mapping[str, str], by: dict[str, list[str]]) -> str:
+    """One colour's words for a session whose images all share it, else each with its images."""
+    if len(by) <= 1:
+        return words[next(iter(by), "srgb")]
+    return "; ".join(f"{words[c]}: {', '.join(n)}" for c, n in by.items())
+
+
+def _grey_tiff(root: Path, record: StepRecord) -> bool:
+    """Whether the step's linear TIFF holds one channel (its first page's header alone is read;
+    a file that cannot be read is not said to be grey: the verdict names it)."""
+    import tifffile  # on use, as the writer imports it
+
+    try:
+        with tifffile.TiffFile(root / record.linear_image) as tif:
+            return tif.pages.first.ndim == 2
+    except (OSError, ValueError, tifffile.TiffFileError):
+        return False
 
 
 def session_notices(records: list[StepRecord]) -> list[str]:

@@ -2,7 +2,8 @@
 
 Why: 4ca842a4 labelled every linear TIFF not from a RAW "linear sRGB …": a grey replayed
 acquisition's TIFFs were called sRGB, colours they have none of. Through the front door: a
-replayed acquisition of grey PNGs, run, and its TIFFs read back with tifffile."""
+replayed acquisition of grey PNGs, run, and its TIFFs read back with tifffile; the manifest's
+``image_colour`` says the same of them."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import tifffile
+from conftest import manifest
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -42,3 +44,8 @@ def test_a_grey_replayed_image_is_said_to_be_linear_grey(tmp_path: Path) -> None
             assert page.ndim == 2, page.shape
             assert page.description.startswith("rti-rig: linear grey"), page.description
             assert "sRGB (" not in page.description and "NOT sRGB-encoded" in page.description
+    # the manifest agrees with the files (it had called them linear sRGB, ICC-tagged), in one
+    # sentence (it had two parentheticals back to back)
+    linear = manifest(out)["image_colour"]["linear"]
+    assert linear.startswith("linear grey") and "sRGB (" not in linear, linear
+    assert "ImageDescription" in linear and ") (" not in linear, linear

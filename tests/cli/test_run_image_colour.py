@@ -158,6 +158,7 @@ def test_a_session_linear_tiff_says_it_is_linear_and_the_manifest_agrees(session
         np.testing.assert_array_equal(_xyz(tags[primary]), _xyz(jpeg_tags[primary]))
     colour = manifest(session)["image_colour"]
     assert colour["linear"].startswith("linear sRGB") and "ICC" in colour["linear"]
+    assert ") (" not in colour["linear"], colour  # one sentence, not two parentheticals
     assert colour["jpeg"].startswith("sRGB") and "ColorSpace 1" in colour["jpeg"]
 
 
