@@ -35,7 +35,7 @@ from rti_rig.runtime.disowned import MARKER as DISOWN_MARKER
 from rti_rig.runtime.disowned import disown
 from rti_rig.runtime.flash_sync import CameraTriggeredLighting, LightSlipError
 from rti_rig.runtime.lighting import ActualLight
-from rti_rig.runtime.session import SessionWriteError
+from rti_rig.runtime.session import SessionWriteError, linear_tiff_labels
 
 #: What each known flash-stepped firmware does by itself (cceh/rti ``firmware/rti.cpp``).
 FIRMWARES: dict[str, dict[str, Any]] = {
@@ -363,7 +363,7 @@ def keep_unlabelled(
     root: Path, index: int, frame: Frame, verdict: dict[str, Any], stem: str = "image"
 ) -> str:
     """Write a slipped (or proof) image under ``unlabelled/`` (linear TIFF, sRGB JPEG, the
-    verdict)."""
+    verdict), its files labelled and tagged as a session's of the same decode are."""
     from rti_rig.core.image_colour import decode_colour
     from rti_rig.core.image_files import (
         linear_to_srgb8,
@@ -380,9 +380,13 @@ def keep_unlabelled(
     while tif.exists():  # never overwrite a kept image
         base = f"{stem}_{index + 1:03d}_{n}"
         tif, n = folder / f"{base}.tif", n + 1
-    write_linear_tiff(tif, frame.pixels)
+    decode = dict(frame.metadata.get("decode") or {})
+    # labelled as a session's linear TIFF of the same decode is (it had no description and no
+    # profile, so viewers took it as sRGB-encoded and showed it dark)
+    description, icc = linear_tiff_labels(decode, frame)
+    write_linear_tiff(tif, frame.pixels, description=description, iccprofile=icc)
     # tagged sRGB only where it is: a RAW with no colour matrix gives camera RGB
-    srgb = decode_colour(frame.metadata.get("decode") or {}) == "srgb"
+    srgb = decode_colour(decode) == "srgb"
     writer = write_srgb_jpeg if srgb else write_untagged_jpeg
     writer(folder / f"{base}.jpg", linear_to_srgb8(frame.pixels, frame.white_level))
     (folder / f"{base}.json").write_text(json.dumps(verdict, indent=1) + "\n", encoding="utf-8")

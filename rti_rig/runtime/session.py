@@ -944,10 +944,8 @@ class SessionFolder:
                     decode["camera_file"] = originals[rel][1]
             sha = {name: digest for name, (digest, _) in originals.items()}
             current = self.root / tif
-            description = _tiff_description(decode, frame.white_level, grey=frame.pixels.ndim == 2)
+            description, icc = linear_tiff_labels(decode, frame)
             colour = decode_colour(decode)
-            # only sRGB pixels are said to be sRGB: camera RGB or a mosaic carries no tag
-            icc = icc_profile("linear") if colour == "srgb" else None
             jpeg_writer = write_srgb_jpeg if colour == "srgb" else write_untagged_jpeg
             # the pixels' checksum is taken while the files are encoded and written (hashing
             # releases the GIL): about 0.4 s of CPU for a 24 MP frame, overlapped, not added
@@ -1525,6 +1523,17 @@ def _fsync_sha256(path: Path) -> str:
             h.update(chunk)
         os.fsync(fh.fileno())
     return h.hexdigest()
+
+
+def linear_tiff_labels(decode: dict[str, Any], frame: Frame) -> tuple[str, bytes | None]:
+    """The ImageDescription and ICC profile (None: untagged) of a linear TIFF of ``frame``
+    decoded as ``decode`` says: a session's, and an image kept aside under ``unlabelled/``,
+    which had carried neither and was taken as sRGB-encoded by viewers. Only sRGB pixels are
+    said to be sRGB: camera RGB or a mosaic carries no profile (nor does a grey image, the
+    writer's rule)."""
+    description = _tiff_description(decode, frame.white_level, grey=frame.pixels.ndim == 2)
+    icc = icc_profile("linear") if decode_colour(decode) == "srgb" else None
+    return description, icc
 
 
 def _tiff_description(

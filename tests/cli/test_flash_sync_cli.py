@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import tifffile
 from conftest import CONFIGS
 from typer.testing import CliRunner
 
@@ -137,6 +138,14 @@ def test_a_slip_is_caught_at_its_image_named_and_never_labelled(  # type: ignore
     kept = out / "unlabelled" / f"image_{at_image:03d}"
     assert kept.with_suffix(".tif").is_file() and kept.with_suffix(".json").is_file()
     assert len(list(out.glob("image_*.jpg"))) == at_image - 1
+    # labelled and tagged as the session's own linear TIFFs are (it had neither: viewers took
+    # it as sRGB-encoded)
+    labels = []
+    for tif in (kept.with_suffix(".tif"), out / "linear" / "image_001.tif"):
+        with tifffile.TiffFile(tif) as f:
+            page = f.pages.first
+            labels.append((page.description, page.tags.get(34675) and page.tags[34675].value))
+    assert labels[0] == labels[1] and labels[0][0].startswith("rti-rig: linear"), labels
     # the lights' state is said as it is: nothing could be sent, nothing confirmed
     low = text.lower()
     assert "no all-off could be sent" in low and "that lights are off is not confirmed" in low
