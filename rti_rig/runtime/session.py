@@ -763,7 +763,10 @@ class SessionFolder:
         dest = self.root / rel
         try:
             dest.parent.mkdir(parents=True, exist_ok=True)
-            write_linear_tiff(dest, frame.pixels, description=why)
+            # labelled as a session's linear TIFF of it would be, then why it is not one (it
+            # had said only why: no word of its pixels being linear, no profile)
+            label, icc = linear_tiff_labels(dict(frame.metadata.get("decode") or {}), frame)
+            write_linear_tiff(dest, frame.pixels, description=f"{label}; {why}", iccprofile=icc)
         except OSError as exc:
             raise SessionWriteError(dest, exc) from None
         kept = [rel]

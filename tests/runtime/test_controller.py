@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import tifffile
 from conftest import REPO, SMALL_DOME, write_config
 
 from rti_rig.app.compose import build_rig
@@ -205,6 +206,14 @@ def test_a_frame_of_another_size_stops_the_session_and_is_kept_aside(tmp_path: P
     assert rig.lighting.source.lit is None  # type: ignore[attr-defined]
     kept = list((out / "recovered").rglob("image_004.tif"))
     assert len(kept) == 1  # the frame is not lost, only kept out of the session
+    # labelled as the session's linear TIFFs are, then why it is not one (it said only why)
+    pages = []
+    for tif in (kept[0], out / "linear" / "image_001.tif"):
+        with tifffile.TiffFile(tif) as f:
+            page = f.pages.first
+            pages.append((page.description, page.tags.get(34675) and page.tags[34675].value))
+    assert pages[0][0].startswith(pages[1][0] + "; not image 4 of the session"), pages
+    assert pages[0][1] == pages[1][1] is not None, pages
     # a resume on a camera that gives another size than the images on disk stops the same way
     rig = small_rig(tmp_path)
     rig.camera = ResizingCamera(rig.camera, 0)
