@@ -12,6 +12,7 @@ from rich.markup import escape
 from rti_rig.cli.app import app, err, fail, out, print_notes, shown_path
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import ensure_writable_folder, refuse_a_file_in_the_way
+from rti_rig.core.shell_words import shell_word
 
 bench_app = typer.Typer(
     help="Benchmarks: the speed/accuracy trade, on the simulator or on your own acquisition."
@@ -232,7 +233,9 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
     rows = run_tradeoff(settings, progress=lambda msg: out.print(msg, highlight=False))
     command = "rti-rig bench tradeoff" + (" --quick" if quick else "")
     if out_dir is not None:
-        command += f" --out {out_dir}" + (" --force" if force else "")
+        # one shell word, as the command is pasted from summary.md (a folder with a space had
+        # been written bare, and pasted ran into two arguments)
+        command += f" --out {shell_word(out_dir)}" + (" --force" if force else "")
     text = summarise(rows, settings, time.perf_counter() - t0, command)
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)

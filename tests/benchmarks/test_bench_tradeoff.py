@@ -92,10 +92,12 @@ def test_bench_writes_nothing_unless_asked(  # type: ignore[no-untyped-def]
     assert r.exit_code == 0, r.output
     assert list(tmp_path.rglob("*")) == []
     assert "nothing written" in r.output
-    r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick", "--out", "res"])
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick", "--out", "my res"])
     assert r.exit_code == 0, r.output
-    assert (tmp_path / "res" / "summary.md").is_file()
-    assert (tmp_path / "res" / "results.csv").is_file()
+    assert (tmp_path / "my res" / "results.csv").is_file()
+    # the command in the summary pastes back as run (the folder had been written bare)
+    summary = (tmp_path / "my res" / "summary.md").read_text(encoding="utf-8")
+    assert "`rti-rig bench tradeoff --quick --out 'my res'`" in summary, summary
 
 
 def test_fault_campaign_writes_its_report_only_when_asked(
