@@ -26,12 +26,12 @@ def test_the_advised_planned_run_keeps_to_the_band(tmp_path: Path) -> None:
     text = said(r)
     assert "none left to choose" in text
     advised = text.split("shoot its 4 with a planned run: ", 1)[1]
-    assert advised == f"rti-rig run {cfg} --out DIR --lights 4 --min-elevation-deg 45"
+    # the run's own --out, nothing written to it (--out DIR, pasted, made a folder named DIR)
+    assert advised == f"rti-rig run {cfg} --out {tmp_path / 's'} --lights 4 --min-elevation-deg 45"
     argv = shlex.split(advised)[1:]
-    argv[argv.index("DIR")] = str(tmp_path / "planned")
     r = runner.invoke(app, [*argv, "--no-verdict"])
     assert r.exit_code == 0, r.output
-    steps = journal(tmp_path / "planned")
+    steps = journal(tmp_path / "s")
     assert len(steps) == 4
     assert all(math.degrees(math.asin(s["actual_direction"][2])) > 45 for s in steps)
 

@@ -348,7 +348,7 @@ def test_a_rig_with_no_light_beyond_the_start_refuses_adaptive_with_one_remedy(
     r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), *args])
     assert r.exit_code == 2, r.output
     assert "this rig offers 4 lights" in said(r) and "none left to choose" in said(r)
-    assert f"rti-rig run {cfg} --out DIR" in said(r)
+    assert f"rti-rig run {cfg} --out {tmp_path / 's'}" in said(r)  # the run's own, not DIR
     assert not (tmp_path / "s").exists()
 
 

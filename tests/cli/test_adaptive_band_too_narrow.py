@@ -25,11 +25,15 @@ NAB = CONFIGS / "emulated_nab_rti_v1.toml"
 
 
 def _advised(text: str, lead: str, tmp_path: Path, name: str) -> list[str]:
-    """The command after ``lead`` in ``text`` (up to its parenthesis), DIR made a folder."""
+    """The command after ``lead`` in ``text`` (up to its parenthesis), its ``--out`` the run's
+    own (``tmp_path / "s"``: ``--out DIR`` had been printed, which pasted made a folder named
+    DIR), then made ``name``, for a test that pastes more than one command."""
     command = text.split(lead, 1)[1].split(" (", 1)[0]
     argv = shlex.split(command)
     assert argv[:2] == ["rti-rig", "run"], command
-    argv[argv.index("DIR")] = str(tmp_path / name)
+    at = argv.index("--out") + 1
+    assert argv[at] == str(tmp_path / "s"), command
+    argv[at] = str(tmp_path / name)
     return argv[1:]
 
 
@@ -53,7 +57,7 @@ def test_a_band_of_one_nab_led_is_refused_with_a_band_that_holds_the_session(
     assert "this rig offers 1 light between 0° and 20° elevation" in text, text
     assert "its 12 LEDs are at 16.8°–75.7° elevation" in text, text
     assert "an adaptive session needs at least 5: it starts from 4" in text, text
-    assert f"--out DIR {kept} --max-elevation-deg 33 (5 lights between 0° and 33°" in text, text
+    assert f"--out {out} {kept} --max-elevation-deg 33 (5 lights between 0° and 33°" in text, text
     # the widened band's command works, and keeps to its band
     argv = _advised(text, "Widen the band to hold 5: ", tmp_path, "wide")
     r = runner.invoke(app, [*argv, "--no-verdict"])
@@ -246,5 +250,5 @@ def test_the_band_advised_to_a_dome_keeps_the_objective_asked(tmp_path: Path) ->
     assert r.exit_code == 2, text
     assert not out.exists()
     assert (
-        "--out DIR --adaptive --lights 6 --objective relight --max-elevation-deg 37 (6 lights"
+        f"--out {out} --adaptive --lights 6 --objective relight --max-elevation-deg 37 (6 lights"
     ) in text, text

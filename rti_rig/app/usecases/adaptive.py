@@ -1401,9 +1401,12 @@ def _nothing_to_choose_words(
     config: str,
     until_error_deg: float | None,
     objective: str,
+    out: str = "DIR",
 ) -> str:
     """The refusal of ``facts``, with its ways out as commands of the user's own options
-    (``config``: the rig config, quoted for a shell).
+    (``config``: the rig config, ``out``: the run's own ``--out``, nothing written to it yet,
+    both quoted for a shell; ``--out DIR`` had been printed, which pasted ran into a folder
+    named DIR).
 
     The advice is the band that holds the session (:func:`_band_holding`), and the planned
     run of the band's lights as the other way: the planned run alone had been advised,
@@ -1435,7 +1438,7 @@ def _nothing_to_choose_words(
             "one that holds them"
         )
         words.append(
-            f"{lead}: rti-rig run {config} --out DIR {asked}"
+            f"{lead}: rti-rig run {config} --out {out} {asked}"
             f"{band_options(wider)} ({_held(el, wider)} lights"
             f"{_band_words(wider) or ' at every elevation'})"
         )
@@ -1454,7 +1457,7 @@ def _nothing_to_choose_words(
             if wider is not None
             else "Shoot them all with a planned run"
         )
-        words.append(f"{shoot}: rti-rig run {config} --out DIR{in_band}{caveat}")
+        words.append(f"{shoot}: rti-rig run {config} --out {out}{in_band}{caveat}")
     return ". ".join(words[:2]) + "".join(f"; or {w}" for w in words[2:])
 
 
@@ -1466,9 +1469,11 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
     band: tuple[float, float] = _FULL_BAND,
     min_lights: int | None = None,
     objective: str = "normals",
+    out_dir: Path | None = None,
 ) -> None:
     """Refuse ``--adaptive`` (or ``--lights N`` with it) on a rig offering no more lights than
-    the starting layout: there is nothing left to choose. ``--lights 4`` was refused with "give
+    the starting layout: there is nothing left to choose (``out_dir``: the run's ``--out``, for
+    the commands it advises). ``--lights 4`` was refused with "give
     at least 5" and ``--lights 5`` with "give at most 4", sending the user round in a circle,
     while ``--adaptive`` alone ran the lights as a planned run would, labelled adaptive.
     Decided by :func:`_nothing_to_choose`, worded by :func:`_nothing_to_choose_words`."""
@@ -1480,7 +1485,8 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
     facts = _nothing_to_choose(el, offered, lights, until_error_deg, band, min_lights)
     if facts is not None:
         config = shell_word(str(loaded.path))
-        raise RtiRigError(_nothing_to_choose_words(facts, config, until_error_deg, objective))
+        out = "DIR" if out_dir is None else shell_word(str(out_dir))
+        raise RtiRigError(_nothing_to_choose_words(facts, config, until_error_deg, objective, out))
 
 
 def _held(el: NDArray[np.float64], band: tuple[float, float]) -> int:
@@ -1526,6 +1532,7 @@ def _arm_widen_to_hold(  # type: ignore[no-untyped-def]
     offered: int,
     band: tuple[float, float],
     asked: Callable[[int], str],
+    out_dir: Path | None = None,
 ) -> str:
     """The advice after "give at most ``offered``" for an arm asked ``need`` lights in
     ``band``: the band widened to hold them where one would (its ceiling raised to the top,
@@ -1551,11 +1558,12 @@ def _arm_widen_to_hold(  # type: ignore[no-untyped-def]
         if held >= need:
             return f" (or widen the band to hold {need}:{band_options(wider)})"
     config = shell_word(str(loaded.path))
+    out = "DIR" if out_dir is None else shell_word(str(out_dir))  # the run's own --out
     widening = "; a wider band holds no more on this arm" if tuple(band) != _FULL_BAND else ""
     return (
         f"{widening} (an arm's lights are its {ARM_CANDIDATES} candidate directions spread over "
         f"the band asked, {offered} of them within its reach and lighting rules): rti-rig run "
-        f"{config} --out DIR {asked(offered)}{band_options(band)}"
+        f"{config} --out {out} {asked(offered)}{band_options(band)}"
     )
 
 
@@ -1597,7 +1605,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         elevations = az_el_from_direction(geometry.directions)[1]
         offered = _held(elevations, band)
         _refuse_nothing_to_choose(
-            loaded, offered, lights, until_error_deg, band, min_lights, objective
+            loaded, offered, lights, until_error_deg, band, min_lights, objective, out_dir
         )
     if lights is not None and lights < START_LIGHTS + 1:
         # the options as given, worded as every adaptive refusal words them (this one had
@@ -1639,7 +1647,9 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
                 return adaptive_options(until_error_deg, lights_now, min_now, objective)
 
             def widen(asked: Callable[[int], str]) -> Callable[[int], str]:
-                return lambda need: _arm_widen_to_hold(rig, loaded, need, in_reach, band, asked)
+                return lambda need: _arm_widen_to_hold(
+                    rig, loaded, need, in_reach, band, asked, out_dir
+                )
 
             _check_lights_within(
                 lights,
