@@ -549,7 +549,15 @@ def _finished_hint(root: Path, manifest: dict[str, Any]) -> str:
             f" (it holds a finished preview: plan from it with rti-rig plan {folder} --rig "
             f"{shown} --lights 12 --out plan.lp)"  # plan's default count: N pasted was refused
         )
-    return f" (it holds a finished session: fit it with rti-rig fit {folder} --out DIR)"
+    # a real, free folder beside the session (fit refuses one inside it): ``--out DIR`` had
+    # been printed, which pasted made a folder named DIR
+    fit_out, n = root.with_name(f"{root.name}-fit"), 2
+    while fit_out.exists() or fit_out.is_symlink():
+        fit_out, n = root.with_name(f"{root.name}-fit-{n}"), n + 1
+    return (
+        f" (it holds a finished session: fit it with rti-rig fit {folder} --out "
+        f"{shell_word(str(fit_out))})"
+    )
 
 
 def refuse_if_in_use(root: Path, what: str) -> None:

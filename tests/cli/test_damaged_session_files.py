@@ -214,6 +214,10 @@ def test_a_new_session_into_a_finished_one_is_not_offered_a_resume(session: Path
     text = said(r)
     assert r.exit_code != 0 and "is not empty" in text, text
     assert "--resume" not in text and "it holds a finished session: fit it with" in text
+    # a real, free folder beside it, pasteable as said (it had said --out DIR)
+    advised = text.split("fit it with ", 1)[1].split(")", 1)[0]
+    assert advised == f"rti-rig fit {session} --out {session}-fit", advised
+    assert not Path(f"{session}-fit").exists()
 
 
 def test_reshoot_lost_does_not_vouch_for_what_it_cannot_check(
