@@ -47,7 +47,12 @@ def test_a_folder_with_two_lp_files_and_no_lights_lp_is_refused(
     r = runner.invoke(app, ["fit", str(acq), "--out", str(tmp_path / "fit")])
     assert r.exit_code == 2, r.output
     assert "2 .lp files and no lights.lp (a_subset.lp, dirs.lp)" in said(r)
-    assert f"rti-rig fit {acq / 'a_subset.lp'} --out DIR" in said(r)
+    # the file to give instead, with the user's own --out (not a template "--out DIR" that,
+    # pasted, made a folder named DIR)
+    assert f"giving it in the folder's place, with the same --out (e.g. {acq / 'a_subset.lp'})" in (
+        said(r)
+    )
+    assert "DIR" not in said(r)
     assert not (tmp_path / "fit").exists()
     r = runner.invoke(app, ["fit", str(acq / "dirs.lp"), "--out", str(tmp_path / "fit")])
     assert r.exit_code == 0, r.output

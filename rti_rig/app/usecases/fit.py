@@ -422,7 +422,9 @@ def acquisition_files(
             raise FitInputError(f"{shown_path(source)} holds no .lp file: not a session folder")
         if not (source / LP_NAME).is_file() and len(lps) > 1:
             # the first in name order had been fitted, said only of a session: a folder with
-            # dirs.lp and a_subset.lp was fitted from the 4 lights of the subset, "good"
+            # dirs.lp and a_subset.lp was fitted from the 4 lights of the subset, "good". The
+            # way out names the file, the --out being the user's own (this reader has none):
+            # "rti-rig fit X.lp --out DIR", pasted, made a folder named DIR
             shown = ", ".join(p.name for p in lps[:6]) + (" …" if len(lps) > 6 else "")
             rebuild = (
                 f"; or rebuild the session's own {LP_NAME} from its journal with: rti-rig "
@@ -433,8 +435,9 @@ def acquisition_files(
             )
             raise FitInputError(
                 f"{shown_path(source)} holds {len(lps)} .lp files and no {LP_NAME} ({shown}): "
-                "which one lists its lights cannot be told; fit the one you mean, e.g. rti-rig fit "
-                f"{shell_word(str(lps[0]))} --out DIR{rebuild}"
+                "which one lists its lights cannot be told; fit the one you mean by giving it in "
+                f"the folder's place, with the same --out (e.g. {shell_word(str(lps[0]))})"
+                f"{rebuild}"
             )
         lp = source / LP_NAME if (source / LP_NAME).is_file() else lps[0]
         if notes is not None and lp.name != LP_NAME and (source / JOURNAL).is_file():
