@@ -32,6 +32,7 @@ from rti_rig.cli.app import (
 from rti_rig.cli.stopping import Terminated, sigterm_stops, stamp, stop_signal, written_since
 from rti_rig.core.deferred_signals import (
     as_received,
+    default_action,
     handlers_settable,
     hangup_as_sigterm,
     put_back,
@@ -720,8 +721,9 @@ def _late_term_held() -> Iterator[list[signal.Signals]]:
     def late(signum, frame) -> None:  # type: ignore[no-untyped-def]
         received = as_received(signum)  # a hang-up's: SIGHUP
         if held:  # asked twice: stop now (a summary that hangs must not outlive a stop)
-            signal.signal(received, signal.SIG_DFL)
-            signal.raise_signal(received)
+            # the capture's handlers are the ones in place while the rig works: this one
+            # answers before the opening or after the teardown, so the words may be waited on
+            default_action(received)
         held.append(received)
 
     with signal_handlers({signal.SIGTERM: late}):
@@ -1789,8 +1791,7 @@ def _as_before(handler: Any, signum: int, frame: Any) -> None:
         handler(signum, frame)
     elif handler != signal.SIG_IGN:  # the default action (or one set outside Python)
         received = as_received(signum)  # a hang-up answered as a SIGTERM ends as SIGHUP
-        signal.signal(received, signal.SIG_DFL)
-        signal.raise_signal(received)
+        default_action(received)  # called once the capture (and its teardown) has ended
 
 
 @contextmanager

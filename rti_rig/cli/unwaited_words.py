@@ -31,6 +31,8 @@ import sys
 import threading
 from typing import Any
 
+from rti_rig.core.deferred_signals import before_default_action
+
 #: How many characters may wait for a stalled reader before further words are dropped.
 HELD_LIMIT = 1 << 20
 
@@ -74,14 +76,15 @@ class WordsWriter:
         self._items.append((stream, _FLUSH))
         self._wake()
 
-    def drain(self) -> None:
-        """Wait until every word said so far is written (or dropped by a gone reader)."""
+    def drain(self, timeout: float | None = None) -> bool:
+        """Wait until every word said so far is written (or dropped by a gone reader), at
+        most ``timeout`` seconds if given; whether they were."""
         if not self._thread.is_alive() or threading.current_thread() is self._thread:
-            return
+            return True
         done = threading.Event()
         self._items.append(done)
         self._wake()
-        done.wait()
+        return done.wait(timeout)
 
     def _wake(self) -> None:
         with contextlib.suppress(OSError):  # full: the thread is awake already
@@ -228,6 +231,7 @@ def words_unwaited(consoles: tuple[Any, Any]) -> None:
     if _writer is None:  # one thread a process; each entry's streams are its own
         _writer = WordsWriter(notes_to=stderr)
         atexit.register(words_written)
+        before_default_action.append(words_written_before_signal)
     copy = _fd2_copy(stderr)  # stderr's words never land where fd 2 is pointed for a moment
     if _copy is not None:  # the last entry's: closed by the thread after its queued words
         _writer.flush(_ClosedInTurn(_copy))
@@ -253,6 +257,26 @@ def words_written() -> None:
 
 #: A Ctrl-C ended a wait for the reader: the process no longer waits for it.
 _given_up = False
+
+#: How long the words may be waited on before a signal's default action ends the process.
+#: Long enough for a reader that reads at all to take the whole queue (:data:`HELD_LIMIT`
+#: is written in milliseconds), short beside a supervisor's grace before its SIGKILL
+#: (``docker stop``'s 10 s): a stalled reader does not hold the stop up for long.
+BEFORE_DEFAULT_ACTION_S = 2.0
+
+
+def words_written_before_signal() -> None:
+    """Wait up to :data:`BEFORE_DEFAULT_ACTION_S` for the queued words to be written, before
+    a signal's default action ends the process (registered with the core's
+    ``before_default_action``: it calls this only where the rig is safe).
+
+    Why: the default action ends the process at once; the words still queued (the last lines
+    of a summary, a stop's words) were lost, where each print had been written before it
+    returned. A Ctrl-C during the wait ends the wait, the signal still acted on."""
+    if _writer is None or _given_up:
+        return
+    with contextlib.suppress(KeyboardInterrupt):
+        _writer.drain(BEFORE_DEFAULT_ACTION_S)
 
 
 def say_unwaited(text: str) -> None:

@@ -89,8 +89,7 @@ def hangup_as_sigterm() -> Iterator[None]:
         if callable(handler):
             _deliver(handler, sighup, frame)
         elif handler != signal.SIG_IGN:  # the default (or a handler set outside Python)
-            signal.signal(sighup, signal.SIG_DFL)
-            signal.raise_signal(sighup)
+            default_action(sighup)  # within run/check/preview: nothing opened yet
 
     with signal_handlers({sighup: hung_up}):
         yield
@@ -183,7 +182,7 @@ def signals_deferred(
                 except BaseException as exc:
                     raised.append(exc)
             elif handler != signal.SIG_IGN:  # the default action: raised again, now unheld
-                signal.raise_signal(received)  # a hang-up's: SIGHUP (exit 129)
+                default_action(received)  # a hang-up's: SIGHUP (exit 129)
 
     def hold(signum: int, frame: Any) -> None:
         received = as_received(signum)  # SIGHUP for a hang-up's: delivered later as one
@@ -303,3 +302,23 @@ def _swap_handler(sig: int, handler: Any, raised: list[BaseException]) -> Any:
             return signal.signal(sig, handler)
         except BaseException as exc:
             raised.append(exc)
+
+
+#: Called (no arguments) just before :func:`default_action` ends the process; the CLI
+#: registers the wait for its queued words here (the core may not import the CLI).
+before_default_action: list[Callable[[], None]] = []
+
+
+def default_action(sig: int) -> None:
+    """End the process by ``sig``'s default action, the hooks of :data:`before_default_action`
+    run first (an exception in one is dropped: the signal is still acted on).
+
+    Why: the CLI's words are written by a thread of their own; the default action ends the
+    process at once, and the words still queued for a slow reader were lost (a scratch script
+    lost 1-11 of 50 lines in 4 runs of 10). Only for call sites where the rig is already safe
+    (or was never opened): a hook may wait a moment for the reader."""
+    for hook in list(before_default_action):
+        with contextlib.suppress(BaseException):
+            hook()
+    signal.signal(sig, signal.SIG_DFL)
+    signal.raise_signal(sig)
