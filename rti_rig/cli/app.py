@@ -426,6 +426,16 @@ class ReaderGoneTolerant:
         except OSError as exc:
             self._reader_gone(exc)
 
+    def say_failure_on(self, stream) -> None:  # type: ignore[no-untyped-def]
+        """Say a failure on ``stream`` from now on, where one is said at all (stdout's).
+
+        Why: once the words are written by a thread of their own, stdout's failure is noticed
+        there, and its note written to stderr's stream went straight to fd 2: during a RAW
+        decode, fd 2 is LibRaw's capture for a moment (the note came out later, out of order).
+        The console entry gives it the copy of fd 2 its stderr words go to."""
+        if self._said_on is not None:
+            self._said_on = stream
+
     def _reader_gone(self, exc: OSError | None = None) -> None:
         if exc is not None and not isinstance(exc, BrokenPipeError) and self._said_on:
             said_on, self._said_on = self._said_on, None  # said once

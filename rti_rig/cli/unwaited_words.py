@@ -237,6 +237,11 @@ def words_unwaited(consoles: tuple[Any, Any]) -> None:
         _writer.flush(_ClosedInTurn(_copy))
     _copy = copy
     _writer.notes_to = stderr if copy is None else copy
+    if copy is not None:  # stdout's failure note, written by the thread: to the copy too
+        from rti_rig.cli.app import ReaderGoneTolerant  # app imports this module when it runs
+
+        if isinstance(stdout, ReaderGoneTolerant):
+            stdout.say_failure_on(copy)
     sys.stdout = out.file = UnwaitedStream(stdout, _writer)  # type: ignore[assignment]
     sys.stderr = err.file = UnwaitedStream(stderr, _writer, copy)  # type: ignore[assignment]
 

@@ -15,6 +15,7 @@ import io
 import os
 import select
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -107,3 +108,54 @@ def test_a_later_entry_closes_the_last_copy_only_after_the_word_being_written(
     finally:
         os.close(r)
         os.close(w)
+
+
+def test_stdouts_failure_note_goes_to_the_copy_not_to_the_decoders_hold_on_fd_2(
+    capfd: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """stdout's "output could not be written" note, written by the words thread as stdout's
+    write fails, went straight to fd 2: while the decoder held fd 2 it landed in the capture
+    and came out only after the decode (here: not yet on the command's stderr)."""
+    import errno
+    import importlib
+    import types
+
+    from rti_rig.cli import unwaited_words
+    from rti_rig.cli.unwaited_words import words_unwaited
+
+    app = importlib.import_module("rti_rig.cli.app")
+    log = os.open(tmp_path / "log", os.O_WRONLY | os.O_CREAT)
+
+    class DiskFull:  # a `> log` whose disk is full
+        def write(self, text: str) -> int:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+        def flush(self) -> None:
+            pass
+
+        def fileno(self) -> int:
+            return log
+
+    writer = WordsWriter(notes_to=io.StringIO())
+    monkeypatch.setattr(unwaited_words, "_writer", writer)
+    monkeypatch.setattr(unwaited_words, "_copy", None)
+    try:
+        with open(2, "w", closefd=False) as stderr:  # the command's stderr: fd 2 as it began
+            monkeypatch.setattr(sys, "stdout", app.ReaderGoneTolerant(DiskFull(), said_on=stderr))
+            monkeypatch.setattr(sys, "stderr", app.ReaderGoneTolerant(stderr))
+            consoles = (types.SimpleNamespace(file=None), types.SimpleNamespace(file=None))
+            words_unwaited(consoles)
+            copy = unwaited_words._copy
+            assert copy is not None
+            try:
+                capfd.readouterr()
+                printed: list[str] = []
+                with libraw_printed(NAME, printed):
+                    sys.stdout.write("Captured 12 images\n")
+                    writer.drain()  # the note written while fd 2 is the decoder's capture
+                    assert "output could not be written" in capfd.readouterr().err
+            finally:
+                copy.close()
+    finally:
+        os.close(log)
+    assert printed == []
