@@ -187,6 +187,9 @@ def test_mask_unknown_code_and_t000_share_one_opening(monkeypatch: pytest.Monkey
         ("USB I/O 24R1", "USB I/O 24R1", True),
         ("\x01", None, False),  # before anything was sent: no acknowledgement
         ("\x01", "\x01", True),
+        ("\x01\x01", "\x01\x01", True),  # a late acknowledgement read with the next one
+        ("\x01\x01\x01", "\x01\x01\x01", True),
+        ("\x01\x00", "\x01\x00", False),
         ("\x00\x01", "\x00\x01", False),
         ("I received: T,0,0,0 the instructionByte was: ", "", False),
         ("I received: T,0,0,0 the instructionByte was: T", "", True),

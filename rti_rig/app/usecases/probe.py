@@ -906,10 +906,10 @@ def _answered(text: str, reply: str | None = None) -> bool:
     listening on can change nothing the probe decides: the Nab sketch's banner to its last
     line (``ready_pattern``) or its whole answer to an unknown code, nichlock's banner to its
     prompt or its calibration (whose note depends on which comes), a whole line of nichlock's
-    answer to a key, the Elexol board's ``USB I/O 24R1``, minirti's acknowledgement (the one
-    byte ``0x01``, all the reply), RTIPy's whole answer, or a whole boot banner of rti-rig's own
-    protocols. Anything else (silence, bytes at another rate, a banner still arriving) is no
-    answer yet: the listen runs on to its end."""
+    answer to a key, the Elexol board's ``USB I/O 24R1``, minirti's acknowledgement (the byte
+    ``0x01``, all the reply: once, or more than once read in one chunk), RTIPy's whole answer,
+    or a whole boot banner of rti-rig's own protocols. Anything else (silence, bytes at another
+    rate, a banner still arriving) is no answer yet: the listen runs on to its end."""
     if _NAB_READY.search(text) or _NAB_UNKNOWN_CODE.search(text):
         return True
     if "Reflectance Transformation Imager Serial Interface" in text:
@@ -917,9 +917,18 @@ def _answered(text: str, reply: str | None = None) -> bool:
     lines = text.split("\n")[:-1]  # the lines that ended
     if any(words in line for line in lines for words in _NICHLOCK_SAYS):
         return True
-    if _ELEXOL_SAYS in text or _RTIPY_SAYS in text or reply == "\x01":
+    if _ELEXOL_SAYS in text or _RTIPY_SAYS in text or _acknowledgements(reply):
         return True
     return _own_protocol(text) is not None
+
+
+def _acknowledgements(reply: str | None) -> bool:
+    """``reply`` is minirti's acknowledgement ``0x01`` and nothing else, one or more of them.
+
+    Why more than one: a board whose acknowledgement came late (the one byte of an earlier
+    mask, or one said twice) can be read in one chunk with the next: ``"\\x01\\x01"`` taken as no
+    answer had the probes after it (``<9>``, ``T,0,0,0``) sent to a board that had answered."""
+    return reply is not None and reply != "" and reply.strip("\x01") == ""
 
 
 def _acknowledged_mask(result: ProbeResult, mask_at: int) -> bool:
