@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import eventually
+from conftest import ended_on_exit, eventually
 
 from rti_rig.simulator.domes import board_for
 from rti_rig.simulator.pty_link import serve_on_pty
@@ -55,7 +55,7 @@ def test_a_nab_dome_is_switched_off_while_stderr_is_never_read() -> None:
                 stderr=w,
                 cwd=Path(__file__).resolve().parents[2],
             )
-            try:
+            with ended_on_exit(proc):  # killed by its own handle and reaped, however it ends
                 # lit at its boot (every LED), then dark: the all-off, acknowledged, went
                 # through with the probe's first "Trying" line still waiting for room
                 lit_then_dark = eventually(
@@ -67,9 +67,6 @@ def test_a_nab_dome_is_switched_off_while_stderr_is_never_read() -> None:
                 )
                 assert lit_then_dark, (board.timeline, board.events)
                 assert proc.poll() is None  # its words still wait for a reader: none lost
-            finally:
-                proc.kill()  # the process this test started, by its own handle
-                proc.wait(timeout=30)
     finally:
         os.close(r)
         os.close(w)
