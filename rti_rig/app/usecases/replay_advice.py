@@ -11,6 +11,7 @@ records what the session was asked for; the command repeats it.
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 from typing import Any
 
@@ -83,7 +84,8 @@ def session_options(manifest: dict[str, Any]) -> str:
                 float(until) if until is not None else None,
                 int(lights) if lights is not None else None,  # --lights was given
                 int(floor) if floor is not None else None,
-                shell_word(str(adaptive.get("objective") or "normals")),
+                # a word, not a path: shell_word's ``$'...'`` form is for names on disk
+                shlex.quote(str(adaptive.get("objective") or "normals")),
             )
         )
         band = adaptive
