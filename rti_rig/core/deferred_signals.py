@@ -182,7 +182,10 @@ def signals_deferred(
                 except BaseException as exc:
                     raised.append(exc)
             elif handler != signal.SIG_IGN:  # the default action: raised again, now unheld
-                default_action(received)  # a hang-up's: SIGHUP (exit 129)
+                # no wait for the CLI's words here: SIGTERM's action is the default only in a
+                # command with no SIGTERM handler, whose hold is a port's opening (a dome may
+                # be lit from its boot, its all-off not yet sent)
+                signal.raise_signal(received)  # a hang-up's: SIGHUP (exit 129)
 
     def hold(signum: int, frame: Any) -> None:
         received = as_received(signum)  # SIGHUP for a hang-up's: delivered later as one

@@ -1,6 +1,6 @@
 """The words still queued for a slow reader are written before a signal's default action
-ends the process, where the rig is safe at that point: a held SIGTERM delivered by a hold's
-end where SIGTERM's action is the default, a second SIGTERM while a run's summary prints, and
+ends the process, where the rig is safe at that point: a hang-up where SIGTERM's action is
+the default (before a run opens its rig), a second SIGTERM while a run's summary prints, and
 a SIGTERM after the capture answered as before it (the default action).
 
 Before, the default action ended the process at once and the words the writer thread still
@@ -50,9 +50,9 @@ app.err.print("a console's word", markup=False)
 # without that wait, nearly every run ends with the words queued as the reader begins
 sys.setswitchinterval(1000.0)
 path = sys.argv[1]
-if path == "hold":
-    with deferred_signals.signals_deferred():
-        signal.raise_signal(signal.SIGTERM)
+if path == "hangup":  # a hang-up answered as SIGTERM is, whose action is the default
+    with deferred_signals.hangup_as_sigterm():
+        signal.raise_signal(signal.SIGHUP)
 elif path == "summary":
     from rti_rig.cli.session import _late_term_held
     with _late_term_held():
@@ -65,7 +65,7 @@ print("the signal did not end the process", file=sys.stderr)
 """.replace("LINES", str(LINES))
 
 
-@pytest.mark.parametrize("path", ["hold", "summary", "as_before"])
+@pytest.mark.parametrize("path", ["hangup", "summary", "as_before"])
 def test_queued_words_are_written_before_a_signals_default_action(path: str) -> None:
     ready_r, ready_w = os.pipe()
     try:
@@ -88,4 +88,4 @@ def test_queued_words_are_written_before_a_signals_default_action(path: str) -> 
     assert not missing, f"{len(missing)} lines lost, first {missing[:3]}; tail {text[-300:]!r}"
     assert "a console's word" in text
     assert "did not end the process" not in text
-    assert process.returncode == -signal.SIGTERM
+    assert process.returncode == -(signal.SIGHUP if path == "hangup" else signal.SIGTERM)
