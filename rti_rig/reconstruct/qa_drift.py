@@ -96,15 +96,46 @@ class EdgeImages:
         self.edges = [edge_image(c) if usable[i] else None for i, c in enumerate(crops)]
         self.have = [i for i in range(crops.shape[0]) if self.edges[i] is not None]
         self._median_all: NDArray[np.float32] | None = None
+        self._spectra: dict[int, NDArray[np.complex128]] = {}
+        self._medians: dict[tuple[int, ...], NDArray[np.float32]] = {}
+        #: The Hanning window of the crops' shape both searches correlate under.
+        self.window: NDArray[np.float64] = _hanning(crops.shape[1:3])
+
+    def spectrum(self, i: int, window: NDArray[np.float64]) -> NDArray[np.complex128]:
+        """:func:`_spectrum` of edge image ``i`` (float64) under ``window``, made once.
+
+        Why: measure_drift's three rounds and step_candidates' peaks each took the windowed
+        FFT of every edge image again (four times the same 48 spectra on a still session);
+        the edge images do not change. Cached only under :attr:`window` (any other window is
+        computed afresh)."""
+        edge = self.edges[i]
+        assert edge is not None  # only images in ``have`` are correlated
+        if window is not self.window:
+            return _spectrum(edge.astype(np.float64), window)
+        cached = self._spectra.get(i)
+        if cached is None:
+            cached = self._spectra[i] = _spectrum(edge.astype(np.float64), window)
+        return cached
 
     def median_of(self, images: list[int]) -> NDArray[np.float64]:
         """``median_of_images`` of those edge images, float64 (the median of every usable
-        one kept, as both callers take it first)."""
+        one kept, as both callers take it first; any other set's kept as well: the step
+        search's refinements and its three seeds judge the same before and after sides
+        again, each a median of up to 48 edge images made anew)."""
         if images == self.have:
             if self._median_all is None:
                 self._median_all = median_of_images([self.edges[i] for i in images])
             return self._median_all.astype(np.float64)
-        return median_of_images([self.edges[i] for i in images]).astype(np.float64)
+        key = tuple(images)
+        kept = self._medians.get(key)
+        if kept is None:
+            kept = self._medians[key] = median_of_images([self.edges[i] for i in images])
+        return kept.astype(np.float64)
+
+
+def _hanning(shape: tuple[int, ...]) -> NDArray[np.float64]:
+    """The Hanning window both searches use for edge images of ``shape`` (h, w)."""
+    return cv2.createHanningWindow((shape[1], shape[0]), cv2.CV_64F)
 
 
 def _move(img: NDArray, dx: float, dy: float) -> NDArray:
@@ -181,7 +212,11 @@ def _peak_near_zero(
     ref_spectrum: NDArray[np.complex128], img: NDArray[np.float64], window: NDArray[np.float64]
 ) -> tuple[tuple[float, float], float]:
     """:func:`local_phase_correlation` with the reference's spectrum computed once a round."""
-    corr = _correlation(ref_spectrum, img, window)
+    return _peak_of(_correlation(ref_spectrum, img, window))
+
+
+def _peak_of(corr: NDArray[np.float64]) -> tuple[tuple[float, float], float]:
+    """:func:`_peak_near_zero` on a correlation surface already made."""
     h, w = corr.shape
     cy, cx = h // 2, w // 2
     r = min(MAX_SHIFT_PX, cy - 3, cx - 3)
@@ -221,7 +256,7 @@ def measure_drift(
     response = np.zeros(n)
     if len(have) < 3:
         return np.full((n, 2), np.nan), response
-    window = cv2.createHanningWindow((crops.shape[2], crops.shape[1]), cv2.CV_64F)
+    window = edge_set.window
     for _ in range(ROUNDS):
         # only measured shifts move an image back: a wrong one would drag the reference
         # (an image not moved is itself, not a warped copy: the identity warp gives the same
@@ -238,7 +273,8 @@ def measure_drift(
         ref_spectrum = _spectrum(ref, window)
         for i in have:
             e = edges[i].astype(np.float64)
-            (dx, dy), r = _peak_near_zero(ref_spectrum, e, window)
+            corr = _cross_correlation(ref_spectrum, edge_set.spectrum(i, window), e.shape)
+            (dx, dy), r = _peak_of(corr)
             response[i] = r
             measured[i] = bool(np.isfinite(dx)) and r >= MIN_RESPONSE and _confirmed(ref, e, dx, dy)
             shifts[i] = (dx, dy) if measured[i] else (0.0, 0.0)
@@ -331,7 +367,7 @@ def step_candidates(
     edges, have = edge_set.edges, edge_set.have
     if len(have) < 2 * STEP_MIN_IMAGES:
         return
-    window = cv2.createHanningWindow((crops.shape[2], crops.shape[1]), cv2.CV_64F)
+    window = edge_set.window
     median_of = edge_set.median_of
 
     def peaks_against(refs: list[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
@@ -346,7 +382,7 @@ def step_candidates(
             return outs
         ref_spectra = [_spectrum(ref, window) for ref in refs]
         for i in have:
-            spectrum = _spectrum(edges[i].astype(np.float64), window)
+            spectrum = edge_set.spectrum(i, window)
             for out, ref_spectrum in zip(outs, ref_spectra, strict=True):
                 corr = _cross_correlation(ref_spectrum, spectrum, edges[i].shape)
                 near = corr[cy - r : cy + r + 1, cx - r : cx + r + 1]
