@@ -63,6 +63,10 @@ EDGE_BLUR = 1.5
 MIN_RESPONSE = 0.03
 #: Rounds of (median reference, shifts, move back).
 ROUNDS = 3
+#: Bytes of edge-image spectra :class:`EdgeImages` keeps for reuse (about 1.2 MB a spectrum of
+#: a 384 px crop: 48 images take 57 MB); past it a spectrum is computed afresh each time, the
+#: same bits, so a dense acquisition's QA does not grow by a spectrum per light.
+SPECTRA_KEPT_BYTES = 128 * 2**20
 #: The phase-correlation peak is searched within this many pixels of no shift (each axis); a
 #: peak on the border is rejected, so the largest shift measured is about one pixel less.
 MAX_SHIFT_PX = 12
@@ -107,14 +111,16 @@ class EdgeImages:
         Why: measure_drift's three rounds and step_candidates' peaks each took the windowed
         FFT of every edge image again (four times the same 48 spectra on a still session);
         the edge images do not change. Cached only under :attr:`window` (any other window is
-        computed afresh)."""
+        computed afresh), and up to :data:`SPECTRA_KEPT_BYTES`."""
         edge = self.edges[i]
         assert edge is not None  # only images in ``have`` are correlated
         if window is not self.window:
             return _spectrum(edge.astype(np.float64), window)
         cached = self._spectra.get(i)
         if cached is None:
-            cached = self._spectra[i] = _spectrum(edge.astype(np.float64), window)
+            cached = _spectrum(edge.astype(np.float64), window)
+            if (len(self._spectra) + 1) * cached.nbytes <= SPECTRA_KEPT_BYTES:
+                self._spectra[i] = cached
         return cached
 
     def median_of(self, images: list[int]) -> NDArray[np.float64]:

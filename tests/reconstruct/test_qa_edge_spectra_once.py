@@ -39,3 +39,20 @@ def test_another_window_is_not_served_from_the_cache() -> None:
     got = edges.spectrum(0, flat)
     assert np.array_equal(got, _spectrum(edges.edges[0].astype(np.float64), flat))
     assert not np.array_equal(got, edges.spectrum(0, edges.window))
+
+
+def test_spectra_past_the_budget_are_made_afresh_not_kept(monkeypatch) -> None:
+    """A dense acquisition's QA does not keep a spectrum per light: past SPECTRA_KEPT_BYTES
+    each is computed again (the same values), so its memory does not grow with the lights."""
+    from rti_rig.reconstruct import qa_drift
+
+    crops = _stack()
+    edges = EdgeImages(crops, np.ones(len(crops), bool))
+    one = edges.spectrum(0, edges.window).nbytes
+    edges = EdgeImages(crops, np.ones(len(crops), bool))
+    monkeypatch.setattr(qa_drift, "SPECTRA_KEPT_BYTES", 2 * one)
+    made = [edges.spectrum(i, edges.window) for i in edges.have]
+    assert len(edges._spectra) == 2  # the first two kept, the rest not
+    last = edges.have[-1]
+    again = edges.spectrum(last, edges.window)
+    assert again is not made[-1] and np.array_equal(again, made[-1])
