@@ -540,7 +540,7 @@ def calibration_toml(
 
     lines = [
         f"# Light calibration of dome '{rig_name}' from the card session "
-        f"{_toml_string(_as_text(session))}.",
+        f"{toml_basic_string(_as_text(session))}.",
         "# Use it from the rig config, under [dome.serial]:",
         '#   intensity_correction_file = "<path of this file, relative to the config>"',
         "# then shoot the card again and calibrate that session: its spread is what is left.",
@@ -550,8 +550,8 @@ def calibration_toml(
         f"{weakest} ({names[weakest]}) at {cal.output[weakest]:.3f} of the median.",
         f"# {evened_sentence(cal, 3)}.",
         f'format = "{FORMAT}"',
-        f"rig = {_toml_string(rig_name)}",
-        f"session = {_toml_string(_as_text(session))}",
+        f"rig = {toml_basic_string(rig_name)}",
+        f"session = {toml_basic_string(_as_text(session))}",
         f'created = "{created}"',
         f"measured = {listing(['true' if m else 'false' for m in cal.measured])}",
         "# each LED's output at full drive relative to the median measured LED, LED order",
@@ -561,10 +561,6 @@ def calibration_toml(
         "",
     ]
     return "\n".join(lines)
-
-
-def _toml_string(text: str) -> str:
-    return toml_basic_string(text)
 
 
 def _as_text(path: Path) -> str:

@@ -8,6 +8,7 @@ it; left in B, relight or RTIBuilder given it paired B's images with A's lights 
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 
 from conftest import CONFIGS, said
@@ -113,6 +114,15 @@ def test_an_export_into_its_own_session_says_so_and_never_replaces_its_lights_lp
     assert own.read_bytes() == captured
 
     own.unlink()  # lost: export-lp writes it again, and says what it wrote
+    # an export beside the lost lights.lp says the command that writes it again, pasteable
+    # (the folder's name holds a space: it was printed unquoted)
+    r = wide.invoke(app, ["export-lp", str(a), "--out", str(a / "other.lp")])
+    assert r.exit_code == 0, r.output
+    assert (
+        f"rti-rig export-lp {shlex.quote(str(a))} --out {shlex.quote(str(own))} writes the "
+        "session's own lights.lp again"
+    ) in said(r), said(r)
+    (a / "other.lp").unlink()
     r = wide.invoke(app, ["export-lp", str(a), "--out", str(own)])
     assert r.exit_code == 0, r.output
     assert (

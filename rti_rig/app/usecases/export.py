@@ -14,7 +14,7 @@ from pathlib import Path
 from rti_rig.app.output_files import check_output_file, lp_name_note
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import LpEntry, write_lp
-from rti_rig.core.shell_words import shown_path
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
     LP_NAME,
@@ -151,7 +151,8 @@ def _in_session_said(out_file: Path, root: Path) -> str:
         )
     return (
         f"{shown_path(out_file)} is written inside the session {shown_path(root)}, which has no "
-        f"{LP_NAME}: rti-rig export-lp {root} --out {own} writes the session's own {LP_NAME} again"
+        f"{LP_NAME}: rti-rig export-lp {shell_word(root)} --out {shell_word(own)} writes the "
+        f"session's own {LP_NAME} again"
     )
 
 
@@ -194,8 +195,6 @@ def relight_move_advice(root: Path, new: str) -> str:
     lights.lp out for relight-cli, also for a name that sorts before it (the guide's
     ``demo_linear.lp``), which relight-cli reads first anyway: the session left without its
     own lights.lp for nothing."""
-    from rti_rig.core.shell_words import shell_word
-
     try:
         order = _relight_order(root, new)
     except OSError:  # a folder that cannot be listed: the moves are the user's to judge
