@@ -77,17 +77,12 @@ def upsampled_peak_shift(
     import rti_rig.reconstruct.qa_drift as qd
 
     corr = qd._correlation(qd._spectrum(ref, window), img, window)
+    peak, total = qd.whole_pixel_peak(corr)
+    if peak is None:
+        return (float("nan"), float("nan")), total
+    y, x = peak
     h, w = corr.shape
     cy, cx = h // 2, w // 2
-    r = min(qd.MAX_SHIFT_PX, cy - 3, cx - 3)
-    if r < 2:
-        return (float("nan"), float("nan")), 0.0
-    near = corr[cy - r : cy + r + 1, cx - r : cx + r + 1]
-    iy, ix = np.unravel_index(int(np.argmax(near)), near.shape)
-    if iy in (0, 2 * r) or ix in (0, 2 * r) or corr.max() > near[iy, ix]:
-        return (float("nan"), float("nan")), float(near[iy, ix])
-    y, x = cy - r + int(iy), cx - r + int(ix)
-    total = float(corr[y - 2 : y + 3, x - 2 : x + 3].sum())
     cross = np.conj(np.fft.fft2(ref * window)) * np.fft.fft2(img * window)
     cross /= np.maximum(np.abs(cross), 1e-30)
     steps = np.arange(-UPSAMPLE, UPSAMPLE + 1) / UPSAMPLE

@@ -221,20 +221,32 @@ def _peak_near_zero(
     return _peak_of(_correlation(ref_spectrum, img, window))
 
 
-def _peak_of(corr: NDArray[np.float64]) -> tuple[tuple[float, float], float]:
-    """:func:`_peak_near_zero` on a correlation surface already made."""
+def whole_pixel_peak(corr: NDArray[np.float64]) -> tuple[tuple[int, int] | None, float]:
+    """The correlation peak's ``(y, x)`` within ``MAX_SHIFT_PX`` of zero shift, and its 5 x 5
+    sum; ``None`` (with the strength to report) where it lies on the search's border or is
+    not the surface's maximum. Shared by :func:`_peak_of` and benchmarks/qa_step_margin.py's
+    alternative placement of the same peak, so both judge one peak."""
     h, w = corr.shape
     cy, cx = h // 2, w // 2
     r = min(MAX_SHIFT_PX, cy - 3, cx - 3)
     if r < 2:  # too small an image for a search with a border
-        return (float("nan"), float("nan")), 0.0
+        return None, 0.0
     near = corr[cy - r : cy + r + 1, cx - r : cx + r + 1]
     iy, ix = np.unravel_index(int(np.argmax(near)), near.shape)
     if iy in (0, 2 * r) or ix in (0, 2 * r) or corr.max() > near[iy, ix]:
-        return (float("nan"), float("nan")), float(near[iy, ix])
+        return None, float(near[iy, ix])
     y, x = cy - r + int(iy), cx - r + int(ix)
+    return (y, x), float(corr[y - 2 : y + 3, x - 2 : x + 3].sum())
+
+
+def _peak_of(corr: NDArray[np.float64]) -> tuple[tuple[float, float], float]:
+    """:func:`_peak_near_zero` on a correlation surface already made."""
+    peak, total = whole_pixel_peak(corr)
+    if peak is None:
+        return (float("nan"), float("nan")), total
+    y, x = peak
+    cy, cx = corr.shape[0] // 2, corr.shape[1] // 2
     patch = corr[y - 2 : y + 3, x - 2 : x + 3]
-    total = float(patch.sum())
     if total <= 0:
         return (float("nan"), float("nan")), total
     ys, xs = np.mgrid[-2:3, -2:3]
