@@ -32,6 +32,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.reconstruct.synthetic import moved_session_copy
+
 REPO = Path(__file__).resolve().parents[1]
 #: (rig, scene, side px, lights)
 STILL = [
@@ -102,17 +104,6 @@ def _config(root: Path, rig: str, scene: str, side: int) -> Path:
     path = root / f"{rig}.toml"
     path.write_text(text, encoding="utf-8")
     return path
-
-
-def _moved_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -> Path:
-    from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
-
-    shutil.copytree(session, dst)
-    for f in sorted((dst / "linear").glob("image_*.tif"))[first - 1 :]:
-        img = read_linear_tiff(f)
-        f.unlink()
-        write_linear_tiff(f, np.roll(img, (dy, dx), axis=(0, 1)))
-    return dst
 
 
 def _row(session: Path, out: Path) -> tuple[float, float, list[str], bool]:
@@ -196,7 +187,7 @@ def main() -> None:
             name = "still " + " ".join(map(str, case))
             print(f"{name:40s} {old:8.2f} {new:8.2f}  {'MOVED' if said else 'still':7s}  {steps}")
         for m in moved:
-            session = _moved_copy(shot[m[:4]], shot[m[:4]].parent / f"moved_{m[4]}", *m[4:])
+            session = moved_session_copy(shot[m[:4]], shot[m[:4]].parent / f"moved_{m[4]}", *m[4:])
             old, new, steps, said = _row(session, session.parent / f"fit_moved_{m[4]}")
             name = "moved " + " ".join(map(str, m))
             print(f"{name:40s} {old:8.2f} {new:8.2f}  {'MOVED' if said else 'still':7s}  {steps}")

@@ -16,7 +16,6 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, AnyStr, NamedTuple
 
-import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
@@ -464,18 +463,11 @@ def dome_variant(tmp_path: Path, scene: str, side: int) -> Path:
 
 
 def moved_session_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -> Path:
-    """A copy of ``session`` whose images from ``first`` (1-based) on are shifted by
-    ``(dx, dy)`` px (x right, y down): the object nudged once, part-way through."""
-    import shutil
+    """:func:`rti_rig.reconstruct.synthetic.moved_session_copy` (there so that
+    benchmarks/qa_step_margin.py, which may not import tests, moves a session the same way)."""
+    from rti_rig.reconstruct.synthetic import moved_session_copy as moved
 
-    from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
-
-    shutil.copytree(session, dst)
-    for f in sorted((dst / "linear").glob("image_*.tif"))[first - 1 :]:
-        img = read_linear_tiff(f)
-        f.unlink()
-        write_linear_tiff(f, np.roll(img, (dy, dx), axis=(0, 1)))
-    return dst
+    return moved(session, dst, first, dx, dy)
 
 
 def dome_session(tmp_path: Path, scene: str, side: int, lights: int) -> Path:

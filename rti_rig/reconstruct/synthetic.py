@@ -6,6 +6,8 @@ Lambertian-plus-Blinn–Phong shader, enough to know what a fit must return.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -79,3 +81,19 @@ def sphere_frames(
         img = img + rng.normal(0, 0.002, img.shape)
         frames.append(np.clip(np.round(img * 65535), 0, 65535).astype(np.uint16))
     return frames, lights
+
+
+def moved_session_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -> Path:
+    """A copy of ``session`` whose images from ``first`` (1-based) on are shifted by
+    ``(dx, dy)`` px (x right, y down): the object nudged once, part-way through. Here, not in
+    tests/, so that benchmarks/qa_step_margin.py measures the same move the QA tests claim."""
+    import shutil
+
+    from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
+
+    shutil.copytree(session, dst)
+    for f in sorted((dst / "linear").glob("image_*.tif"))[first - 1 :]:
+        img = read_linear_tiff(f)
+        f.unlink()
+        write_linear_tiff(f, np.roll(img, (dy, dx), axis=(0, 1)))
+    return dst
