@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import queue
 import re
 import signal
@@ -460,6 +461,38 @@ def dome_variant(tmp_path: Path, scene: str, side: int) -> Path:
     text, n_s = re.subn(r'(?ms)(\[scene\].*?^name = )"[^"]*"', rf'\g<1>"{scene}"', text)
     assert (n_w, n_h, n_s) == (1, 1, 1), "simulated_dome.toml no longer has one width/height/scene"
     return write_config(tmp_path, text, f"{scene}_{side}.toml")
+
+
+#: Linux's fcntl to resize a pipe (``F_SETPIPE_SZ``); Python names it from 3.10 on Linux only.
+F_SETPIPE_SZ = 1031
+
+
+def full_pipe(writer_blocking: bool) -> tuple[int, int, bytes]:
+    """A pipe of one page, filled to the last byte it takes: ``(read end, write end, filler)``.
+    ``writer_blocking``: the write end left blocking (a shell's ``| less``) or non-blocking (a
+    reader that set ``O_NONBLOCK``: node's ``child_process``). Linux only (``F_SETPIPE_SZ``)."""
+    import fcntl
+
+    read_end, write_end = os.pipe()
+    fcntl.fcntl(write_end, F_SETPIPE_SZ, 4096)
+    os.set_blocking(write_end, False)
+    filler = b""
+    try:
+        while True:
+            filler += b"x" * os.write(write_end, b"x" * 512)
+    except BlockingIOError:
+        pass
+    os.set_blocking(write_end, writer_blocking)
+    return read_end, write_end, filler
+
+
+def unread_in_pipe(fd: int) -> int:
+    """How many bytes wait in the pipe ``fd`` for its reader (``FIONREAD``)."""
+    import fcntl
+    import termios
+
+    got = fcntl.ioctl(fd, termios.FIONREAD, b"\0\0\0\0")
+    return int.from_bytes(got, sys.byteorder)
 
 
 def moved_session_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -> Path:

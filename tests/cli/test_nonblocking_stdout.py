@@ -19,26 +19,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import REPO, ended_on_exit
-
-#: Linux's fcntl to resize a pipe (``F_SETPIPE_SZ``); Python names it from 3.10 on Linux only.
-F_SETPIPE_SZ = 1031
-
-
-def _full_nonblocking_pipe() -> tuple[int, int, bytes]:
-    """A pipe of one page, its write end non-blocking, filled to the last byte it takes."""
-    import fcntl
-
-    read_end, write_end = os.pipe()
-    fcntl.fcntl(write_end, F_SETPIPE_SZ, 4096)
-    os.set_blocking(write_end, False)
-    filler = b""
-    try:
-        while True:
-            filler += b"x" * os.write(write_end, b"x" * 512)
-    except BlockingIOError:
-        pass
-    return read_end, write_end, filler
+from conftest import REPO, ended_on_exit, full_pipe, unread_in_pipe
 
 
 def _waits_for_room(pid: int) -> bool:
@@ -60,15 +41,6 @@ def _waits_for_room(pid: int) -> bool:
     return False
 
 
-def _unread(fd: int) -> int:
-    """How many bytes wait in the pipe for its reader (``FIONREAD``)."""
-    import fcntl
-    import termios
-
-    got = fcntl.ioctl(fd, termios.FIONREAD, b"\0\0\0\0")
-    return int.from_bytes(got, sys.byteorder)
-
-
 def _read_all(fd: int) -> bytes:
     with os.fdopen(fd, "rb") as stream:
         return stream.read()
@@ -85,7 +57,7 @@ def test_help_on_a_full_non_blocking_pipe_is_said_whole(tmp_path: Path) -> None:
     ).stdout
     assert len(whole) > 4096, whole  # more than the pipe holds: the command must wait for room
 
-    read_end, write_end, filler = _full_nonblocking_pipe()
+    read_end, write_end, filler = full_pipe(writer_blocking=False)
     with open(tmp_path / "stderr.txt", "wb") as stderr:
         command = subprocess.Popen(
             [sys.executable, "-m", "rti_rig", "run", "--help"],
@@ -103,7 +75,7 @@ def test_help_on_a_full_non_blocking_pipe_is_said_whole(tmp_path: Path) -> None:
         while command.poll() is None and not _waits_for_room(command.pid):
             assert time.monotonic() < deadline, "the command neither ended nor waited in 600 s"
             time.sleep(0.05)
-        assert _unread(read_end) == len(filler)  # nothing was read before it met the pipe
+        assert unread_in_pipe(read_end) == len(filler)  # nothing was read before it met the pipe
         said = _read_all(read_end)
         code = command.wait(timeout=600)
     errors = (tmp_path / "stderr.txt").read_text()

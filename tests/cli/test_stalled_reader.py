@@ -11,46 +11,20 @@ and filled before the command starts, so that its very first word finds no room.
 
 from __future__ import annotations
 
-import fcntl
 import json
 import os
 import subprocess
 import sys
-import termios
 import threading
 import time
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, REPO
-
-#: Linux's fcntl to resize a pipe (``F_SETPIPE_SZ``).
-F_SETPIPE_SZ = 1031
+from conftest import CONFIGS, REPO, full_pipe, unread_in_pipe
 
 pytestmark = pytest.mark.skipif(
     not sys.platform.startswith("linux"), reason="needs Linux's F_SETPIPE_SZ and /proc"
 )
-
-
-def _full_pipe() -> tuple[int, int, bytes]:
-    """A pipe of one page (blocking, as a shell's ``| less`` is), filled to the last byte."""
-    read_end, write_end = os.pipe()
-    fcntl.fcntl(write_end, F_SETPIPE_SZ, 4096)
-    os.set_blocking(write_end, False)
-    filler = b""
-    try:
-        while True:
-            filler += b"x" * os.write(write_end, b"x" * 512)
-    except BlockingIOError:
-        pass
-    os.set_blocking(write_end, True)
-    return read_end, write_end, filler
-
-
-def _unread(fd: int) -> int:
-    """How many bytes wait in the pipe for its reader (``FIONREAD``)."""
-    got = fcntl.ioctl(fd, termios.FIONREAD, b"\0\0\0\0")
-    return int.from_bytes(got, sys.byteorder)
 
 
 def _main_thread_waits_on_pipe(pid: int) -> bool:
@@ -75,7 +49,7 @@ def _finished(manifest: Path) -> dict | None:  # type: ignore[type-arg]
 
 def test_a_run_whose_reader_stalls_switches_its_lamp_off_then_waits(tmp_path: Path) -> None:
     session = tmp_path / "session"
-    read_end, write_end, filler = _full_pipe()
+    read_end, write_end, filler = full_pipe(writer_blocking=True)
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     config = str(CONFIGS / "simulated_dome.toml")
     command = subprocess.Popen(
@@ -105,7 +79,7 @@ def test_a_run_whose_reader_stalls_switches_its_lamp_off_then_waits(tmp_path: Pa
         assert runner["finish_reason"] == "completed", runner
         assert runner["teardown_failures"] == [], runner
         assert runner["steps_done_this_run"] == 4, runner
-        assert _unread(read_end) == len(filler)
+        assert unread_in_pipe(read_end) == len(filler)
         assert command.poll() is None  # its words still wait for the reader
         reader.start()  # the reader reads again: every word comes, and the command ends
         code = command.wait(timeout=600)
