@@ -463,6 +463,37 @@ def dome_variant(tmp_path: Path, scene: str, side: int) -> Path:
     return write_config(tmp_path, text, f"{scene}_{side}.toml")
 
 
+#: A folder name whose byte 0xe9 is not UTF-8 (Latin-1's é), with a space and a quote.
+NOT_UTF8_NAME = b"caf\xe9 it's"
+#: A ``$'...'`` word as printed: its quote and backslash escaped inside.
+DOLLAR_WORD = re.compile(rb"\$'(?:[^'\\]|\\.)*'")
+#: A C locale with an ASCII stdout, as a script on a legacy system runs rti-rig.
+ASCII_LOCALE_ENV = {
+    **os.environ,
+    "PYTHONPATH": str(REPO),
+    "LC_ALL": "C",
+    "PYTHONIOENCODING": "ascii",
+}
+
+
+def rti_rig_in_ascii_locale(*args: str | Path) -> subprocess.CompletedProcess[bytes]:
+    """``python -m rti_rig *args`` in :data:`ASCII_LOCALE_ENV`, its streams as bytes; no
+    traceback."""
+    r = subprocess.run(
+        [sys.executable, "-m", "rti_rig", *map(str, args)],
+        capture_output=True,
+        env=ASCII_LOCALE_ENV,
+        timeout=600,
+    )
+    assert b"Traceback" not in r.stderr, r.stderr
+    return r
+
+
+def pasted(word: bytes) -> bytes:
+    """What bash makes of ``word`` pasted into a command line."""
+    return subprocess.run(["bash", "-c", b"printf %s " + word], capture_output=True).stdout
+
+
 #: Linux's fcntl to resize a pipe (``F_SETPIPE_SZ``); Python names it from 3.10 on Linux only.
 F_SETPIPE_SZ = 1031
 

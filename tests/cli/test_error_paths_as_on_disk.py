@@ -12,39 +12,23 @@ each word given to bash as the user would paste it.
 from __future__ import annotations
 
 import os
-import re
 import shutil
 import subprocess
-import sys
 import tomllib
 from pathlib import Path
 
 import pytest
 from card_support import card_rig, shoot
-from conftest import CONFIGS, REPO
-
-#: A folder name whose byte 0xe9 is not UTF-8 (Latin-1's é), with a space and a quote.
-NAME = b"caf\xe9 it's"
-#: A ``$'...'`` word as printed: its quote and backslash escaped inside.
-WORD = re.compile(rb"\$'(?:[^'\\]|\\.)*'")
-ENV = {**os.environ, "PYTHONPATH": str(REPO), "LC_ALL": "C", "PYTHONIOENCODING": "ascii"}
+from conftest import CONFIGS, pasted, rti_rig_in_ascii_locale
+from conftest import DOLLAR_WORD as WORD
+from conftest import NOT_UTF8_NAME as NAME
 
 
 def rti_rig(*args: str | Path) -> subprocess.CompletedProcess[bytes]:
-    r = subprocess.run(
-        [sys.executable, "-m", "rti_rig", *map(str, args)],
-        capture_output=True,
-        env=ENV,
-        timeout=600,
-    )
-    assert b"Traceback" not in r.stderr and b"unexpected" not in r.stderr, r.stderr
+    r = rti_rig_in_ascii_locale(*args)
+    assert b"unexpected" not in r.stderr, r.stderr
     assert b"udce9" not in r.stderr + r.stdout, r.stderr
     return r
-
-
-def pasted(word: bytes) -> bytes:
-    """What bash makes of ``word`` pasted into a command line."""
-    return subprocess.run(["bash", "-c", b"printf %s " + word], capture_output=True).stdout
 
 
 def first_word_after_error(said: bytes) -> bytes:

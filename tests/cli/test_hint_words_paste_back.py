@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -20,29 +19,11 @@ from pathlib import Path
 
 import pytest
 from card_support import card_rig
-from conftest import CONFIGS, REPO
-
-#: A folder name whose byte 0xe9 is not UTF-8 (Latin-1's é), with a space and a quote.
-NAME = b"caf\xe9 it's"
-#: A ``$'...'`` word as printed: its quote and backslash escaped inside.
-WORD = re.compile(rb"\$'(?:[^'\\]|\\.)*'")
-ENV = {**os.environ, "PYTHONPATH": str(REPO), "LC_ALL": "C", "PYTHONIOENCODING": "ascii"}
-
-
-def rti_rig(*args: str | Path) -> subprocess.CompletedProcess[bytes]:
-    r = subprocess.run(
-        [sys.executable, "-m", "rti_rig", *map(str, args)],
-        capture_output=True,
-        env=ENV,
-        timeout=600,
-    )
-    assert b"Traceback" not in r.stderr, r.stderr
-    return r
-
-
-def pasted(word: bytes) -> bytes:
-    """What bash makes of ``word`` pasted into a command line."""
-    return subprocess.run(["bash", "-c", b"printf %s " + word], capture_output=True).stdout
+from conftest import ASCII_LOCALE_ENV as ENV
+from conftest import CONFIGS, pasted
+from conftest import DOLLAR_WORD as WORD
+from conftest import NOT_UTF8_NAME as NAME
+from conftest import rti_rig_in_ascii_locale as rti_rig
 
 
 def words_after(said: bytes, before: bytes) -> list[bytes]:
