@@ -463,6 +463,27 @@ def dome_variant(tmp_path: Path, scene: str, side: int) -> Path:
     return write_config(tmp_path, text, f"{scene}_{side}.toml")
 
 
+def signal_as_the_teardown_switches_off(
+    monkeypatch: pytest.MonkeyPatch, signum: signal.Signals
+) -> list[bool]:
+    """Raise ``signum`` in this process as the first emergency teardown switches the dome's
+    lights off (``DomeLighting.safe(emergency=True)``), once, with no timing: a signal landing
+    mid-teardown. The list returned holds ``True`` once it was raised."""
+    from rti_rig.runtime.lighting import DomeLighting
+
+    real_safe = DomeLighting.safe
+    sent: list[bool] = []
+
+    def safe(self, emergency: bool = False) -> list[str]:  # type: ignore[no-untyped-def]
+        if emergency and not sent:
+            sent.append(True)
+            signal.raise_signal(signum)
+        return real_safe(self, emergency)
+
+    monkeypatch.setattr(DomeLighting, "safe", safe)
+    return sent
+
+
 #: A folder name whose byte 0xe9 is not UTF-8 (Latin-1's é), with a space and a quote.
 NOT_UTF8_NAME = b"caf\xe9 it's"
 #: A ``$'...'`` word as printed: its quote and backslash escaped inside.

@@ -16,11 +16,10 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, manifest, said
+from conftest import CONFIGS, manifest, said, signal_as_the_teardown_switches_off
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.runtime.lighting import DomeLighting
 from rti_rig.runtime.session import SessionFolder
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
@@ -45,20 +44,6 @@ def _signals_as_the_second_image_is_committed(
     monkeypatch.setattr(SessionFolder, "write_step", write_step)
 
 
-def _ctrl_c_as_the_teardown_switches_off(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
-    real_safe = DomeLighting.safe
-    sent: list[bool] = []
-
-    def safe(self, emergency: bool = False) -> list[str]:  # type: ignore[no-untyped-def]
-        if emergency and not sent:
-            sent.append(True)
-            signal.raise_signal(signal.SIGINT)  # held by the teardown, delivered after it
-        return real_safe(self, emergency)
-
-    monkeypatch.setattr(DomeLighting, "safe", safe)
-    return sent
-
-
 @pytest.mark.parametrize(
     ("in_one_hold", "in_teardown", "also_said"),
     [
@@ -77,7 +62,9 @@ def test_a_ctrl_c_during_a_sigterms_stop_is_said_and_the_stop_goes_on(
     also_said: int,
 ) -> None:
     _signals_as_the_second_image_is_committed(monkeypatch, in_one_hold)
-    teardown = _ctrl_c_as_the_teardown_switches_off(monkeypatch) if in_teardown else None
+    teardown = (
+        signal_as_the_teardown_switches_off(monkeypatch, signal.SIGINT) if in_teardown else None
+    )
     out = tmp_path / "s"
     argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--lights", "6", "--out", str(out)]
     r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
@@ -103,16 +90,7 @@ def test_a_sigusr1_during_a_sigterms_teardown_does_not_say_it_pauses(
     """SIGUSR1 is not held (a pause acts between images): in a stop's teardown it had been
     told "Pausing after this image", of a run that was ending."""
     _signals_as_the_second_image_is_committed(monkeypatch, [signal.SIGTERM])
-    real_safe = DomeLighting.safe
-    sent: list[bool] = []
-
-    def safe(self, emergency: bool = False) -> list[str]:  # type: ignore[no-untyped-def]
-        if emergency and not sent:
-            sent.append(True)
-            signal.raise_signal(signal.SIGUSR1)
-        return real_safe(self, emergency)
-
-    monkeypatch.setattr(DomeLighting, "safe", safe)
+    sent = signal_as_the_teardown_switches_off(monkeypatch, signal.SIGUSR1)
     out = tmp_path / "s"
     argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--lights", "6", "--out", str(out)]
     r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import pytest
 from conftest import CONFIGS, ended_on_exit, eventually, manifest, said, sighup_at_lit_led
+from conftest import signal_as_the_teardown_switches_off as signal_in_teardown
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -76,24 +77,15 @@ def test_a_sigterm_during_a_hangups_teardown_is_said_and_the_teardown_finishes(
     dome off (no timing): it had raised a second emergency stop as the teardown's hold ended,
     which replaced the hang-up's (said "Emergency stop (SIGTERM)", exit 143, while the manifest
     recorded SIGHUP)."""
-    from rti_rig.runtime.lighting import DomeLighting
-
     out = tmp_path / "s"
-    real_safe = DomeLighting.safe
-    sent: list[bool] = []
-
-    def safe(self, emergency: bool = False) -> list[str]:  # type: ignore[no-untyped-def]
-        if emergency and not sent:
-            sent.append(True)
-            signal.raise_signal(signal.SIGTERM)  # held by the teardown, delivered after it
-        return real_safe(self, emergency)
 
     def unhandled(signum: int, frame: object) -> None:
         raise SigtermUnhandled("SIGTERM was not handled by rti-rig")
 
     with monkeypatch.context() as patched, signal_handlers({signal.SIGTERM: unhandled}):
         firmwares = sighup_at_lit_led(patched, 3)
-        patched.setattr(DomeLighting, "safe", safe)
+        # held by the teardown, delivered after it
+        sent = signal_in_teardown(patched, signal.SIGTERM)
         argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
         r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
     words = said(r)
