@@ -2074,16 +2074,14 @@ def _plan_light_count(opened, low_deg: float, high_deg: float) -> int:  # type: 
 
     Why: the line said ``--lights N``, which pasted as printed was refused as not a whole
     number; a count the dome cannot give would be refused too."""
-    import math
-
+    from rti_rig.core.geometry import az_el_from_direction
     from rti_rig.core.rig_geometry import DomeGeometry
 
     geometry = opened.rig.geometry  # a flash-synced dome's and a replayed .lp's too
     if not isinstance(geometry, DomeGeometry):
         return PLAN_HINT_LIGHTS
-    z = geometry.directions[:, 2].clip(-1.0, 1.0)
-    elevations = [math.degrees(math.asin(float(v))) for v in z]
-    in_band = sum(1 for e in elevations if low_deg - 1e-6 <= e <= high_deg + 1e-6)
+    _, elevations = az_el_from_direction(geometry.directions)
+    in_band = int(((elevations >= low_deg - 1e-6) & (elevations <= high_deg + 1e-6)).sum())
     return max(3, min(PLAN_HINT_LIGHTS, in_band))
 
 
