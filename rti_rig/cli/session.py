@@ -1562,7 +1562,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
                 raise EmergencyStop(stopping, escalated)
             err.print(
                 f"[yellow]Ctrl-C also arrived: the stop ({began}) is already under way "
-                "(lights off, records).[/]"
+                "(switching the lights off, writing its records).[/]"
             )
             return
         if cancel.cancelled:
@@ -1599,7 +1599,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             # still ends an opening that may hang
             err.print(
                 f"[yellow]{stop_words(as_received(signum))} also arrived: the stop "
-                f"({stop_words(stopping)}) is already under way (lights off, records).[/]"
+                f"({stop_words(stopping)}) is already under way (switching the lights off, "
+                "writing its records).[/]"
             )
             return
         stopping = as_received(signum)
@@ -1613,7 +1614,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             # been said in a stop's teardown, of a run that was ending
             err.print(
                 f"[yellow]SIGUSR1 ignored: the stop ({stop_words(stopping)}) is under way "
-                "(lights off, records).[/]"
+                "(switching the lights off, writing its records).[/]"
             )
             return
         if cancel.paused:
