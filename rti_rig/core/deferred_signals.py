@@ -89,7 +89,9 @@ def hangup_as_sigterm() -> Iterator[None]:
         if callable(handler):
             _deliver(handler, sighup, frame)
         elif handler != signal.SIG_IGN:  # the default (or a handler set outside Python)
-            default_action(sighup)  # within run/check/preview: nothing opened yet
+            # within run/check/preview, nothing opened yet: the words are waited on (a
+            # hang-up a port's opening held is acted on by the hold, without the wait)
+            default_action(sighup)
 
     with signal_handlers({sighup: hung_up}):
         yield
@@ -176,16 +178,18 @@ def signals_deferred(
             handler = installed.get(signum)
             if handler is None:
                 continue
-            if callable(handler):
+            if handler == signal.SIG_DFL or handler is default_after_hooks:
+                # the default action, now unheld, with no wait for the CLI's words (not even
+                # a hang-up's, which :func:`hangup_as_sigterm`'s handler would have waited
+                # on): SIGTERM's action is the default only in a command with no SIGTERM
+                # handler, whose hold is a port's opening (a dome may be lit from its boot,
+                # its all-off not yet sent)
+                _default_now(received)  # a hang-up's: SIGHUP (exit 129)
+            elif callable(handler):
                 try:  # a held hang-up is delivered as one: named SIGHUP, not SIGTERM
                     _deliver(handler, received, frame)
                 except BaseException as exc:
                     raised.append(exc)
-            elif handler != signal.SIG_IGN:  # the default action: raised again, now unheld
-                # no wait for the CLI's words here: SIGTERM's action is the default only in a
-                # command with no SIGTERM handler, whose hold is a port's opening (a dome may
-                # be lit from its boot, its all-off not yet sent)
-                signal.raise_signal(received)  # a hang-up's: SIGHUP (exit 129)
 
     def hold(signum: int, frame: Any) -> None:
         received = as_received(signum)  # SIGHUP for a hang-up's: delivered later as one
@@ -323,5 +327,23 @@ def default_action(sig: int) -> None:
     for hook in list(before_default_action):
         with contextlib.suppress(BaseException):
             hook()
+    _default_now(sig)
+
+
+def _default_now(sig: int) -> None:
+    """End the process by ``sig``'s default action at once: no hook, no handler of ours (a
+    hang-up's SIGHUP would otherwise meet :func:`hangup_as_sigterm`'s, which may wait)."""
     signal.signal(sig, signal.SIG_DFL)
     signal.raise_signal(sig)
+
+
+def default_after_hooks(signum: int, frame: Any) -> None:
+    """A SIGTERM handler that is the default action with :data:`before_default_action`'s
+    hooks run first: the CLI's handler for the moments no command has its own (``bench``;
+    ``fit`` and ``plan`` once their work is done; any command's end, waiting for its words).
+
+    Why a handler of the core's: the default action ended the process at once and the words
+    the CLI still held for a slow reader were lost. A hold over a port's opening
+    (:func:`signals_deferred`) knows it by name and takes the default action it stands for
+    at once, without the wait."""
+    default_action(as_received(signum))
