@@ -536,9 +536,14 @@ def main() -> None:
     unwrapped_when_piped()
     help_styled_as_the_consoles()
     reader_gone_tolerated()
-    from rti_rig.cli.unwaited_words import words_unwaited, words_written
+    from rti_rig.cli.unwaited_words import (
+        sigterm_waits_for_the_words,
+        words_unwaited,
+        words_written,
+    )
 
     words_unwaited((out, err))  # no print waits on the reader while the rig works
+    sigterm_waits_for_the_words()  # nor is a word said lost to SIGTERM's default action
     try:
         app()
     finally:

@@ -27,11 +27,12 @@ import contextlib
 import errno
 import os
 import select
+import signal
 import sys
 import threading
 from typing import Any
 
-from rti_rig.core.deferred_signals import before_default_action
+from rti_rig.core.deferred_signals import before_default_action, default_after_hooks
 
 #: How many characters may wait for a stalled reader before further words are dropped.
 HELD_LIMIT = 1 << 20
@@ -282,6 +283,25 @@ def words_written_before_signal() -> None:
         return
     with contextlib.suppress(KeyboardInterrupt):
         _writer.drain(BEFORE_DEFAULT_ACTION_S)
+
+
+def sigterm_waits_for_the_words() -> None:
+    """Where SIGTERM's action is the default as the console entry begins, answer it with the
+    core's :func:`~rti_rig.core.deferred_signals.default_after_hooks`: the default action,
+    after up to :data:`BEFORE_DEFAULT_ACTION_S` for the words already said. A command that
+    sets its own handler (``run``, ``check``, ``probe`` while it works; ``fit`` and ``plan``
+    while they write) puts this one back as it ends. Main thread only; a SIGTERM ignored or
+    handled outside Python is left as it is.
+
+    Why: ``bench`` has no SIGTERM handler, ``fit`` and ``plan`` none once their work is done,
+    and no command one in the end's wait for the words: a SIGTERM there (``timeout``, a
+    scheduler) ended the process at once and the words still queued for a slow reader (a
+    summary, a stop's words, a help text) were lost. None of those moments holds hardware
+    (``probe`` has closed its dome by then), so a wait of 2 s at most costs no safety."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    if signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, default_after_hooks)
 
 
 def say_unwaited(text: str) -> None:

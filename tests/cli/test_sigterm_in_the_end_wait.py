@@ -1,0 +1,82 @@
+"""A SIGTERM while a command with no SIGTERM handler of its own (``plan``'s help here; ``fit``,
+``plan`` and ``bench`` once their work is done, ``probe`` once its dome is closed) waits at
+its end for a stalled reader: the words said before the signal still reach the reader, and
+the process ends by SIGTERM (143 in a shell).
+
+Before, SIGTERM's default action ended the process at once and the words queued for the
+reader were lost (the writer thread, not the print, held them). Through ``python -m rti_rig``
+on a real one-page pipe filled before the command starts; the signal is sent once /proc shows
+the command at its end (the main thread waiting, the words thread blocked writing to the
+pipe), and the reader reads as soon as it is sent: the words have up to 2 s
+(``BEFORE_DEFAULT_ACTION_S``) to go, which a reader that reads at all takes in milliseconds.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+from conftest import REPO, ended_on_exit, full_pipe
+
+pytestmark = pytest.mark.skipif(
+    not sys.platform.startswith("linux"), reason="needs Linux's F_SETPIPE_SZ and /proc"
+)
+
+
+def _wchans(pid: int) -> dict[int, str]:
+    """What each thread of ``pid`` waits on in the kernel, by thread id (main thread: pid)."""
+    found: dict[int, str] = {}
+    try:
+        tids = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return found
+    for tid in tids:
+        try:
+            with open(f"/proc/{pid}/task/{tid}/wchan") as wchan:
+                found[int(tid)] = wchan.read()
+        except OSError:
+            pass
+    return found
+
+
+def _at_its_end(pid: int) -> bool:
+    """Whether ``pid`` has said its words and waits for them: its main thread waits on a lock
+    (the end's wait for the words thread: a futex) while another thread is blocked writing
+    to the full pipe."""
+    wchans = _wchans(pid)
+    main = wchans.pop(pid, "")
+    return "futex" in main and any("pipe_write" in w for w in wchans.values())
+
+
+def test_a_sigterm_in_the_end_wait_keeps_the_words_said_and_ends_by_sigterm() -> None:
+    read_end, write_end, filler = full_pipe(writer_blocking=True)
+    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "100"}
+    command = subprocess.Popen(
+        [sys.executable, "-m", "rti_rig", "plan", "--help"],
+        stdout=write_end,
+        stderr=write_end,
+        env=env,
+    )
+    os.close(write_end)
+    said: list[bytes] = []
+    reader = threading.Thread(target=lambda: said.append(os.fdopen(read_end, "rb").read()))
+    with ended_on_exit(command):
+        deadline = time.monotonic() + 600
+        while not _at_its_end(command.pid):
+            assert command.poll() is None, "the command ended with its reader stalled"
+            assert time.monotonic() < deadline, "the command did not reach its end in 600 s"
+            time.sleep(0.05)
+        command.send_signal(signal.SIGTERM)
+        reader.start()  # at once: the words have up to 2 s once the signal is handled
+        code = command.wait(timeout=600)
+        reader.join(timeout=600)
+    assert said[0].startswith(filler)
+    words = said[0][len(filler) :].decode("utf-8", "replace")
+    assert "Usage:" in words and "--rig" in words and "--out" in words, words
+    assert "Traceback" not in words, words
+    assert code == -signal.SIGTERM, (code, words)
