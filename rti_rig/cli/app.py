@@ -547,4 +547,5 @@ def main() -> None:
     try:
         app()
     finally:
-        words_written()
+        if not words_written():  # a Ctrl-C left words unwritten: not the command's own exit
+            raise SystemExit(stop_exit_code(signal.SIGINT))

@@ -38,21 +38,28 @@ from rti_rig.core.deferred_signals import before_default_action, default_after_h
 HELD_LIMIT = 1 << 20
 
 _FLUSH = object()
+_CLOSE = object()  # the thread ends here (:meth:`WordsWriter.close`)
 
 
 class WordsWriter:
     """One thread writing, in the order they were said, the words of both standard streams.
 
     The saying side (any thread, and signal handlers in the main thread) only appends to a
-    deque and writes a byte to a non-blocking wake-up pipe: no lock is taken there, so a
-    handler that speaks while the main thread was speaking cannot deadlock, and nothing there
-    can block. One queue for both streams keeps their order (``2>&1``) as it was said."""
+    deque and writes a byte to a non-blocking wake-up pipe: nothing there can block on the
+    reader. The counts of characters held and dropped are changed under ``_count_lock``, held
+    only for the arithmetic (never across a write), re-entrant so that a handler that speaks
+    while the main thread was counting cannot deadlock: ``+=`` from the saying threads and
+    ``-=`` from the writer thread had raced, and the held count drifted (words dropped below
+    the limit, or the limit overrun). One queue for both streams keeps their order (``2>&1``)
+    as it was said."""
 
     def __init__(self, notes_to: Any, limit: int = HELD_LIMIT) -> None:
         self._items: collections.deque[Any] = collections.deque()
         self._limit = limit
-        self._held = 0  # characters queued (approximate: a count, not a lock)
+        self._count_lock = threading.RLock()
+        self._held = 0  # characters queued, not yet written
         self._dropped = 0
+        self._closed = False
         self.notes_to = notes_to
         self._wake_r, self._wake_w = os.pipe()
         os.set_blocking(self._wake_w, False)
@@ -60,18 +67,19 @@ class WordsWriter:
         self._thread.start()
 
     def write(self, stream: Any, text: str) -> None:
-        if not self._thread.is_alive():  # a forked child, or a writer that ended: as before
-            stream.write(text)
+        if self._closed or not self._thread.is_alive():  # a forked child, a closed writer
+            stream.write(text)  # as before
             return
-        if self._held + len(text) > self._limit:
-            self._dropped += len(text)
-            return
-        self._held += len(text)
+        with self._count_lock:
+            if self._held + len(text) > self._limit:
+                self._dropped += len(text)
+                return
+            self._held += len(text)
         self._items.append((stream, text))
         self._wake()
 
     def flush(self, stream: Any) -> None:
-        if not self._thread.is_alive():
+        if self._closed or not self._thread.is_alive():
             stream.flush()
             return
         self._items.append((stream, _FLUSH))
@@ -87,6 +95,33 @@ class WordsWriter:
         self._wake()
         return done.wait(timeout)
 
+    def unwritten(self) -> int:
+        """How many characters said are not written: queued for the reader, or dropped and
+        not yet said to be."""
+        with self._count_lock:
+            return self._held + self._dropped
+
+    def close(self, timeout: float | None = None) -> bool:
+        """Let the thread write what is queued, then end it and close its wake-up pipe, at
+        most ``timeout`` seconds waited for; whether it ended. Words said after this are
+        written by the caller, as without a writer.
+
+        Why: each writer kept a thread and two descriptors for the rest of the process; a
+        program or test that makes writers of its own had no way to give them back. Where the
+        thread does not end in time (a stalled reader), its pipe is left open for it."""
+        self._closed = True
+        self._items.append(_CLOSE)
+        self._wake()
+        if threading.current_thread() is self._thread:
+            return False
+        self._thread.join(timeout)
+        if self._thread.is_alive():
+            return False
+        for fd in (self._wake_r, self._wake_w):
+            with contextlib.suppress(OSError):
+                os.close(fd)
+        return True
+
     def _wake(self) -> None:
         with contextlib.suppress(OSError):  # full: the thread is awake already
             os.write(self._wake_w, b"\0")
@@ -96,6 +131,8 @@ class WordsWriter:
             os.read(self._wake_r, 4096)
             while self._items:
                 item = self._items.popleft()
+                if item is _CLOSE:
+                    return
                 if isinstance(item, threading.Event):  # a drain: the note before its end
                     if self._dropped:
                         self._say_dropped()
@@ -106,15 +143,19 @@ class WordsWriter:
                     if text is _FLUSH:
                         stream.flush()
                     else:
-                        self._held -= len(text)
-                        stream.write(text)
+                        try:
+                            stream.write(text)
+                        finally:  # counted until written: a word a stalled reader holds
+                            with self._count_lock:  # is not yet written
+                                self._held -= len(text)
                 except Exception:  # a word lost, never the writer
                     pass
                 if not self._items and self._dropped:
                     self._say_dropped()
 
     def _say_dropped(self) -> None:
-        dropped, self._dropped = self._dropped, 0
+        with self._count_lock:
+            dropped, self._dropped = self._dropped, 0
         with contextlib.suppress(Exception):
             self.notes_to.write(
                 f"note: {dropped} characters of output were dropped: its reader did not read "
@@ -231,7 +272,7 @@ def words_unwaited(consoles: tuple[Any, Any]) -> None:
     stdout, stderr = sys.stdout, sys.stderr
     if _writer is None:  # one thread a process; each entry's streams are its own
         _writer = WordsWriter(notes_to=stderr)
-        atexit.register(words_written)
+        atexit.register(words_written)  # a Ctrl-C there changes no exit status: main's does
         before_default_action.append(words_written_before_signal)
     copy = _fd2_copy(stderr)  # stderr's words never land where fd 2 is pointed for a moment
     if _copy is not None:  # the last entry's: closed by the thread after its queued words
@@ -247,18 +288,43 @@ def words_unwaited(consoles: tuple[Any, Any]) -> None:
     sys.stderr = err.file = UnwaitedStream(stderr, _writer, copy)  # type: ignore[assignment]
 
 
-def words_written() -> None:
-    """Wait for the reader to take every word said (the command's end: the rig is safe).
+def words_written() -> bool:
+    """Wait for the reader to take every word said (the command's end: the rig is safe);
+    False if a Ctrl-C ended the wait (now or earlier), the words left unwritten.
 
     A Ctrl-C during the wait ends it, and every later one (the exit's): the user chose to
-    leave the words a stalled reader never took."""
+    leave the words a stalled reader never took. How many is said on stderr where it can be
+    without a wait (:func:`_say_now`), and the caller exits as a Ctrl-C does (130), not as
+    the command did: the words it said were not all written, and a ``0`` had claimed a
+    success the reader never saw."""
     global _given_up
-    if _writer is None or _given_up:
-        return
+    if _writer is None:
+        return True
+    if _given_up:
+        return False
     try:
         _writer.drain()
     except KeyboardInterrupt:
         _given_up = True
+        _say_now(
+            f"rti-rig: stopped waiting for the output's reader (Ctrl-C): {_writer.unwritten()} "
+            "characters of output were not written\n"
+        )
+        return False
+    return True
+
+
+def _say_now(text: str) -> None:
+    """Write ``text`` to stderr's descriptor (the console entry's copy of it) only if that
+    can be done without waiting: a pipe with room, a terminal, a file; else it is dropped
+    (stderr is the stalled reader's own pipe: the exit status still says the stop).
+
+    Why not through the writer: its thread is blocked on the stalled reader, and the words
+    queued behind it are exactly the ones given up."""
+    fd = _copy.fd if _copy is not None else 2
+    with contextlib.suppress(OSError, ValueError):
+        if select.select([], [fd], [], 0)[1]:
+            os.write(fd, text.encode("utf-8", "backslashreplace"))
 
 
 #: A Ctrl-C ended a wait for the reader: the process no longer waits for it.

@@ -9,6 +9,10 @@ on a real one-page pipe filled before the command starts; the signal is sent onc
 the command at its end (the main thread waiting, the words thread blocked writing to the
 pipe), and the reader reads as soon as it is sent: the words have up to 2 s
 (``BEFORE_DEFAULT_ACTION_S``) to go, which a reader that reads at all takes in milliseconds.
+
+And a Ctrl-C in that wait ends it with the interrupt's exit status (130) and says, where
+stderr has room, how much output was not written: the command had exited 0 (its own status),
+claiming a success whose words the reader never got.
 """
 
 from __future__ import annotations
@@ -80,3 +84,34 @@ def test_a_sigterm_in_the_end_wait_keeps_the_words_said_and_ends_by_sigterm() ->
     assert "Usage:" in words and "--rig" in words and "--out" in words, words
     assert "Traceback" not in words, words
     assert code == -signal.SIGTERM, (code, words)
+
+
+def test_a_ctrl_c_in_the_end_wait_says_the_words_unwritten_and_exits_130() -> None:
+    read_end, write_end, _filler = full_pipe(writer_blocking=True)
+    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "100"}
+    command = subprocess.Popen(
+        [sys.executable, "-m", "rti_rig", "plan", "--help"],
+        stdout=write_end,  # the stalled reader: ``| less`` paused
+        stderr=subprocess.PIPE,  # a terminal's stderr, read throughout
+        env=env,
+    )
+    os.close(write_end)
+    assert command.stderr is not None
+    errors = command.stderr
+    said: list[bytes] = []
+    reader = threading.Thread(target=lambda: said.append(errors.read()))
+    reader.start()
+    with ended_on_exit(command), os.fdopen(read_end, "rb"):
+        deadline = time.monotonic() + 600
+        while not _at_its_end(command.pid):
+            assert command.poll() is None, "the command ended with its reader stalled"
+            assert time.monotonic() < deadline, "the command did not reach its end in 600 s"
+            time.sleep(0.05)
+        command.send_signal(signal.SIGINT)
+        code = command.wait(timeout=600)  # the stdout reader never reads
+        reader.join(timeout=600)
+    words = said[0].decode("utf-8", "replace")
+    assert code == 130, (code, words)
+    assert "stopped waiting for the output's reader (Ctrl-C)" in words, words
+    assert "characters of output were not written" in words, words
+    assert "Traceback" not in words, words

@@ -8,6 +8,7 @@ writer whose stream never takes its word, the Ctrl-C sent to the main thread whi
 
 from __future__ import annotations
 
+import os
 import signal
 import threading
 from typing import Any
@@ -82,3 +83,35 @@ def test_a_ctrl_c_in_the_wait_for_a_stalled_reader_ends_it_and_the_exits_wait(
             presser.join(600)
         signal.signal(signal.SIGINT, previous)
         stream.room.set()  # the reader reads again: the writer thread ends its word
+
+
+def test_a_closed_writer_writes_what_was_queued_ends_its_thread_and_writes_later_words_itself() -> (
+    None
+):
+    """close(): the words queued before it are written by the thread, which then ends (its
+    wake-up pipe closed); a word said after it is written by the caller. Before, a writer
+    kept its thread and two descriptors for the rest of the process."""
+    got: list[tuple[str, threading.Thread]] = []
+
+    class Stream:
+        def write(self, text: str) -> int:
+            got.append((text, threading.current_thread()))
+            return len(text)
+
+        def flush(self) -> None:
+            pass
+
+    stream = Stream()
+    writer = WordsWriter(notes_to=stream)
+    wake_r = writer._wake_r
+    for i in range(3):
+        writer.write(stream, f"word {i}\n")
+    assert writer.close(600)
+    assert not writer._thread.is_alive()
+    writer.write(stream, "after\n")
+    assert [text for text, _ in got] == ["word 0\n", "word 1\n", "word 2\n", "after\n"]
+    assert got[-1][1] is threading.current_thread()
+    assert all(by is not threading.current_thread() for _, by in got[:3])
+    assert writer.unwritten() == 0
+    with pytest.raises(OSError):
+        os.fstat(wake_r)
