@@ -90,12 +90,24 @@ def _main() -> None:
         raise SystemExit(INTERRUPTED_EXIT) from None
     try:
         run_cli()
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        ending = _exit_under_way(exc)
+        if ending is not None:
+            # the command had already ended (a SIGTERM's stop said, its 143 on the way out)
+            # and put its handlers back: the Ctrl-C landed in the unwinding. The stop is named
+            # by the signal that began it: its words said SIGTERM, and the exit had said 130
+            _say(_exit_stands(ending))
+            raise SystemExit(ending) from None
         # a Ctrl-C no command handled: one line, not Python's traceback
         _say("rti-rig: stopped (Ctrl-C)\n")
         raise SystemExit(INTERRUPTED_EXIT) from None
     except SystemExit as exc:
-        if _from_keyboard_interrupt(exc):
+        interrupt = _from_keyboard_interrupt(exc)
+        ending = _exit_under_way(interrupt) if interrupt is not None else None
+        if ending is not None:  # as above, the Ctrl-C turned into click's Abort on the way
+            _say(_exit_stands(ending))
+            raise SystemExit(ending) from None
+        if interrupt is not None:
             # typer turns a Ctrl-C no command handled (its options still being parsed, a
             # command with nothing to make safe) into exit 130 without a word (older typer:
             # "Aborted!" and exit 1): said, and the shell's code for a Ctrl-C either way
@@ -118,14 +130,47 @@ def _say(text: str) -> None:
         pass
 
 
-def _from_keyboard_interrupt(exc: BaseException) -> bool:
-    """Whether ``exc`` was raised while handling a KeyboardInterrupt (its chain holds one);
-    a command's own exit 130 after its message is raised ``from None`` and holds none."""
+def _exit_under_way(exc: KeyboardInterrupt) -> int | None:
+    """The exit status (not 0) a command was already leaving with when the Ctrl-C ``exc``
+    was raised (a ``SystemExit``, or click's and typer's ``Exit``, in its context: a
+    ``finally`` or ``except`` on the way out was running), else None.
+
+    Why: a command that ends with a stop's status (``run`` stopped by SIGTERM: 143) puts its
+    signal handlers back before the exit reaches the interpreter; a Ctrl-C then raised
+    KeyboardInterrupt in the unwinding, which replaced the exit: "Emergency stop (SIGTERM)"
+    said, exit 130. A command leaving with 0 has claimed nothing a Ctrl-C could belie: that
+    Ctrl-C is the user's stop, exit 130 as ever."""
+    seen: set[int] = set()
+    link: BaseException | None = exc.__context__
+    while link is not None and id(link) not in seen:
+        seen.add(id(link))
+        code = link.code if isinstance(link, SystemExit) else getattr(link, "exit_code", None)
+        if isinstance(link, SystemExit | Exception) and isinstance(code, int) and code:
+            return code
+        link = link.__context__
+    return None
+
+
+def _exit_stands(code: int) -> str:
+    """What a Ctrl-C that landed as the command left with ``code`` is told: the stop that
+    ended it (a signal's: 128 + its number) or its exit, kept."""
+    import signal
+
+    try:
+        stop = f"the stop by {signal.Signals(code - 128).name}"
+    except ValueError:
+        stop = "its exit"
+    return f"rti-rig: Ctrl-C as the command was ending: {stop} stands (exit {code})\n"
+
+
+def _from_keyboard_interrupt(exc: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt ``exc`` was raised while handling (its chain holds one), else
+    None; a command's own exit 130 after its message is raised ``from None`` and holds none."""
     seen: set[int] = set()
     link: BaseException | None = exc
     while link is not None and id(link) not in seen:
         if isinstance(link, KeyboardInterrupt):
-            return True
+            return link
         seen.add(id(link))
         link = link.__cause__ or (None if link.__suppress_context__ else link.__context__)
-    return False
+    return None

@@ -544,8 +544,14 @@ def main() -> None:
 
     words_unwaited((out, err))  # no print waits on the reader while the rig works
     sigterm_waits_for_the_words()  # nor is a word said lost to SIGTERM's default action
+    ending: object = 0  # the exit the command left with
     try:
         app()
+    except SystemExit as exc:
+        ending = exc.code
+        raise
     finally:
-        if not words_written():  # a Ctrl-C left words unwritten: not the command's own exit
+        # a Ctrl-C left words unwritten: a success is not claimed (a stop's or an error's
+        # exit stands: the stop is named by the signal that began it)
+        if not words_written() and ending in (0, None):
             raise SystemExit(stop_exit_code(signal.SIGINT))

@@ -115,3 +115,26 @@ def test_a_ctrl_c_in_the_end_wait_says_the_words_unwritten_and_exits_130() -> No
     assert "stopped waiting for the output's reader (Ctrl-C)" in words, words
     assert "characters of output were not written" in words, words
     assert "Traceback" not in words, words
+
+
+def test_a_ctrl_c_in_the_end_wait_keeps_a_failed_commands_exit() -> None:
+    """A command that ended with its own failure (a usage error's 2) keeps it: a Ctrl-C in
+    the wait for its words claims no success it could belie."""
+    read_end, write_end, _filler = full_pipe(writer_blocking=True)
+    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "100"}
+    command = subprocess.Popen(
+        [sys.executable, "-m", "rti_rig", "plan", "--no-such-option"],
+        stdout=write_end,
+        stderr=write_end,
+        env=env,
+    )
+    os.close(write_end)
+    with ended_on_exit(command), os.fdopen(read_end, "rb"):
+        deadline = time.monotonic() + 600
+        while not _at_its_end(command.pid):
+            assert command.poll() is None, "the command ended with its reader stalled"
+            assert time.monotonic() < deadline, "the command did not reach its end in 600 s"
+            time.sleep(0.05)
+        command.send_signal(signal.SIGINT)
+        code = command.wait(timeout=600)
+    assert code == 2
