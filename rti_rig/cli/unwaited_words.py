@@ -90,6 +90,9 @@ class WordsWriter:
         most ``timeout`` seconds if given; whether they were."""
         if not self._thread.is_alive() or threading.current_thread() is self._thread:
             return True
+        if self._closed:  # nothing queued now would be taken: the thread's end is the wait
+            self._thread.join(timeout)
+            return not self._thread.is_alive()
         done = threading.Event()
         self._items.append(done)
         self._wake()
@@ -127,12 +130,14 @@ class WordsWriter:
             os.write(self._wake_w, b"\0")
 
     def _run(self) -> None:
-        while True:
+        closing = False
+        while not closing:
             os.read(self._wake_r, 4096)
             while self._items:
                 item = self._items.popleft()
-                if item is _CLOSE:
-                    return
+                if item is _CLOSE:  # ends once what came in meanwhile is written too
+                    closing = True
+                    continue
                 if isinstance(item, threading.Event):  # a drain: the note before its end
                     if self._dropped:
                         self._say_dropped()
