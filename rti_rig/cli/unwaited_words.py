@@ -16,7 +16,9 @@ is bounded (:data:`HELD_LIMIT` characters): beyond it the words are dropped, cou
 to be on stderr once the reader reads again, so a reader stalled for hours (a stopped terminal
 under a progress bar's redraws) cannot fill the memory. Nothing captured depends on the words:
 the images, journal and manifest are written as before. At the command's end the process waits
-for the reader to take what is queued (as it did before for each print), the rig then safe.
+for the reader to take what is queued (as it did before for each print), the rig then safe; a
+Ctrl-C there gives the words up, says so, and exits 130 unless the command ended otherwise; a
+SIGTERM no command handles gives them up to 2 s (:func:`sigterm_waits_for_the_words`).
 """
 
 from __future__ import annotations
