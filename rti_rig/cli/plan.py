@@ -29,6 +29,7 @@ from rti_rig.core.fit_minimums import (
     NORMAL_ERROR_LIMIT_DEG,
     NORMAL_MIN_LIGHTS,
     NORMAL_NOISE,
+    PLAN_DEFAULT_LIGHTS,
 )
 
 if TYPE_CHECKING:
@@ -66,7 +67,7 @@ def plan(
             help=f"Number of lights to plan: at least {NORMAL_MIN_LIGHTS}; below "
             f"{FIT_MINIMUMS.rti_file} a note says what `rti-rig fit` will not make of them.",
         ),
-    ] = 12,
+    ] = PLAN_DEFAULT_LIGHTS,
     method: Annotated[
         str | None,
         typer.Option(

@@ -44,6 +44,7 @@ from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free)
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, NORMAL_ERROR_LIMIT_DEG, NORMAL_NOISE
+from rti_rig.core.out_folders import free_name
 
 if TYPE_CHECKING:
     from rti_rig.runtime.run_ending import RunEnding
@@ -2026,8 +2027,11 @@ def preview(
             )
             if given
         )
-        plan_lp = _free_name(Path("plan.lp"))
-        lights = _plan_light_count(opened, min_elevation_deg, max_elevation_deg)
+        from rti_rig.core.rig_geometry import hint_light_count  # numpy: not at import
+
+        plan_lp = free_name(Path("plan.lp"))
+        # a flash-synced dome's and a replayed .lp's geometry too
+        lights = hint_light_count(opened.rig.geometry, min_elevation_deg, max_elevation_deg)
         out.print(
             f"Plan from it: rti-rig plan {_arg(out_dir)} --rig "
             f"{_arg(rig_config)} --lights {lights}{band} --out {_arg(plan_lp)}",
@@ -2039,7 +2043,7 @@ def preview(
         if metered is not None:
             out.print(
                 f"Then: rti-rig run {_arg(rig_config)} --plan {_arg(plan_lp)} --out "
-                f"{_arg(_free_name(out_dir.parent / 'planned'))} "
+                f"{_arg(free_name(out_dir.parent / 'planned', folder=True))} "
                 f"--auto-exposure (this preview was metered at {metered[0]:.4g} s; without "
                 f"--auto-exposure the run uses the config's exposure_s = {metered[1]:g} s)",
                 highlight=False,
@@ -2063,38 +2067,6 @@ def preview(
             " (plan from it as above)",
         )
         _refuse_unsafe_end(unsafe)
-
-
-#: The lights a preview's closing line suggests planning: ``plan``'s own default (``--lights``).
-PLAN_HINT_LIGHTS = 12
-
-
-def _plan_light_count(opened, low_deg: float, high_deg: float) -> int:  # type: ignore[no-untyped-def]
-    """How many lights the preview's closing ``plan`` command asks for: ``plan``'s default,
-    or fewer on a dome with fewer LEDs in the band (at least 3, what a plan needs).
-
-    Why: the line said ``--lights N``, which pasted as printed was refused as not a whole
-    number; a count the dome cannot give would be refused too."""
-    from rti_rig.core.geometry import az_el_from_direction
-    from rti_rig.core.rig_geometry import DomeGeometry
-
-    geometry = opened.rig.geometry  # a flash-synced dome's and a replayed .lp's too
-    if not isinstance(geometry, DomeGeometry):
-        return PLAN_HINT_LIGHTS
-    _, elevations = az_el_from_direction(geometry.directions)
-    in_band = int(((elevations >= low_deg - 1e-6) & (elevations <= high_deg + 1e-6)).sum())
-    return max(3, min(PLAN_HINT_LIGHTS, in_band))
-
-
-def _free_name(path: Path) -> Path:
-    """``path``, or ``path`` with ``-2``, ``-3``… before its suffix if that is taken: the name a
-    closing hint gives for a file or folder the next command writes (``plan`` refuses an
-    existing ``--out`` without ``--force``, ``run`` a non-empty folder)."""
-    candidate, n = path, 2
-    while candidate.exists() or candidate.is_symlink():
-        candidate = path.with_name(f"{path.stem}-{n}{path.suffix}")
-        n += 1
-    return candidate
 
 
 def _metered_apart(opened) -> tuple[float, float] | None:  # type: ignore[no-untyped-def]

@@ -19,6 +19,11 @@ N_COEFFICIENTS = {"lambert": 3, "hsh1": 4, "ptm": 6, "hsh2": 9, "hsh3": 16}
 #: determine no normal, whatever their placement.
 NORMAL_MIN_LIGHTS = N_COEFFICIENTS["lambert"]
 
+#: ``rti-rig plan``'s ``--lights`` when none is given, and the count a hint's command suggests
+#: where the rig does not limit it (``core.rig_geometry.hint_light_count``): one number, which
+#: had been a literal 12 in the plan command, its use case and four hints.
+PLAN_DEFAULT_LIGHTS = 12
+
 #: Image noise, as a fraction of the brightness of a surface facing the light (its albedo), at
 #: which a light set's normals are judged: 1 %, an 8-bit JPEG's quantisation and shot noise.
 NORMAL_NOISE = 0.01

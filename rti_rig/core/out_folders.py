@@ -115,3 +115,27 @@ def ensure_writable_folder(folder: Path) -> None:
     except OSError as exc:
         raise _cannot_write_there(folder, exc) from None
     _probe(folder, folder, "--out")
+
+
+def free_name(path: Path, *, folder: bool = False) -> Path:
+    """``path``, or ``path`` with ``-2``, ``-3``… added (before a file's suffix; at the end of a
+    ``folder``'s name, whose dots are its own) if that is taken: the name a hint gives for a
+    file or folder the command it suggests will write.
+
+    Why one function: ``plan`` refuses an existing ``--out`` without ``--force``, ``run`` a
+    non-empty folder and ``fit`` an existing one, so a hint's ``--out DIR`` pasted as printed
+    made a folder named DIR, and an existing name was refused; the CLI and the session folder
+    each had their own copy of this loop."""
+    stem, suffix = (path.name, "") if folder else (path.stem, path.suffix)
+    candidate, n = path, 2
+    while candidate.exists() or candidate.is_symlink():
+        candidate = path.with_name(f"{stem}-{n}{suffix}")
+        n += 1
+    return candidate
+
+
+def free_folder_beside(root: Path, tag: str) -> Path:
+    """A folder that does not exist yet beside ``root``, named ``ROOT-tag`` (``-2``… added if
+    taken): the ``--out`` of a command a hint about session ``root`` suggests (``fit`` refuses
+    an ``--out`` inside the session, so beside it, not in it)."""
+    return free_name(root.with_name(f"{root.name}-{tag}"), folder=True)

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core.errors import ScheduleError
+from rti_rig.core.fit_minimums import NORMAL_MIN_LIGHTS, PLAN_DEFAULT_LIGHTS
 from rti_rig.core.geometry import (
     angle_between_deg,
     az_el_from_direction,
@@ -92,6 +93,22 @@ class DomeGeometry:
         ang = angle_between_deg(self.directions, np.asarray(direction, dtype=np.float64))
         i = int(np.argmin(ang))
         return i, float(ang[i])
+
+
+def hint_light_count(geometry: object, low_deg: float = 0.0, high_deg: float = 90.0) -> int:
+    """How many lights a hint's ``plan`` or ``run --lights`` command asks for:
+    :data:`PLAN_DEFAULT_LIGHTS`, or fewer on a dome with fewer LEDs between ``low_deg`` and
+    ``high_deg`` of elevation (at least :data:`NORMAL_MIN_LIGHTS`, what a plan needs); any
+    other rig (an arm) has no such limit.
+
+    Why: ``--lights N`` pasted as printed was refused as not a whole number, and a fixed
+    ``--lights 12`` on a dome of 8 LEDs (or 8 in the band) was refused as more lights than it
+    has; the preview computed the real count and the other hints did not."""
+    if not isinstance(geometry, DomeGeometry):
+        return PLAN_DEFAULT_LIGHTS
+    _, elevations = az_el_from_direction(geometry.directions)
+    in_band = int(((elevations >= low_deg - 1e-6) & (elevations <= high_deg + 1e-6)).sum())
+    return max(NORMAL_MIN_LIGHTS, min(PLAN_DEFAULT_LIGHTS, in_band))
 
 
 #: How far past an arm's limit (degrees) a direction may lie and count as on it: an `.lp`

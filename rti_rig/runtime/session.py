@@ -57,6 +57,7 @@ from typing import Any
 from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import SessionError
+from rti_rig.core.fit_minimums import PLAN_DEFAULT_LIGHTS
 from rti_rig.core.image_colour import (
     JPEG_COLOUR_WORDS,
     LINEAR_CAMERA_RGB,
@@ -76,7 +77,7 @@ from rti_rig.core.image_files import (
     write_untagged_jpeg,
 )
 from rti_rig.core.lp_format import LpEntry, format_lp, lp_files_in
-from rti_rig.core.out_folders import refuse_a_file_in_the_way
+from rti_rig.core.out_folders import free_folder_beside, free_name, refuse_a_file_in_the_way
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
 from rti_rig.runtime.unrecorded_end import CAUSES, unrecorded_end
@@ -545,15 +546,14 @@ def _finished_hint(root: Path, manifest: dict[str, Any]) -> str:
     if (manifest.get("schedule") or {}).get("method") == "preview":
         rig = (manifest.get("rig") or {}).get("config_path")
         shown = shell_word(str(rig)) if isinstance(rig, str) and rig else "RIG.toml"
-        return (
+        plan_lp = shell_word(str(free_name(Path("plan.lp"))))  # plan refuses an existing one
+        return (  # plan's default count (the rig config is not loaded here): N was refused
             f" (it holds a finished preview: plan from it with rti-rig plan {folder} --rig "
-            f"{shown} --lights 12 --out plan.lp)"  # plan's default count: N pasted was refused
+            f"{shown} --lights {PLAN_DEFAULT_LIGHTS} --out {plan_lp})"
         )
     # a real, free folder beside the session (fit refuses one inside it): ``--out DIR`` had
     # been printed, which pasted made a folder named DIR
-    fit_out, n = root.with_name(f"{root.name}-fit"), 2
-    while fit_out.exists() or fit_out.is_symlink():
-        fit_out, n = root.with_name(f"{root.name}-fit-{n}"), n + 1
+    fit_out = free_folder_beside(root, "fit")
     return (
         f" (it holds a finished session: fit it with rti-rig fit {folder} --out "
         f"{shell_word(str(fit_out))})"

@@ -30,6 +30,7 @@ from rti_rig.app.output_files import (
 from rti_rig.app.preview_source import given_light_differs, resolve_preview
 from rti_rig.app.usecases.fit_outlook import fit_needs, fit_outlook, fit_without_normals
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.fit_minimums import PLAN_DEFAULT_LIGHTS
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.image_files import png_alpha_note
 from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
@@ -54,7 +55,7 @@ class PlanLightsRequest:
 
     rig: Path
     out_file: Path = Path("plan.lp")
-    lights: int = 12
+    lights: int = PLAN_DEFAULT_LIGHTS
     #: False where ``lights`` is the command's default, not the user's: a rig with fewer
     #: lights is then told what the default is (it was told it had "asked for 12 lights").
     lights_given: bool = True
