@@ -16,6 +16,7 @@ from typing import Any
 
 from rti_rig.app.usecases.replay_advice import new_session_command
 from rti_rig.core.errors import ConfigError, RtiRigError
+from rti_rig.core.out_folders import free_name
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.controller import (
@@ -963,7 +964,9 @@ PLAN_WANTED = (
 )
 
 
-def _refuse_rig_config_as_plan(plan: Path, rig_config: Path, out_dir: Path) -> None:
+def _refuse_rig_config_as_plan(
+    plan: Path, rig_config: Path, out_dir: Path, geometry: object
+) -> None:
     """Refuse a rig config given as ``--plan``, saying that it is one, what ``--plan`` takes
     and the commands that make and run a plan.
 
@@ -972,8 +975,13 @@ def _refuse_rig_config_as_plan(plan: Path, rig_config: Path, out_dir: Path) -> N
     content (a TOML table with a rig's ``kind``), not its name alone; any other file is left to
     the .lp reader, which says what it is. The commands name the run's own ``--out`` (nothing
     was written to it) and a real count: ``--out SESSION`` and ``--lights N`` had been printed,
-    which pasted as printed ran into a folder named SESSION or were refused."""
+    which pasted as printed ran into a folder named SESSION or were refused, and the fixed
+    ``--lights 12`` that replaced it was refused on a dome of fewer LEDs
+    (:func:`~rti_rig.core.rig_geometry.hint_light_count`); the plan file is one that does not
+    exist yet (``plan`` refuses an existing one without ``--force``)."""
     import tomllib
+
+    from rti_rig.core.rig_geometry import hint_light_count
 
     if plan.suffix.lower() != ".toml" or not plan.is_file():
         return
@@ -985,12 +993,13 @@ def _refuse_rig_config_as_plan(plan: Path, rig_config: Path, out_dir: Path) -> N
         return
     name = f" ({data['name']})" if isinstance(data.get("name"), str) and data["name"] else ""
     rig, out = shell_word(str(rig_config)), shell_word(str(out_dir))
+    plan_lp = shell_word(str(free_name(Path("plan.lp"))))
     raise RtiRigError(
-        f"--plan {plan} is a rig config{name}, not a plan: --plan takes a plan file, the .lp "
-        "light list (a count line, then 'name x y z' per image) that rti-rig plan writes; "
-        f"make one with: rti-rig plan --rig {rig} --out plan.lp, then run it with: rti-rig run "
-        f"{rig} --plan plan.lp --out {out} (or run a homogeneous layout without a plan: "
-        f"rti-rig run {rig} --lights 12 --out {out})"
+        f"--plan {shown_path(plan)} is a rig config{name}, not a plan: --plan takes a plan file, "
+        "the .lp light list (a count line, then 'name x y z' per image) that rti-rig plan writes; "
+        f"make one with: rti-rig plan --rig {rig} --out {plan_lp}, then run it with: rti-rig "
+        f"run {rig} --plan {plan_lp} --out {out} (or run a homogeneous layout without a plan: "
+        f"rti-rig run {rig} --lights {hint_light_count(geometry)} --out {out})"
     )
 
 
@@ -1012,7 +1021,9 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     if req.plan is not None:
         if req.lights is not None:
             raise RtiRigError("give either --plan or --lights, not both")
-        _refuse_rig_config_as_plan(Path(req.plan), Path(req.rig_config), Path(req.out_dir))
+        _refuse_rig_config_as_plan(
+            Path(req.plan), Path(req.rig_config), Path(req.out_dir), geometry
+        )
         plan_notes: list[str] = []
         entries = read_lp(req.plan, upper_hemisphere=True, notes=plan_notes, wanted=PLAN_WANTED)
         for note in plan_notes:

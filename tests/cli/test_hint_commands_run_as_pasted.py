@@ -1,0 +1,71 @@
+"""A hint's command, pasted into bash as printed, does what the hint says.
+
+Why: hints had printed templates (``--out DIR``, ``--lights 12`` whatever the dome holds):
+pasted, ``--out DIR`` made a folder named DIR and ``--lights 12`` was refused on a dome of 8
+LEDs. Each test below runs the CLI into the situation, takes the command it prints and runs it
+through bash (``rti-rig`` as ``python -m rti_rig``) in the same folder.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from conftest import ASCII_LOCALE_ENV as ENV
+from conftest import shipped_variant
+
+
+def rti_rig(cwd: Path, *args: str | Path) -> subprocess.CompletedProcess[str]:
+    """``rti-rig *args`` run in ``cwd``, as a user runs it; no traceback."""
+    r = subprocess.run(
+        [sys.executable, "-m", "rti_rig", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env={**ENV, "COLUMNS": "400"},
+        timeout=600,
+    )
+    assert "Traceback" not in r.stderr, r.stderr
+    return r
+
+
+def pasted_run(cwd: Path, command: str) -> subprocess.CompletedProcess[str]:
+    """``command`` (``rti-rig ...`` as printed) run by bash in ``cwd``."""
+    assert command.startswith("rti-rig "), command
+    r = subprocess.run(
+        ["bash", "-c", command.replace("rti-rig", '"$PY" -m rti_rig', 1)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env={**ENV, "PY": sys.executable, "COLUMNS": "400"},
+        timeout=600,
+    )
+    assert "Traceback" not in r.stderr, r.stderr
+    return r
+
+
+def command_after(said: str, before: str, end: str = ")") -> str:
+    """The command printed after ``before`` in ``said`` (one line however it wrapped), up to
+    ``end``."""
+    text = " ".join(said.split())
+    assert before in text, text
+    return text.split(before, 1)[1].split(end, 1)[0].strip()
+
+
+def test_a_rig_config_given_as_plan_on_an_8_led_dome_suggests_a_run_of_8_lights(
+    tmp_path: Path,
+) -> None:
+    """The shipped 8-LED dome (simulated, for speed: its geometry as shipped): the advised
+    homogeneous run had said ``--lights 12``, which that dome refuses."""
+    rig = shipped_variant(
+        tmp_path, "emulated_rti_dome.toml", (('backend = "emulated"', 'backend = "simulated"'),)
+    )
+    r = rti_rig(tmp_path, "run", rig, "--out", "S", "--plan", rig)
+    assert r.returncode == 2, r.stderr
+    command = command_after(r.stderr, "run a homogeneous layout without a plan: ")
+    assert " --lights 8 " in command, command
+    done = pasted_run(tmp_path, command + " --no-verdict")
+    assert done.returncode == 0, done.stderr
+    lp = (tmp_path / "S" / "lights.lp").read_text(encoding="utf-8").split()
+    assert lp[0] == "8", lp[:4]
