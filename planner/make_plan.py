@@ -250,9 +250,11 @@ def check_plan_options(
     signal_noise: float = 0.0,
     material: str = "auto",
     rig: str = "RIG.toml",
+    out: str = "DIR",
 ) -> PlanMethod:
     """The one definition of what a plan may ask; returns the method to plan with (``rig``: the
-    rig config as given, for the commands a refusal offers).
+    rig config as given, and ``out`` a folder for a run, shell words for the commands a
+    refusal offers).
 
     Refused, naming the command-line option: an unknown method, objective or material; a signal
     noise the objective does not model; a method that needs a preview without one; a preview's
@@ -261,7 +263,7 @@ def check_plan_options(
     an .lp file may list). Callers check early (before reading any image) with ``has_preview``;
     :func:`plan` checks its request again.
     """
-    chosen = get_method(method, rig)
+    chosen = get_method(method, rig, out, n)
     if objective not in OBJECTIVES:
         known = ", ".join(OBJECTIVES)
         raise ScheduleError(f"--objective {objective!r} is not known; choose {known}")

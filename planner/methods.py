@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import ScheduleError
+from rti_rig.core.fit_minimums import PLAN_DEFAULT_LIGHTS
 
 if TYPE_CHECKING:
     from rti_rig.planner.objectives import Candidates, NormalsObjective, RelightObjective
@@ -107,10 +108,14 @@ def method_names() -> tuple[str, ...]:
     return tuple(_METHODS)
 
 
-def get_method(name: str, rig: str = "RIG.toml") -> PlanMethod:
-    """The method called ``name``; an unknown name is refused with the known ones. ``rig``: the
-    rig config as the user's command gave it, for the command the refusal offers (it had
-    always said ``RIG.toml``, where the command line at hand named the config)."""
+def get_method(
+    name: str, rig: str = "RIG.toml", out: str = "DIR", lights: int = PLAN_DEFAULT_LIGHTS
+) -> PlanMethod:
+    """The method called ``name``; an unknown name is refused with the known ones. ``rig``,
+    ``out`` and ``lights``: the rig config as the user's command gave it, a folder for the run
+    (shell words; the planner looks at no folder, its caller does) and a count, for the command
+    the refusal offers (it had always said ``RIG.toml``, where the command line at hand named
+    the config, and ``--lights N --out DIR``, which pasted was refused or made DIR)."""
     _load_builtins()
     try:
         return _METHODS[name]
@@ -120,8 +125,8 @@ def get_method(name: str, rig: str = "RIG.toml") -> PlanMethod:
         # the bare refusal had not said where it is
         adaptive = (
             " (an adaptive session is not planned ahead: it chooses each next light from the "
-            f"images captured so far; run it with rti-rig run {rig} --adaptive --lights N "
-            "--out DIR)"
+            f"images captured so far; run it with rti-rig run {rig} --adaptive --lights {lights} "
+            f"--out {out})"
             if name.strip().lower() == "adaptive"
             else ""
         )

@@ -29,6 +29,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import ConfigError, DeviceError, RtiRigError
+from rti_rig.core.out_folders import free_name
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import MARKER as DISOWN_MARKER
@@ -454,10 +455,12 @@ def build_flash_sync_rig(loaded, geometry: DomeGeometry, clock: Clock, camera=No
     return rig
 
 
-def refuse_options(loaded, **given: bool) -> None:  # type: ignore[no-untyped-def]
+def refuse_options(loaded, out: Path, **given: bool) -> None:  # type: ignore[no-untyped-def]
     """Refuse, by name, what would fire the camera outside the firmware's sequence, with the
     run that shoots the whole sequence on this config (its path as one shell word: the advice
-    had said ``rti-rig run CONFIG``, leaving the user to find which config)."""
+    had said ``rti-rig run CONFIG``, leaving the user to find which config) into ``out``, or
+    ``out`` with ``-2``… if that is taken (``--out DIR`` had been said, which pasted made a
+    folder named DIR)."""
     fs = flash_sync_of(loaded)
     if fs is None:
         return
@@ -477,7 +480,7 @@ def refuse_options(loaded, **given: bool) -> None:  # type: ignore[no-untyped-de
                 f"{shown_path(loaded.path)}: {option} cannot be used with a camera-triggered dome "
                 f"({fs.firmware}): {why[option]}. Long-press the dome's start button to rewind "
                 f"it, then run the whole sequence: rti-rig run {shell_word(str(loaded.path))} "
-                "--out DIR"
+                f"--out {shell_word(str(free_name(Path(out), folder=True)))}"
             )
 
 
@@ -531,6 +534,7 @@ def check_new_session(req, loaded) -> None:  # type: ignore[no-untyped-def]
 
     refuse_options(
         loaded,
+        req.out_dir,  # nothing was written to it
         **{
             "--plan": req.plan is not None,
             req.adaptive_option: req.is_adaptive,

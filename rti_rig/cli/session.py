@@ -44,7 +44,7 @@ from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free)
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, NORMAL_ERROR_LIMIT_DEG, NORMAL_NOISE
-from rti_rig.core.out_folders import free_name
+from rti_rig.core.out_folders import free_folder_beside, free_name
 
 if TYPE_CHECKING:
     from rti_rig.runtime.run_ending import RunEnding
@@ -841,17 +841,20 @@ def _sentence(text: str) -> str:
     return text[:1].upper() + text[1:]
 
 
-def _cannot_resume(rig) -> str | None:  # type: ignore[no-untyped-def]
+def _cannot_resume(opened) -> str | None:  # type: ignore[no-untyped-def]
     """What is said instead of "continue with --resume" of a session this rig cannot resume
     (None: it can): a camera-triggered dome, whose own count went on, or an image-sequence
     camera, read from its first file again by every run (a stopped dry run had been told to
-    resume, and the resume gave the remaining lights the pictures of the first ones)."""
+    resume, and the resume gave the remaining lights the pictures of the first ones); it
+    shoots again into a folder beside the session that does not exist yet."""
     from rti_rig.runtime.flash_sync import CameraTriggeredLighting
     from rti_rig.runtime.session import image_sequence_restarts
 
+    rig = opened.rig
     if isinstance(rig.lighting, CameraTriggeredLighting):  # by type, not a getattr probe
         return str(rig.lighting.resume_hint)
-    why = image_sequence_restarts(rig.loaded.config.camera.device, _arg(rig.loaded.path))
+    again = _arg(free_folder_beside(Path(opened.out_dir), "again"))
+    why = image_sequence_restarts(rig.loaded.config.camera.device, _arg(rig.loaded.path), again)
     return None if why is None else f"It cannot be resumed: {why}."
 
 
@@ -862,7 +865,7 @@ def _dead_led_hint(opened, exc: BaseException) -> str | None:  # type: ignore[no
     from rti_rig.app.dead_led import dead_led_advice, dead_led_of
 
     led = dead_led_of(exc)
-    if led is None or _cannot_resume(opened.rig):
+    if led is None or _cannot_resume(opened):
         return None
     adaptive = opened.source is not None  # its schedule is only its first design
     return dead_led_advice(opened.rig.loaded, opened.schedule, opened.out_dir, led, adaptive)
@@ -879,7 +882,7 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
     from rti_rig.runtime.session import RECORDS_DIR, SessionWriteError
 
     kept = opened.folder.images_kept
-    if not isinstance(exc, SessionWriteError) or _cannot_resume(opened.rig):
+    if not isinstance(exc, SessionWriteError) or _cannot_resume(opened):
         return exc
     if not kept:
         return _first_write_failed_said(exc, opened)
@@ -1161,7 +1164,7 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
     from rti_rig.runtime.run_ending import read_run_ending
 
     ending = read_run_ending(opened.folder, opened.total_steps)
-    cannot = _cannot_resume(opened.rig)
+    cannot = _cannot_resume(opened)
     if _reshoot_not_begun(opened, ending, cannot):
         resume_hint = f"Continue with: {_resume_before_begin(opened, ending)}"
     stop = _Stop(ending, opened.out_dir, opened.resumed, cannot, resume_hint)
@@ -1192,9 +1195,7 @@ def _resume_before_begin(opened: Any, ending: RunEnding | None = None) -> str:
         return _resume_command(opened.request)
     if ending is None:
         ending = read_run_ending(opened.folder, opened.total_steps)
-    tail = (
-        " --reshoot-lost" if _reshoot_not_begun(opened, ending, _cannot_resume(opened.rig)) else ""
-    )
+    tail = " --reshoot-lost" if _reshoot_not_begun(opened, ending, _cannot_resume(opened)) else ""
     return f"rti-rig run --resume {_arg(opened.out_dir)}{tail}"
 
 
@@ -1652,7 +1653,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {shown}")
 
     def resume_hint() -> str:  # said once the run stopped: what it wrote decides the command
-        return _cannot_resume(rig) or f"Continue with: {_continue_command(opened)}"
+        return _cannot_resume(opened) or f"Continue with: {_continue_command(opened)}"
 
     try:
         if settable:

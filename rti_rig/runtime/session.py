@@ -2201,6 +2201,7 @@ def rebuild_finished_journal(root: Path) -> list[str]:
         scan = scan_journal(root, names)
         taken, unproven, lost = _finished_rebuild(root, manifest, names, scan)
         folder = shell_word(str(root))
+        fit_out = shell_word(str(free_folder_beside(root, "fit")))  # ``--out DIR`` made DIR
         if unproven is None:
             # what is lost, named with what gets it back: the user who reached for the rebuild
             # had been sent to a fit to find out
@@ -2211,8 +2212,8 @@ def rebuild_finished_journal(root: Path) -> list[str]:
                 + (
                     f"; but {gone}"
                     if gone
-                    else f" (the QA verdict of rti-rig fit {folder} --out DIR names any image "
-                    "changed since capture)"
+                    else f" (the QA verdict of rti-rig fit {folder} --out {fit_out} names any "
+                    "image changed since capture)"
                 )
             )
         if len(lost) < len(unproven):
@@ -2221,8 +2222,8 @@ def rebuild_finished_journal(root: Path) -> list[str]:
                 f"{shown_path(root)}: {JOURNAL} cannot be rebuilt: {len(unproven)} of the "
                 f"session's images cannot be proven as captured: {shown}; nothing in this folder "
                 f"was changed: restore {JOURNAL} (or those files) from a backup copy of the "
-                f"folder, then run this again; meanwhile rti-rig fit {folder} --out DIR fits the "
-                "session as it is, its verdict naming the images it cannot check"
+                f"folder, then run this again; meanwhile rti-rig fit {folder} --out {fit_out} fits "
+                "the session as it is, its verdict naming the images it cannot check"
             )
         notes: list[str] = []
         try:
@@ -2757,21 +2758,24 @@ def unresumable(root: Path) -> str | None:
     dome = config_of.get("dome")
     sync = dome.get("flash_sync") if isinstance(dome, dict) else None
     config = shell_word(str(rig.get("config_path") or "CONFIG"))
+    # a folder that does not exist yet beside it: ``--out NEWDIR`` pasted made NEWDIR
+    again = shell_word(str(free_folder_beside(Path(root), "again")))
     if not isinstance(sync, dict):
         camera = config_of.get("camera")
         device = camera.get("device") if isinstance(camera, dict) else None
-        return image_sequence_restarts(device, config)
+        return image_sequence_restarts(device, config, again)
     return (
         f"a camera-triggered dome ({sync.get('firmware', 'flash-stepped')}) cannot continue a "
         "session or reshoot single images (its own count went on): long-press its start "
-        f"button to rewind it, then shoot the session again: rti-rig run {config} --out NEWDIR"
+        f"button to rewind it, then shoot the session again: rti-rig run {config} --out {again}"
     )
 
 
-def image_sequence_restarts(device: object, config: str) -> str | None:
+def image_sequence_restarts(device: object, config: str, out: str) -> str | None:
     """Why a session cannot be resumed, nor single images reshot, if its camera (the
     ``[camera.device]`` table ``device`` of rig config ``config``) is an image sequence
-    (``backend = "images"``), with what to do instead; None for any other camera.
+    (``backend = "images"``), with what to do instead (shoot again into ``out``, a shell word);
+    None for any other camera.
 
     Why: an image sequence is opened at its first file by every run, so a resume gave the
     lights still to shoot the files of the lights already shot (image_006 held f_000's
@@ -2787,7 +2791,7 @@ def image_sequence_restarts(device: object, config: str) -> str | None:
         f"{device.get('device')!r}), which every run reads from its first file again, so it "
         "cannot continue a session or reshoot single images: a resume would give the lights "
         "still to shoot the pictures of the lights already shot. Shoot the dry run again into "
-        f"a new folder: rti-rig run {config} --out NEWDIR (to rehearse on recorded images "
+        f"a new folder: rti-rig run {config} --out {out} (to rehearse on recorded images "
         "paired with their lights, a resumable replay rig: rti-rig run ACQ/dirs.lp --out DIR)"
     )
 
@@ -2908,9 +2912,13 @@ def _acquisition_lp_use(lp: Path) -> str:
     """What to do with an `.lp` outside any session (a recorded acquisition's, its images
     beside it): it is fitted and replayed as it is, with no session to export or resume."""
     q = shell_word(str(lp))
+    # folders that do not exist yet beside it: ``--out DIR`` pasted made a folder named DIR
+    fit_out = shell_word(str(free_name(lp.with_name(f"{lp.stem}-fit"), folder=True)))
+    run_out = shell_word(str(free_name(lp.with_name(f"{lp.stem}-replay"), folder=True)))
     return (
         "if that is a recorded acquisition's .lp (its images beside it), use it as it is: "
-        f"rti-rig fit {q} --out DIR, or replay it as a rig: rti-rig run {q} --out DIR"
+        f"rti-rig fit {q} --out {fit_out}, or replay it as a rig: rti-rig run {q} --out "
+        f"{run_out}"
     )
 
 
@@ -2947,7 +2955,7 @@ def read_manifest(root: Path) -> dict[str, Any]:
             # session folder" had been said of a folder of its images and journal
             fit = (
                 f", but its images can still be fitted: rti-rig fit {shell_word(str(root))} "
-                "--out DIR"
+                f"--out {shell_word(str(free_folder_beside(Path(root), 'fit')))}"
                 if (Path(root) / LP_NAME).is_file()
                 else ""
             )

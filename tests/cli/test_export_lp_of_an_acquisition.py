@@ -48,11 +48,13 @@ def test_an_acquisition_is_told_to_be_used_as_it_is(
     assert "Traceback" not in r.output and not (tmp_path / "x.lp").exists()
     assert "give the session folder that holds it" not in text
     assert "recorded acquisition's .lp" in text
-    assert f"rti-rig fit {shlex.quote(str(lp))} --out DIR" in text
-    # the replay command it names runs as printed (DIR a new folder)
-    found = re.search(r"rti-rig run (\S+) --out DIR", text)
+    # folders that do not exist yet beside it (``--out DIR``, pasted, had made DIR)
+    fit_out, out = acquisition / "dirs-fit", acquisition / "dirs-replay"
+    assert f"rti-rig fit {shlex.quote(str(lp))} --out {shlex.quote(str(fit_out))}" in text
+    # the replay command it names runs as printed, into the folder it names
+    found = re.search(r"rti-rig (run \S+ --out \S+)", text)
     assert found is not None, text
-    out = tmp_path / "replayed"
-    run = runner.invoke(app, ["run", *shlex.split(found.group(1)), "--out", str(out)])
+    assert found.group(1) == f"run {shlex.quote(str(lp))} --out {shlex.quote(str(out))}", text
+    run = runner.invoke(app, shlex.split(found.group(1)))
     assert run.exit_code == 0, said(run)
     assert (out / "lights.lp").read_text().splitlines()[0] == "18"

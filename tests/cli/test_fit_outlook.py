@@ -9,6 +9,7 @@ least 3", each its own way.
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 
 import pytest
@@ -68,6 +69,12 @@ def test_too_few_lights_are_refused_alike_with_the_fits_figures(tmp_path: Path) 
     assert r.exit_code == 2 and not (tmp_path / "p.lp").exists(), r.output
     plan_said = said(r)
     assert "--lights 2: give at least 3 lights to plan;" in plan_said
-    assert "rti-rig run RIG --lights 1" in plan_said and "Traceback" not in plan_said
+    assert "Traceback" not in plan_said
+    # the test shot's command, real (it had said "rti-rig run RIG --lights 1"), runs as said
+    shot = tmp_path / "planned"
+    command = plan_said.split("needs no plan: ", 1)[1].split(f" --out {shot}", 1)[0]
+    assert command.startswith("rti-rig run ") and " --lights 1" in command, plan_said
+    r = runner.invoke(app, [*shlex.split(command)[1:], "--out", str(shot), "--no-verdict"])
+    assert r.exit_code == 0 and (shot / "lights.lp").read_text().startswith("1"), r.output
     for text in (run_said, plan_said):  # the fit's own figures, in the same words
         assert "needs 3 for a normal map with --model ps, 4 for its default --model auto" in text

@@ -395,7 +395,7 @@ def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None
             assert "(image_003, image_010)" in text
             assert "put the originals back from a copy" in text
             assert "cannot continue a session or reshoot single images" in text
-            assert "long-press its start button" in text and "--out NEWDIR" in text
+            assert "long-press its start button" in text and "NEWDIR" not in text, text
             assert "--reshoot-lost" not in text
 
 
@@ -493,7 +493,8 @@ def test_refusals_give_the_run_of_the_config_actually_used(tmp_path: Path, rigs)
     result = runner.invoke(app, ["preview", str(cfg), "--out", str(tmp_path / "p")])
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())
-    assert f"run the whole sequence: {run_it} DIR" in text, text
+    # the run into the preview's own --out (nothing was written to it), not a template DIR
+    assert f"run the whole sequence: {run_it} {shlex.quote(str(tmp_path / 'p'))}" in text, text
     assert "CONFIG" not in text and rigs == []
     out = tmp_path / "s"
     assert runner.invoke(app, ["run", str(cfg), "--out", str(out), "--no-verdict"]).exit_code == 0
@@ -501,4 +502,5 @@ def test_refusals_give_the_run_of_the_config_actually_used(tmp_path: Path, rigs)
     result = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost"])
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())
-    assert f"then {run_it} NEWDIR)" in text and "CONFIG" not in text, text
+    again = shlex.quote(str(tmp_path / "s-again"))  # beside the session, not there yet
+    assert f"then {run_it} {again})" in text and "CONFIG" not in text, text

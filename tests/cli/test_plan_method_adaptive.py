@@ -22,7 +22,8 @@ def test_plan_method_adaptive_points_to_run_adaptive(tmp_path: Path) -> None:
     assert r.exit_code == 2, text
     assert "--method 'adaptive' is not known; choose uniform" in text, text
     rig = CONFIGS / "simulated_arm.toml"
-    assert f"rti-rig run {rig} --adaptive --lights N --out DIR" in text, text
+    # plan's count and a folder beside the plan that is not there yet (N and DIR had been said)
+    assert f"rti-rig run {rig} --adaptive --lights 12 --out {tmp_path / 'planned'})" in text, text
     assert "RIG.toml" not in text, text  # the config at hand is named, not a placeholder
     assert not out.exists()
 
@@ -33,7 +34,7 @@ def test_a_bare_lp_rig_is_offered_a_config_placeholder(tmp_path: Path) -> None:
     r = CliRunner(env={"COLUMNS": "400"}).invoke(app, [*args, "--out", str(tmp_path / "p.lp")])
     text = said(r)
     assert r.exit_code == 2, text
-    assert "rti-rig run RIG.toml --adaptive --lights N --out DIR" in text, text
+    assert f"rti-rig run RIG.toml --adaptive --lights 12 --out {tmp_path / 'planned'})" in text
 
 
 def test_another_unknown_method_is_not_sent_to_run_adaptive(tmp_path: Path) -> None:

@@ -96,7 +96,9 @@ def test_allow_no_normals_plans_a_horizon_ring_saying_so(tmp_path: Path, objecti
     assert "planned as asked (--allow-no-normals)" in said
     assert "along the direction the lights do not span, their relighting is a guess" in said
     # a bare .lp rig is no config `run` takes: RIG.toml stands for it
-    assert f"rti-rig run RIG.toml --plan {out} --out DIR --allow-no-normals" in said
+    assert (
+        f"rti-rig run RIG.toml --plan {out} --out {tmp_path / 'planned'} --allow-no-normals" in said
+    )
     assert len(read_lp(out)) == 12
 
 
@@ -136,11 +138,12 @@ def test_the_advised_run_command_names_the_rig_and_plan_and_runs(tmp_path: Path)
         said.index("rti-rig run ") : said.index("--allow-no-normals", said.index("rti-rig run "))
         + len("--allow-no-normals")
     ]
+    # into a folder beside the plan that does not exist yet (``--out DIR`` had made DIR)
+    planned = folder / "planned"
     assert advised == (
-        f"rti-rig run {shlex.quote(str(rig))} --plan {shlex.quote(str(plan_file))} --out DIR "
-        "--allow-no-normals"
+        f"rti-rig run {shlex.quote(str(rig))} --plan {shlex.quote(str(plan_file))} --out "
+        f"{shlex.quote(str(planned))} --allow-no-normals"
     ), advised
-    args = [str(tmp_path / "s") if a == "DIR" else a for a in shlex.split(advised)[1:]]
-    r = CliRunner().invoke(app, [*args, "--no-verdict"])
+    r = CliRunner().invoke(app, [*shlex.split(advised)[1:], "--no-verdict"])
     assert r.exit_code == 0, " ".join(r.output.split())
-    assert len(read_lp(tmp_path / "s" / "lights.lp")) == 6
+    assert len(read_lp(planned / "lights.lp")) == 6

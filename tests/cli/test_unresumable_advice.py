@@ -50,7 +50,7 @@ def test_an_image_lost_from_a_finished_session_is_not_sent_to_reshoot_lost(
     assert "image_003.jpg missing since capture" in said(r)
     assert "--reshoot-lost" not in said(r) and "--resume" not in said(r)
     assert "put the originals back from a copy; a camera-triggered dome (cceh-rti)" in said(r)
-    again = f"then shoot the session again: rti-rig run {SHIPPED} --out NEWDIR"
+    again = f"then shoot the session again: rti-rig run {SHIPPED} --out {out}-again"
     assert "long-press its start button to rewind it" in said(r) and again in said(r)
     r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost"])
     assert r.exit_code == 2  # what it had advised

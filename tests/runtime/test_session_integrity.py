@@ -804,7 +804,10 @@ def test_a_fit_of_a_session_whose_images_are_gone_names_them_all_and_the_way_out
     assert "(image_004: neither its JPEG nor its linear TIFF on disk; image_006: neither" in out
     assert f"rti-rig run --resume {done} --reshoot-lost" in out
     assert f"rti-rig export-lp {done} --linear --out {done / 'rest.lp'}" in out
-    _fit_the_rest(done, tmp_path / "fit")
+    # the fit's --out a folder beside the session that is not there yet (DIR had been said)
+    fit_out = done.with_name(f"{done.name}-fit")
+    assert f"then rti-rig fit {done / 'rest.lp'} --out {fit_out}" in out, out
+    _fit_the_rest(done, fit_out)
 
 
 def test_a_camera_original_changed_since_capture_is_lost_said_alike_and_reshot_on_request(

@@ -108,7 +108,7 @@ def check_rig(
         from rti_rig.app.usecases.session import refuse_unmeterable_rig
 
         refuse_unmeterable_rig(loaded)
-        refuse_options(loaded, **{"--auto-exposure": True})
+        refuse_options(loaded, Path("session"), **{"--auto-exposure": True})
     if on_start is not None:
         on_start()
     if loaded.config.backend == "replay":

@@ -60,6 +60,7 @@ from rti_rig.core.lp_format import (
 )
 from rti_rig.core.out_folders import (
     ensure_writable_folder,
+    free_folder_beside,
     refuse_a_file_in_the_way,
 )
 from rti_rig.core.raw_rows import DecodedStore, RawRows
@@ -563,11 +564,12 @@ def _refuse_lost_images(lp: Path, damaged: list[tuple[Path, str]]) -> None:
         )
     folder = shell_word(str(root))
     rest = shell_word(str(root / "rest.lp"))
+    fit_out = shell_word(str(free_folder_beside(root, "fit")))  # ``--out DIR`` pasted made DIR
     raise FitInputError(
         f"{shown_path(root)}: {len(damaged)} image(s) its {lp.name} lists cannot be read as "
         f"captured ({shown}){moved}: {lost_image_advice(root, adaptive)}; or fit the images that "
         "remain, listed from the session's journal: rti-rig export-lp "
-        f"{folder} --linear --out {rest}, then rti-rig fit {rest} --out DIR"
+        f"{folder} --linear --out {rest}, then rti-rig fit {rest} --out {fit_out}"
     )
 
 

@@ -34,6 +34,7 @@ from rti_rig.core.fit_minimums import PLAN_DEFAULT_LIGHTS
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.image_files import png_alpha_note
 from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
+from rti_rig.core.out_folders import free_name
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.core.shell_words import shell_word, shown_path
@@ -163,7 +164,8 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             f"--lights {req.lights}: give at least {MIN_PLAN_LIGHTS} lights to plan; fewer "
             f"cannot determine a surface normal ({fit_needs()}), so no planner can do better than "
             "another (a 2-light plan read 90° expected error); a test shot of 1 or 2 lights "
-            "needs no plan: rti-rig run RIG --lights 1"
+            f"needs no plan: rti-rig run {_config_shown(req.rig)} --lights 1 --out "
+            f"{_run_folder(req.out_file)}"
         )
     check_plan_options(
         method=method,
@@ -177,13 +179,15 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         signal_noise=req.signal_noise or 0.0,
         material=req.material,
         rig=_config_shown(req.rig),
+        out=_run_folder(req.out_file),
     )
     bare_lp = req.rig.suffix.lower() == ".lp"
     loaded = None if bare_lp else load_rig_config(req.rig)
     if loaded is not None:
         from rti_rig.app.flash_sync import refuse_options
 
-        refuse_options(loaded, plan=True)  # a camera-triggered dome runs its own order only
+        # a camera-triggered dome runs its own order only: a session beside the plan's file
+        refuse_options(loaded, req.out_file.parent / "session", plan=True)
     notes: list[str] = [] if loaded is None else list(loaded.notes)
     _check_outputs(req, loaded)
     arm_order = None
@@ -365,15 +369,26 @@ def _config_shown(rig: Path) -> str:
     return "RIG.toml" if Path(rig).suffix.lower() == ".lp" else shell_word(str(rig))
 
 
+def _run_folder(plan_file: Path) -> str:
+    """A folder for a ``run`` that a ``plan`` message offers, as a shell word: ``planned``
+    beside the plan file, ``-2``… added if taken (``--out DIR`` pasted had made DIR)."""
+    return shell_word(str(free_name(Path(plan_file).parent / "planned", folder=True)))
+
+
 def run_plan_command(rig: Path, plan_file: Path) -> str:
     """The ``rti-rig run`` command line that runs ``plan_file`` on ``rig`` with
     ``--allow-no-normals``: the rig config given to ``plan`` (a bare ``.lp`` rig is no config:
-    ``RIG.toml`` stands for the one whose lights it lists), the plan, and ``--out DIR``.
+    ``RIG.toml`` stands for the one whose lights it lists), the plan, and a folder beside the
+    plan that does not exist yet.
 
     Why: the advice had been ``rti-rig run --plan PLAN.lp --allow-no-normals``, which ``run``
-    refuses ("give a RIG_CONFIG and --out DIR")."""
+    refuses ("give a RIG_CONFIG and --out DIR"), then ``--out DIR``, which pasted made a
+    folder named DIR."""
     plan = shell_word(str(plan_file))
-    return f"rti-rig run {_config_shown(rig)} --plan {plan} --out DIR --allow-no-normals"
+    return (
+        f"rti-rig run {_config_shown(rig)} --plan {plan} --out {_run_folder(plan_file)} "
+        "--allow-no-normals"
+    )
 
 
 def _lp_labels(labels: list[str]) -> list[str]:

@@ -16,7 +16,7 @@ from typing import Any
 
 from rti_rig.app.usecases.replay_advice import new_session_command
 from rti_rig.core.errors import ConfigError, RtiRigError
-from rti_rig.core.out_folders import free_name
+from rti_rig.core.out_folders import free_folder_beside, free_name
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.controller import (
@@ -1757,9 +1757,10 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         raise RtiRigError(
             done + " (a camera-triggered dome cannot reshoot single images either: to shoot "
             "again, long-press the dome's start button, then rti-rig run "
-            f"{shell_word(str(config_path))} --out NEWDIR)"
+            f"{shell_word(str(config_path))} --out "
+            f"{shell_word(str(free_folder_beside(Path(req.session_dir), 'again')))})"
         )
-    refuse_options(loaded, **{"--resume": True})
+    refuse_options(loaded, free_folder_beside(Path(req.session_dir), "again"), **{"--resume": True})
     _refuse_image_sequence_resume(loaded, Path(req.session_dir))
     # the rig first: another rig given with the session's own options is refused as another
     # rig (its layout compared with the session's had been blamed on the options, with the
@@ -1800,7 +1801,8 @@ def _refuse_image_sequence_resume(loaded: Any, root: Path) -> None:
     an image sequence (:func:`rti_rig.runtime.session.image_sequence_restarts`)."""
     from rti_rig.runtime.session import holds_no_image, image_sequence_restarts
 
-    why = image_sequence_restarts(loaded.config.camera.device, shell_word(str(loaded.path)))
+    again = shell_word(str(free_folder_beside(Path(root), "again")))  # shoot again into it
+    why = image_sequence_restarts(loaded.config.camera.device, shell_word(str(loaded.path)), again)
     if why is None or holds_no_image(root):
         return  # nothing shot yet: the sequence's first file is the first image's
     raise RtiRigError(
@@ -1884,7 +1886,7 @@ def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> Op
     loaded = load_rig_config(req.rig_config)
     from rti_rig.app.flash_sync import refuse_options
 
-    refuse_options(loaded, preview=True)
+    refuse_options(loaded, req.out_dir, preview=True)  # nothing was written to it
     # the folder before the light: a note on which LED stands in for the light asked had been
     # printed above the refusal of an --out that is not empty or lies in a session
     SessionFolder.check_new(req.out_dir)
