@@ -16,7 +16,8 @@ from typing import Any
 
 from rti_rig.core.dome_link import DomeLedError, DomeLinkError, LinkFault
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.out_folders import free_folder_beside, free_name
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.drivers.led_dome.messages import ERR_LED_FAULT
 
 
@@ -72,9 +73,14 @@ def dead_led_advice(
         f"{shell_word(str(out_dir))}"
     )
     resume, resume_sentence = f"once {repaired}", f"Once {repaired}"
+    # real names beside the session, not there yet: PLAN.lp and NEW_DIR pasted had made a
+    # folder named NEW_DIR (and a plan by hand in whatever folder the shell was in)
+    base = Path(out_dir)
+    plan_lp = shell_word(str(free_name(base.with_name(f"{base.name}-without-led-{led}.lp"))))
+    new_dir = shell_word(str(free_folder_beside(base, f"without-led-{led}")))
     rig_lp = (
-        f"copy {loaded.folder / dome.lp_file} (the rig's LED .lp) without the line of "
-        f"{which}, the count on its first line one less, as PLAN.lp"
+        f"copy {shown_path(loaded.folder / dome.lp_file)} (the rig's LED .lp) without the line "
+        f"of {which}, the count on its first line one less, as {plan_lp}"
         if dome is not None and dome.lp_file
         else None
     )
@@ -83,7 +89,7 @@ def dead_led_advice(
             ""
             if rig_lp is None
             else f" To shoot every other LED now instead (not adaptively), {rig_lp} and run "
-            f"rti-rig run {cfg} --plan PLAN.lp --out NEW_DIR."
+            f"rti-rig run {cfg} --plan {plan_lp} --out {new_dir}."
         )
         return (
             f"A resume lights {which} first and stops there again. An adaptive session "
@@ -103,14 +109,14 @@ def dead_led_advice(
                 f"A resume lights {which} first and stops there again. The session's "
                 f"{len(leds - {led})} other lights, in its order, {how} beside it "
                 f"as {written.name}; to shoot them now: rti-rig run {cfg} --plan "
-                f"{shell_word(str(written))} --out NEW_DIR. {resume_sentence}"
+                f"{shell_word(str(written))} --out {new_dir}. {resume_sentence}"
             )
         step = next((s for s in schedule.steps if s.led == led), None)
         where = "" if step is None else " ({:.6f} {:.6f} {:.6f})".format(*step.direction)
-        plan = f"write the lights to shoot without the direction of {which}{where} as PLAN.lp"
+        plan = f"write the lights to shoot without the direction of {which}{where} as {plan_lp}"
     return (
         f"A resume lights {which} first and stops there again. To shoot the other lights now, "
-        f"{plan} and run rti-rig run {cfg} --plan PLAN.lp --out NEW_DIR; {resume}"
+        f"{plan} and run rti-rig run {cfg} --plan {plan_lp} --out {new_dir}; {resume}"
     )
 
 

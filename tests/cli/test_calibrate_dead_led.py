@@ -40,19 +40,22 @@ def test_a_dead_led_is_named_and_the_advice_calibrates_the_others(tmp_path: Path
     text = said(r)
     assert f"LED {DEAD} (led_{DEAD}.jpg, session image image_{DEAD + 1:03d}.jpg)" in text, text
     assert "drop its image" not in text and "Traceback" not in r.output
-    assert "--plan PLAN.lp" in text, text
+    # real names beside the card, not there yet (PLAN.lp and NEW_CARD had been said, and no
+    # calibrate command): the plan written as said, the two commands then run as printed
+    plan, again = tmp_path / f"card-without-led-{DEAD}.lp", tmp_path / f"card-without-led-{DEAD}"
+    shoot = f"rti-rig run {cfg} --plan {plan} --out {again}"
+    calibrate = f"rti-rig calibrate-lights {again} --rig {cfg}"
+    assert f"as {plan}, run {shoot} and calibrate that with {calibrate}" in text, text
     assert not (card / "light_calibration.toml").exists()
 
     # the advice, followed as written: the session's lights.lp without that image's line
     lines = (card / "lights.lp").read_text().splitlines()
     kept = [ln for ln in lines[1:] if not ln.startswith(f"image_{DEAD + 1:03d}.jpg ")]
     assert len(kept) == len(lines) - 2
-    plan = tmp_path / "PLAN.lp"
     plan.write_text("\n".join([str(len(kept)), *kept]) + "\n")
-    again = tmp_path / "NEW_CARD"
-    r = runner.invoke(app, ["run", str(cfg), "--plan", str(plan), "--out", str(again)])
+    r = runner.invoke(app, shoot.split()[1:])
     assert r.exit_code == 0, r.output
-    r = runner.invoke(app, ["calibrate-lights", str(again), "--rig", str(cfg)])
+    r = runner.invoke(app, calibrate.split()[1:])
     assert r.exit_code == 0, r.output
     text = said(r)
     assert "47 of 48 LEDs measured" in text, text
@@ -86,18 +89,20 @@ def test_a_card_session_stopped_at_a_dead_led_says_how_to_shoot_the_others(
     assert "continue it with rti-rig run --resume" not in text, text
     assert f"stopped at an LED after {DEAD} of 48 images" in text, text
     assert f"without the line of LED {DEAD} (led_{DEAD}.jpg)" in text, text
-    assert "--plan PLAN.lp --out NEW_CARD" in text and "Traceback" not in r.output
+    plan, again = tmp_path / f"card-without-led-{DEAD}.lp", tmp_path / f"card-without-led-{DEAD}"
+    shoot = f"rti-rig run {cfg} --plan {plan} --out {again}"
+    calibrate = f"rti-rig calibrate-lights {again} --rig {cfg}"
+    assert f"as {plan}, run {shoot} and calibrate that with {calibrate}" in text, text
+    assert "Traceback" not in r.output
 
     # the advice, followed as written: the rig's LED .lp without that LED's line
     lines = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
     kept = [ln for ln in lines[1:] if not ln.startswith(f"led_{DEAD}.jpg ")]
     assert "the rig's LED .lp" in text and len(kept) == 47
-    plan = tmp_path / "PLAN.lp"
     plan.write_text("\n".join([str(len(kept)), *kept]) + "\n")
-    again = tmp_path / "NEW_CARD"
-    r = runner.invoke(app, ["run", str(cfg), "--plan", str(plan), "--out", str(again)])
+    r = runner.invoke(app, shoot.split()[1:])
     assert r.exit_code == 0, r.output
-    r = runner.invoke(app, ["calibrate-lights", str(again), "--rig", str(cfg)])
+    r = runner.invoke(app, calibrate.split()[1:])
     assert r.exit_code == 0, r.output
     assert "47 of 48 LEDs measured" in said(r)
 
@@ -121,7 +126,7 @@ def test_a_card_session_stopped_by_a_board_reboot_under_an_led_is_resumed(
     assert r.exit_code == 2, r.output
     text = said(r)
     assert f"continue it with rti-rig run --resume {card}" in text, text
-    assert "Repair LED" not in text and "PLAN.lp" not in text, text
+    assert "Repair LED" not in text and "without-led" not in text, text
     assert "Traceback" not in r.output
 
     # the advice, followed: each resume's emulator reboots at its 40th command again, and
@@ -160,4 +165,4 @@ def test_a_card_session_an_led_s_thermal_refusal_stopped_is_resumed(tmp_path: Pa
     assert r.exit_code == 2, r.output
     text = said(r)
     assert f"continue it with rti-rig run --resume {card}" in text, text
-    assert "PLAN.lp" not in text and "Traceback" not in r.output, text
+    assert "without-led" not in text and "Traceback" not in r.output, text

@@ -45,12 +45,14 @@ def test_a_stop_at_a_dead_led_advises_a_plan_without_it_that_works(tmp_path: Pat
     lines = Path(named.group(1)).read_text().splitlines()
     kept = [ln for ln in lines[1:] if not ln.startswith(f"led_0{DEAD}.jpg ")]
     assert len(kept) == len(lines) - 2
-    plan = tmp_path / "PLAN.lp"
+    # the plan's name and the new folder real ones beside the session (PLAN.lp and NEW_DIR,
+    # pasted, had made a folder named NEW_DIR)
+    plan, new = tmp_path / f"s-without-led-{DEAD}.lp", tmp_path / f"s-without-led-{DEAD}"
+    assert f"one less, as {plan} and run rti-rig run" in text, text
     plan.write_text("\n".join([str(len(kept)), *kept]) + "\n")
-    assert f"rti-rig run {cfg} --plan PLAN.lp --out NEW_DIR" in text, text
-    r = runner.invoke(
-        app, ["run", str(cfg), "--plan", str(plan), "--out", str(tmp_path / "new"), "--no-verdict"]
-    )
+    command = f"rti-rig run {cfg} --plan {plan} --out {new}"
+    assert command in text, text
+    r = runner.invoke(app, [*command.removeprefix("rti-rig ").split(), "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert "47 image(s) in the session" in said(r), r.output
 
@@ -86,7 +88,8 @@ def test_a_partial_plan_stopped_at_a_dead_led_is_given_a_plan_that_runs(
     assert f"LED {DEAD} refused" in text and "Continue with: rti-rig run --resume" not in text
     assert f"continue with: rti-rig run --resume {s}" in text, text  # once repaired
     written = tmp_path / f"s-without-led-{DEAD}.lp"
-    command = f"rti-rig run {cfg} --plan {written} --out NEW_DIR."
+    new = tmp_path / f"s-without-led-{DEAD}"  # beside the session, not there yet
+    command = f"rti-rig run {cfg} --plan {written} --out {new}."
     assert (
         f"The session's 23 other lights, in its order, were written beside it as {written.name}"
         in text
@@ -95,8 +98,7 @@ def test_a_partial_plan_stopped_at_a_dead_led_is_given_a_plan_that_runs(
     assert [p.name for p in s.glob("*.lp")] == ["lights.lp"]  # nothing added in the session
 
     # the command, run as said: the other 23 lights, LED 2 not among them
-    new = tmp_path / "new"
-    argv = command.removeprefix("rti-rig ").removesuffix(".").replace("NEW_DIR", str(new))
+    argv = command.removeprefix("rti-rig ").removesuffix(".")
     r = runner.invoke(app, [*argv.split(), "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert "23 image(s) in the session" in said(r), r.output
@@ -159,7 +161,7 @@ def test_a_resume_stopped_at_the_same_dead_led_reuses_the_plan_it_wrote(tmp_path
     text = said(r)
     assert r.exit_code == 2 and f"LED {DEAD} refused" in text, text
     assert f"other lights, in its order, are already beside it as {first.name}" in text, text
-    assert f"--plan {first} --out NEW_DIR" in text, text
+    assert f"--plan {first} --out {tmp_path / f's-without-led-{DEAD}'}" in text, text
     assert sorted(p.name for p in tmp_path.glob("s-without-led-*.lp")) == [first.name]
     assert first.read_bytes() == content
 

@@ -30,6 +30,7 @@ from rti_rig.app.light_calibration import (
 )
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.out_folders import free_folder_beside, free_name
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.drivers.led_dome.settings import DIMMING_LINK, IMAGE_GAINS_REMEDY
@@ -107,32 +108,45 @@ def _dead_led_advice(
     led = int(card.leds[exc.light])
     image = card.image_of.get(led, f"image {exc.light + 1}")
     name = names[led] if 0 <= led < len(names) else f"LED {led}"
-    session = shell_word(str(req.card_session))
+    session_lp = shell_word(str(Path(req.card_session) / "lights.lp"))
     return (
         f"{shown_path(req.card_session)}: LED {led} ({name}, session image {image}) gave "
         f"{exc.gain:.3f} of the median LED's light: a dead LED (or a black frame), which no "
         "correction can even out. Check that LED and its wiring, then shoot the card again; to "
         "calibrate the other LEDs meanwhile, shoot the card under all but it: copy "
-        f"{session}/lights.lp without the line of {image} (the count on its first line one less) "
-        f"as PLAN.lp, run rti-rig run {shell_word(str(req.rig_config))} --plan PLAN.lp --out "
-        "NEW_CARD and calibrate NEW_CARD"
+        f"{session_lp} without the line of {image} (the count on its first line one less) "
+        f"{_shoot_and_calibrate(req, f'without-led-{led}')}"
     )
 
 
-def _without_led(req: CalibrateRequest, loaded: LoadedRig, which: str) -> str:
+def _shoot_and_calibrate(req: CalibrateRequest, tag: str) -> str:
+    """The end of a dead LED's advice: the plan's name, the card session that shoots it and
+    the calibration of that session, in real names beside the card session that do not exist
+    yet (``tag`` in each). Why: ``as PLAN.lp … --out NEW_CARD and calibrate NEW_CARD`` had
+    been said, which pasted made a folder named NEW_CARD, and no calibrate command."""
+    card = Path(req.card_session)
+    plan = shell_word(str(free_name(card.with_name(f"{card.name}-{tag}.lp"))))
+    new_card = shell_word(str(free_folder_beside(card, tag)))
+    rig = shell_word(str(req.rig_config))
+    return (
+        f"as {plan}, run rti-rig run {rig} --plan {plan} --out {new_card} and calibrate that "
+        f"with rti-rig calibrate-lights {new_card} --rig {rig}"
+    )
+
+
+def _without_led(req: CalibrateRequest, loaded: LoadedRig, which: str, led: int | None) -> str:
     """How to calibrate the other LEDs while ``which`` LED waits for repair: a card session of
     a plan that leaves it out (an LED not in a card session is assumed at the median)."""
     dome = loaded.config.dome
     lp = (
-        f"{loaded.folder / dome.lp_file} (the rig's LED .lp)"
+        f"{shell_word(str(loaded.folder / dome.lp_file))} (the rig's LED .lp)"
         if dome is not None and dome.lp_file
         else "a list of every LED's direction (x y z, as rti-rig plan writes them)"
     )
     return (
         f"Repair {which} or its wiring and shoot the card again; to calibrate the other LEDs "
         f"meanwhile, copy {lp} without the line of {which} (the count on its first line one "
-        f"less) as PLAN.lp, run rti-rig run {shell_word(str(req.rig_config))} --plan PLAN.lp "
-        "--out NEW_CARD and calibrate NEW_CARD"
+        f"less) {_shoot_and_calibrate(req, 'others' if led is None else f'without-led-{led}')}"
     )
 
 
@@ -268,7 +282,7 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             if exc.led is not None and 0 <= exc.led < len(names)
             else "that LED"
         )
-        raise RtiRigError(f"{exc}. {_without_led(req, loaded, which)}") from None
+        raise RtiRigError(f"{exc}. {_without_led(req, loaded, which, exc.led)}") from None
     target = req.target
     if req.out_file is None and target.exists():
         raise RtiRigError(
