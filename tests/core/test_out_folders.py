@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.out_folders import ensure_writable_folder
+from rti_rig.core.out_folders import ensure_writable_folder, free_folder_beside, free_name
 
 
 def test_a_new_folder_is_created_and_left_empty(tmp_path: Path) -> None:
@@ -65,3 +65,18 @@ def test_a_folder_the_user_may_not_look_into_is_refused_by_name(
         ensure_writable_folder(target)
     monkeypatch.undo()
     assert not (locked / "x").exists()
+
+
+def test_a_free_name_skips_what_is_taken_a_broken_link_too(tmp_path: Path) -> None:
+    """The name a hint gives for the file or folder its command writes: taken names (a broken
+    symlink included: ``plan`` and ``run`` would refuse it) get ``-2``, ``-3``… before a file's
+    suffix, at the end of a folder's name (its dots are its own: ``v1.2`` is no suffix)."""
+    assert free_name(tmp_path / "plan.lp") == tmp_path / "plan.lp"
+    (tmp_path / "plan.lp").write_text("3\n")
+    (tmp_path / "plan-2.lp").symlink_to(tmp_path / "gone")
+    assert free_name(tmp_path / "plan.lp") == tmp_path / "plan-3.lp"
+    session = tmp_path / "scan v1.2"
+    session.mkdir()
+    assert free_folder_beside(session, "fit") == tmp_path / "scan v1.2-fit"
+    (tmp_path / "scan v1.2-fit").mkdir()
+    assert free_folder_beside(session, "fit") == tmp_path / "scan v1.2-fit-2"

@@ -1233,13 +1233,14 @@ def check_objective(objective: str, lights: int | None, until_error_deg: float |
         raise RtiRigError(
             "--until-error goes with --objective normals only: it stops on the estimated mean "
             "normal error, which a session chosen for relighting does not aim at (no relighting "
-            "error estimate is calibrated). Give --objective relight a count (--lights 12, "
-            "say), or drop --objective for --until-error"
+            "error estimate is calibrated). Give --objective relight a count (--lights "
+            f"{fit_minimums.PLAN_DEFAULT_LIGHTS}, say), or drop --objective for --until-error"
         )
     if lights is None:
         raise RtiRigError(
             "--objective relight chooses a design of a given number of lights by its simulated "
-            "relighting: give the count with --lights (e.g. --lights 12)"
+            "relighting: give the count with --lights (e.g. --lights "
+            f"{fit_minimums.PLAN_DEFAULT_LIGHTS})"
         )
 
 
