@@ -71,7 +71,7 @@ def test_too_few_lights_are_refused_alike_with_the_fits_figures(tmp_path: Path) 
     assert "--lights 2: give at least 3 lights to plan;" in plan_said
     assert "Traceback" not in plan_said
     # the test shot's command, real (it had said "rti-rig run RIG --lights 1"), runs as said
-    shot = tmp_path / "planned"
+    shot = tmp_path / "test-shot"
     command = plan_said.split("needs no plan: ", 1)[1].split(f" --out {shot}", 1)[0]
     assert command.startswith("rti-rig run ") and " --lights 1" in command, plan_said
     r = runner.invoke(app, [*shlex.split(command)[1:], "--out", str(shot), "--no-verdict"])

@@ -165,7 +165,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             f"cannot determine a surface normal ({fit_needs()}), so no planner can do better than "
             "another (a 2-light plan read 90° expected error); a test shot of 1 or 2 lights "
             f"needs no plan: rti-rig run {_config_shown(req.rig)} --lights 1 --out "
-            f"{_run_folder(req.out_file)}"
+            f"{_run_folder(req.out_file, 'test-shot')}"
         )
     check_plan_options(
         method=method,
@@ -369,10 +369,10 @@ def _config_shown(rig: Path) -> str:
     return "RIG.toml" if Path(rig).suffix.lower() == ".lp" else shell_word(str(rig))
 
 
-def _run_folder(plan_file: Path) -> str:
-    """A folder for a ``run`` that a ``plan`` message offers, as a shell word: ``planned``
-    beside the plan file, ``-2``… added if taken (``--out DIR`` pasted had made DIR)."""
-    return shell_word(str(free_name(Path(plan_file).parent / "planned", folder=True)))
+def _run_folder(plan_file: Path, name: str = "planned") -> str:
+    """A folder for a ``run`` that a ``plan`` message offers, as a shell word: ``name`` beside
+    the plan file, ``-2``… added if taken (``--out DIR`` pasted had made DIR)."""
+    return shell_word(str(free_name(Path(plan_file).parent / name, folder=True)))
 
 
 def run_plan_command(rig: Path, plan_file: Path) -> str:
