@@ -8,17 +8,33 @@ Metered at the one light nearest the zenith, 7 of its 48 images clipped 56–100
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 import tifffile
-from conftest import CONFIGS
+from conftest import CONFIGS, REPO
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 
 runner = CliRunner()
+GUIDE = REPO / "docs" / "guide.md"
+
+
+def _guide_metering_figures() -> tuple[str, str]:
+    """The guide's section 4 sample "Exposure fixed at …" line up to its "(…)", and its quoted
+    "Session time on the real rig: …" line up to "simulated in", which a reader compares with
+    their own run of this dome (no test had read the sample: its figures had gone stale)."""
+    text = GUIDE.read_text(encoding="utf-8")
+    found = re.search(r"^## 4\. A DSLR\n(.*?)^## 5\.", text, re.S | re.M)
+    assert found, "the guide's section 4 is gone"
+    section = found.group(1)
+    fixed = re.search(r"^(Exposure fixed at .*?) \(…\)$", section, re.M)
+    time_line = re.search(r"`(Session time on the real rig: [^`]*?simulated in)", section, re.S)
+    assert fixed and time_line, "the guide's metering sample is gone"
+    return fixed.group(1), " ".join(time_line.group(1).split())
 
 
 @pytest.mark.slow
@@ -69,3 +85,10 @@ def test_auto_exposure_on_the_uneven_card_dome_clips_no_image(tmp_path: Path) ->
         f"Session time on the real rig: {total:.1f} s including {chosen['metering_shots']} "
         f"metering shots (metering {metering_s:.1f} s, simulated in "
     ) in said
+    # the guide's sample of this very run (section 4) shows what it printed
+    fixed, time_line = _guide_metering_figures()
+    assert fixed in said, (fixed, said)
+    # its time line: the same shots (the seconds are not compared: the emulated link's real
+    # reply times are added to the rig's clock, so they grow with the machine's load)
+    shots = re.search(r"including (\d+) metering shots", time_line)
+    assert shots and f"including {shots.group(1)} metering shots (metering " in said, time_line
