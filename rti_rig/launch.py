@@ -174,3 +174,10 @@ def _from_keyboard_interrupt(exc: BaseException) -> KeyboardInterrupt | None:
         seen.add(id(link))
         link = link.__cause__ or (None if link.__suppress_context__ else link.__context__)
     return None
+
+
+if __name__ == "__main__":
+    # `python -m rti_rig.launch ARGS`, the console script's own module run by hand (a checkout
+    # whose venv scripts point elsewhere): it had loaded these definitions and exited 0 having
+    # done nothing, a silent "success" of any command asked
+    main()

@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 REPO = Path(__file__).resolve().parents[2]
 
 _INTERRUPTED_RUN = """
@@ -53,9 +55,12 @@ def test_the_installed_script_starts_through_the_quiet_entry_point() -> None:
     assert script.value == "rti_rig.launch:main"
 
 
-def test_python_dash_m_runs_the_command_line() -> None:
+@pytest.mark.parametrize("module", ["rti_rig", "rti_rig.launch"])
+def test_python_dash_m_runs_the_command_line(module: str) -> None:
+    """Also ``python -m rti_rig.launch``, the entry point's module: it had exited 0 having
+    done nothing (no ``__main__`` guard), so a command run that way seemed to succeed."""
     done = subprocess.run(
-        [sys.executable, "-m", "rti_rig", "--help"], capture_output=True, text=True, timeout=120
+        [sys.executable, "-m", module, "--help"], capture_output=True, text=True, timeout=120
     )
     assert done.returncode == 0, done.stderr
     assert "run" in done.stdout and "plan" in done.stdout
