@@ -63,9 +63,12 @@ def print_verdict(session: Path | None) -> None:
         # Ctrl-C here had exited 0, so ``run && fit`` went on to fit after the user asked to
         # stop, and the two stops of the same moment disagreed
         signum = exc.signum if isinstance(exc, VerdictTerminated) else signal.SIGINT
+        from rti_rig.core.out_folders import free_folder_beside
+
         err.print(
             f"[yellow]QA verdict skipped ({stop_words(signum)}):[/] the session is complete; "
-            f"rti-rig fit {escape(shell_word(session))} --out FOLDER gives the verdict"
+            f"rti-rig fit {escape(shell_word(session))} --out "
+            f"{escape(shell_word(free_folder_beside(Path(session), 'fit')))} gives the verdict"
         )
         raise typer.Exit(code=stop_exit_code(signum)) from None
 

@@ -377,8 +377,8 @@ def run(
             err.print(
                 f"[yellow]Stopped ({stop_words(late_term[0])}) once the session had ended: it "
                 "is complete; its QA "
-                "verdict was not computed:[/] rti-rig fit "
-                f"{escape(_arg(opened.out_dir))} --out FOLDER gives it",
+                "verdict was not computed:[/] "
+                f"{escape(_fit_next(opened.out_dir))} gives it",
                 soft_wrap=True,
             )
             raise typer.Exit(code=stop_exit_code(late_term[0]))
@@ -388,7 +388,7 @@ def run(
             unsafe,
             "the session",
             "; its QA verdict was not computed:",
-            f" rti-rig fit {escape(_arg(opened.out_dir))} --out FOLDER gives it",
+            f" {escape(_fit_next(opened.out_dir))} gives it",
         )
         if not no_verdict:
             from rti_rig.cli.fit import print_verdict
@@ -440,10 +440,10 @@ def _rebuilt_finished(req: Any) -> bool:
             print_note(Note(line, "warning"))
         lost = lost_since_capture_said(req.session_dir)
         return f"Stopped ({why}) once {JOURNAL} was rebuilt: " + (
-            f"the session is whole again; rti-rig fit {folder} --out FOLDER fits it "
+            f"the session is whole again; {_fit_next(req.session_dir)} fits it "
             "and gives its QA verdict"
             if lost is None
-            else f"{lost}; meanwhile rti-rig fit {folder} --out FOLDER fits the rest"
+            else f"{lost}; meanwhile {_fit_next(req.session_dir)} fits the rest"
         )
 
     # the opening's answers, shared with run and preview: this third copy had lacked the one
@@ -470,14 +470,14 @@ def _rebuilt_finished(req: Any) -> bool:
         out.print(
             f"{shown_path(req.session_dir)}: {JOURNAL} rebuilt from every image it could prove (no "
             f"rig was opened, nothing was shot), but the session is not whole: {lost}; meanwhile "
-            f"rti-rig fit {folder} --out FOLDER fits it, its QA verdict naming what is lost",
+            f"{_fit_next(req.session_dir)} fits it, its QA verdict naming what is lost",
             highlight=False,
             markup=False,
         )
         return True
     out.print(
         f"{shown_path(req.session_dir)}: {JOURNAL} rebuilt; the session is complete and whole "
-        f"again (no rig was opened, nothing was shot). Next: rti-rig fit {folder} --out FOLDER "
+        f"again (no rig was opened, nothing was shot). Next: {_fit_next(req.session_dir)} "
         "fits it and gives its QA verdict",
         highlight=False,
         markup=False,
@@ -787,7 +787,7 @@ def _verdict_failed(exc: Exception, session: Path) -> None:
     err.print(
         f"[yellow]QA verdict unavailable:[/] unexpected {escape(what)} (a fault that rti-rig "
         "should have named: please report it); the "
-        f"session is complete: rti-rig fit {escape(_arg(session))} --out FOLDER gives the "
+        f"session is complete: {escape(_fit_next(session))} gives the "
         "verdict",
         highlight=False,
         soft_wrap=True,
@@ -834,6 +834,16 @@ def _arg(path: Path | str) -> str:
     with a space in its name ("Object 12 recto") had been printed bare, so the resume hint
     pasted into a shell ran ``--resume Object`` with "12" and "recto" as other arguments."""
     return shell_word(path)  # and as $'...' where a stream cannot print it (shell_word)
+
+
+def _fit_next(session: Path | str) -> str:
+    """The ``rti-rig fit`` a message names as a complete session's next step, its ``--out`` a
+    real folder beside the session that does not exist yet
+    (:func:`rti_rig.core.out_folders.free_folder_beside`).
+
+    Why: ``--out FOLDER`` had been printed, which pasted made a folder named FOLDER (beside
+    whatever the shell's folder was), where a hint is to paste as it stands."""
+    return f"rti-rig fit {_arg(session)} --out {_arg(free_folder_beside(Path(session), 'fit'))}"
 
 
 def _sentence(text: str) -> str:
@@ -1054,7 +1064,7 @@ class _Stop:
     def fit_it(self) -> str:
         """The command that fits the images as they are: offered where a resume is not
         possible or not needed, so the user is not left without a next step."""
-        return f"`rti-rig fit {_arg(self.out_dir)} --out FOLDER` fits the images as they are"
+        return f"`{_fit_next(self.out_dir)}` fits the images as they are"
 
 
 def _said_disowned(s: _Stop) -> str:
@@ -1094,7 +1104,7 @@ def _said_stopping_rule(s: _Stop) -> str:
     return (
         f"{s.kept}, listed in {s.lp}: the session is complete (its stopping rule ended it at {n} "
         f"of at most {s.ending.total_steps} lights), nothing is left to resume. Next: "
-        f"rti-rig fit {_arg(s.out_dir)} --out FOLDER"
+        f"{_fit_next(s.out_dir)}"
     )
 
 
@@ -1103,7 +1113,7 @@ def _said_complete(s: _Stop) -> str:
     # been said of a complete session, which the resume refused as "already completed"
     return (
         f"{s.kept}, listed in {s.lp}: the session is complete, nothing is left to resume. "
-        f"Next: rti-rig fit {_arg(s.out_dir)} --out FOLDER"
+        f"Next: {_fit_next(s.out_dir)}"
     )
 
 

@@ -137,5 +137,8 @@ def free_name(path: Path, *, folder: bool = False) -> Path:
 def free_folder_beside(root: Path, tag: str) -> Path:
     """A folder that does not exist yet beside ``root``, named ``ROOT-tag`` (``-2``… added if
     taken): the ``--out`` of a command a hint about session ``root`` suggests (``fit`` refuses
-    an ``--out`` inside the session, so beside it, not in it)."""
+    an ``--out`` inside the session, so beside it, not in it). A session given as ``.`` or
+    ``..`` is named by its absolute path: it has no name to add to."""
+    if root.name in ("", ".."):
+        root = Path(os.path.normpath(root.absolute()))
     return free_name(root.with_name(f"{root.name}-{tag}"), folder=True)

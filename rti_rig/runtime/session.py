@@ -2029,7 +2029,7 @@ def _refuse_complete(root: Path, manifest: dict[str, Any], total: int, finished:
         f"{shown_path(root)}: {done}, and every image is as captured (each JPEG and linear "
         "TIFF matches its journaled checksum); nothing to resume, nothing was changed"
     )
-    fit = f"rti-rig fit {folder} --out FOLDER (FOLDER new or empty, outside the session)"
+    fit = f"rti-rig fit {folder} --out {shell_word(str(free_folder_beside(root, 'fit')))}"
     if not (root / LP_NAME).is_file():
         # fit refuses a session folder without it (naming export-lp): the next step had been
         # named as fit alone, which then failed

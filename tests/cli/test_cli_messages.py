@@ -99,7 +99,7 @@ def test_ctrl_c_during_the_verdict_of_a_complete_session_says_it_is_complete(
     assert code == 130, said
     assert "6 image(s) in the session" in said and "Traceback" not in said
     assert "QA verdict skipped (Ctrl-C): the session is complete" in said
-    assert f"rti-rig fit {out} --out FOLDER" in said
+    assert f"rti-rig fit {out} --out {out}-fit" in said
 
 
 def test_a_late_ctrl_c_does_not_cut_the_summary(
@@ -198,7 +198,7 @@ def test_a_sigterm_during_the_verdict_says_the_session_is_complete(tmp_path: Pat
     assert code == 143, (code, said)
     assert "6 image(s) in the session" in said
     assert "QA verdict skipped (SIGTERM): the session is complete" in said, said
-    assert f"rti-rig fit {out} --out FOLDER gives the verdict" in said
+    assert f"rti-rig fit {out} --out {out}-fit gives the verdict" in said
     assert "SIGTERM handler restored: True" in said and "Traceback" not in said
 
 

@@ -361,7 +361,7 @@ def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())
     assert "this session is complete: all 60 steps were captured" in text
-    assert f"Next: rti-rig fit {out} --out FOLDER" in text
+    assert f"Next: rti-rig fit {out} --out {out}-fit" in text
     assert "cannot be used" not in text and "error" not in text
     # an image renamed is named with its fix (the refusal had said only "nothing to resume")
     (out / "image_020.jpg").rename(out / "photo_x.jpg")

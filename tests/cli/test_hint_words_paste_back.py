@@ -62,10 +62,15 @@ def test_a_resume_of_a_complete_session_gives_its_fit_as_a_word_that_pastes_back
 ) -> None:
     r = rti_rig("run", "--resume", session)
     assert r.returncode == 0, r.stderr
-    assert words_after(r.stdout, b"Next: rti-rig fit ") == [os.fsencode(session)], r.stdout
-    assert words_after(r.stdout, b": this session is complete") == [os.fsencode(session)]
+    # the fit's --out is a folder beside the session, free, as a word too (it had been FOLDER)
+    fit_out = os.fsencode(session.with_name(session.name + "-fit"))
+    said_session = os.fsencode(session)
+    assert words_after(r.stdout, b"Next: rti-rig fit ") == [said_session, fit_out], r.stdout
+    assert words_after(r.stdout, b" --out ") == [fit_out], r.stdout
+    assert words_after(r.stdout, b": this session is complete") == [said_session, fit_out]
     assert r.stdout.startswith(b"$'"), r.stdout  # and the session it names, as said first
-    assert [pasted(w) for w in WORD.findall(r.stdout)] == [os.fsencode(session)] * 2, r.stdout
+    words = [pasted(w) for w in WORD.findall(r.stdout)]
+    assert words == [said_session, said_session, fit_out], r.stdout
     assert b"udce9" not in r.stdout, r.stdout
 
 

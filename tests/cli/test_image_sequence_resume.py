@@ -113,7 +113,7 @@ def test_a_stop_once_every_image_is_in_says_what_fit_will_say(
     assert len(list(out.glob("image_*.jpg"))) == 4 and "Traceback" not in said, said
     assert "session is complete" not in said and "--resume" not in said, said
     assert "every image is in, but the stop came before the run recorded its end" in said, said
-    fit_it = f"rti-rig fit {out} --out FOLDER` fits the images as they are."
+    fit_it = f"rti-rig fit {out} --out {out}-fit` fits the images as they are."
     assert f"{fit_it} It cannot be resumed: its camera is an image sequence" in said, said
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
     assert "the session is not finished" in " ".join(r.output.split()), r.output

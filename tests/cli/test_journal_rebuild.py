@@ -377,7 +377,7 @@ def test_a_completed_session_whose_journal_is_lost_is_made_whole(
     r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
     assert r.exit_code == 0, r.output
     assert "journal.jsonl rebuilt from manifest.json: 8 image(s) taken back" in said(r)
-    assert "whole again" in said(r) and f"rti-rig fit {out} --out FOLDER" in said(r)
+    assert "whole again" in said(r) and f"rti-rig fit {out} --out {out}-fit" in said(r)
     assert (out / "journal.jsonl").read_bytes() == (ref / "journal.jsonl").read_bytes()
     assert _images(out) == _images(ref)
     (report,) = (out / "recovered").rglob("journal-rebuild.txt")

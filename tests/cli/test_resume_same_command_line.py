@@ -66,7 +66,7 @@ def test_the_line_the_session_began_with_continues_it(stopped: Path, tmp_path: P
     r = runner.invoke(app, [*line, "--resume", str(out)])
     assert r.exit_code == 0, r.output
     assert "this session is complete: all 8 steps were captured" in said(r)
-    assert f"Next: rti-rig fit {out} --out FOLDER" in said(r)
+    assert f"Next: rti-rig fit {out} --out {out}-fit" in said(r)
     assert tree(out) == after
 
 

@@ -92,7 +92,7 @@ def test_two_ctrl_c_in_a_completed_adaptive_sessions_teardown_say_complete(
     assert "Emergency stop (second Ctrl-C)" in said and "Traceback" not in said, said
     assert "--resume" not in said, said
     assert f"{kept} image(s) kept in {out}, listed in lights.lp: the session is complete" in said
-    assert f"Next: rti-rig fit {out} --out FOLDER" in said, said
+    assert f"Next: rti-rig fit {out} --out {out}-fit" in said, said
 
 
 def test_two_ctrl_c_with_images_missing_still_say_the_resume(tmp_path: Path) -> None:

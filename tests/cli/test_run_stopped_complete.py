@@ -66,7 +66,7 @@ def test_a_sigterm_as_the_last_image_is_committed_says_all_in_fit_and_resume(
     assert "before the run recorded its end," in said, said
     assert "nothing is left to resume" not in said, said
     assert f"rti-rig run --resume {out}` records it complete without shooting" in said, said
-    assert f"rti-rig fit {out} --out FOLDER" in said, said
+    assert f"rti-rig fit {out} --out {out}-fit" in said, said
     assert len((out / "lights.lp").read_text().splitlines()) == 7  # its count and 6 lights
 
 
@@ -143,11 +143,11 @@ def test_a_sigterm_after_an_until_error_stop_says_complete_not_resume(tmp_path: 
     assert f"the session is complete (its stopping rule ended it at {kept} of at most {total}" in (
         said
     )
-    assert f"Next: rti-rig fit {out} --out FOLDER" in said, said
+    assert f"Next: rti-rig fit {out} --out {out}-fit" in said, said
     code, again = _cli("run", "--resume", str(out))
     # what the advice would have met: complete, said so, with the same next step
     assert code == 0 and "this adaptive session is complete: it stopped after" in again, again
-    assert f"Next: rti-rig fit {out} --out FOLDER" in again, again
+    assert f"Next: rti-rig fit {out} --out {out}-fit" in again, again
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")

@@ -56,7 +56,7 @@ def test_a_sigterm_during_the_summary_keeps_it_and_says_how_to_get_the_verdict(
     code, said = _run_signalled(tmp_path, "run", str(cfg), "--out", str(out), "--lights", "8")
     assert code == 143, said
     assert "8 image(s) in the session" in said and "Session time on the real rig" in said
-    assert "QA verdict was not computed" in said and f"rti-rig fit {out} --out FOLDER" in said
+    assert "QA verdict was not computed" in said and f"rti-rig fit {out} --out {out}-fit" in said
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["runner"]["finish_reason"] == "completed"
 

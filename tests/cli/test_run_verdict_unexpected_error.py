@@ -45,6 +45,6 @@ def test_an_unexpected_verdict_failure_is_said_in_one_line_after_a_complete_run(
     assert "All-off sent and acknowledged by the dome: lights are off." in text, text
     name = type(error).__name__
     assert f"QA verdict unavailable: unexpected {name}" in text, text
-    assert f"the session is complete: rti-rig fit {out} --out FOLDER gives the verdict" in text
+    assert f"the session is complete: rti-rig fit {out} --out {out}-fit gives the verdict" in text
     assert "Traceback" not in text, text
     assert len(list(out.glob("image_*.jpg"))) == 6
