@@ -387,6 +387,8 @@ def test_a_completed_session_whose_journal_is_lost_is_made_whole(
     assert (tmp_path / "x.lp").read_bytes() == (ref / "lights.lp").read_bytes()
     r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
     assert r.exit_code == 2 and "nothing to rebuild" in said(r), r.output
+    # the fit it names pastes as it stands: a free folder beside the session (it said DIR)
+    assert f"the QA verdict of rti-rig fit {out} --out {out}-fit names any image" in said(r)
 
 
 def test_a_completed_session_with_a_record_given_another_light_is_refused_untouched(
