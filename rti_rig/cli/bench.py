@@ -128,16 +128,16 @@ def _acquisition_lp(given: Path) -> Path:
                 "images, with the images beside it (or a session folder: its lights.lp)"
             )
         return given
-    from rti_rig.core.lp_format import lp_files_in
+    from rti_rig.core.lp_format import acquisition_lp_files
 
-    found = lp_files_in(given)
+    found = acquisition_lp_files(given)  # an RTIBuilder project's in its assembly-files/
     if len(found) == 1:
         return found[0]
+    names = ", ".join(p.relative_to(given).as_posix() for p in found[:5])
     raise RtiRigError(
         f"--from {given}: a folder with "
         + (
-            f"{len(found)} .lp files ({', '.join(p.name for p in found[:5])}"
-            + (", …)" if len(found) > 5 else ")")
+            f"{len(found)} .lp files ({names}" + (", …)" if len(found) > 5 else ")")
             if found
             else "no .lp file"
         )

@@ -124,6 +124,21 @@ def lp_files_in(folder: Path) -> list[Path]:
     return sorted(found)
 
 
+#: The subfolder of an RTIBuilder project that holds its ``.lp`` (its images are in
+#: ``jpeg-exports/`` beside it).
+ASSEMBLY_FILES = "assembly-files"
+
+
+def acquisition_lp_files(folder: Path) -> list[Path]:
+    """The ``.lp`` files of a folder given as an acquisition: its own (:func:`lp_files_in`),
+    or, where it holds none, those of its ``assembly-files/`` subfolder (RTIBuilder's project
+    layout, the project folder being what a user sees as the acquisition).
+
+    Why: ``fit PROJECT`` and ``bench tradeoff --from PROJECT`` had said the project "holds no
+    .lp file", and ``run PROJECT`` named none, where RTIBuilder had put it one folder down."""
+    return lp_files_in(folder) or lp_files_in(Path(folder) / ASSEMBLY_FILES)
+
+
 def is_absolute_name(name: str) -> bool:
     """An image name that is a path from the root, on either system's rules."""
     return any(

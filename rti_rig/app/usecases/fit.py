@@ -49,6 +49,7 @@ from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation, png_al
 from rti_rig.core.json_values import strict_dumps
 from rti_rig.core.lp_format import (
     LpEntry,
+    acquisition_lp_files,
     case_hint,
     directions_of,
     format_lp,
@@ -420,13 +421,17 @@ def acquisition_files(
                     f"{JOURNAL}: its images cannot be paired with their lights or verified as "
                     "captured; restore both from a backup copy of the folder"
                 )
-            raise FitInputError(f"{shown_path(source)} holds no .lp file: not a session folder")
+            lps = acquisition_lp_files(source)  # an RTIBuilder project: its assembly-files/
+            if not lps:
+                raise FitInputError(f"{shown_path(source)} holds no .lp file: not a session folder")
         if not (source / LP_NAME).is_file() and len(lps) > 1:
             # the first in name order had been fitted, said only of a session: a folder with
             # dirs.lp and a_subset.lp was fitted from the 4 lights of the subset, "good". The
             # way out names the file, the --out being the user's own (this reader has none):
             # "rti-rig fit X.lp --out DIR", pasted, made a folder named DIR
-            shown = ", ".join(p.name for p in lps[:6]) + (" …" if len(lps) > 6 else "")
+            shown = ", ".join(p.relative_to(source).as_posix() for p in lps[:6]) + (
+                " …" if len(lps) > 6 else ""
+            )
             rebuild = (
                 f"; or rebuild the session's own {LP_NAME} from its journal with: rti-rig "
                 f"export-lp {shell_word(str(source))} --out "
@@ -441,6 +446,10 @@ def acquisition_files(
                 f"{rebuild}"
             )
         lp = source / LP_NAME if (source / LP_NAME).is_file() else lps[0]
+        if notes is not None and lp.parent != source:
+            notes.append(
+                f"{shown_path(source)}: fitted from {shown_path(lp)} (RTIBuilder's layout)"
+            )
         if notes is not None and lp.name != LP_NAME and (source / JOURNAL).is_file():
             # a session that lost its lights.lp had been fitted from another .lp in it (one
             # the user exported: a subset, say) without a word

@@ -1,0 +1,83 @@
+"""An RTIBuilder project folder given where an acquisition goes (`fit`, `run`, `check`,
+`bench tradeoff --from`).
+
+RTIBuilder keeps a project's .lp in ``assembly-files/`` and its images in ``jpeg-exports/``;
+the project folder is what a user sees as the acquisition. `fit PROJECT` had said it "holds
+no .lp file", `run PROJECT` and `check PROJECT` named no .lp to give, and `bench tradeoff
+--from PROJECT` said "a folder with no .lp file".
+"""
+
+from __future__ import annotations
+
+import json
+import shlex
+from pathlib import Path
+
+import numpy as np
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+LIGHTS = 8
+
+
+def _project(root: Path) -> Path:
+    """A tiny RTIBuilder project (8 lights, 64x48 JPEGs; the .lp with absolute Windows names,
+    a BOM and CRLF, as RTIBuilder writes it), in a folder whose name has a space; its .lp."""
+    import cv2
+
+    project = root / "icon RTI"
+    (project / "assembly-files").mkdir(parents=True)
+    (project / "jpeg-exports").mkdir()
+    yy, xx = np.mgrid[0:48, 0:64]
+    nx, ny = (xx - 32) / 100, (yy - 24) / 100
+    nz = np.sqrt(1 - nx**2 - ny**2)
+    lines = []
+    for i in range(LIGHTS):
+        az, el = 2 * np.pi * i / LIGHTS, np.radians(20 + 50 * (i % 2))
+        d = (np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el))
+        shade = np.clip(nx * d[0] + ny * d[1] + nz * d[2], 0, 1) * 220
+        name = f"icon_{i + 1:02d}.JPG"
+        assert cv2.imwrite(str(project / "jpeg-exports" / name), np.dstack([shade] * 3))
+        xyz = " ".join(f"{c:.6f}" for c in d)
+        lines.append(f"C:\\RTI\\icon RTI\\jpeg-exports\\{name} {xyz}")
+    lp = project / "assembly-files" / "icon.lp"
+    lp.write_bytes(("\ufeff" + "\r\n".join([str(LIGHTS), *lines]) + "\r\n").encode())
+    return lp
+
+
+def test_fit_of_an_rtibuilder_project_folder_fits_its_assembly_files_lp(tmp_path: Path) -> None:
+    lp = _project(tmp_path)
+    out = tmp_path / "fit"
+    r = runner.invoke(app, ["fit", str(lp.parents[1]), "--out", str(out), "--no-qa", "--model", "ps"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert f"fitted from {lp} (RTIBuilder's layout)" in said
+    assert json.loads((out / "fit.json").read_text())["read"] == f"{LIGHTS} images from {lp}"
+
+
+def test_run_and_check_of_an_rtibuilder_project_folder_name_its_lp_as_a_word_to_paste(
+    tmp_path: Path,
+) -> None:
+    lp = _project(tmp_path)
+    project = str(lp.parents[1])
+    for command in (["run", project, "--out", str(tmp_path / "s")], ["check", project]):
+        r = runner.invoke(app, command)
+        said = " ".join(r.output.split())
+        assert r.exit_code == 2, said
+        assert "its RTIBuilder light list is assembly-files/icon.lp: give " in said, said
+        word = said.rsplit(": give ", 1)[1]
+        assert word.endswith(")"), said
+        assert shlex.split(word[:-1]) == [str(lp)], said
+        assert not (tmp_path / "s").exists()
+
+
+def test_tradeoff_from_an_rtibuilder_project_folder_takes_its_assembly_files_lp(
+    tmp_path: Path,
+) -> None:
+    """Checked on the function `--from` goes through: the trade-off itself takes minutes."""
+    from rti_rig.cli.bench import _acquisition_lp
+
+    lp = _project(tmp_path)
+    assert _acquisition_lp(lp.parents[1]) == lp
