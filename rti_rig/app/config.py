@@ -25,7 +25,7 @@ from rti_rig.core.errors import ConfigError, LpFormatError
 from rti_rig.core.exposure_range import Bound, shared_range
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
 from rti_rig.core.image_files import looks_like_image
-from rti_rig.core.lp_format import lp_files_in, read_lp
+from rti_rig.core.lp_format import acquisition_lp_files, lp_files_in, read_lp
 from rti_rig.core.rig_geometry import (
     COINCIDENT_LED_DEG,
     ArmGeometry,
@@ -33,7 +33,7 @@ from rti_rig.core.rig_geometry import (
     coincident_leds,
     default_led_name,
 )
-from rti_rig.core.shell_words import shown_path
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.core.validation_text import error_text as _error_text
 from rti_rig.core.validation_text import key_of as _key_of
 from rti_rig.drivers.dynamixel.settings import ArmSettings
@@ -845,6 +845,24 @@ def _lps_beside(path: Path) -> list[str]:
         return []
 
 
+def _lps_in_folder_said(folder: Path) -> str:
+    """What to say of the ``.lp`` files of a folder given as the rig: its own, or its
+    ``assembly-files/`` ones (an RTIBuilder project), the one to give as a word that pastes.
+
+    Why: an RTIBuilder project folder had been told only "is a folder", its .lp one folder
+    down not named."""
+    lps = acquisition_lp_files(folder)
+    if not lps:
+        return ""
+    names = ", ".join(p.relative_to(folder).as_posix() for p in lps[:3])
+    more = " ..." if len(lps) > 3 else ""
+    where = "this folder holds" if lps[0].parent == folder else "its RTIBuilder light list is"
+    if len(lps) > 1:
+        where = "this folder holds" if lps[0].parent == folder else "its assembly-files holds"
+        return f" ({where} {names}{more}: give the one that lists this acquisition's images)"
+    return f" ({where} {names}: give {shell_word(lps[0])})"
+
+
 def _not_toml_hint(raw: bytes) -> str:
     """What a text file that is no TOML was given as a rig instead, where that can be told: an
     acquisition's light list saved under another suffix (``lights.txt``), which a rig is read
@@ -868,16 +886,11 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     if path.suffix.lower() == ".lp":
         return load_replay_rig(path)
     if path.is_dir():  # an acquisition's folder, given for its .lp: say which file to give
-        lps = sorted(p.name for p in path.glob("*") if p.suffix.lower() == ".lp")
         raise ConfigError(
             path,
             None,
             "is a folder: give a rig config (.toml) or a recorded acquisition's .lp"
-            + (
-                f" (this folder holds {', '.join(lps[:3])}{' ...' if len(lps) > 3 else ''})"
-                if lps
-                else ""
-            ),
+            + _lps_in_folder_said(path),
         )
     try:
         raw_bytes = path.read_bytes()

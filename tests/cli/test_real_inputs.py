@@ -607,7 +607,9 @@ def test_an_acquisitions_folder_given_as_the_rig_names_its_lp(tmp_path: Path) ->
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "is a folder: give a rig config (.toml) or a recorded acquisition's .lp" in said
-    assert "(this folder holds dirs.lp)" in said and "Traceback" not in r.output
+    assert "(this folder holds dirs.lp: give " in said and "Traceback" not in r.output
+    # the .lp to give, as a word that pastes (it had been named only as 'dirs.lp')
+    assert shlex.split(said.rsplit(": give ", 1)[1].removesuffix(")")) == [str(ACQ / "dirs.lp")]
 
 
 def test_an_image_or_a_light_list_named_txt_given_as_the_rig_says_what_it_is(
