@@ -50,7 +50,9 @@ def _project(root: Path) -> Path:
 def test_fit_of_an_rtibuilder_project_folder_fits_its_assembly_files_lp(tmp_path: Path) -> None:
     lp = _project(tmp_path)
     out = tmp_path / "fit"
-    r = runner.invoke(app, ["fit", str(lp.parents[1]), "--out", str(out), "--no-qa", "--model", "ps"])
+    r = runner.invoke(
+        app, ["fit", str(lp.parents[1]), "--out", str(out), "--no-qa", "--model", "ps"]
+    )
     said = " ".join(r.output.split())
     assert r.exit_code == 0, said
     assert f"fitted from {lp} (RTIBuilder's layout)" in said
