@@ -23,7 +23,12 @@ from rti_rig.core.image_files import (
     tiff_sample_problem,
     tiff_several_images,
 )
-from rti_rig.core.lp_format import LpEntry, image_paths, missing_images_advice
+from rti_rig.core.lp_format import (
+    LpEntry,
+    exports_folder,
+    image_paths,
+    missing_images_advice,
+)
 from rti_rig.core.shell_words import shown_path
 
 
@@ -109,15 +114,19 @@ def check_image_files(
     if missing:
         more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
         shown = ", ".join(missing[:5]) + more
+        lp_dir = Path(lp_path).parent
+        # an RTIBuilder project's others are in its jpeg-exports/: said, and copied, there
+        exports = exports_folder(lp_dir, [paths[n] for n in names if n not in missing])
         problems.append(
             f"{lead}{len(missing)} of {len(names)} image(s) missing in "
-            f"{Path(lp_path).parent} ({shown})"
+            f"{shown_path(exports or lp_dir)} ({shown})"
             + missing_images_advice(
                 missing,
                 [paths[m] for m in missing],
-                Path(lp_path).parent,
+                lp_dir,
                 use,
                 total=len(names),
+                into=exports,
             )
         )
     gone = set(missing)

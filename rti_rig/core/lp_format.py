@@ -359,8 +359,30 @@ def _kin_said(kin: list[str], missing: int) -> str:
     )
 
 
+def exports_folder(lp_dir: Path, found: Sequence[Path]) -> Path | None:
+    """The ``jpeg-exports`` folder that every image ``found`` for an `.lp` in ``lp_dir`` was
+    read from (RTIBuilder's layout: see :func:`image_path`), or None.
+
+    Why: an image missing from such a project had been said to be missing "in" the `.lp`'s
+    ``assembly-files/`` and to be copied there, away from its eleven siblings; any absolute
+    name is looked for in this folder too, so a file copied beside its siblings is found."""
+    folders = {p.parent for p in found}
+    if len(folders) != 1:
+        return None
+    (folder,) = folders
+    lp_dir = Path(lp_dir)
+    exports = (lp_dir / "jpeg-exports", lp_dir.parent / "jpeg-exports")
+    return folder if folder in exports else None
+
+
 def missing_images_advice(
-    names: Sequence[str], paths: Sequence[Path], lp_dir: Path, use: str, *, total: int
+    names: Sequence[str],
+    paths: Sequence[Path],
+    lp_dir: Path,
+    use: str,
+    *,
+    total: int,
+    into: Path | None = None,
 ) -> str:
     """What to say after "N image(s) missing" of the images an `.lp` in ``lp_dir`` lists as
     ``names``, looked for at ``paths`` (:func:`image_path`): where an absolute name is looked
@@ -378,7 +400,11 @@ def missing_images_advice(
     `.lp` and to "copy them where their names point" (which leads only to the "exists at the
     path the .lp names" refusal): it is told to copy them into ``lp_dir``. "Remove their lines
     from the .lp to fit the others" is offered only when there are others (it had been said
-    with every image missing)."""
+    with every image missing).
+
+    ``into``: where an absolute name's file is to be copied, when not ``lp_dir``: the
+    :func:`exports_folder` its siblings were read from."""
+    into = lp_dir if into is None else into
     absolute = [n for n in names if is_absolute_name(n)]
     where = (
         "an absolute name (a path on the machine that wrote the .lp) is looked for by its "
@@ -396,17 +422,17 @@ def missing_images_advice(
         return (
             f"; {which} at the path the .lp names, but an .lp's images are read beside it: "
             f"{where}; "
-            f"copy them into {shown_path(lp_dir)}, or write an .lp whose names are relative to its "
+            f"copy them into {shown_path(into)}, or write an .lp whose names are relative to its "
             "folder"
         )
     if not absolute:
         copy = "copy them where their names point"
     elif len(absolute) == len(names):
-        copy = f"copy them into {shown_path(lp_dir)}"
+        copy = f"copy them into {shown_path(into)}"
     else:  # a relative name may name a subfolder; an absolute one is read by its file name
         copy = (
             "copy them where their names point, an absolute name's file by its file name "
-            f"into {shown_path(lp_dir)}"
+            f"into {shown_path(into)}"
         )
     others = f", or remove their lines from the .lp to {use} the others"
     plain = f"; {copy}{others if len(names) < total else ''}"

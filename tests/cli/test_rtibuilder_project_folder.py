@@ -83,3 +83,23 @@ def test_tradeoff_from_an_rtibuilder_project_folder_takes_its_assembly_files_lp(
 
     lp = _project(tmp_path)
     assert _acquisition_lp(lp.parents[1]) == lp
+
+
+def test_an_image_missing_from_an_rtibuilder_project_is_to_be_copied_beside_its_siblings(
+    tmp_path: Path,
+) -> None:
+    """It had been said "missing in" the .lp's assembly-files/ and to be copied there, away
+    from the others in jpeg-exports/; copied where it is now said to go, it is found."""
+    lp = _project(tmp_path)
+    exports = lp.parents[1] / "jpeg-exports"
+    lost = exports / "icon_05.JPG"
+    kept = lost.read_bytes()
+    lost.unlink()
+    for command in (["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"], ["check", str(lp)]):
+        said = " ".join(runner.invoke(app, command).output.split())
+        assert f"1 of {LIGHTS} image(s) missing in {exports} (" in said, said
+        assert f"copy them into {exports}, or remove their lines" in said, said
+        assert "assembly-files," not in said and "assembly-files (" not in said, said
+    lost.write_bytes(kept)
+    r = runner.invoke(app, ["check", str(lp)])
+    assert r.exit_code == 0 and "RESULT: PASS" in r.output, r.output
