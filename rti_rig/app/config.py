@@ -25,7 +25,7 @@ from rti_rig.core.errors import ConfigError, LpFormatError
 from rti_rig.core.exposure_range import Bound, shared_range
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
 from rti_rig.core.image_files import looks_like_image
-from rti_rig.core.lp_format import acquisition_lp_files, lp_files_in, read_lp
+from rti_rig.core.lp_format import acquisition_lp_files, lp_files_in, lp_name_from, read_lp
 from rti_rig.core.rig_geometry import (
     COINCIDENT_LED_DEG,
     ArmGeometry,
@@ -846,19 +846,21 @@ def _lps_beside(path: Path) -> list[str]:
 
 
 def _lps_in_folder_said(folder: Path) -> str:
-    """What to say of the ``.lp`` files of a folder given as the rig: its own, or its
-    ``assembly-files/`` ones (an RTIBuilder project), the one to give as a word that pastes.
+    """What to say of the ``.lp`` files of a folder given as the rig: its own, or an
+    RTIBuilder project's in ``assembly-files/`` (the project folder, or its ``jpeg-exports``,
+    given), the one to give as a word that pastes.
 
     Why: an RTIBuilder project folder had been told only "is a folder", its .lp one folder
     down not named."""
     lps = acquisition_lp_files(folder)
     if not lps:
         return ""
-    names = ", ".join(p.relative_to(folder).as_posix() for p in lps[:3])
+    names = ", ".join(lp_name_from(folder, p) for p in lps[:3])
     more = " ..." if len(lps) > 3 else ""
-    where = "this folder holds" if lps[0].parent == folder else "its RTIBuilder light list is"
+    own = lps[0].parent == folder
+    where = "this folder holds" if own else "the RTIBuilder project's light list is"
     if len(lps) > 1:
-        where = "this folder holds" if lps[0].parent == folder else "its assembly-files holds"
+        where = "this folder holds" if own else "the RTIBuilder project's assembly-files holds"
         return f" ({where} {names}{more}: give the one that lists this acquisition's images)"
     return f" ({where} {names}: give {shell_word(lps[0])})"
 

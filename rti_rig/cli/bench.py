@@ -128,12 +128,12 @@ def _acquisition_lp(given: Path) -> Path:
                 "images, with the images beside it (or a session folder: its lights.lp)"
             )
         return given
-    from rti_rig.core.lp_format import acquisition_lp_files
+    from rti_rig.core.lp_format import acquisition_lp_files, lp_name_from
 
     found = acquisition_lp_files(given)  # an RTIBuilder project's in its assembly-files/
     if len(found) == 1:
         return found[0]
-    names = ", ".join(p.relative_to(given).as_posix() for p in found[:5])
+    names = ", ".join(lp_name_from(given, p) for p in found[:5])
     raise RtiRigError(
         f"--from {given}: a folder with "
         + (

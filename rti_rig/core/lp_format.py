@@ -27,6 +27,7 @@ from __future__ import annotations
 import codecs
 import contextlib
 import math
+import os
 import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -131,12 +132,25 @@ ASSEMBLY_FILES = "assembly-files"
 
 def acquisition_lp_files(folder: Path) -> list[Path]:
     """The ``.lp`` files of a folder given as an acquisition: its own (:func:`lp_files_in`),
-    or, where it holds none, those of its ``assembly-files/`` subfolder (RTIBuilder's project
-    layout, the project folder being what a user sees as the acquisition).
+    or, where it holds none, those of RTIBuilder's ``assembly-files/``: the folder's own
+    (the project folder, what a user sees as the acquisition) or, for a ``jpeg-exports``
+    folder (the project's images), the one beside it.
 
     Why: ``fit PROJECT`` and ``bench tradeoff --from PROJECT`` had said the project "holds no
     .lp file", and ``run PROJECT`` named none, where RTIBuilder had put it one folder down."""
-    return lp_files_in(folder) or lp_files_in(Path(folder) / ASSEMBLY_FILES)
+    folder = Path(folder)
+    own = lp_files_in(folder)
+    if own:
+        return own
+    if folder.name.casefold() == "jpeg-exports":
+        return lp_files_in(folder.parent / ASSEMBLY_FILES)
+    return lp_files_in(folder / ASSEMBLY_FILES)
+
+
+def lp_name_from(folder: Path, lp: Path) -> str:
+    """``lp`` (:func:`acquisition_lp_files`) as named from ``folder``: ``dirs.lp``,
+    ``assembly-files/proj.lp`` or ``../assembly-files/proj.lp``."""
+    return Path(os.path.relpath(lp, folder)).as_posix()
 
 
 def is_absolute_name(name: str) -> bool:

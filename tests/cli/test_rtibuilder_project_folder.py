@@ -1,10 +1,11 @@
-"""An RTIBuilder project folder given where an acquisition goes (`fit`, `run`, `check`,
-`bench tradeoff --from`).
+"""An RTIBuilder project folder (or its jpeg-exports) given where an acquisition goes (`fit`,
+`run`, `check`, `bench tradeoff --from`).
 
 RTIBuilder keeps a project's .lp in ``assembly-files/`` and its images in ``jpeg-exports/``;
 the project folder is what a user sees as the acquisition. `fit PROJECT` had said it "holds
 no .lp file", `run PROJECT` and `check PROJECT` named no .lp to give, and `bench tradeoff
---from PROJECT` said "a folder with no .lp file".
+--from PROJECT` said "a folder with no .lp file"; and so of its jpeg-exports folder, where a
+user sees the images.
 """
 
 from __future__ import annotations
@@ -14,12 +15,15 @@ import shlex
 from pathlib import Path
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 
 runner = CliRunner()
 LIGHTS = 8
+#: the folders of a project a user may give for the acquisition: the project, its images
+GIVEN = pytest.mark.parametrize("given", [".", "jpeg-exports"])
 
 
 def _project(root: Path) -> Path:
@@ -47,42 +51,47 @@ def _project(root: Path) -> Path:
     return lp
 
 
-def test_fit_of_an_rtibuilder_project_folder_fits_its_assembly_files_lp(tmp_path: Path) -> None:
+@GIVEN
+def test_fit_of_an_rtibuilder_project_folder_fits_its_assembly_files_lp(
+    tmp_path: Path, given: str
+) -> None:
     lp = _project(tmp_path)
     out = tmp_path / "fit"
-    r = runner.invoke(
-        app, ["fit", str(lp.parents[1]), "--out", str(out), "--no-qa", "--model", "ps"]
-    )
+    folder = str(lp.parents[1] / given)
+    r = runner.invoke(app, ["fit", folder, "--out", str(out), "--no-qa", "--model", "ps"])
     said = " ".join(r.output.split())
     assert r.exit_code == 0, said
     assert f"fitted from {lp} (RTIBuilder's layout)" in said
     assert json.loads((out / "fit.json").read_text())["read"] == f"{LIGHTS} images from {lp}"
 
 
+@GIVEN
 def test_run_and_check_of_an_rtibuilder_project_folder_name_its_lp_as_a_word_to_paste(
-    tmp_path: Path,
+    tmp_path: Path, given: str
 ) -> None:
     lp = _project(tmp_path)
-    project = str(lp.parents[1])
+    project = str(lp.parents[1] / given)
+    named = "assembly-files/icon.lp" if given == "." else "../assembly-files/icon.lp"
     for command in (["run", project, "--out", str(tmp_path / "s")], ["check", project]):
         r = runner.invoke(app, command)
         said = " ".join(r.output.split())
         assert r.exit_code == 2, said
-        assert "its RTIBuilder light list is assembly-files/icon.lp: give " in said, said
+        assert f"the RTIBuilder project's light list is {named}: give " in said, said
         word = said.rsplit(": give ", 1)[1]
         assert word.endswith(")"), said
         assert shlex.split(word[:-1]) == [str(lp)], said
         assert not (tmp_path / "s").exists()
 
 
+@GIVEN
 def test_tradeoff_from_an_rtibuilder_project_folder_takes_its_assembly_files_lp(
-    tmp_path: Path,
+    tmp_path: Path, given: str
 ) -> None:
     """Checked on the function `--from` goes through: the trade-off itself takes minutes."""
     from rti_rig.cli.bench import _acquisition_lp
 
     lp = _project(tmp_path)
-    assert _acquisition_lp(lp.parents[1]) == lp
+    assert _acquisition_lp(lp.parents[1] / given).resolve() == lp.resolve()
 
 
 def test_an_image_missing_from_an_rtibuilder_project_is_to_be_copied_beside_its_siblings(

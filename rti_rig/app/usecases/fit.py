@@ -56,6 +56,7 @@ from rti_rig.core.lp_format import (
     image_file_name,
     image_paths,
     lp_files_in,
+    lp_name_from,
     parse_lp,
     read_lp,
 )
@@ -429,7 +430,7 @@ def acquisition_files(
             # dirs.lp and a_subset.lp was fitted from the 4 lights of the subset, "good". The
             # way out names the file, the --out being the user's own (this reader has none):
             # "rti-rig fit X.lp --out DIR", pasted, made a folder named DIR
-            shown = ", ".join(p.relative_to(source).as_posix() for p in lps[:6]) + (
+            shown = ", ".join(lp_name_from(source, p) for p in lps[:6]) + (
                 " …" if len(lps) > 6 else ""
             )
             rebuild = (
