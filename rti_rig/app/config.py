@@ -1539,7 +1539,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     found = check_acquisition_images(
         lp_path,
         entries,
-        lead="as a rig, an .lp is a recorded acquisition whose images lie beside it: ",
+        lead="as a rig, an .lp is a recorded acquisition, replayed from the images it lists: ",
     )
     # their readers drop a PNG's alpha: said once, among the rig's notes (run, check)
     notes.extend(png_alpha_note([e.name for e in entries], found.paths))

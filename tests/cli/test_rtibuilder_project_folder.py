@@ -104,11 +104,18 @@ def test_an_image_missing_from_an_rtibuilder_project_is_to_be_copied_beside_its_
     lost = exports / "icon_05.JPG"
     kept = lost.read_bytes()
     lost.unlink()
-    for command in (["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"], ["check", str(lp)]):
+    for command in (
+        ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"],
+        ["check", str(lp)],
+        ["run", str(lp), "--out", str(tmp_path / "s")],
+    ):
         said = " ".join(runner.invoke(app, command).output.split())
         assert f"1 of {LIGHTS} image(s) missing in {exports} (" in said, said
         assert f"copy them into {exports}, or remove their lines" in said, said
         assert "assembly-files," not in said and "assembly-files (" not in said, said
+        # nor "an .lp is a recorded acquisition whose images lie beside it" (run, check)
+        assert "beside it:" not in said, said
+    assert not (tmp_path / "s").exists()
     lost.write_bytes(kept)
     r = runner.invoke(app, ["check", str(lp)])
     assert r.exit_code == 0 and "RESULT: PASS" in r.output, r.output
