@@ -119,3 +119,16 @@ def test_an_image_missing_from_an_rtibuilder_project_is_to_be_copied_beside_its_
     lost.write_bytes(kept)
     r = runner.invoke(app, ["check", str(lp)])
     assert r.exit_code == 0 and "RESULT: PASS" in r.output, r.output
+
+
+def test_fit_of_images_without_an_lp_says_what_to_give(tmp_path: Path) -> None:
+    """A folder of images alone (jpeg-exports copied without its project) had been told only
+    that it "holds no .lp file: not a session folder"."""
+    lp = _project(tmp_path)
+    images = (lp.parents[1] / "jpeg-exports").rename(tmp_path / "images")
+    r = runner.invoke(app, ["fit", str(images), "--out", str(tmp_path / "f")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert f"{images} holds no .lp file: not a session folder; give a session folder" in said
+    assert "the .lp that lists the images with their lights" in said, said
+    assert not (tmp_path / "f").exists()

@@ -424,7 +424,12 @@ def acquisition_files(
                 )
             lps = acquisition_lp_files(source)  # an RTIBuilder project: its assembly-files/
             if not lps:
-                raise FitInputError(f"{shown_path(source)} holds no .lp file: not a session folder")
+                # what to give said (a folder of images alone had been told only what it is not)
+                raise FitInputError(
+                    f"{shown_path(source)} holds no .lp file: not a session folder; give a "
+                    "session folder, or the .lp that lists the images with their lights (a "
+                    "count line, then 'name x y z' per image)"
+                )
         if not (source / LP_NAME).is_file() and len(lps) > 1:
             # the first in name order had been fitted, said only of a session: a folder with
             # dirs.lp and a_subset.lp was fitted from the 4 lights of the subset, "good". The
