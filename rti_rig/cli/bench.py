@@ -124,8 +124,9 @@ def _acquisition_lp(given: Path) -> Path:
     if not given.is_dir():
         if given.exists() and given.suffix.lower() != ".lp":
             raise RtiRigError(
-                f"--from {given}: not an .lp file; give the .lp that lists the acquisition's "
-                "images, with the images beside it (or a session folder: its lights.lp)"
+                f"--from {shown_path(given)}: not an .lp file; give the .lp that lists the "
+                "acquisition's images, with the images beside it (or a session folder: its "
+                "lights.lp)"
             )
         return given
     from rti_rig.core.lp_format import acquisition_lp_files, lp_name_from
@@ -135,7 +136,7 @@ def _acquisition_lp(given: Path) -> Path:
         return found[0]
     names = ", ".join(lp_name_from(given, p) for p in found[:5])
     raise RtiRigError(
-        f"--from {given}: a folder with "
+        f"--from {shown_path(given)}: a folder with "
         + (
             f"{len(found)} .lp files ({names}" + (", …)" if len(found) > 5 else ")")
             if found

@@ -140,3 +140,15 @@ def test_a_calibration_written_into_such_a_card_session_says_how_to_give_it_to_t
     assert b"not UTF-8 text, which a TOML file cannot hold" in said, r.stderr
     assert pasted(WORD.match(said)[0]) == os.fsencode(target), r.stderr
     assert pasted(WORD.match(said.split(b"(cp ", 1)[1])[0]) == os.fsencode(target), r.stderr
+
+
+def test_tradeoff_from_a_folder_with_no_lp_names_it_as_on_disk(odd: Path) -> None:
+    """`bench tradeoff --from` had said the folder as Python's escape ('caf\\udce9'), which no
+    shell reads back as the folder."""
+    r = rti_rig("bench", "tradeoff", "--from", odd)
+    assert r.returncode == 2, r.stderr
+    said = r.stderr + r.stdout
+    assert b"a folder with no .lp file" in said, said
+    assert said.startswith(b"error: --from $'"), said
+    word = WORD.match(said, len(b"error: --from "))
+    assert word is not None and pasted(word[0]) == os.fsencode(odd), said
