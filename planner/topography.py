@@ -25,6 +25,7 @@ would otherwise cost seconds.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -109,7 +110,7 @@ def read_preview(path: Path) -> NDArray:
     tiff = _read_tiff_preview(p)
     if tiff is not None:
         return tiff
-    img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
+    img = cv2.imread(os.fsencode(p), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise ScheduleError(
             f"{shown_path(p)}: cannot read this file as an image (JPEG, PNG or TIFF)"

@@ -20,6 +20,7 @@ specular lobe and the flat plate pays for neither shadows nor specular.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -588,7 +589,7 @@ def _read_map(path: Path) -> NDArray:
 
             data = tifffile.imread(path)
         else:
-            data = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+            data = cv2.imread(os.fsencode(path), cv2.IMREAD_UNCHANGED)
             if data is None:
                 raise SceneError(
                     f"{shown_path(path)}: not an image OpenCV can read (try .npy, .tif, .png)"

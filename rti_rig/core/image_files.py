@@ -635,7 +635,7 @@ def read_jpeg_rgb(path: Path) -> NDArray[np.uint8]:
 
     if Path(path).is_file():
         refuse_truncated_jpeg(path)  # before OpenCV, which decodes it with a grey part
-    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    img = cv2.imread(os.fsencode(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(f"cannot read image {shown_path(path)}")
     return img[..., ::-1] if img.ndim == 3 else img
@@ -720,7 +720,7 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
     if not p.is_file():  # said here, before OpenCV prints its own warning line about it
         raise SessionError(f"cannot read image {shown_path(p)}: there is no such file")
     refuse_truncated_jpeg(p)  # before OpenCV, which decodes it with a grey part
-    img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
+    img = cv2.imread(os.fsencode(p), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(
             f"cannot read image {shown_path(p)} (missing, or not an image OpenCV decodes)"

@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import json
 import mmap
+import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -304,7 +305,7 @@ def write_normal_map(stem: Path, normals: NDArray[Any], npy: bool = True) -> lis
             np.round((n[..., ::-1] + 1.0) * 0.5 * 65535.0), 0, 65535
         )
         _drop_pages(normals)
-    if not cv2.imwrite(str(png), enc):
+    if not cv2.imwrite(os.fsencode(png), enc):
         raise ReconstructionError(f"could not write {png}")
     path = stem.with_suffix(".npy")
     if npy:
@@ -324,7 +325,7 @@ def write_albedo(
             a = a[..., ::-1]
         enc[top : top + ENCODE_ROWS] = np.clip(np.round(a / white * 65535.0), 0, 65535)
         _drop_pages(albedo)
-    if not cv2.imwrite(str(png), enc):
+    if not cv2.imwrite(os.fsencode(png), enc):
         raise ReconstructionError(f"could not write {png}")
     path = stem.with_suffix(".npy")
     if npy:

@@ -1449,7 +1449,7 @@ def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
         cv2.COLORMAP_VIRIDIS,
     )
     cov_img[qa.coverage < 3] = (0, 0, 255)
-    if not cv2.imwrite(str(out / "qa_coverage.png"), cov_img):
+    if not cv2.imwrite(os.fsencode(out / "qa_coverage.png"), cov_img):
         # OpenCV says a failed write only by its return value: unchecked, qa.html showed a
         # map that was never written (a full disk, a folder that turned read-only)
         raise RtiRigError(

@@ -18,6 +18,7 @@ ordinary way, which tells the two apart (None on failure). Where the overload do
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import cv2
@@ -58,7 +59,7 @@ def imread_into(path: Path, buffer: np.ndarray) -> np.ndarray | None:
     canary = np.invert(buffer[-1])
     buffer[-1] = canary
     try:
-        img = cv2.imread(str(path), buffer, cv2.IMREAD_UNCHANGED)
+        img = cv2.imread(os.fsencode(path), buffer, cv2.IMREAD_UNCHANGED)
     except (cv2.error, TypeError):  # OpenCV < 4.10: no decoding into a given array
         return _imread(path)
     if img is None or img.size == 0:
@@ -69,5 +70,5 @@ def imread_into(path: Path, buffer: np.ndarray) -> np.ndarray | None:
 
 
 def _imread(path: Path) -> np.ndarray | None:
-    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    img = cv2.imread(os.fsencode(path), cv2.IMREAD_UNCHANGED)
     return None if img is None or img.size == 0 else img
