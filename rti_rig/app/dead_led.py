@@ -17,7 +17,8 @@ from typing import Any
 from rti_rig.core.dome_link import DomeLedError, DomeLinkError, LinkFault
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import free_folder_beside, free_name
-from rti_rig.core.shell_words import shell_word, shown_path
+from rti_rig.core.rig_geometry import led_said
+from rti_rig.core.shell_words import shell_word
 from rti_rig.drivers.led_dome.messages import ERR_LED_FAULT
 
 
@@ -65,8 +66,10 @@ def dead_led_advice(
     a plan of a few lights offered in the session's place."""
     dome = loaded.config.dome
     cfg = shell_word(str(loaded.path))
-    names = _led_names(loaded)
-    which = f"LED {led} ({names[led]})" if 0 <= led < len(names) else f"LED {led}"
+    directions, names = _dome_leds(loaded)
+    # by its number and direction ("LED 36 (az 112.5°, el 55.0°)"): a ring dome's LED had
+    # been said "LED 36 (led_036)", the id its plans and manifests keep
+    which = led_said(led, directions[led], names[led]) if 0 <= led < len(names) else f"LED {led}"
     leds = {s.led for s in schedule.steps}
     repaired = (
         f"that LED or its wiring is repaired, continue with: rti-rig run --resume "
@@ -79,8 +82,8 @@ def dead_led_advice(
     plan_lp = shell_word(str(free_name(base.with_name(f"{base.name}-without-led-{led}.lp"))))
     new_dir = shell_word(str(free_folder_beside(base, f"without-led-{led}")))
     rig_lp = (
-        f"copy {shown_path(loaded.folder / dome.lp_file)} (the rig's LED .lp) without the line "
-        f"of {which}, the count on its first line one less, as {plan_lp}"
+        f"copy {shell_word(str(loaded.folder / dome.lp_file))} (the rig's LED .lp) without the "
+        f"line of {which}, the count on its first line one less, as {plan_lp}"
         if dome is not None and dome.lp_file
         else None
     )
@@ -164,11 +167,12 @@ def _holds(path: Path, text: str) -> bool:
         return False
 
 
-def _led_names(loaded: Any) -> tuple[str, ...]:
-    """The dome's LED names (``.lp`` labels), empty where they cannot be read."""
+def _dome_leds(loaded: Any) -> tuple[Any, list[str]]:
+    """The dome's LED directions and names, none where they cannot be read (advice only: an
+    LED is then said by its number alone)."""
     from rti_rig.app.config import dome_led_directions
 
     try:
-        return tuple(dome_led_directions(loaded)[1])
-    except RtiRigError:  # advice only: an LED said by its number alone
-        return ()
+        return dome_led_directions(loaded)
+    except RtiRigError:
+        return (), []

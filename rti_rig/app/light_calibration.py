@@ -34,6 +34,7 @@ from rti_rig.app.config import CALIBRATION_FORMAT as FORMAT
 from rti_rig.app.dead_led import dead_led_recorded
 from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.core.toml_strings import toml_basic_string
 from rti_rig.planner.topography import downsample
@@ -522,11 +523,11 @@ def evened_sentence(cal: LightCalibration, digits: int) -> str:
 
 
 def calibration_toml(
-    cal: LightCalibration, rig_name: str, session: Path, names: Sequence[str]
+    cal: LightCalibration, rig_name: str, session: Path, dome: DomeGeometry
 ) -> str:
     """The calibration file: the correction list plus the evidence, as commented TOML.
 
-    ``names`` are the dome's LED names (from its config or ``.lp``), for the comments.
+    ``dome`` names the weakest LED in the comments, by its number and direction.
     """
     created = datetime.now(UTC).isoformat(timespec="seconds")
     weakest = int(np.argmin(cal.output))
@@ -546,8 +547,9 @@ def calibration_toml(
         "# then shoot the card again and calibrate that session: its spread is what is left.",
         f"# Measured {int(cal.measured.sum())} of {len(cal.output)} LEDs; the unmeasured ones "
         "are assumed to give the median LED's light under the correction in force.",
-        f"# Spread of the lights as shot (RMS of ln gain): {cal.shot_spread:.3f}; weakest LED "
-        f"{weakest} ({names[weakest]}) at {cal.output[weakest]:.3f} of the median.",
+        f"# Spread of the lights as shot (RMS of ln gain): {cal.shot_spread:.3f}; weakest "
+        f"{dome.led_said(weakest)} at "
+        f"{cal.output[weakest]:.3f} of the median.",
         f"# {evened_sentence(cal, 3)}.",
         f'format = "{FORMAT}"',
         f"rig = {toml_basic_string(rig_name)}",

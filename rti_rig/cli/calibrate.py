@@ -232,13 +232,13 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
     # is assumed at its old figure, and had been named as if measured ("is still 0.74 to 1.57
     # (LED 38)" from a card session of 12 LEDs without LED 38)
     low, high = (int(measured[f(cal.output[measured])]) for f in (np.argmin, np.argmax))
-    names = geometry.names
     each = "each LED" if cal.measured.all() else "each measured LED"
 
     def led(i: int) -> str:
-        """An LED as the dome names it and as the session shot it (the image to open)."""
+        """An LED by its number and direction (a ring dome's had been said by its id,
+        "LED 36, led_036") and as the session shot it (the image to open)."""
         shot = card.image_of.get(i)
-        return f"LED {i}, {names[i]}" + (f", session image {shot}" if shot else "")
+        return geometry.led_fields(i) + (f", session image {shot}" if shot else "")
 
     out.print(
         f"Card session {escape(shown_path(card_session))}: {len(card.leds)} images of rig "
@@ -272,7 +272,7 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
         )
     out.print(evened_sentence(cal, 2) + ".")
     if not cal.measured.all():
-        skipped = ", ".join(names[i] for i in np.flatnonzero(~cal.measured))
+        skipped = "; ".join(geometry.led_said(int(i)) for i in np.flatnonzero(~cal.measured))
         err.print(
             f"[yellow]note:[/] not measured (not in the session, or lower than "
             f"{request.min_elevation_deg:g}° above the card), assumed to give the median light "

@@ -69,6 +69,33 @@ def default_led_name(index: int) -> str:
     return f"led_{index:03d}"
 
 
+def direction_said(direction: ArrayLike) -> str:
+    """Where a light comes from, as every word to a user says it: ``az 112.5°, el 55.0°``
+    (one decimal: a dome's LEDs are degrees apart, an arm's ticks a tenth of one)."""
+    az, el = (float(v) for v in az_el_from_direction(np.asarray(direction, dtype=np.float64)))
+    return f"az {az:.1f}°, el {el:.1f}°"
+
+
+def led_fields(index: int, direction: ArrayLike, name: str | None = None) -> str:
+    """Dome LED ``index`` as a list inside the caller's own parentheses:
+    ``LED 36, az 112.5°, el 55.0°``. A name the user gave it (a dome ``.lp``'s image name) is
+    said beside the number (``LED 36, led_36.jpg, az …``); the dome's own id for it
+    (:func:`default_led_name`, ``led_036``) is not, as it names nothing the user wrote."""
+    given = f", {name}" if name and name != default_led_name(index) else ""
+    return f"LED {index}{given}, {direction_said(direction)}"
+
+
+def led_said(index: int, direction: ArrayLike, name: str | None = None) -> str:
+    """Dome LED ``index`` as a user is told of it: ``LED 36 (az 112.5°, el 55.0°)``, or
+    ``LED 36 (led_36.jpg, az 112.5°, el 55.0°)`` with a name the user gave it.
+
+    Why: words had named a ring dome's LED "LED 36 (led_036)", the id the dome keeps in plans
+    and manifests, which tells the user nothing about which LED to look at; its direction
+    does (the preview's note and a refused step already said it so)."""
+    number, _, rest = led_fields(index, direction, name).partition(", ")
+    return f"{number} ({rest})"
+
+
 @dataclass(frozen=True, eq=False)
 class DomeGeometry:
     """A dome: LED ``i`` lights from ``directions[i]`` and is called ``names[i]``."""
@@ -87,6 +114,14 @@ class DomeGeometry:
     @property
     def count(self) -> int:
         return len(self.directions)
+
+    def led_said(self, index: int) -> str:
+        """LED ``index`` as words say it (:func:`led_said`): its number and direction."""
+        return led_said(index, self.directions[index], self.names[index])
+
+    def led_fields(self, index: int) -> str:
+        """LED ``index`` as a list inside the caller's parentheses (:func:`led_fields`)."""
+        return led_fields(index, self.directions[index], self.names[index])
 
     def nearest_led(self, direction: ArrayLike) -> tuple[int, float]:
         """Index of the LED closest to ``direction`` and the angle to it in degrees."""

@@ -26,9 +26,8 @@ from rti_rig.core.devices import (
 )
 from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
-from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.lp_format import MAX_LIGHTS
-from rti_rig.core.rig_geometry import default_led_name
+from rti_rig.core.rig_geometry import led_fields
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.core.shell_words import shown_path
 from rti_rig.runtime.lighting import ArmLighting, Lighting, port_close_failures
@@ -522,9 +521,7 @@ def _step_named(step: LightStep) -> str:
     name the user gave (a dome ``.lp``'s image name) is still said beside the number."""
     if step.led is None:
         return f" ({step.label})" if step.label else ""
-    az, el = (float(v) for v in az_el_from_direction(step.direction))
-    given = f", {step.label}" if step.label and step.label != default_led_name(step.led) else ""
-    return f" (LED {step.led}{given}, az {az:.1f}°, el {el:.1f}°)"
+    return f" ({led_fields(step.led, step.direction, step.label)})"
 
 
 def frame_layout(frame: Frame) -> tuple[int, int, bool]:

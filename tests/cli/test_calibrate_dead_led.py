@@ -38,7 +38,9 @@ def test_a_dead_led_is_named_and_the_advice_calibrates_the_others(tmp_path: Path
 
     assert r.exit_code == 2, r.output
     text = said(r)
-    assert f"LED {DEAD} (led_{DEAD}.jpg, session image image_{DEAD + 1:03d}.jpg)" in text, text
+    image = f"image_{DEAD + 1:03d}.jpg"
+    said_as = f"LED {DEAD} (led_{DEAD}.jpg, az 254.4°, el 25.2°, session image {image})"
+    assert said_as in text, text
     assert "drop its image" not in text and "Traceback" not in r.output
     # real names beside the card, not there yet (PLAN.lp and NEW_CARD had been said, and no
     # calibrate command): the plan written as said, the two commands then run as printed
@@ -88,7 +90,7 @@ def test_a_card_session_stopped_at_a_dead_led_says_how_to_shoot_the_others(
     text = said(r)
     assert "continue it with rti-rig run --resume" not in text, text
     assert f"stopped at an LED after {DEAD} of 48 images" in text, text
-    assert f"without the line of LED {DEAD} (led_{DEAD}.jpg)" in text, text
+    assert f"without the line of LED {DEAD} (led_{DEAD}.jpg, az 254.4°, el 25.2°)" in text, text
     plan, again = tmp_path / f"card-without-led-{DEAD}.lp", tmp_path / f"card-without-led-{DEAD}"
     shoot = f"rti-rig run {cfg} --plan {plan} --out {again}"
     calibrate = f"rti-rig calibrate-lights {again} --rig {cfg}"

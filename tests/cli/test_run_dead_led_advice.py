@@ -36,7 +36,8 @@ def test_a_stop_at_a_dead_led_advises_a_plan_without_it_that_works(tmp_path: Pat
     assert r.exit_code == 2, text
     assert f"LED {DEAD} refused" in text and "LED fault" in text, text
     assert "Continue with: rti-rig run --resume" not in text, text
-    assert f"A resume lights LED {DEAD} (led_0{DEAD}.jpg) first and stops there again" in text
+    assert f"A resume lights LED {DEAD} (led_0{DEAD}.jpg, az " in text, text
+    assert "°) first and stops there again" in text, text
     assert f"continue with: rti-rig run --resume {s}" in text, text  # once repaired
 
     # the advice, followed as written: the rig's LED .lp it names, without that LED's line

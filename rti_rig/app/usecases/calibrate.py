@@ -9,7 +9,6 @@ input and the output are checked, and a card session's own calibration file is n
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -96,7 +95,7 @@ def _check_dome_can_dim(req: CalibrateRequest, loaded: LoadedRig) -> None:
 
 
 def _dead_led_advice(
-    req: CalibrateRequest, card: CardSession, names: Sequence[str], exc: DeadLightError
+    req: CalibrateRequest, card: CardSession, geometry: DomeGeometry, exc: DeadLightError
 ) -> str:
     """A dark card image named as the LED and session image it is, with what can be done.
 
@@ -107,10 +106,12 @@ def _dead_led_advice(
     the session's own lights.lp without that line) is what calibrates the rest."""
     led = int(card.leds[exc.light])
     image = card.image_of.get(led, f"image {exc.light + 1}")
-    name = names[led] if 0 <= led < len(names) else f"LED {led}"
+    # its number and direction, the image to open beside them
+    said = geometry.led_fields(led) if 0 <= led < geometry.count else f"LED {led}"
+    number, _, rest = f"{said}, ".partition(", ")
     session_lp = shell_word(str(Path(req.card_session) / "lights.lp"))
     return (
-        f"{shown_path(req.card_session)}: LED {led} ({name}, session image {image}) gave "
+        f"{shown_path(req.card_session)}: {number} ({rest}session image {image}) gave "
         f"{exc.gain:.3f} of the median LED's light: a dead LED (or a black frame), which no "
         "correction can even out. Check that LED and its wiring, then shoot the card again; to "
         "calibrate the other LEDs meanwhile, shoot the card under all but it: copy "
@@ -276,10 +277,11 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     try:
         card = read_card_session(req.card_session, rig_name=loaded.config.name)
     except CardStoppedAtLedError as exc:
-        names = rig_geometry(loaded).names
         which = (
-            f"LED {exc.led} ({names[exc.led]})"
-            if exc.led is not None and 0 <= exc.led < len(names)
+            geometry.led_said(exc.led)
+            if isinstance(geometry, DomeGeometry)
+            and exc.led is not None
+            and 0 <= exc.led < geometry.count
             else "that LED"
         )
         raise RtiRigError(f"{exc}. {_without_led(req, loaded, which, exc.led)}") from None
@@ -310,8 +312,8 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             min_elevation_deg=req.min_elevation_deg,
         )
     except DeadLightError as exc:
-        raise RtiRigError(_dead_led_advice(req, card, geometry.names, exc)) from None
-    text = calibration_toml(cal, loaded.config.name, req.card_session.resolve(), geometry.names)
+        raise RtiRigError(_dead_led_advice(req, card, geometry, exc)) from None
+    text = calibration_toml(cal, loaded.config.name, req.card_session.resolve(), geometry)
     # atomically: a write cut off (a full disk, a Ctrl-C) had left a partial file under the
     # name, and a card session's own light_calibration.toml is never replaced, so every later
     # calibrate-lights of the session was refused as "calibrated already"
