@@ -15,6 +15,7 @@ from rti_rig.core.errors import ScheduleError
 from rti_rig.core.lp_format import LpEntry
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule
+from rti_rig.core.shell_words import shown_path
 
 #: Plan directions farther than this from every LED are not that dome's LEDs.
 SNAP_TOLERANCE_DEG = 1.0
@@ -28,13 +29,15 @@ def schedule_from_lp(
 ) -> LightSchedule:
     """The schedule an `.lp` plan describes on this rig, in the plan's order."""
     dirs = np.array([e.direction for e in entries], dtype=np.float64)
-    prov = {"plan_file": source}
+    prov = {"plan_file": source}  # as on disk, for the manifest
+    # as the user pastes it: a name that is not UTF-8 (or unprintable here) as its bytes
+    named = shown_path(source)
     if isinstance(geometry, ArmGeometry):
         for i, (e, d) in enumerate(zip(entries, dirs, strict=True)):
             reason = geometry.unreachable_reason(d)
             if reason:  # what to do, as a dome's refusal says it (it had said only why)
                 raise ScheduleError(
-                    f"{source}, light {i + 1} ({e.name}): {reason}; the plan was made for "
+                    f"{named}, light {i + 1} ({e.name}): {reason}; the plan was made for "
                     "another rig — replan with --rig for this arm"
                 )
         return LightSchedule.from_directions(
@@ -46,14 +49,14 @@ def schedule_from_lp(
         led, off = geometry.nearest_led(d)
         if off > tolerance_deg:
             raise ScheduleError(
-                f"{source}, light {i + 1} ({e.name}): no LED of this dome within "
-                f"{tolerance_deg:g}° (nearest is LED {led}, {off:.2f}° away); the plan was "
-                "made for another dome — replan with --rig for this one"
+                f"{named}, light {i + 1} ({e.name}): no LED of this dome within "
+                f"{tolerance_deg:g}° (nearest is {geometry.led_said(led)}, {off:.2f}° away); "
+                "the plan was made for another dome — replan with --rig for this one"
             )
         if led in used:
             raise ScheduleError(
-                f"{source}, light {i + 1} ({e.name}): LED {led} is already used by light "
-                f"{used[led] + 1}; a plan fires each LED once"
+                f"{named}, light {i + 1} ({e.name}): {geometry.led_said(led)} is already used by "
+                f"light {used[led] + 1}; a plan fires each LED once"
             )
         used[led] = i
         leds.append(led)

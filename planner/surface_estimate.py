@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import ScheduleError
+from rti_rig.core.shell_words import shown_path
 from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.normals import (
     ReliefFit,
@@ -124,7 +125,7 @@ def estimate_surface(
             origin, why_zenith = LightOrigin.ZENITH_ASSUMED, est.why_zenith
     if depth_model is not None:
         raw = depth_from_onnx(preview, Path(depth_model), depth_spec, out_shape=image.shape)
-        source = f"depth model {Path(depth_model).name}"
+        source = f"depth model {shown_path(Path(depth_model).name)}"
         height, bad = sanitize_height(raw, source)
     else:
         height, bad = shape_from_shading(image, light, albedo), 0

@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from rti_rig.core.errors import ConfigError
+from rti_rig.core.shell_words import shown_path
 from rti_rig.drivers.led_dome.driver import LedDomeDriver
 from rti_rig.drivers.led_dome.profiles import make_codec
 from rti_rig.drivers.led_dome.protocol_spec import MissingSection, ProtocolSpec, parse_led_map
@@ -32,7 +33,8 @@ def protocol_for(settings: DomeSerialSettings) -> ProtocolSpec:
                 str(path), "dome.serial.led_map_file", f"cannot read it: {exc.strerror or exc}"
             ) from None
         try:
-            led_map = parse_led_map(text, settings.led_map_section, str(path))
+            # named in its errors as the user pastes it (a name not UTF-8 as its bytes)
+            led_map = parse_led_map(text, settings.led_map_section, shown_path(path))
             return settings.protocol_spec(led_map)
         except MissingSection:
             raise  # the rig config's led_map_section is at fault: its loader names that key

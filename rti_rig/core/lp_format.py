@@ -685,7 +685,7 @@ def parse_lp(
         # ending in three numbers would have been read as a light)
         content = [(n, ln) for n, ln in content if not ln.startswith("#")]
         notes.append(
-            f"{source}, line{'s' if len(comments) > 1 else ''} "
+            f"{shown_path(source)}, line{'s' if len(comments) > 1 else ''} "
             f"{', '.join(map(str, comments[:5]))}{' ...' if len(comments) > 5 else ''}: "
             "comment line(s) starting with '#' skipped"
         )
@@ -757,8 +757,8 @@ def parse_lp(
         if upper_hemisphere and -HORIZON_TOLERANCE < z / norm < -1e-9:
             flat = math.hypot(x, y)
             notes.append(
-                f"{source}, line {lineno}: light z = {z / norm:.4f} is a hair below the object "
-                f"plane (calibration noise at the horizon?); clamped to z = 0"
+                f"{shown_path(source)}, line {lineno}: light z = {z / norm:.4f} is a hair below "
+                "the object plane (calibration noise at the horizon?); clamped to z = 0"
             )
             x, y, z, norm = x / flat, y / flat, 0.0, 1.0
         if upper_hemisphere and z / norm < -1e-9:
@@ -789,7 +789,7 @@ def parse_lp(
         # one length when they all print alike: a file scaled by 3 had been told "length 3–3"
         span = shortest if shortest == longest else f"{shortest}–{longest}"
         notes.append(
-            f"{source}, line {off_unit[0][0]}"
+            f"{shown_path(source)}, line {off_unit[0][0]}"
             + (f" and {len(off_unit) - 1} more" if len(off_unit) > 1 else "")
             + f": light vector length {span}"
             + ", not 1; read as directions (normalised). If the file gives lamp positions "
@@ -797,8 +797,8 @@ def parse_lp(
         )
     if declared is not None and declared != len(entries):
         notes.append(
-            f"{source}, line {first_no}: count line says {declared} lights but the file lists "
-            f"{len(entries)}; the {len(entries)} listed lights are used"
+            f"{shown_path(source)}, line {first_no}: count line says {declared} lights but the "
+            f"file lists {len(entries)}; the {len(entries)} listed lights are used"
         )
     return entries
 

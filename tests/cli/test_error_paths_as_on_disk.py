@@ -79,6 +79,26 @@ def test_a_run_with_a_plan_in_such_a_folder_that_is_no_lp_names_it_as_on_disk(od
     assert not (odd / "S").exists()
 
 
+def test_a_plan_s_note_and_refusal_name_it_as_on_disk(odd: Path) -> None:
+    """The .lp's notes ("count line says 3") and the plan's refusal for a light no LED is near
+    had begun with the raw path: ``caf\\udce9`` in a C locale, naming no file."""
+    # a count one too many, and a light 7.65° from the nearest LED of the simulated dome
+    (odd / "plan.lp").write_text("3\nx1.jpg 0.3 0.3 0.9055\nx2.jpg 0.2 0.1 0.97\n")
+    r = rti_rig(
+        "run", CONFIGS / "simulated_dome.toml", "--plan", odd / "plan.lp", "--out", odd / "S"
+    )
+    assert r.returncode == 2, r.stderr
+    note = r.stderr[r.stderr.index(b"note: ") + len(b"note: ") :]
+    word = WORD.match(note)
+    assert word is not None and b", line 1: count line says 3 lights" in note, r.stderr
+    assert pasted(word[0]) == os.fsencode(odd / "plan.lp")
+    error = r.stderr[r.stderr.index(b"error: ") :]
+    assert first_word_after_error(error) == os.fsencode(odd / "plan.lp")
+    assert b"light 1 (x1.jpg): no LED of this dome within" in error, error
+    assert b"(nearest is LED 43 (az 60.0" in error, error  # by its direction, as words say LEDs
+    assert not (odd / "S").exists()
+
+
 @pytest.fixture(scope="module")
 def card(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     """A card session shot on the emulated dome, and its rig config (both in ASCII folders)."""
