@@ -12,6 +12,7 @@ taken as this host's, and its removal is said.
 from __future__ import annotations
 
 import json
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -68,7 +69,7 @@ def test_another_host_s_attempt_is_left_to_it_and_said_once(tmp_path: Path) -> N
     assert (out / "A" / "fit.json").is_file()  # this batch fits its own copy all the same
     note = f"{folder} is the folder of a fit running on host lab-node-7 (PID {pid} there)"
     assert said.count(note) == 1, said
-    assert f"rm -r '{folder}'" in said and "if that host is gone" in said, said
+    assert f"rm -r {shlex.quote(str(folder))})" in said and "if that host is gone" in said, said
     # the finished session's end-of-fit clean-up leaves it too; the next run says it again
     code, said = batch(a, b, out)
     assert code == 0 and folder.is_dir() and said.count(note) == 1, said
@@ -201,7 +202,8 @@ def test_a_host_of_the_same_name_without_machine_ids_is_left_and_said(
     assert (out / "A" / "fit.json").is_file()
     note = f"{folder} is the folder of a fit running on host {record['host']}, or on this host"
     assert said.count(note) == 1, said
-    assert "which of the two cannot be told" in said and f"rm -r '{folder}'" in said, said
+    assert "which of the two cannot be told" in said, said
+    assert f"rm -r {shlex.quote(str(folder))})" in said, said
 
 
 def test_without_machine_ids_the_same_boot_tells_this_host(
@@ -275,7 +277,7 @@ def test_an_interrupted_swap_is_finished_leaving_another_host_s_set_aside_fit(
     assert (elsewhere / "fit.json").read_bytes() == (fitted / "fit.json").read_bytes(), said
     note = f"{elsewhere} is the folder of a fit running on host lab-node-7 (PID {theirs} there)"
     assert said.count(note) == 1, said
-    assert f"rm -r '{elsewhere}'" in said and "if that host is gone" in said, said
+    assert f"rm -r {shlex.quote(str(elsewhere))})" in said and "if that host is gone" in said, said
     # this host's attempt leaves nothing behind; the other host's record stays with its folder
     assert not owner_record_path(AttemptFolder.parse(mine.name), out).exists()  # type: ignore[arg-type]
     assert owner_record_path(AttemptFolder.parse(elsewhere.name), out).exists()  # type: ignore[arg-type]

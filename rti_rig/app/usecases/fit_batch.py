@@ -42,6 +42,7 @@ from rti_rig.app.usecases.fit_owners import (
 )
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.session import JOURNAL, file_sha256
 
 
@@ -103,8 +104,8 @@ def batch_out_dir(root: Path, source: Path) -> Path:
         name = Path(os.path.abspath(source)).name
         if not name:
             raise FitInputError(
-                f"{source}: the root of a file system is no session folder; give the session's "
-                "own folder"
+                f"{shown_path(source)}: the root of a file system is no session folder; give "
+                "the session's own folder"
             )
         return root / name
     folder = source.resolve().parent.name
@@ -192,9 +193,11 @@ def _left_to_its_owner(folder: Path, owner: Owner) -> str:
     """What a batch says, once, of an attempt's folder it leaves to a process elsewhere."""
     pid = "" if owner.pid is None else f" (PID {owner.pid} there)"
     return (
-        f"{folder} is the folder of a fit running on {owner.elsewhere}{pid}, which this host "
-        "cannot see: it is left to that fit. If it still runs there, let it finish; if that "
-        f"host is gone or its fit was stopped, remove the folder by hand (rm -r '{folder}') "
+        f"{shown_path(folder)} is the folder of a fit running on {owner.elsewhere}{pid}, which "
+        "this host cannot see: it is left to that fit. If it still runs there, let it finish; "
+        "if that host is gone or its fit was stopped, remove the folder by hand (rm -r "
+        # a shell word: hand-quoted '...', a name with a quote (or not UTF-8) did not paste
+        f"{shell_word(folder)}) "
         "and run the same command again"
     )
 
@@ -202,10 +205,10 @@ def _left_to_its_owner(folder: Path, owner: Owner) -> str:
 def _removed_unrecorded(folder: Path, owner: Owner) -> str:
     """What a batch says of an older rti-rig's folder, recording no host, that it removed."""
     return (
-        f"removed {folder}, left by an interrupted fit of an older rti-rig, which records no "
-        f"host: its PID {owner.pid} was taken as this host's, where no such process runs (a "
-        "fit of that older rti-rig still running on another host sharing this folder fails "
-        "there; run it again with this rti-rig)"
+        f"removed {shown_path(folder)}, left by an interrupted fit of an older rti-rig, which "
+        f"records no host: its PID {owner.pid} was taken as this host's, where no such process "
+        "runs (a fit of that older rti-rig still running on another host sharing this folder "
+        "fails there; run it again with this rti-rig)"
     )
 
 
@@ -277,8 +280,8 @@ def prepare_batch(sources: list[Path], root: Path) -> dict[Path, tuple[str, ...]
         root.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise FitInputError(
-            f"--out {root}: cannot create the batch folder ({exc.strerror or exc}); choose a "
-            "folder you can write to"
+            f"--out {shown_path(root)}: cannot create the batch folder "
+            f"({exc.strerror or exc}); choose a folder you can write to"
         ) from None
     notes: dict[Path, tuple[str, ...]] = {}
     for source in sources:

@@ -18,7 +18,7 @@ from typing import Any
 
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.shell_words import shell_word, shown_path
 
 #: Two lights of a plan are the same light within this angle (°): an .lp carries six decimals
 #: (or fewer, rewritten by another program), which moves a direction by far less than this.
@@ -79,7 +79,7 @@ def check_same_start(
         began = f"{said} and {rest}" if rest else said
         give = "give those options without --lights, or none" if rest else "drop those options"
     raise RtiRigError(
-        f"{root}: this resume asks for another session than the one in it ("
+        f"{shown_path(root)}: this resume asks for another session than the one in it ("
         + "; ".join(diffs)
         + f"). It began with {began or 'the defaults'} (nothing in the folder was changed): "
         f"to continue it as it began, {give} (rti-rig run --resume "
