@@ -31,7 +31,6 @@ averaged to grey, and shrunk to at most ``MAX_PX`` wide for speed.
 
 from __future__ import annotations
 
-import shlex
 import time
 from collections.abc import Callable
 from itertools import pairwise
@@ -42,6 +41,7 @@ import cv2
 import numpy as np
 
 from benchmarks.tradeoff import Row, best_floor, plot, write_csv
+from rti_rig.core.shell_words import shell_word
 
 COUNTS = (6, 9, 12, 18, 24, 36, 48)
 FLOORS = (0.0, 10.0, 20.0, 30.0)
@@ -390,8 +390,10 @@ def bench_from(
     t0 = time.perf_counter()
     rows, held = run_tradeoff_from(lp, progress)
     # quoted as a shell reads it: an archive's folder with a space (``Tablet 3/dirs.lp``) had
-    # been written bare, a command that fails when copied from summary.md
-    command = f"rti-rig bench tradeoff --from {shlex.quote(str(lp))}"
+    # been written bare, a command that fails when copied from summary.md; shell_word, not
+    # shlex.quote: a name whose bytes are not UTF-8 is said as $'...' of those bytes (quoted,
+    # it was a '\udce9' no shell reads back, and summary.md's UTF-8 write failed on it)
+    command = f"rti-rig bench tradeoff --from {shell_word(lp)}"
     if out_dir is None:
         return summarise_from(rows, time.perf_counter() - t0, command, held)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -399,7 +401,7 @@ def bench_from(
     for path in plot(rows, out_dir):
         if "arm_time" in path.name:  # a replayed acquisition is a dome: no arm time to plot
             path.unlink()
-    command += f" --out {shlex.quote(str(out_dir))}" + (" --force" if force else "")
+    command += f" --out {shell_word(out_dir)}" + (" --force" if force else "")
     text = summarise_from(rows, time.perf_counter() - t0, command, held)
     (out_dir / "summary.md").write_text(text + "\n", encoding="utf-8")
     return text

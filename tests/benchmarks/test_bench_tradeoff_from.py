@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import itertools
+import os
 from pathlib import Path
 from typing import Any
 
@@ -18,13 +19,15 @@ ACQ = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay" / "dirs.
 
 def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
     import re
-    import shlex
     import shutil
+    import subprocess
+
+    from conftest import NOT_UTF8_NAME
 
     # in folders with spaces, as an archive's are (``Tablet 3/dirs.lp``)
     acq = tmp_path / "Tablet 3" / "dirs.lp"
     shutil.copytree(ACQ.parent, acq.parent)
-    out = tmp_path / "trade off"
+    out = tmp_path / os.fsdecode(b"trade off " + NOT_UTF8_NAME)  # bytes that are not UTF-8
     r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(acq), "--out", str(out)])
     assert r.exit_code == 0, r.output
     rows = list(csv.DictReader((out / "results.csv").open()))
@@ -49,13 +52,17 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
     text = (out / "summary.md").read_text()
     assert "--from" in text and "adaptive" in text
     # its command line, pasted into a shell, names the same acquisition and --out (it had
-    # written the paths bare, a command that fails where a folder's name has a space)
+    # written the paths bare, a command that fails where a folder's name has a space, then
+    # shlex-quoted, '\udce9' where the name's byte is not UTF-8, which summary.md's write
+    # refused)
     found = re.search(r"Command: `([^`]*)`", text)
     assert found is not None
-    words = shlex.split(found.group(1))
-    assert words[:3] == ["rti-rig", "bench", "tradeoff"], words
-    assert words[words.index("--from") + 1] == str(acq)
-    assert words[words.index("--out") + 1] == str(out)
+    words = subprocess.run(
+        ["bash", "-c", "printf '%s\\0' " + found.group(1)], capture_output=True, check=True
+    ).stdout.split(b"\0")[:-1]
+    assert words[:3] == [b"rti-rig", b"bench", b"tradeoff"], words
+    assert words[words.index(b"--from") + 1] == os.fsencode(acq)
+    assert words[words.index(b"--out") + 1] == os.fsencode(out)
     assert "on the same 3 held-out lights for every plan" in text
     # and what the user opens: the fit.rti `rti-rig fit` would write, on the same lights
     assert "**Relighting as `rti-rig fit` writes it**" in text
