@@ -58,11 +58,14 @@ def print_verdict(session: Path | None) -> None:
         _say_verdict_warnings(caught)
     except (RtiRigError, ValueError) as exc:
         err.print(f"[yellow]QA verdict unavailable:[/] {escape(str(exc))}")
-    except (KeyboardInterrupt, VerdictTerminated) as exc:  # only the advice is cut short
+    except (KeyboardInterrupt, Terminated) as exc:  # only the advice is cut short
         # said, then the exit the stop has everywhere else (Ctrl-C 130, SIGTERM 143): a
         # Ctrl-C here had exited 0, so ``run && fit`` went on to fit after the user asked to
-        # stop, and the two stops of the same moment disagreed
-        signum = exc.signum if isinstance(exc, VerdictTerminated) else signal.SIGINT
+        # stop, and the two stops of the same moment disagreed. The run's SIGTERM handler
+        # for the verdict (``session._verdict_terminable``) raises the stopping module's
+        # Terminated, as every command's does: it is the only handler installed while the
+        # verdict is computed, so a Terminated here is the verdict's stop
+        signum = stop_signal(exc)
         from rti_rig.core.out_folders import free_folder_beside
 
         err.print(
@@ -106,19 +109,6 @@ def _say_verdict_warnings(caught: list[warnings.WarningMessage]) -> None:
             )
         else:
             warning_note(text)
-
-
-class VerdictTerminated(BaseException):
-    """A SIGTERM while ``run`` computes its QA verdict (raised by the run's handler for that
-    phase): the session is complete, so it is said like a Ctrl-C there; it had ended the
-    process silently (exit 143), which read like a failed session. A BaseException, as
-    KeyboardInterrupt is, so that no ``except Exception`` on the way swallows it.
-    ``signum``: the signal as received (SIGHUP for a hang-up answered as a SIGTERM), kept as
-    the handler ran: a hang-up is named and exited as itself, a SIGTERM after one as SIGTERM."""
-
-    def __init__(self, signum: signal.Signals = signal.SIGTERM) -> None:
-        super().__init__(signum)
-        self.signum = signum
 
 
 def _stopped(

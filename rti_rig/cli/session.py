@@ -692,13 +692,14 @@ class HandOver:
 
 @contextmanager
 def _verdict_terminable() -> Iterator[None]:
-    """A SIGTERM while the QA verdict is computed raises :class:`~rti_rig.cli.fit.
-    VerdictTerminated`, which the verdict says as it says a Ctrl-C (the session is complete)
-    before exiting 143; it had ended the process with no word."""
-    from rti_rig.cli.fit import VerdictTerminated
+    """A SIGTERM while the QA verdict is computed raises :class:`~rti_rig.cli.stopping.
+    Terminated`, which the verdict says as it says a Ctrl-C (the session is complete) before
+    exiting 143; it had ended the process with no word. (It had its own class, fit's
+    ``VerdictTerminated``, a copy of Terminated: the same base, fields and signal kept as
+    received; which stop it is follows from the handler installed, not the class.)"""
 
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
-        raise VerdictTerminated(as_received(signum))  # a hang-up's: SIGHUP
+        raise Terminated(as_received(signum))  # a hang-up's: SIGHUP
 
     with signal_handlers({signal.SIGTERM: terminated}):
         yield

@@ -1,8 +1,8 @@
 """A SIGTERM as ``run``'s QA verdict loads its code is said as one during the verdict.
 
 An audit sent SIGTERM to ``rti-rig run rig_configs/simulated_arm.toml`` just after "Lamp off":
-the handler's ``VerdictTerminated`` landed while ``print_verdict`` imported the fit's code,
-outside the ``try`` that says it, and a traceback ended a complete session with exit 1.
+the handler's ``Terminated`` landed while ``print_verdict`` imported the fit's code, outside
+the ``try`` that says it, and a traceback ended a complete session with exit 1.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import pytest
 import typer
 
 from rti_rig.cli import fit as cli_fit
+from rti_rig.cli.stopping import Terminated
 
 
 def test_a_sigterm_while_the_verdict_s_code_loads_is_said_and_exits_143(
@@ -23,7 +24,7 @@ def test_a_sigterm_while_the_verdict_s_code_loads_is_said_and_exits_143(
 
     def import_hit_by_sigterm(name, *args, **kwargs):  # type: ignore[no-untyped-def]
         if name == "rti_rig.app.usecases.fit":
-            raise cli_fit.VerdictTerminated  # where the run's SIGTERM handler raises it
+            raise Terminated  # where the run's SIGTERM handler raises it
         return real_import(name, *args, **kwargs)
 
     monkeypatch.setattr(builtins, "__import__", import_hit_by_sigterm)

@@ -72,14 +72,13 @@ def test_a_command_stopped_by_sigterm_after_a_hangup_exits_143() -> None:
 def test_the_run_verdicts_stop_keeps_the_signal_as_received() -> None:
     """The run's QA verdict is cut short by a SIGTERM or a hang-up: each is named and exited
     as itself (it had been named by the flag later, as ``fit`` said the verdict's stop)."""
-    from rti_rig.cli.fit import VerdictTerminated
     from rti_rig.cli.session import _verdict_terminable
 
-    caught: list[VerdictTerminated] = []
+    caught: list[Terminated] = []
     with hangup_as_sigterm(), _verdict_terminable():
         for sig in (signal.SIGHUP, signal.SIGTERM):
             try:
                 signal.raise_signal(sig)
-            except VerdictTerminated as exc:
+            except Terminated as exc:
                 caught.append(exc)
     assert [e.signum for e in caught] == [signal.SIGHUP, signal.SIGTERM]
