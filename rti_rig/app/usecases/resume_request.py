@@ -18,6 +18,7 @@ from typing import Any
 
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
+from rti_rig.core.rig_geometry import led_said
 from rti_rig.core.shell_words import shell_word, shown_path
 
 #: Two lights of a plan are the same light within this angle (°): an .lp carries six decimals
@@ -300,7 +301,7 @@ def _layout(schedule: Any) -> str:
 def _light(step: Any) -> str:
     """``LED 13`` (a dome's), or the light's azimuth/elevation."""
     if step.led is not None:
-        return f"LED {step.led}"
+        return led_said(step.led, step.direction, step.label)
     az, el = az_el_from_direction(step.direction)
     return f"az {float(az):.2f}° el {float(el):.2f}°"
 

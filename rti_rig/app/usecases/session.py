@@ -17,6 +17,7 @@ from typing import Any
 from rti_rig.app.usecases.replay_advice import new_session_command
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.out_folders import free_folder_beside, free_name
+from rti_rig.core.rig_geometry import led_fields, led_said
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.controller import (
@@ -422,7 +423,8 @@ def _check_steps_fit_lit(  # type: ignore[no-untyped-def]
     if not over:
         return
     i, step = over[0]
-    led = f" (LED {step.led})" if step.led is not None else ""
+    # a dome's LED by its number and direction, as every word names it
+    led = f" ({led_fields(step.led, step.direction, step.label)})" if step.led is not None else ""
     _, said = shot_said(loaded, "its exposure_s", round(step.exposure_s or 0.0, 6))
     need = math.ceil((fixed + max(s.exposure_s or 0.0 for _, s in over)) * 100) / 100
     steps = ", ".join(str(j + 1) for j, _ in over[:10]) + (" ..." if len(over) > 10 else "")
@@ -604,8 +606,10 @@ def fix_exposure(
     where = ""
     if probes > 1:
         at = chosen["metered_at_step"] - 1
-        led = schedule.steps[at].led
-        which = f" (LED {led})" if led is not None else ""
+        step = schedule.steps[at]
+        which = (
+            f" ({led_said(step.led, step.direction, step.label)})" if step.led is not None else ""
+        )
         metered = len(chosen["lights_metered_at_steps"])
         where = (
             f" at {image_names(len(schedule))[at]}'s light{which}, the brightest of the "
