@@ -377,18 +377,21 @@ def _exchange(
             if not step.send or _settled(heard.decode("latin-1"), reply):
                 break  # an answer came (or a banner began): nothing more is sent
             if n:
-                # the next probe on this open port: what the one before heard is said under
-                # its label, this one told as it begins (the telling never waits on output:
-                # a board may be lit meanwhile, see the CLI's ``trying``)
-                result.heard.append(Heard(saying, baud, heard[said_from:].decode("latin-1")))
-                saying, said_from = step.what, len(heard)
+                # the next probe on this open port, told as it begins (the telling never waits
+                # on output: a board may be lit meanwhile, see the CLI's ``trying``)
                 if result.on_try is not None:
                     result.on_try(step.what, "" if step.tries is None else step.tries.value)
                 left = max(opened + step.not_before_s, wrote + step.quiet_s) - time.monotonic()
                 if left > 0:
                     _listen(t, left, into=heard, done=_answered)
+                # what came before it is sent is said under the probe before it, the last
+                # sent: RTIPy answers once 1 s of silence ends a command, so its answer to the
+                # mask and '<9>' came in the wait before 'T,0,0,0' and had been shown as what
+                # 'T,0,0,0' heard; a probe never sent (an answer came first) heard nothing
                 if _settled(heard.decode("latin-1"), reply):
                     break
+                result.heard.append(Heard(saying, baud, heard[said_from:].decode("latin-1")))
+                saying, said_from = step.what, len(heard)
             t.write(step.send)
             wrote, asked = time.monotonic(), len(heard)
 

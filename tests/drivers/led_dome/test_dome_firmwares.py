@@ -63,13 +63,21 @@ def said(result) -> str:  # type: ignore[no-untyped-def]
 def test_probe_names_the_firmware_and_leaves_it_dark(profile: str) -> None:
     board = board_for(profile)
     with serve_on_pty(board, profile) as link:
-        r = runner.invoke(app, ["probe", link.port])
+        r = runner.invoke(app, ["probe", link.port], terminal_width=400)
         assert r.exit_code == 0, r.output
         assert f'profile = "{profile}"' in r.output
         # the rate it answered at, which a config copied from the example (baudrate = 115200)
         # must be given: the printed lines had left it out
         assert f"baudrate = {builtin_spec(profile)['baudrate']}" in r.output, r.output
         assert eventually(lambda: board.lit == frozenset())
+    if profile == "rtipy":
+        # each probe's line holds what came while it was the last one sent: RTIPy answers a
+        # command once 1 s of silence ends it, so its answer to the mask and '<9>' (one
+        # command to it) came before 'T,0,0,0' was sent, and had been shown as T's
+        heard = dict(line.split(": ", 1) for line in r.stdout.splitlines()[:9])
+        assert heard["'T,0,0,0' at 9600 baud"] == "'I received: T,0,0,0 the instructionByte was: T'"
+        unknown = heard["'<9>' (an unknown code) at 9600 baud"]
+        assert unknown.startswith("'I received: ") and "<9> the instructionByte was: " in unknown
 
 
 @pytest.mark.slow  # real firmware timing over a pty
