@@ -93,6 +93,7 @@ from rti_rig.app.usecases.worker_code import (
     worker_pythons,
 )
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.shell_words import shown_path
 from rti_rig.reconstruct.lazy_stack import ImageReadError, StackSource, lazy_stack
 from rti_rig.reconstruct.stack import ImageStack
 
@@ -880,7 +881,8 @@ def _fit_one_task(source: Path, root: Path, template: FitRequest, threads: int |
             source,
             batch_out_dir(root, source),
             Outcome.FAILED,
-            f": {source} does not exist on worker host {socket.gethostname()}: {SHARED_PATHS}",
+            f": {shown_path(source)} does not exist on worker host {socket.gethostname()}: "
+            f"{SHARED_PATHS}",
         )
     with _SESSION_LOCK, threadpool_limits(limits=threads, user_api="blas"):
         item = fit_one(source, root, template)
@@ -909,10 +911,10 @@ def _finished_kept(sources: list[Path], given: list[tuple[Path, Path]], root: Pa
     its future, which is cancelled with the rest)."""
     finished = [g for s, g in given if batch_out_dir(root, s).exists()]
     return (
-        f"{len(finished)} of {len(sources)} sessions are finished in {root} "
-        f"({', '.join(map(str, finished))}) and are kept"
+        f"{len(finished)} of {len(sources)} sessions are finished in {shown_path(root)} "
+        f"({', '.join(map(shown_path, finished))}) and are kept"
         if finished
-        else f"no session is finished in {root} yet"
+        else f"no session is finished in {shown_path(root)} yet"
     )
 
 
