@@ -243,6 +243,9 @@ def test_calibration_names_the_weakest_led_by_its_session_image(tmp_path: Path) 
     image_of = {s["led"]: s["image"] for s in steps}
     weak = int(np.argmin(TRUE_POWER))
     assert f"(LED {weak}, " in said and f"session image {image_of[weak]})" in said, said
+    # the calibration file's comment names it by its number and direction too
+    written = (tmp_path / "card" / "light_calibration.toml").read_text(encoding="utf-8")
+    assert f"weakest LED {weak} (led_{weak}.jpg, az " in written, written
 
 
 @pytest.mark.parametrize(
