@@ -30,6 +30,7 @@ from rti_rig.core.device_said import say_or_log
 from rti_rig.core.devices import ReadBackCarrier, TorqueAtClose
 from rti_rig.core.errors import MoveCancelled, UnheldJoint
 from rti_rig.core.geometry import az_el_from_direction
+from rti_rig.core.shell_words import shell_word
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.bus import DxlBus, resends_said
@@ -727,8 +728,8 @@ class DynamixelArm(ReadBackCarrier):
             self._tell(
                 f"{self.name}: torque stays on: the arm is not at its park pose, and "
                 'torque_policy = "release_on_close" releases it only there, where it cannot '
-                "drop onto the object. Park it with 'rti-rig check' before switching off the "
-                "servos' power."
+                f"drop onto the object. Park it with {self._check_command()} before switching "
+                "off the servos' power."
             )
             return
         off = [j for j in self.settings.joints if j not in on and j not in unknown]
@@ -742,8 +743,15 @@ class DynamixelArm(ReadBackCarrier):
             f"{self.name}: no torque-off sent: the arm is not at its park pose, and "
             'torque_policy = "release_on_close" releases it only there; Torque Enable '
             f"{read}{unread}. Support the arm before switching off the servos' power, and "
-            "park it with 'rti-rig check'."
+            f"park it with {self._check_command()}."
         )
+
+    def _check_command(self) -> str:
+        """The check that parks this arm, its rig config named as shell words so that it
+        pastes and runs (a bare 'rti-rig check' is refused for its missing config); quoted
+        bare only for an arm opened without a rig config (the manual tools)."""
+        config = self._bus.config
+        return f"rti-rig check {shell_word(config)}" if config else "'rti-rig check'"
 
     def _torque_record(self, off_sent: bool, on: list[Any], unknown: list[Any]) -> TorqueAtClose:
         """The close's :class:`TorqueAtClose` from Torque Enable as read back."""

@@ -273,6 +273,7 @@ def _arm_lighting(loaded: LoadedRig, carrier) -> ArmLighting:  # type: ignore[no
         carrier,
         park_after_session=arm.park_after_session,
         park_on_emergency=arm.park_on_emergency_stop,
+        config=str(loaded.path),
     )
 
 

@@ -26,6 +26,7 @@ from rti_rig.core.errors import DeviceError, MoveCancelled, StopIncomplete, Unhe
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.schedule import LightStep
+from rti_rig.core.shell_words import shell_word
 from rti_rig.runtime.arm_end import ArmEnd, left_end, park_end
 from rti_rig.runtime.dome_policy import DomePolicy, DutyWait
 
@@ -297,6 +298,16 @@ class DomeLighting:
         return False if known is None else bool(known.link_open)
 
 
+def park_check(config: str | None) -> str:
+    """The command that parks an arm after a failure: ``rti-rig check CONFIG``, the config's
+    path as shell words, so that it pastes and runs; ``'rti-rig check'`` only where no config
+    is known (an arm built without one, as in unit tests).
+
+    Why: the run's end said "park it with 'rti-rig check'", a command that, pasted, is refused
+    for its missing RIG_CONFIG, while the error above it named the config in full."""
+    return f"rti-rig check {shell_word(config)}" if config else "'rti-rig check'"
+
+
 class ArmLighting:
     """An arm: move, then lamp on; the reached direction is the recorded one.
 
@@ -319,9 +330,13 @@ class ArmLighting:
         carrier: LightCarrier,
         park_after_session: bool = True,
         park_on_emergency: bool = False,
+        config: str | None = None,
     ) -> None:
         self.carrier = carrier
         self.name = carrier.name
+        #: the rig config's path, named in the check that parks the arm after a failure
+        #: ("park it with 'rti-rig check'" had named no config: pasted, it was refused)
+        self.config = config
         self.park_after_session = park_after_session
         self.park_on_emergency = park_on_emergency
         #: the arm's own failure since the last connect (a move or the lamp): no park after it
@@ -559,12 +574,13 @@ class ArmLighting:
             # what to do, in the order it is done: after a failed stop the power goes off
             # first (as the stop's error and the lights line say); "park it with rti-rig
             # check" had followed "switch the power off" with no word of the power coming back
+            check = park_check(self.config)
             todo = (
                 "Support the lamp and switch the arm's power off first (a joint the stop did "
                 "not hold may still be moving, or sag); then clear the fault (its error says "
-                "how), switch the power back on and park it with 'rti-rig check'"
+                f"how), switch the power back on and park it with {check}"
                 if stop_failed
-                else "Clear the fault (its error says how), then park it with 'rti-rig check'"
+                else f"Clear the fault (its error says how), then park it with {check}"
             )
             # said once, as where the arm was left: it had also been listed as a teardown
             # failure ("park: not attempted because …"), and the arm's sentence repeated it

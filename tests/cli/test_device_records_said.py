@@ -25,6 +25,7 @@ from conftest import CONFIGS, REPO, inprocess_arm_config, said, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.core.shell_words import shell_word
 
 #: What the raw records had said, in any of their forms.
 RAW = (
@@ -42,11 +43,16 @@ RELEASED_UNPARKED = (
     'torque_policy = "release_on_close"',
     "park_after_session = false",
 )
-TORQUE_LINE = (
-    "arm: torque stays on: the arm is not at its park pose, and torque_policy = "
-    '"release_on_close" releases it only there, where it cannot drop onto the object. Park it '
-    "with 'rti-rig check' before switching off the servos' power."
-)
+
+
+def torque_line(cfg: Path) -> str:
+    """The line said of the torque kept on, whose check names ``cfg``, ready to paste (a bare
+    'rti-rig check' had been said, refused when pasted for its missing config)."""
+    return (
+        "arm: torque stays on: the arm is not at its park pose, and torque_policy = "
+        '"release_on_close" releases it only there, where it cannot drop onto the object. Park '
+        f"it with rti-rig check {shell_word(cfg)} before switching off the servos' power."
+    )
 
 
 def _release_unparked(tmp_path: Path) -> Path:
@@ -72,12 +78,13 @@ def test_run_says_the_torque_kept_on_once_in_words(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
     out = tmp_path / "S"
-    argv = ["run", str(_release_unparked(tmp_path)), "--lights", "2", "--out", str(out)]
+    cfg = _release_unparked(tmp_path)
+    argv = ["run", str(cfg), "--lights", "2", "--out", str(out)]
     with caplog.at_level(logging.DEBUG):
         r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
     text = said(r)
     assert r.exit_code == 0, text
-    assert text.count(TORQUE_LINE) == 1, text
+    assert text.count(torque_line(cfg)) == 1, text
     assert not _loud(caplog), _loud(caplog)  # said through the run, not as a record
     for raw in RAW:
         assert raw not in text, (raw, text)
@@ -98,7 +105,7 @@ def test_the_installed_command_says_it_on_stderr_with_no_raw_record(tmp_path: Pa
     )
     both = " ".join((proc.stdout + proc.stderr).split())
     assert proc.returncode == 0, both
-    assert both.count(TORQUE_LINE) == 1, both
+    assert both.count(torque_line(cfg)) == 1, both
     for raw in RAW:
         assert raw not in proc.stderr, (raw, proc.stderr)
 
@@ -107,9 +114,10 @@ def test_check_says_the_torque_kept_on(tmp_path: Path, caplog: pytest.LogCapture
     """``check`` parks the arm unless park_after_session is off: then its close keeps the
     torque on, and says so once."""
     with caplog.at_level(logging.DEBUG):
-        r = CliRunner().invoke(app, ["check", str(_release_unparked(tmp_path))], terminal_width=400)
+        cfg = _release_unparked(tmp_path)
+        r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
     text = said(r)
-    assert text.count(TORQUE_LINE) == 1, text
+    assert text.count(torque_line(cfg)) == 1, text
     assert not _loud(caplog), _loud(caplog)
     for raw in RAW:
         assert raw not in text, (raw, text)

@@ -16,7 +16,9 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, REPO, servo_fault
+from conftest import CONFIGS, REPO, pasted, servo_fault
+
+from rti_rig.core.shell_words import shell_word
 
 #: runs rti-rig with, as the environment asks, a SIGTERM sent to itself as the arm is about
 #: to light the Nth image (``ARM_END_SIGTERM_AT``), or the park failing (``ARM_END_JAM``)
@@ -168,7 +170,9 @@ def test_a_fault_that_blocks_the_park_is_said_once(tmp_path: Path) -> None:
     said twice (a "park: not attempted because …" teardown problem, then the arm's sentence
     "park is NOT confirmed: not attempted because …"), and the fault's paragraph of what to do
     twice too (in the teardown's stop, then in the error)."""
-    cfg = _config(tmp_path, "simulated_arm.toml")
+    # in a folder whose name a shell splits: the check to paste names it as one word
+    (tmp_path / "arm rig").mkdir()
+    cfg = _config(tmp_path / "arm rig", "simulated_arm.toml")
     with cfg.open("a") as f:
         f.write(servo_fault(200, 2))
     code, said, out = _run(tmp_path, cfg, lights=6)
@@ -181,12 +185,14 @@ def test_a_fault_that_blocks_the_park_is_said_once(tmp_path: Path) -> None:
     ), said
     # what to do, in order: the stop did not hold servo 2, so the power goes off first (as
     # the lights line says), and comes back on before the park ("then park it with 'rti-rig
-    # check'" had followed "switch the arm's power supply off")
+    # check'" had followed "switch the arm's power supply off"); the park's check names the
+    # rig config, ready to paste (a bare 'rti-rig check' is refused for its missing config)
     assert (
         "Support the lamp and switch the arm's power off first (a joint the stop did not hold "
         "may still be moving, or sag); then clear the fault (its error says how), switch the "
-        "power back on and park it with 'rti-rig check'" in said
+        f"power back on and park it with rti-rig check {shell_word(cfg)} " in said
     ), said
+    assert pasted(shell_word(cfg).encode()) == bytes(cfg)
     assert said.count("clear the obstruction") == 1, said  # in the error, said last
     assert said.rindex("clear the obstruction") > said.index("(as in the error below)"), said
     assert _arm_end(out)["outcome"] == "park-unconfirmed"

@@ -21,6 +21,7 @@ from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.geometry import direction_from_az_el
+from rti_rig.core.shell_words import shell_word
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
 from rti_rig.runtime.lighting import ArmLighting
@@ -127,8 +128,9 @@ KEPT = (
 )
 
 
-def _run_unparked(tmp_path: Path) -> tuple[int, str, dict]:  # type: ignore[type-arg]
-    """Run 2 lights, no park (``park_after_session = false``): the close keeps the torque on."""
+def _run_unparked(tmp_path: Path) -> tuple[int, str, dict, Path]:  # type: ignore[type-arg]
+    """Run 2 lights, no park (``park_after_session = false``): the close keeps the torque on.
+    Returns the exit code, the words, the manifest's arm end and the rig config run."""
     cfg = _config(tmp_path)
     text = cfg.read_text()
     assert "\n[arm]\n" in text
@@ -142,7 +144,7 @@ def _run_unparked(tmp_path: Path) -> tuple[int, str, dict]:  # type: ignore[type
     said = " ".join(r.output.split())
     assert "Traceback" not in said, said
     end = json.loads((out / "manifest.json").read_text())["runner"]["arm_end"]
-    return r.exit_code, said, end
+    return r.exit_code, said, end, cfg
 
 
 def test_a_torque_kept_on_at_the_close_is_in_the_manifest(
@@ -153,9 +155,12 @@ def test_a_torque_kept_on_at_the_close_is_in_the_manifest(
     the close established: no torque-off sent, Torque Enable read back on from each servo,
     with the pose read back."""
     emulators = emulators_built_by_check(monkeypatch)
-    code, said, end = _run_unparked(tmp_path)
+    code, said, end, cfg = _run_unparked(tmp_path)
     assert code == 0, said
     assert said.count(KEPT) == 1, said
+    # the check that parks it names the rig config, ready to paste (a bare 'rti-rig check'
+    # is refused for its missing config)
+    assert f"Park it with rti-rig check {shell_word(cfg)} before switching off" in said, said
     assert end["outcome"] == "left" and end["azimuth_deg"] is not None, end
     assert end["torque"] is None, end  # nothing released: no release note
     assert end["torque_at_close"] == {
@@ -181,9 +186,10 @@ def test_a_kept_torque_read_back_off_is_not_said_to_hold(
         return failures
 
     monkeypatch.setattr(ArmLighting, "safe", safe)
-    code, said, end = _run_unparked(tmp_path)
+    code, said, end, cfg = _run_unparked(tmp_path)
     assert code == 0, said
     assert "torque stays on" not in said, said
+    assert f"and park it with rti-rig check {shell_word(cfg)}." in said, said
     assert (
         "Torque Enable reads back ON from servo 1 (azimuth); reads back OFF (limp) from servo 2 "
         "(elevation)" in said
