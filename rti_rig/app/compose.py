@@ -266,7 +266,7 @@ class _ArmLamp:
         return 1.0 if self._arm.lamp_is_on else 0.0
 
 
-def _arm_lighting(loaded: LoadedRig, carrier) -> ArmLighting:  # type: ignore[no-untyped-def]
+def _arm_lighting(loaded: LoadedRig, carrier, clock: Clock) -> ArmLighting:  # type: ignore[no-untyped-def]
     arm = loaded.config.arm
     assert arm is not None
     return ArmLighting(
@@ -274,6 +274,7 @@ def _arm_lighting(loaded: LoadedRig, carrier) -> ArmLighting:  # type: ignore[no
         park_after_session=arm.park_after_session,
         park_on_emergency=arm.park_on_emergency_stop,
         config=str(loaded.path),
+        clock=clock,
     )
 
 
@@ -313,7 +314,7 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     except BaseException:
         stack.close_said(loaded.config.name)
         raise
-    rig = Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock, stack)
+    rig = Rig(loaded, geometry, _arm_lighting(loaded, arm, clock), camera, clock, stack)
     rig.emulator = emulator  # type: ignore[attr-defined]  # for tests and the fault campaign
     return rig
 
@@ -398,7 +399,7 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
             named, dynamixel_sdk.PortHandler(settings.port), clock, config_path=loaded.path
         )
         camera = build_camera(camera_settings, clock=clock)
-        rig = Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock)
+        rig = Rig(loaded, geometry, _arm_lighting(loaded, arm, clock), camera, clock)
     rig.session_hooks.append(_session_hook(camera))
     return rig
 
@@ -495,6 +496,7 @@ def _build_simulated(loaded: LoadedRig, clock: Clock | None) -> Rig:
                 resolution_deg=cfg.arm.resolution_deg,
                 switch_s=cfg.timing.light_switch_s,
             ),
+            clock,
         )
     camera = _simulated_camera(loaded, state, clock)
     return Rig(loaded=loaded, geometry=geometry, lighting=lighting, camera=camera, clock=clock)

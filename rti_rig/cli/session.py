@@ -1370,14 +1370,27 @@ def _duty_clause(rig) -> str:  # type: ignore[no-untyped-def]
 def _moving_clause(rig, folder) -> str:  # type: ignore[no-untyped-def]
     """For an arm, the part of the session's time spent moving it: the sum of its images'
     ``light_s`` (from a step's start until its lamp is on, i.e. the move and the lamp-on; all
-    runs' images); "" for a dome. Why: only the total was said, and on an arm the moves are
-    the part a faster profile or a better light order would cut."""
+    runs' images), then this run's park at its end as timed on the rig's clock; "" for a
+    dome. Why: only the total was said, and on an arm the moves are the part a faster profile
+    or a better light order would cut."""
     from rti_rig.runtime.lighting import ArmLighting
 
     if not isinstance(rig.lighting, ArmLighting) or not folder.committed:
         return ""
     moving = sum(float(r.light_s) for r in folder.committed.values())
-    return f"; of which moving the arm (and switching its lamp on) {moving:.1f} s"
+    # the park at the end is a move too, and in the session's time: unsaid, a 2 s park on a
+    # 21 s session was time a user could not find (this run's only: an earlier run's park
+    # is in no record)
+    park = rig.lighting.park_s
+    runs = len(folder.manifest.get("runs") or [])
+    parked = (
+        ""
+        if park is None
+        else f", and parking it {park:.1f} s"
+        if runs <= 1
+        else f", and parking it at this run's end {park:.1f} s"
+    )
+    return f"; of which moving the arm (and switching its lamp on) {moving:.1f} s{parked}"
 
 
 def _execute(opened, handover: HandOver | None = None) -> bool:  # type: ignore[no-untyped-def]

@@ -15,6 +15,7 @@ from typing import Protocol
 
 import numpy as np
 
+from rti_rig.core.clock import Clock
 from rti_rig.core.deferred_signals import signals_deferred, stop_words
 from rti_rig.core.devices import (
     DiscreteLightSource,
@@ -331,8 +332,15 @@ class ArmLighting:
         park_after_session: bool = True,
         park_on_emergency: bool = False,
         config: str | None = None,
+        clock: Clock | None = None,
     ) -> None:
         self.carrier = carrier
+        #: the rig's clock, to time the teardown's park (None: not timed)
+        self.clock = clock
+        #: how long the last :meth:`safe`'s park took on the rig's clock (None: no park begun,
+        #: or no clock): a session's time line says it beside the moves to the lights, which
+        #: had left the park's seconds of the session's time unaccounted for
+        self.park_s: float | None = None
         self.name = carrier.name
         #: the rig config's path, named in the check that parks the arm after a failure
         #: ("park it with 'rti-rig check'" had named no config: pasted, it was refused)
@@ -527,6 +535,7 @@ class ArmLighting:
         return f"the park was stopped by {who}: held where it stopped, torque on"
 
     def _safe(self, emergency: bool) -> list[str]:
+        self.park_s = None
         lamp_failed = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
         unheld: list[UnheldJoint] = []
         stop_failed = attempt_all([("stop", lambda: stop_reading_unheld(self.carrier, unheld))])
@@ -596,6 +605,7 @@ class ArmLighting:
             self.stopped_by = self._stop_asked
             self.end = left_end(self.carrier, self._stopped_why())
             return failures
+        began = self.clock.now() if self.clock is not None else None
         try:
             self.carrier.park(cancelled=lambda: self._stop_asked is not None)
         except MoveCancelled:  # held where it stood, every joint (the driver's stop)
@@ -606,6 +616,9 @@ class ArmLighting:
             parked = [f"park: {exc}"]
             self.end = park_end(self.carrier, parked[0])
             return failures + parked
+        finally:
+            if began is not None and self.clock is not None:
+                self.park_s = self.clock.now() - began
         self.end = park_end(self.carrier, None)
         return failures
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -95,9 +96,19 @@ def test_a_completed_run_says_the_arm_parked_where_read_back_and_its_moving_time
     assert end["outcome"] == "parked" and end["elevation_deg"] == pytest.approx(park_el, abs=1)
     # the moves: each image's start to lamp-on, summed, said beside the session time
     records = [json.loads(line) for line in (out / "journal.jsonl").read_text().splitlines()]
-    moving = sum(r["light_s"] for r in records if "light_s" in r)
+    steps = [r for r in records if "light_s" in r]
+    moving = sum(r["light_s"] for r in steps)
     assert moving > 0
     assert f"of which moving the arm (and switching its lamp on) {moving:.1f} s" in said, said
+    # and the park at the end, the rest of the session's time after its last image (it had
+    # been left out: a 2 s park on a 21 s session was time no line accounted for)
+    last = steps[-1]
+    after_last = json.loads((out / "manifest.json").read_text())["runs"][0]["rig_time_s"] - (
+        last["rig_start_s"] + last["light_s"] + last["settle_s"] + last["capture_s"]
+    )
+    parking = re.search(r"s, and parking it (\d+\.\d) s", said)
+    assert parking is not None, said
+    assert after_last > 0.5 and float(parking[1]) == pytest.approx(after_last, abs=0.1), said
 
 
 def test_a_run_with_park_off_says_where_the_arm_is_left(tmp_path: Path) -> None:
