@@ -33,6 +33,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from functools import partial
+from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
@@ -52,6 +53,8 @@ from rti_rig.core.dome_link import (
     OffReport,
 )
 from rti_rig.core.errors import DeviceError
+from rti_rig.core.out_folders import free_name
+from rti_rig.core.shell_words import shell_word
 from rti_rig.runtime.duty_ledger import SAVE_EVERY_S, DutyLedger
 
 log = logging.getLogger("rti_rig.dome")
@@ -1799,6 +1802,9 @@ class SelfTestReport:
     #: been identified and had answered instantly, beside a walk timed on the simulation's
     #: clock (the arm's check says its clock, the dome's did not).
     simulated: bool = False
+    #: The rig config checked, as one shell word ("": not known), for the session its advice
+    #: names: the advice had said ``rti-rig fit S --out FOLDER``, no command that ran pasted.
+    rig_config: str = ""
 
     @property
     def failed(self) -> list[LedCheck]:
@@ -1817,6 +1823,21 @@ class SelfTestReport:
     def median_light_latency_s(self) -> float | None:
         lat = self.light_latency_s
         return float(np.median(lat)) if lat else None
+
+    def _dark_image_advice(self) -> str:
+        """The session of every LED, and the fit whose QA names a dark image, as commands that
+        run pasted: the rig config checked, and folders free in the working folder when said
+        (``S`` and ``FOLDER``, pasted, had made folders of those names)."""
+        fit_options = "--no-ptm --no-hsh --no-normals"
+        if not self.rig_config:
+            return f"shoot a session of every LED and fit it with {fit_options}"
+        session = free_name(Path("led-check"))
+        fit = free_name(Path(f"{session.name}-fit"))
+        return (
+            f"shoot a session of every LED (`rti-rig run {self.rig_config} --out "
+            f"{shell_word(str(session))}`) and fit it (`rti-rig fit {shell_word(str(session))} "
+            f"--out {shell_word(str(fit))} {fit_options}`)"
+        )
 
     def lines(self) -> list[str]:
         fw = (
@@ -1875,8 +1896,8 @@ class SelfTestReport:
                 out.append(
                     "  whether each LED lights cannot be sensed by this firmware (it measures "
                     "no LED current, so a dead LED is acknowledged too): look at the dome "
-                    "during the check, or run a short session and `rti-rig fit S --out FOLDER "
-                    "--no-ptm --no-hsh --no-normals`, whose QA names a dark image"
+                    f"during the check, or {self._dark_image_advice()}, whose QA names a dark "
+                    "image"
                 )
         out += [f"  LED {c.index}: {c.message}" for c in self.failed]
         if self.light_latency_s and self.foreign_firmware is None and not self.simulated:

@@ -8,6 +8,7 @@ the board's acknowledgement was established. The emulated board here has LED 3 d
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 
 import pytest
@@ -28,14 +29,23 @@ def _nab(tmp_path: Path, dead: str) -> Path:
 
 
 @pytest.mark.pty
-def test_a_check_of_a_board_that_senses_no_current_claims_no_led_lit(tmp_path: Path) -> None:
+def test_a_check_of_a_board_that_senses_no_current_claims_no_led_lit(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "led-check").mkdir()  # taken: the advice names the next free folder
     r = runner.invoke(app, ["check", str(_nab(tmp_path, "[3]"))], terminal_width=400)
     text = said(r)
     assert r.exit_code == 0 and "Traceback" not in text, text
     assert "LEDs stepped: 12, acknowledged by the board: 12, failed: 0" in text, text
     assert "passed: 12" not in text, text
     assert "whether each LED lights cannot be sensed by this firmware" in text, text
-    assert "rti-rig fit S --out FOLDER --no-ptm --no-hsh --no-normals" in text, text
+    # the session and its fit as commands that run pasted: the config checked and free
+    # folders (it had said `rti-rig fit S --out FOLDER`, which pasted made folders S, FOLDER)
+    cfg = shlex.quote(str(tmp_path / "nab.toml"))
+    assert f"(`rti-rig run {cfg} --out led-check-2`)" in text, text
+    fit = "`rti-rig fit led-check-2 --out led-check-2-fit --no-ptm --no-hsh --no-normals`"
+    assert fit in text, text
     assert r.output.rstrip().splitlines()[-1] == (
         "RESULT: PASS (LEDs acknowledged; lit not verified: board cannot sense current)"
     )

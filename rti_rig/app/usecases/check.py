@@ -27,7 +27,7 @@ from rti_rig.core.devices import (
 )
 from rti_rig.core.errors import DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry
-from rti_rig.core.shell_words import shown_path
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.arm_check import arm_self_test
 from rti_rig.runtime.controller import EmergencyStop
 from rti_rig.runtime.dome_policy import self_test
@@ -130,6 +130,7 @@ def check_rig(
             if isinstance(rig.lighting, DomeLighting):
                 rig.lighting.listen(on_note)
                 lights = self_test(rig.lighting.source, rig.clock, intensity=intensity)
+                lights.rig_config = shell_word(str(req.rig_config))  # for its advice's commands
                 camera = camera_line(rig, auto_exposure=req.auto_exposure, test_shot=True)
                 return WithCamera(lights, camera, config_note_lines(loaded))
             if isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
