@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import shlex
 import shutil
 from pathlib import Path
 
@@ -97,6 +98,16 @@ def test_another_request_is_refused_naming_what_differs(
     assert "It began with --lights 8" in said(r)
     assert f"rti-rig run --resume {out})" in said(r)
     assert tree(out) == before
+    # the request as a new session, a command that runs pasted: the rig, the options asked and
+    # a free folder beside the session ("start a new session in a new --out" had been said)
+    new = said(r).split("to shoot this request, start a new session: ", 1)[1]
+    assert new.startswith(f"rti-rig run {DOME} ") and new.endswith(f"--out {tmp_path / 's-2'}")
+    words = shlex.split(new)
+    assert [w for w in options if w not in words] == [], new
+    if options == ["--lights", "9"]:  # pasted, it runs (one case: each is the same command)
+        r = runner.invoke(app, [*words[1:], "--no-verdict"])
+        assert r.exit_code == 0, r.output
+        assert len(list((tmp_path / "s-2").glob("image_*.jpg"))) == 9
 
 
 def test_another_out_folder_is_refused(stopped: Path, tmp_path: Path) -> None:

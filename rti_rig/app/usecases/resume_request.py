@@ -12,12 +12,14 @@ anything on disk is touched, naming what differs and what to do.
 from __future__ import annotations
 
 import math
+import shlex
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
+from rti_rig.core.out_folders import free_name
 from rti_rig.core.rig_geometry import led_said
 from rti_rig.core.shell_words import shell_word, shown_path
 
@@ -84,8 +86,41 @@ def check_same_start(
         + "; ".join(diffs)
         + f"). It began with {began or 'the defaults'} (nothing in the folder was changed): "
         f"to continue it as it began, {give} (rti-rig run --resume "
-        f"{folder}); to shoot this request, start a new session in a new --out"
+        f"{folder}); to shoot this request, start a new session: "
+        f"{_new_session_command(asked, loaded, root)}"
     )
+
+
+def _new_session_command(asked: StartOptions, loaded: Any, root: Path) -> str:
+    """The ``run`` that shoots ``asked`` on ``loaded``'s rig as a new session, into a folder
+    beside ``root`` free when said, as words that run pasted.
+
+    Why: "start a new session in a new --out" had left the command to be put together, the
+    config and a folder to be found."""
+    words = ["rti-rig", "run", shell_word(str(loaded.path))]
+    if asked.plan is not None:
+        words += ["--plan", shell_word(str(asked.plan))]
+    if asked.lights is not None:
+        words += ["--lights", str(asked.lights)]
+    if asked.adaptive:
+        words.append("--adaptive")
+    if asked.until_error_deg is not None:
+        words += ["--until-error", f"{asked.until_error_deg:g}"]
+    if asked.min_lights is not None:
+        words += ["--min-lights", str(asked.min_lights)]
+    if asked.auto_exposure:
+        words.append("--auto-exposure")
+    if asked.max_saturated is not None:
+        words += ["--max-saturated", f"{asked.max_saturated:g}"]
+    if asked.min_elevation_deg != 0.0:
+        words += ["--min-elevation-deg", f"{asked.min_elevation_deg:g}"]
+    if asked.max_elevation_deg != 90.0:
+        words += ["--max-elevation-deg", f"{asked.max_elevation_deg:g}"]
+    if asked.allow_no_normals:
+        words.append("--allow-no-normals")
+    if asked.objective is not None:
+        words += ["--objective", shlex.quote(asked.objective)]  # a fixed choice, not a path
+    return " ".join([*words, "--out", shell_word(str(free_name(root)))])
 
 
 def _default_count_said(
