@@ -1831,8 +1831,8 @@ class SelfTestReport:
         fit_options = "--no-ptm --no-hsh --no-normals"
         if not self.rig_config:
             return f"shoot a session of every LED and fit it with {fit_options}"
-        session = free_name(Path("led-check"))
-        fit = free_name(Path(f"{session.name}-fit"))
+        session = free_name(Path("led-check"), folder=True)
+        fit = free_name(Path(f"{session.name}-fit"), folder=True)
         return (
             f"shoot a session of every LED (`rti-rig run {self.rig_config} --out "
             f"{shell_word(str(session))}`) and fit it (`rti-rig fit {shell_word(str(session))} "

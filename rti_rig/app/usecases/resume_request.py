@@ -120,7 +120,7 @@ def _new_session_command(asked: StartOptions, loaded: Any, root: Path) -> str:
         words.append("--allow-no-normals")
     if asked.objective is not None:
         words += ["--objective", shlex.quote(asked.objective)]  # a fixed choice, not a path
-    return " ".join([*words, "--out", shell_word(str(free_name(root)))])
+    return " ".join([*words, "--out", shell_word(str(free_name(root, folder=True)))])
 
 
 def _default_count_said(
