@@ -862,9 +862,9 @@ def _cannot_resume(opened) -> str | None:  # type: ignore[no-untyped-def]
     from rti_rig.runtime.session import image_sequence_restarts
 
     rig = opened.rig
-    if isinstance(rig.lighting, CameraTriggeredLighting):  # by type, not a getattr probe
-        return str(rig.lighting.resume_hint)
     again = _arg(free_folder_beside(Path(opened.out_dir), "again"))
+    if isinstance(rig.lighting, CameraTriggeredLighting):  # by type, not a getattr probe
+        return rig.lighting.resume_hint(_arg(rig.loaded.path), again)
     why = image_sequence_restarts(rig.loaded.config.camera.device, _arg(rig.loaded.path), again)
     return None if why is None else f"It cannot be resumed: {why}."
 

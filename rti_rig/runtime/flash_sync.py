@@ -139,11 +139,17 @@ class CameraTriggeredLighting:
         it), so there is no all-off to send."""
         return False
 
-    #: What the CLI says instead of "continue with --resume": the dome's count went on.
-    resume_hint = (
-        "A camera-triggered dome cannot resume a session (its own count went on): long-press "
-        "its start button to rewind it and start a new session."
-    )
+    @staticmethod
+    def resume_hint(config: str, out: str) -> str:
+        """What the CLI says instead of "continue with --resume": the dome's count went on, so
+        the whole sequence is shot again, by the run of ``config`` into ``out`` (both as shell
+        words; ``out`` a folder free when said). Why the command: "start a new session" had
+        left the user to find the config and a folder."""
+        return (
+            "A camera-triggered dome cannot resume a session (its own count went on): long-press "
+            f"its start button to rewind it, then start a new session: rti-rig run {config} "
+            f"--out {out}"
+        )
 
     def lights_state(self) -> str:
         return (

@@ -166,6 +166,10 @@ def test_a_camera_triggered_run_stopped_before_its_proof_is_not_said_complete(
     marker = out / "LABELS_NOT_VERIFIED.txt"
     assert f"listed in lights.lp, their labels NOT verified: {marker} says why" in said, said
     assert "A camera-triggered dome cannot resume a session" in said, said
+    # with the run that shoots it again, into a free folder beside it ("start a new session"
+    # had left the config and a folder to find)
+    config = CONFIGS / "emulated_cceh_rti.toml"
+    assert f"then start a new session: rti-rig run {config} --out {tmp_path / 's-again'}" in said
     code, fitted = _cli("fit", str(out), "--out", str(tmp_path / "fit"))  # what fit says of it
     assert code != 0 and "it is not used" in fitted, fitted
 
