@@ -27,7 +27,7 @@ from rti_rig.core.devices import (
 from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
-from rti_rig.core.rig_geometry import led_fields
+from rti_rig.core.rig_geometry import hint_light_count, led_fields
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.core.shell_words import shown_path
 from rti_rig.runtime.lighting import ArmLighting, Lighting, port_close_failures
@@ -721,6 +721,10 @@ def run_session(
             "config_path": rig.loaded.path,
             "config_sha256": rig.loaded.sha256,
             "config": rig.loaded.raw,
+            # what a hint read from the manifest alone (a finished preview's plan command)
+            # may ask for: the runtime cannot load the rig's geometry there, and plan's default
+            # 12 was refused on a dome of 8 LEDs
+            "plan_lights": hint_light_count(getattr(rig, "geometry", None)),
         },
         "schedule": schedule.to_dict(),
         **({"adaptive": source.header()} if source is not None else {}),

@@ -547,9 +547,15 @@ def _finished_hint(root: Path, manifest: dict[str, Any]) -> str:
         rig = (manifest.get("rig") or {}).get("config_path")
         shown = shell_word(str(rig)) if isinstance(rig, str) and rig else "RIG.toml"
         plan_lp = shell_word(str(free_name(Path("plan.lp"))))  # plan refuses an existing one
-        return (  # plan's default count (the rig config is not loaded here): N was refused
+        # the count the rig allows, recorded at capture (the rig's geometry is not loaded
+        # here): plan's default 12 was refused on a dome of 8 LEDs; a session recorded before
+        # the count was gets plan's default
+        lights = (manifest.get("rig") or {}).get("plan_lights")
+        if not isinstance(lights, int) or isinstance(lights, bool) or lights < 1:
+            lights = PLAN_DEFAULT_LIGHTS
+        return (
             f" (it holds a finished preview: plan from it with rti-rig plan {folder} --rig "
-            f"{shown} --lights {PLAN_DEFAULT_LIGHTS} --out {plan_lp})"
+            f"{shown} --lights {lights} --out {plan_lp})"
         )
     # a real, free folder beside the session (fit refuses one inside it): ``--out DIR`` had
     # been printed, which pasted made a folder named DIR

@@ -69,3 +69,28 @@ def test_a_rig_config_given_as_plan_on_an_8_led_dome_suggests_a_run_of_8_lights(
     assert done.returncode == 0, done.stderr
     lp = (tmp_path / "S" / "lights.lp").read_text(encoding="utf-8").split()
     assert lp[0] == "8", lp[:4]
+
+
+def eight_led_dome(folder: Path) -> Path:
+    """The shipped 8-LED dome, simulated (for speed: its geometry as shipped)."""
+    return shipped_variant(
+        folder, "emulated_rti_dome.toml", (('backend = "emulated"', 'backend = "simulated"'),)
+    )
+
+
+def test_a_finished_preview_given_again_suggests_a_plan_the_8_led_dome_takes(
+    tmp_path: Path,
+) -> None:
+    """A preview folder given again to ``preview --out`` points to ``plan`` with the count the
+    rig allows, recorded at capture: it had said plan's default ``--lights 12``, which the
+    8-LED dome refuses."""
+    rig = eight_led_dome(tmp_path)
+    assert rti_rig(tmp_path, "preview", rig, "--out", "pv").returncode == 0
+    r = rti_rig(tmp_path, "preview", rig, "--out", "pv")
+    assert r.returncode == 2, r.stderr
+    command = command_after(r.stderr, "a finished preview: plan from it with ")
+    assert " --lights 8 " in command, command
+    done = pasted_run(tmp_path, command)
+    assert done.returncode == 0, done.stderr
+    lp = (tmp_path / "plan.lp").read_text(encoding="utf-8").split()
+    assert lp[0] == "8", lp[:4]
