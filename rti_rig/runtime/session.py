@@ -697,9 +697,12 @@ class SessionFolder:
                 )
                 if not finished and in_use_by_another(root):  # running, not interrupted
                     resume = " (another rti-rig process is capturing a session in it right now)"
+            # a folder that does not exist yet, named: "choose a new --out folder" named none
+            fresh = shell_word(str(free_name(root, folder=True)))
             raise SessionError(
                 f"{shown_path(root)} is not empty: refusing to write a session over existing "
-                f"files; choose a new --out folder{resume}"
+                f"files; choose a new --out folder (such as --out {fresh}, which does not exist "
+                f"yet){resume}"
             )
         # where the session's folder would be made: found unwritable only at the first image,
         # a session had lit the rig (and on an arm, moved it) for nothing

@@ -8,12 +8,14 @@ through bash (``rti-rig`` as ``python -m rti_rig``) in the same folder.
 
 from __future__ import annotations
 
+import os
+import shlex
 import subprocess
 import sys
 from pathlib import Path
 
 from conftest import ASCII_LOCALE_ENV as ENV
-from conftest import shipped_variant
+from conftest import NOT_UTF8_NAME, shipped_variant
 
 
 def rti_rig(cwd: Path, *args: str | Path) -> subprocess.CompletedProcess[str]:
@@ -94,3 +96,26 @@ def test_a_finished_preview_given_again_suggests_a_plan_the_8_led_dome_takes(
     assert done.returncode == 0, done.stderr
     lp = (tmp_path / "plan.lp").read_text(encoding="utf-8").split()
     assert lp[0] == "8", lp[:4]
+
+
+def test_a_run_into_a_finished_session_names_a_new_out_folder_that_pastes(
+    tmp_path: Path,
+) -> None:
+    """``run --out S`` into a finished session is refused with a folder that does not exist
+    yet (it said "choose a new --out folder" and named none); the run given it, pasted, writes
+    there and leaves the first session as it was. The folder's name is not UTF-8, with a space
+    and a quote: the word printed must paste back as its bytes."""
+    rig = eight_led_dome(tmp_path)
+    first = os.fsdecode(NOT_UTF8_NAME)
+    run = ("run", rig, "--lights", "8", "--no-verdict", "--out")
+    assert rti_rig(tmp_path, *run, first).returncode == 0
+    before = sorted(p.name for p in (tmp_path / first).iterdir())
+    r = rti_rig(tmp_path, *run, first)
+    assert r.returncode == 2, r.stderr
+    word = command_after(r.stderr, "choose a new --out folder (such as --out ", ", which")
+    command = "rti-rig " + " ".join(map(shlex.quote, map(str, run))) + " " + word
+    done = pasted_run(tmp_path, command)
+    assert done.returncode == 0, done.stderr
+    lp = (tmp_path / os.fsdecode(NOT_UTF8_NAME + b"-2") / "lights.lp").read_text(encoding="utf-8")
+    assert lp.split()[0] == "8", lp[:40]
+    assert sorted(p.name for p in (tmp_path / first).iterdir()) == before
