@@ -8,11 +8,14 @@ said "condition number inf".
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, said
+from conftest import CONFIGS, REPO, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -51,7 +54,20 @@ def test_the_verdict_gives_a_command_line_answer(seven) -> None:
     assert "QA verdict unavailable" in text
     assert "from Python" not in text and "ill_conditioned" not in text
     assert "No option of `rti-rig fit` gives a verdict on such lights" in text
-    assert f"rti-rig fit {session} --out FOLDER` still writes the relighting files" in text
+    # a real folder beside the session, not there yet (FOLDER pasted made a folder so named)
+    fit_out = session.with_name(f"{session.name}-fit")
+    command = f"rti-rig fit {session} --out {fit_out}"
+    assert f"`{command}` still writes the relighting files" in text
+    assert not fit_out.exists()
+    pasted = subprocess.run(
+        ["bash", "-c", command.replace("rti-rig", '"$PY" -m rti_rig', 1)],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PY": sys.executable, "PYTHONPATH": str(REPO)},
+        timeout=600,
+    )
+    assert pasted.returncode == 0, pasted.stderr
+    assert list(fit_out.glob("*.ptm")) or list(fit_out.glob("*.rti")), list(fit_out.iterdir())
 
 
 def test_an_infinite_condition_number_is_said_as_what_it_means(seven, tmp_path: Path) -> None:

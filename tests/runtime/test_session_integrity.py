@@ -797,17 +797,22 @@ def test_a_fit_of_a_session_whose_images_are_gone_names_them_all_and_the_way_out
     for stem in ("image_004", "image_006"):
         (done / f"{stem}.jpg").unlink()
         (done / "linear" / f"{stem}.tif").unlink()
+    # a rest.lp an earlier export left, which export-lp refuses to overwrite: the .lp named is
+    # one that is not there yet
+    (done / "rest.lp").write_bytes(b"an earlier export")
     r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
     assert r.exit_code == 2, r.output
     out = said(r)
     assert "2 image(s) its lights.lp lists cannot be read as captured" in out
     assert "(image_004: neither its JPEG nor its linear TIFF on disk; image_006: neither" in out
     assert f"rti-rig run --resume {done} --reshoot-lost" in out
-    assert f"rti-rig export-lp {done} --linear --out {done / 'rest.lp'}" in out
+    rest = done / "rest-2.lp"
+    assert f"rti-rig export-lp {done} --linear --out {rest}" in out
     # the fit's --out a folder beside the session that is not there yet (DIR had been said)
     fit_out = done.with_name(f"{done.name}-fit")
-    assert f"then rti-rig fit {done / 'rest.lp'} --out {fit_out}" in out, out
-    _fit_the_rest(done, fit_out)
+    assert f"then rti-rig fit {rest} --out {fit_out}" in out, out
+    _fit_the_rest(done, fit_out, rest)
+    assert (done / "rest.lp").read_bytes() == b"an earlier export"
 
 
 def test_a_camera_original_changed_since_capture_is_lost_said_alike_and_reshot_on_request(
@@ -1067,10 +1072,11 @@ def test_the_journal_time_counts_a_killed_run_of_one_image() -> None:
     assert rig_time_of_records(killed_after_one) == pytest.approx(1.0 + 2.0)
 
 
-def _fit_the_rest(done: Path, out: Path) -> None:
+def _fit_the_rest(done: Path, out: Path, rest: Path | None = None) -> None:
     """The way out a refused session is given: ``export-lp --linear`` of the images still
-    intact into ``rest.lp``, then ``fit`` of that, which must succeed."""
-    rest = done / "rest.lp"
+    intact into ``rest`` (``rest.lp`` in the session by default), then ``fit`` of that, which
+    must succeed."""
+    rest = rest or done / "rest.lp"
     r = runner.invoke(app, ["export-lp", str(done), "--linear", "--out", str(rest)])
     assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["fit", str(rest), "--out", str(out), "--model", "ps"])

@@ -63,6 +63,7 @@ from rti_rig.core.lp_format import (
 from rti_rig.core.out_folders import (
     ensure_writable_folder,
     free_folder_beside,
+    free_name,
     refuse_a_file_in_the_way,
 )
 from rti_rig.core.raw_rows import DecodedStore, RawRows
@@ -578,7 +579,7 @@ def _refuse_lost_images(lp: Path, damaged: list[tuple[Path, str]]) -> None:
             f"session names: {renamed_note(renamed)}; then run this again"
         )
     folder = shell_word(str(root))
-    rest = shell_word(str(root / "rest.lp"))
+    rest = shell_word(str(free_name(root / "rest.lp")))  # export-lp refuses an existing one
     fit_out = shell_word(str(free_folder_beside(root, "fit")))  # ``--out DIR`` pasted made DIR
     raise FitInputError(
         f"{shown_path(root)}: {len(damaged)} image(s) its {lp.name} lists cannot be read as "
@@ -1557,8 +1558,9 @@ def qa_without_normals(lights: np.ndarray, session: Path | None = None) -> str |
     fit = (
         ""
         if session is None
-        else f"; `rti-rig fit {shell_word(str(session))} --out FOLDER` still writes the "
-        "relighting files"
+        # a folder that does not exist yet beside the session: FOLDER pasted made a folder so named
+        else f"; `rti-rig fit {shell_word(str(session))} --out "
+        f"{shell_word(str(free_folder_beside(session, 'fit')))}` still writes the relighting files"
     )
     return (
         f"the QA judges every image against a normal map, and {reason}. No option of "
