@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 
 from conftest import ASCII_LOCALE_ENV as ENV
-from conftest import NOT_UTF8_NAME, shipped_variant
+from conftest import CONFIGS, NOT_UTF8_NAME, shipped_variant
 
 
 def rti_rig(cwd: Path, *args: str | Path) -> subprocess.CompletedProcess[str]:
@@ -119,3 +119,23 @@ def test_a_run_into_a_finished_session_names_a_new_out_folder_that_pastes(
     lp = (tmp_path / os.fsdecode(NOT_UTF8_NAME + b"-2") / "lights.lp").read_text(encoding="utf-8")
     assert lp.split()[0] == "8", lp[:40]
     assert sorted(p.name for p in (tmp_path / first).iterdir()) == before
+
+
+def test_a_bare_lp_rig_refused_a_2_light_plan_is_offered_the_test_shot_on_its_config(
+    tmp_path: Path,
+) -> None:
+    """``plan --rig dome.lp --lights 2``: the test shot offered names the rig config beside
+    the .lp whose lp_file it is (it said ``RIG.toml``, which pasted was a file not there), and
+    pasted it shoots one image into a folder beside the plan."""
+    (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
+    config = shipped_variant(
+        tmp_path, "emulated_dome.toml", (('backend = "emulated"', 'backend = "simulated"'),)
+    )
+    r = rti_rig(tmp_path, "plan", "--rig", "example_dome_48.lp", "--lights", "2", "--out", "p.lp")
+    assert r.returncode == 2, r.stderr
+    command = command_after(r.stderr, "a test shot of 1 or 2 lights needs no plan: ", "\n")
+    assert command == "rti-rig run rig.toml --lights 1 --out test-shot", command
+    done = pasted_run(tmp_path, command + " --no-verdict")
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "test-shot" / "lights.lp").read_text(encoding="utf-8").split()[0] == "1"
+    assert config.is_file() and not (tmp_path / "p.lp").exists()

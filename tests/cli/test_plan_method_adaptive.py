@@ -28,13 +28,15 @@ def test_plan_method_adaptive_points_to_run_adaptive(tmp_path: Path) -> None:
     assert not out.exists()
 
 
-def test_a_bare_lp_rig_is_offered_a_config_placeholder(tmp_path: Path) -> None:
-    """A bare .lp given as --rig lists a dome's lights, and is no config to run adaptively."""
+def test_a_bare_lp_rig_is_offered_the_config_that_lists_it(tmp_path: Path) -> None:
+    """A bare .lp given as --rig lists a dome's lights, and is no config to run adaptively:
+    the first config beside it whose lp_file it is is named (RIG.toml had been said)."""
     args = ["plan", "--rig", str(CONFIGS / "example_dome_48.lp"), "--method", "adaptive"]
     r = CliRunner(env={"COLUMNS": "400"}).invoke(app, [*args, "--out", str(tmp_path / "p.lp")])
     text = said(r)
     assert r.exit_code == 2, text
-    assert f"rti-rig run RIG.toml --adaptive --lights 12 --out {tmp_path / 'planned'})" in text
+    config = CONFIGS / "emulated_dome.toml"
+    assert f"rti-rig run {config} --adaptive --lights 12 --out {tmp_path / 'planned'})" in text
 
 
 def test_another_unknown_method_is_not_sent_to_run_adaptive(tmp_path: Path) -> None:

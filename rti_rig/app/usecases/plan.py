@@ -364,9 +364,41 @@ def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: li
 
 
 def _config_shown(rig: Path) -> str:
-    """The rig config ``plan`` was given, as a ``run`` command line names it: a bare ``.lp``
-    rig is no config, and ``RIG.toml`` stands for the one whose lights it lists."""
-    return "RIG.toml" if Path(rig).suffix.lower() == ".lp" else shell_word(str(rig))
+    """The rig ``plan`` was given, as a ``run`` command line names it, one shell word: a bare
+    ``.lp`` rig is named by the rig config beside it whose ``[dome] lp_file`` it is, or as
+    itself where none is (``run`` replays an ``.lp`` whose images are beside it).
+
+    Why: ``RIG.toml`` had been said for a bare ``.lp``, which pasted was refused as a file
+    that does not exist."""
+    rig = Path(rig)
+    if rig.suffix.lower() != ".lp":
+        return shell_word(str(rig))
+    config = _config_listing(rig)
+    return shell_word(str(config if config is not None else rig))
+
+
+def _config_listing(lp: Path) -> Path | None:
+    """The first rig config (``*.toml``, by name) in ``lp``'s folder whose ``[dome] lp_file``
+    (relative to the config's real folder, as the config is read) is ``lp``; None where none
+    is, or the folder cannot be read. A config that does not parse is passed over: this only
+    names a command, the command's own run says what is wrong with it."""
+    import tomllib
+
+    try:
+        target = lp.resolve()
+        candidates = sorted(lp.parent.glob("*.toml"))
+    except OSError:
+        return None
+    for path in candidates:
+        try:
+            data = tomllib.loads(path.read_text(encoding="utf-8"))
+            dome = data.get("dome")
+            name = dome.get("lp_file") if isinstance(dome, dict) else None
+            if isinstance(name, str) and (path.resolve().parent / name).resolve() == target:
+                return path
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, ValueError):
+            continue
+    return None
 
 
 def _run_folder(plan_file: Path, name: str = "planned") -> str:
@@ -377,9 +409,9 @@ def _run_folder(plan_file: Path, name: str = "planned") -> str:
 
 def run_plan_command(rig: Path, plan_file: Path) -> str:
     """The ``rti-rig run`` command line that runs ``plan_file`` on ``rig`` with
-    ``--allow-no-normals``: the rig config given to ``plan`` (a bare ``.lp`` rig is no config:
-    ``RIG.toml`` stands for the one whose lights it lists), the plan, and a folder beside the
-    plan that does not exist yet.
+    ``--allow-no-normals``: the rig config given to ``plan`` (a bare ``.lp`` rig named as
+    :func:`_config_shown` names it), the plan, and a folder beside the plan that does not
+    exist yet.
 
     Why: the advice had been ``rti-rig run --plan PLAN.lp --allow-no-normals``, which ``run``
     refuses ("give a RIG_CONFIG and --out DIR"), then ``--out DIR``, which pasted made a
