@@ -2801,7 +2801,8 @@ def image_sequence_restarts(device: object, config: str, out: str) -> str | None
         "cannot continue a session or reshoot single images: a resume would give the lights "
         "still to shoot the pictures of the lights already shot. Shoot the dry run again into "
         f"a new folder: rti-rig run {config} --out {out} (to rehearse on recorded images "
-        "paired with their lights, a resumable replay rig: rti-rig run ACQ/dirs.lp --out DIR)"
+        "paired with their lights, a replay rig resumes: give run a recorded acquisition's "
+        ".lp, its images beside it, as the rig)"
     )
 
 

@@ -8,12 +8,15 @@ through bash (``rti-rig`` as ``python -m rti_rig``) in the same folder.
 
 from __future__ import annotations
 
+import json
 import os
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from conftest import ASCII_LOCALE_ENV as ENV
 from conftest import CONFIGS, NOT_UTF8_NAME, shipped_variant
 
@@ -98,17 +101,29 @@ def test_a_finished_preview_given_again_suggests_a_plan_the_8_led_dome_takes(
     assert lp[0] == "8", lp[:4]
 
 
+RUN_8 = ("run", "rig.toml", "--lights", "8", "--no-verdict", "--out")
+
+
+@pytest.fixture(scope="module")
+def finished_8(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder holding the simulated 8-LED dome's ``rig.toml`` and a finished session of it
+    whose name is not UTF-8, with a space and a quote (:data:`NOT_UTF8_NAME`)."""
+    folder = tmp_path_factory.mktemp("finished_8")
+    eight_led_dome(folder)
+    assert rti_rig(folder, *RUN_8, os.fsdecode(NOT_UTF8_NAME)).returncode == 0
+    return folder
+
+
 def test_a_run_into_a_finished_session_names_a_new_out_folder_that_pastes(
-    tmp_path: Path,
+    finished_8: Path, tmp_path: Path
 ) -> None:
     """``run --out S`` into a finished session is refused with a folder that does not exist
     yet (it said "choose a new --out folder" and named none); the run given it, pasted, writes
-    there and leaves the first session as it was. The folder's name is not UTF-8, with a space
-    and a quote: the word printed must paste back as its bytes."""
-    rig = eight_led_dome(tmp_path)
+    there and leaves the first session as it was. The word printed must paste back as the
+    folder name's bytes."""
+    shutil.copytree(finished_8, tmp_path, dirs_exist_ok=True)
     first = os.fsdecode(NOT_UTF8_NAME)
-    run = ("run", rig, "--lights", "8", "--no-verdict", "--out")
-    assert rti_rig(tmp_path, *run, first).returncode == 0
+    run = RUN_8
     before = sorted(p.name for p in (tmp_path / first).iterdir())
     r = rti_rig(tmp_path, *run, first)
     assert r.returncode == 2, r.stderr
@@ -139,3 +154,22 @@ def test_a_bare_lp_rig_refused_a_2_light_plan_is_offered_the_test_shot_on_its_co
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "test-shot" / "lights.lp").read_text(encoding="utf-8").split()[0] == "1"
     assert config.is_file() and not (tmp_path / "p.lp").exists()
+
+
+def test_a_resume_of_a_session_whose_manifest_names_no_config_names_the_session(
+    finished_8: Path, tmp_path: Path
+) -> None:
+    """A manifest that does not say which rig config it was shot with: the resume to give
+    names the session as a word that pastes back (it said ``--resume DIR``); the config,
+    which nothing records, is the one word left to fill in."""
+    shutil.copytree(finished_8, tmp_path, dirs_exist_ok=True)
+    session = tmp_path / os.fsdecode(NOT_UTF8_NAME)
+    manifest = json.loads((session / "manifest.json").read_text(encoding="utf-8"))
+    del manifest["rig"]["config_path"]
+    (session / "manifest.json").write_text(json.dumps(manifest), encoding="utf-8")
+    r = rti_rig(tmp_path, "run", "--resume", session.name)
+    assert r.returncode != 0, r.stderr
+    command = command_after(r.stderr, "give it: ", " (RIG.toml")
+    done = pasted_run(tmp_path, command.replace("RIG.toml", "rig.toml", 1))
+    assert "does not say which rig config" not in done.stderr, done.stderr
+    assert "is complete" in done.stderr + done.stdout, done.stderr + done.stdout

@@ -77,6 +77,7 @@ def test_a_session_shot_from_an_image_sequence_is_not_resumed(dome, tmp_path: Pa
     assert "this session cannot be resumed (nothing was changed)" in said, said
     assert "from its first file" in said, said
     assert f"rti-rig run {config} --out {out}-again" in said, said  # free, beside it
+    assert "DIR" not in said and "ACQ/" not in said, said  # no placeholder to paste
     assert "Traceback" not in r.output
     after = sorted((p.relative_to(out), p.read_bytes()) for p in out.rglob("*") if p.is_file())
     assert after == before  # refused before the folder was touched

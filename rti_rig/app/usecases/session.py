@@ -1727,7 +1727,8 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     if req.rig_config is None and not rig_entry.get("config_path"):
         raise RtiRigError(
             f"{shown_path(req.session_dir)}: the manifest does not say which rig config it was "
-            "shot with; give it: rti-rig run RIG.toml --resume DIR"
+            "shot with; give it: rti-rig run RIG.toml --resume "
+            f"{shell_word(str(req.session_dir))} (RIG.toml: that config's path)"
         )
     config_path = req.rig_config or Path(rig_entry["config_path"])
     if req.rig_config is None and not config_path.is_file():
