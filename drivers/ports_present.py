@@ -26,6 +26,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from rti_rig.core.shell_words import shell_word
+
 #: Where udev keeps names that survive a replug (one symlink per USB serial device).
 BY_ID = Path("/dev/serial/by-id")
 
@@ -45,11 +47,16 @@ def _stable_names() -> dict[str, str]:
     return names
 
 
-def ports_present_note(port: str) -> str:
+def ports_present_note(port: str, command: str | None = None) -> str:
     """A sentence for an error about ``port`` that does not exist: the serial ports present
     now and how to point the config at one ("" outside /dev: a URL such as ``loop://``, an
     emulator's pseudo-terminal). Never raises: a listing that fails says so, rather than
-    replacing the error it was to explain."""
+    replacing the error it was to explain.
+
+    ``command``: the command that was given the port itself (``rti-rig probe``), said again
+    with each port present (its stable name where udev keeps one), as one shell word; None:
+    the port came from a rig config, which is where to set it. Why: ``rti-rig probe`` of a
+    missing port had been told to "set that port in the rig config", which it was not given."""
     if not port.startswith("/dev/"):
         # a URL (``loop://``), or an emulator's pseudo-terminal that its own config serves: no
         # device a user would point a config at
@@ -65,8 +72,8 @@ def ports_present_note(port: str) -> str:
     stable = _stable_names()
     kernel_name = not port.startswith(("/dev/serial/by-id/", "/dev/serial/by-path/"))
     advice = (
-        f" ({port} is a name the system gives at each plugging; the /dev/serial/by-id/ name "
-        "stays the same, use it)"
+        f" ({shell_word(port)} is a name the system gives at each plugging; the "
+        "/dev/serial/by-id/ name stays the same, use it)"
         if kernel_name
         else ""
     )
@@ -81,9 +88,20 @@ def ports_present_note(port: str) -> str:
         ]
         name = stable.get(os.path.realpath(p.device)) or stable.get(p.device)
         if name:
-            facts.append(name)
-        described.append(f"{p.device} ({', '.join(facts)})" if facts else p.device)
+            facts.append(shell_word(name))  # a path said pastes as the bytes on disk
+        device = shell_word(p.device)
+        described.append(f"{device} ({', '.join(facts)})" if facts else device)
+    if command is None:
+        fix = "set that port in the rig config"
+    else:
+        names = [
+            stable.get(os.path.realpath(p.device)) or stable.get(p.device) or p.device
+            for p in found
+        ]
+        fix = "give it to the command again: " + " or ".join(
+            f"{command} {shell_word(name)}" for name in names
+        )
     return (
         f"serial ports present now: {'; '.join(described)}. If the device came back under "
-        f"another name, set that port in the rig config{advice}"
+        f"another name, {fix}{advice}"
     )

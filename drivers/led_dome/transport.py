@@ -84,9 +84,18 @@ class SerialTransport:
     board's ready banner rather than sleeping a fixed time.
     """
 
-    def __init__(self, port: str, baudrate: int = 115200, write_timeout_s: float = 1.0) -> None:
+    def __init__(
+        self,
+        port: str,
+        baudrate: int = 115200,
+        write_timeout_s: float = 1.0,
+        given_to: str | None = None,
+    ) -> None:
         self.name = port
         self.port = port
+        #: The command the port was given to as its argument (``rti-rig probe``), which a
+        #: missing port's error says again with the ports present; None: a rig config's port.
+        self.given_to = given_to
         self.baudrate = baudrate
         self.write_timeout_s = write_timeout_s
         self.clock: Clock = SystemClock()
@@ -158,7 +167,7 @@ class SerialTransport:
                 why = str(exc)
             error = PortHeldError if "exclusively lock" in str(exc) else TransportError
             if errno == ENOENT:  # the device went (or came back under another name)
-                note = ports_present_note(self.port)
+                note = ports_present_note(self.port, self.given_to)
                 why += f"; {note}" if note else ""
             elif errno == EACCES:  # there, but not this user's to open: say what to do
                 why = permission_denied_why(self.port)

@@ -270,6 +270,11 @@ class ProbeStopped(Exception):
 # What the probe knows of the Nab sketch is read from its profile (``nab_rti_v1``), so that
 # a fix there (a rate, a reply's words) reaches the probe too: they had been written out here.
 
+#: The command a probed port was given to, said again with the ports present where it is
+#: missing (it had been told to "set that port in the rig config", which probe takes none of).
+PROBE_COMMAND = "rti-rig probe"
+
+
 #: The Nab sketch's profile name, as a rig config names it.
 _NAB_NAME: str = nab.SPEC["name"]
 
@@ -338,7 +343,7 @@ def _exchange(
     all-off reset it once more."""
     if result.on_try is not None:
         result.on_try(what, "" if tries is None else tries.value)
-    t = SerialTransport(result.port, baud)
+    t = SerialTransport(result.port, baud, given_to=PROBE_COMMAND)
     result.openings += 1
     # the bytes are collected here as they come, not when a listen returns: a stop inside a
     # listen had lost all it heard (a Nab banner already in, then "stopped before a firmware
@@ -529,7 +534,7 @@ def _reopened_at_nab_rate(result: ProbeResult, wait_s: float) -> None:
     once more: a Nab board boots lit either way) and do the stop's teardown on it
     (:func:`_stopped_on_open_port`): its boot listened out, its all-off sent if it is the
     sketch. A port that fails meanwhile is said in ``result``."""
-    t = SerialTransport(result.port, _NAB_BAUD)
+    t = SerialTransport(result.port, _NAB_BAUD, given_to=PROBE_COMMAND)
     result.openings += 1
     try:
         t.open()
@@ -595,7 +600,7 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
     the boot listen is: left open, it had been reopened by the caller's teardown while still
     locked, and the dome left lit."""
     result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
-    t = SerialTransport(result.port, _NAB_BAUD)
+    t = SerialTransport(result.port, _NAB_BAUD, given_to=PROBE_COMMAND)
     result.openings += 1
     stop: EmergencyStop | None = None
     try:
