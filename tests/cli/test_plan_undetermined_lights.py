@@ -95,8 +95,10 @@ def test_allow_no_normals_plans_a_horizon_ring_saying_so(tmp_path: Path, objecti
     assert "the 12 planned lights cannot determine a surface normal" in said
     assert "planned as asked (--allow-no-normals)" in said
     assert "along the direction the lights do not span, their relighting is a guess" in said
-    # a bare .lp with no config beside it that lists it is named as itself (not RIG.toml)
-    assert f"rti-rig run {rig} --plan {out} --out {tmp_path / 'planned'} --allow-no-normals" in said
+    # a bare .lp with no config beside it that lists it: RIG.toml, the word left to fill in
+    # (the .lp itself pasted would be replayed as an acquisition, and refused for its images)
+    planned = tmp_path / "planned"
+    assert f"rti-rig run RIG.toml --plan {out} --out {planned} --allow-no-normals" in said
     assert len(read_lp(out)) == 12
 
 

@@ -365,16 +365,18 @@ def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: li
 
 def _config_shown(rig: Path) -> str:
     """The rig ``plan`` was given, as a ``run`` command line names it, one shell word: a bare
-    ``.lp`` rig is named by the rig config beside it whose ``[dome] lp_file`` it is, or as
-    itself where none is (``run`` replays an ``.lp`` whose images are beside it).
+    ``.lp`` rig is named by the rig config beside it whose ``[dome] lp_file`` it is, or, where
+    none is, by ``RIG.toml``, the one word left to fill in.
 
-    Why: ``RIG.toml`` had been said for a bare ``.lp``, which pasted was refused as a file
-    that does not exist."""
+    Why: ``RIG.toml`` had been said for a bare ``.lp`` even with its config beside it. Where
+    no config lists it, the ``.lp`` itself is no answer: ``run`` takes an ``.lp`` as a
+    recorded acquisition to replay, and refuses one with no images beside it for its missing
+    images, which would send the user after images, not a rig config."""
     rig = Path(rig)
     if rig.suffix.lower() != ".lp":
         return shell_word(str(rig))
     config = _config_listing(rig)
-    return shell_word(str(config if config is not None else rig))
+    return "RIG.toml" if config is None else shell_word(str(config))
 
 
 def _config_listing(lp: Path) -> Path | None:
