@@ -339,6 +339,13 @@ class SessionComplete(SessionError):
         self.next_step = next_step
 
 
+class CompleteJournalNotWhole(SessionError):
+    """A resume of a session that completed, its images as captured, whose journal is missing
+    or lacks records (proved by the step record files instead): refused, naming
+    ``--rebuild-journal``. Not :class:`SessionComplete` (exit 0): the session's record is not
+    whole, and a script running the same ``--resume`` line must see that."""
+
+
 class ImagesLostSinceCapture(SessionError):
     """A resume refused because the session completed: ``note`` is what the refusal says of
     its images missing or changed since capture (:func:`_lost_note`) or renamed (empty when
@@ -1880,7 +1887,7 @@ def _prepare_resume(
         intact = not reshoot_lost and not lost and not renamed
         # the manifest and journal as read above (they had been read again for this)
         if intact and not unchecked_images(root, scan, manifest)[0]:
-            _refuse_complete(root, manifest, total, finished)
+            _refuse_complete(root, manifest, total, finished, scan)
         if manifest.get("adaptive") and finished < total:  # an adaptive session that stopped
             stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
             raise SessionError(
@@ -2022,10 +2029,26 @@ def _prepare_resume(
     )
 
 
-def _refuse_complete(root: Path, manifest: dict[str, Any], total: int, finished: int) -> None:
+def _refuse_complete(
+    root: Path, manifest: dict[str, Any], total: int, finished: int, scan: JournalScan
+) -> None:
     """Raise :class:`SessionComplete` for ``root``, a session that completed with every image
-    as captured (checked by the caller), naming its next step: ``rti-rig fit``."""
+    as captured (checked by the caller), naming its next step: ``rti-rig fit``.
+
+    A journal missing or lacking records (``scan.mended``: images vouched for by their step
+    record files instead) raises :class:`CompleteJournalNotWhole`, naming the rebuild. Why: a
+    session whose ``journal.jsonl`` was deleted had been called complete with "every image
+    … matches its journaled checksum … nothing was changed", exit 0, and left with no
+    journal: its record gone, it was said to be intact."""
     folder = shell_word(str(root))
+    mend = journal_mend_note(root) if scan.mended else None
+    if mend is not None:
+        fit = f"rti-rig fit {folder} --out {shell_word(str(free_folder_beside(root, 'fit')))}"
+        raise CompleteJournalNotWhole(
+            f"{shown_path(root)}: this session completed all {finished} steps, but its "
+            f"record is not whole: {mend} (no rig is opened, nothing is shot). Nothing was "
+            f"changed. Run that first, then {fit}"
+        )
     if manifest.get("adaptive") and finished < total:
         stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
         done = (

@@ -347,6 +347,35 @@ def test_a_completed_sessions_journal_rebuild_refuses_the_options_it_cannot_chec
     assert (out / "journal.jsonl").is_file()
 
 
+def test_a_complete_session_whose_journal_was_deleted_is_not_called_intact(
+    stopped: Path, tmp_path: Path
+) -> None:
+    """A plain resume of a finished session whose journal.jsonl was deleted had said "complete
+    … every image … matches its journaled checksum … nothing was changed", exit 0, and left it
+    with no journal. It now says the journal is missing, what the images were checked against
+    instead, and the rebuild as a command that pastes (run here as given); exit 2, nothing
+    changed, and the same resume after the rebuild says complete."""
+    out = copy_of(stopped, tmp_path)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    (out / "journal.jsonl").unlink()
+    before = tree(out)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "journal.jsonl is missing" in text and "record is not whole" in text, text
+    assert "journaled checksum" not in text and "this session is complete" not in text, text
+    command = f"rti-rig run --resume {out} --rebuild-journal"
+    assert command in text, text
+    assert tree(out) == before
+    r = runner.invoke(app, shlex.split(command)[1:])
+    assert r.exit_code == 0, r.output
+    assert (out / "journal.jsonl").is_file()
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "this session is complete: all 8 steps were captured" in said(r)
+
+
 def test_a_session_begun_without_lights_is_said_to_have_every_light(
     tmp_path_factory: pytest.TempPathFactory,
 ) -> None:

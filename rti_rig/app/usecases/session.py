@@ -1688,6 +1688,7 @@ def _say_if_complete(session_dir: Path) -> str:
     lost are named in its words (their advice already what this dome can do: put them back,
     or shoot again into a new folder): the refusal had said only "nothing to resume"."""
     from rti_rig.runtime.session import (
+        CompleteJournalNotWhole,
         ImagesLostSinceCapture,
         SessionComplete,
         SessionError,
@@ -1696,8 +1697,8 @@ def _say_if_complete(session_dir: Path) -> str:
 
     try:
         prepare_resume(session_dir)
-    except SessionComplete:
-        raise
+    except (SessionComplete, CompleteJournalNotWhole):
+        raise  # the journal's rebuild is said as any other session's
     except ImagesLostSinceCapture as exc:
         return exc.note  # the flash refusal says them, then why it cannot reshoot
     except SessionError:
