@@ -661,6 +661,11 @@ class DynamixelBusEmulator(HostBaudDevice):
         self.corrupt_next_replies = 0
         self.drop_next_replies = 0
         self.reply_faults: dict[int, str] = {}
+        #: ``delay_reply`` faults: the K-th packet's status, late by this many seconds
+        self.reply_delays: dict[int, float] = {}
+        #: statuses on their way late (``delay_reply``): ``(delay s, bytes)``, delivered by
+        #: the port after the host's reply window if it is shorter (:meth:`take_late`)
+        self.late: list[tuple[float, bytes]] = []
         self.hardware_faults: dict[int, list[tuple[int, str]]] = {}
         #: instruction packets received so far (what ``reply_faults`` counts)
         self.instructions_received = 0
@@ -771,11 +776,29 @@ class DynamixelBusEmulator(HostBaudDevice):
                     reply = b""  # the servo acted; its status was lost on the wire
                 elif reply and fault == "garble_reply":
                     reply = reply[:-1] + bytes([reply[-1] ^ 0xFF])
+                elif reply and fault == "delay_reply":
+                    # not the servo's (it answers within its Return Delay Time) but its link's:
+                    # a slow USB-serial adapter or a host too loaded to read in time
+                    delay = self.reply_delays.get(self.instructions_received, 1.0)
+                    self.late.append((delay, reply))
+                    reply = b""
                 out += reply
             self._errors_changed()  # a fault raised or a Reboot among these packets
             return bytes(out)
 
-    def add_fault(self, at: int, kind: str, servo_id: int | None = None) -> None:
+    def take_late(self) -> tuple[float, bytes] | None:
+        """The statuses on their way late, as one: ``(longest delay s, bytes)``; None if none."""
+        with self._lock:
+            if not self.late:
+                return None
+            delay = max(d for d, _ in self.late)
+            data = b"".join(b for _, b in self.late)
+            self.late.clear()
+            return delay, data
+
+    def add_fault(
+        self, at: int, kind: str, servo_id: int | None = None, delay_s: float = 1.0
+    ) -> None:
         """Rehearse a fault at the ``at``-th instruction packet: a status lost or damaged
         (``drop_reply``, ``garble_reply``) or servo ``servo_id``'s hardware error (a key of
         :data:`HARDWARE_FAULT_BITS`). One place for a config's ``[[emulator.faults]]`` and the
@@ -785,6 +808,8 @@ class DynamixelBusEmulator(HostBaudDevice):
             self.hardware_faults.setdefault(at, []).append((int(servo_id or 0), kind))
         else:
             self.reply_faults[at] = kind
+            if kind == "delay_reply":
+                self.reply_delays[at] = delay_s
 
     def _reply(self, dxl_id: int, number: int = 0, params: bytes = b"") -> bytes:
         servo = self.servos[dxl_id]
@@ -889,6 +914,11 @@ class DynamixelBusEmulator(HostBaudDevice):
         return p2.ERR_INSTRUCTION, b""
 
 
+#: The SDK's reply window for a short status packet, ms (``LATENCY_TIMER * 2 + 2``, its
+#: ``PortHandler.setPacketTimeout`` without the bytes' wire time).
+SDK_REPLY_WINDOW_MS = 34.0
+
+
 class InProcessPort:
     """A stand-in for ``dynamixel_sdk.PortHandler`` wired straight to an emulator.
 
@@ -904,6 +934,7 @@ class InProcessPort:
         self.baudrate = 1_000_000
         self._rx = bytearray()
         self.tx_log: list[bytes] = []
+        self.packet_timeout = SDK_REPLY_WINDOW_MS
 
     def openPort(self) -> bool:
         """Opened at the current baud rate, as the SDK's ``openPort`` (1 Mbps unless set)."""
@@ -916,6 +947,7 @@ class InProcessPort:
 
     def clearPort(self) -> None:
         self._rx.clear()
+        self.emulator.take_late()  # a late status arriving before the clear: discarded too
 
     def setBaudRate(self, baudrate: int) -> bool:
         self.baudrate = baudrate
@@ -945,13 +977,20 @@ class InProcessPort:
         return len(data)
 
     def setPacketTimeout(self, packet_length: int) -> None:
-        pass
+        # the SDK's window (ms): only a ``delay_reply`` status is measured against it
+        self.packet_timeout = SDK_REPLY_WINDOW_MS
 
     def setPacketTimeoutMillis(self, msec: float) -> None:
-        pass
+        self.packet_timeout = msec
 
     def isPacketTimeout(self) -> bool:
-        return not self._rx
+        if self._rx:
+            return False
+        late = self.emulator.take_late()
+        if late is None:
+            return True
+        self._rx += late[1]  # it comes: within the host's window, or after it
+        return late[0] * 1000.0 > self.packet_timeout
 
 
 #: How fast the emulated arm's elevation joint falls once its torque goes off (degrees of

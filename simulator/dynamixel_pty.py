@@ -195,6 +195,10 @@ class PtyServoServer:
                 self.host_baud_device.host_baud = host_baud(master)
             reply = self.emulator.receive(data)
             ledger = self.ledger
+            if ledger is None and (late := self.emulator.take_late()) is not None:
+                time.sleep(late[0])  # a plain port: the late status after its delay, in time
+                with contextlib.suppress(OSError):
+                    _write_all(master, late[1])
             if ledger is not None:
                 with ledger.lock:
                     ledger.device_read += len(data)
@@ -272,6 +276,7 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
             with ledger.lock:
                 if ledger.device_read >= ledger.host_sent:
                     ledger.held.clear()
+                    self._server.emulator.take_late()
                     if ledger.host_got >= ledger.device_sent:
                         ledger.listening = False
                         return
@@ -294,6 +299,7 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
         ledger = self._ledger
         with ledger.lock:
             ledger.listening = False
+            self._server.emulator.take_late()  # arrived before the clear: discarded too
         self._take_waiting()
 
     def _take_waiting(self) -> None:
@@ -341,6 +347,12 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
         self._listen()
         with self._ledger.lock:
             over = self._ledger.quiet()
+            late = self._server.emulator.take_late() if over else None
+            if late is not None:
+                # a status on its way late (``delay_reply``, a slow link's): it comes, within
+                # the host's window if that is the longer, else just after it ends
+                self._server.send(late[1])
+                over = late[0] * 1000.0 > self.packet_timeout
         if over or self.getTimeSinceStart() > max(self.packet_timeout, LOST_LINK_S * 1000.0):
             self.packet_timeout = 0
             return True

@@ -293,7 +293,7 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     # [[emulator.faults]]: the status of the K-th instruction packet lost or damaged, or a
     # servo's hardware error (overload …) raised as that packet arrives
     for f in loaded.config.emulator.faults:
-        emulator.add_fault(f.at_command, f.kind, f.servo_id)
+        emulator.add_fault(f.at_command, f.kind, f.servo_id, f.delay_s)
     # the chain stays powered between commands: what its servos hold (torque, pose, RAM, an
     # error latched by an earlier command on this rig) is still there until a Reboot or a
     # power cycle (the recovery, check --reboot-faulted, had found a fresh servo with nothing

@@ -248,6 +248,7 @@ class EmulatorFault(_Strict):
 ARM_FAULT_KINDS = (
     "drop_reply",
     "garble_reply",
+    "delay_reply",
     "overload",
     "overheating",
     "input_voltage",
@@ -391,9 +392,10 @@ class RigConfig(_Strict):
             if fault.kind not in ARM_FAULT_KINDS:
                 raise ValueError(
                     f"emulator.faults[{i}].kind = {fault.kind!r}: the emulated servo bus "
-                    f"rehearses {', '.join(ARM_FAULT_KINDS[:2])} (the status packet of "
-                    "the at_command-th instruction packet the servos receive, lost or "
-                    f"damaged) and {', '.join(ARM_HARDWARE_FAULTS)} (a servo's hardware "
+                    f"rehearses {', '.join(ARM_FAULT_KINDS[:3])} (the status packet of "
+                    "the at_command-th instruction packet the servos receive, lost, "
+                    "damaged, or delay_s late, as on a slow USB-serial adapter) and "
+                    f"{', '.join(ARM_HARDWARE_FAULTS)} (a servo's hardware "
                     "error, on servo_id, as that packet arrives)"
                 )
             ids = [j.servo_id for j in (self.arm.dynamixel.azimuth, self.arm.dynamixel.elevation)]
