@@ -18,16 +18,18 @@ Known SDK behaviours handled here:
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import logging
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
 import dynamixel_sdk as sdk
 import serial
 
 from rti_rig.core.deferred_signals import signals_deferred
+from rti_rig.core.shell_words import shell_word
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.faults import (
@@ -40,6 +42,16 @@ from rti_rig.drivers.ports_present import ports_present_note
 from rti_rig.drivers.serial_ports import finish_close, identity, permission_denied_why
 
 log = logging.getLogger("rti_rig.dynamixel.traffic")
+
+#: How long (ms) the one retry of an exchange whose status did not come within the SDK's reply
+#: window waits for its status, and the wait before it for the late one. The SDK's window
+#: (``LATENCY_TIMER * 2 + 2`` = 34 ms plus the bytes' wire time, wall time) assumes an adapter
+#: whose latency timer is at most 16 ms and a host that reads at once; a slower adapter, or a
+#: host (or a pty emulator) too loaded to run within it, gets a present servo's status after
+#: the window. The retry had the same window, so two late statuses ended a check or a session
+#: with "its cable, or the servos' power supply was lost"; a servo that is really gone costs
+#: this once more before the error is said.
+PATIENT_REPLY_MS = 500.0
 
 #: SDK communication result codes by name, for error messages (COMM_RX_TIMEOUT, ...).
 COMM_NAMES = {getattr(sdk, n): n for n in dir(sdk) if n.startswith("COMM_")}
@@ -148,6 +160,9 @@ class DxlBus:
         self.answered: set[int] = set()
         #: the open port's file (device, inode), to tell it from a descriptor number reused
         self._opened_as: tuple[int, int] | None = None
+        #: ids whose status to the last command came after the SDK's window (then the retry's
+        #: was not in either): said as a slow link, not as a cable or power lost
+        self.late: set[int] = set()
 
     # -- port -------------------------------------------------------------------------------
     def open(self, baudrate: int) -> None:
@@ -256,6 +271,18 @@ class DxlBus:
     def _check(self, result: int, error: int, dxl_id: int, command: str, alert: bool = True):
         if result != sdk.COMM_SUCCESS:
             at = f" at {self.baudrate} baud" if self.baudrate else ""
+            if result == sdk.COMM_RX_TIMEOUT and dxl_id in self.late:
+                raise CommunicationError(
+                    self.device,
+                    f"{comm_text(self.ph, result)}{at}: its status came on "
+                    f"{self.port.getPortName()!r}, but late (after the SDK's reply window), and "
+                    f"the retry's did not come within {PATIENT_REPLY_MS:g} ms: the servo is "
+                    "there, its answers are slow to reach this computer, a slow USB-serial "
+                    f"adapter{_latency_note(self.port.getPortName())} or a computer too busy to "
+                    "read the port in time; close what loads it and run the command again",
+                    command,
+                    dxl_id,
+                )
             if result == sdk.COMM_RX_TIMEOUT and dxl_id in self.answered:
                 # it answered at this id and rate before: "check id and baud rate" had sent a
                 # user whose cable came out mid-session to a config that was right
@@ -329,6 +356,7 @@ class DxlBus:
         its status packet was lost or corrupt: reading twice changes nothing on the servo, and
         writing a register's value twice leaves it as writing it once does (Goal Position
         included: the servo plans its profile to the same goal from where it is)."""
+        self.late.discard(dxl_id)
         reply = call()
         if reply[-2] in self.RETRYABLE:
             # never a warning the command line would print raw beside its progress bar: a
@@ -342,16 +370,44 @@ class DxlBus:
                 what,
                 comm_text(self.ph, reply[-2]),
             )
+            late = False
             if reply[-2] == sdk.COMM_RX_TIMEOUT:
-                # a reply that was only late must not be read as the answer to a later command
-                self.drain_reply()
-            reply = call()
+                # a reply that was only late must not be read as the answer to a later command;
+                # one that comes is the sign of a slow link, not of a servo gone
+                late = self.drain_reply(PATIENT_REPLY_MS)
+                with self._patient():
+                    reply = call()
+            else:
+                reply = call()
+            if late and reply[-2] == sdk.COMM_RX_TIMEOUT:
+                self.late.add(dxl_id)
             if reply[-2] == sdk.COMM_SUCCESS:
                 lost = (
-                    "no status packet" if first == sdk.COMM_RX_TIMEOUT else "damaged status packet"
+                    "damaged status packet"
+                    if first != sdk.COMM_RX_TIMEOUT
+                    else "late status packet"
+                    if late
+                    else "no status packet"
                 )
                 self.resent.append(f"id {dxl_id} {what}: {lost}")
         return reply
+
+    @contextlib.contextmanager
+    def _patient(self) -> Iterator[None]:
+        """The SDK's reply windows set while inside last at least :data:`PATIENT_REPLY_MS`
+        (its exchanges set their own window, so the port's setter is wrapped)."""
+        port = self.port
+        own = port.setPacketTimeout
+
+        def patient(packet_length: int) -> None:
+            own(packet_length)
+            port.packet_timeout = max(float(getattr(port, "packet_timeout", 0)), PATIENT_REPLY_MS)
+
+        port.setPacketTimeout = patient
+        try:
+            yield
+        finally:
+            del port.setPacketTimeout
 
     # -- commands ---------------------------------------------------------------------------
     def ping(self, dxl_id: int, *, once: bool = False) -> int:
@@ -501,10 +557,14 @@ class DxlBus:
             )
         self.drain_reply()
 
-    def drain_reply(self) -> None:
-        """Read and discard one pending status packet, if any (bounded by the SDK timeout)."""
-        self.port.setPacketTimeout(11)
-        self.ph.rxPacket(self.port, False)
+    def drain_reply(self, wait_ms: float | None = None) -> bool:
+        """Read and discard one pending status packet, if any (bounded by the SDK timeout, or
+        ``wait_ms``); whether any byte of one came."""
+        if wait_ms is None:
+            self.port.setPacketTimeout(11)
+        else:
+            self.port.setPacketTimeoutMillis(wait_ms)
+        return self.ph.rxPacket(self.port, False)[1] != sdk.COMM_RX_TIMEOUT
 
     def sync_write(self, reg: ct.Register, values: Mapping[int, int]) -> None:
         """Same register on several servos in one broadcast packet (no reply to wait for)."""
@@ -564,6 +624,20 @@ def _span_name(address: int, length: int) -> str:
     return first.name if first is last else f"{first.name}..{last.name}"
 
 
+def _latency_note(port: str) -> str:
+    """`` (set its latency timer to 1 ms: COMMAND)`` for a USB-serial adapter whose latency
+    timer Linux shows (an FTDI's, 16 ms by default, which the SDK's window just covers), with
+    the real file of ``port``; "" where there is none (the command would be a template)."""
+    try:
+        name = os.path.basename(os.path.realpath(port))
+    except (OSError, ValueError):
+        return ""
+    timer = f"/sys/bus/usb-serial/devices/{name}/latency_timer"
+    if not name or not os.path.isfile(timer):
+        return ""
+    return f" (set its latency timer to 1 ms: echo 1 | sudo tee {shell_word(timer)})"
+
+
 def resends_said(resent: list[str]) -> str | None:
     """One line for the commands sent once more after their status packet was lost or damaged
     and then answered, counted by what was lost; None when there were none.
@@ -577,7 +651,8 @@ def resends_said(resent: list[str]) -> str | None:
     lost = [entry.rsplit(": ", 1)[-1] for entry in resent]
     counts = ", ".join(f"{lost.count(x)} {x}" for x in dict.fromkeys(lost))
     n = len(resent)
+    how = "lost, late or damaged" if "late status packet" in lost else "lost or damaged"
     return (
         f"The arm's servos were asked again {n} time{'s' if n != 1 else ''} after a status "
-        f"packet was lost or damaged ({counts}); each then answered."
+        f"packet was {how} ({counts}); each then answered."
     )

@@ -77,3 +77,38 @@ def test_a_clean_run_says_nothing_of_it(tmp_path: Path, caplog: pytest.LogCaptur
     assert r.exit_code == 0, said  # type: ignore[attr-defined]
     assert "asked again" not in said, said
     assert "arm_resent" not in json.loads((out / "manifest.json").read_text())["runner"]
+
+
+def _late(at: int, delay_s: float) -> str:
+    """The statuses of instruction packets ``at`` and ``at + 1`` (a command and its retry)
+    ``delay_s`` late: a slow USB-serial adapter, or a host too loaded to read in time."""
+    return "\n".join(
+        f'[[emulator.faults]]\nat_command = {k}\nkind = "delay_reply"\ndelay_s = {delay_s}'
+        for k in (at, at + 1)
+    )
+
+
+def test_a_status_late_past_the_sdks_window_is_waited_for_on_the_retry(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Statuses 100 ms late (past the SDK's 34 ms window) to a command and to its retry: the
+    retry had the same window, so the check aborted with "its cable … or the servos' power
+    supply was lost" (what a loaded machine did to the pty emulator). The retry now waits
+    PATIENT_REPLY_MS for it, and the status is counted as late, not lost."""
+    r, said = _invoke(["check", str(_config(tmp_path, _late(12, 0.1)))], caplog)
+    assert r.exit_code == 0, said  # type: ignore[attr-defined]
+    assert "RESULT: PASS" in said and "power supply was lost" not in said, said
+    assert "(1 late status packet); each then answered." in said, said
+
+
+def test_statuses_later_than_the_retry_waits_are_said_as_a_slow_link_not_a_lost_cable(
+    tmp_path: Path,
+) -> None:
+    """Late past the retry's wait too: the servo answered, so its cable and power are not
+    in question (they had been named as lost); the slow link is."""
+    cfg = _config(tmp_path, _late(12, 2.0))
+    r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1, said
+    assert "its status came on" in said and "but late (after the SDK's reply window)" in said
+    assert "a slow USB-serial adapter" in said and "power supply was lost" not in said, said
