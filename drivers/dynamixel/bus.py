@@ -624,7 +624,11 @@ def _span_name(address: int, length: int) -> str:
     return first.name if first is last else f"{first.name}..{last.name}"
 
 
-def _latency_note(port: str) -> str:
+#: Where Linux shows each USB-serial adapter's settings (its ``latency_timer`` among them).
+USB_SERIAL_DEVICES = "/sys/bus/usb-serial/devices"
+
+
+def _latency_note(port: str, devices: str = USB_SERIAL_DEVICES) -> str:
     """`` (set its latency timer to 1 ms: COMMAND)`` for a USB-serial adapter whose latency
     timer Linux shows (an FTDI's, 16 ms by default, which the SDK's window just covers), with
     the real file of ``port``; "" where there is none (the command would be a template)."""
@@ -632,7 +636,7 @@ def _latency_note(port: str) -> str:
         name = os.path.basename(os.path.realpath(port))
     except (OSError, ValueError):
         return ""
-    timer = f"/sys/bus/usb-serial/devices/{name}/latency_timer"
+    timer = os.path.join(devices, name, "latency_timer")
     if not name or not os.path.isfile(timer):
         return ""
     return f" (set its latency timer to 1 ms: echo 1 | sudo tee {shell_word(timer)})"

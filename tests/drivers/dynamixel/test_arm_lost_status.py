@@ -82,3 +82,24 @@ def test_an_arm_fault_the_servo_bus_cannot_rehearse_is_refused_naming_the_key(
     assert r.exit_code == 2, r.output
     assert "emulator.faults[0].kind = 'reset'" in r.output, r.output
     assert "drop_reply, garble_reply" in r.output and "overload" in r.output
+
+
+def test_a_slow_links_advice_names_the_adapters_own_latency_timer(tmp_path: Path) -> None:
+    """The latency timer is named with the file of the port's own adapter, ready to paste
+    (through a by-id link, as a config names the port); a port with none (a pty) is given no
+    command, never a template."""
+    from rti_rig.drivers.dynamixel.bus import _latency_note
+
+    tty = tmp_path / "dev" / "ttyUSB3"
+    tty.parent.mkdir()
+    tty.touch()
+    link = tmp_path / "usb-FTDI_U2D2-if00-port0"
+    link.symlink_to(tty)
+    devices = tmp_path / "sys devices"
+    (devices / "ttyUSB3").mkdir(parents=True)
+    (devices / "ttyUSB3" / "latency_timer").write_text("16\n")
+    timer = devices / "ttyUSB3" / "latency_timer"
+    assert _latency_note(str(link), str(devices)) == (
+        f" (set its latency timer to 1 ms: echo 1 | sudo tee '{timer}')"
+    )
+    assert _latency_note(str(tmp_path / "pts3"), str(devices)) == ""
