@@ -398,6 +398,7 @@ class DxlBus:
         (its exchanges set their own window, so the port's setter is wrapped)."""
         port = self.port
         own = port.setPacketTimeout
+        shadowed = vars(port).get("setPacketTimeout")  # a stand-in's own, put back after
 
         def patient(packet_length: int) -> None:
             own(packet_length)
@@ -407,7 +408,10 @@ class DxlBus:
         try:
             yield
         finally:
-            del port.setPacketTimeout
+            if shadowed is None:
+                del port.setPacketTimeout
+            else:
+                port.setPacketTimeout = shadowed
 
     # -- commands ---------------------------------------------------------------------------
     def ping(self, dxl_id: int, *, once: bool = False) -> int:
