@@ -99,6 +99,7 @@ from rti_rig.drivers.cameras.raw_decode import (
     decode_raw,
     exposure_stats,
     libraw_printed,
+    libraw_source,
 )
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
 from rti_rig.drivers.cameras.tiff_structure import (
@@ -289,7 +290,8 @@ def _read_capture_time(path: Path) -> tuple[bool, float | None]:
 
         # LibRaw prints its own line about a file cut short, naming it: kept off the
         # terminal (the file's decode says what is wrong with it, naming the folder's file)
-        with libraw_printed(str(path), []), rawpy.imread(str(path)) as raw:
+        name, source = libraw_source(path)  # its bytes where the path is not UTF-8
+        with libraw_printed(name, []), rawpy.imread(source) as raw:
             stamp = raw.other.timestamp
     except Exception as exc:  # no evidence yet, or none: the file's own decode says why
         unsupported = type(exc).__name__ == "LibRawFileUnsupportedError"

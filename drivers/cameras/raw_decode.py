@@ -225,13 +225,37 @@ def exposure_stats(
     }
 
 
-def _source(source: Path | str | bytes) -> tuple[str, Any]:
+def libraw_source(path: Path | str) -> tuple[str, str | io.BytesIO]:
+    """(the name LibRaw's printed lines give the file, what to hand ``rawpy.imread``) for the
+    file at ``path``: its path, or its bytes where the path is not UTF-8.
+
+    Why: rawpy hands LibRaw a ``str`` path encoded as UTF-8 (outside Windows), which a name
+    that is not UTF-8 cannot be (Python holds its bytes as lone surrogates): a RAW in a folder
+    named in Latin-1 (a tethering share on an old NAS, an archive unpacked with its Windows
+    names) raised UnicodeEncodeError from every read. LibRaw reads the same file from memory
+    (rawpy's file-object form) as it reads it from disk; other paths keep being read from
+    disk, as LibRaw needs them, not whole. Raises OSError if the file cannot be read."""
+    text = str(path)
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return LIBRAW_BUFFER_NAME, io.BytesIO(Path(path).read_bytes())
+    return text, text
+
+
+def _source(source: Path | str | bytes) -> tuple[Path | None, str, Any]:
+    """(the file read, None for bytes; the name LibRaw prints it by; what ``rawpy.imread``
+    is given) for :func:`decode_raw`'s ``source``."""
     if isinstance(source, bytes | bytearray):
-        return "<bytes>", io.BytesIO(bytes(source))
+        return None, LIBRAW_BUFFER_NAME, io.BytesIO(bytes(source))
     path = Path(source)
+    gone = "RAW file not found (moved or deleted before it was read)"
     if not path.is_file():
-        raise RawFileMissingError(path, "RAW file not found (moved or deleted before it was read)")
-    return str(path), str(path)
+        raise RawFileMissingError(path, gone)
+    try:
+        return (path, *libraw_source(path))
+    except FileNotFoundError:
+        raise RawFileMissingError(path, gone) from None
 
 
 def _iso_from_tiff(source: Path | str | bytes) -> float:
@@ -524,8 +548,7 @@ def decode_raw(
     ``metadata["decode"]`` is the provenance the session journals for each image.
     """
     settings = settings or RawDecodeSettings()
-    name, handle = _source(source)
-    read = None if name == "<bytes>" else Path(name)
+    read, printed_name, handle = _source(source)
     printed: list[str] = []  # LibRaw's own lines, kept off the terminal (libraw_printed)
     blind = None if read is None else read_blind(read)
     if blind is not None:  # before LibRaw, which decodes such a file without a word
@@ -536,7 +559,7 @@ def decode_raw(
         )
     try:
         with (
-            libraw_printed(LIBRAW_BUFFER_NAME if read is None else name, printed),
+            libraw_printed(printed_name, printed),
             rawpy.imread(handle) as raw,
         ):
             raw_vis = np.array(raw.raw_image_visible)  # uint16 copy out of LibRaw memory
@@ -652,8 +675,8 @@ def decode_raw(
     iso = float(other.iso_speed) or _iso_from_tiff(source)
     exposure = float(other.shutter_speed)
     if timestamp_s is None:
-        timestamp_s = Path(name).stat().st_mtime if name != "<bytes>" else 0.0
-    source_file = None if name == "<bytes>" else name
+        timestamp_s = read.stat().st_mtime if read is not None else 0.0
+    source_file = None if read is None else str(read)
     orientation = orientation_record(flip, _orientation_tag(source))
     decode = {
         "mode": settings.mode,
