@@ -58,6 +58,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rti_rig.core.shell_words import shown_path
 from rti_rig.reconstruct.errors import ReconstructionError
 
 #: A PTM's coefficients are stored for images scaled to 0–255: PTM viewers show the relit
@@ -288,6 +289,17 @@ def _drop_pages(array: Any) -> None:
         mm.madvise(mmap.MADV_DONTNEED)
 
 
+def _not_written(png: Path) -> str:
+    """The refusal of a map OpenCV did not write: the file as a word that pastes (through
+    :func:`shown_path`: a folder named in Latin-1 had been said with Python's lone surrogate,
+    ``caf\\udce9``, which no shell reads back), and what to check. OpenCV says a failed write
+    only by its return value, so no reason can be given."""
+    return (
+        f"could not write {shown_path(png)}: check the free space and that the folder is "
+        "writable, then run again"
+    )
+
+
 #: Rows of a map converted at a time for its PNG: the float temporaries (and the file-backed
 #: pages of a memmapped map, dropped after each chunk) stay around 1.5 MB at 2.5 MP instead of
 #: 12 MB each; the result does not depend on it (every pixel is converted on its own).
@@ -306,7 +318,7 @@ def write_normal_map(stem: Path, normals: NDArray[Any], npy: bool = True) -> lis
         )
         _drop_pages(normals)
     if not cv2.imwrite(os.fsencode(png), enc):
-        raise ReconstructionError(f"could not write {png}")
+        raise ReconstructionError(_not_written(png))
     path = stem.with_suffix(".npy")
     if npy:
         np.save(path, np.asarray(normals, dtype=np.float32))
@@ -326,7 +338,7 @@ def write_albedo(
         enc[top : top + ENCODE_ROWS] = np.clip(np.round(a / white * 65535.0), 0, 65535)
         _drop_pages(albedo)
     if not cv2.imwrite(os.fsencode(png), enc):
-        raise ReconstructionError(f"could not write {png}")
+        raise ReconstructionError(_not_written(png))
     path = stem.with_suffix(".npy")
     if npy:
         np.save(path, np.asarray(albedo, dtype=np.float32))

@@ -128,7 +128,7 @@ def _output_error(exc: OSError, req: FitRequest, out: Path, created: bool) -> Fi
     traceback ending in ``OSError: [Errno 27] File too large``."""
     code = errno.errorcode.get(exc.errno or 0, "")
     reason = f"{exc.strerror or exc}{f' ({code})' if code else ''}"
-    where = f" ({exc.filename})" if exc.filename else ""
+    where = f" ({shown_path(os.fsdecode(exc.filename))})" if exc.filename else ""
     left = "removed" if created else "emptied again"
     remedy = {
         errno.EFBIG: "raise the file-size limit (ulimit -f)",
@@ -1454,8 +1454,8 @@ def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
         # OpenCV says a failed write only by its return value: unchecked, qa.html showed a
         # map that was never written (a full disk, a folder that turned read-only)
         raise RtiRigError(
-            f"could not write {out / 'qa_coverage.png'}: check the free space and that the "
-            "folder is writable, then fit again"
+            f"could not write {shown_path(out / 'qa_coverage.png')}: check the free space and "
+            "that the folder is writable, then fit again"
         )
     (out / "qa.json").write_text(strict_dumps(qa.to_json(), indent=1) + "\n", encoding="utf-8")
     rows = "\n".join(_qa_row(c) for c in qa.images)
