@@ -8,6 +8,7 @@ a full disk or a read-only folder kept from being written was still shown by qa.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import cv2
@@ -27,8 +28,9 @@ def test_a_qa_map_that_could_not_be_written_fails_the_fit_by_name(
 ) -> None:  # type: ignore[no-untyped-def]
     real = cv2.imwrite
 
-    def refuse_qa_map(path: str, img, *args):  # type: ignore[no-untyped-def]
-        return False if path.endswith("qa_coverage.png") else real(path, img, *args)
+    def refuse_qa_map(path: bytes, img, *args):  # type: ignore[no-untyped-def]
+        # the path as OpenCV is given it: its bytes on disk (image io)
+        return False if os.fsdecode(path).endswith("qa_coverage.png") else real(path, img, *args)
 
     monkeypatch.setattr(fit_module.cv2, "imwrite", refuse_qa_map)
     out = tmp_path / "fit"
