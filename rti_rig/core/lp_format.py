@@ -6,10 +6,12 @@ line (at most 1000), then ``name x y z`` with one space, LF endings, unit vector
 ``1.0`` and exponents are never written; components are clamped to ±0.999999).
 
 The reader is tolerant of what real files contain (tabs, CRLF, trailing blanks, blank lines, a
-missing count line, non-unit vectors, which are renormalised; a UTF-8 or UTF-16 byte-order mark)
-and precise about what it rejects: every error names the file, the line and the reason, and where
-a known tool writes such a file (relight's "0 0 0" for a light it did not find, a dome's nameless
-"skeleton" list, relight's JSON dome) the error says which, so the fix is plain.
+missing count line, non-unit vectors, which are renormalised; a UTF-8 or UTF-16 byte-order mark;
+names that are not UTF-8, read as Latin-1, with or without a mark; DOS's end-of-file mark, Ctrl-Z,
+after the last line) and precise about what it rejects: every error names the file, the line and
+the reason, and where a known tool writes such a file (relight's "0 0 0" for a light it did not
+find, a dome's nameless "skeleton" list, relight's JSON dome) the error says which, so the fix is
+plain.
 
 Two flaws of real calibrated files are kept and *reported* (appended to ``notes``, each naming
 the file and line) rather than refused:
@@ -659,6 +661,25 @@ def _refuse_non_lp_text(content: list[tuple[int, str]], source: str) -> None:
         )
 
 
+#: DOS's end-of-file mark (Ctrl-Z, SUB): what old Windows tools end a text file with
+DOS_EOF = "\x1a"
+
+
+def _without_dos_eof(text: str) -> str:
+    """``text`` without the DOS end-of-file marks (Ctrl-Z, 0x1A) after its last line, and the
+    blanks around them.
+
+    Why: DOS's ``COPY /A`` and editors of its time end a text file with a Ctrl-Z (CP/M padded
+    a file's last 128-byte record with them), where DOS and Windows text readers stop: it is
+    no content, like a final CRLF, and is dropped without a note as a CRLF is. It had been
+    refused as a light line ("expected 'name x y z', found 1 field(s): '\\x1a'"), or, after
+    the last number with no line end, as "z component '0.8\\x1a' is not a number". One inside
+    the file is left for the line that holds it to be refused: what follows it may be a
+    light."""
+    stripped = text.rstrip()
+    return stripped.rstrip(DOS_EOF + " \t\r\n") if stripped.endswith(DOS_EOF) else text
+
+
 def parse_lp(
     text: str,
     source: str = "<lp>",
@@ -674,7 +695,7 @@ def parse_lp(
     appended to ``notes`` (``"FILE, line N: what and what was done"``) for the caller to show.
     """
     notes = notes if notes is not None else []
-    lines = text.splitlines()  # handles LF, CRLF and CR
+    lines = _without_dos_eof(text).splitlines()  # handles LF, CRLF and CR
     numbered = [(i + 1, ln.strip()) for i, ln in enumerate(lines)]
     content = [(n, ln) for n, ln in numbered if ln]
     comments = [n for n, ln in content if ln.startswith("#")]
@@ -842,14 +863,19 @@ def _decode(raw: bytes) -> str:
     "UTF-8 with BOM") or UTF-16 (Notepad's "Unicode"; what Windows PowerShell 5.1's ``>`` and
     ``Out-File`` write by default), which relight reads (Qt's QTextStream detects the mark) and
     which had been refused as ``count line 'ÿþ1\\x008\\x00'``. Without a mark, UTF-8, else
-    Latin-1 (a Windows tool's ANSI names), which never fails."""
+    Latin-1 (a Windows tool's ANSI names), which never fails.
+
+    A UTF-8 mark before names that are not UTF-8 (ANSI names added to a file an editor had
+    saved as "UTF-8 with BOM") is read as each is alone: the mark dropped, the rest Latin-1. It
+    had been kept as Latin-1 text and the file refused at its ``count line 'ï»¿48'``, a reason
+    that was not the file's; no Latin-1 file begins with those three letters."""
     if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
         with contextlib.suppress(UnicodeDecodeError):  # cut off mid-character: NULs, said
             return raw.decode("utf-16")
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError:
-        return raw.decode("latin-1")
+        return raw.removeprefix(codecs.BOM_UTF8).decode("latin-1")
 
 
 def directions_of(entries: Iterable[LpEntry]) -> NDArray[np.float64]:

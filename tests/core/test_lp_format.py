@@ -397,6 +397,13 @@ def test_utf8_bom_from_windows_editors_reads(tmp_path: Path) -> None:
     assert [e.name for e in read_lp(p)] == ["a_1.jpg", "a_2.jpg"]
 
 
+def test_a_dos_eof_inside_the_file_is_still_refused_on_its_line() -> None:
+    """Only Ctrl-Z after the last line is DOS's end-of-file mark: one with a light after it is
+    no end of the file, and is refused on its line rather than the light dropped."""
+    with pytest.raises(LpFormatError, match=r"line 3: expected 'name x y z', found 1 field"):
+        parse_lp("2\na_1.jpg 0 0 1\n\x1a\na_2.jpg 0 0.6 0.8\n\x1a", "eof.lp")
+
+
 def test_utf16_from_windows_powershell_or_notepad_reads(tmp_path: Path) -> None:
     """Windows PowerShell 5.1's ``>`` and ``Out-File`` write UTF-16 with a byte-order mark by
     default, as does Notepad's "Unicode"; relight reads such a file (Qt's QTextStream detects
