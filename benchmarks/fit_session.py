@@ -19,6 +19,7 @@ prints the peak memory as the lights grow (square images of ``--width``).
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
 import subprocess
 import sys
@@ -88,7 +89,8 @@ def make_twins(session: Path, jpeg: Path, zlib: Path) -> None:
         px = tifffile.imread(tif)
         write_linear_tiff(zlib / "linear" / tif.name, px, compression="zlib")
         srgb = linear_to_srgb8(px, 65535)
-        cv2.imwrite(str(jpeg / f"{tif.stem}.jpg"), srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
+        jpg = os.fsencode(jpeg / f"{tif.stem}.jpg")  # bytes: OpenCV crashes on a str not UTF-8
+        cv2.imwrite(jpg, srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
 
 
 def folder_mb(path: Path) -> float:
@@ -182,7 +184,7 @@ def make_jpeg_session(root: Path, width: int, height: int, n: int) -> Path:
         srgb = linear_to_srgb8(np.clip(np.round(img * 65535), 0, 65535).astype(np.uint16), 65535)
         srgb = cv2.resize(srgb, (width, height), interpolation=cv2.INTER_LINEAR)
         name = f"image_{i + 1:03d}.jpg"
-        cv2.imwrite(str(root / name), srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
+        cv2.imwrite(os.fsencode(root / name), srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
         entries.append(LpEntry(name, tuple(float(x) for x in d)))
     write_lp(root / "lights.lp", entries)
     return root

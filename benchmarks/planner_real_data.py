@@ -35,6 +35,7 @@ the repository; writes the results section of docs/research/planner.md).
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from dataclasses import dataclass
@@ -83,7 +84,7 @@ def load(data: Path) -> tuple[DomeGeometry, np.ndarray, list[np.ndarray]]:
     entries = read_lp(data / "dirs.lp")
     dirs = np.array([e.direction for e in entries])
     names = tuple(e.name for e in entries)
-    rgb8 = [cv2.cvtColor(cv2.imread(str(data / n)), cv2.COLOR_BGR2RGB) for n in names]
+    rgb8 = [cv2.cvtColor(cv2.imread(os.fsencode(data / n)), cv2.COLOR_BGR2RGB) for n in names]
     lum = np.stack([srgb_to_linear(im / 255.0) @ REC709 for im in rgb8])
     return DomeGeometry(dirs, names), lum.astype(np.float32), rgb8
 

@@ -119,7 +119,8 @@ def cli_inputs(folder: Path) -> tuple[Path, Path]:
     scene = relief_scene(96, 128, seed=0)
     image = lambert_radiance(scene, direction_from_az_el(30.0, 50.0))
     png = folder / "preview.png"
-    cv2.imwrite(str(png), np.round(image / image.max() * 65535).astype(np.uint16)[..., ::-1])
+    encoded = np.round(image / image.max() * 65535).astype(np.uint16)[..., ::-1]
+    cv2.imwrite(os.fsencode(png), encoded)  # bytes: OpenCV crashes on a str that is not UTF-8
     lp = folder / "dome200.lp"
     dirs = fibonacci_cap(200, 5.0)
     lp.write_text(
