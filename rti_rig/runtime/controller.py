@@ -606,11 +606,11 @@ def _checked_real_size(
             DeviceSays(
                 rig.camera.name,
                 f"The camera delivers {got[1]} x {got[0]} px images, but camera.width x "
-                f"camera.height in {rig.loaded.path} say {cam.width} x {cam.height} px: set "
-                f"camera.width = {width} and camera.height = {height} there (the real size "
-                "is recorded in the session's manifest: a --resume takes either). The disk "
-                f"was checked for images of the config's size; the {left} image(s) left are "
-                "checked again at the real size",
+                f"camera.height in {shown_path(rig.loaded.path)} say {cam.width} x "
+                f"{cam.height} px: set camera.width = {width} and camera.height = {height} "
+                "there (the real size is recorded in the session's manifest: a --resume "
+                "takes either). The disk was checked for images of the config's size; the "
+                f"{left} image(s) left are checked again at the real size",
             )
         )
         folder.manifest.setdefault("rig", {})[FRAME_SIZE_KEY] = {
