@@ -119,11 +119,22 @@ class ReplayCamera:
                 )
             source = str(path)
         self._clock.sleep(exposure_s + self._readout_s + self._transfer_s)
+        metadata: dict[str, object] = {
+            "source": "replay",
+            "replayed_image": source,
+            "exposure_modelled": False,
+        }
+        if source is not None:
+            # the recorded file is the step's camera file: the session copies it whole under
+            # raw/ with its checksum, as a watched folder's or a DSLR's (an 8-bit JPEG's own
+            # bytes cannot be re-encoded: without this a replay held only a re-encoding)
+            # ("copy": the user's file, never moved, wherever it lies)
+            metadata["originals"] = [{"path": source, "name": path.name, "copy": True}]
         return Frame(
             pixels=pixels,
             exposure_s=exposure_s,
             gain=1.0,
             white_level=WHITE,
             timestamp_s=t0,
-            metadata={"source": "replay", "replayed_image": source, "exposure_modelled": False},
+            metadata=metadata,
         )

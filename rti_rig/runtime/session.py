@@ -797,8 +797,8 @@ class SessionFolder:
         root = self.root.resolve()
         for item in frame.metadata.get("originals") or []:
             src = Path(item["path"])
-            if not src.is_file() or not src.resolve().is_relative_to(root):
-                continue  # a watched folder's own file: another program's, left where it is
+            if item.get("copy") or not src.is_file() or not src.resolve().is_relative_to(root):
+                continue  # a watched folder's (or a replay's) own file: left where it is
             raw_rel = f"recovered/{stamp}/{RAW_DIR}/{src.name}"
             try:
                 (self.root / raw_rel).parent.mkdir(parents=True, exist_ok=True)
@@ -1083,7 +1083,10 @@ class SessionFolder:
                 raise SessionError(
                     f"{shown_path(dest)} already exists: refusing to overwrite a captured file"
                 )
-            kept[rel] = (_take_whole(src, dest, root), str(item.get("name") or src.name))
+            # a replay's recorded file is the user's acquisition: copied, never moved, even
+            # from inside the session folder (``"copy": True``)
+            owner = None if item.get("copy") else root
+            kept[rel] = (_take_whole(src, dest, owner), str(item.get("name") or src.name))
         return kept
 
     def _keep_strays(self, base: str, strays: list[dict[str, Any]]) -> dict[str, dict[str, str]]:
@@ -1509,16 +1512,17 @@ def stopped_before_journal_line(scan: JournalScan) -> str | None:
     return stem if int(last["index"]) == after and last["image"] == f"{stem}.jpg" else None
 
 
-def _take_whole(src: Path, dest: Path, root: Path) -> str:
+def _take_whole(src: Path, dest: Path, root: Path | None) -> str:
     """Put the camera's file ``src`` at ``dest`` whole and return its SHA-256.
 
     A download staged inside the session (``root``, e.g. raw/.incoming) may be the only copy
     (the camera may have deleted its own): it is checksummed where it lies, then renamed in one
-    step, so at every moment it is whole under one of its two names; one from elsewhere is
-    copied whole. An OSError is the session's write error, naming ``dest``."""
+    step, so at every moment it is whole under one of its two names; one from elsewhere (or
+    any, when ``root`` is None) is copied whole. An OSError is the session's write error,
+    naming ``dest``."""
     try:
         dest.parent.mkdir(parents=True, exist_ok=True)
-        if src.resolve().is_relative_to(root):
+        if root is not None and src.resolve().is_relative_to(root):
             digest = _fsync_sha256(src)
             os.replace(src, dest)
             return digest
