@@ -9,8 +9,9 @@ controller gets the figure through :attr:`rti_rig.runtime.rig.Rig.bytes_per_imag
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 
-from rti_rig.app.config import LoadedRig, camera_device_settings
+from rti_rig.app.config import LoadedRig, camera_device_settings, rig_geometry
 from rti_rig.runtime.session import estimated_bytes_per_image
 
 
@@ -18,7 +19,8 @@ def bytes_per_image(loaded: LoadedRig) -> int:
     """The bound :func:`~rti_rig.runtime.session.estimated_bytes_per_image` gives for this
     rig's camera: a RAW camera (``gphoto2``, ``folder_watch``) by its decode mode, with its
     RAW kept in the session's ``raw/`` (and the camera's JPEG with ``keep_jpeg``); any other
-    camera, a full-size 16-bit RGB TIFF and its JPEG."""
+    camera, a full-size 16-bit RGB TIFF and its JPEG; a replay's, plus its largest recorded
+    file, which the session keeps a copy of in ``raw/``."""
     cam = loaded.config.camera
     return _bytes_for(loaded, cam.width, cam.height)
 
@@ -53,7 +55,7 @@ def _bytes_for(loaded: LoadedRig, width: int, height: int) -> int:
     """:func:`bytes_per_image` for a sensor of ``width`` x ``height``."""
     mode = _decode_mode(loaded)
     if mode is None:  # a camera that delivers frames, not RAW files (opencv), or a dry run
-        return estimated_bytes_per_image(width, height)
+        return estimated_bytes_per_image(width, height) + _recorded_file_bytes(loaded)
     settings = camera_device_settings(loaded)
     return estimated_bytes_per_image(
         width,
@@ -62,3 +64,24 @@ def _bytes_for(loaded: LoadedRig, width: int, height: int) -> int:
         kept_raw=True,
         kept_jpeg=bool(getattr(settings, "keep_jpeg", False)),
     )
+
+
+def _recorded_file_bytes(loaded: LoadedRig) -> int:
+    """A replay rig's largest recorded file (and a file's overhead), which each step copies
+    whole into the session's ``raw/``; 0 for any other rig.
+
+    Why: a replay's session keeps its recorded files byte for byte (a 16-bit TIFF source as
+    large as the session's own TIFF); uncounted, a disk that cannot hold them was let
+    through, to fill mid-session."""
+    if loaded.config.backend != "replay":
+        return 0
+    from rti_rig.core.lp_format import image_path
+
+    folder = Path(loaded.path).parent
+    largest = 0
+    for name in rig_geometry(loaded).names:
+        try:
+            largest = max(largest, image_path(folder, name).stat().st_size)
+        except OSError:  # a missing file is refused by the run's image check, not here
+            continue
+    return largest + 16_384

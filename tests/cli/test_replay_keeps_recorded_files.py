@@ -91,3 +91,13 @@ def test_a_resumed_replay_holds_them_too(tmp_path: Path) -> None:
     _holds_the_recorded_files(lp.parent, out)
     aside = list((out / "recovered").glob("*/raw/image_004.jpg"))
     assert [p.read_bytes() for p in aside] == [b"half a copy"]  # set aside, not lost
+
+
+def test_a_replays_disk_check_counts_the_recorded_files(tmp_path: Path) -> None:
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.app.disk_estimate import bytes_per_image
+    from rti_rig.runtime.session import estimated_bytes_per_image
+
+    lp = _acquisition(tmp_path / "acq")
+    largest = max((lp.parent / n).stat().st_size for n in NAMES)  # the 16-bit TIFF
+    assert bytes_per_image(load_rig_config(lp)) >= estimated_bytes_per_image(32, 24) + largest
