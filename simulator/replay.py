@@ -3,6 +3,11 @@
 With the simulated dome of the same `.lp`, a real acquisition becomes a rig, so that every
 planner (adaptive or not) can be rehearsed on real data. What the session then holds:
 
+* **The recorded files, byte for byte**: each frame hands its recorded file to the session as
+  the step's camera original (``metadata["originals"]``, marked ``"copy"``: the user's file is
+  copied, never moved), which the session keeps under ``raw/`` with the step's name and its
+  sha256 journaled, as a watched folder's or a DSLR's files. Whatever its format, the session
+  holds the real image; the files below are the session's own, made from its pixels.
 * **16-bit sources** (linear TIFF or PNG): the frame *is* the recorded pixels, so the session's
   linear TIFF holds exactly the source's pixels (and, for a source written by rti-rig, the same
   bytes: same writer, same settings).
@@ -11,7 +16,8 @@ planner (adaptive or not) can be rehearsed on real data. What the session then h
   a table chosen so that the session's own sRGB encoding
   (:func:`rti_rig.core.image_files.linear_to_srgb8`) gives back exactly the decoded pixels: the
   session's linear TIFF, encoded as the session encodes it, is pixel-identical to the decoded
-  source JPEG. The session's JPEG is a re-encoding (quality 95) and is not byte-identical.
+  source JPEG. The session's JPEG is a re-encoding (quality 95) and is not byte-identical
+  (the source's bytes are its copy in ``raw/``).
 
 Exposure is not modelled: the recorded image is returned whatever exposure is asked (it is
 noted in the frame's metadata). Capturing advances the injected clock as a camera would.
