@@ -80,3 +80,20 @@ def test_a_free_name_skips_what_is_taken_a_broken_link_too(tmp_path: Path) -> No
     assert free_folder_beside(session, "fit") == tmp_path / "scan v1.2-fit"
     (tmp_path / "scan v1.2-fit").mkdir()
     assert free_folder_beside(session, "fit") == tmp_path / "scan v1.2-fit-2"
+
+
+def test_a_folder_beside_a_session_given_as_dot_or_dotdot_is_named_from_its_real_name(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A session given as ``.`` (``rti-rig fit .`` from inside it) or ``..`` has no name to
+    add ``-fit`` to: ``Path('.').with_name`` raised ValueError (a traceback in a hint), and
+    ``..-fit`` named a folder nobody meant. The folder is named from the absolute path."""
+    session = tmp_path / "scan 3"
+    (session / "images").mkdir(parents=True)
+    monkeypatch.chdir(session)
+    assert free_folder_beside(Path("."), "fit") == tmp_path / "scan 3-fit"
+    monkeypatch.chdir(session / "images")
+    assert free_folder_beside(Path(".."), "fit") == tmp_path / "scan 3-fit"
+    (tmp_path / "scan 3-fit").mkdir()
+    assert free_folder_beside(Path(".."), "again") == tmp_path / "scan 3-again"
+    assert free_folder_beside(Path("../."), "fit") == tmp_path / "scan 3-fit-2"
