@@ -25,7 +25,6 @@ would otherwise cost seconds.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -34,6 +33,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.core import opencv_files
 from rti_rig.core.errors import ConfigError, ScheduleError
 from rti_rig.core.geometry import direction_from_az_el, normalize
 from rti_rig.core.image_files import (
@@ -110,7 +110,7 @@ def read_preview(path: Path) -> NDArray:
     tiff = _read_tiff_preview(p)
     if tiff is not None:
         return tiff
-    img = cv2.imread(os.fsencode(p), cv2.IMREAD_UNCHANGED)
+    img = opencv_files.imread(p)
     if img is None:
         raise ScheduleError(
             f"{shown_path(p)}: cannot read this file as an image (JPEG, PNG or TIFF)"

@@ -20,7 +20,6 @@ specular lobe and the flat plate pays for neither shadows nor specular.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +28,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rti_rig.core import opencv_files
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.shell_words import shown_path
 
@@ -589,7 +589,7 @@ def _read_map(path: Path) -> NDArray:
 
             data = tifffile.imread(path)
         else:
-            data = cv2.imread(os.fsencode(path), cv2.IMREAD_UNCHANGED)
+            data = opencv_files.imread(path)
             if data is None:
                 raise SceneError(
                     f"{shown_path(path)}: not an image OpenCV can read (try .npy, .tif, .png)"

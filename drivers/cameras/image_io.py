@@ -8,15 +8,14 @@ explicit response curve: ``"srgb"`` (inverse sRGB) or ``"linear"`` (the user ass
 
 from __future__ import annotations
 
-import os
 import struct
 from pathlib import Path
 from typing import Any, Literal
 
-import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.core import opencv_files
 from rti_rig.core.errors import CaptureError
 from rti_rig.core.image_files import (
     SeveralFullSizeImages,
@@ -282,7 +281,7 @@ def read_image_file(path: Path, device: str) -> NDArray:
         # a planar TIFF (Photoshop's "Per Channel") decodes samples first, (3, H, W): it had
         # been refused mid-run as an image of the wrong shape, as the core reader puts it right
         return tiff_samples_last(image, page is not None and tiff_is_planar(page))
-    img = cv2.imread(os.fsencode(path), cv2.IMREAD_UNCHANGED)
+    img = opencv_files.imread(path)
     if img is None:
         raise ImageReadError(device, path, "", is_tiff=False)
     return opencv_as_stored(img, path)  # grey + alpha as grey, BGR(A) -> RGB, alpha dropped

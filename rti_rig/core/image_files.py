@@ -631,11 +631,11 @@ def refuse_truncated_jpeg(path: Path) -> None:
 
 
 def read_jpeg_rgb(path: Path) -> NDArray[np.uint8]:
-    import cv2
+    from rti_rig.core import opencv_files  # OpenCV imported only when needed
 
     if Path(path).is_file():
         refuse_truncated_jpeg(path)  # before OpenCV, which decodes it with a grey part
-    img = cv2.imread(os.fsencode(path), cv2.IMREAD_UNCHANGED)
+    img = opencv_files.imread(path)
     if img is None:
         raise SessionError(f"cannot read image {shown_path(path)}")
     return img[..., ::-1] if img.ndim == 3 else img
@@ -715,12 +715,12 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
         if img.dtype not in (np.uint8, np.uint16) or img.ndim not in (2, 3):
             raise SessionError(_not_8_or_16_bit(p, img.dtype, img.shape))
         return colour_or_grey(img)
-    import cv2
+    from rti_rig.core import opencv_files
 
     if not p.is_file():  # said here, before OpenCV prints its own warning line about it
         raise SessionError(f"cannot read image {shown_path(p)}: there is no such file")
     refuse_truncated_jpeg(p)  # before OpenCV, which decodes it with a grey part
-    img = cv2.imread(os.fsencode(p), cv2.IMREAD_UNCHANGED)
+    img = opencv_files.imread(p)
     if img is None:
         raise SessionError(
             f"cannot read image {shown_path(p)} (missing, or not an image OpenCV decodes)"

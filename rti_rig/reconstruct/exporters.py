@@ -49,15 +49,14 @@ from __future__ import annotations
 
 import json
 import mmap
-import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rti_rig.core import opencv_files
 from rti_rig.core.shell_words import shown_path
 from rti_rig.reconstruct.errors import ReconstructionError
 
@@ -317,7 +316,7 @@ def write_normal_map(stem: Path, normals: NDArray[Any], npy: bool = True) -> lis
             np.round((n[..., ::-1] + 1.0) * 0.5 * 65535.0), 0, 65535
         )
         _drop_pages(normals)
-    if not cv2.imwrite(os.fsencode(png), enc):
+    if not opencv_files.imwrite(png, enc):
         raise ReconstructionError(_not_written(png))
     path = stem.with_suffix(".npy")
     if npy:
@@ -337,7 +336,7 @@ def write_albedo(
             a = a[..., ::-1]
         enc[top : top + ENCODE_ROWS] = np.clip(np.round(a / white * 65535.0), 0, 65535)
         _drop_pages(albedo)
-    if not cv2.imwrite(os.fsencode(png), enc):
+    if not opencv_files.imwrite(png, enc):
         raise ReconstructionError(_not_written(png))
     path = stem.with_suffix(".npy")
     if npy:

@@ -42,6 +42,7 @@ from rti_rig.app.usecases.fit_outlook import auto_way_out, fit_outlook
 from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.app.usecases.fit_signal import no_signal_warning
 from rti_rig.app.usecases.session_integrity import with_lost_files
+from rti_rig.core import opencv_files
 from rti_rig.core.acquisition_images import check_image_files
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, PHOTOMETRIC_STEREO, AutoFit, auto_models
@@ -1450,7 +1451,7 @@ def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
         cv2.COLORMAP_VIRIDIS,
     )
     cov_img[qa.coverage < 3] = (0, 0, 255)
-    if not cv2.imwrite(os.fsencode(out / "qa_coverage.png"), cov_img):
+    if not opencv_files.imwrite(out / "qa_coverage.png", cov_img):
         # OpenCV says a failed write only by its return value: unchecked, qa.html showed a
         # map that was never written (a full disk, a folder that turned read-only)
         raise RtiRigError(

@@ -18,13 +18,14 @@ ordinary way, which tells the two apart (None on failure). Where the overload do
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import cv2
 import numpy as np
 
+from rti_rig.core import opencv_files
 from rti_rig.core.image_files import png_colour_type
+from rti_rig.core.opencv_files import opencv_name
 
 
 def imread_rgb(path: Path, into: np.ndarray | None = None) -> np.ndarray | None:
@@ -59,7 +60,7 @@ def imread_into(path: Path, buffer: np.ndarray) -> np.ndarray | None:
     canary = np.invert(buffer[-1])
     buffer[-1] = canary
     try:
-        img = cv2.imread(os.fsencode(path), buffer, cv2.IMREAD_UNCHANGED)
+        img = cv2.imread(opencv_name(path), buffer, cv2.IMREAD_UNCHANGED)
     except (cv2.error, TypeError):  # OpenCV < 4.10: no decoding into a given array
         return _imread(path)
     if img is None or img.size == 0:
@@ -70,5 +71,5 @@ def imread_into(path: Path, buffer: np.ndarray) -> np.ndarray | None:
 
 
 def _imread(path: Path) -> np.ndarray | None:
-    img = cv2.imread(os.fsencode(path), cv2.IMREAD_UNCHANGED)
+    img = opencv_files.imread(path)
     return None if img is None or img.size == 0 else img
