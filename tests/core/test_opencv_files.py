@@ -71,3 +71,19 @@ def test_a_name_not_utf8_is_written_and_read_back(
     assert np.array_equal(opencv_files.imread(png), _image())
     assert opencv_files.imread(folder / "missing.png") is None
     assert not opencv_files.imwrite(folder / "none" / "img.png", _image())
+
+
+def test_a_map_that_could_not_be_written_is_named_as_a_shell_reads_it(tmp_path: Path) -> None:
+    """``could not write`` named the file by Python's str of it: in a folder whose name is not
+    UTF-8, ``caf\\udce9/...``, which no shell reads back; it goes through shown_path now."""
+    from rti_rig.core.shell_words import shown_path
+    from rti_rig.reconstruct.errors import ReconstructionError
+    from rti_rig.reconstruct.exporters import write_albedo, write_normal_map
+
+    gone = tmp_path / NOT_UTF8 / "fit"  # no such folder: OpenCV's write fails
+    normals = np.zeros((4, 5, 3), np.float32)
+    for write in (write_normal_map, write_albedo):
+        with pytest.raises(ReconstructionError) as refused:
+            write(gone / "map", normals)
+        assert f"could not write {shown_path(gone / 'map.png')}" in str(refused.value)
+        assert "\udce9" not in str(refused.value)
