@@ -19,7 +19,6 @@ prints the peak memory as the lights grow (square images of ``--width``).
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
 import subprocess
 import sys
@@ -30,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.report import machine_line, write_section
+from rti_rig.core import opencv_files
 from rti_rig.core.image_files import write_linear_tiff
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
@@ -89,8 +89,8 @@ def make_twins(session: Path, jpeg: Path, zlib: Path) -> None:
         px = tifffile.imread(tif)
         write_linear_tiff(zlib / "linear" / tif.name, px, compression="zlib")
         srgb = linear_to_srgb8(px, 65535)
-        jpg = os.fsencode(jpeg / f"{tif.stem}.jpg")  # bytes: OpenCV crashes on a str not UTF-8
-        cv2.imwrite(jpg, srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
+        jpg = jpeg / f"{tif.stem}.jpg"  # opencv_files: a name not UTF-8 crashes OpenCV as a str
+        opencv_files.imwrite(jpg, srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
 
 
 def folder_mb(path: Path) -> float:
@@ -184,7 +184,7 @@ def make_jpeg_session(root: Path, width: int, height: int, n: int) -> Path:
         srgb = linear_to_srgb8(np.clip(np.round(img * 65535), 0, 65535).astype(np.uint16), 65535)
         srgb = cv2.resize(srgb, (width, height), interpolation=cv2.INTER_LINEAR)
         name = f"image_{i + 1:03d}.jpg"
-        cv2.imwrite(os.fsencode(root / name), srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
+        opencv_files.imwrite(root / name, srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
         entries.append(LpEntry(name, tuple(float(x) for x in d)))
     write_lp(root / "lights.lp", entries)
     return root

@@ -35,7 +35,6 @@ the repository; writes the results section of docs/research/planner.md).
 
 from __future__ import annotations
 
-import os
 import sys
 import time
 from dataclasses import dataclass
@@ -45,6 +44,7 @@ import cv2
 import numpy as np
 
 from benchmarks.metrics import angular_error_map, relight_psnr, relight_ssim
+from rti_rig.core import opencv_files
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import DomeGeometry
@@ -84,7 +84,8 @@ def load(data: Path) -> tuple[DomeGeometry, np.ndarray, list[np.ndarray]]:
     entries = read_lp(data / "dirs.lp")
     dirs = np.array([e.direction for e in entries])
     names = tuple(e.name for e in entries)
-    rgb8 = [cv2.cvtColor(cv2.imread(os.fsencode(data / n)), cv2.COLOR_BGR2RGB) for n in names]
+    bgr8 = [opencv_files.imread(data / n, cv2.IMREAD_COLOR) for n in names]
+    rgb8 = [cv2.cvtColor(im, cv2.COLOR_BGR2RGB) for im in bgr8]
     lum = np.stack([srgb_to_linear(im / 255.0) @ REC709 for im in rgb8])
     return DomeGeometry(dirs, names), lum.astype(np.float32), rgb8
 

@@ -24,6 +24,7 @@ import cv2
 import numpy as np
 
 from benchmarks.report import machine_line, write_section
+from rti_rig.core import opencv_files
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
@@ -120,7 +121,7 @@ def cli_inputs(folder: Path) -> tuple[Path, Path]:
     image = lambert_radiance(scene, direction_from_az_el(30.0, 50.0))
     png = folder / "preview.png"
     encoded = np.round(image / image.max() * 65535).astype(np.uint16)[..., ::-1]
-    cv2.imwrite(os.fsencode(png), encoded)  # bytes: OpenCV crashes on a str that is not UTF-8
+    opencv_files.imwrite(png, encoded)  # a name not UTF-8 crashes OpenCV as a str
     lp = folder / "dome200.lp"
     dirs = fibonacci_cap(200, 5.0)
     lp.write_text(
