@@ -372,16 +372,19 @@ def run(
         with _sigterm_exit_wins(late_term):
             opened, handover = _open_for_capture(opening)
             unsafe = _execute(opened, handover)
-        if late_term:  # the summary is out; the verdict, not computed, is fit's to give
+        # a SIGTERM held as the summary printed, or a second Ctrl-C once the capture had
+        # ended (it stopped no image: the manifest keeps the capture's end, "completed")
+        late = late_term[0] if late_term else opened.stopped_once_over
+        if late is not None:  # the summary is out; the verdict, not computed, is fit's to give
             _refuse_unsafe_end(unsafe, exit_code=None)
             err.print(
-                f"[yellow]Stopped ({stop_words(late_term[0])}) once the session had ended: it "
+                f"[yellow]Stopped ({stop_words(late)}) once the session had ended: it "
                 "is complete; its QA "
                 "verdict was not computed:[/] "
                 f"{escape(_fit_next(opened.out_dir))} gives it",
                 soft_wrap=True,
             )
-            raise typer.Exit(code=stop_exit_code(late_term[0]))
+            raise typer.Exit(code=stop_exit_code(late))
         # the verdict is not computed: the stop asked for no more
         _exit_if_park_stopped(
             opened,
@@ -1590,6 +1593,21 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
                 f"[yellow]Ctrl-C also arrived: the stop ({began}) is already under way "
                 "(switching the lights off, writing its records).[/]"
             )
+            return
+        if cancel.cancelled and cancel.over and not within_after_a_stop():
+            # a second Ctrl-C once the capture has ended (held by the teardown, delivered once
+            # it is done) stops no image: the manifest keeps how the capture ended ("cancelled"
+            # after the first's image, or "completed") and the teardown ran as that end's, not
+            # an emergency's. Raised here, it had been said "Emergency stop (second Ctrl-C)"
+            # above that manifest: said in one line, the stop that began it stands; a complete
+            # session stops before its verdict, as for a late SIGTERM (``run``: exit 130, "it
+            # is complete"). A park it cut short is said by the arm's line; while the teardown
+            # reopens a port (after_a_stop) it still escalates, below
+            if _park_stopped_by(opened.rig) is None:
+                opened.stopped_once_over = signal.SIGINT
+                if not late_said:
+                    late_said = True
+                    err.print(f"[yellow]{_LATE_CTRL_C}[/]")
             return
         if cancel.cancelled:
             ended = not started  # stopped before the capture began: it never will

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import signal
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -180,6 +181,10 @@ class OpenedSession:
     #: the finish reason of the stop that left the capture's ``with`` (an emergency stop, a
     #: Ctrl-C), for :meth:`close` to record where it cut the run's end; None: no stop
     cut_by: str | None = None
+    #: a stop the user insisted on (a second Ctrl-C) once the capture had ended, which stopped
+    #: no image: the command's run stops after its summary (no QA verdict), exit 128 + its
+    #: number, while the manifest keeps how the capture ended; None: none came
+    stopped_once_over: signal.Signals | None = None
 
     @property
     def dry_run(self) -> bool:

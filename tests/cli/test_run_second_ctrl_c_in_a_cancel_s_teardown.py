@@ -1,0 +1,78 @@
+"""A second Ctrl-C that lands once a run stopped by a first one has ended its capture (held by
+the teardown as it switches the dome off, delivered once that is done) is said in one line;
+the stop stays the first Ctrl-C's, "Session cancelled", as the manifest records it.
+
+Found by a dome audit (the Nab dome's emulator, 12 lights): after "Stopping after this image",
+a second Ctrl-C at the end of an image said "Emergency stop (second Ctrl-C)" while
+manifest.json recorded ``finish_reason: cancelled`` (4 times in 12). The manifest was right:
+the capture had already ended as the first Ctrl-C asked, after its image, and the teardown ran
+as a cancel's, not an emergency's (``safe(emergency=False)``); there was nothing left to stop
+at once. A second Ctrl-C during the capture still stops it at once
+(tests/cli/test_run_ctrl_c_after_last_image.py). Through the console entry in a child
+process; no timing: the first Ctrl-C is raised as image 2 is committed, the second as the
+teardown sends its all-off.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, REPO
+
+_CHILD = r"""
+import signal, sys
+from rti_rig.runtime.lighting import DomeLighting
+from rti_rig.runtime.session import SessionFolder
+
+real_write, real_safe, teardowns = SessionFolder.write_step, DomeLighting.safe, []
+
+def write_step(self, index, *args, **kwargs):
+    record = real_write(self, index, *args, **kwargs)
+    if index == 1:
+        signal.raise_signal(signal.SIGINT)  # the first Ctrl-C: stop after this image
+    return record
+
+def safe(self, *args, **kwargs):
+    teardowns.append(kwargs.get("emergency", args[0] if args else False))
+    if len(teardowns) == 1:
+        signal.raise_signal(signal.SIGINT)  # the second, as the teardown switches off
+    return real_safe(self, *args, **kwargs)
+
+SessionFolder.write_step = write_step
+DomeLighting.safe = safe
+sys.argv = ["rti-rig", *sys.argv[1:]]
+from rti_rig.launch import main
+try:
+    main()
+finally:
+    print(f"teardowns: {teardowns}", file=sys.stderr)
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_second_ctrl_c_in_a_cancelled_run_s_teardown_keeps_the_cancel(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    config = CONFIGS / "emulated_nab_rti_v1.toml"
+    argv = ["run", str(config), "--lights", "4", "--out", str(out), "--no-verdict"]
+    result = subprocess.run(
+        [sys.executable, "-c", _CHILD, *argv],
+        capture_output=True,
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
+        timeout=600,
+    )
+    said = " ".join(result.stderr.decode("utf-8", "replace").split())
+    assert "teardowns: [False]" in said, said  # one teardown, a cancel's: the second came in it
+    run = json.loads((out / "manifest.json").read_text())["runs"][-1]
+    assert run["finish_reason"] == "cancelled", run
+    assert "Stopping after this image" in said, said
+    assert "Emergency stop" not in said and "Traceback" not in said, said
+    assert said.count("Ctrl-C after the capture had ended: there was nothing left to stop") == 1
+    assert "Session cancelled; the images captured so far are kept." in said, said
+    assert "All-off sent and acknowledged by the dome: lights are off." in said, said
+    assert f"Continue with: rti-rig run --resume {out}" in said, said
+    assert result.returncode == 130, said
