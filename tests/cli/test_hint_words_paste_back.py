@@ -50,10 +50,10 @@ def test_a_run_into_a_finished_session_names_it_and_its_fit_as_words_that_paste_
     r = rti_rig("run", CONFIGS / "simulated_dome.toml", "--lights", "4", "--out", session)
     assert r.returncode == 2, r.stderr
     assert b"is not empty" in r.stderr and b"udce9" not in r.stderr, r.stderr
-    # the folder refused, the fit its hint gives (the session's own bytes, both) and the free
-    # folder beside it the hint gives the fit's --out
-    fit_out = os.fsencode(session) + b"-fit"
-    assert words_after(r.stderr, b"error: ") == [os.fsencode(session)] * 2 + [fit_out], r.stderr
+    # the folder refused, the new folder it offers (free, beside it), the fit its hint gives
+    # (the session's own bytes) and the free folder beside it the hint gives the fit's --out
+    here, fit_out = os.fsencode(session), os.fsencode(session) + b"-fit"
+    assert words_after(r.stderr, b"error: ") == [here, here + b"-2", here, fit_out], r.stderr
     assert b"rti-rig fit $'" in r.stderr, r.stderr
 
 

@@ -18,7 +18,7 @@ from typing import Any
 from rti_rig.app.usecases.replay_advice import new_session_command
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.out_folders import free_folder_beside, free_name
-from rti_rig.core.rig_geometry import led_fields, led_said
+from rti_rig.core.rig_geometry import led_fields
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.controller import (
@@ -613,7 +613,7 @@ def fix_exposure(
         at = chosen["metered_at_step"] - 1
         step = schedule.steps[at]
         which = (
-            f" ({led_said(step.led, step.direction, step.label)})" if step.led is not None else ""
+            f" ({led_fields(step.led, step.direction, step.label)})" if step.led is not None else ""
         )
         metered = len(chosen["lights_metered_at_steps"])
         where = (
