@@ -25,7 +25,7 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,6 +33,9 @@ from numpy.typing import ArrayLike, NDArray
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.geometry import fibonacci_cap
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+
+if TYPE_CHECKING:
+    from rti_rig.app.config import LoadedRig
 
 FULL_COUNTS = (3, 4, 5, 6, 8, 10, 12, 16, 20, 30, 50, 100)
 QUICK_COUNTS = (3, 6, 12, 30)
@@ -244,13 +247,16 @@ def score_plan(
 
 
 def session_times(
-    directions: NDArray[np.float64],
-    per_light_s: float,
-    arm: ArmGeometry,
-    speed: float,
-    accel: float,
+    directions: NDArray[np.float64], dome: LoadedRig, arm: LoadedRig
 ) -> tuple[float, float]:
     """Session time of a plan on the simulated dome and on the simulated arm (seconds).
+
+    Every figure is the shipped config's (``dome``, ``arm``: :func:`shipped_rig`), as
+    ``rti-rig run`` reads it: the per-light time is :func:`per_light_s` of each rig, and the
+    arm is the :class:`~rti_rig.simulator.sim_lights.SimulatedArm` ``run`` builds from the
+    arm config's ``[arm]`` (speed, acceleration, resolution, band, park) and lamp switch time.
+    Until 2026-12-02 the benchmark kept its own copy of them, with the dome's 0.1 s settle
+    where the arm's config settles 0.3 s: every arm time was low by 0.2 s a light.
 
     The dome takes the same time for every light. The arm visits the lights in the order
     ``rti-rig run`` gives a simulated arm (the move-time order of
@@ -260,33 +266,39 @@ def session_times(
     in nearest-neighbour order by angle, which ``run`` no longer uses for a simulated arm.
     Lights the arm cannot reach (inside its keep-out cone) are clamped to its band for timing.
     """
-    from types import SimpleNamespace
-
     from rti_rig.app.compose import simulated_arm_motion
+    from rti_rig.app.config import rig_geometry
     from rti_rig.planner.arm_order import order_for_arm
     from rti_rig.simulator.sim_lights import LightState, SimulatedArm
 
-    dome_s = len(directions) * per_light_s
+    dome_s = len(directions) * per_light_s(dome)
+    geometry = rig_geometry(arm)
+    settings = arm.config.arm
+    assert isinstance(geometry, ArmGeometry) and settings is not None, arm.path
     clock = VirtualClock()
-    carrier = SimulatedArm(arm, LightState(), clock, speed, accel, 360.0 / 4096, 0.02)
-    carrier.connect()
-    reachable = np.array([_clamp_to_band(d, arm) for d in directions])
-    # the [arm] table simulated_arm_motion reads, as a simulated rig's config holds it
-    config = SimpleNamespace(
-        backend="simulated",
-        arm=SimpleNamespace(
-            speed_deg_s=speed,
-            acceleration_deg_s2=accel,
-            min_elevation_deg=arm.min_elevation_deg,
-            max_elevation_deg=arm.max_elevation_deg,
-            park_azimuth_deg=arm.park_azimuth_deg,
-            park_elevation_deg=arm.park_elevation_deg,
-        ),
+    carrier = SimulatedArm(
+        geometry,
+        LightState(),
+        clock,
+        speed_deg_s=settings.speed_deg_s,
+        acceleration_deg_s2=settings.acceleration_deg_s2,
+        resolution_deg=settings.resolution_deg,
+        switch_s=arm.config.timing.light_switch_s,
     )
-    motion = simulated_arm_motion(SimpleNamespace(config=config))
-    for i in order_for_arm(reachable, arm.park_direction, motion):  # as plan_uniform gives it
+    carrier.connect()
+    reachable = np.array([_clamp_to_band(d, geometry) for d in directions])
+    t = arm.config.timing
+    # lit: settle, expose, read out, transfer; the lamp switched on before and off after each
+    # light, and off once at the start and once at the end, as ``run`` does (the dry run's
+    # rig_time_s for the same lights, tests/benchmarks)
+    lit_s = t.settle_s + arm.config.camera.exposure_s + t.readout_s + t.transfer_s
+    carrier.lamp(False)
+    for i in order_for_arm(reachable, geometry.park_direction, simulated_arm_motion(arm)):
         carrier.move_to(reachable[i])
-        clock.sleep(per_light_s)
+        carrier.lamp(True)
+        clock.sleep(lit_s)
+        carrier.lamp(False)
+    carrier.lamp(False)
     carrier.park()
     return dome_s, clock.now()
 
@@ -311,29 +323,40 @@ def run_tradeoff(s: TradeoffSettings, progress: Callable[[str], None] = print) -
     return rows
 
 
-#: The simulated rigs every plan is timed on.
-BENCH_ARM = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)
-PER_LIGHT_S = 0.02 + 0.1 + 0.05 + 0.3 + 0.7  # LED switch, settle, exposure, readout, transfer
+#: The shipped rigs every plan is timed on (rig_configs/): every timing figure is theirs.
+DOME_CONFIG = "simulated_dome.toml"
+ARM_CONFIG = "virtual_arm.toml"
 
 
-def run_scene(
-    data: SceneData, s: TradeoffSettings, progress: Callable[[str], None] = print
-) -> list[Row]:
-    """Every plan for one rendered scene."""
+def shipped_rig(name: str) -> LoadedRig:
+    """A shipped rig config, read as ``rti-rig run`` reads it: the benchmark's times are that
+    rig's, with no second copy of a figure to drift from it."""
+    from importlib import resources
+
+    from rti_rig.app.config import load_rig_config
+
+    return load_rig_config(str(resources.files("rti_rig.rig_configs").joinpath(name)))
+
+
+def per_light_s(rig: LoadedRig) -> float:
+    """Time a light costs besides any move: LED switch, settle, exposure, readout, transfer,
+    the sum the controller's session estimate makes of ``[timing]`` and the camera's exposure."""
+    t = rig.config.timing
+    return t.light_switch_s + t.settle_s + rig.config.camera.exposure_s + t.readout_s + t.transfer_s
+
+
+def plans(
+    data: SceneData, s: TradeoffSettings
+) -> Iterable[tuple[str, str, int, float, NDArray[np.intp], float]]:
+    """Every plan for one rendered scene: (method, objective, N, floor, chosen, planning s)."""
     from rti_rig.core.errors import ScheduleError
     from rti_rig.planner.make_plan import make_plan
     from rti_rig.planner.uniform import select_uniform_leds
 
     dome = DomeGeometry(data.candidate_dirs, tuple(f"c{i:03d}" for i in range(s.candidates)))
-    rows: list[Row] = []
 
-    def add(
-        method: str, objective: str, n: int, floor: float, chosen: Iterable[int], plan_s: float
-    ) -> None:
-        idx = np.asarray(list(chosen), dtype=np.intp)
-        scores = score_plan(data, idx)
-        dome_s, arm_s = session_times(data.candidate_dirs[idx], PER_LIGHT_S, BENCH_ARM, 60.0, 120.0)
-        rows.append(Row(data.name, method, objective, n, floor, *scores, dome_s, arm_s, plan_s))
+    def idx(chosen: Iterable[int]) -> NDArray[np.intp]:
+        return np.asarray(list(chosen), dtype=np.intp)
 
     for n in s.counts:
         if n > s.candidates:
@@ -344,7 +367,7 @@ def run_scene(
                 chosen = select_uniform_leds(dome, n, floor)
             except ScheduleError:  # fewer candidates above this floor than N: not a layout
                 continue
-            add("uniform", "-", n, floor, chosen, time.perf_counter() - t)
+            yield "uniform", "-", n, floor, idx(chosen), time.perf_counter() - t
         for method, objective in s.methods:
             if method == "uniform":
                 continue
@@ -353,8 +376,68 @@ def run_scene(
                 data.preview, dome, n, method, objective, preview_light=s.preview_light_az_el_deg
             )
             leds = [int(step.led) for step in sched.steps if step.led is not None]
-            add(method, objective, n, 0.0, leds, time.perf_counter() - t)
-        progress(f"{data.name}: N={n} done")
+            yield method, objective, n, 0.0, idx(leds), time.perf_counter() - t
+
+
+def run_scene(
+    data: SceneData, s: TradeoffSettings, progress: Callable[[str], None] = print
+) -> list[Row]:
+    """Every plan for one rendered scene, scored and timed."""
+    dome_rig, arm_rig = shipped_rig(DOME_CONFIG), shipped_rig(ARM_CONFIG)
+    rows: list[Row] = []
+    last_n = None
+    for method, objective, n, floor, idx, plan_s in plans(data, s):
+        if last_n is not None and n != last_n:
+            progress(f"{data.name}: N={last_n} done")
+        last_n = n
+        scores = score_plan(data, idx)
+        dome_s, arm_s = session_times(data.candidate_dirs[idx], dome_rig, arm_rig)
+        rows.append(Row(data.name, method, objective, n, floor, *scores, dome_s, arm_s, plan_s))
+    if last_n is not None:
+        progress(f"{data.name}: N={last_n} done")
+    return rows
+
+
+def retime_arm(
+    folder: Path, s: TradeoffSettings, progress: Callable[[str], None] = print
+) -> list[Row]:
+    """Re-measure the arm time column of a run's ``results.csv`` in ``folder`` alone, and its
+    two ``*_vs_arm_time.png`` plots: every plan made again, timed on :data:`ARM_CONFIG`, its
+    scores kept (they do not depend on the arm). Minutes, where the whole run takes longer:
+    for a change to the arm's timing, not to a plan or a score.
+
+    A row whose plan is no longer made (a planner that changed) is refused by name rather
+    than kept with a time of another plan."""
+    import dataclasses
+
+    path = folder / "results.csv"
+    with path.open(newline="", encoding="utf-8") as f:
+        recorded = list(csv.DictReader(f))
+    fields = {f.name: f.type for f in dataclasses.fields(Row)}
+    arm_rig = shipped_rig(ARM_CONFIG)
+    timed: dict[tuple[str, str, str, int, float], float] = {}
+    for scene in dict.fromkeys(r["scene"] for r in recorded):
+        data = render_scene_data(scene, s)
+        for method, objective, n, floor, idx, _ in plans(data, s):
+            key = (scene, method, objective, n, floor)
+            timed[key] = session_times(data.candidate_dirs[idx], arm_rig, arm_rig)[1]
+        progress(f"{scene}: arm times re-measured")
+    rows: list[Row] = []
+    for r in recorded:
+        key = (r["scene"], r["method"], r["objective"], int(r["n"]), float(r["floor_deg"]))
+        if key not in timed:
+            raise ValueError(f"{path}: no plan is made today for the row {key}")
+        values: dict[str, Any] = {}
+        for name, kind in fields.items():
+            text = r[name]
+            if kind in ("int", int):
+                values[name] = int(text)
+            elif kind in ("float", float):
+                values[name] = float(text) if text != "" else float("nan")
+            else:
+                values[name] = text
+        values["arm_time_s"] = timed[key]
+        rows.append(Row(**values))
     return rows
 
 
@@ -570,3 +653,29 @@ def _verdicts(scene: str, series: dict[str, list[Row]], counts: list[int]) -> li
             + "."
         )
     return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m benchmarks.tradeoff --retime-arm FOLDER``: the arm time column alone.
+
+    The whole run is ``rti-rig bench tradeoff --out FOLDER``; this re-measures a full run's
+    arm times (:func:`retime_arm`) in place after a change to the arm's timing, and rewrites
+    results.csv and the plots from it (the scores and the dome's plots are unchanged)."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=main.__doc__.split("\n")[0] if main.__doc__ else "")
+    ap.add_argument(
+        "--retime-arm",
+        type=Path,
+        required=True,
+        metavar="FOLDER",
+        help="a full run's folder (results.csv): re-measure its arm time column and arm plots",
+    )
+    args = ap.parse_args(argv)
+    rows = retime_arm(args.retime_arm, TradeoffSettings())
+    write_csv(rows, args.retime_arm / "results.csv")
+    plot(rows, args.retime_arm)
+
+
+if __name__ == "__main__":
+    main()

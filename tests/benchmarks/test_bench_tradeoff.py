@@ -9,12 +9,14 @@ import numpy as np
 import pytest
 
 from benchmarks.tradeoff import (
-    PER_LIGHT_S,
+    DOME_CONFIG,
     TradeoffSettings,
+    per_light_s,
     plot,
     render_scene_data,
     run_scene,
     score_plan,
+    shipped_rig,
     summarise,
     write_csv,
 )
@@ -43,7 +45,7 @@ def test_every_plan_is_scored_and_timed(rows) -> None:  # type: ignore[no-untype
     assert ("uniform", "-", 20.0) in kinds
     for r in rows:
         assert math.isfinite(r.normal_mean_deg) and 0 <= r.normal_mean_deg <= 180
-        assert r.dome_time_s == pytest.approx(r.n * PER_LIGHT_S)
+        assert r.dome_time_s == pytest.approx(r.n * per_light_s(shipped_rig(DOME_CONFIG)))
         assert r.arm_time_s > r.dome_time_s  # the arm also moves between lights
         assert math.isfinite(r.relight_psnr_db)
 
@@ -192,7 +194,8 @@ def test_the_arm_is_timed_in_the_order_run_gives_a_simulated_arm() -> None:
     not by angle: the benchmark's arm time must be that order's, never the nearest-neighbour
     order's when that one is slower (stops either side of ±180°, which the azimuth cannot
     cross: nearest by angle, a whole turn apart for the arm)."""
-    from benchmarks.tradeoff import BENCH_ARM, session_times
+    from benchmarks.tradeoff import ARM_CONFIG, session_times
+    from rti_rig.app.config import rig_geometry
     from rti_rig.core.clock import VirtualClock
     from rti_rig.core.geometry import direction_from_az_el
     from rti_rig.planner.uniform import order_nearest_neighbour
@@ -201,13 +204,15 @@ def test_the_arm_is_timed_in_the_order_run_gives_a_simulated_arm() -> None:
     dirs = np.array(
         [direction_from_az_el(az, 30.0) for az in (170.0, -170.0, 100.0, -100.0, 30.0, -30.0)]
     )
+    rig = shipped_rig(ARM_CONFIG)
+    geometry = rig_geometry(rig)
     clock = VirtualClock()
-    arm = SimulatedArm(BENCH_ARM, LightState(), clock, 60.0, 120.0, 360.0 / 4096, 0.02)
+    arm = SimulatedArm(geometry, LightState(), clock, 60.0, 120.0, 360.0 / 4096, 0.02)
     arm.connect()
-    for i in order_nearest_neighbour(dirs, BENCH_ARM.park_direction):
+    for i in order_nearest_neighbour(dirs, geometry.park_direction):
         arm.move_to(dirs[i])
-        clock.sleep(PER_LIGHT_S)
+        clock.sleep(1.41)  # lamp on, settle, exposure, readout, transfer, lamp off
     arm.park()
-    _, timed = session_times(dirs, PER_LIGHT_S, BENCH_ARM, 60.0, 120.0)
+    _, timed = session_times(dirs, shipped_rig(DOME_CONFIG), rig)
     # nearest by angle: 30, -30, -100, -170, then 170 a whole turn away (22.9 s in all)
     assert timed < clock.now() - 0.5, (timed, clock.now())

@@ -109,6 +109,24 @@ def test_a_completed_run_says_the_arm_parked_where_read_back_and_its_moving_time
     parking = re.search(r"s, and parking it (\d+\.\d) s", said)
     assert parking is not None, said
     assert after_last > 0.5 and float(parking[1]) == pytest.approx(after_last, abs=0.1), said
+    if shipped == "virtual_arm.toml":  # the rig bench tradeoff times its arm column on
+        _the_benchmark_times_the_arm_as_run_does(out)
+
+
+def _the_benchmark_times_the_arm_as_run_does(out: Path) -> None:
+    """``bench tradeoff``'s arm time for this session's lights is the dry run's own session
+    time: the same shipped config's timing (its arm column had counted the dome's 0.1 s
+    settle where virtual_arm.toml settles 0.3 s, and one lamp switch a light of run's two),
+    the same order, the same moves and park."""
+    import numpy as np
+
+    from benchmarks.tradeoff import ARM_CONFIG, DOME_CONFIG, session_times, shipped_rig
+
+    lines = (out / "lights.lp").read_text().splitlines()[1:]
+    dirs = np.array([[float(v) for v in line.split()[1:4]] for line in lines])
+    _, arm_s = session_times(dirs, shipped_rig(DOME_CONFIG), shipped_rig(ARM_CONFIG))
+    rig_s = json.loads((out / "manifest.json").read_text())["runs"][0]["rig_time_s"]
+    assert arm_s == pytest.approx(rig_s, abs=0.01), (arm_s, rig_s)
 
 
 def test_a_run_with_park_off_says_where_the_arm_is_left(tmp_path: Path) -> None:
