@@ -855,6 +855,20 @@ def _sentence(text: str) -> str:
     return text[:1].upper() + text[1:]
 
 
+def _with_min_lights(opened, minimum: int) -> str:  # type: ignore[no-untyped-def]
+    """The ``rti-rig run`` that starts this adaptive session again with ``--min-lights
+    minimum``: its rig config and the options it began with (the manifest's record, as a
+    refused resume repeats them), into a folder beside it that is free now."""
+    from rti_rig.app.usecases.replay_advice import session_options
+
+    manifest = dict(opened.folder.manifest)
+    manifest["adaptive"] = {**(manifest.get("adaptive") or {}), "min_lights": minimum}
+    more = free_folder_beside(Path(opened.out_dir), "more")
+    return f"rti-rig run {_arg(opened.rig.loaded.path)} --out {_arg(more)}" + session_options(
+        manifest
+    )
+
+
 def _cannot_resume(opened) -> str | None:  # type: ignore[no-untyped-def]
     """What is said instead of "continue with --resume" of a session this rig cannot resume
     (None: it can): a camera-triggered dome, whose own count went on, or an image-sequence
@@ -1928,9 +1942,9 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
             f"{adaptive_result['stop']['reason']}; {estimate_phrase(adaptive_result)}",
             highlight=False,
         )
-        short = few_lights_note(adaptive_result)
-        if short is not None:
-            err.print(f"[yellow]note:[/] {escape(short)}", highlight=False)
+        short = few_lights_note(adaptive_result, lambda m: _with_min_lights(opened, m))
+        if short is not None:  # one line: the command it ends with pastes whole
+            err.print(f"[yellow]note:[/] {escape(short)}", highlight=False, soft_wrap=True)
     if result.finish_reason is FinishReason.CANCELLED:
         err.print(
             f"[yellow]Session cancelled; the images captured so far are kept.[/] "

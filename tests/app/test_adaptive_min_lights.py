@@ -10,6 +10,8 @@ before anything is opened.
 
 from __future__ import annotations
 
+import os
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -43,6 +45,20 @@ def test_a_loose_target_stops_at_the_start_and_says_no_rti_file_follows(
     assert "a PTM needs 6 and an HSH fit needs 5" in text
     assert "without fit.ptm and fit.rti" in text
     assert "To get fit.ptm and fit.rti, start a session with --min-lights 6" in text
+    # the session it names, as a command that runs pasted: the rig config, the options this
+    # one had, a free folder beside it ("with --min-lights 6" had left the rest to find)
+    more = tmp_path / "s-more"
+    command = f"rti-rig run {cfg} --out {more} --until-error {LOOSE} --min-lights 6"
+    lines = [line.rstrip() for line in r.output.splitlines()]  # one line: it pastes whole
+    assert any(line.endswith(f"with --min-lights 6: {command}") for line in lines), r.output
+    words = subprocess.run(
+        ["bash", "-c", 'printf "%s\\0" ' + command], capture_output=True, check=True
+    ).stdout.split(b"\0")[:-1]
+    assert words[0] == b"rti-rig"
+    again = runner.invoke(app, [os.fsdecode(w) for w in words[1:]])
+    assert again.exit_code == 0, again.output
+    assert len(read_lp(more / "lights.lp")) == 6
+    assert "without fit.ptm" not in said(again), said(again)
 
 
 @pytest.mark.parametrize("minimum", ["3", "4"])

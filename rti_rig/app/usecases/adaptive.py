@@ -1172,14 +1172,20 @@ RTI_FILE_LIGHTS = (
 )
 
 
-def few_lights_note(result: dict[str, Any]) -> str | None:
+def few_lights_note(
+    result: dict[str, Any], start_with: Callable[[int], str] | None = None
+) -> str | None:
     """What a session whose --until-error target was reached before it had the lights of an
     RTI file gives and does not give, and how to ask for more (None: nothing to say — no
     target, not reached, or lights enough). The target is a normal error; a user who came for
     a PTM or an .rti learns it here, not when `fit` skips them. The advice never exceeds the
     session's maximum (``--lights`` or the rig's lights). A minimum asked for is no reason to
     be silent: one below an RTI file's lights (``--min-lights 4``, below the 4 starting lights
-    that a loose target stops at) had silenced the note of a session with no RTI file."""
+    that a loose target stops at) had silenced the note of a session with no RTI file.
+
+    ``start_with(m)``: the ``rti-rig run`` command that starts that session with
+    ``--min-lights m`` (the rig config, this session's options, a free --out), said last so it
+    pastes whole; "start a session with --min-lights 6" had left the rest to find."""
     used = int(result.get("lights_used") or 0)
     if not result.get("target_claimed"):
         return None
@@ -1201,17 +1207,18 @@ def few_lights_note(result: dict[str, Any]) -> str | None:
     text = f"{used} lights reached the normal-error target, but {needs}: `rti-rig fit` {makes}."
     cap = int(result.get("max_lights") or 0)
     reachable = [(name, n) for name, _, n in short if n <= cap]
-    if reachable:
-        names = " and ".join(name for name, _ in reachable)
-        fewest = max(n for _, n in reachable)
-        text += f" To get {names}, start a session with --min-lights {fewest}"
     beyond = [name for name, _, n in short if n > cap]
     if beyond:
         verb = "needs" if len(beyond) == 1 else "need"
         text += (
-            f"{';' if reachable else ''} {' and '.join(beyond)} {verb} more than this session's "
-            f"maximum of {cap} lights (--lights, or the lights the rig offers)"
+            f" {' and '.join(beyond)} {verb} more than this session's maximum of {cap} lights "
+            "(--lights, or the lights the rig offers)."
         )
+    if reachable:
+        names = " and ".join(name for name, _ in reachable)
+        fewest = max(n for _, n in reachable)
+        text += f" To get {names}, start a session with --min-lights {fewest}"
+        text += f": {start_with(fewest)}" if start_with is not None else "."
     return text
 
 
