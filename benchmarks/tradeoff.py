@@ -429,6 +429,8 @@ def retime_arm(
             raise ValueError(f"{path}: no plan is made today for the row {key}")
         values: dict[str, Any] = {}
         for name, kind in fields.items():
+            if name not in r:  # a column newer than the run (file_model): its default
+                continue
             text = r[name]
             if kind in ("int", int):
                 values[name] = int(text)
@@ -452,16 +454,24 @@ def best_floor(rows: Iterable[Row], scene: str) -> float:
     return min(by_floor, key=lambda f: float(np.mean([by_floor[f][n] for n in common])))
 
 
-def write_csv(rows: list[Row], path: Path) -> Path:
+def write_csv(rows: list[Row], path: Path, columns: list[str] | None = None) -> Path:
     """One line per row; a figure that does not apply (no arm on a replayed dome, no fit.rti
-    written) is an empty cell, which a spreadsheet reads as missing, not the text "nan"."""
+    written) is an empty cell, which a spreadsheet reads as missing, not the text "nan".
+    ``columns``: those to write (default every field; a re-timed run keeps its own)."""
     path.parent.mkdir(parents=True, exist_ok=True)
+    names = columns or list(asdict(rows[0]))
     with open(path, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(asdict(rows[0])))
+        writer = csv.DictWriter(fh, fieldnames=names)
         writer.writeheader()
         for r in rows:
+            cells = asdict(r)
             writer.writerow(
-                {k: "" if isinstance(v, float) and np.isnan(v) else v for k, v in asdict(r).items()}
+                {k: "" if isinstance(v, float) and np.isnan(v) else v for k, v in cells.items()}
+                if columns is None
+                else {
+                    k: "" if isinstance(cells[k], float) and np.isnan(cells[k]) else cells[k]
+                    for k in names
+                }
             )
     return path
 
@@ -655,12 +665,13 @@ def _verdicts(scene: str, series: dict[str, list[Row]], counts: list[int]) -> li
     return out
 
 
-def main(argv: list[str] | None = None) -> None:
+def main(argv: list[str] | None = None, settings: TradeoffSettings | None = None) -> None:
     """``python -m benchmarks.tradeoff --retime-arm FOLDER``: the arm time column alone.
 
     The whole run is ``rti-rig bench tradeoff --out FOLDER``; this re-measures a full run's
     arm times (:func:`retime_arm`) in place after a change to the arm's timing, and rewrites
-    results.csv and the plots from it (the scores and the dome's plots are unchanged)."""
+    results.csv and the plots from it (the scores and the dome's plots are unchanged).
+    ``settings``: the run's (the full run's by default; a test's smaller one)."""
     import argparse
 
     ap = argparse.ArgumentParser(description=main.__doc__.split("\n")[0] if main.__doc__ else "")
@@ -672,8 +683,11 @@ def main(argv: list[str] | None = None) -> None:
         help="a full run's folder (results.csv): re-measure its arm time column and arm plots",
     )
     args = ap.parse_args(argv)
-    rows = retime_arm(args.retime_arm, TradeoffSettings())
-    write_csv(rows, args.retime_arm / "results.csv")
+    path = args.retime_arm / "results.csv"
+    with path.open(newline="", encoding="utf-8") as f:
+        columns = next(csv.reader(f))
+    rows = retime_arm(args.retime_arm, settings or TradeoffSettings())
+    write_csv(rows, path, columns)
     plot(rows, args.retime_arm)
 
 

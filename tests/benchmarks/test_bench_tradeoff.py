@@ -216,3 +216,37 @@ def test_the_arm_is_timed_in_the_order_run_gives_a_simulated_arm() -> None:
     _, timed = session_times(dirs, shipped_rig(DOME_CONFIG), rig)
     # nearest by angle: 30, -30, -100, -170, then 170 a whole turn away (22.9 s in all)
     assert timed < clock.now() - 0.5, (timed, clock.now())
+
+
+def test_retime_arm_keeps_the_scores_and_remeasures_the_arm_column(rows, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    """``python -m benchmarks.tradeoff --retime-arm``: the plans made again give the arm times
+    of the run, every other column of results.csv kept as written (a run from before a
+    column, file_model, keeps its columns)."""
+    import csv
+
+    from benchmarks.tradeoff import main, retime_arm
+
+    write_csv(rows, tmp_path / "results.csv")
+    again = retime_arm(tmp_path, TINY, progress=lambda _m: None)
+    assert [r.arm_time_s for r in again] == pytest.approx([r.arm_time_s for r in rows])
+    assert [r.normal_mean_deg for r in again] == pytest.approx([r.normal_mean_deg for r in rows])
+    # an arm column off by 0.2 s a light, as the run before 2026-12-02 wrote it, and a file
+    # without the newest columns: the arm column is measured again, the columns kept
+    old = tmp_path / "old"
+    old.mkdir()
+    with (tmp_path / "results.csv").open(newline="") as f:
+        recorded = list(csv.DictReader(f))
+    columns = [c for c in recorded[0] if c not in ("file_model", "file_psnr_db")]
+    with (old / "results.csv").open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
+        w.writeheader()
+        for r in recorded:
+            w.writerow({**r, "arm_time_s": float(r["arm_time_s"]) - 0.2 * int(r["n"])})
+    main(["--retime-arm", str(old)], TINY)
+    with (old / "results.csv").open(newline="") as f:
+        rewritten = list(csv.DictReader(f))
+    assert list(rewritten[0]) == columns
+    assert [float(r["arm_time_s"]) for r in rewritten] == pytest.approx(
+        [r.arm_time_s for r in rows]
+    )
+    assert [r["normal_mean_deg"] for r in rewritten] == [r["normal_mean_deg"] for r in recorded]
