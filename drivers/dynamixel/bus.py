@@ -646,6 +646,17 @@ def _latency_note(port: str, devices: str = USB_SERIAL_DEVICES) -> str:
     return f" (set its latency timer to 1 ms: echo 1 | sudo tee {shell_word(timer)})"
 
 
+def _count_said(n: int, lost: str) -> str:
+    """``n`` statuses ``lost`` the way a :attr:`DxlBus.resent` entry says ("no status packet",
+    "late status packet", "damaged status packet") as counted words: "1 lost status packet",
+    "109 late status packets".
+
+    Why: the count had been put before the entry's own words, so 109 statuses that came late
+    were said as "109 late status packet", and a missing one as "1 no status packet"."""
+    kind = "lost status packet" if lost == "no status packet" else lost
+    return f"{n} {kind}{'s' if n != 1 else ''}"
+
+
 def resends_said(resent: list[str]) -> str | None:
     """One line for the commands sent once more after their status packet was lost or damaged
     and then answered, counted by what was lost; None when there were none.
@@ -657,7 +668,7 @@ def resends_said(resent: list[str]) -> str | None:
     if not resent:
         return None
     lost = [entry.rsplit(": ", 1)[-1] for entry in resent]
-    counts = ", ".join(f"{lost.count(x)} {x}" for x in dict.fromkeys(lost))
+    counts = ", ".join(_count_said(lost.count(x), x) for x in dict.fromkeys(lost))
     n = len(resent)
     how = "lost, late or damaged" if "late status packet" in lost else "lost or damaged"
     return (

@@ -26,7 +26,7 @@ FAULTS = (
 )
 LINE = (
     "The arm's servos were asked again 2 times after a status packet was lost or damaged "
-    "(1 no status packet, 1 damaged status packet); each then answered."
+    "(1 lost status packet, 1 damaged status packet); each then answered."
 )
 
 
@@ -112,3 +112,18 @@ def test_statuses_later_than_the_retry_waits_are_said_as_a_slow_link_not_a_lost_
     assert r.exit_code == 1, said
     assert "its status came on" in said and "but late (after the SDK's reply window)" in said
     assert "a slow USB-serial adapter" in said and "power supply was lost" not in said, said
+
+
+def test_the_counts_said_are_plural_past_one() -> None:
+    """The loaded-machine check's line had said "(109 late status packet)": each count now
+    agrees with its number, whichever way the statuses were lost."""
+    from rti_rig.drivers.dynamixel.bus import resends_said
+
+    resent = ["id 1 read Present Position: late status packet" for _ in range(109)]
+    resent += ["id 2 ping: no status packet"] * 2 + ["id 1 ping: damaged status packet"] * 3
+    said = resends_said(resent)
+    assert said == (
+        "The arm's servos were asked again 114 times after a status packet was lost, late or "
+        "damaged (109 late status packets, 2 lost status packets, 3 damaged status packets); "
+        "each then answered."
+    ), said
