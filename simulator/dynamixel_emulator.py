@@ -39,7 +39,7 @@ import threading
 import time
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.shell_words import shown_path
@@ -1120,7 +1120,7 @@ def served_arm(
     settings: Any,
     clock: Clock,
     baudrate: int = 57600,
-    faults: Iterable[tuple[int, str, int | None]] = (),
+    faults: Iterable[ToolFault] = (),
 ) -> Iterator[tuple[Any, DynamixelBusEmulator]]:
     """``(server, emulator)``: the servos of ``settings`` (ids, models, modes) resting at its
     park pose, served on a pty for any client (the manual tool; a plain SDK ``PortHandler``).
@@ -1130,9 +1130,9 @@ def served_arm(
     Baud Rate: the host and the servo must use the same rate). The tool had always served
     57600, so a bus a user had set to 1 Mbps could not be rehearsed.
 
-    ``faults``: ``(K, kind, servo id or None)``, as a rig config's ``[[emulator.faults]]``
-    (:func:`parse_tool_fault`): the status of the K-th instruction packet lost or damaged, or
-    a servo's own hardware error raised as it arrives.
+    ``faults``: :class:`ToolFault`, as a rig config's ``[[emulator.faults]]``
+    (:func:`parse_tool_fault`): the status of the K-th instruction packet lost, damaged or
+    late, or a servo's own hardware error raised as it arrives.
 
     The tool had served two XL430s at 2048 ticks each: on the shipped arm's geometry
     (elevation zero at 1024 ticks) that is 90° elevation, inside every keep-out cone, so a
@@ -1149,46 +1149,77 @@ def served_arm(
     emulator = emulator_for_arm(settings, clock)
     for servo in emulator.servos.values():
         servo._set(ct.BAUD_RATE, codes[baudrate])
-    for at, kind, dxl_id in faults:
-        emulator.add_fault(at, kind, dxl_id)
+    for fault in faults:
+        emulator.add_fault(fault.at, fault.kind, fault.servo_id, fault.delay_s)
     with PtyServoServer(emulator) as server:
         yield server, emulator
 
 
 #: What the manual tool's ``--fault`` takes, as a rig config's ``[[emulator.faults]]`` on an
-#: arm: a status packet lost or damaged, or a servo's own hardware error.
-TOOL_FAULT_KINDS = ("drop_reply", "garble_reply", *HARDWARE_FAULT_BITS)
+#: arm: a status packet lost, damaged or late, or a servo's own hardware error.
+TOOL_FAULT_KINDS = ("drop_reply", "garble_reply", "delay_reply", *HARDWARE_FAULT_BITS)
+
+#: A ``delay_reply``'s lateness bounds and default (s), as ``[[emulator.faults]]`` ``delay_s``.
+TOOL_DELAY_S = (0.0, 60.0, 1.0)
 
 
-def parse_tool_fault(spec: str, servo_ids: Iterable[int]) -> tuple[int, str, int | None]:
-    """``K:KIND`` (a status lost or damaged) or ``K:KIND:ID`` (servo ID's hardware error) as
-    ``(K, kind, id or None)``; a ValueError that says what to give otherwise.
+class ToolFault(NamedTuple):
+    """One ``--fault`` of the manual tool: at the ``at``-th instruction packet, ``kind`` (on
+    servo ``servo_id`` for a hardware error), a ``delay_reply``'s status ``delay_s`` late."""
+
+    at: int
+    kind: str
+    servo_id: int | None = None
+    delay_s: float = TOOL_DELAY_S[2]
+
+    def said(self) -> str:
+        """The tool's ``Fault:`` line, so a user sees what the served servos will do."""
+        if self.servo_id is not None:
+            whose = f"servo {self.servo_id}'s {self.kind}"
+        elif self.kind == "delay_reply":
+            whose = f"delay_reply (its status {self.delay_s:g} s late)"
+        else:
+            whose = f"{self.kind} (its status)"
+        return f"Fault: {whose} at instruction packet {self.at}"
+
+
+def parse_tool_fault(spec: str, servo_ids: Iterable[int]) -> ToolFault:
+    """``K:KIND`` (a status lost or damaged), ``K:delay_reply[:SECONDS]`` (a status late, 1 s
+    unless given) or ``K:KIND:ID`` (servo ID's hardware error) as a :class:`ToolFault`; a
+    ValueError that says what to give otherwise.
 
     Why: the dome firmware tool took ``--fault`` and this one did not, so a servo's overload
     could be rehearsed through a rig config's ``[[emulator.faults]]`` but not on the served
-    pty a user points a hardware config at."""
+    pty a user points a hardware config at; a late status (``delay_reply`` with ``delay_s``,
+    a slow adapter's) could be rehearsed in a config but not here either."""
     ids = sorted(servo_ids)
     parts = spec.split(":")
+    low, high, default = TOOL_DELAY_S
     usage = (
-        f"--fault {spec}: give K:KIND or, for a servo's hardware error, K:KIND:ID (K the "
-        f"instruction packet, 1 = the first; KIND one of {', '.join(TOOL_FAULT_KINDS)}; ID "
-        f"one of {', '.join(map(str, ids))})"
+        f"--fault {spec}: give K:KIND, K:delay_reply:SECONDS for a status that late "
+        f"({low:g} to {high:g}, default {default:g}) or, for a servo's hardware error, "
+        f"K:KIND:ID (K the instruction packet, 1 = the first; KIND one of "
+        f"{', '.join(TOOL_FAULT_KINDS)}; ID one of {', '.join(map(str, ids))})"
     )
     if len(parts) not in (2, 3) or parts[1] not in TOOL_FAULT_KINDS:
         raise ValueError(usage)
+    kind = parts[1]
+    delay_s = default
     try:
         at = int(parts[0])
+        if kind == "delay_reply" and len(parts) == 3:
+            delay_s = float(parts[2])
+            parts.pop()
         dxl_id = int(parts[2]) if len(parts) == 3 else None
     except ValueError:
         raise ValueError(usage) from None
-    kind = parts[1]
-    if at < 1:
+    if at < 1 or not low <= delay_s <= high:
         raise ValueError(usage)
     if kind in HARDWARE_FAULT_BITS and dxl_id not in ids:
         raise ValueError(f"{usage}: {kind} is a servo's own error, so it needs the servo's id")
     if kind not in HARDWARE_FAULT_BITS and dxl_id is not None:
         raise ValueError(f"{usage}: {kind} is the bus's, not a servo's: give no id")
-    return at, kind, dxl_id
+    return ToolFault(at, kind, dxl_id, delay_s)
 
 
 def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual tool
@@ -1222,9 +1253,10 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
         "--fault",
         action="append",
         default=[],
-        metavar="K:KIND[:ID]",
+        metavar="K:KIND[:ID|:SECONDS]",
         help="as [[emulator.faults]]: at the K-th instruction packet, the status lost or "
-        "damaged (drop_reply, garble_reply) or servo ID's hardware error (overload, "
+        "damaged (drop_reply, garble_reply), late by SECONDS (K:delay_reply:SECONDS, as "
+        "delay_s; 1 s unless given), or servo ID's hardware error (overload, "
         "overheating, input_voltage, electrical_shock: the Alert bit until a Reboot, torque "
         "off where its Shutdown selects it); repeatable",
     )
@@ -1263,9 +1295,8 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
             "Ctrl-C stops the servos.",
             flush=True,
         )
-        for at, kind, dxl_id in faults:
-            whose = f"servo {dxl_id}'s {kind}" if dxl_id is not None else f"{kind} (its status)"
-            print(f"Fault: {whose} at instruction packet {at}", flush=True)
+        for fault in faults:
+            print(fault.said(), flush=True)
         if settings.baudrate != args.baud:
             print(
                 f"Note: the config's [arm.dynamixel] baudrate = {settings.baudrate}, but these "

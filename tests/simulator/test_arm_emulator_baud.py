@@ -60,7 +60,7 @@ def test_the_tool_raises_a_servos_hardware_error_as_emulator_faults_does() -> No
 
     settings, _ = arm_settings_of(None)
     fault = parse_tool_fault("2:overload:2", (1, 2))
-    assert fault == (2, "overload", 2)
+    assert fault == (2, "overload", 2, 1.0)
     with served_arm(settings, VirtualClock(), 57600, [fault]) as (server, emulator):
         bus = DxlBus(server.port_handler(), "arm on A")
         bus.open(57600)
@@ -74,14 +74,40 @@ def test_the_tool_raises_a_servos_hardware_error_as_emulator_faults_does() -> No
     assert emulator.servos[2].get(ct.TORQUE_ENABLE) == 0  # the XL430 shuts down for it
     run = [sys.executable, "-m", "rti_rig.simulator.dynamixel_emulator", "--seconds", "0"]
     out = subprocess.run(
-        [*run, "--fault", "60:overload:2", "--fault", "3:drop_reply"],
+        [
+            *run,
+            "--fault",
+            "60:overload:2",
+            "--fault",
+            "3:drop_reply",
+            "--fault",
+            "4:delay_reply:0.25",
+        ],
         capture_output=True,
         text=True,
         timeout=120,
     )
     assert out.returncode == 0, out.stderr
     assert "Fault: servo 2's overload at instruction packet 60" in out.stdout
+    assert "Fault: delay_reply (its status 0.25 s late) at instruction packet 4" in out.stdout
     bad = subprocess.run(
         [*run, "--fault", "60:overload"], capture_output=True, text=True, timeout=120
     )
     assert bad.returncode == 2 and "needs the servo's id" in bad.stderr
+
+
+def test_the_manual_tool_rehearses_a_late_status_with_its_delay() -> None:
+    """``--fault K:delay_reply[:SECONDS]``, as ``[[emulator.faults]]`` ``delay_s``: a slow
+    adapter's late status could be rehearsed in a rig config but the tool refused it."""
+    from rti_rig.simulator.dynamixel_emulator import parse_tool_fault
+
+    assert parse_tool_fault("4:delay_reply:0.25", (1, 2)) == (4, "delay_reply", None, 0.25)
+    assert parse_tool_fault("4:delay_reply", (1, 2)).delay_s == 1.0  # as delay_s's default
+    for bad in ("4:delay_reply:61", "4:delay_reply:-1", "4:delay_reply:soon", "4:drop_reply:2"):
+        with pytest.raises(ValueError, match="K:delay_reply:SECONDS"):
+            parse_tool_fault(bad, (1, 2))
+    settings, _ = arm_settings_of(None)
+    late = parse_tool_fault("3:delay_reply:0.25", (1, 2))
+    with served_arm(settings, VirtualClock(), 57600, [late]) as (_server, emulator):
+        assert emulator.reply_faults[3] == "delay_reply"
+        assert emulator.reply_delays[3] == 0.25
