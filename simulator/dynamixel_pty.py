@@ -27,7 +27,8 @@ its answer — the SDK pitfall the driver must handle, reproduced every time ins
 A plain ``dynamixel_sdk.PortHandler`` opened on :attr:`PtyServoServer.device_path` (or any other
 client) still works: without a ledger, replies are written in real time after
 each servo's own Return Delay Time (address 9) plus the packet's wire time at the host's
-baud rate (:func:`real_time_replies`), and the SDK's wall-time timeout applies.
+baud rate (:func:`real_time_replies`), counted from when the instruction was read (as a servo
+counts from its last byte), and the SDK's wall-time timeout applies.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ import sys
 import threading
 import time
 import tty
+from collections.abc import Callable
 from typing import Any
 
 import dynamixel_sdk
@@ -134,12 +136,21 @@ class PtyServoServer:
     SDK closes its port); ``stop()`` joins the thread within a bounded time.
 
     Clients without a ledger (a plain ``PortHandler``) get their replies in real time, as
-    :func:`real_time_replies` paces them (``real_time = False``: at once)."""
+    :func:`real_time_replies` paces them (``real_time = False``: at once), counted from the
+    moment the instruction was read (``monotonic``, ``sleep``: the wall clock the pacing
+    reads and waits on, a test's own where it checks the pacing)."""
 
     def __init__(
-        self, emulator: DynamixelBusEmulator, poll_s: float = 0.02, real_time: bool = True
+        self,
+        emulator: DynamixelBusEmulator,
+        poll_s: float = 0.02,
+        real_time: bool = True,
+        monotonic: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], None] = time.sleep,
     ) -> None:
         self.emulator = emulator
+        self._monotonic = monotonic
+        self._sleep = sleep
         # told the host's line speed where it declares it (decided once, as pty_link's
         # server decides: a runtime protocol's isinstance walks its members each time)
         self.host_baud_device = emulator if isinstance(emulator, HostBaudDevice) else None
@@ -189,6 +200,9 @@ class PtyServoServer:
                 data = os.read(master, 4096)
             except OSError:
                 continue
+            # the instruction's last byte is here now: a real servo's Return Delay Time runs
+            # from this moment, not from when this thread gets round to answering
+            read_at = self._monotonic()
             # the line speed the host set on its end (a pty pair shares its termios), as the
             # servos hear it: one at another Baud Rate answers nothing
             if self.host_baud_device is not None:
@@ -196,9 +210,8 @@ class PtyServoServer:
             reply = self.emulator.receive(data)
             ledger = self.ledger
             if ledger is None and (late := self.emulator.take_late()) is not None:
-                time.sleep(late[0])  # a plain port: the late status after its delay, in time
-                with contextlib.suppress(OSError):
-                    _write_all(master, late[1])
+                # a plain port: the late status after its delay, in time
+                self._write_paced(master, [late], read_at)
             if ledger is not None:
                 with ledger.lock:
                     ledger.device_read += len(data)
@@ -214,10 +227,28 @@ class PtyServoServer:
                     _write_all(master, reply)
                 continue
             baud = self.emulator.host_baud
-            for wait_s, packet in real_time_replies(self.emulator, reply, baud, len(data)):
-                time.sleep(wait_s)  # emulator thread only; tests never sleep
-                with contextlib.suppress(OSError):
-                    _write_all(master, packet)
+            self._write_paced(
+                master, real_time_replies(self.emulator, reply, baud, len(data)), read_at
+            )
+
+    def _write_paced(self, fd: int, paced: list[tuple[float, bytes]], read_at: float) -> None:
+        """Write each ``(wait s, bytes)`` of ``paced`` (:func:`real_time_replies`) once its
+        wait, added to the ones before it, has passed since ``read_at`` (when the instruction
+        was read); one already due is written at once.
+
+        Why: each wait had been slept after the emulator had handled the instruction, so a
+        thread that was itself late (a loaded host, the GIL) answered that much later than
+        the Return Delay Time (ROBOTIS e-manual, Return Delay Time (9): 2 µs units, 250 =
+        500 µs), which a real servo counts from the instruction's last byte. Emulator thread
+        only; tests inject ``sleep``."""
+        due = read_at
+        for wait_s, packet in paced:
+            due += wait_s
+            left = due - self._monotonic()
+            if left > 0:
+                self._sleep(left)
+            with contextlib.suppress(OSError):
+                _write_all(fd, packet)
 
     def stop(self, timeout_s: float = 1.0) -> None:
         self._stop.set()
