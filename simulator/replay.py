@@ -88,9 +88,13 @@ class ReplayCamera:
         shape: tuple[int, ...],
         readout_s: float = 0.3,
         transfer_s: float = 0.7,
+        names: Sequence[str] | None = None,
     ) -> None:
         self.name = "replay camera"
         self._images = [Path(p) for p in images]
+        # each image's name as the session records it: its path relative to the .lp (two
+        # files of one name in two subfolders had both been recorded by their file name)
+        self._names = [str(n) for n in names] if names is not None else None
         self._dome = dome
         self._clock = clock
         self._shape = shape
@@ -135,7 +139,8 @@ class ReplayCamera:
             # raw/ with its checksum, as a watched folder's or a DSLR's (an 8-bit JPEG's own
             # bytes cannot be re-encoded: without this a replay held only a re-encoding)
             # ("copy": the user's file, never moved, wherever it lies)
-            metadata["originals"] = [{"path": source, "name": path.name, "copy": True}]
+            name = self._names[lit] if self._names is not None else path.name
+            metadata["originals"] = [{"path": source, "name": name, "copy": True}]
         return Frame(
             pixels=pixels,
             exposure_s=exposure_s,

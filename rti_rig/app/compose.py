@@ -6,6 +6,7 @@ This is the one place in the core that imports ``simulator`` (and, as backends a
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -451,13 +452,17 @@ def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
     folder = Path(loaded.path).parent
     dome = SimulatedDome(geometry, LightState(), clock, cfg.timing.light_switch_s)
     dome.name = "replayed dome"
+    images = [image_path(folder, name) for name in geometry.names]
     camera = ReplayCamera(
-        [image_path(folder, name) for name in geometry.names],
+        images,
         dome,
         clock,
         shape=(cfg.camera.height, cfg.camera.width),
         readout_s=cfg.timing.readout_s,
         transfer_s=cfg.timing.transfer_s,
+        # recorded as the path relative to the .lp: unambiguous where two subfolders hold a
+        # file of one name (RTIBuilder's ../jpeg-exports/… climbs out of assembly-files/)
+        names=[Path(os.path.relpath(p, folder)).as_posix() for p in images],
     )
     return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
 

@@ -121,6 +121,10 @@ class StepRecord:
     pixels_sha256: dict[str, str] = field(default_factory=dict)
     #: session file → the camera's (or watched folder's) own name for it
     originals: dict[str, str] = field(default_factory=dict)
+    #: session file → the absolute path of the user's file it was copied from and that stays
+    #: there (a replay's recorded acquisition file): where a lost one is copied back from
+    #: (empty in sessions written before 2026-12-02, and for a camera's own downloads)
+    copied_from: dict[str, str] = field(default_factory=dict)
     #: how the linear image was made from the RAW file (mode, CFA pattern, black/white levels
     #: per channel, white balance, colour, orientation, source file); empty for non-RAW cameras
     decode: dict[str, Any] = field(default_factory=dict)
@@ -1002,6 +1006,11 @@ class SessionFolder:
             sha256=sha,
             pixels_sha256=pixel_sums,
             originals={name: source for name, (_, source) in originals.items()},
+            copied_from={
+                rel: os.path.abspath(item["path"])
+                for item, rel in zip(listed, originals, strict=True)
+                if item.get("copy")
+            },
             decode=decode,
             notices=[str(n) for n in frame.metadata.get("notices") or []],
             strays=strays,
@@ -2837,6 +2846,48 @@ def lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None = Non
     """What to do about images of a finished session lost since capture (the QA verdict and
     a refused resume say the same). ``scan``: the caller's scan of the journal, if it holds one
     (:func:`_journal_records`)."""
+    copies, only_those = _copy_back(Path(root), scan)
+    if copies and only_those:  # a replay's recorded files: the acquisition still holds them
+        return f"copy {'it' if len(copies) == 1 else 'them'} back from the acquisition: " + (
+            " && ".join(copies)
+        )
+    back = f"; copy the acquisition's back: {' && '.join(copies)}" if copies else ""
+    return _lost_image_advice(root, adaptive, scan) + back
+
+
+def _copy_back(root: Path, scan: JournalScan | None = None) -> tuple[list[str], bool]:
+    """The ``cp`` commands (shell words) that put back the missing files of session ``root``
+    that were copied from a file still there as captured (``StepRecord.copied_from``: a
+    replay's recorded acquisition file, its checksum the journaled one), and whether they are
+    all that is lost. A file changed in the session is not copied over (the user's edit is
+    theirs to set aside).
+
+    Why: a replay session whose kept original was deleted was told "the camera's original
+    capture is lost … reshoot with the object where it was": the acquisition holds it."""
+    records = _journal_records(root, scan)
+    if not records or not any(r.get("copied_from") for r in records):
+        return [], False
+    copies: list[str] = []
+    covered = True
+    renamed = renamed_jpegs(root, records)
+    for rec in _latest_records(records).values():
+        sources = rec.get("copied_from") or {}
+        for lost in _lost_files(root, rec, renamed):
+            name, _, how = lost.rpartition(" ")
+            source = sources.get(name)
+            if (
+                how == "missing"
+                and isinstance(source, str)
+                and file_sha256(Path(source)) == rec["sha256"].get(name)
+            ):
+                copies.append(f"cp -- {shell_word(source)} {shell_word(str(root / name))}")
+            else:
+                covered = False
+    return copies, covered
+
+
+def _lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None) -> str:
+    """:func:`lost_image_advice` for the files no acquisition holds."""
     instead = unresumable(root)
     if instead is not None:  # --reshoot-lost is refused for it
         return f"put the originals back from a copy; {instead}"
