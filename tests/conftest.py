@@ -33,25 +33,59 @@ CONFIGS = REPO / "rig_configs"
 
 @contextlib.contextmanager
 def shipped_dome_on_pty(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterator[Any]:
-    """The dome firmware a hardware config names (48 LEDs), emulated on a pty, the config's
-    port redirected there: everything above ``serial.serial_for_url`` is the real stack, as
-    a user's command builds it from the file. Yields the emulated firmware (its history)."""
+    """The dome firmware a hardware config names, emulated on a pty, the config's port
+    redirected there: everything above ``serial.serial_for_url`` is the real stack, as a
+    user's command builds it from the file. Yields the emulator (its history).
+
+    The emulator is the one the config's profile names: rti-rig's own protocols (``default``,
+    ``framed``, ``binary``) get :class:`DomeFirmware` with 48 LEDs; another project's firmware
+    (``rtipy``, ``nab-rti-v1`` …) gets its own board from ``rti_rig.simulator.domes``, as the
+    shipped ``emulated_*.toml`` dry runs do (``Board``: its own LEDs, baud rate, ``events``).
+    Why: the fixture had served every profile the codec-driven ``DomeFirmware``, which speaks
+    the binary protocol for a scripted profile: a test "on RTIPy" met a binary board (probe:
+    "Found: binary"). A profile with no serial emulator (a dome stepped by the camera's flash,
+    no ``[dome.serial]``) is refused, never served something else."""
     import serial
 
     from rti_rig.app.config import load_rig_config
     from rti_rig.core.clock import SystemClock
     from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
+    from rti_rig.simulator.domes import SERIAL_FIRMWARES, board_for
+    from rti_rig.simulator.pty_link import serve_on_pty
 
-    serial_settings = load_rig_config(config).config.dome.serial
-    firmware = firmware_for(serial_settings, led_count=48, clock=SystemClock())
+    dome = load_rig_config(config).config.dome
+    if dome is None or dome.serial is None:
+        raise ValueError(f"{config}: no [dome.serial], so no serial firmware to emulate on a pty")
+    serial_settings = dome.serial
+    profile = serial_settings.profile
+    serving: contextlib.AbstractContextManager[Any]
+    if profile in SERIAL_FIRMWARES:
+        from rti_rig.drivers.led_dome.factory import protocol_for
+
+        led_map = protocol_for(serial_settings).led_map
+        firmware: Any = board_for(profile, clock=SystemClock(), led_map=led_map)
+        serving = serve_on_pty(firmware, profile)
+    elif profile in OWN_DOME_PROTOCOLS:
+        firmware = firmware_for(serial_settings, led_count=48, clock=SystemClock())
+        serving = emulated_dome_on_pty(firmware)
+    else:
+        raise ValueError(
+            f"{config}: no emulator of dome profile {profile!r} to serve (own protocols "
+            f"{', '.join(OWN_DOME_PROTOCOLS)}; firmwares {', '.join(SERIAL_FIRMWARES)})"
+        )
     real = serial.serial_for_url
-    with emulated_dome_on_pty(firmware) as link:
+    with serving as link:
 
         def redirect(url, *args, **kwargs):  # type: ignore[no-untyped-def]
             return real(link.port if url == serial_settings.port else url, *args, **kwargs)
 
         monkeypatch.setattr(serial, "serial_for_url", redirect)
         yield firmware
+
+
+#: The dome protocols of rti-rig's own (docs/protocols/led-dome.md), which ``DomeFirmware``
+#: emulates with the driver's codec; every other profile is a real firmware's.
+OWN_DOME_PROTOCOLS = ("default", "framed", "binary")
 
 
 def folder_watch_config(
@@ -441,15 +475,70 @@ def virtual_arm_variant(tmp_path: Path, scene: str, side: int | None = None) -> 
 def emulated_dome_as_hardware(tmp_path: Path, shipped: str, port: str) -> Path:
     """The shipped emulated dome config ``shipped`` as a user's hardware copy of it: its board
     on ``port`` (an emulator served on a pty) and a watched-folder camera, as a real dome with
-    a tethered camera is configured."""
-    text = (CONFIGS / shipped).read_text()
-    assert 'backend = "emulated"' in text and 'port = "emulated"' in text, shipped
-    text = text.replace('backend = "emulated"', 'backend = "hardware"')
-    text = text.replace('port = "emulated"', f'port = "{port}"')
+    a tethered camera is configured.
+
+    Edited as TOML (read with tomllib, written back by :func:`toml_text`), not as text: the
+    text edit put ``[camera.device]`` at the first ``[timing]`` of the file, which in
+    emulated_rtipy.toml is inside a comment, and wrote a file TOML refuses."""
+    import tomllib
+
+    data = tomllib.loads((CONFIGS / shipped).read_text(encoding="utf-8"))
+    assert data["backend"] == "emulated" and data["dome"]["serial"]["port"] == "emulated", shipped
+    data["backend"] = "hardware"
+    data["dome"]["serial"]["port"] = port
     (tmp_path / "tether").mkdir()
-    device = f'[camera.device]\nkind = "folder_watch"\nfolder = "{tmp_path / "tether"}"\n'
-    at = text.index("[timing]")
-    return write_config(tmp_path, text[:at] + device + text[at:], "dome.toml")
+    data["camera"]["device"] = {"kind": "folder_watch", "folder": str(tmp_path / "tether")}
+    return write_config(tmp_path, toml_text(data), "dome.toml")
+
+
+def toml_text(data: dict[str, Any]) -> str:
+    """``data`` (as ``tomllib`` reads a rig config: tables, arrays of tables, strings,
+    numbers, booleans and arrays of those) as a TOML document that reads back as ``data``,
+    checked. For tests that change a shipped config by key (the standard library reads TOML
+    but writes none)."""
+    from rti_rig.core.toml_strings import toml_basic_string
+
+    def value(v: Any) -> str:
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, int | float):
+            return repr(v)
+        if isinstance(v, str):
+            return toml_basic_string(v)
+        if isinstance(v, list):
+            return "[" + ", ".join(value(x) for x in v) + "]"
+        if isinstance(v, dict):
+            return "{" + ", ".join(f"{key(k)} = {value(x)}" for k, x in v.items()) + "}"
+        raise TypeError(f"no TOML for {v!r}")
+
+    def key(k: str) -> str:
+        return k if re.fullmatch(r"[A-Za-z0-9_-]+", k) else toml_basic_string(k)
+
+    def is_tables(v: Any) -> bool:
+        return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
+
+    lines: list[str] = []
+
+    def table(d: dict[str, Any], path: list[str]) -> None:
+        for k, v in d.items():
+            if not isinstance(v, dict) and not is_tables(v):
+                lines.append(f"{key(k)} = {value(v)}")
+        for k, v in d.items():
+            name = ".".join(key(p) for p in [*path, k])
+            if isinstance(v, dict):
+                lines.extend(["", f"[{name}]"])
+                table(v, [*path, k])
+            elif is_tables(v):
+                for item in v:
+                    lines.extend(["", f"[[{name}]]"])
+                    table(item, [*path, k])
+
+    table(data, [])
+    text = "\n".join(lines).lstrip("\n") + "\n"
+    import tomllib
+
+    assert tomllib.loads(text) == data, "toml_text wrote a document that reads back otherwise"
+    return text
 
 
 def dome_variant(tmp_path: Path, scene: str, side: int) -> Path:
