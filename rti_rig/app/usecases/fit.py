@@ -671,6 +671,8 @@ def load_acquisition(
     if notes is not None:
         # dropped by the reader: said once, by the files' names (``names`` are stems)
         notes.extend(png_alpha_note([p.name for p in paths], paths))
+    # the description is fit.json's "read", a record beside its raw "source" (compared as such
+    # by a batch's rerun), never printed: the path stays as it is, not a shell word
     return frames, lights, names, f"{len(frames)} images from {lp}"
 
 
