@@ -54,6 +54,7 @@ from rti_rig.core.dome_link import (
 )
 from rti_rig.core.errors import DeviceError
 from rti_rig.core.out_folders import free_name
+from rti_rig.core.rig_geometry import led_said
 from rti_rig.core.shell_words import shell_word
 from rti_rig.runtime.duty_ledger import SAVE_EVERY_S, DutyLedger
 
@@ -811,7 +812,8 @@ class DomePolicy:
         lit = sum(max(0.0, e - max(s, now - window)) for s, e in spans)
         ago = max(0.0, now - max(e for _, e in spans)) if spans else 0.0
         warnings.warn(
-            f"LED {index} was lit {lit:.1f} s by an earlier command {ago:.0f} s ago: waiting "
+            f"{self.led_said(index)} was lit {lit:.1f} s by an earlier command {ago:.0f} s "
+            f"ago: waiting "
             f"{wait_s:.1f} s for its duty limit ([dome.serial.thermal] max_duty = "
             f"{self.settings.thermal.max_duty:g} over duty_window_s = {window:g} s)",
             RuntimeWarning,
@@ -831,6 +833,16 @@ class DomePolicy:
             raise DeviceError(self.name, "no calibrated LED directions were given (.lp file)")
         self._check_index(index, len(self.directions))
         return self.directions[index].copy()
+
+    def led_said(self, index: int) -> str:
+        """LED ``index`` as a user is told of it: ``LED 36 (az 112.5°, el 55.0°)``
+        (:func:`rti_rig.core.rig_geometry.led_said`), the number alone only where no calibrated
+        direction is known for it (no ``.lp`` given, or an index the firmware reported beyond
+        the dome's). Why: "LED 36" alone sends the user counting LEDs round the dome; its
+        direction says which one to look at."""
+        if self.directions is not None and 0 <= index < len(self.directions):
+            return led_said(index, self.directions[index])
+        return f"LED {index}"
 
     # ------------------------------------------------------------------ verbs
 
@@ -861,8 +873,8 @@ class DomePolicy:
                 if lit != index or got != level:
                     raise DomeLinkError(
                         self.link.device,
-                        f"the firmware reports LED {lit} at level {got} lit, not LED {index} at "
-                        f"level {level}",
+                        f"the firmware reports {self.led_said(lit)} at level {got} lit, not "
+                        f"{self.led_said(index)} at level {level}",
                         command,
                         LinkFault.MISMATCH,
                         retryable=True,
@@ -874,7 +886,7 @@ class DomePolicy:
             self._fail_safe()
             if exc.fault is LinkFault.REJECTED:
                 raise DomeLedError(
-                    self.name, index, f"LED {index} refused: {exc.message}", command
+                    self.name, index, f"{self.led_said(index)} refused: {exc.message}", command
                 ) from exc
             raise
         since = self.clock.now()
@@ -1007,7 +1019,7 @@ class DomePolicy:
                     self.guard.record(lost.index, lost.since, self.clock.now())
                     # "went dark with it" was not established: a board powered apart from
                     # its USB link keeps its LED lit through a drop of the port
-                    lit = f"LED {lost.index} was meant to be lit when the port went"
+                    lit = f"{self.led_said(lost.index)} was meant to be lit when the port went"
                     stops = (
                         f"{lit}, so the session stops at its image"
                         if self.lights_images
@@ -1047,7 +1059,8 @@ class DomePolicy:
                     raise DomeLedError(
                         self.name,
                         lost.index,
-                        f"the board {what} while LED {lost.index} was meant to be lit (found "
+                        f"the board {what} while {self.led_said(lost.index)} was meant to be "
+                        f"lit (found "
                         f"during '{command}'): {lost_what}",
                         command,
                     ) from exc
@@ -1344,7 +1357,8 @@ class DomePolicy:
             raise DomeLedError(
                 self.name,
                 lit.index,
-                f"LED {lit.index} stayed on {on_s:.3f} s, beyond max_on_s = {limit:g} s;{cut} "
+                f"{self.led_said(lit.index)} stayed on {on_s:.3f} s, beyond max_on_s = "
+                f"{limit:g} s;{cut} "
                 "raise max_on_s or shorten settle and exposure",
                 command,
             )

@@ -11,6 +11,7 @@ refused as "not as captured": the advice led nowhere. A card shot under every ot
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 from card_support import card_rig
@@ -158,7 +159,9 @@ def test_a_card_session_an_led_s_thermal_refusal_stopped_is_resumed(tmp_path: Pa
     assert r.exit_code != 0, r.output
     path = card / "manifest.json"
     manifest = json.loads(path.read_text(encoding="utf-8"))
-    assert f"LED {DEAD} refused: " in manifest["runner"]["error"]
+    assert re.search(
+        rf"LED {DEAD} \(az [-\d.]+°, el [-\d.]+°\) refused: ", manifest["runner"]["error"]
+    )
     manifest["runner"]["led_error"]["code"] = ERR_THERMAL
     path.write_text(json.dumps(manifest), encoding="utf-8")
 

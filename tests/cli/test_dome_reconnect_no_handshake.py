@@ -11,6 +11,7 @@ board acknowledges, so there both are established (tests/cli/test_dome_reconnect
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -40,7 +41,9 @@ def test_the_never_answering_rti_dome_is_not_said_to_answer_or_be_off(tmp_path: 
     # command 3: the all-off after LED 0's image (1: connect all-off, 2: light LED 0)
     code, text = _run_dropped_with_led_lit(tmp_path, "emulated_rti_dome.toml", 3)
     assert code == 2, text
-    assert "LED 0 was meant to be lit when the port went" in text, text
+    assert re.search(
+        r"LED 0 \(az [-\d.]+°, el [-\d.]+°\) was meant to be lit when the port went", text
+    ), text
     assert "it answered" not in text, text
     assert "The dome is back: its port reopened after " in text, text
     assert "the dome is off again" not in text, text
@@ -54,7 +57,9 @@ def test_the_minirti_dome_is_said_off_by_its_acknowledged_closing_all_off(
     # command 4: the all-off after LED 0's image (1, 2: the connect's all-offs, 3: LED 0)
     code, text = _run_dropped_with_led_lit(tmp_path, "emulated_minirti.toml", 4)
     assert code == 2, text
-    assert "LED 0 was meant to be lit when the port went" in text, text
+    assert re.search(
+        r"LED 0 \(az [-\d.]+°, el [-\d.]+°\) was meant to be lit when the port went", text
+    ), text
     assert "it answered" not in text, text
     assert "the dome is off again" not in text, text
     assert "whether the dome is dark is what the closing all-off established" in text, text

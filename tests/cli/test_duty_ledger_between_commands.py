@@ -34,7 +34,8 @@ duty_window_s = 600.0
 """
 
 EARLIER = re.compile(
-    r"LED 0 was lit (\d+\.\d) s by an earlier command (\d+) s ago: waiting (\d+\.\d) s for its "
+    r"LED 0 \(az [-\d.]+°, el [-\d.]+°\) was lit (\d+\.\d) s by an earlier command (\d+) s ago: "
+    r"waiting (\d+\.\d) s for its "
     r"duty limit \(\[dome\.serial\.thermal\] max_duty = 0\.006 over duty_window_s = 600 s\)"
 )
 
@@ -93,7 +94,7 @@ def test_a_check_right_after_a_run_waits_for_the_runs_leds_and_says_so(tmp_path:
     # nothing: LED 0 waits for most of the window before it lights again
     assert 1.0 < float(m.group(1)) < 3.0, text
     assert 300.0 < float(m.group(3)) <= 600.0, text
-    assert "note: LED 0 was lit" in text, text
+    assert "note: LED 0 (az " in text, text  # the note names the LED by its direction
     assert "RESULT: PASS" in text, text
     assert "lights: all-off sent and acknowledged by the dome: lights are off" in text, text
     assert "Traceback" not in text, text
@@ -161,7 +162,10 @@ def test_a_ledger_from_the_future_is_taken_as_just_ended(tmp_path: Path) -> None
     ledger.path.parent.mkdir(parents=True, exist_ok=True)
     tomorrow = time.time() + 86_400
     ledger.path.write_text(json.dumps({"format": 1, "lit": {"0": [[tomorrow, tomorrow + 1.5]]}}))
-    with pytest.warns(RuntimeWarning, match=r"LED 0 was lit 1\.5 s by an earlier command 0 s ago"):
+    with pytest.warns(
+        RuntimeWarning,
+        match=r"LED 0 \(az [-\d.]+°, el [-\d.]+°\) was lit 1\.5 s by an earlier command 0 s ago",
+    ):
         code, text = _run(config, tmp_path / "s")
     assert code == 0, text
     waited, earlier = _waited(text)

@@ -40,6 +40,6 @@ def test_a_stop_at_a_ring_dome_s_dead_led_names_it_by_its_direction(tmp_path: Pa
     cfg = _ring_dome(tmp_path, dead=2)  # the lowest ring's third LED: 2 × 30° from +x
     r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--no-verdict"])
     text = said(r)
-    assert r.exit_code == 2 and "LED 2 refused" in text, text
+    assert r.exit_code == 2 and "LED 2 (az 60.0°, el 10.0°) refused" in text, text
     assert "A resume lights LED 2 (az 60.0°, el 10.0°) first and stops there again" in text, text
     assert "led_0" not in text, text

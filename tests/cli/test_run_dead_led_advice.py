@@ -34,7 +34,9 @@ def test_a_stop_at_a_dead_led_advises_a_plan_without_it_that_works(tmp_path: Pat
     r = runner.invoke(app, ["run", str(cfg), "--out", str(s), "--no-verdict"])
     text = said(r)
     assert r.exit_code == 2, text
-    assert f"LED {DEAD} refused" in text and "LED fault" in text, text
+    assert (
+        re.search(rf"LED {DEAD} \(az [-\d.]+°, el [-\d.]+°\) refused", text) and "LED fault" in text
+    ), text
     assert "Continue with: rti-rig run --resume" not in text, text
     assert f"A resume lights LED {DEAD} (led_0{DEAD}.jpg, az " in text, text
     assert "°) first and stops there again" in text, text
@@ -86,7 +88,10 @@ def test_a_partial_plan_stopped_at_a_dead_led_is_given_a_plan_that_runs(
     r = runner.invoke(app, ["run", str(cfg), "--out", str(s), *chosen, "--no-verdict"])
     text = said(r)
     assert r.exit_code == 2, text
-    assert f"LED {DEAD} refused" in text and "Continue with: rti-rig run --resume" not in text
+    assert (
+        re.search(rf"LED {DEAD} \(az [-\d.]+°, el [-\d.]+°\) refused", text)
+        and "Continue with: rti-rig run --resume" not in text
+    )
     assert f"continue with: rti-rig run --resume {s}" in text, text  # once repaired
     written = tmp_path / f"s-without-led-{DEAD}.lp"
     new = tmp_path / f"s-without-led-{DEAD}"  # beside the session, not there yet
@@ -135,7 +140,10 @@ def test_an_adaptive_session_stopped_at_a_dead_led_it_chose_is_given_no_plan_of_
     r = runner.invoke(app, ["run", str(cfg), "--out", str(s), *adaptive])
     text = said(r)
     assert r.exit_code == 2, text
-    assert f"LED {dead} refused" in text and "Continue with: rti-rig run --resume" not in text
+    assert (
+        re.search(rf"LED {dead} \(az [-\d.]+°, el [-\d.]+°\) refused", text)
+        and "Continue with: rti-rig run --resume" not in text
+    )
     assert "no plan of its other lights exists" in text, text
     assert (
         f"copy {tmp_path / 'example_dome_48.lp'} (the rig's LED .lp) without the line of LED {dead}"
@@ -160,7 +168,9 @@ def test_a_resume_stopped_at_the_same_dead_led_reuses_the_plan_it_wrote(tmp_path
 
     r = runner.invoke(app, ["run", "--resume", str(s), "--no-verdict"])
     text = said(r)
-    assert r.exit_code == 2 and f"LED {DEAD} refused" in text, text
+    assert r.exit_code == 2 and re.search(
+        rf"LED {DEAD} \(az [-\d.]+°, el [-\d.]+°\) refused", text
+    ), text
     assert f"other lights, in its order, are already beside it as {first.name}" in text, text
     assert f"--plan {first} --out {tmp_path / f's-without-led-{DEAD}'}" in text, text
     assert sorted(p.name for p in tmp_path.glob("s-without-led-*.lp")) == [first.name]

@@ -272,7 +272,7 @@ def test_a_dead_led_that_stops_a_session_says_to_repair_it_before_the_resume(
     r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--no-verdict"])
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
-    assert "LED 2 refused" in said and "LED fault" in said, said
+    assert "LED 2 (az 60.1°, el 9.6°) refused" in said and "LED fault" in said, said
     repair = (
         "the LED or its wiring needs repair: until then a session that lights it, or its "
         "resume, stops there again"
