@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from rti_rig.app.usecases.run_options import adaptive_options, band_options
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
 from rti_rig.core.out_folders import free_name
@@ -100,27 +101,26 @@ def _new_session_command(asked: StartOptions, loaded: Any, root: Path) -> str:
     words = ["rti-rig", "run", shell_word(str(loaded.path))]
     if asked.plan is not None:
         words += ["--plan", shell_word(str(asked.plan))]
-    if asked.lights is not None:
-        words += ["--lights", str(asked.lights)]
-    if asked.adaptive:
-        words.append("--adaptive")
-    if asked.until_error_deg is not None:
-        words += ["--until-error", f"{asked.until_error_deg:g}"]
-    if asked.min_lights is not None:
-        words += ["--min-lights", str(asked.min_lights)]
+    if asked.is_adaptive:  # as every advised adaptive run says them (run_options)
+        objective = shlex.quote(asked.objective or "normals")  # a fixed choice, not a path
+        words.append(
+            adaptive_options(asked.until_error_deg, asked.lights, asked.min_lights, objective)
+        )
+    else:
+        # a planned request's --min-lights or --objective kept as asked: pasted, run says why
+        # it refuses them, rather than shooting a request the user did not make
+        words += ["--lights", str(asked.lights)] if asked.lights is not None else []
+        words += ["--min-lights", str(asked.min_lights)] if asked.min_lights is not None else []
+        words += ["--objective", shlex.quote(asked.objective)] if asked.objective else []
     if asked.auto_exposure:
         words.append("--auto-exposure")
     if asked.max_saturated is not None:
         words += ["--max-saturated", f"{asked.max_saturated:g}"]
-    if asked.min_elevation_deg != 0.0:
-        words += ["--min-elevation-deg", f"{asked.min_elevation_deg:g}"]
-    if asked.max_elevation_deg != 90.0:
-        words += ["--max-elevation-deg", f"{asked.max_elevation_deg:g}"]
+    words.append(band_options((asked.min_elevation_deg, asked.max_elevation_deg)).strip())
     if asked.allow_no_normals:
         words.append("--allow-no-normals")
-    if asked.objective is not None:
-        words += ["--objective", shlex.quote(asked.objective)]  # a fixed choice, not a path
-    return " ".join([*words, "--out", shell_word(str(free_name(root, folder=True)))])
+    words += ["--out", shell_word(str(free_name(root, folder=True)))]
+    return " ".join(w for w in words if w)  # no band: no word
 
 
 def _default_count_said(

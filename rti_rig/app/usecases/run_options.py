@@ -2,8 +2,9 @@
 rti-rig advises repeat them.
 
 Why a module of its own: an adaptive refusal's advised command
-(:mod:`rti_rig.app.usecases.adaptive`) and a refused replay resume's new-session command
-(:mod:`rti_rig.app.usecases.replay_advice`) each spelled these options out, one way each; a
+(:mod:`rti_rig.app.usecases.adaptive`), a refused replay resume's new-session command
+(:mod:`rti_rig.app.usecases.replay_advice`) and a resume refused as another request
+(:mod:`rti_rig.app.usecases.resume_request`) each spelled these options out, one way each; a
 command the user pastes must read the same whichever advice printed it. (A planned run's
 ``--lights N`` with its band is :func:`rti_rig.planner.uniform.band_run_options`.)
 """
