@@ -627,6 +627,26 @@ def full_pipe(writer_blocking: bool) -> tuple[int, int, bytes]:
     return read_end, write_end, filler
 
 
+def rti_rig_on_pipe(
+    args: list[str], write_end: int, stderr: Any = None, columns: int | None = 100
+) -> subprocess.Popen[bytes]:
+    """``python ARGS`` (``-m rti_rig ...`` or ``-c CODE``) from this checkout, its stdout the
+    pipe's ``write_end`` (its stderr too unless ``stderr`` is given), ``COLUMNS`` set unless
+    None; the test's own copy of ``write_end`` is closed, so its reader meets the pipe's end
+    when the command's closes. The stalled-reader tests had each written this out."""
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    if columns is not None:
+        env["COLUMNS"] = str(columns)
+    command = subprocess.Popen(
+        [sys.executable, *args],
+        stdout=write_end,
+        stderr=write_end if stderr is None else stderr,
+        env=env,
+    )
+    os.close(write_end)
+    return command
+
+
 def unread_in_pipe(fd: int) -> int:
     """How many bytes wait in the pipe ``fd`` for its reader (``FIONREAD``)."""
     import fcntl

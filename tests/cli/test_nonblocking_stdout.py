@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import REPO, ended_on_exit, full_pipe, unread_in_pipe
+from conftest import REPO, ended_on_exit, full_pipe, rti_rig_on_pipe, unread_in_pipe
 
 
 def _waits_for_room(pid: int) -> bool:
@@ -59,13 +59,7 @@ def test_help_on_a_full_non_blocking_pipe_is_said_whole(tmp_path: Path) -> None:
 
     read_end, write_end, filler = full_pipe(writer_blocking=False)
     with open(tmp_path / "stderr.txt", "wb") as stderr:
-        command = subprocess.Popen(
-            [sys.executable, "-m", "rti_rig", "run", "--help"],
-            stdout=write_end,
-            stderr=stderr,
-            env=env,
-        )
-    os.close(write_end)
+        command = rti_rig_on_pipe(["-m", "rti_rig", "run", "--help"], write_end, stderr, 80)
     with ended_on_exit(command):
         # The pipe is read only once the command has met it full: it ended (a command that
         # drops its words) or one of its threads waits for room in it (select/poll). Read

@@ -27,7 +27,7 @@ import threading
 import time
 
 import pytest
-from conftest import REPO, ended_on_exit, full_pipe
+from conftest import ended_on_exit, full_pipe, rti_rig_on_pipe
 
 pytestmark = pytest.mark.skipif(
     not sys.platform.startswith("linux"), reason="needs Linux's F_SETPIPE_SZ and /proc"
@@ -59,6 +59,16 @@ def _at_its_end(pid: int) -> bool:
     return "futex" in main and any("pipe_write" in w for w in wchans.values())
 
 
+def _wait_at_its_end(command: subprocess.Popen[bytes]) -> None:
+    """Return once ``command`` is at its end (:func:`_at_its_end`), however long a loaded
+    machine takes (up to 600 s); fail if it ends first."""
+    deadline = time.monotonic() + 600
+    while not _at_its_end(command.pid):
+        assert command.poll() is None, "the command ended with its reader stalled"
+        assert time.monotonic() < deadline, "the command did not reach its end in 600 s"
+        time.sleep(0.05)
+
+
 #: ``python -m rti_rig plan --help`` with the wait for the words bounded at 600 s, not 2 s.
 _PLAN_HELP_UNHURRIED = r"""
 import sys
@@ -72,22 +82,11 @@ main()
 
 def test_a_sigterm_in_the_end_wait_keeps_the_words_said_and_ends_by_sigterm() -> None:
     read_end, write_end, filler = full_pipe(writer_blocking=True)
-    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "100"}
-    command = subprocess.Popen(
-        [sys.executable, "-c", _PLAN_HELP_UNHURRIED],
-        stdout=write_end,
-        stderr=write_end,
-        env=env,
-    )
-    os.close(write_end)
+    command = rti_rig_on_pipe(["-c", _PLAN_HELP_UNHURRIED], write_end)
     said: list[bytes] = []
     reader = threading.Thread(target=lambda: said.append(os.fdopen(read_end, "rb").read()))
     with ended_on_exit(command):
-        deadline = time.monotonic() + 600
-        while not _at_its_end(command.pid):
-            assert command.poll() is None, "the command ended with its reader stalled"
-            assert time.monotonic() < deadline, "the command did not reach its end in 600 s"
-            time.sleep(0.05)
+        _wait_at_its_end(command)
         command.send_signal(signal.SIGTERM)
         reader.start()  # the words are waited on (600 s here) once the signal is handled
         code = command.wait(timeout=600)
@@ -101,25 +100,15 @@ def test_a_sigterm_in_the_end_wait_keeps_the_words_said_and_ends_by_sigterm() ->
 
 def test_a_ctrl_c_in_the_end_wait_says_the_words_unwritten_and_exits_130() -> None:
     read_end, write_end, _filler = full_pipe(writer_blocking=True)
-    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "100"}
-    command = subprocess.Popen(
-        [sys.executable, "-m", "rti_rig", "plan", "--help"],
-        stdout=write_end,  # the stalled reader: ``| less`` paused
-        stderr=subprocess.PIPE,  # a terminal's stderr, read throughout
-        env=env,
-    )
-    os.close(write_end)
+    # stdout the stalled reader (``| less`` paused), stderr a terminal's, read throughout
+    command = rti_rig_on_pipe(["-m", "rti_rig", "plan", "--help"], write_end, subprocess.PIPE)
     assert command.stderr is not None
     errors = command.stderr
     said: list[bytes] = []
     reader = threading.Thread(target=lambda: said.append(errors.read()))
     reader.start()
     with ended_on_exit(command), os.fdopen(read_end, "rb"):
-        deadline = time.monotonic() + 600
-        while not _at_its_end(command.pid):
-            assert command.poll() is None, "the command ended with its reader stalled"
-            assert time.monotonic() < deadline, "the command did not reach its end in 600 s"
-            time.sleep(0.05)
+        _wait_at_its_end(command)
         command.send_signal(signal.SIGINT)
         code = command.wait(timeout=600)  # the stdout reader never reads
         reader.join(timeout=600)
@@ -134,20 +123,9 @@ def test_a_ctrl_c_in_the_end_wait_keeps_a_failed_commands_exit() -> None:
     """A command that ended with its own failure (a usage error's 2) keeps it: a Ctrl-C in
     the wait for its words claims no success it could belie."""
     read_end, write_end, _filler = full_pipe(writer_blocking=True)
-    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "100"}
-    command = subprocess.Popen(
-        [sys.executable, "-m", "rti_rig", "plan", "--no-such-option"],
-        stdout=write_end,
-        stderr=write_end,
-        env=env,
-    )
-    os.close(write_end)
+    command = rti_rig_on_pipe(["-m", "rti_rig", "plan", "--no-such-option"], write_end)
     with ended_on_exit(command), os.fdopen(read_end, "rb"):
-        deadline = time.monotonic() + 600
-        while not _at_its_end(command.pid):
-            assert command.poll() is None, "the command ended with its reader stalled"
-            assert time.monotonic() < deadline, "the command did not reach its end in 600 s"
-            time.sleep(0.05)
+        _wait_at_its_end(command)
         command.send_signal(signal.SIGINT)
         code = command.wait(timeout=600)
     assert code == 2

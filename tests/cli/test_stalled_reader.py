@@ -13,14 +13,13 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
 import sys
 import threading
 import time
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, REPO, full_pipe, unread_in_pipe
+from conftest import CONFIGS, full_pipe, rti_rig_on_pipe, unread_in_pipe
 
 pytestmark = pytest.mark.skipif(
     not sys.platform.startswith("linux"), reason="needs Linux's F_SETPIPE_SZ and /proc"
@@ -50,15 +49,10 @@ def _finished(manifest: Path) -> dict | None:  # type: ignore[type-arg]
 def test_a_run_whose_reader_stalls_switches_its_lamp_off_then_waits(tmp_path: Path) -> None:
     session = tmp_path / "session"
     read_end, write_end, filler = full_pipe(writer_blocking=True)
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
     config = str(CONFIGS / "simulated_dome.toml")
-    command = subprocess.Popen(
-        [sys.executable, "-m", "rti_rig", "run", config, "--out", str(session), "--lights", "4"],
-        stdout=write_end,
-        stderr=write_end,  # ``2>&1 | less``: every word, the device's and the warnings too
-        env=env,
-    )
-    os.close(write_end)
+    # ``2>&1 | less``: every word, the device's and the warnings too
+    run = ["-m", "rti_rig", "run", config, "--out", str(session), "--lights", "4"]
+    command = rti_rig_on_pipe(run, write_end, columns=None)
     said: list[bytes] = []
     reader = threading.Thread(target=lambda: said.append(os.fdopen(read_end, "rb").read()))
     try:
