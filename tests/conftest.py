@@ -586,6 +586,27 @@ ASCII_LOCALE_ENV = {
 }
 
 
+@pytest.fixture
+def not_utf8_acquisition(tmp_path: Path) -> Path:
+    """The .lp of six small grey JPEGs in a folder whose name is not UTF-8
+    (:data:`NOT_UTF8_NAME`: an archive unpacked with its Windows names), lit from two
+    elevations so a photometric-stereo fit finds normals. Two tests had each built it."""
+    import cv2
+    import numpy as np
+
+    odd = tmp_path / os.fsdecode(NOT_UTF8_NAME)
+    odd.mkdir()
+    lines = ["6"]
+    for i in range(6):
+        az, el = 2 * np.pi * i / 6, np.radians(30 + 30 * (i % 2))
+        d = (np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el))
+        grey = np.full((24, 32), 40 + 30 * i, np.uint8)
+        (odd / f"img{i}.jpg").write_bytes(cv2.imencode(".jpg", grey)[1].tobytes())
+        lines.append(f"img{i}.jpg " + " ".join(f"{c:.6f}" for c in d))
+    (odd / "dirs.lp").write_text("\n".join(lines) + "\n")
+    return odd / "dirs.lp"
+
+
 def rti_rig_in_ascii_locale(*args: str | Path) -> subprocess.CompletedProcess[bytes]:
     """``python -m rti_rig *args`` in :data:`ASCII_LOCALE_ENV`, its streams as bytes; no
     traceback."""

@@ -13,9 +13,7 @@ import os
 from pathlib import Path
 
 import cv2
-import numpy as np
 import pytest
-from conftest import NOT_UTF8_NAME
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -24,19 +22,9 @@ from rti_rig.reconstruct import exporters
 
 
 @pytest.fixture
-def acquisition(tmp_path: Path) -> Path:
+def acquisition(not_utf8_acquisition: Path) -> Path:
     """Six small grey JPEGs and their .lp, in a folder whose name is not UTF-8."""
-    odd = tmp_path / os.fsdecode(NOT_UTF8_NAME)
-    odd.mkdir()
-    lines = ["6"]
-    for i in range(6):
-        az, el = 2 * np.pi * i / 6, np.radians(30 + 30 * (i % 2))
-        d = (np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el))
-        grey = np.full((24, 32), 40 + 30 * i, np.uint8)
-        (odd / f"img{i}.jpg").write_bytes(cv2.imencode(".jpg", grey)[1].tobytes())
-        lines.append(f"img{i}.jpg " + " ".join(f"{c:.6f}" for c in d))
-    (odd / "dirs.lp").write_text("\n".join(lines) + "\n")
-    return odd / "dirs.lp"
+    return not_utf8_acquisition
 
 
 def _fit(acquisition: Path, *qa: str) -> tuple[int, str]:
