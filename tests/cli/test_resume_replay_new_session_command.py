@@ -195,3 +195,21 @@ def test_a_session_from_before_the_record_whose_lights_needed_no_flag_is_not_giv
     text = said(r)
     assert r.exit_code == 2 and "--lights 7" in text, text
     assert "--allow-no-normals" not in text, text
+
+
+def test_a_replay_session_resumed_as_dot_is_told_a_new_session_beside_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``run --resume .`` from inside a changed replay's session: its new-session folder is
+    named from the session's absolute path (``S-new``). The folder had been made by adding
+    to the name of ``.``, which has none: "unexpected ValueError", exit 1, no advice."""
+    acq, out = tmp_path / "acq", tmp_path / "S"
+    shutil.copytree(ACQ, acq)
+    _cut_session(acq, out, lights=7)
+    names = [e.name for e in read_lp(acq / "dirs.lp")]
+    shutil.copy(acq / names[0], acq / names[-1])  # an image replaced since
+    monkeypatch.chdir(out)
+    r = runner.invoke(app, ["run", "--resume", "."])
+    text = said(r)
+    assert r.exit_code == 2 and "Traceback" not in text, text
+    assert f"--out {tmp_path / 'S-new'} --lights 7" in text, text

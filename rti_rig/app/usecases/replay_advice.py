@@ -16,19 +16,17 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.app.usecases.run_options import adaptive_options, band_options
+from rti_rig.core.out_folders import free_folder_beside
 from rti_rig.core.shell_words import shell_word
 
 
 def new_session_dir(session_dir: Path | str) -> Path:
-    """A folder beside ``session_dir`` that does not exist yet (``S-new``, ``S-new2``...), for
+    """A folder beside ``session_dir`` that does not exist yet (``S-new``, ``S-new-2``...), for
     the new session a refused resume is told to start: never the session's own folder, whose
-    images nothing may overwrite."""
-    root = Path(session_dir)
-    new = root.with_name(f"{root.name}-new")
-    n = 2
-    while new.exists():
-        new, n = root.with_name(f"{root.name}-new{n}"), n + 1
-    return new
+    images nothing may overwrite. A session given as ``.`` is named from its absolute path
+    (:func:`~rti_rig.core.out_folders.free_folder_beside`; its own loop here had ended a
+    ``run --resume .`` in "unexpected ValueError: PosixPath('.') has an empty name")."""
+    return free_folder_beside(Path(session_dir), "new")
 
 
 def _allowed_no_normals(manifest: dict[str, Any], provenance: dict[str, Any]) -> bool:
