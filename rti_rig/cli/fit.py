@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out, print_notes, shell_word, shown_path, stop_exit_code
+from rti_rig.cli.app import app, err, fail, out, print_notes, shown_path, stop_exit_code
 from rti_rig.cli.stopping import Terminated, sigterm_stops, stop_signal
 from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
@@ -66,12 +66,11 @@ def print_verdict(session: Path | None) -> None:
         # Terminated, as every command's does: it is the only handler installed while the
         # verdict is computed, so a Terminated here is the verdict's stop
         signum = stop_signal(exc)
-        from rti_rig.core.out_folders import free_folder_beside
+        from rti_rig.core.out_folders import fit_beside
 
         err.print(
             f"[yellow]QA verdict skipped ({stop_words(signum)}):[/] the session is complete; "
-            f"rti-rig fit {escape(shell_word(session))} --out "
-            f"{escape(shell_word(free_folder_beside(Path(session), 'fit')))} gives the verdict"
+            f"{escape(fit_beside(session))} gives the verdict"
         )
         raise typer.Exit(code=stop_exit_code(signum)) from None
 

@@ -44,7 +44,7 @@ from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free)
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, NORMAL_ERROR_LIMIT_DEG, NORMAL_NOISE
-from rti_rig.core.out_folders import free_folder_beside, free_name
+from rti_rig.core.out_folders import fit_beside, free_folder_beside, free_name
 
 if TYPE_CHECKING:
     from rti_rig.runtime.run_ending import RunEnding
@@ -381,7 +381,7 @@ def run(
                 f"[yellow]Stopped ({stop_words(late)}) once the session had ended: it "
                 "is complete; its QA "
                 "verdict was not computed:[/] "
-                f"{escape(_fit_next(opened.out_dir))} gives it",
+                f"{escape(fit_beside(opened.out_dir))} gives it",
                 soft_wrap=True,
             )
             raise typer.Exit(code=stop_exit_code(late))
@@ -391,7 +391,7 @@ def run(
             unsafe,
             "the session",
             "; its QA verdict was not computed:",
-            f" {escape(_fit_next(opened.out_dir))} gives it",
+            f" {escape(fit_beside(opened.out_dir))} gives it",
         )
         if not no_verdict:
             from rti_rig.cli.fit import print_verdict
@@ -443,10 +443,10 @@ def _rebuilt_finished(req: Any) -> bool:
             print_note(Note(line, "warning"))
         lost = lost_since_capture_said(req.session_dir)
         return f"Stopped ({why}) once {JOURNAL} was rebuilt: " + (
-            f"the session is whole again; {_fit_next(req.session_dir)} fits it "
+            f"the session is whole again; {fit_beside(req.session_dir)} fits it "
             "and gives its QA verdict"
             if lost is None
-            else f"{lost}; meanwhile {_fit_next(req.session_dir)} fits the rest"
+            else f"{lost}; meanwhile {fit_beside(req.session_dir)} fits the rest"
         )
 
     # the opening's answers, shared with run and preview: this third copy had lacked the one
@@ -473,14 +473,14 @@ def _rebuilt_finished(req: Any) -> bool:
         out.print(
             f"{shown_path(req.session_dir)}: {JOURNAL} rebuilt from every image it could prove (no "
             f"rig was opened, nothing was shot), but the session is not whole: {lost}; meanwhile "
-            f"{_fit_next(req.session_dir)} fits it, its QA verdict naming what is lost",
+            f"{fit_beside(req.session_dir)} fits it, its QA verdict naming what is lost",
             highlight=False,
             markup=False,
         )
         return True
     out.print(
         f"{shown_path(req.session_dir)}: {JOURNAL} rebuilt; the session is complete and whole "
-        f"again (no rig was opened, nothing was shot). Next: {_fit_next(req.session_dir)} "
+        f"again (no rig was opened, nothing was shot). Next: {fit_beside(req.session_dir)} "
         "fits it and gives its QA verdict",
         highlight=False,
         markup=False,
@@ -791,7 +791,7 @@ def _verdict_failed(exc: Exception, session: Path) -> None:
     err.print(
         f"[yellow]QA verdict unavailable:[/] unexpected {escape(what)} (a fault that rti-rig "
         "should have named: please report it); the "
-        f"session is complete: {escape(_fit_next(session))} gives the "
+        f"session is complete: {escape(fit_beside(session))} gives the "
         "verdict",
         highlight=False,
         soft_wrap=True,
@@ -838,16 +838,6 @@ def _arg(path: Path | str) -> str:
     with a space in its name ("Object 12 recto") had been printed bare, so the resume hint
     pasted into a shell ran ``--resume Object`` with "12" and "recto" as other arguments."""
     return shell_word(path)  # and as $'...' where a stream cannot print it (shell_word)
-
-
-def _fit_next(session: Path | str) -> str:
-    """The ``rti-rig fit`` a message names as a complete session's next step, its ``--out`` a
-    real folder beside the session that does not exist yet
-    (:func:`rti_rig.core.out_folders.free_folder_beside`).
-
-    Why: ``--out FOLDER`` had been printed, which pasted made a folder named FOLDER (beside
-    whatever the shell's folder was), where a hint is to paste as it stands."""
-    return f"rti-rig fit {_arg(session)} --out {_arg(free_folder_beside(Path(session), 'fit'))}"
 
 
 def _sentence(text: str) -> str:
@@ -1082,7 +1072,7 @@ class _Stop:
     def fit_it(self) -> str:
         """The command that fits the images as they are: offered where a resume is not
         possible or not needed, so the user is not left without a next step."""
-        return f"`{_fit_next(self.out_dir)}` fits the images as they are"
+        return f"`{fit_beside(self.out_dir)}` fits the images as they are"
 
 
 def _said_disowned(s: _Stop) -> str:
@@ -1122,7 +1112,7 @@ def _said_stopping_rule(s: _Stop) -> str:
     return (
         f"{s.kept}, listed in {s.lp}: the session is complete (its stopping rule ended it at {n} "
         f"of at most {s.ending.total_steps} lights), nothing is left to resume. Next: "
-        f"{_fit_next(s.out_dir)}"
+        f"{fit_beside(s.out_dir)}"
     )
 
 
@@ -1131,7 +1121,7 @@ def _said_complete(s: _Stop) -> str:
     # been said of a complete session, which the resume refused as "already completed"
     return (
         f"{s.kept}, listed in {s.lp}: the session is complete, nothing is left to resume. "
-        f"Next: {_fit_next(s.out_dir)}"
+        f"Next: {fit_beside(s.out_dir)}"
     )
 
 

@@ -7,7 +7,7 @@ import tempfile
 from pathlib import Path
 
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.shell_words import shown_path
+from rti_rig.core.shell_words import shell_word, shown_path
 
 #: How the file written and removed to prove the folder writable (permissions, read-only
 #: mounts) is named: this, then a part unique to each probe (:func:`tempfile.mkstemp`).
@@ -142,3 +142,15 @@ def free_folder_beside(root: Path, tag: str) -> Path:
     if root.name in ("", ".."):
         root = Path(os.path.normpath(root.absolute()))
     return free_name(root.with_name(f"{root.name}-{tag}"), folder=True)
+
+
+def fit_beside(session: Path | str) -> str:
+    """``rti-rig fit S --out S-fit``: the fit a hint names as a complete session's next step,
+    its ``--out`` a free folder beside the session (:func:`free_folder_beside`), both as shell
+    words.
+
+    Why one function: ``--out FOLDER`` had been printed, which pasted made a folder named
+    FOLDER; the fix then spelled this command out in eight places (run's words, fit's verdict,
+    the session's refusals)."""
+    root = Path(session)
+    return f"rti-rig fit {shell_word(root)} --out {shell_word(free_folder_beside(root, 'fit'))}"

@@ -77,7 +77,12 @@ from rti_rig.core.image_files import (
     write_untagged_jpeg,
 )
 from rti_rig.core.lp_format import LpEntry, format_lp, lp_files_in
-from rti_rig.core.out_folders import free_folder_beside, free_name, refuse_a_file_in_the_way
+from rti_rig.core.out_folders import (
+    fit_beside,
+    free_folder_beside,
+    free_name,
+    refuse_a_file_in_the_way,
+)
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
 from rti_rig.runtime.unrecorded_end import CAUSES, unrecorded_end
@@ -570,11 +575,7 @@ def _finished_hint(root: Path, manifest: dict[str, Any]) -> str:
         )
     # a real, free folder beside the session (fit refuses one inside it): ``--out DIR`` had
     # been printed, which pasted made a folder named DIR
-    fit_out = free_folder_beside(root, "fit")
-    return (
-        f" (it holds a finished session: fit it with rti-rig fit {folder} --out "
-        f"{shell_word(str(fit_out))})"
-    )
+    return f" (it holds a finished session: fit it with {fit_beside(root)})"
 
 
 def refuse_if_in_use(root: Path, what: str) -> None:
@@ -2056,7 +2057,7 @@ def _refuse_complete(
     folder = shell_word(str(root))
     mend = journal_mend_note(root) if scan.mended else None
     if mend is not None:
-        fit = f"rti-rig fit {folder} --out {shell_word(str(free_folder_beside(root, 'fit')))}"
+        fit = fit_beside(root)
         raise CompleteJournalNotWhole(
             f"{shown_path(root)}: this session completed all {finished} steps, but its "
             f"record is not whole: {mend} (no rig is opened, nothing is shot). Nothing was "
@@ -2074,7 +2075,7 @@ def _refuse_complete(
         f"{shown_path(root)}: {done}, and every image is as captured (each JPEG and linear "
         "TIFF matches its journaled checksum); nothing to resume, nothing was changed"
     )
-    fit = f"rti-rig fit {folder} --out {shell_word(str(free_folder_beside(root, 'fit')))}"
+    fit = fit_beside(root)
     if not (root / LP_NAME).is_file():
         # fit refuses a session folder without it (naming export-lp): the next step had been
         # named as fit alone, which then failed
@@ -2245,8 +2246,7 @@ def rebuild_finished_journal(root: Path) -> list[str]:
         names = image_names(planned_steps(manifest))
         scan = scan_journal(root, names)
         taken, unproven, lost = _finished_rebuild(root, manifest, names, scan)
-        folder = shell_word(str(root))
-        fit_out = shell_word(str(free_folder_beside(root, "fit")))  # ``--out DIR`` made DIR
+        fit = fit_beside(root)
         if unproven is None:
             # what is lost, named with what gets it back: the user who reached for the rebuild
             # had been sent to a fit to find out
@@ -2257,8 +2257,7 @@ def rebuild_finished_journal(root: Path) -> list[str]:
                 + (
                     f"; but {gone}"
                     if gone
-                    else f" (the QA verdict of rti-rig fit {folder} --out {fit_out} names any "
-                    "image changed since capture)"
+                    else f" (the QA verdict of {fit} names any image changed since capture)"
                 )
             )
         if len(lost) < len(unproven):
@@ -2267,7 +2266,7 @@ def rebuild_finished_journal(root: Path) -> list[str]:
                 f"{shown_path(root)}: {JOURNAL} cannot be rebuilt: {len(unproven)} of the "
                 f"session's images cannot be proven as captured: {shown}; nothing in this folder "
                 f"was changed: restore {JOURNAL} (or those files) from a backup copy of the "
-                f"folder, then run this again; meanwhile rti-rig fit {folder} --out {fit_out} fits "
+                f"folder, then run this again; meanwhile {fit} fits "
                 "the session as it is, its verdict naming the images it cannot check"
             )
         notes: list[str] = []
@@ -3042,8 +3041,7 @@ def read_manifest(root: Path) -> dict[str, Any]:
             # a session that lost its manifest (deleted, or left out of a copy): "not an rti-rig
             # session folder" had been said of a folder of its images and journal
             fit = (
-                f", but its images can still be fitted: rti-rig fit {shell_word(str(root))} "
-                f"--out {shell_word(str(free_folder_beside(Path(root), 'fit')))}"
+                f", but its images can still be fitted: {fit_beside(root)}"
                 if (Path(root) / LP_NAME).is_file()
                 else ""
             )

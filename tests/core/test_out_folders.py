@@ -9,7 +9,12 @@ from pathlib import Path
 import pytest
 
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.out_folders import ensure_writable_folder, free_folder_beside, free_name
+from rti_rig.core.out_folders import (
+    ensure_writable_folder,
+    fit_beside,
+    free_folder_beside,
+    free_name,
+)
 
 
 def test_a_new_folder_is_created_and_left_empty(tmp_path: Path) -> None:
@@ -97,3 +102,14 @@ def test_a_folder_beside_a_session_given_as_dot_or_dotdot_is_named_from_its_real
     (tmp_path / "scan 3-fit").mkdir()
     assert free_folder_beside(Path(".."), "again") == tmp_path / "scan 3-again"
     assert free_folder_beside(Path("../."), "fit") == tmp_path / "scan 3-fit-2"
+
+
+def test_the_fit_beside_a_session_pastes_back_to_it_and_a_free_folder(tmp_path: Path) -> None:
+    """The one fit command every complete session's hint names: both paths one shell word
+    each, its --out beside the session and not taken."""
+    import shlex
+
+    session = tmp_path / "Object 12"
+    (tmp_path / "Object 12-fit").mkdir()
+    words = shlex.split(fit_beside(session))
+    assert words == ["rti-rig", "fit", str(session), "--out", str(tmp_path / "Object 12-fit-2")]

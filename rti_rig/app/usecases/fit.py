@@ -63,6 +63,7 @@ from rti_rig.core.lp_format import (
 )
 from rti_rig.core.out_folders import (
     ensure_writable_folder,
+    fit_beside,
     free_folder_beside,
     free_name,
     refuse_a_file_in_the_way,
@@ -1562,8 +1563,7 @@ def qa_without_normals(lights: np.ndarray, session: Path | None = None) -> str |
         ""
         if session is None
         # a folder that does not exist yet beside the session: FOLDER pasted made a folder so named
-        else f"; `rti-rig fit {shell_word(str(session))} --out "
-        f"{shell_word(str(free_folder_beside(session, 'fit')))}` still writes the relighting files"
+        else f"; `{fit_beside(session)}` still writes the relighting files"
     )
     return (
         f"the QA judges every image against a normal map, and {reason}. No option of "
