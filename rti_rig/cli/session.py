@@ -1390,12 +1390,15 @@ def _moving_clause(rig, folder) -> str:  # type: ignore[no-untyped-def]
     # is in no record)
     park = rig.lighting.park_s
     runs = len(folder.manifest.get("runs") or [])
+    # a park stopped or failed part-way took its seconds too, but is not said as "parking it"
+    # (the arm's own line says where it was left)
+    what = "parking it" if rig.lighting.park_finished else "its park, cut short,"
     parked = (
         ""
         if park is None
-        else f", and parking it {park:.1f} s"
+        else f", and {what} {park:.1f} s"
         if runs <= 1
-        else f", and parking it at this run's end {park:.1f} s"
+        else f", and {what} at this run's end {park:.1f} s"
     )
     return f"; of which moving the arm (and switching its lamp on) {moving:.1f} s{parked}"
 

@@ -341,6 +341,9 @@ class ArmLighting:
         #: or no clock): a session's time line says it beside the moves to the lights, which
         #: had left the park's seconds of the session's time unaccounted for
         self.park_s: float | None = None
+        #: whether that park reached the park pose (False: stopped or failed part-way, its
+        #: seconds still spent): words must not call a park cut short "parking it"
+        self.park_finished = False
         self.name = carrier.name
         #: the rig config's path, named in the check that parks the arm after a failure
         #: ("park it with 'rti-rig check'" had named no config: pasted, it was refused)
@@ -535,7 +538,7 @@ class ArmLighting:
         return f"the park was stopped by {who}: held where it stopped, torque on"
 
     def _safe(self, emergency: bool) -> list[str]:
-        self.park_s = None
+        self.park_s, self.park_finished = None, False
         lamp_failed = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
         unheld: list[UnheldJoint] = []
         stop_failed = attempt_all([("stop", lambda: stop_reading_unheld(self.carrier, unheld))])
@@ -619,6 +622,7 @@ class ArmLighting:
         finally:
             if began is not None and self.clock is not None:
                 self.park_s = self.clock.now() - began
+        self.park_finished = True
         self.end = park_end(self.carrier, None)
         return failures
 
