@@ -2856,22 +2856,41 @@ def lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None = Non
 
 def _copy_back(root: Path, scan: JournalScan | None = None) -> tuple[list[str], bool]:
     """The ``cp`` commands (shell words) that put back the missing files of session ``root``
-    that were copied from a file still there as captured (``StepRecord.copied_from``: a
-    replay's recorded acquisition file, its checksum the journaled one), and whether they are
-    all that is lost. A file changed in the session is not copied over (the user's edit is
+    that the acquisition still holds (:func:`held_by_acquisition`), and whether they are all
+    that is lost. A file changed in the session is not copied over (the user's edit is
     theirs to set aside).
 
     Why: a replay session whose kept original was deleted was told "the camera's original
     capture is lost … reshoot with the object where it was": the acquisition holds it."""
-    records = _journal_records(root, scan)
-    if not records or not any(r.get("copied_from") for r in records):
+    held = held_by_acquisition(root, scan)
+    if not held:
         return [], False
-    copies: list[str] = []
-    covered = True
-    renamed = renamed_jpegs(root, records)
+    copies = [
+        f"cp -- {shell_word(source)} {shell_word(str(Path(root) / name))}"
+        for name, source in held.items()
+    ]
+    lost = files_lost_since_capture(root, scan)
+    covered = all(g.rpartition(" ")[0] in held for gone in lost.values() for g in gone)
+    return copies, covered
+
+
+def held_by_acquisition(root: Path, scan: JournalScan | None = None) -> dict[str, str]:
+    """Per file of session ``root`` missing since capture (its path in the session,
+    ``raw/image_002.jpg``) that was copied from a file still there as captured
+    (``StepRecord.copied_from``: a replay's recorded acquisition file, its checksum the
+    journaled one), that file's path; in capture order.
+
+    Why: the verdict and export-lp said of a replay's deleted copy "the camera's original
+    capture is lost" beside the ``cp`` that puts it back; what is lost is the copy alone, and
+    what they say of it is told from this one criterion, the one the ``cp`` advice uses."""
+    records = _journal_records(Path(root), scan)
+    if not records or not any(r.get("copied_from") for r in records):
+        return {}
+    held: dict[str, str] = {}
+    renamed = renamed_jpegs(Path(root), records)
     for rec in _latest_records(records).values():
         sources = rec.get("copied_from") or {}
-        for lost in _lost_files(root, rec, renamed):
+        for lost in _lost_files(Path(root), rec, renamed):
             name, _, how = lost.rpartition(" ")
             source = sources.get(name)
             if (
@@ -2879,10 +2898,8 @@ def _copy_back(root: Path, scan: JournalScan | None = None) -> tuple[list[str], 
                 and isinstance(source, str)
                 and file_sha256(Path(source)) == rec["sha256"].get(name)
             ):
-                copies.append(f"cp -- {shell_word(source)} {shell_word(str(root / name))}")
-            else:
-                covered = False
-    return copies, covered
+                held[name] = source
+    return held
 
 
 def _lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None) -> str:

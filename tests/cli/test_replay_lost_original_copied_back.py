@@ -5,7 +5,9 @@ since was said as "the camera's original capture is lost … reshoot exactly tho
 object where it was": the acquisition holds the file, so the advice is now the ``cp`` that puts
 it back (its path journaled as ``copied_from``). Two files of one name in two subfolders of the
 ``.lp`` had been recorded under one original name (their file name): the name recorded is now
-the path relative to the ``.lp``."""
+the path relative to the ``.lp``. The fit's QA verdict and export-lp, which said of it "the
+camera's original capture is lost" beside that ``cp``, say what is true: the copy in ``raw/``
+is missing, the acquisition still holds it."""
 
 from __future__ import annotations
 
@@ -56,6 +58,15 @@ def test_a_replays_lost_original_is_copied_back_from_the_acquisition(tmp_path: P
     r = runner.invoke(app, ["run", "--resume", str(out)])
     text = said(r)
     assert "object where it was" not in text, text
+    # the verdict (a fit without its slow models) and export-lp say the copy alone is missing
+    held = "kept in raw/ is missing, the acquisition still holds it as recorded"
+    fit = ["fit", str(out), "--out", str(tmp_path / "fit"), "--model", "lambert"]
+    exported = ["export-lp", str(out), "--out", str(tmp_path / "x.lp")]
+    for args in ([*fit, "--no-ptm", "--no-hsh"], exported):
+        r = runner.invoke(app, args)
+        assert r.exit_code == 0, said(r)
+        assert held in said(r) and "original capture" not in said(r), said(r)
+        assert "copy it back from the acquisition: cp -- " in said(r), said(r)
     line = next(x for x in text.splitlines() if "copy it back from the acquisition: " in x)
     command = line.split("copy it back from the acquisition: ", 1)[1].rstrip(".")
     subprocess.run(["sh", "-c", command], check=True, timeout=60)

@@ -21,6 +21,7 @@ from rti_rig.runtime.session import (
     MANIFEST,
     JournalScan,
     files_lost_since_capture,
+    held_by_acquisition,
     image_names,
     list_unwritten_step,
     lost_image_advice,
@@ -255,7 +256,9 @@ def _raw_lost(root: Path, listed: set[str], scan: JournalScan, adaptive: bool) -
     """What to say of the images ``listed`` whose camera originals alone are lost: the RAW is
     the original capture, so the image is lost, though its developed file is as captured and
     listed. Why: export-lp said nothing of it, while the QA verdict names it and
-    ``--reshoot-lost`` shoots it again."""
+    ``--reshoot-lost`` shoots it again. A replay's copies that its acquisition still holds
+    (:func:`held_by_acquisition`) are said as missing copies, not as a lost capture (that had
+    stood beside the ``cp`` that copies them back)."""
     lost = sorted(
         (n, g)
         for n, g in files_lost_since_capture(root, scan).items()
@@ -263,13 +266,30 @@ def _raw_lost(root: Path, listed: set[str], scan: JournalScan, adaptive: bool) -
     )
     if not lost:
         return ""
-    files = ", ".join(f for _, g in lost[:8] for f in g) + (" …" if len(lost) > 8 else "")
-    return (
-        f"{files} since capture: the camera's original capture of "
-        f"{', '.join(n for n, _ in lost[:8])} is lost (the developed "
-        f"{'image is' if len(lost) == 1 else 'images are'} as captured, and listed); "
-        + lost_image_advice(root, adaptive, scan)
-    )
+    held = held_by_acquisition(root, scan)
+    copies = [(n, g) for n, g in lost if all(f.rpartition(" ")[0] in held for f in g)]
+    gone = [(n, g) for n, g in lost if (n, g) not in copies]
+    said = []
+    for group, held_there in ((gone, False), (copies, True)):
+        if not group:
+            continue
+        one = len(group) == 1
+        files = ", ".join(f for _, g in group[:8] for f in g) + (" …" if len(group) > 8 else "")
+        names = ", ".join(n for n, _ in group[:8])
+        what = (
+            f"the copy of {names}'s recorded file kept in raw/ is missing, the acquisition "
+            "still holds it as recorded"
+            if held_there and one
+            else f"the copies of {names}'s recorded files kept in raw/ are missing, the "
+            "acquisition still holds them as recorded"
+            if held_there
+            else f"the camera's original capture of {names} is lost"
+        )
+        said.append(
+            f"{files} since capture: {what} (the developed "
+            f"{'image is' if one else 'images are'} as captured, and listed)"
+        )
+    return "; ".join(said) + "; " + lost_image_advice(root, adaptive, scan)
 
 
 def _mosaic_said(listed: set[str], scan: JournalScan) -> str:

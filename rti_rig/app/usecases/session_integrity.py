@@ -39,6 +39,7 @@ from rti_rig.runtime.session import (
     RUN_ENDED,
     STRAY_DIR,
     files_lost_since_capture,
+    held_by_acquisition,
     image_names,
     journal_mend_note,
     lost_image_advice,
@@ -119,11 +120,12 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     # is said too: it had gone unsaid, the verdict "good", of a session no longer whole
     unlisted = [n for n in sorted(lost) if n not in {c.name for c in qa.images}]
     once = len(lost) > 1 or bool(unlisted)  # the advice said once, not after each of 48 images
+    held = held_by_acquisition(source)  # a replay's copies its acquisition still holds
     images = []
     for check in qa.images:
         gone = lost.get(check.name)
         if gone:
-            problem = f"{', '.join(gone)} since capture" + _developed_stand(gone)
+            problem = f"{', '.join(gone)} since capture" + _developed_stand(gone, held)
             if not once:
                 problem += f"; {relight}" if check.name in relisted else ""
                 problem += f"; {todo}"
@@ -138,11 +140,17 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             shown += f"; {', '.join(unlisted[:8])}{' …' if len(unlisted) > 8 else ''} not in "
             shown += f"{lp.name}, so not fitted"
         plural = "images" if len(lost) > 1 else "image"
-        raws = sorted(n for n, g in lost.items() if originals_lost(g))
+        raws = sorted(n for n, g in lost.items() if originals_lost(g) and not _all_held(g, held))
         if raws:  # the camera's originals: lost, though what was fitted of them stands
             shown += (
                 f"; of {', '.join(raws[:8])}{' …' if len(raws) > 8 else ''} the RAW original is "
                 "lost, the developed JPEG and linear TIFF are as captured and were fitted"
+            )
+        copies = sorted(n for n, g in lost.items() if originals_lost(g) and _all_held(g, held))
+        if copies:  # a replay's copies of its recorded files: the acquisition holds them
+            shown += (
+                f"; of {', '.join(copies[:8])}{' …' if len(copies) > 8 else ''} "
+                f"{_held_said(len(copies))}"
             )
         note = f"{len(lost)} {plural} missing or changed since capture ({shown}): {todo}"
         if relisted:
@@ -153,13 +161,37 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     return qa
 
 
-def _developed_stand(gone: list[str]) -> str:
+def _held_said(images: int) -> str:
+    """What is said of ``images`` images whose kept originals are missing copies a replay's
+    acquisition still holds as recorded (:func:`rti_rig.runtime.session.held_by_acquisition`)."""
+    if images == 1:
+        return (
+            "the copy of the recorded file kept in raw/ is missing, the acquisition still "
+            "holds it as recorded; the JPEG and linear TIFF are as captured and were fitted"
+        )
+    return (
+        "the copies of the recorded files kept in raw/ are missing, the acquisition still "
+        "holds them as recorded; their JPEGs and linear TIFFs are as captured and were fitted"
+    )
+
+
+def _all_held(gone: list[str], held: dict[str, str]) -> bool:
+    """Whether every file of one image :func:`files_lost_since_capture` names (``gone``, each
+    ``raw/image_002.jpg missing``) is a copy its acquisition still holds (``held``)."""
+    return all(g.rpartition(" ")[0] in held for g in gone)
+
+
+def _developed_stand(gone: list[str], held: dict[str, str]) -> str:
     """What to add to an image's lost files ``gone`` when only its camera originals are lost:
     the RAW is the original capture, so the image is lost, but its developed JPEG and linear
     TIFF are as captured and were fitted (the verdict had called a missing RAW no reason to
-    reshoot while a resume and a rebuild called the step unproven)."""
+    reshoot while a resume and a rebuild called the step unproven). A replay's copies that
+    its acquisition still holds (``held``) are said as such: "the original capture is lost"
+    had stood beside the ``cp`` that copies it back."""
     if not originals_lost(gone):
         return ""
+    if _all_held(gone, held):
+        return f": {_held_said(1)}"
     return (
         ": the camera's original capture is lost, its developed JPEG and linear TIFF are as "
         "captured and were fitted"
