@@ -958,11 +958,13 @@ class DomePolicy:
         return self._run(self.link.query, "query lit LED")
 
     def level_for(self, index: int, intensity: float) -> int:
-        """PWM level for ``intensity`` on LED ``index`` after its intensity correction."""
+        """PWM level for ``intensity`` on LED ``index`` after its intensity correction. A
+        refusal names the LED by its number and direction (:meth:`led_said`), as the module's
+        other refusals do: "LED 2" alone sent the user counting LEDs round the dome."""
         if not (math.isfinite(intensity) and 0.0 < intensity <= 1.0):
             raise DeviceError(
                 self.name,
-                f"intensity {intensity} for LED {index} is outside (0, 1]",
+                f"intensity {intensity} for {self.led_said(index)} is outside (0, 1]",
                 f"light LED {index}",
             )
         corr = self.settings.intensity_correction
@@ -972,7 +974,7 @@ class DomePolicy:
             raise DomeLedError(
                 self.name,
                 index,
-                f"LED {index} cannot give intensity {intensity}: with its correction "
+                f"{self.led_said(index)} cannot give intensity {intensity}: with its correction "
                 f"{factor:g} it would need level {level} > {self.link.max_level}; lower the "
                 "intensity or renormalise the correction list so its largest factor is 1",
                 f"light LED {index}",

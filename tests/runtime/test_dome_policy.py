@@ -418,6 +418,26 @@ def test_intensity_correction_maps_to_levels():
             dome.light(0, bad)
 
 
+def test_intensity_refusals_name_the_led_by_its_direction():
+    """An intensity outside (0, 1], or one its correction lifts beyond the firmware's top
+    level, is refused naming the LED by number and direction, as the other refusals do."""
+    clock = VirtualClock()
+    # a factor above 1 the config refuses (DomeSerialSettings' validator): the level check is
+    # the policy's own guard for settings built without it, so they are built so here
+    s = DomeSerialSettings(port="emulated").model_copy(
+        update={"intensity_correction": [1.0, 1.0, 2.0, 1.0]}
+    )
+    fw = firmware_for(s, clock=clock, led_count=4)
+    dirs = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])
+    dome = build_dome(s, clock, transport=InProcessDomeTransport(fw), directions=dirs)
+    dome.connect()
+    with pytest.raises(DeviceError, match=r"intensity 1\.5 for LED 1 \(az 90\.0°, el 0\.0°\) is"):
+        dome.light(1, 1.5)
+    with pytest.raises(DomeLedError, match=r": LED 2 \(az 0\.0°, el 90\.0°\) cannot give") as e:
+        dome.light(2, 1.0)
+    assert e.value.led == 2 and fw.lit is None
+
+
 def test_correction_list_of_the_wrong_length_fails_at_connect():
     dome, _fw, _clock = make("default", intensity_correction=[1.0] * 5)
     with pytest.raises(DeviceError, match="intensity_correction has 5 factors but the firmware"):
