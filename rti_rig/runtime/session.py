@@ -3329,8 +3329,12 @@ def journal_mend_note(root: Path) -> str | None:
     scan = scan_journal(root, image_names(total))
     if not scan.mended:
         return None
-    unwritten = stopped_before_journal_line(scan)
-    if unwritten is not None:  # not damage: "damaged (records missing)" had been said of it
+    completed = (manifest.get("runner") or {}).get("finish_reason") == "completed"
+    # not damage ("damaged (records missing)" had been said of it), unless the run completed:
+    # then it journaled every step, and a line missing now was lost after (said as "the run
+    # stopped", with a plain resume as the mend, which refuses a completed session)
+    unwritten = None if completed else stopped_before_journal_line(scan)
+    if unwritten is not None:
         return _unwritten_line_note(root, unwritten)
     stems = [Path(rel).stem for rel in scan.mended]
     parts = []
@@ -3341,7 +3345,6 @@ def journal_mend_note(root: Path) -> str | None:
         parts.append("its last line cut short")
     why = ", ".join(parts) or "records missing"
     state = "is missing, so it" if scan.missing else f"is damaged ({why}) and"
-    completed = (manifest.get("runner") or {}).get("finish_reason") == "completed"
     mend = f"rti-rig run --resume {shell_word(str(root))}" + (
         " --rebuild-journal" if completed else ""
     )

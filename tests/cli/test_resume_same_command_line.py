@@ -376,6 +376,28 @@ def test_a_complete_session_whose_journal_was_deleted_is_not_called_intact(
     assert "this session is complete: all 8 steps were captured" in said(r)
 
 
+def test_a_complete_session_missing_its_last_journal_line_is_told_the_rebuild(
+    stopped: Path, tmp_path: Path
+) -> None:
+    """A completed session whose journal lost only its last line had been told "the run
+    stopped after image_008's record file, before its journal line; rti-rig run --resume S
+    writes it back": the run had completed, and that very resume was what refused it (a
+    loop). It is told the rebuild, which mends it."""
+    out = copy_of(stopped, tmp_path)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    lines = (out / "journal.jsonl").read_text().splitlines(keepends=True)
+    (out / "journal.jsonl").write_text("".join(lines[:-1]))
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "the run stopped" not in text, text
+    command = f"rti-rig run --resume {out} --rebuild-journal"
+    assert command in text, text
+    r = runner.invoke(app, shlex.split(command)[1:])
+    assert r.exit_code == 0, r.output
+
+
 def test_a_session_begun_without_lights_is_said_to_have_every_light(
     tmp_path_factory: pytest.TempPathFactory,
 ) -> None:
