@@ -269,9 +269,14 @@ class DxlBus:
 
     # -- checks -----------------------------------------------------------------------------
     def _check(self, result: int, error: int, dxl_id: int, command: str, alert: bool = True):
+        # the mark is this command's alone (set by its retry just before): a later command
+        # that is not retried (a reboot, a ping sent once) must not inherit it, or a servo
+        # gone since would be said to be there, only slow
+        late = dxl_id in self.late
+        self.late.discard(dxl_id)
         if result != sdk.COMM_SUCCESS:
             at = f" at {self.baudrate} baud" if self.baudrate else ""
-            if result == sdk.COMM_RX_TIMEOUT and dxl_id in self.late:
+            if result == sdk.COMM_RX_TIMEOUT and late:
                 raise CommunicationError(
                     self.device,
                     f"{comm_text(self.ph, result)}{at}: its status came on "

@@ -103,3 +103,32 @@ def test_a_slow_links_advice_names_the_adapters_own_latency_timer(tmp_path: Path
         f" (set its latency timer to 1 ms: echo 1 | sudo tee '{timer}')"
     )
     assert _latency_note(str(tmp_path / "pts3"), str(devices)) == ""
+
+
+def test_a_late_status_is_not_said_of_a_later_command_that_gets_none() -> None:
+    """A read whose statuses came too late is said as a slow link; a reboot sent after it,
+    whose status is lost, is not (the mark had stayed on the servo's id: a servo gone since
+    would have been called there, only slow)."""
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.drivers.dynamixel import control_table as ct
+    from rti_rig.drivers.dynamixel.bus import DxlBus
+    from rti_rig.drivers.dynamixel.faults import CommunicationError
+    from rti_rig.simulator.dynamixel_emulator import (
+        DynamixelBusEmulator,
+        EmulatedServo,
+        InProcessPort,
+    )
+
+    emu = DynamixelBusEmulator([EmulatedServo(1, 1060, VirtualClock())], VirtualClock())
+    bus = DxlBus(InProcessPort(emu), "arm")
+    bus.open(57600)
+    assert bus.ping(1) == 1060
+    for k in (1, 2):  # the read and its retry
+        emu.add_fault(emu.instructions_received + k, "delay_reply", delay_s=2.0)
+    with pytest.raises(CommunicationError, match="but late"):
+        bus.read(1, ct.PRESENT_POSITION)
+    bus.drain_reply()
+    emu.add_fault(emu.instructions_received + 1, "drop_reply")
+    with pytest.raises(CommunicationError) as lost:
+        bus.reboot(1)
+    assert "late" not in str(lost.value), lost.value
