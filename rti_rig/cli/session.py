@@ -2100,15 +2100,19 @@ def preview(
                 markup=False,
                 soft_wrap=True,
             )
-        if late_term:  # the preview and its summary are out; the run's word on the stop
+        # a SIGTERM held as the summary printed, or a second Ctrl-C once the capture had
+        # ended (it stopped no image), as ``run`` says them: the second Ctrl-C had ended a
+        # complete preview with exit 0, where it had been 130 (said "Emergency stop")
+        late = late_term[0] if late_term else opened.stopped_once_over
+        if late is not None:  # the preview and its summary are out; the run's word on the stop
             _refuse_unsafe_end(unsafe, exit_code=None)
             err.print(
-                f"[yellow]Stopped ({stop_words(late_term[0])}) once the preview was taken: it "
+                f"[yellow]Stopped ({stop_words(late)}) once the preview was taken: it "
                 "is complete in "
                 f"{escape(_arg(out_dir))}[/] (plan from it as above)",
                 soft_wrap=True,
             )
-            raise typer.Exit(code=stop_exit_code(late_term[0]))
+            raise typer.Exit(code=stop_exit_code(late))
         _exit_if_park_stopped(
             opened,
             unsafe,

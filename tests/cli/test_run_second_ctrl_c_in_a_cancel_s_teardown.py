@@ -25,7 +25,7 @@ import pytest
 from conftest import CONFIGS, REPO
 
 _CHILD = r"""
-import signal, sys
+import os, signal, sys
 from rti_rig.runtime.lighting import DomeLighting
 from rti_rig.runtime.session import SessionFolder
 
@@ -33,7 +33,7 @@ real_write, real_safe, teardowns = SessionFolder.write_step, DomeLighting.safe, 
 
 def write_step(self, index, *args, **kwargs):
     record = real_write(self, index, *args, **kwargs)
-    if index == 1:
+    if index == int(os.environ.get("FIRST_AT", "1")):
         signal.raise_signal(signal.SIGINT)  # the first Ctrl-C: stop after this image
     return record
 
@@ -59,12 +59,7 @@ def test_a_second_ctrl_c_in_a_cancelled_run_s_teardown_keeps_the_cancel(tmp_path
     out = tmp_path / "s"
     config = CONFIGS / "emulated_nab_rti_v1.toml"
     argv = ["run", str(config), "--lights", "4", "--out", str(out), "--no-verdict"]
-    result = subprocess.run(
-        [sys.executable, "-c", _CHILD, *argv],
-        capture_output=True,
-        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
-        timeout=600,
-    )
+    result = _two_ctrl_c(argv)
     said = " ".join(result.stderr.decode("utf-8", "replace").split())
     assert "teardowns: [False]" in said, said  # one teardown, a cancel's: the second came in it
     run = json.loads((out / "manifest.json").read_text())["runs"][-1]
@@ -76,3 +71,39 @@ def test_a_second_ctrl_c_in_a_cancelled_run_s_teardown_keeps_the_cancel(tmp_path
     assert "All-off sent and acknowledged by the dome: lights are off." in said, said
     assert f"Continue with: rti-rig run --resume {out}" in said, said
     assert result.returncode == 130, said
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_two_ctrl_c_as_a_preview_ends_stop_it_once_it_is_taken(tmp_path: Path) -> None:
+    """The preview's one image is in when the first Ctrl-C comes, the second as the teardown
+    switches off: the preview is complete (its manifest: completed) and the run says so as
+    for a late SIGTERM, exit 130. It had ended with exit 0 and no word of the stop the user
+    asked for twice (before the second Ctrl-C stopped nothing: "Emergency stop", 130)."""
+    out = tmp_path / "p"
+    argv = ["preview", str(CONFIGS / "simulated_dome.toml"), "--out", str(out)]
+    result = _two_ctrl_c(argv, first_at=0)
+    said = " ".join(result.stderr.decode("utf-8", "replace").split())
+    assert "teardowns: [False]" in said, said
+    run = json.loads((out / "manifest.json").read_text())["runs"][-1]
+    assert run["finish_reason"] == "completed", run
+    assert "Emergency stop" not in said and "Traceback" not in said, said
+    assert said.count("Ctrl-C after the capture had ended: there was nothing left to stop") == 1
+    assert f"Stopped (Ctrl-C) once the preview was taken: it is complete in {out}" in said, said
+    assert "rti-rig plan" in result.stdout.decode("utf-8", "replace"), result.stdout
+    assert result.returncode == 130, said
+
+
+def _two_ctrl_c(argv: list[str], first_at: int = 1) -> subprocess.CompletedProcess[bytes]:
+    """``rti-rig ARGV`` in a child whose first Ctrl-C comes as image ``first_at`` (from 0) is
+    committed and whose second comes as the teardown switches the lights off."""
+    return subprocess.run(
+        [sys.executable, "-c", _CHILD, *argv],
+        capture_output=True,
+        env={
+            **os.environ,
+            "PYTHONPATH": str(REPO),
+            "COLUMNS": "300",
+            "FIRST_AT": str(first_at),
+        },
+        timeout=600,
+    )

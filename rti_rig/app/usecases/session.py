@@ -182,8 +182,9 @@ class OpenedSession:
     #: Ctrl-C), for :meth:`close` to record where it cut the run's end; None: no stop
     cut_by: str | None = None
     #: a stop the user insisted on (a second Ctrl-C) once the capture had ended, which stopped
-    #: no image: the command's run stops after its summary (no QA verdict), exit 128 + its
-    #: number, while the manifest keeps how the capture ended; None: none came
+    #: no image: the command stops after its summary (``run`` before its QA verdict,
+    #: ``preview`` after its plan hint), exit 128 + its number, while the manifest keeps how
+    #: the capture ended; None: none came
     stopped_once_over: signal.Signals | None = None
 
     @property
