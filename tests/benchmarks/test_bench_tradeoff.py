@@ -206,15 +206,33 @@ def test_the_arm_is_timed_in_the_order_run_gives_a_simulated_arm() -> None:
     )
     rig = shipped_rig(ARM_CONFIG)
     geometry = rig_geometry(rig)
+    settings, t = rig.config.arm, rig.config.timing
+    assert settings is not None
     clock = VirtualClock()
-    arm = SimulatedArm(geometry, LightState(), clock, 60.0, 120.0, 360.0 / 4096, 0.02)
+    # the same arm, lamp and lit time as session_times (virtual_arm.toml's), in the other
+    # order: its figures had been typed in (1.41 s lit where the config gives 1.35 s + two
+    # 0.02 s lamp switches), so the two differed by more than the order
+    arm = SimulatedArm(
+        geometry,
+        LightState(),
+        clock,
+        speed_deg_s=settings.speed_deg_s,
+        acceleration_deg_s2=settings.acceleration_deg_s2,
+        resolution_deg=settings.resolution_deg,
+        switch_s=t.light_switch_s,
+    )
     arm.connect()
+    arm.lamp(False)
     for i in order_nearest_neighbour(dirs, geometry.park_direction):
         arm.move_to(dirs[i])
-        clock.sleep(1.41)  # lamp on, settle, exposure, readout, transfer, lamp off
+        arm.lamp(True)
+        clock.sleep(t.settle_s + rig.config.camera.exposure_s + t.readout_s + t.transfer_s)
+        arm.lamp(False)
+    arm.lamp(False)
     arm.park()
     _, timed = session_times(dirs, shipped_rig(DOME_CONFIG), rig)
-    # nearest by angle: 30, -30, -100, -170, then 170 a whole turn away (22.9 s in all)
+    # nearest by angle: 30, -30, -100, -170, then 170 a whole turn away (24.2 s in all, the
+    # move-time order 23.2 s)
     assert timed < clock.now() - 0.5, (timed, clock.now())
 
 
