@@ -252,11 +252,13 @@ def session_times(
     """Session time of a plan on the simulated dome and on the simulated arm (seconds).
 
     Every figure is the shipped config's (``dome``, ``arm``: :func:`shipped_rig`), as
-    ``rti-rig run`` reads it: the per-light time is :func:`per_light_s` of each rig, and the
+    ``rti-rig run`` reads it: a dome light costs :func:`per_light_s` of the dome, and the
     arm is the :class:`~rti_rig.simulator.sim_lights.SimulatedArm` ``run`` builds from the
-    arm config's ``[arm]`` (speed, acceleration, resolution, band, park) and lamp switch time.
+    arm config's ``[arm]`` (speed, acceleration, resolution, band, park), its lamp switched
+    on and off at each light and off at the start and the end (``light_switch_s`` each).
     Until 2026-12-02 the benchmark kept its own copy of them, with the dome's 0.1 s settle
-    where the arm's config settles 0.3 s: every arm time was low by 0.2 s a light.
+    where the arm's config settles 0.3 s and one switch a light: every arm time was low by
+    0.22 s a light and 0.04 s a session (docs/research/tradeoff.md).
 
     The dome takes the same time for every light. The arm visits the lights in the order
     ``rti-rig run`` gives a simulated arm (the move-time order of
