@@ -1575,7 +1575,12 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         if ended:
             # a second Ctrl-C meant as "stop at once", landing as the session's end is
             # reported (its except or finally clauses, before the ignore is set) had raised
-            # EmergencyStop where nothing caught it: a traceback, the summary and resume unsaid
+            # EmergencyStop where nothing caught it: a traceback, the summary and resume unsaid.
+            # After a first Ctrl-C it is the second, as one a moment earlier in the teardown:
+            # the run stops after its summary (it had been said, then forgotten: the verdict
+            # computed, exit 0). A stopped capture's own exit stands; a park's stop says itself
+            if started and cancel.cancelled and _park_stopped_by(opened.rig) is None:
+                opened.stopped_once_over = signal.SIGINT
             if not late_said:
                 late_said = True
                 closing = _CLOSING_RESUME_CTRL_C if opened.resumed else _CLOSING_CTRL_C

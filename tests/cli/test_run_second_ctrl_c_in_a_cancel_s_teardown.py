@@ -107,3 +107,55 @@ def _two_ctrl_c(argv: list[str], first_at: int = 1) -> subprocess.CompletedProce
         },
         timeout=600,
     )
+
+
+#: the second Ctrl-C once the capture has returned, as the progress bar closes (after the
+#: teardown, before the summary's ignore is set)
+_AS_THE_BAR_CLOSES = r"""
+import os, signal, sys
+import rich.progress
+from rti_rig.runtime.session import SessionFolder
+
+real_write, real_exit = SessionFolder.write_step, rich.progress.Progress.__exit__
+
+def write_step(self, index, *args, **kwargs):
+    record = real_write(self, index, *args, **kwargs)
+    if index == 3:
+        signal.raise_signal(signal.SIGINT)  # the first Ctrl-C, as the last image is in
+    return record
+
+def bar_closes(self, *args):
+    signal.raise_signal(signal.SIGINT)  # the second, the capture returned
+    return real_exit(self, *args)
+
+SessionFolder.write_step = write_step
+rich.progress.Progress.__exit__ = bar_closes
+sys.argv = ["rti-rig", *sys.argv[1:]]
+from rti_rig.launch import main
+main()
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_second_ctrl_c_just_after_the_teardown_stops_the_run_as_one_in_it(
+    tmp_path: Path,
+) -> None:
+    """Landing once the capture has returned (its progress bar closing) rather than in the
+    teardown, the second Ctrl-C of a complete session had been said and then forgotten: the
+    run went on to its verdict and exited 0, where one a moment earlier exits 130 before it."""
+    out = tmp_path / "s"
+    argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--lights", "4", "--out", str(out)]
+    result = subprocess.run(
+        [sys.executable, "-c", _AS_THE_BAR_CLOSES, *argv],
+        capture_output=True,
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
+        timeout=600,
+    )
+    said = " ".join(result.stderr.decode("utf-8", "replace").split())
+    run = json.loads((out / "manifest.json").read_text())["runs"][-1]
+    assert run["finish_reason"] == "completed", run
+    assert "Every image is in" in said and "Emergency stop" not in said, said
+    assert said.count("Ctrl-C after the capture had ended: there was nothing left to stop") == 1
+    assert "Stopped (Ctrl-C) once the session had ended: it is complete" in said, said
+    assert "verdict" not in result.stdout.decode("utf-8", "replace").lower(), result.stdout
+    assert result.returncode == 130, said
