@@ -1946,7 +1946,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
     if result.finish_reason is FinishReason.CANCELLED:
         err.print(
             f"[yellow]Session cancelled; the images captured so far are kept.[/] "
-            f"{escape(lights)} {resume_hint}"
+            f"{escape(lights)} {escape(resume_hint)}"
         )
         raise typer.Exit(code=stop_exit_code(signal.SIGINT))
     from rti_rig.app.usecases.safe_state import safe_state_unsure
