@@ -20,6 +20,13 @@ bench_app = typer.Typer(
 app.add_typer(bench_app, name="bench")
 
 
+
+def _plain(text: str) -> None:
+    """Print ``text`` as it is. Why: the trade-off's progress lines and summary carry paths
+    (the acquisition's, the --out folder's), and rich's markup took a folder's ``[v2]`` for a
+    style tag and dropped it (a ``[/x]`` would have raised MarkupError)."""
+    out.print(text, highlight=False, markup=False)
+
 def _find_benchmarks() -> None:
     """Make the checkout's ``benchmarks`` package importable for the installed command.
 
@@ -218,20 +225,20 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
     if from_lp is not None:
         try:
             text = bench_from(
-                from_lp, out_dir, lambda msg: out.print(msg, highlight=False), force=force
+                from_lp, out_dir, _plain, force=force
             )
         except RtiRigError as exc:
             raise fail(exc) from None
         except ValueError as exc:
             raise fail(RtiRigError(str(exc))) from None
-        out.print(text, highlight=False)
+        _plain(text)
         if out_dir is None:
             out.print("(nothing written: give --out DIR to keep the results)", highlight=False)
         return
 
     settings = TradeoffSettings.quick() if quick else TradeoffSettings()
     t0 = time.perf_counter()
-    rows = run_tradeoff(settings, progress=lambda msg: out.print(msg, highlight=False))
+    rows = run_tradeoff(settings, progress=_plain)
     command = "rti-rig bench tradeoff" + (" --quick" if quick else "")
     if out_dir is not None:
         # one shell word, as the command is pasted from summary.md (a folder with a space had
@@ -243,6 +250,6 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
         write_csv(rows, out_dir / "results.csv")
         plot(rows, out_dir)
         (out_dir / "summary.md").write_text(text, encoding="utf-8")
-    out.print(text, highlight=False)
+    _plain(text)
     if out_dir is None:
         out.print("(nothing written: give --out DIR to keep the results)", highlight=False)

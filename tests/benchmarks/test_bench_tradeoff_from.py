@@ -24,8 +24,8 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
 
     from conftest import NOT_UTF8_NAME
 
-    # in folders with spaces, as an archive's are (``Tablet 3/dirs.lp``)
-    acq = tmp_path / "Tablet 3" / "dirs.lp"
+    # in folders with spaces and brackets, as an archive's are (``Tablet [v3]/dirs.lp``)
+    acq = tmp_path / "Tablet [v3]" / "dirs.lp"
     shutil.copytree(ACQ.parent, acq.parent)
     out = tmp_path / os.fsdecode(b"trade off " + NOT_UTF8_NAME)  # bytes that are not UTF-8
     r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(acq), "--out", str(out)])
@@ -51,6 +51,9 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
     assert not list(out.glob("*arm_time*"))
     text = (out / "summary.md").read_text()
     assert "--from" in text and "adaptive" in text
+    # the summary as printed holds the acquisition's folder whole (rich's markup had taken
+    # '[v3]' for a style tag and dropped it)
+    assert "Tablet [v3]" in r.output, r.output
     # its command line, pasted into a shell, names the same acquisition and --out (it had
     # written the paths bare, a command that fails where a folder's name has a space, then
     # shlex-quoted, '\udce9' where the name's byte is not UTF-8, which summary.md's write
