@@ -125,7 +125,11 @@ def free_name(path: Path, *, folder: bool = False) -> Path:
     Why one function: ``plan`` refuses an existing ``--out`` without ``--force``, ``run`` a
     non-empty folder and ``fit`` an existing one, so a hint's ``--out DIR`` pasted as printed
     made a folder named DIR, and an existing name was refused; the CLI and the session folder
-    each had their own copy of this loop."""
+    each had their own copy of this loop.
+
+    A path with no name of its own (``.``, ``..``, ``a/..``) is named by its absolute path:
+    ``--out .`` of a non-empty folder had ended in "unexpected ValueError" here."""
+    path = _named(path)
     stem, suffix = (path.name, "") if folder else (path.stem, path.suffix)
     candidate, n = path, 2
     while candidate.exists() or candidate.is_symlink():
@@ -139,9 +143,17 @@ def free_folder_beside(root: Path, tag: str) -> Path:
     taken): the ``--out`` of a command a hint about session ``root`` suggests (``fit`` refuses
     an ``--out`` inside the session, so beside it, not in it). A session given as ``.`` or
     ``..`` is named by its absolute path: it has no name to add to."""
-    if root.name in ("", ".."):
-        root = Path(os.path.normpath(root.absolute()))
+    root = _named(root)
     return free_name(root.with_name(f"{root.name}-{tag}"), folder=True)
+
+
+def _named(path: Path) -> Path:
+    """``path``, or its absolute, normalised form where it has no name to add to (``.``,
+    ``..``, ``a/..``, the root ``/`` excepted: it has none either way)."""
+    path = Path(path)
+    if path.name in ("", "..") or path.parts[-1:] == ("..",):
+        return Path(os.path.normpath(path.absolute()))
+    return path
 
 
 def fit_beside(session: Path | str) -> str:

@@ -46,4 +46,7 @@ def test_the_current_folder_written_as_a_dot_is_still_a_folder(
     assert result.exit_code == 2, result.output
     assert "is not empty" in said(result)
     assert "an empty path" not in said(result)
+    # the new folder it offers is the current one's sibling, by its absolute path (`.` has
+    # no name to add -2 to: the offer had ended in "unexpected ValueError")
+    assert f"--out {tmp_path}-2" in said(result), said(result)
     assert [p.name for p in tmp_path.iterdir()] == ["kept.txt"]
