@@ -269,31 +269,13 @@ def session_times(
     Lights the arm cannot reach (inside its keep-out cone) are clamped to its band for timing.
     """
     from rti_rig.app.compose import simulated_arm_motion
-    from rti_rig.app.config import rig_geometry
     from rti_rig.planner.arm_order import order_for_arm
-    from rti_rig.simulator.sim_lights import LightState, SimulatedArm
 
     dome_s = len(directions) * per_light_s(dome)
-    geometry = rig_geometry(arm)
-    settings = arm.config.arm
-    assert isinstance(geometry, ArmGeometry) and settings is not None, arm.path
-    clock = VirtualClock()
-    carrier = SimulatedArm(
-        geometry,
-        LightState(),
-        clock,
-        speed_deg_s=settings.speed_deg_s,
-        acceleration_deg_s2=settings.acceleration_deg_s2,
-        resolution_deg=settings.resolution_deg,
-        switch_s=arm.config.timing.light_switch_s,
-    )
-    carrier.connect()
+    carrier, geometry, clock, lit_s = timed_arm(arm)
     reachable = np.array([_clamp_to_band(d, geometry) for d in directions])
-    t = arm.config.timing
-    # lit: settle, expose, read out, transfer; the lamp switched on before and off after each
-    # light, and off once at the start and once at the end, as ``run`` does (the dry run's
-    # rig_time_s for the same lights, tests/benchmarks)
-    lit_s = t.settle_s + arm.config.camera.exposure_s + t.readout_s + t.transfer_s
+    # the lamp switched on before and off after each light, and off once at the start and
+    # once at the end, as ``run`` does (the dry run's rig_time_s for the same lights)
     carrier.lamp(False)
     for i in order_for_arm(reachable, geometry.park_direction, simulated_arm_motion(arm)):
         carrier.move_to(reachable[i])
@@ -303,6 +285,34 @@ def session_times(
     carrier.lamp(False)
     carrier.park()
     return dome_s, clock.now()
+
+
+def timed_arm(arm: LoadedRig) -> tuple[Any, ArmGeometry, VirtualClock, float]:
+    """The :class:`~rti_rig.simulator.sim_lights.SimulatedArm` ``run`` builds from ``arm``'s
+    config (speed, acceleration, resolution, lamp switch), connected, its geometry, a fresh
+    virtual clock it runs on, and the seconds each light is lit (settle, expose, read out,
+    transfer), all as the config says. Why one place: a test timing the arm in another order
+    had built its own copy, and a copy's figures drift (this benchmark's own had been low by
+    0.22 s a light)."""
+    from rti_rig.app.config import rig_geometry
+    from rti_rig.simulator.sim_lights import LightState, SimulatedArm
+
+    geometry = rig_geometry(arm)
+    settings, t = arm.config.arm, arm.config.timing
+    assert isinstance(geometry, ArmGeometry) and settings is not None, arm.path
+    clock = VirtualClock()
+    carrier = SimulatedArm(
+        geometry,
+        LightState(),
+        clock,
+        speed_deg_s=settings.speed_deg_s,
+        acceleration_deg_s2=settings.acceleration_deg_s2,
+        resolution_deg=settings.resolution_deg,
+        switch_s=t.light_switch_s,
+    )
+    carrier.connect()
+    lit_s = t.settle_s + arm.config.camera.exposure_s + t.readout_s + t.transfer_s
+    return carrier, geometry, clock, lit_s
 
 
 def _clamp_to_band(d: NDArray[np.float64], arm: ArmGeometry) -> NDArray[np.float64]:

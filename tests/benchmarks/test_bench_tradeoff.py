@@ -194,39 +194,23 @@ def test_the_arm_is_timed_in_the_order_run_gives_a_simulated_arm() -> None:
     not by angle: the benchmark's arm time must be that order's, never the nearest-neighbour
     order's when that one is slower (stops either side of ±180°, which the azimuth cannot
     cross: nearest by angle, a whole turn apart for the arm)."""
-    from benchmarks.tradeoff import ARM_CONFIG, session_times
-    from rti_rig.app.config import rig_geometry
-    from rti_rig.core.clock import VirtualClock
+    from benchmarks.tradeoff import ARM_CONFIG, session_times, timed_arm
     from rti_rig.core.geometry import direction_from_az_el
     from rti_rig.planner.uniform import order_nearest_neighbour
-    from rti_rig.simulator.sim_lights import LightState, SimulatedArm
 
     dirs = np.array(
         [direction_from_az_el(az, 30.0) for az in (170.0, -170.0, 100.0, -100.0, 30.0, -30.0)]
     )
     rig = shipped_rig(ARM_CONFIG)
-    geometry = rig_geometry(rig)
-    settings, t = rig.config.arm, rig.config.timing
-    assert settings is not None
-    clock = VirtualClock()
     # the same arm, lamp and lit time as session_times (virtual_arm.toml's), in the other
     # order: its figures had been typed in (1.41 s lit where the config gives 1.35 s + two
     # 0.02 s lamp switches), so the two differed by more than the order
-    arm = SimulatedArm(
-        geometry,
-        LightState(),
-        clock,
-        speed_deg_s=settings.speed_deg_s,
-        acceleration_deg_s2=settings.acceleration_deg_s2,
-        resolution_deg=settings.resolution_deg,
-        switch_s=t.light_switch_s,
-    )
-    arm.connect()
+    arm, geometry, clock, lit_s = timed_arm(rig)
     arm.lamp(False)
     for i in order_nearest_neighbour(dirs, geometry.park_direction):
         arm.move_to(dirs[i])
         arm.lamp(True)
-        clock.sleep(t.settle_s + rig.config.camera.exposure_s + t.readout_s + t.transfer_s)
+        clock.sleep(lit_s)
         arm.lamp(False)
     arm.lamp(False)
     arm.park()
