@@ -36,3 +36,26 @@ def terminated() -> None:
     """This process is sent SIGTERM, as `timeout` or a service manager sends it; its handler
     runs at the next bytecode, so the statement after this one is not reached."""
     os.kill(os.getpid(), signal.SIGTERM)
+
+
+#: ``python -c`` source of an ``rti-rig`` run that sends itself ``{signal}`` as image ``AT``
+#: (0-based, its first argument, popped) is committed: the commit holds the signal, which
+#: stops the run right after that image (no sleeps, no timing)
+_SIGNAL_AT_COMMIT = """
+import os, signal, sys
+from rti_rig.runtime.session import SessionFolder
+AT = int(sys.argv.pop(1))
+real = SessionFolder.write_step
+def write_step(self, i, *a, **k):
+    if i == AT:
+        os.kill(os.getpid(), signal.{signal})
+    return real(self, i, *a, **k)
+SessionFolder.write_step = write_step
+from rti_rig.cli import app
+app(sys.argv[1:], prog_name="rti-rig")
+"""
+
+
+def signal_at_commit(name: str) -> str:
+    """:data:`_SIGNAL_AT_COMMIT` for signal ``name`` (``"SIGTERM"``, ``"SIGINT"``)."""
+    return _SIGNAL_AT_COMMIT.replace("{signal}", name)

@@ -17,22 +17,11 @@ from pathlib import Path
 
 import pytest
 from conftest import CONFIGS, REPO
+from sigterm_support import signal_at_commit
 
 #: ``rti-rig run`` that sends itself a Ctrl-C (SIGINT) as image ``AT`` (0-based) is committed:
 #: the commit holds it, and the run stops after that image, cancelled
-SCRIPT = """
-import os, signal, sys
-from rti_rig.runtime.session import SessionFolder
-AT = int(sys.argv.pop(1))
-real = SessionFolder.write_step
-def write_step(self, i, *a, **k):
-    if i == AT:
-        os.kill(os.getpid(), signal.SIGINT)
-    return real(self, i, *a, **k)
-SessionFolder.write_step = write_step
-from rti_rig.cli import app
-app(sys.argv[1:], prog_name="rti-rig")
-"""
+SCRIPT = signal_at_commit("SIGINT")
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
