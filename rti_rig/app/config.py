@@ -857,14 +857,49 @@ def _lps_in_folder_said(folder: Path) -> str:
     lps = acquisition_lp_files(folder)
     if not lps:
         return ""
-    names = ", ".join(lp_name_from(folder, p) for p in lps[:3])
     more = " ..." if len(lps) > 3 else ""
     own = lps[0].parent == folder
-    where = "this folder holds" if own else "the RTIBuilder project's light list is"
     if len(lps) > 1:
+        # each as a word that pastes: the user gives one of them in the folder's place
+        names = ", ".join(shell_word(p) for p in lps[:3])
         where = "this folder holds" if own else "the RTIBuilder project's assembly-files holds"
         return f" ({where} {names}{more}: give the one that lists this acquisition's images)"
+    names = lp_name_from(folder, lps[0])
+    where = "this folder holds" if own else "the RTIBuilder project's light list is"
     return f" ({where} {names}: give {shell_word(lps[0])})"
+
+
+def rtibuilder_project_lp(folder: Path) -> Path | None:
+    """The one ``.lp`` an RTIBuilder project folder (or its ``jpeg-exports``) holds in
+    ``assembly-files/``, to replay in the folder's place; None for any other folder (one with
+    ``.lp`` files of its own, a session folder among them, is still refused: which of its
+    files is the acquisition is the user's to say). Several in ``assembly-files/``: refused,
+    each named as a word to paste.
+
+    Why: a conservator holds the project folder and expects `run PROJECT` to replay it as
+    `run PROJECT/assembly-files/X.lp` does; it had been refused, naming the .lp to give."""
+    folder = Path(folder)
+    if not folder.is_dir() or lp_files_in(folder):
+        return None
+    lps = acquisition_lp_files(folder)
+    if len(lps) > 1:
+        raise ConfigError(
+            folder,
+            None,
+            f"is an RTIBuilder project whose assembly-files holds {len(lps)} light lists, "
+            "so which acquisition to replay is not known; give the one that lists its images: "
+            + " or ".join(shell_word(p) for p in lps),
+        )
+    return lps[0] if lps else None
+
+
+def project_replayed_note(folder: Path, lp: Path) -> str:
+    """What is said (and kept among the rig's notes in the manifest) of a project folder given
+    as the rig: the ``.lp`` it replays, by its full path."""
+    return (
+        f"{shown_path(folder)} is an RTIBuilder project: replaying its light list "
+        f"{lp_name_from(folder, lp)} ({shell_word(lp)})"
+    )
 
 
 def _not_toml_hint(raw: bytes) -> str:
@@ -889,6 +924,11 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     path = Path(path)
     if path.suffix.lower() == ".lp":
         return load_replay_rig(path)
+    project_lp = rtibuilder_project_lp(path)
+    if project_lp is not None:
+        loaded = load_replay_rig(project_lp)  # its path, in the manifest, is the .lp replayed
+        note = project_replayed_note(path, project_lp)
+        return loaded.model_copy(update={"notes": (note, *loaded.notes)})
     if path.is_dir():  # an acquisition's folder, given for its .lp: say which file to give
         raise ConfigError(
             path,

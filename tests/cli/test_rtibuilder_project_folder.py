@@ -26,9 +26,10 @@ LIGHTS = 8
 GIVEN = pytest.mark.parametrize("given", [".", "jpeg-exports"])
 
 
-def _project(root: Path) -> Path:
-    """A tiny RTIBuilder project (8 lights, 64x48 JPEGs; the .lp with absolute Windows names,
-    a BOM and CRLF, as RTIBuilder writes it), in a folder whose name has a space; its .lp."""
+def _project(root: Path, lights: int = LIGHTS) -> Path:
+    """A tiny RTIBuilder project (``lights`` lights, 64x48 JPEGs; the .lp with absolute Windows
+    names, a BOM and CRLF, as RTIBuilder writes it), in a folder whose name has a space; its
+    .lp."""
     import cv2
 
     project = root / "icon RTI"
@@ -38,8 +39,8 @@ def _project(root: Path) -> Path:
     nx, ny = (xx - 32) / 100, (yy - 24) / 100
     nz = np.sqrt(1 - nx**2 - ny**2)
     lines = []
-    for i in range(LIGHTS):
-        az, el = 2 * np.pi * i / LIGHTS, np.radians(20 + 50 * (i % 2))
+    for i in range(lights):
+        az, el = 2 * np.pi * i / lights, np.radians(20 + 50 * (i % 2))
         d = (np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el))
         shade = np.clip(nx * d[0] + ny * d[1] + nz * d[2], 0, 1) * 220
         name = f"icon_{i + 1:02d}.JPG"
@@ -47,7 +48,7 @@ def _project(root: Path) -> Path:
         xyz = " ".join(f"{c:.6f}" for c in d)
         lines.append(f"C:\\RTI\\icon RTI\\jpeg-exports\\{name} {xyz}")
     lp = project / "assembly-files" / "icon.lp"
-    lp.write_bytes(("\ufeff" + "\r\n".join([str(LIGHTS), *lines]) + "\r\n").encode())
+    lp.write_bytes(("\ufeff" + "\r\n".join([str(lights), *lines]) + "\r\n").encode())
     return lp
 
 
@@ -65,22 +66,75 @@ def test_fit_of_an_rtibuilder_project_folder_fits_its_assembly_files_lp(
     assert json.loads((out / "fit.json").read_text())["read"] == f"{LIGHTS} images from {lp}"
 
 
+def test_run_of_an_rtibuilder_project_folder_replays_its_one_lp_and_resumes(
+    tmp_path: Path,
+) -> None:
+    """`run PROJECT` had been refused, naming the .lp to give; it replays that .lp, says so,
+    keeps the .lp in the manifest (a bare `--resume` finds it), and `run PROJECT --resume`
+    continues a session it began."""
+    from rti_rig.app.usecases.session import NewSessionRequest
+    from rti_rig.runtime.controller import FinishReason
+    from tests.conftest import cut_new_session
+
+    lp = _project(tmp_path, lights=4)
+    project = lp.parents[1]
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(project), "--out", str(out)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert f"replaying its light list assembly-files/icon.lp ({shlex.quote(str(lp))})" in said
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["rig"]["config_path"] == str(lp.resolve()), manifest["rig"]
+    assert len(list(out.glob("image_*.jpg"))) == 4
+
+    cut = tmp_path / "cut"
+    run = cut_new_session(NewSessionRequest(project, cut, lights=4), after_step=1)
+    assert run.finish_reason is FinishReason.CANCELLED
+    r = runner.invoke(app, ["run", str(project), "--resume", str(cut)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "4 image(s) in the session" in said, said
+    assert json.loads((cut / "manifest.json").read_text())["rig"]["config_path"] == str(
+        lp.resolve()
+    )
+
+
 @GIVEN
-def test_run_and_check_of_an_rtibuilder_project_folder_name_its_lp_as_a_word_to_paste(
+def test_check_and_plan_of_an_rtibuilder_project_folder_take_its_one_lp(
     tmp_path: Path, given: str
 ) -> None:
-    lp = _project(tmp_path)
-    project = str(lp.parents[1] / given)
-    named = "assembly-files/icon.lp" if given == "." else "../assembly-files/icon.lp"
-    for command in (["run", project, "--out", str(tmp_path / "s")], ["check", project]):
+    lp = _project(tmp_path, lights=4)
+    folder = str(lp.parents[1] / given)
+    r = runner.invoke(app, ["check", folder])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "RESULT: PASS" in said, said
+    assert f"replaying its light list {'../' if given != '.' else ''}assembly-files/icon" in said
+    plan = tmp_path / "plan.lp"
+    r = runner.invoke(app, ["plan", "--rig", folder, "--lights", "4", "--out", str(plan)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "planning on its light list" in said and "on a dome of 4 LEDs" in said, said
+
+
+def test_a_project_folder_with_several_lps_is_refused_naming_each_to_paste(
+    tmp_path: Path,
+) -> None:
+    lp = _project(tmp_path, lights=4)
+    other = lp.with_name("icon (old).lp")
+    other.write_bytes(lp.read_bytes())
+    project = str(lp.parents[1])
+    for command in (
+        ["run", project, "--out", str(tmp_path / "s")],
+        ["check", project],
+        ["plan", "--rig", project, "--out", str(tmp_path / "p.lp")],
+    ):
         r = runner.invoke(app, command)
         said = " ".join(r.output.split())
         assert r.exit_code == 2, said
-        assert f"the RTIBuilder project's light list is {named}: give " in said, said
-        word = said.rsplit(": give ", 1)[1]
-        assert word.endswith(")"), said
-        assert shlex.split(word[:-1]) == [str(lp)], said
-        assert not (tmp_path / "s").exists()
+        assert "assembly-files holds 2 light lists" in said, said
+        words = shlex.split(said.rsplit("give the one that lists its images: ", 1)[1])
+        assert [w for w in words if w != "or"][:2] == [str(other), str(lp)], said
+        assert not (tmp_path / "s").exists() and not (tmp_path / "p.lp").exists()
 
 
 @GIVEN

@@ -9,13 +9,19 @@ meaning "a dome with exactly these lights".
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from rti_rig.app.compose import arm_order_for, read_preview_image
-from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
+from rti_rig.app.config import (
+    LoadedRig,
+    load_rig_config,
+    project_replayed_note,
+    rig_geometry,
+    rtibuilder_project_lp,
+)
 from rti_rig.app.normals_determined import (
     band_advice,
     refuse_undetermined,
@@ -158,6 +164,11 @@ def _check_outputs(req: PlanLightsRequest, loaded: LoadedRig | None) -> None:
 
 def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     """Check, plan and write ``req.out_file``; nothing is read before the options are checked."""
+    project_lp = rtibuilder_project_lp(req.rig)
+    if project_lp is not None:  # an RTIBuilder project folder: planned on its .lp, as given
+        said = project_replayed_note(req.rig, project_lp).replace("replaying", "planning on")
+        planned = plan_lights(replace(req, rig=project_lp))
+        return replace(planned, notes=(said, *planned.notes))
     method, objective = req.method_or_default, req.objective_or_default
     if req.lights < MIN_PLAN_LIGHTS:
         raise RtiRigError(
