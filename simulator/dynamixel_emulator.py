@@ -667,6 +667,10 @@ class DynamixelBusEmulator(HostBaudDevice):
         #: the port after the host's reply window if it is shorter (:meth:`take_late`)
         self.late: list[tuple[float, bytes]] = []
         self.hardware_faults: dict[int, list[tuple[int, str]]] = {}
+        #: ``power_lost``: from this instruction packet on (1 = the first), the chain's supply
+        #: is gone: no servo hears, acts or answers (ROBOTIS e-manual: an unpowered servo is
+        #: simply absent from the bus); None: powered throughout
+        self.power_lost_at: int | None = None
         #: instruction packets received so far (what ``reply_faults`` counts)
         self.instructions_received = 0
         self.goal_log: list[tuple[int, int]] = []
@@ -754,6 +758,7 @@ class DynamixelBusEmulator(HostBaudDevice):
                     and ct.BAUD_CODES.get(servo.get(ct.BAUD_RATE)) != self.host_baud
                 )
                 or servo.get(ct.PROTOCOL_TYPE) != PROTOCOL_2
+                or self._unpowered(self.instructions_received + 1)
             }
             self._parser.feed(bytes(data))
             out = bytearray()
@@ -765,6 +770,8 @@ class DynamixelBusEmulator(HostBaudDevice):
                     continue
                 self.instructions.append(item)
                 self.instructions_received += 1
+                if self._unpowered(self.instructions_received):
+                    self._deaf = set(self.servos)  # this packet and every later one unheard
                 for dxl_id, kind in self.hardware_faults.get(self.instructions_received, ()):
                     if dxl_id in self.servos:
                         # the servo's own error, as it meets it (an overload under load): its
@@ -786,6 +793,10 @@ class DynamixelBusEmulator(HostBaudDevice):
             self._errors_changed()  # a fault raised or a Reboot among these packets
             return bytes(out)
 
+    def _unpowered(self, packet: int) -> bool:
+        """Whether the chain's supply is gone (``power_lost``) by the ``packet``-th packet."""
+        return self.power_lost_at is not None and packet >= self.power_lost_at
+
     def take_late(self) -> tuple[float, bytes] | None:
         """The statuses on their way late, as one: ``(longest delay s, bytes)``; None if none."""
         with self._lock:
@@ -806,6 +817,8 @@ class DynamixelBusEmulator(HostBaudDevice):
         had been kept by packet, the last one alone)."""
         if kind in HARDWARE_FAULT_BITS:
             self.hardware_faults.setdefault(at, []).append((int(servo_id or 0), kind))
+        elif kind == "power_lost":
+            self.power_lost_at = at
         else:
             self.reply_faults[at] = kind
             if kind == "delay_reply":
@@ -935,6 +948,10 @@ class InProcessPort:
         self._rx = bytearray()
         self.tx_log: list[bytes] = []
         self.packet_timeout = SDK_REPLY_WINDOW_MS
+        #: ms of reply windows that ran out: what a real port would have spent waiting for
+        #: statuses that never came in time (silence costs no wall time here), so the cost of a
+        #: silent chain to the driver can be told without a clock
+        self.silent_ms = 0.0
 
     def openPort(self) -> bool:
         """Opened at the current baud rate, as the SDK's ``openPort`` (1 Mbps unless set)."""
@@ -988,9 +1005,12 @@ class InProcessPort:
             return False
         late = self.emulator.take_late()
         if late is None:
+            self.silent_ms += self.packet_timeout
             return True
         self._rx += late[1]  # it comes: within the host's window, or after it
-        return late[0] * 1000.0 > self.packet_timeout
+        over = late[0] * 1000.0 > self.packet_timeout
+        self.silent_ms += self.packet_timeout if over else 0.0
+        return over
 
 
 #: How fast the emulated arm's elevation joint falls once its torque goes off (degrees of
@@ -1157,7 +1177,13 @@ def served_arm(
 
 #: What the manual tool's ``--fault`` takes, as a rig config's ``[[emulator.faults]]`` on an
 #: arm: a status packet lost, damaged or late, or a servo's own hardware error.
-TOOL_FAULT_KINDS = ("drop_reply", "garble_reply", "delay_reply", *HARDWARE_FAULT_BITS)
+TOOL_FAULT_KINDS = (
+    "drop_reply",
+    "garble_reply",
+    "delay_reply",
+    "power_lost",
+    *HARDWARE_FAULT_BITS,
+)
 
 #: A ``delay_reply``'s lateness bounds and default (s), as ``[[emulator.faults]]`` ``delay_s``.
 TOOL_DELAY_S = (0.0, 60.0, 1.0)
@@ -1178,6 +1204,9 @@ class ToolFault(NamedTuple):
             whose = f"servo {self.servo_id}'s {self.kind}"
         elif self.kind == "delay_reply":
             whose = f"delay_reply (its status {self.delay_s:g} s late)"
+        elif self.kind == "power_lost":
+            silent = "power_lost (no servo hears or answers)"
+            return f"Fault: {silent} from instruction packet {self.at}"
         else:
             whose = f"{self.kind} (its status)"
         return f"Fault: {whose} at instruction packet {self.at}"
@@ -1256,7 +1285,8 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
         metavar="K:KIND[:ID|:SECONDS]",
         help="as [[emulator.faults]]: at the K-th instruction packet, the status lost or "
         "damaged (drop_reply, garble_reply), late by SECONDS (K:delay_reply:SECONDS, as "
-        "delay_s; 1 s unless given), or servo ID's hardware error (overload, "
+        "delay_s; 1 s unless given), every servo silent from then on (power_lost: the chain's "
+        "supply gone), or servo ID's hardware error (overload, "
         "overheating, input_voltage, electrical_shock: the Alert bit until a Reboot, torque "
         "off where its Shutdown selects it); repeatable",
     )

@@ -236,6 +236,7 @@ class EmulatorFault(_Strict):
         "overheating",
         "input_voltage",
         "electrical_shock",
+        "power_lost",
     ]
     delay_s: float = Field(default=1.0, ge=0, le=60)
     #: The servo a hardware error (``overload`` …) is raised on; arm faults only.
@@ -253,6 +254,7 @@ ARM_FAULT_KINDS = (
     "overheating",
     "input_voltage",
     "electrical_shock",
+    "power_lost",  # from the at_command-th packet on, no servo answers (the chain's supply)
 )
 
 #: The ``[[emulator.faults]]`` kinds that are a servo's own hardware error (a bit of its
@@ -394,7 +396,9 @@ class RigConfig(_Strict):
                     f"emulator.faults[{i}].kind = {fault.kind!r}: the emulated servo bus "
                     f"rehearses {', '.join(ARM_FAULT_KINDS[:3])} (the status packet of "
                     "the at_command-th instruction packet the servos receive, lost, "
-                    "damaged, or delay_s late, as on a slow USB-serial adapter) and "
+                    "damaged, or delay_s late, as on a slow USB-serial adapter), "
+                    "power_lost (from that packet on no servo answers: the chain's supply "
+                    "lost) and "
                     f"{', '.join(ARM_HARDWARE_FAULTS)} (a servo's hardware "
                     "error, on servo_id, as that packet arrives)"
                 )
