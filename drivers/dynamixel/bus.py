@@ -163,6 +163,12 @@ class DxlBus:
         #: ids whose status to the last command came after the SDK's window (then the retry's
         #: was not in either): said as a slow link, not as a cable or power lost
         self.late: set[int] = set()
+        #: whether the last exchange that timed out got nothing at all through a whole patient
+        #: wait (:data:`PATIENT_REPLY_MS`, twice: no status, not even a late one), and no status
+        #: has come since: a link where no servo answers (the chain's power or the cable to the
+        #: adapter lost). Its next silent servos get the SDK's window, not the slow link's
+        #: allowance (:meth:`_exchange`); any status that comes clears it.
+        self.link_silent = False
 
     # -- port -------------------------------------------------------------------------------
     def open(self, baudrate: int) -> None:
@@ -256,6 +262,7 @@ class DxlBus:
         that number. The close is finished before the stop goes on, as the dome's transport
         finishes its own (:func:`finish_close`)."""
         self.answered.clear()
+        self.link_silent = False
         if not getattr(self.port, "is_open", False):
             return
         ser = getattr(self.port, "ser", None)
@@ -274,6 +281,8 @@ class DxlBus:
         # gone since would be said to be there, only slow
         late = dxl_id in self.late
         self.late.discard(dxl_id)
+        if result != sdk.COMM_RX_TIMEOUT:
+            self.link_silent = False  # a status came: the link carries answers
         if result != sdk.COMM_SUCCESS:
             at = f" at {self.baudrate} baud" if self.baudrate else ""
             if result == sdk.COMM_RX_TIMEOUT and late:
@@ -376,12 +385,16 @@ class DxlBus:
                 comm_text(self.ph, reply[-2]),
             )
             late = False
-            if reply[-2] == sdk.COMM_RX_TIMEOUT:
+            if reply[-2] == sdk.COMM_RX_TIMEOUT and self.link_silent:
+                reply, late = self._retry_on_silent_link(call)
+            elif reply[-2] == sdk.COMM_RX_TIMEOUT:
                 # a reply that was only late must not be read as the answer to a later command;
                 # one that comes is the sign of a slow link, not of a servo gone
                 late = self.drain_reply(PATIENT_REPLY_MS)
                 with self._patient():
                     reply = call()
+                # nothing at all in a whole patient wait, twice: no slow link, a silent one
+                self.link_silent = not late and reply[-2] == sdk.COMM_RX_TIMEOUT
             else:
                 reply = call()
             if late and reply[-2] == sdk.COMM_RX_TIMEOUT:
@@ -396,6 +409,30 @@ class DxlBus:
                 )
                 self.resent.append(f"id {dxl_id} {what}: {lost}")
         return reply
+
+    def _retry_on_silent_link(self, call):  # type: ignore[no-untyped-def]
+        """The retry of an exchange that timed out on a :attr:`link_silent` link: ``(reply,
+        late)``, within the SDK's own windows, not the slow link's allowance.
+
+        Why: when the chain loses power, every servo is silent, and each had cost the
+        allowance (about 1 s: the wait for a late status, then a patient retry) before its
+        error: a stop and a close reading N servos took seconds on an arm whose lamp may be
+        lit, before the user read what had happened. The allowance is for a link whose
+        statuses come late; this one has just delivered nothing at all through a whole
+        patient wait. Should a status come after all (a slow link on which one servo alone
+        is gone), the allowance is back: a late status in the short drain is waited for as
+        before, and a retry that is answered is followed by the patient drain of the status
+        its first try may still owe (never read as a later command's answer)."""
+        if self.drain_reply():  # the SDK's short window: something came, the link lives
+            self.link_silent = False
+            self.drain_reply(PATIENT_REPLY_MS)
+            with self._patient():
+                return call(), True
+        reply = call()
+        if reply[-2] != sdk.COMM_RX_TIMEOUT:
+            self.link_silent = False
+            self.drain_reply(PATIENT_REPLY_MS)  # the first try's status, if it is on its way
+        return reply, False
 
     @contextlib.contextmanager
     def _patient(self) -> Iterator[None]:

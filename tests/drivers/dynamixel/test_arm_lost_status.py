@@ -132,3 +132,42 @@ def test_a_late_status_is_not_said_of_a_later_command_that_gets_none() -> None:
     with pytest.raises(CommunicationError) as lost:
         bus.reboot(1)
     assert "late" not in str(lost.value), lost.value
+
+
+def test_after_a_silent_servo_a_slow_but_live_one_keeps_the_slow_links_allowance() -> None:
+    """A servo found silent through a whole patient wait marks the link silent, and the next
+    silent servo gets the SDK's window alone (a chain without power); but a servo whose
+    statuses come late on that link is still waited for, its late status counted as such, and
+    one that never answers in time is still said to be there but slow, not a lost cable."""
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.drivers.dynamixel import control_table as ct
+    from rti_rig.drivers.dynamixel.bus import PATIENT_REPLY_MS, DxlBus
+    from rti_rig.drivers.dynamixel.faults import CommunicationError
+    from rti_rig.simulator.dynamixel_emulator import (
+        DynamixelBusEmulator,
+        EmulatedServo,
+        InProcessPort,
+    )
+
+    clock = VirtualClock()
+    emu = DynamixelBusEmulator([EmulatedServo(i, 1060, clock) for i in (1, 2, 3)], clock)
+    port = InProcessPort(emu)
+    bus = DxlBus(port, "arm")
+    bus.open(57600)
+    for i in (1, 2, 3):
+        bus.ping(i)
+    emu.silent_ids.add(1)  # its cable alone pulled
+    before = port.silent_ms
+    with pytest.raises(CommunicationError, match="has stopped answering"):
+        bus.read(1, ct.PRESENT_POSITION)
+    assert port.silent_ms - before > 2 * PATIENT_REPLY_MS  # the allowance, once
+    assert bus.link_silent
+    emu.add_fault(emu.instructions_received + 1, "delay_reply", delay_s=0.2)
+    assert bus.read(2, ct.TORQUE_ENABLE) in (0, 1)  # late, waited for, answered
+    assert not bus.link_silent and bus.resent == ["id 2 read Torque Enable: late status packet"]
+    with pytest.raises(CommunicationError, match="has stopped answering"):
+        bus.read(1, ct.PRESENT_POSITION)
+    for k in (1, 2):  # the read and its retry, both late
+        emu.add_fault(emu.instructions_received + k, "delay_reply", delay_s=2.0)
+    with pytest.raises(CommunicationError, match="but late"):
+        bus.read(3, ct.PRESENT_POSITION)

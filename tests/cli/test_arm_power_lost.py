@@ -1,0 +1,61 @@
+"""The arm's chain losing its power is said after one servo's slow-link allowance, not one
+for every servo the stop and the close then ask.
+
+When the servos' supply goes, every servo is silent. Each exchange that timed out had waited
+for a late status (500 ms) and retried patiently (500 ms) before its error: the move's read,
+then the stop's and the close's reads of each servo, about 1 s apiece, 5.2 s of a check on the
+shipped two-servo arm before the user read what had happened, the lamp on the arm perhaps
+still lit. Once one servo has given nothing at all through a whole patient wait, the others
+get the SDK's own window. The in-process port counts the reply windows that ran out
+(``silent_ms``: what a real port waits; silence costs no wall time here), so the cost is told
+without a clock.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import inprocess_arm_config
+from typer.testing import CliRunner
+
+import rti_rig.simulator.dynamixel_emulator as de
+from rti_rig.cli import app
+
+#: instruction packets into a check, a run: past the connect, in the first moves
+LOSS_AT = {"check": 300, "run": 150}
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+def test_a_chain_that_loses_its_power_is_said_after_one_servos_allowance(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, command: str
+) -> None:
+    ports: list[de.InProcessPort] = []
+
+    class Counted(de.InProcessPort):
+        def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
+            super().__init__(*args, **kwargs)
+            ports.append(self)
+
+        def writePort(self, packet):  # type: ignore[no-untyped-def]
+            if self.emulator.instructions_received + 1 == LOSS_AT[command]:
+                self.silent_at_loss = self.silent_ms  # type: ignore[attr-defined]
+            return super().writePort(packet)
+
+    monkeypatch.setattr(de, "InProcessPort", Counted)
+    fault = f'\n[[emulator.faults]]\nat_command = {LOSS_AT[command]}\nkind = "power_lost"\n'
+    cfg = inprocess_arm_config(tmp_path, fault)
+    args = ["check", str(cfg)]
+    if command == "run":
+        args = ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6"]
+    r = CliRunner().invoke(app, args, terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0 and "Traceback" not in said, said
+    assert "has stopped answering: its cable, the chain of cables to it, or the servos' " in said
+    assert "but late" not in said, said  # no slow link: a silent one
+    (port,) = ports
+    waited_s = (port.silent_ms - port.silent_at_loss) / 1000  # type: ignore[attr-defined]
+    # the first silent servo's allowance (34 + 500 + 500 ms), then the SDK's window for the
+    # others (34 ms, a short drain and a retry: about 0.1 s each); it had been 1.03 s each
+    print(f"{command}: {waited_s:.2f} s of reply windows from the loss to the error")
+    assert 1.0 < waited_s < 1.6, said
