@@ -420,12 +420,12 @@ class DxlBus:
         lit, before the user read what had happened. The allowance is for a link whose
         statuses come late; this one has just delivered nothing at all through a whole
         patient wait. Should a status come after all (a slow link on which one servo alone
-        is gone), the allowance is back: a late status in the short drain is waited for as
-        before, and a retry that is answered is followed by the patient drain of the status
-        its first try may still owe (never read as a later command's answer)."""
-        if self.drain_reply():  # the SDK's short window: something came, the link lives
+        is gone), the allowance is back: after a late status in the short drain the retry is
+        waited for patiently, as before, and a retry that is answered is followed by the
+        patient drain of the status its first try may still owe (never read as a later
+        command's answer)."""
+        if self.drain_reply():  # the first try's status, late: the link lives, only slow
             self.link_silent = False
-            self.drain_reply(PATIENT_REPLY_MS)
             with self._patient():
                 return call(), True
         reply = call()

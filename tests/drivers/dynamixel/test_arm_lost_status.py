@@ -167,6 +167,12 @@ def test_after_a_silent_servo_a_slow_but_live_one_keeps_the_slow_links_allowance
     assert not bus.link_silent and bus.resent == ["id 2 read Torque Enable: late status packet"]
     with pytest.raises(CommunicationError, match="has stopped answering"):
         bus.read(1, ct.PRESENT_POSITION)
+    assert bus.link_silent
+    emu.add_fault(emu.instructions_received + 1, "drop_reply")  # a status lost, not late
+    assert bus.read(3, ct.TORQUE_ENABLE) in (0, 1)  # its retry answered: the link lives
+    assert not bus.link_silent and bus.resent[-1] == "id 3 read Torque Enable: no status packet"
+    with pytest.raises(CommunicationError, match="has stopped answering"):
+        bus.read(1, ct.PRESENT_POSITION)
     for k in (1, 2):  # the read and its retry, both late
         emu.add_fault(emu.instructions_received + k, "delay_reply", delay_s=2.0)
     with pytest.raises(CommunicationError, match="but late"):
