@@ -321,8 +321,11 @@ def test_replay_of_planar_or_alpha_tiffs_gives_their_rgb_pixels(
 
 def test_a_resume_whose_acquisition_moved_asks_for_its_lp_not_a_toml(tmp_path: Path) -> None:
     """The replayed acquisition moved after the session: the resume had asked for
-    "rti-rig run RIG.toml --resume S", a rig config the user never had."""
-    acq = tmp_path / "acq"
+    "rti-rig run RIG.toml --resume S", a rig config the user never had, then for
+    "rti-rig run ACQ/dirs.lp --resume S", a template; it names the path the manifest holds,
+    as shell words (a folder with a space and a quote), and that command resumes once the
+    acquisition is back."""
+    acq = tmp_path / "Coin 'A' acq"
     shutil.copytree(ACQ, acq)
     out = tmp_path / "s"
     r = runner.invoke(
@@ -334,7 +337,13 @@ def test_a_resume_whose_acquisition_moved_asks_for_its_lp_not_a_toml(tmp_path: P
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "the recorded acquisition it replayed" in said and "is not there any more" in said
-    assert f"give it: rti-rig run ACQ/dirs.lp --resume {out}" in said and "RIG.toml" not in said
+    assert "ACQ/" not in said and "RIG.toml" not in said, said
+    command = said.split("put it back there (its images beside it): ", 1)[1].split(", or ")[0]
+    words = shlex.split(command)
+    assert words == ["rti-rig", "run", str(acq / "dirs.lp"), "--resume", str(out)], said
+    (tmp_path / "moved").rename(acq)
+    r = runner.invoke(app, words[1:])
+    assert r.exit_code == 0 and "this session is complete" in " ".join(r.output.split()), r.output
 
 
 #: The four lights of the small acquisitions the refusals below are built on.

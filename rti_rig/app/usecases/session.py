@@ -1742,12 +1742,21 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         # a replay rig is an acquisition's .lp, moved with its images: ask for that, not a TOML
         replay = config_path.suffix.lower() == ".lp"
         what = "recorded acquisition it replayed" if replay else "rig config it was shot with"
-        give = f"ACQ/{config_path.name}" if replay else "RIG.toml"
+        resume = f"--resume {shell_word(str(req.session_dir))}"
+        if replay:
+            # the path it was, from the manifest, as shell words: "ACQ/dirs.lp" was a
+            # template the user had to fill in (and, pasted, named a folder that never was)
+            give = (
+                f"put it back there (its images beside it): rti-rig run "
+                f"{shell_word(str(config_path))} {resume}, or give the path it has now in "
+                "its place"
+            )
+        else:
+            give = f"give it: rti-rig run RIG.toml {resume}"
         raise RtiRigError(
             f"{shown_path(req.session_dir)}: the {what}, {shown_path(config_path)}, is not there "
-            f"any more (moved or renamed?); give it: rti-rig run {give} --resume "
-            f"{shell_word(str(req.session_dir))} (the session's manifest keeps a copy of the rig "
-            "it began with, and a resume checks the rig against it)"
+            f"any more (moved or renamed?); {give} (the session's manifest keeps a copy of the "
+            "rig it began with, and a resume checks the rig against it)"
         )
     loaded = load_rig_config(config_path)
     for note in loaded.notes:
