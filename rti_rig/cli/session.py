@@ -897,11 +897,13 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
     …/records/image_003.json``, as if the image were lost, though its journal line (which
     commits a step whose record file cannot be written) was on disk; the resume command was
     said only lines above it."""
-    from rti_rig.runtime.session import RECORDS_DIR, SessionWriteError
+    from rti_rig.runtime.session import RECORDS_DIR, SessionWriteError, SourceReadError
 
     kept = opened.folder.images_kept
     if not isinstance(exc, SessionWriteError) or _cannot_resume(opened):
         return exc
+    if isinstance(exc, SourceReadError):
+        return _source_unread_said(exc, kept, opened)
     if not kept:
         return _first_write_failed_said(exc, opened)
     shot = ""
@@ -923,6 +925,27 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
     return RtiRigError(
         f"{exc}: the session stopped there; {what}{shot}; {_disk_fix(exc.errno_name)}, then "
         f"continue with {_continue_command(opened)}"
+    )
+
+
+def _source_unread_said(exc: Any, kept: int, opened) -> RtiRigError:  # type: ignore[no-untyped-def]
+    """A camera file to keep that could not be read (``exc`` a ``SourceReadError``: a
+    replay's acquisition on a drive unplugged mid-run, a file moved or deleted), said with what
+    is kept and the resume that takes it up once the file is back.
+
+    Why: it had been said as a failed write of the session's copy ("cannot write
+    …/raw/image_003.jpg … check that disk"): the session's disk was fine, and the file that
+    could not be read went unnamed."""
+    shot = (
+        f"; this light's shot ({', '.join(exc.shot)}) is not recorded and the resume shoots "
+        "this light again"
+        if exc.shot
+        else ""
+    )
+    return RtiRigError(
+        f"{exc}: the session stopped there; {kept} image(s) are kept, nothing captured is "
+        f"lost{shot}; re-attach the drive that holds {shown_path(exc.source)} (or put the file "
+        f"back there), then continue with {_continue_command(opened)}"
     )
 
 

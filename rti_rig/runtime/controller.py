@@ -37,6 +37,7 @@ from rti_rig.runtime.session import (
     NoSpaceError,
     SessionFolder,
     SessionWriteError,
+    SourceReadError,
     StepRecord,
     check_free_space,
     estimated_bytes_per_image,
@@ -869,6 +870,9 @@ def run_session(
         raise
     except NoSpaceError as exc:
         reason, error = FinishReason.NO_SPACE, str(exc)
+        raise
+    except SourceReadError as exc:  # a camera file unreadable, not the session's write
+        reason, error = FinishReason.ERROR, str(exc)
         raise
     except SessionWriteError as exc:
         reason, error = FinishReason.WRITE_FAILED, str(exc)

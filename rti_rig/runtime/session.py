@@ -209,6 +209,35 @@ class SessionWriteError(SessionError):
         super().__init__(f"cannot write {shown_path(self.path)}: {reason}{code}")
 
 
+class SourceReadError(SessionWriteError):
+    """A camera file the session was to keep (a replay's recorded file, a watched folder's)
+    could not be read: its drive unplugged, the file moved, deleted or unreadable. The
+    session's own disk is not at fault; ``source`` is the file, ``path`` the session's name it
+    was to be kept under.
+
+    Why: it was said as the session's failed write ("cannot write …/raw/image_003.jpg: No
+    such file or directory … check that disk"), naming a file that was never the problem and
+    a disk that was fine."""
+
+    def __init__(self, source: Path, dest: Path, exc: OSError) -> None:
+        super().__init__(dest, exc)
+        self.source = Path(source)
+        reason = exc.strerror or str(exc)
+        code = f" ({self.errno_name})" if self.errno_name else ""
+        self.args = (
+            f"cannot read {shown_path(self.source)} (to keep it in the session as "
+            f"{self.path.parent.name}/{self.path.name}): {reason}{code}",
+        )
+
+
+class _SourceUnreadable(Exception):
+    """An OSError reading the file being copied, not writing its copy (:func:`_copy_whole`)."""
+
+    def __init__(self, error: OSError) -> None:
+        super().__init__(error)
+        self.error = error
+
+
 def _write_bytes_atomic(path: Path, data: bytes) -> None:
     """Replace ``path`` with ``data`` atomically (temporary file, fsync, rename); the temporary
     file is removed if anything fails, so a failed write leaves the old file and nothing else."""
@@ -1528,8 +1557,10 @@ def _take_whole(src: Path, dest: Path, root: Path | None) -> str:
     A download staged inside the session (``root``, e.g. raw/.incoming) may be the only copy
     (the camera may have deleted its own): it is checksummed where it lies, then renamed in one
     step, so at every moment it is whole under one of its two names; one from elsewhere (or
-    any, when ``root`` is None) is copied whole. An OSError is the session's write error,
-    naming ``dest``."""
+    any, when ``root`` is None) is copied whole. An OSError writing is the session's write
+    error, naming ``dest``; one reading a file copied from elsewhere is
+    :class:`SourceReadError`, naming ``src`` (a replay's acquisition on a drive unplugged
+    mid-run had been said as a failed write of ``dest``)."""
     try:
         dest.parent.mkdir(parents=True, exist_ok=True)
         if root is not None and src.resolve().is_relative_to(root):
@@ -1537,16 +1568,35 @@ def _take_whole(src: Path, dest: Path, root: Path | None) -> str:
             os.replace(src, dest)
             return digest
         return _copy_whole(src, dest)
+    except _SourceUnreadable as exc:
+        raise SourceReadError(src, dest, exc.error) from None
     except OSError as exc:
         raise SessionWriteError(dest, exc) from None
 
 
+#: How much of a file :func:`_copy_whole` reads at a time.
+_COPY_CHUNK = 1 << 20
+
+
 def _copy_whole(src: Path, dest: Path) -> str:
     """Copy ``src`` to ``dest`` through a temporary file, never leaving a partial one; returns
-    the copy's SHA-256."""
+    the copy's SHA-256. A failure to open or read ``src`` raises :class:`_SourceUnreadable`
+    (the file's drive, not the session's), any other OSError is the copy's."""
     tmp = dest.with_name(f".{dest.name}.partial")
     try:
-        shutil.copyfile(src, tmp)
+        try:
+            source = open(src, "rb")  # noqa: SIM115 - closed below, its errors told apart
+        except OSError as exc:
+            raise _SourceUnreadable(exc) from None
+        with source, open(tmp, "wb") as copy:
+            while True:
+                try:
+                    chunk = source.read(_COPY_CHUNK)
+                except OSError as exc:
+                    raise _SourceUnreadable(exc) from None
+                if not chunk:
+                    break
+                copy.write(chunk)
         digest = _fsync_sha256(tmp)
         os.replace(tmp, dest)
     except BaseException:

@@ -1,0 +1,72 @@
+"""A replay whose acquisition file cannot be read mid-run names that file, not the session's.
+
+A recorded acquisition on a drive unplugged mid-run (or a file moved or deleted as the run
+went) had been said as a failed write of the session's copy: "cannot write S/raw/image_003.jpg:
+No such file or directory … check that disk", of a disk that was fine, the file that could
+not be read unnamed. It is now "cannot read ACQ/IMG 2.JPG …", with the images kept, and the
+resume that takes the run up once the drive is back; that resume completes the session."""
+
+from __future__ import annotations
+
+import math
+import shlex
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import rti_rig.simulator.replay as replay
+from rti_rig.cli import app
+from tests.conftest import journal, said
+
+runner = CliRunner()
+
+
+def _acquisition(folder: Path) -> Path:
+    """Four small JPEGs, named with a space as Windows exports name them, and their .lp."""
+    folder.mkdir()
+    rng = np.random.default_rng(3)
+    lines = ["4"]
+    for i in range(4):
+        name = f"IMG {i}.JPG"
+        assert cv2.imwrite(str(folder / name), rng.integers(10, 240, (24, 32, 3), np.uint8))
+        az, el = math.pi * i / 2, math.radians(40)
+        x, y, z = math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)
+        lines.append(f"{name} {x:.6f} {y:.6f} {z:.6f}")
+    (folder / "dirs.lp").write_text("\n".join(lines) + "\n")
+    return folder / "dirs.lp"
+
+
+def test_a_recorded_file_gone_as_it_is_kept_is_named_and_the_resume_completes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    lp = _acquisition(tmp_path / "acq")
+    gone = lp.parent / "IMG 2.JPG"
+    aside = tmp_path / "unplugged.JPG"
+    read = replay.recorded_frame_pixels
+
+    def read_then_unplugged(path: Path) -> np.ndarray:
+        pixels = read(path)
+        if path == gone:  # the drive goes between the camera's read and the session's copy
+            path.rename(aside)
+        return pixels
+
+    monkeypatch.setattr(replay, "recorded_frame_pixels", read_then_unplugged)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--no-verdict"])
+    text = said(r)
+    assert r.exit_code != 0, text
+    assert "cannot write" not in text and "check that disk" not in text, text
+    assert f"cannot read {gone}" in text and "2 image(s) are kept" in text, text
+    assert f"re-attach the drive that holds {gone}" in text, text
+    assert [e["index"] for e in journal(out)] == [0, 1]  # what was captured is all there
+    assert not list((out / "raw").glob(".*partial"))
+    monkeypatch.undo()
+    aside.rename(gone)  # the drive back: the resume said completes the session
+    command = text.rsplit("then continue with ", 1)[1].strip().rstrip(".")
+    r = runner.invoke(app, [*shlex.split(command)[1:], "--no-verdict"])
+    assert r.exit_code == 0, said(r)
+    assert [e["index"] for e in journal(out)] == [0, 1, 2, 3]
+    assert (out / "raw" / "image_003.jpg").read_bytes() == gone.read_bytes()
