@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
-from rti_rig.core.errors import CaptureError
+from rti_rig.core.errors import CaptureError, SessionError
 from rti_rig.core.image_files import linear_to_srgb8, read_image_any
 from rti_rig.core.shell_words import shown_path
 
@@ -108,6 +108,23 @@ class ReplayCamera:
     def close(self) -> None:
         self._connected = False
 
+    def _recorded(self, path: Path) -> NDArray[np.uint16]:
+        """The recorded image at ``path``; one gone since the run began (its drive unplugged,
+        the file moved or deleted) is the camera's failure, naming the file and what brings
+        it back (it had been a bare "cannot read image …: there is no such file")."""
+        try:
+            return recorded_frame_pixels(path)
+        except (OSError, SessionError) as exc:
+            if path.is_file() and not isinstance(exc, OSError):
+                raise  # there, but not readable as an image: the reader's words say why
+            raise CaptureError(
+                self.name,
+                f"cannot read the recorded file {shown_path(path)}, there when the run began "
+                "(its drive unplugged, or the file moved or deleted?): re-attach the drive "
+                "that holds it, or put the file back there, then resume",
+                "capture",
+            ) from None
+
     def capture(self, exposure_s: float) -> Frame:
         if not self._connected:
             raise CaptureError(self.name, "not connected; call connect() first", "capture")
@@ -118,7 +135,7 @@ class ReplayCamera:
             source = None
         else:
             path = self._images[lit]
-            pixels = recorded_frame_pixels(path)
+            pixels = self._recorded(path)
             if pixels.shape[:2] != self._shape[:2]:
                 raise CaptureError(
                     self.name,

@@ -70,3 +70,29 @@ def test_a_recorded_file_gone_as_it_is_kept_is_named_and_the_resume_completes(
     assert r.exit_code == 0, said(r)
     assert [e["index"] for e in journal(out)] == [0, 1, 2, 3]
     assert (out / "raw" / "image_003.jpg").read_bytes() == gone.read_bytes()
+
+
+def test_a_recorded_file_gone_before_the_camera_reads_it_names_it_and_the_resume(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Unplugged before the replay camera reads the next file: it had been a bare "cannot
+    read image …: there is no such file"; it says what brings the file back, with the
+    resume command."""
+    lp = _acquisition(tmp_path / "acq")
+    gone = lp.parent / "IMG 2.JPG"
+    read = replay.recorded_frame_pixels
+
+    def unplugged_then_read(path: Path) -> np.ndarray:
+        if path == gone:
+            path.unlink()
+        return read(path)
+
+    monkeypatch.setattr(replay, "recorded_frame_pixels", unplugged_then_read)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--no-verdict"])
+    text = said(r)
+    assert r.exit_code != 0, text
+    assert f"cannot read the recorded file {gone}" in text, text
+    assert "re-attach the drive that holds it" in text, text
+    assert f"Continue with: rti-rig run --resume {out}" in text, text
+    assert [e["index"] for e in journal(out)] == [0, 1]
