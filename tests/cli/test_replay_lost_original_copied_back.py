@@ -7,10 +7,12 @@ it back (its path journaled as ``copied_from``). Two files of one name in two su
 ``.lp`` had been recorded under one original name (their file name): the name recorded is now
 the path relative to the ``.lp``. The fit's QA verdict and export-lp, which said of it "the
 camera's original capture is lost" beside that ``cp``, say what is true: the copy in ``raw/``
-is missing, the acquisition still holds it."""
+is missing, the acquisition still holds it; the verdict calls the session "recoverable", not
+"flawed" (the recording is not at fault, the ``cp`` makes the session whole)."""
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import subprocess
@@ -67,6 +69,10 @@ def test_a_replays_lost_original_is_copied_back_from_the_acquisition(tmp_path: P
         assert r.exit_code == 0, said(r)
         assert held in said(r) and "original capture" not in said(r), said(r)
         assert "copy it back from the acquisition: cp -- " in said(r), said(r)
+        if args[0] == "fit":  # judged recoverable, not "flawed"; not good until the cp
+            assert "QA verdict: recoverable: image_002 (" in said(r), said(r)
+            assert "flawed" not in said(r) and "cannot be reshot" not in said(r), said(r)
+            assert json.loads((tmp_path / "fit" / "qa.json").read_text())["good"] is False
     line = next(x for x in text.splitlines() if "copy it back from the acquisition: " in x)
     command = line.split("copy it back from the acquisition: ", 1)[1].rstrip(".")
     subprocess.run(["sh", "-c", command], check=True, timeout=60)

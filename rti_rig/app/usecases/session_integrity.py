@@ -121,6 +121,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     unlisted = [n for n in sorted(lost) if n not in {c.name for c in qa.images}]
     once = len(lost) > 1 or bool(unlisted)  # the advice said once, not after each of 48 images
     held = held_by_acquisition(source)  # a replay's copies its acquisition still holds
+    flawed_before = {c.name for c in qa.images if c.problems}
     images = []
     for check in qa.images:
         gone = lost.get(check.name)
@@ -158,7 +159,33 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         qa = _noted(qa, note)
     if unlisted:
         qa = replace(qa, lost_unfitted=tuple(unlisted))
-    return qa
+    return _recoverable_word(qa, lost, held, flawed_before)
+
+
+#: The verdict's word when all it names are a replay's copies in raw/ that the acquisition
+#: still holds as recorded: the session is not whole, but one ``cp`` makes it so.
+RECOVERABLE = "recoverable"
+
+
+def _recoverable_word(
+    qa: QAReport, lost: dict[str, list[str]], held: dict[str, str], flawed_before: set[str]
+) -> QAReport:
+    """``qa`` headed "recoverable" where every image it names is so only for its kept copy of
+    a recorded file that the acquisition still holds as recorded (``held``), nothing else
+    found wrong (``flawed_before``: the images with problems before the lost files were
+    added). An image the session itself uses that is damaged keeps the session's word.
+
+    Why: a replay whose copy in raw/ had been deleted was judged "flawed: image_002 (…; copy
+    it back from the acquisition: cp …)": the fitted images were as captured and the cp puts
+    the copy back; "flawed" told a conservator the recording was at fault. Not "good" (it is
+    not whole until the cp: ``qa.json``'s ``good`` stays false)."""
+    if flawed_before or qa.lost_unfitted or qa.lights_likely_wrong or qa.lights_mirrored:
+        return qa
+    named = {c.name for c in qa.reshoot}
+    recoverable = {n for n, g in lost.items() if originals_lost(g) and _all_held(g, held)}
+    if not named or not named <= recoverable:
+        return qa
+    return replace(qa, verdict_word=RECOVERABLE)
 
 
 def _held_said(images: int) -> str:
