@@ -2920,8 +2920,18 @@ def _copy_back(root: Path, scan: JournalScan | None = None) -> tuple[list[str], 
         for name, source in held.items()
     ]
     lost = files_lost_since_capture(root, scan)
-    covered = all(g.rpartition(" ")[0] in held for gone in lost.values() for g in gone)
+    covered = all(all_held(gone, held) for gone in lost.values())
     return copies, covered
+
+
+def all_held(gone: list[str], held: Mapping[str, str]) -> bool:
+    """Whether every file of one image :func:`files_lost_since_capture` names (``gone``) is a
+    copy its acquisition still holds (``held``, :func:`held_by_acquisition`): each is what
+    :func:`_lost_files` says of a held file, matched whole. Why: the file's name had been
+    parsed back out of those words (``rpartition(" ")``) in three places, the verdict, export-lp
+    and the ``cp`` advice; one criterion, no parsing."""
+    said = {f"{name} missing" for name in held}
+    return bool(gone) and all(g in said for g in gone)
 
 
 def held_by_acquisition(root: Path, scan: JournalScan | None = None) -> dict[str, str]:
@@ -2940,8 +2950,7 @@ def held_by_acquisition(root: Path, scan: JournalScan | None = None) -> dict[str
     renamed = renamed_jpegs(Path(root), records)
     for rec in _latest_records(records).values():
         sources = rec.get("copied_from") or {}
-        for lost in _lost_files(Path(root), rec, renamed):
-            name, _, how = lost.rpartition(" ")
+        for name, how in _lost_entries(Path(root), rec, renamed):
             source = sources.get(name)
             if (
                 how == "missing"
@@ -3149,6 +3158,14 @@ def read_manifest(root: Path) -> dict[str, Any]:
 def _lost_files(
     root: Path, rec: dict[str, Any], renamed: Mapping[str, str] | None = None
 ) -> list[str]:
+    """:func:`_lost_entries` as the words the verdict, a resume and ``--reshoot-lost`` say
+    (``raw/image_002.jpg missing``)."""
+    return [f"{name} {how}" for name, how in _lost_entries(root, rec, renamed)]
+
+
+def _lost_entries(
+    root: Path, rec: dict[str, Any], renamed: Mapping[str, str] | None = None
+) -> list[tuple[str, str]]:
     """The image files of one journaled step gone or changed since capture: its JPEG (what
     relight and RTIBuilder read) and its linear TIFF (what ``fit`` reads) against their
     journaled checksums. A TIFF whose bytes differ but whose pixels match the journaled pixel
@@ -3170,16 +3187,16 @@ def _lost_files(
         path = root / name
         if name not in (rec.get("image"), rec.get("linear_image")):  # a camera original
             if not path.is_file():
-                lost.append(f"{name} missing")
+                lost.append((name, "missing"))
             elif not _as_captured(root, rec, name, digest):
-                lost.append(f"{name} changed")
+                lost.append((name, "changed"))
             continue
         if not path.is_file():
             if renamed and name in renamed:
                 continue
-            lost.append(f"{name} missing")
+            lost.append((name, "missing"))
         elif not _as_captured(root, rec, name, digest):
-            lost.append(f"{name} changed")
+            lost.append((name, "changed"))
     return lost
 
 

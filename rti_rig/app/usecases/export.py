@@ -20,6 +20,7 @@ from rti_rig.runtime.session import (
     LP_NAME,
     MANIFEST,
     JournalScan,
+    all_held,
     files_lost_since_capture,
     held_by_acquisition,
     image_names,
@@ -267,7 +268,7 @@ def _raw_lost(root: Path, listed: set[str], scan: JournalScan, adaptive: bool) -
     if not lost:
         return ""
     held = held_by_acquisition(root, scan)
-    copies = [(n, g) for n, g in lost if all(f.rpartition(" ")[0] in held for f in g)]
+    copies = [(n, g) for n, g in lost if all_held(g, held)]
     gone = [(n, g) for n, g in lost if (n, g) not in copies]
     said = []
     for group, held_there in ((gone, False), (copies, True)):

@@ -38,6 +38,7 @@ from rti_rig.runtime.session import (
     RECORDS_DIR,
     RUN_ENDED,
     STRAY_DIR,
+    all_held,
     files_lost_since_capture,
     held_by_acquisition,
     image_names,
@@ -141,13 +142,13 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             shown += f"; {', '.join(unlisted[:8])}{' …' if len(unlisted) > 8 else ''} not in "
             shown += f"{lp.name}, so not fitted"
         plural = "images" if len(lost) > 1 else "image"
-        raws = sorted(n for n, g in lost.items() if originals_lost(g) and not _all_held(g, held))
+        raws = sorted(n for n, g in lost.items() if originals_lost(g) and not all_held(g, held))
         if raws:  # the camera's originals: lost, though what was fitted of them stands
             shown += (
                 f"; of {', '.join(raws[:8])}{' …' if len(raws) > 8 else ''} the RAW original is "
                 "lost, the developed JPEG and linear TIFF are as captured and were fitted"
             )
-        copies = sorted(n for n, g in lost.items() if originals_lost(g) and _all_held(g, held))
+        copies = sorted(n for n, g in lost.items() if originals_lost(g) and all_held(g, held))
         if copies:  # a replay's copies of its recorded files: the acquisition holds them
             shown += (
                 f"; of {', '.join(copies[:8])}{' …' if len(copies) > 8 else ''} "
@@ -182,7 +183,7 @@ def _recoverable_word(
     if flawed_before or qa.lost_unfitted or qa.lights_likely_wrong or qa.lights_mirrored:
         return qa
     named = {c.name for c in qa.reshoot}
-    recoverable = {n for n, g in lost.items() if originals_lost(g) and _all_held(g, held)}
+    recoverable = {n for n, g in lost.items() if originals_lost(g) and all_held(g, held)}
     if not named or not named <= recoverable:
         return qa
     return replace(qa, verdict_word=RECOVERABLE)
@@ -202,12 +203,6 @@ def _held_said(images: int) -> str:
     )
 
 
-def _all_held(gone: list[str], held: dict[str, str]) -> bool:
-    """Whether every file of one image :func:`files_lost_since_capture` names (``gone``, each
-    ``raw/image_002.jpg missing``) is a copy its acquisition still holds (``held``)."""
-    return all(g.rpartition(" ")[0] in held for g in gone)
-
-
 def _developed_stand(gone: list[str], held: dict[str, str]) -> str:
     """What to add to an image's lost files ``gone`` when only its camera originals are lost:
     the RAW is the original capture, so the image is lost, but its developed JPEG and linear
@@ -217,7 +212,7 @@ def _developed_stand(gone: list[str], held: dict[str, str]) -> str:
     had stood beside the ``cp`` that copies it back."""
     if not originals_lost(gone):
         return ""
-    if _all_held(gone, held):
+    if all_held(gone, held):
         return f": {_held_said(1)}"
     return (
         ": the camera's original capture is lost, its developed JPEG and linear TIFF are as "
