@@ -98,8 +98,8 @@ from rti_rig.drivers.cameras.raw_decode import (
     UnsupportedRawError,
     decode_raw,
     exposure_stats,
+    libraw_opened,
     libraw_printed,
-    libraw_source,
 )
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
 from rti_rig.drivers.cameras.tiff_structure import (
@@ -290,8 +290,13 @@ def _read_capture_time(path: Path) -> tuple[bool, float | None]:
 
         # LibRaw prints its own line about a file cut short, naming it: kept off the
         # terminal (the file's decode says what is wrong with it, naming the folder's file)
-        name, source = libraw_source(path)  # its bytes where the path is not UTF-8
-        with libraw_printed(name, []), rawpy.imread(source) as raw:
+        # a path that is not UTF-8 as /dev/fd/N: LibRaw reads the header it needs, not the
+        # whole file into memory at each try
+        with (
+            libraw_opened(path) as (name, source),
+            libraw_printed(name, []),
+            rawpy.imread(source) as raw,
+        ):
             stamp = raw.other.timestamp
     except Exception as exc:  # no evidence yet, or none: the file's own decode says why
         unsupported = type(exc).__name__ == "LibRawFileUnsupportedError"

@@ -243,6 +243,41 @@ def libraw_source(path: Path | str) -> tuple[str, str | io.BytesIO]:
     return text, text
 
 
+#: Where a process's open files can be opened again by number (Linux, macOS, the BSDs):
+#: an ASCII path to a file whose own path LibRaw cannot be given.
+_FD_DIR = "/dev/fd"
+
+
+@contextmanager
+def libraw_opened(path: Path | str) -> Iterator[tuple[str, str | io.BytesIO]]:
+    """:func:`libraw_source` for a read that may be repeated: a path that is not UTF-8 is
+    opened here and handed to LibRaw as ``/dev/fd/N`` (ASCII, the same file), so LibRaw reads
+    it from disk as it reads any other; only where there is no ``/dev/fd`` are its bytes
+    read. Raises OSError if the file cannot be opened.
+
+    Why: the capture time of a RAW in a folder whose name is not UTF-8 read the whole file
+    into memory at each try (25 MB a DNG, 200 ms and 49 MB of peak memory each; a file still
+    being written is tried again after each change), where LibRaw reads only its header.
+    (A ``str`` of its name by ``os.fsdecode`` holds lone surrogates, which rawpy cannot
+    encode: that is the UnicodeEncodeError this avoids.)"""
+    text = str(path)
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        pass
+    else:
+        yield text, text
+        return
+    if not os.path.isdir(_FD_DIR):
+        yield libraw_source(path)
+        return
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        yield f"{_FD_DIR}/{fd}", f"{_FD_DIR}/{fd}"
+    finally:
+        os.close(fd)
+
+
 def _source(source: Path | str | bytes) -> tuple[Path | None, str, Any]:
     """(the file read, None for bytes; the name LibRaw prints it by; what ``rawpy.imread``
     is given) for :func:`decode_raw`'s ``source``."""
