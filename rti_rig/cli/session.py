@@ -936,6 +936,15 @@ def _source_unread_said(exc: Any, kept: int, opened) -> RtiRigError:  # type: ig
     Why: it had been said as a failed write of the session's copy ("cannot write
     …/raw/image_003.jpg … check that disk"): the session's disk was fine, and the file that
     could not be read went unnamed."""
+    from rti_rig.runtime.session import holds_no_image
+
+    if not kept and holds_no_image(Path(opened.out_dir)):
+        # as the stop's own line says of it: the folder is used again by the same command
+        return RtiRigError(
+            f"{exc}: the session stopped before any image was kept; re-attach the drive that "
+            f"holds {shown_path(exc.source)} (or put the file back there), then run the same "
+            f"command again ({_arg(opened.out_dir)} holds no image and may be used again)"
+        )
     shot = (
         f"; this light's shot ({', '.join(exc.shot)}) is not recorded and the resume shoots "
         "this light again"

@@ -96,3 +96,31 @@ def test_a_recorded_file_gone_before_the_camera_reads_it_names_it_and_the_resume
     assert "re-attach the drive that holds it" in text, text
     assert f"Continue with: rti-rig run --resume {out}" in text, text
     assert [e["index"] for e in journal(out)] == [0, 1]
+
+
+def test_the_first_recorded_file_gone_as_it_is_kept_leaves_the_folder_to_run_again(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """At the first image nothing is kept: the folder holds no image, and the same command
+    is told (the stop's own line says the folder may be used again), not a resume."""
+    lp = _acquisition(tmp_path / "acq")
+    gone, aside = lp.parent / "IMG 0.JPG", tmp_path / "unplugged.JPG"
+    read = replay.recorded_frame_pixels
+
+    def read_then_unplugged(path: Path) -> np.ndarray:
+        pixels = read(path)
+        if path == gone:
+            path.rename(aside)
+        return pixels
+
+    monkeypatch.setattr(replay, "recorded_frame_pixels", read_then_unplugged)
+    command = ["run", str(lp), "--out", str(tmp_path / "s"), "--no-verdict"]
+    r = runner.invoke(app, command)
+    text = said(r)
+    assert r.exit_code != 0 and f"cannot read {gone}" in text, text
+    assert "then run the same command again" in text and "--resume" not in text, text
+    monkeypatch.undo()
+    aside.rename(gone)
+    r = runner.invoke(app, command)
+    assert r.exit_code == 0, said(r)
+    assert len(journal(tmp_path / "s")) == 4
