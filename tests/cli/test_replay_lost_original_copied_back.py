@@ -27,7 +27,8 @@ from tests.conftest import journal, manifest, said
 
 runner = CliRunner()
 #: two files named alike in two subfolders, and six beside the .lp
-NAMES = ("a/IMG.JPG", "b/IMG.JPG", *(f"IMG_{i}.JPG" for i in range(3, 9)))
+#: (named with a space, as Windows exports name them: the cp must quote it)
+NAMES = ("a/IMG 0001.JPG", "b/IMG 0001.JPG", *(f"IMG_{i}.JPG" for i in range(3, 9)))
 
 
 def _acquisition(folder: Path) -> Path:
@@ -51,7 +52,7 @@ def test_a_replays_lost_original_is_copied_back_from_the_acquisition(tmp_path: P
     assert r.exit_code == 0, said(r)
     steps = {e["index"]: e for e in journal(out)}
     listed = {s["index"]: s for s in manifest(out)["steps"]}
-    for i in (0, 1):  # each by its path relative to the .lp, not both as IMG.JPG
+    for i in (0, 1):  # each by its path relative to the .lp, not both as "IMG 0001.JPG"
         raw = f"raw/image_00{i + 1}.jpg"
         for entry in (steps[i], listed[i]):
             assert entry["originals"] == {raw: NAMES[i]}
@@ -76,6 +77,6 @@ def test_a_replays_lost_original_is_copied_back_from_the_acquisition(tmp_path: P
     line = next(x for x in text.splitlines() if "copy it back from the acquisition: " in x)
     command = line.split("copy it back from the acquisition: ", 1)[1].rstrip(".")
     subprocess.run(["sh", "-c", command], check=True, timeout=60)
-    assert (out / "raw" / "image_002.jpg").read_bytes() == (lp.parent / "b/IMG.JPG").read_bytes()
+    assert (out / "raw" / "image_002.jpg").read_bytes() == (lp.parent / NAMES[1]).read_bytes()
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0 and "every image is as captured" in said(r), said(r)
