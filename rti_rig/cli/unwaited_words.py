@@ -69,22 +69,39 @@ class WordsWriter:
         self._thread.start()
 
     def write(self, stream: Any, text: str) -> None:
-        if self._closed or not self._thread.is_alive():  # a forked child, a closed writer
-            stream.write(text)  # as before
-            return
-        with self._count_lock:
-            if self._held + len(text) > self._limit:
-                self._dropped += len(text)
+        with self._count_lock:  # the check and the queueing as one against close()
+            if self._open():
+                if self._held + len(text) > self._limit:
+                    self._dropped += len(text)
+                    return
+                self._held += len(text)
+                self._queue((stream, text))
                 return
-            self._held += len(text)
-        self._items.append((stream, text))
-        self._wake()
+        stream.write(text)  # a forked child, a closed writer: as before
 
     def flush(self, stream: Any) -> None:
-        if self._closed or not self._thread.is_alive():
-            stream.flush()
-            return
-        self._items.append((stream, _FLUSH))
+        with self._count_lock:
+            if self._open():
+                self._queue((stream, _FLUSH))
+                return
+        stream.flush()
+
+    def _open(self) -> bool:
+        """Whether the thread takes what is queued now; under ``_count_lock`` (see
+        :meth:`_queue`)."""
+        return not self._closed and self._thread.is_alive()
+
+    def _queue(self, item: Any) -> None:
+        """Queue ``item`` and wake the thread; under ``_count_lock``, :meth:`_open` checked
+        under the same hold.
+
+        Why: checked before the lock, a word said as another thread closed the writer could
+        be queued after the close's end mark, once the thread had passed it and ended: neither
+        written nor counted as dropped (its characters counted held for ever), and its wake-up
+        byte written to a descriptor the close had closed, or that a later ``open()`` got.
+        :meth:`close` sets ``_closed`` and queues its mark under the lock: a word is queued
+        before the mark (written by the thread) or finds the writer closed (written here)."""
+        self._items.append(item)
         self._wake()
 
     def drain(self, timeout: float | None = None) -> bool:
@@ -96,8 +113,13 @@ class WordsWriter:
             self._thread.join(timeout)
             return not self._thread.is_alive()
         done = threading.Event()
-        self._items.append(done)
-        self._wake()
+        with self._count_lock:
+            queued = self._open()
+            if queued:
+                self._queue(done)
+        if not queued:  # closed meanwhile: the thread's end is the wait (out of the lock,
+            self._thread.join(timeout)  # which the thread takes as it writes)
+            return not self._thread.is_alive()
         return done.wait(timeout)
 
     def unwritten(self) -> int:
@@ -114,17 +136,21 @@ class WordsWriter:
         Why: each writer kept a thread and two descriptors for the rest of the process; a
         program or test that makes writers of its own had no way to give them back. Where the
         thread does not end in time (a stalled reader), its pipe is left open for it."""
-        self._closed = True
-        self._items.append(_CLOSE)
-        self._wake()
+        with self._count_lock:  # no word queued after the mark (see :meth:`_queue`)
+            if not self._closed:
+                self._closed = True
+                self._queue(_CLOSE)
         if threading.current_thread() is self._thread:
             return False
         self._thread.join(timeout)
         if self._thread.is_alive():
             return False
-        for fd in (self._wake_r, self._wake_w):
-            with contextlib.suppress(OSError):
-                os.close(fd)
+        with self._count_lock:  # closed once: a second close() never closes a number reused
+            fds, self._wake_r, self._wake_w = (self._wake_r, self._wake_w), -1, -1
+        for fd in fds:
+            if fd >= 0:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
         return True
 
     def _wake(self) -> None:

@@ -1,0 +1,88 @@
+"""A word said while another thread closes the :class:`WordsWriter` is written (by the writer
+thread before it ends, or by the caller after it): never queued behind the thread's end, where
+it was neither written nor counted as dropped (and its wake-up byte went to a closed
+descriptor, or to whatever a later ``open()`` got that number for).
+
+Deterministic: the saying thread is stopped inside ``write`` (as it takes the count lock, the
+one hook the method has) until the closing thread has either finished the close or is waiting
+on that lock; no sleeps, no timing. Before the fix the close finished and the word went to a
+queue no thread read any more.
+"""
+
+from __future__ import annotations
+
+import io
+import threading
+from typing import Any
+
+from rti_rig.cli.unwaited_words import WordsWriter
+
+#: Far beyond what either step takes on a loaded machine: only a broken writer waits this long.
+DEADLINE_S = 60.0
+
+
+class _Gate:
+    """An RLock standing for the writer's count lock: the saying thread's first acquire is
+    held there (after the lock is taken) until ``progress`` is set; any thread that finds the
+    lock taken sets ``progress`` before it waits (the close reached the lock)."""
+
+    def __init__(self, sayer: threading.Thread | None = None) -> None:
+        self._lock = threading.RLock()
+        self.sayer = sayer
+        self.at_gate = threading.Event()
+        self.progress = threading.Event()
+        self._gated = False
+
+    def acquire(self, blocking: bool = True, timeout: float = -1) -> bool:
+        if not self._lock.acquire(blocking=False):
+            self.progress.set()  # someone holds it: the close is waiting on the sayer
+            if not self._lock.acquire(blocking, timeout):
+                return False
+        if threading.current_thread() is self.sayer and not self._gated:
+            self._gated = True
+            self.at_gate.set()
+            assert self.progress.wait(DEADLINE_S), "the close neither ended nor waited"
+        return True
+
+    def release(self) -> None:
+        self._lock.release()
+
+    def __enter__(self) -> bool:
+        return self.acquire()
+
+    def __exit__(self, *exc: Any) -> None:
+        self.release()
+
+
+def test_a_word_said_as_the_writer_closes_is_written() -> None:
+    stream = io.StringIO()
+    writer = WordsWriter(notes_to=io.StringIO())
+    gate = _Gate()
+    writer._count_lock = gate  # type: ignore[assignment]
+    failures: list[BaseException] = []
+
+    def say() -> None:
+        try:
+            writer.write(stream, "the last word\n")
+        except BaseException as exc:  # reported by the test
+            failures.append(exc)
+
+    sayer = threading.Thread(target=say, name="sayer")
+    gate.sayer = sayer
+    sayer.start()
+    assert gate.at_gate.wait(DEADLINE_S)
+
+    def close() -> None:
+        try:
+            writer.close(DEADLINE_S)
+        finally:
+            gate.progress.set()  # the close is done (before the fix it never waited on the lock)
+
+    closer = threading.Thread(target=close, name="closer")
+    closer.start()
+    sayer.join(DEADLINE_S)
+    closer.join(DEADLINE_S)
+    assert not sayer.is_alive() and not closer.is_alive()
+    assert not failures
+    assert stream.getvalue() == "the last word\n"
+    assert writer.unwritten() == 0
