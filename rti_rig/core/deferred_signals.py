@@ -204,11 +204,14 @@ def signals_deferred(
                 raise first
 
     installed: dict[int, Any] = {}
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        if signal.getsignal(sig) is None:  # set outside Python: it could not be put back
-            continue
-        installed[sig] = _swap_handler(sig, hold, raised)
     try:  # a stop that came as the hold was set (in ``raised``) acts after the block too
+        # the swaps inside the ``try``: a handler raising between two of them (SIGINT held,
+        # SIGTERM's own handler still in place) had left SIGINT's hold installed for ever, a
+        # hold no block would release (every later Ctrl-C kept in a list nobody reads)
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            if signal.getsignal(sig) is None:  # set outside Python: it could not be put back
+                continue
+            installed[sig] = _swap_handler(sig, hold, raised)
         yield
     finally:
         if not released:

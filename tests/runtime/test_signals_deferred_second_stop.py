@@ -104,3 +104,31 @@ def test_stops_one_hold_delivers_are_raised_first_and_the_rest_kept_in_its_notes
     assert getattr(caught.value, "__notes__", []) == [
         "also raised as the hold ended: Named: SIGINT"
     ]
+
+
+def test_a_stop_raised_as_the_hold_is_set_leaves_no_hold_behind(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A stop whose handler raises between the hold's two swaps (SIGINT already held,
+    SIGTERM's own handler still in place) puts SIGINT's handler back: it had stayed the hold
+    of a block that never began, every later Ctrl-C kept where nobody would deliver it (the
+    controller's teardown sets its hold again after such a stop)."""
+    import rti_rig.core.deferred_signals as deferred
+
+    def ours(signum: int, frame: Any) -> None:
+        raise Stop
+
+    real_getsignal = signal.getsignal
+
+    def getsignal(sig: int) -> Any:
+        if sig == signal.SIGTERM:  # SIGINT is swapped by now: the stop lands between the two
+            signal.raise_signal(signal.SIGTERM)
+        return real_getsignal(sig)
+
+    with signal_handlers({signal.SIGINT: ours, signal.SIGTERM: ours}):
+        monkeypatch.setattr(deferred.signal, "getsignal", getsignal)
+        with pytest.raises(Stop), signals_deferred():
+            raise AssertionError("the block began though its hold was cut short")
+        monkeypatch.undo()
+        assert signal.getsignal(signal.SIGINT) is ours
+        assert signal.getsignal(signal.SIGTERM) is ours
