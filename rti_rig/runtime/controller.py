@@ -11,6 +11,7 @@ from __future__ import annotations
 import signal
 import time
 from collections.abc import Callable, Iterable
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import TYPE_CHECKING, Any, Protocol
@@ -678,6 +679,55 @@ def _teardown_failure(label: str, exc: Exception, earlier: list[str]) -> str:
     return f"{label}: {text}"
 
 
+class _Entered:
+    """A context manager already entered (its ``__enter__`` called): the ``with`` that takes
+    it only exits it."""
+
+    def __init__(self, entered: AbstractContextManager[Any]) -> None:
+        self._entered = entered
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, *exc_info: Any) -> bool | None:
+        return self._entered.__exit__(*exc_info)
+
+
+def _teardown_held(cancel: CancelToken) -> tuple[_Entered, BaseException | None]:
+    """The teardown's hold on SIGINT/SIGTERM, entered, after ``cancel.capture_over()``; and
+    the stop (an exception) a signal handler raised before the hold was set, or None.
+
+    Why: the teardown is :func:`run_session`'s ``finally``, and Python runs a signal handler
+    between any two bytecodes of the main thread. A stop whose handler raises (the CLI's
+    SIGTERM, hang-up or second Ctrl-C: EmergencyStop; an unhandled Ctrl-C: KeyboardInterrupt)
+    landing after the capture's last step or its break, before the hold was set, left the
+    ``finally`` at once: no all-off sent, nothing closed, no end in the manifest (it read as
+    a run still under way). Caught here, the hold set all the same, it is raised once the
+    teardown is done, the manifest naming it, as a stop in the last step is. Once the hold's
+    handlers are in place a signal is only held: nothing raises between here and the
+    ``with`` that exits it."""
+    stopped: BaseException | None = None
+    while True:
+        try:
+            cancel.capture_over()
+            hold = signals_deferred()
+            hold.__enter__()
+            return _Entered(hold), stopped
+        except BaseException as exc:  # a stop's handler, as the hold was being set: again
+            stopped = stopped or exc
+
+
+def _stop_recorded_as(exc: BaseException) -> tuple[FinishReason, str]:
+    """The manifest's end and error for a stop that raised as the capture ended, before the
+    teardown's hold (:func:`_teardown_held`), as the capture's own ``except`` clauses record
+    one raised within it."""
+    if isinstance(exc, KeyboardInterrupt):
+        return FinishReason.INTERRUPTED, "interrupted by the user (Ctrl-C)"
+    if isinstance(exc, EmergencyStop):
+        return FinishReason.EMERGENCY_STOP, f"emergency stop: {exc}"
+    return FinishReason.ERROR, f"{type(exc).__name__}: {exc}"
+
+
 def run_session(
     rig: Rig,
     schedule: LightSchedule,
@@ -882,8 +932,10 @@ def run_session(
         led_error = led_error_record(exc)
         raise
     finally:
-        cancel.capture_over()
-        with signals_deferred():
+        hold, stopped = _teardown_held(cancel)
+        if stopped is not None and reason in (FinishReason.COMPLETED, FinishReason.CANCELLED):
+            reason, error = _stop_recorded_as(stopped)  # held now: nothing raises between
+        with hold:
             # (a dome's safe() marks the teardown first: a reopening now is for its all-off)
             teardown += rig.lighting.safe(emergency=reason is FinishReason.EMERGENCY_STOP)
             for label, close in (
@@ -925,6 +977,8 @@ def run_session(
                 teardown.append(f"session record: {exc}")  # the first failure is the story
             if resends_said is not None:
                 emit(DeviceSays(rig.lighting.name, resends_said))
+        if stopped is not None:
+            raise stopped
     return SessionResult(
         reason, tuple(records), rig_time, wall_time, error, tuple(teardown), tuple(end_notes)
     )

@@ -136,21 +136,23 @@ def _run_three(out: Path, *more: str) -> tuple[int, str]:
 def test_a_port_close_in_a_run_whose_end_a_stop_cut_is_recorded_on_disk(
     tmp_path: Path, close_fails: None, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """A SIGTERM as the controller's teardown begins: the session's close makes the dome safe
-    and closes its port in the teardown's stead, and records the run's cut end. The port's
-    close failure is in that record as the teardown's own would be (it had been said and in
-    no record), said once, and is no teardown problem."""
+    """A SIGTERM that cuts the controller's teardown (raised where it sets its hold, in its
+    place: a stop before the hold is caught and torn down for, so this stands for one the
+    teardown could not catch): the session's close makes the dome safe and closes its port
+    in the teardown's stead, and records the run's cut end. The port's close failure is in
+    that record as the teardown's own would be (it had been said and in no record), said
+    once, and is no teardown problem."""
     import signal
 
     import rti_rig.runtime.controller as controller
 
-    real_over = controller.CancelToken.capture_over
+    real_held = controller._teardown_held
 
-    def capture_over(self) -> None:  # type: ignore[no-untyped-def]
+    def teardown_held(cancel):  # type: ignore[no-untyped-def]
         signal.raise_signal(signal.SIGTERM)
-        real_over(self)
+        return real_held(cancel)
 
-    monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
+    monkeypatch.setattr(controller, "_teardown_held", teardown_held)
     out = tmp_path / "S"
     code, text = _run_three(out)
     assert code == 143, text

@@ -115,20 +115,22 @@ def test_a_sigterm_as_the_controller_checks_the_disk_switches_the_held_dome_off_
 def test_a_sigterm_as_the_teardown_begins_is_not_said_as_before_the_first_image(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """A SIGTERM in the controller's ``finally`` before it holds signals (as it marks the
-    capture over) cuts its teardown before it records the run's end: the session's close
-    makes the dome safe in its place. Every image was in, and the run had said "Stopped
-    (SIGTERM) before the first image: nothing was captured", with no word of the images or
-    the resume. A real SIGTERM, raised in the run's own process there (no timing)."""
+    """A SIGTERM that cuts the controller's teardown before it records the run's end (raised
+    where the teardown sets its hold, in its place: a stop landing before the hold is caught
+    and torn down for, so this stands for one the teardown could not catch): the session's
+    close makes the dome safe in its place. Every image was in, and the run had said
+    "Stopped (SIGTERM) before the first image: nothing was captured", with no word of the
+    images or the resume. A real SIGTERM, raised in the run's own process there (no
+    timing)."""
     received = _dome_commands(monkeypatch)
-    real_over = controller.CancelToken.capture_over
+    real_held = controller._teardown_held
 
-    def capture_over(self) -> None:  # type: ignore[no-untyped-def]
+    def teardown_held(cancel):  # type: ignore[no-untyped-def]
         received.append("capture over")
         signal.raise_signal(signal.SIGTERM)
-        real_over(self)
+        return real_held(cancel)
 
-    monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
+    monkeypatch.setattr(controller, "_teardown_held", teardown_held)
     out = tmp_path / "s"
     r, said = _run_six(out)
     assert len(list(out.glob("image_*"))) == 6, said

@@ -1,6 +1,12 @@
-"""A run whose end a stop cut (a SIGTERM as the controller's teardown begins, before it records
-the run's end) is recorded on disk as stopped, so that a later ``--resume`` says "stopped",
+"""A run whose end a stop cut (the controller's teardown never ran, so it never recorded the
+run's end) is recorded on disk as stopped, so that a later ``--resume`` says "stopped",
 and "killed" only of a run killed outright.
+
+A SIGTERM as the teardown begins (as it marks the capture over, before its hold) had been such
+a cut; the controller now catches a stop there and runs its teardown for it (the run's end
+recorded, its times known): the first test shows that. The cut is then made by a stop raised
+where the teardown sets its hold, in its place (:func:`_teardown_cut`), for the session's close,
+the safety net for a teardown that did not run whatever cut it.
 
 The teardown's end record (:meth:`SessionFolder.finish`) is written only by the controller:
 where a stop cut it, the session's close made the devices safe in its place and wrote nothing,
@@ -44,6 +50,42 @@ def _sigterm_as_the_teardown_begins(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
 
 
+def _teardown_cut(monkeypatch: pytest.MonkeyPatch, before: Any = None) -> None:
+    """A real SIGTERM raised where the controller's teardown sets its hold, in its place: the
+    handler's EmergencyStop leaves the ``finally`` and the teardown does not run (``before``,
+    if given, is called first)."""
+    real_held = controller._teardown_held
+
+    def teardown_held(cancel: Any) -> Any:
+        if before is not None:
+            before()
+        signal.raise_signal(signal.SIGTERM)
+        return real_held(cancel)
+
+    monkeypatch.setattr(controller, "_teardown_held", teardown_held)
+
+
+def test_a_sigterm_as_the_teardown_begins_gets_the_teardown_and_its_end_recorded(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Before, the stop left the controller's ``finally`` before its hold: no teardown of the
+    controller's, the run's end cut (its times unknown), the session's close in its place."""
+    out = tmp_path / "s"
+    with monkeypatch.context() as patched:
+        _sigterm_as_the_teardown_begins(patched)
+        r, said = _run(CONFIGS / "emulated_dome.toml", out)
+    assert r.exit_code == 143, said
+    assert "Emergency stop (SIGTERM)" in said and "6 image(s) kept" in said, said
+    assert "Traceback" not in said and "teardown problem" not in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    (run,) = manifest["runs"]
+    assert run["finish_reason"] == "emergency-stop" and not run.get("end_cut"), run
+    assert "rig_time_s" in run, run
+    runner = manifest["runner"]
+    assert runner["error"] == "emergency stop: SIGTERM", runner
+    assert runner["steps_done_this_run"] == 6, runner
+
+
 def _run(config: Path, out: Path, *more: str) -> tuple[Any, str]:
     argv = ["run", str(config), "--lights", "6", "--out", str(out), "--no-verdict", *more]
     r = CliRunner().invoke(app, argv, terminal_width=400)
@@ -55,7 +97,7 @@ def test_a_run_whose_end_a_stop_cut_is_resumed_as_stopped_not_killed(
 ) -> None:
     out = tmp_path / "s"
     with monkeypatch.context() as patched:
-        _sigterm_as_the_teardown_begins(patched)
+        _teardown_cut(patched)
         r, said = _run(CONFIGS / "emulated_dome.toml", out)
     assert r.exit_code == 143, said
     assert "Emergency stop (SIGTERM)" in said and "6 image(s) kept" in said, said
@@ -85,17 +127,14 @@ def test_an_arm_run_whose_end_a_stop_cut_has_its_lamp_switched_off(
     cfg.write_text(text.replace('lamp = "software"', 'lamp = "servo_led"\nlamp_servo_id = 2'))
     seen = opened_session_kept(monkeypatch)
     lit: list[int] = []
-    real_lamp = controller.CancelToken.capture_over
 
-    def capture_over(self) -> None:  # type: ignore[no-untyped-def]
+    def lamp_lit() -> None:
         # the lamp as the stop lands: lit again here, as a stop during an image leaves it
         emulator = seen["opened"].rig.emulator
         emulator.servos[2]._set(ct.LED, 1)
         lit.append(emulator.servos[2].get(ct.LED))
-        signal.raise_signal(signal.SIGTERM)
-        real_lamp(self)
 
-    monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
+    _teardown_cut(monkeypatch, lamp_lit)
     real_record = SessionFolder.record_cut_end
 
     def record_cut_end(self: SessionFolder, reason: str, *more: Any) -> bool:

@@ -31,18 +31,20 @@ def test_a_simulated_dome_lit_as_a_stop_cuts_the_teardown_is_switched_off_by_the
 ) -> None:
     seen = opened_session_kept(monkeypatch)
     lit: list[int | None] = []
-    real_over = controller.CancelToken.capture_over
+    real_held = controller._teardown_held
 
-    def capture_over(self) -> None:  # type: ignore[no-untyped-def]
+    def teardown_held(cancel):  # type: ignore[no-untyped-def]
         # an LED lit as the stop lands (as a stop during an image leaves it), then a real
-        # SIGTERM before the controller's teardown holds signals: no timing
+        # SIGTERM where the controller's teardown sets its hold, in its place: the teardown
+        # does not run (the controller catches a stop landing before its hold; this one cuts
+        # it, as a stop the teardown cannot catch would): no timing
         dome = seen["opened"].rig.lighting.source
         dome.light(3)
         lit.append(dome.lit_now())
         signal.raise_signal(signal.SIGTERM)
-        real_over(self)
+        return real_held(cancel)
 
-    monkeypatch.setattr(controller.CancelToken, "capture_over", capture_over)
+    monkeypatch.setattr(controller, "_teardown_held", teardown_held)
     real_record = SessionFolder.record_cut_end
 
     def record_cut_end(self: SessionFolder, reason: str, *more: list[str]) -> bool:
