@@ -537,13 +537,13 @@ def main() -> None:
     help_styled_as_the_consoles()
     reader_gone_tolerated()
     from rti_rig.cli.unwaited_words import (
-        sigterm_waits_for_the_words,
+        stops_wait_for_the_words,
         words_unwaited,
         words_written,
     )
 
     words_unwaited((out, err))  # no print waits on the reader while the rig works
-    sigterm_waits_for_the_words()  # nor is a word said lost to SIGTERM's default action
+    stops_wait_for_the_words()  # nor a word said lost to SIGTERM's or SIGHUP's default action
     ending: object = 0  # the exit the command left with
     try:
         app()

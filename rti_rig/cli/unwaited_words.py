@@ -18,7 +18,7 @@ under a progress bar's redraws) cannot fill the memory. Nothing captured depends
 the images, journal and manifest are written as before. At the command's end the process waits
 for the reader to take what is queued (as it did before for each print), the rig then safe; a
 Ctrl-C there gives the words up, says so, and exits 130 unless the command ended otherwise; a
-SIGTERM no command handles gives them up to 2 s (:func:`sigterm_waits_for_the_words`).
+SIGTERM or hang-up no command handles gives them up to 2 s (:func:`stops_wait_for_the_words`).
 """
 
 from __future__ import annotations
@@ -384,23 +384,32 @@ def words_written_before_signal() -> None:
         _writer.drain(BEFORE_DEFAULT_ACTION_S)
 
 
-def sigterm_waits_for_the_words() -> None:
-    """Where SIGTERM's action is the default as the console entry begins, answer it with the
-    core's :func:`~rti_rig.core.deferred_signals.default_after_hooks`: the default action,
-    after up to :data:`BEFORE_DEFAULT_ACTION_S` for the words already said. A command that
-    sets its own handler (``run``, ``check``, ``probe`` while it works; ``fit`` and ``plan``
-    while they write) puts this one back as it ends. Main thread only; a SIGTERM ignored or
-    handled outside Python is left as it is.
+def stops_wait_for_the_words() -> None:
+    """Where SIGTERM's action, or a hang-up's (SIGHUP), is the default as the console entry
+    begins, answer it with the core's
+    :func:`~rti_rig.core.deferred_signals.default_after_hooks`: the default action, after up
+    to :data:`BEFORE_DEFAULT_ACTION_S` for the words already said. A command that sets its own
+    handler (``run``, ``check``, ``probe`` while it works; ``fit`` and ``plan`` while they
+    write; a hang-up answered as their SIGTERM) puts this one back as it ends. Main thread
+    only; a signal ignored (``nohup``) or handled outside Python is left as it is.
 
     Why: ``bench`` has no SIGTERM handler, ``fit`` and ``plan`` none once their work is done,
     and no command one in the end's wait for the words: a SIGTERM there (``timeout``, a
     scheduler) ended the process at once and the words still queued for a slow reader (a
     summary, a stop's words, a help text) were lost. None of those moments holds hardware
-    (``probe`` has closed its dome by then), so a wait of 2 s at most costs no safety."""
+    (``probe`` has closed its dome by then), so a wait of 2 s at most costs no safety.
+
+    Why the hang-up too: it is the terminal or the ssh connection closing, and it had ended
+    those same moments at once (``bench --help`` into a busy pipe lost its whole text, where a
+    SIGTERM's waited for it). Words bound for the terminal that hung up cost nothing to wait
+    for (a write to a hung-up terminal fails at once; the writer drops the word), and words
+    bound for a file or a pipe (``> log``, ``| tee log``) are what the user will read; the
+    process still ends by SIGHUP (exit 129)."""
     if threading.current_thread() is not threading.main_thread():
         return
-    if signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
-        signal.signal(signal.SIGTERM, default_after_hooks)
+    for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
+        if sig is not None and signal.getsignal(sig) == signal.SIG_DFL:
+            signal.signal(sig, default_after_hooks)
 
 
 def say_unwaited(text: str) -> None:

@@ -89,3 +89,62 @@ def test_queued_words_are_written_before_a_signals_default_action(path: str) -> 
     assert "a console's word" in text
     assert "did not end the process" not in text
     assert process.returncode == -(signal.SIGHUP if path == "hangup" else signal.SIGTERM)
+
+
+#: ``python -c`` source of the console entry (``rti_rig.launch``) running ``bench --help``
+#: with its stdout a pipe it has filled itself (a reader that does not read: the help text
+#: stays queued), and a hang-up (SIGHUP) as it ends, before its wait for the words. It says
+#: when it reaches the default action's wait (a hook run just before it), as above.
+_HANGUP_AT_THE_END = r"""
+import os, signal, sys
+from rti_rig.cli import unwaited_words
+from rti_rig.core import deferred_signals
+
+unwaited_words.BEFORE_DEFAULT_ACTION_S = 600.0  # the test reads only once this is waited in
+ready = int(sys.argv[1])
+deferred_signals.before_default_action.insert(0, lambda: os.write(ready, b"r"))
+os.set_blocking(1, False)
+for size in (4096, 1):  # full to the last byte: nothing more goes out until the test reads
+    try:
+        while True:
+            os.write(1, b"f" * size)
+    except BlockingIOError:
+        pass
+os.set_blocking(1, True)
+real_written = unwaited_words.words_written
+
+def words_written():  # the command's end, its words queued: the terminal closes
+    signal.raise_signal(signal.SIGHUP)
+    return real_written()
+
+unwaited_words.words_written = words_written
+sys.argv = ["rti-rig", "bench", "--help"]
+from rti_rig.launch import main
+main()
+"""
+
+
+def test_a_hang_up_as_a_command_ends_waits_for_its_words_then_ends_by_sighup() -> None:
+    """``bench --help`` (no handler of its own) hung up as it ends: its help text, queued for
+    a pipe, is written before the process ends by SIGHUP. Before, SIGHUP's default action
+    ended it at once and the text was lost (where a SIGTERM's waited for it)."""
+    ready_r, ready_w = os.pipe()
+    try:
+        process = subprocess.Popen(
+            [sys.executable, "-c", _HANGUP_AT_THE_END, str(ready_w)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            pass_fds=(ready_w,),
+            env={**os.environ, "COLUMNS": "100"},
+        )
+    finally:
+        os.close(ready_w)
+    with ended_on_exit(process):
+        try:
+            os.read(ready_r, 1)  # the child is at the default action's wait (or ended: EOF)
+        finally:
+            os.close(ready_r)
+        said, _ = process.communicate(timeout=600)
+    text = said.decode(errors="replace").lstrip("f")
+    assert "Benchmarks: the speed/accuracy trade" in text, text[-500:]
+    assert process.returncode == -signal.SIGHUP, text[-500:]
