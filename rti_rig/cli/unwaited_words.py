@@ -49,7 +49,8 @@ class WordsWriter:
     The saying side (any thread, and signal handlers in the main thread) only appends to a
     deque and writes a byte to a non-blocking wake-up pipe: nothing there can block on the
     reader. The counts of characters held and dropped are changed under ``_count_lock``, held
-    only for the arithmetic (never across a write), re-entrant so that a handler that speaks
+    only for the arithmetic and the queueing (never across a stream's write; the wake-up
+    byte's write is non-blocking: see :meth:`_queue`), re-entrant so that a handler that speaks
     while the main thread was counting cannot deadlock: ``+=`` from the saying threads and
     ``-=`` from the writer thread had raced, and the held count drifted (words dropped below
     the limit, or the limit overrun). One queue for both streams keeps their order (``2>&1``)
