@@ -48,20 +48,30 @@ class WordsWriter:
 
     The saying side (any thread, and signal handlers in the main thread) only appends to a
     deque and writes a byte to a non-blocking wake-up pipe: nothing there can block on the
-    reader. The counts of characters held and dropped are changed under ``_count_lock``, held
-    only for the arithmetic and the queueing (never across a stream's write; the wake-up
+    reader. The saying side counts the characters it queued and dropped under ``_count_lock``,
+    held only for the arithmetic and the queueing (never across a stream's write; the wake-up
     byte's write is non-blocking: see :meth:`_queue`), re-entrant so that a handler that speaks
-    while the main thread was counting cannot deadlock: ``+=`` from the saying threads and
-    ``-=`` from the writer thread had raced, and the held count drifted (words dropped below
-    the limit, or the limit overrun). One queue for both streams keeps their order (``2>&1``)
-    as it was said."""
+    while the main thread was counting cannot deadlock; the writer thread counts what it wrote
+    and said dropped in counters of its own, so it never takes that lock: the held count is
+    the difference (``+=`` from the saying threads and ``-=`` from the writer thread on one
+    count had raced, and it drifted: words dropped below the limit, or the limit overrun). One
+    queue for both streams keeps their order (``2>&1``) as it was said.
+
+    Why the writer thread takes no lock: a signal handler that waits for the words (SIGTERM's
+    or a hang-up's, before the default action) can land while the main thread is inside
+    :meth:`write`, the lock held; the writer thread, taking it to count each word written,
+    wrote none until the wait gave up, and the words were lost to the default action."""
 
     def __init__(self, notes_to: Any, limit: int = HELD_LIMIT) -> None:
         self._items: collections.deque[Any] = collections.deque()
         self._limit = limit
         self._count_lock = threading.RLock()
-        self._held = 0  # characters queued, not yet written
+        # saying side, under ``_count_lock``: characters queued, characters dropped
+        self._queued = 0
         self._dropped = 0
+        # writer thread only, no lock: characters written (or lost), dropped and said so
+        self._written = 0
+        self._dropped_said = 0
         self._closed = False
         self.notes_to = notes_to
         self._wake_r, self._wake_w = os.pipe()
@@ -72,10 +82,10 @@ class WordsWriter:
     def write(self, stream: Any, text: str) -> None:
         with self._count_lock:  # the check and the queueing as one against close()
             if self._open():
-                if self._held + len(text) > self._limit:
+                if self._queued - self._written + len(text) > self._limit:
                     self._dropped += len(text)
                     return
-                self._held += len(text)
+                self._queued += len(text)
                 self._queue((stream, text))
                 return
         stream.write(text)  # a forked child, a closed writer: as before
@@ -126,8 +136,12 @@ class WordsWriter:
     def unwritten(self) -> int:
         """How many characters said are not written: queued for the reader, or dropped and
         not yet said to be."""
+        # each count only grows, and the writer's trail the sayers': the writer's read first,
+        # the difference is never below what is unwritten (read after, it could be negative)
+        written, said = self._written, self._dropped_said
         with self._count_lock:
-            return self._held + self._dropped
+            queued, dropped = self._queued, self._dropped
+        return queued - written + dropped - said
 
     def close(self, timeout: float | None = None) -> bool:
         """Let the thread write what is queued, then end it and close its wake-up pipe, at
@@ -168,7 +182,7 @@ class WordsWriter:
                     closing = True
                     continue
                 if isinstance(item, threading.Event):  # a drain: the note before its end
-                    if self._dropped:
+                    if self._dropped != self._dropped_said:
                         self._say_dropped()
                     item.set()
                     continue
@@ -180,16 +194,15 @@ class WordsWriter:
                         try:
                             stream.write(text)
                         finally:  # counted until written: a word a stalled reader holds
-                            with self._count_lock:  # is not yet written
-                                self._held -= len(text)
+                            self._written += len(text)  # is not yet written
                 except Exception:  # a word lost, never the writer
                     pass
-                if not self._items and self._dropped:
+                if not self._items and self._dropped != self._dropped_said:
                     self._say_dropped()
 
     def _say_dropped(self) -> None:
-        with self._count_lock:
-            dropped, self._dropped = self._dropped, 0
+        total = self._dropped  # read once: a later drop is said at the next note
+        dropped, self._dropped_said = total - self._dropped_said, total
         with contextlib.suppress(Exception):
             self.notes_to.write(
                 f"note: {dropped} characters of output were dropped: its reader did not read "

@@ -18,7 +18,7 @@ from typing import Any
 from rti_rig.cli.unwaited_words import WordsWriter
 
 #: Far beyond what either step takes on a loaded machine: only a broken writer waits this long.
-DEADLINE_S = 60.0
+DEADLINE_S = 30.0
 
 
 class _Gate:
@@ -86,3 +86,48 @@ def test_a_word_said_as_the_writer_closes_is_written() -> None:
     assert not failures
     assert stream.getvalue() == "the last word\n"
     assert writer.unwritten() == 0
+
+
+def test_a_drain_from_a_handler_that_interrupted_a_write_is_not_stalled() -> None:
+    """A signal handler (SIGTERM's wait for the words before its default action) landing while
+    the main thread was inside ``write``, the count lock held: the handler's drain waits for
+    the writer thread, which had to take that same lock to count each word written, and so
+    wrote none until the wait gave up (2 s in the CLI, the words then lost to the default
+    action). The writer thread now counts what it wrote on its own, without the lock."""
+    stream = io.StringIO()
+    writer = WordsWriter(notes_to=io.StringIO())
+    try:
+        writer.write(stream, "a word said before\n")
+        with writer._count_lock:  # as the interrupted write holds it
+            writer.write(stream, "the handler's word\n")  # re-entrant: the handler speaks
+            assert writer.drain(DEADLINE_S), "the writer thread waited on the saying thread"
+            assert writer.unwritten() == 0
+        assert stream.getvalue() == "a word said before\nthe handler's word\n"
+    finally:
+        writer.close(DEADLINE_S)
+
+
+def test_words_beyond_the_limit_are_dropped_counted_and_said() -> None:
+    """The counts without the writer thread's lock still keep the limit and the note."""
+    release = threading.Event()
+
+    class Stalled(io.StringIO):
+        def write(self, text: str) -> int:
+            release.wait(DEADLINE_S)  # a reader that does not read until told
+            return super().write(text)
+
+    notes = io.StringIO()
+    stream = Stalled()
+    writer = WordsWriter(notes_to=notes, limit=10)
+    try:
+        writer.write(stream, "12345678\n")  # 9: held
+        writer.write(stream, "abc\n")  # 9 + 4 > 10: dropped
+        assert writer.unwritten() == 13
+        release.set()
+        assert writer.drain(DEADLINE_S)
+        assert writer.unwritten() == 0
+        assert stream.getvalue() == "12345678\n"
+        assert "note: 4 characters of output were dropped" in notes.getvalue()
+    finally:
+        release.set()
+        writer.close(DEADLINE_S)
