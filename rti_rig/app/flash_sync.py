@@ -161,7 +161,8 @@ class SlipGuard:
             raise LightSlipError(
                 _disowned(
                     root,
-                    f"image {index + 1} was lit by LED {index} again: the dome reached the end of "
+                    f"image {index + 1} was lit again by the LED that lit image {index}, the "
+                    f"firmware's last, {self._led(last)}: the dome reached the end of "
                     "its sequence one image early, so it stepped twice earlier, where the check "
                     "did not see it. The labels in lights.lp from that step on are WRONG: do not "
                     f"use this session. Image {index + 1} is kept, unlabelled, as {kept}.",
@@ -176,7 +177,7 @@ class SlipGuard:
             raise LightSlipError(
                 _disowned(
                     root,
-                    f"image {index + 1} was not lit by LED {index + 1} of the dome's order — "
+                    f"image {index + 1} was not lit by {self._led(index)} of the dome's order — "
                     f"{what}: {verdict.reason}. A slip in the first images is seen only some "
                     f"images later, so images {first}–{index} in lights.lp may be mislabelled: "
                     f"do not use this session. Image {index + 1} is kept, unlabelled, as {kept}.",
@@ -185,10 +186,21 @@ class SlipGuard:
             )
         before = f"images 1–{index}" if index > 1 else ("image 1" if index == 1 else "no image")
         raise LightSlipError(
-            f"image {index + 1} was not lit by LED {index + 1} of the dome's order — {what}: "
+            f"image {index + 1} was not lit by {self._led(index)} of the dome's order — {what}: "
             f"{verdict.reason}. The image is kept, unlabelled, as {kept}; lights.lp lists "
             f"{before} only. {rewind}"
         )
+
+    def _led(self, index: int) -> str:
+        """Order position ``index`` as every other word names a dome LED (``led_said``: ``LED 5
+        (az 90.0°, el 44.7°)``, 0-based as ``dead_leds``, plans and manifests count them).
+
+        Why: these words had said the firmware's 1-based ``LED 6`` for the LED the rest of the
+        CLI calls ``LED 5``, so ``dead_leds = [5]`` came back as "Repair or replace LED 6"; the
+        direction says which LED on the dome to look at."""
+        if 0 <= index < self.geometry.count:
+            return self.geometry.led_said(index)
+        return f"LED {index}"
 
     def _after_dark(self, index: int, verdict: Any, kept: str, root: Path, rewind: str) -> str:
         """What a dark image was, from one more frame (:meth:`SequenceChecker.judge_after_dark`).
@@ -200,11 +212,12 @@ class SlipGuard:
         and told them the dome's count was lost when it was not.
         """
         k, n = index + 1, self.geometry.count
-        head = f"image {k} was not lit by LED {k} of the dome's order — {verdict.reason}"
+        led, next_led = self._led(index), self._led(index + 1)
+        head = f"image {k} was not lit by {led} of the dome's order — {verdict.reason}"
         listed = f"images 1–{index}" if index > 1 else ("image 1" if index == 1 else "no image")
         either = (
             f"either the flash pulse did not reach the dome (a missed step: it did not step, "
-            f"and its count no longer matches the session) or LED {k} is dead (the dome "
+            f"and its count no longer matches the session) or {led} is dead (the dome "
             "stepped on)"
         )
         rewind_either = (
@@ -222,7 +235,7 @@ class SlipGuard:
             return (
                 f"{head}: {either}; the frame that would tell them apart could not be shot "
                 f"({exc}). The image is kept, unlabelled, as {kept}; lights.lp lists {listed} "
-                f"only. Look at LED {k} during a flash and check the camera's PC-sync cable. "
+                f"only. Look at {led} during a flash and check the camera's PC-sync cable. "
                 f"{rewind_either}"
             )
         ratio, residuals = self.checker.judge_after_dark(index, frame.pixels, frame.white_level)
@@ -239,30 +252,30 @@ class SlipGuard:
         if residuals is None and ratio < 1.0 and (end or ratio < 0.5):
             # dark again: the firmware re-lights its last (dead) LED; else no LED lit it either
             if end:
-                dead, why = True, f"{shot} is dark too: the firmware re-lit its last LED, {k}"
+                dead, why = True, f"{shot} is dark too: the firmware re-lit its last LED, {led}"
             else:
                 why = f"{shot} is dark too"
         elif due is not None and nxt is not None:
             vs = f"relative residual {min(due, nxt):.3f} against {max(due, nxt):.3f}"
             if nxt < DECIDE_RATIO * due:
-                dead, why = True, f"{shot} was lit by LED {k + 1}, as the order says ({vs})"
+                dead, why = True, f"{shot} was lit by {next_led}, as the order says ({vs})"
             elif due < DECIDE_RATIO * nxt:
                 missed = True
-                why = f"{shot} was lit by LED {k}, the one image {k} was due ({vs})"
+                why = f"{shot} was lit by {led}, the one image {k} was due ({vs})"
             else:
-                why = f"{shot} fits LEDs {k} and {k + 1} alike ({vs})"
+                why = f"{shot} fits {led} and {next_led} alike ({vs})"
         elif due is not None and end:
-            missed, why = True, f"{shot} was lit by LED {k}, the one image {k} was due"
+            missed, why = True, f"{shot} was lit by {led}, the one image {k} was due"
         else:
             why = f"{shot} could not be judged (too few images before it to fit)"
         if dead:
             return (
-                f"image {k} is dark: LED {k} did not light (dead LED?); the dome stepped on: "
+                f"image {k} is dark: {led} did not light (dead LED?); the dome stepped on: "
                 f"{why}. Image {k}: {verdict.reason}; it is kept, unlabelled, as {kept}. The "
                 f"session's other images are good as far as the per-image check can tell: "
                 f"lights.lp lists {listed}, each matched to its LED (the run stopped before its "
                 f"end-of-run proof, so {DISOWN_MARKER} stays in the session). Repair or replace "
-                f"LED {k} (look at it during a flash), then long-press the dome's start button "
+                f"{led} (look at it during a flash), then long-press the dome's start button "
                 "to rewind it and shoot the session again; the dome's count matched the session, "
                 "the run stopped only for the dark image"
             )
@@ -275,7 +288,7 @@ class SlipGuard:
             )
         return (
             f"{head}: {either}; {why}. The image is kept, unlabelled, as {kept}; lights.lp "
-            f"lists {listed} only. Look at LED {k} during a flash and check the camera's "
+            f"lists {listed} only. Look at {led} during a flash and check the camera's "
             f"PC-sync cable. {rewind_either}"
         )
 

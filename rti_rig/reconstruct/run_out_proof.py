@@ -115,7 +115,7 @@ def prove_run_out(
         f"image {n - 1} differs from image {n} no more clearly than the same LED twice does "
         f"({figures}), but consecutive images of this run differ little anyway "
         f"({typical:.4f}, median): either the dome stepped twice somewhere in the run, or this "
-        f"object looks the same under LEDs {n - 1} and {n} at this noise; the order cannot be "
+        "object looks the same under the order's last two LEDs at this noise; the order cannot be "
         "verified",
         same,
         neighbours,

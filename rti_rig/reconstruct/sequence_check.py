@@ -50,6 +50,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rti_rig.core.rig_geometry import led_said
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.photometric_stereo import fit_photometric_stereo
 from rti_rig.reconstruct.stack import channel_mean
@@ -244,8 +245,11 @@ class SequenceChecker:
         return SequenceVerdict(
             index,
             kind,
-            f"lit by the {which} LED of the order (position {best + 1}), not position "
-            f"{index + 1}: relative residual {residuals[best]:.3f} against {expected:.3f}",
+            # LEDs named as every other word names them (0-based, with their direction): a
+            # 1-based "position 12" beside the CLI's "LED 10 (az …)" named two different LEDs
+            f"lit by the {which} LED of the order, {led_said(best, self.order[best])}, not "
+            f"{led_said(index, self.order[index])}: relative residual {residuals[best]:.3f} "
+            f"against {expected:.3f}",
             best,
             True,
             residuals,

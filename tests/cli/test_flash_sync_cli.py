@@ -20,11 +20,19 @@ from conftest import CONFIGS
 from typer.testing import CliRunner
 
 import rti_rig.app.flash_sync as flash_sync
+from rti_rig.app.config import load_rig_config, rig_geometry
 from rti_rig.cli import app
 from rti_rig.core.lp_format import read_lp
 
 runner = CliRunner()
 SHIPPED = CONFIGS / "emulated_cceh_rti.toml"
+
+
+def led(index: int) -> str:
+    """LED ``index`` (0-based) of the shipped dome's order as every word names it, number and
+    direction (``LED 5 (az 112.5°, el 44.7°)``): the words had said the firmware's 1-based
+    ``LED 6`` for the LED ``dead_leds = [5]`` names."""
+    return rig_geometry(load_rig_config(SHIPPED)).led_said(index)
 
 
 @pytest.fixture
@@ -130,7 +138,7 @@ def test_a_slip_is_caught_at_its_image_named_and_never_labelled(  # type: ignore
     )
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())
-    assert f"image {at_image} was not lit by LED {at_image}" in text
+    assert f"image {at_image} was not lit by {led(at_image - 1)} of the dome's order" in text
     assert named in text
     rig = rigs[-1]
     assert lp_matches_truth(out, rig) == at_image - 1  # every listed image is right
@@ -341,7 +349,7 @@ def test_a_run_stopped_before_its_proof_is_not_used(tmp_path: Path, rigs) -> Non
     )
     result = runner.invoke(app, ["run", str(cfg), "--out", str(out)])
     assert result.exit_code == 2, result.output
-    assert "image 41 was not lit by LED 41" in " ".join(result.output.split())
+    assert f"image 41 was not lit by {led(40)}" in " ".join(result.output.split())
     rig = rigs[-1]
     assert truth(rig)[29] == 30  # the fault was real: from the bounce on, one LED ahead
     assert len(read_lp(out / "lights.lp")) == 40  # …and those images are listed in lights.lp
@@ -417,9 +425,9 @@ def test_a_dead_led_is_named_as_such_and_the_dome_said_to_have_stepped_on(  # ty
     lost, both untrue: the frame shot after the dark image is lit by the next LED, as the order
     says, so the dome stepped on and only the LED stayed dark."""
     out, text = _run_with_led_6_dead(tmp_path)
-    assert "image 6 is dark: LED 6 did not light (dead LED?); the dome stepped on" in text, text
-    assert "was lit by LED 7, as the order says" in text
-    assert "Repair or replace LED 6" in text and "other images are good" in text
+    assert f"image 6 is dark: {led(5)} did not light (dead LED?); the dome stepped on" in text
+    assert f"was lit by {led(6)}, as the order says" in text
+    assert f"Repair or replace {led(5)}" in text and "other images are good" in text
     assert "missed step" not in text and "did not reach the dome" not in text
     assert "no longer matches" not in text
     rig = rigs[-1]
@@ -443,9 +451,9 @@ def test_a_missed_pulse_is_told_from_a_dead_led_by_the_frame_after_it(  # type: 
     )
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())
-    assert "image 21 was not lit by LED 21" in text and "missed step" in text, text
+    assert f"image 21 was not lit by {led(20)}" in text and "missed step" in text, text
     assert "the flash pulse did not reach the dome, which therefore did not step" in text
-    assert "was lit by LED 21, the one image 21 was due" in text
+    assert f"was lit by {led(20)}, the one image 21 was due" in text
     assert "The dome's count no longer matches the session" in text
     assert "dead LED" not in text and "stepped on" not in text
     rig = rigs[-1]
@@ -475,7 +483,7 @@ def test_a_check_frame_the_camera_fails_leaves_both_causes_named(  # type: ignor
 
     monkeypatch.setattr(flash_sync, "build_flash_sync_rig", failing_check_frame)
     out, text = _run_with_led_6_dead(tmp_path)
-    assert "image 6 was not lit by LED 6" in text and "or LED 6 is dead" in text, text
+    assert f"image 6 was not lit by {led(5)}" in text and f"or {led(5)} is dead" in text, text
     assert "could not be shot (camera: the USB link dropped)" in text
     assert "Traceback" not in text
     assert (out / "unlabelled" / "image_006.tif").is_file()

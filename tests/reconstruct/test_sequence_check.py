@@ -44,7 +44,8 @@ def test_an_image_lit_by_the_next_led_is_a_double_step() -> None:
         assert chk.check(i, frame(ORDER[i]), 65535).kind == OK
     v = chk.check(10, frame(ORDER[11]), 65535)
     assert v.kind == DOUBLE and v.best_position == 11 and v.fitted
-    assert "next LED" in v.reason and "position 12" in v.reason
+    # named as the CLI names LEDs: 0-based, with its direction (it said "position 12")
+    assert "next LED of the order, LED 11 (az " in v.reason and "not LED 10 (az " in v.reason
 
 
 def test_an_image_lit_by_the_previous_led_is_a_missed_step() -> None:
