@@ -190,33 +190,61 @@ def test_more_lights_than_an_arm_offers_are_refused_with_a_command_that_runs(
     assert len(lit) == offered and max(lit) <= 30.0 + 1e-6, lit
 
 
-@pytest.mark.parametrize(
-    ("asked", "lead", "lit"),
-    [
-        # kept as given, --lights 4 in the widened band was refused: "give at least 5"
-        (["--lights", "4", "--max-elevation-deg", "20"], "Widen the band to hold 5: ", 5),
-        # more than the dome's 12 LEDs in a band of none: no command had been given at all
-        (
-            ["--lights", "14", "--max-elevation-deg", "12"],
-            "No band holds 14 (the dome has 12 LEDs): ask for 12 in one that holds them: ",
-            12,
-        ),
-    ],
-)
-def test_the_lights_asked_for_are_advised_as_a_session_can_take_them(
-    tmp_path: Path, asked: list[str], lead: str, lit: int
+@pytest.mark.parametrize("lights", ["4", "14"])
+def test_lights_no_adaptive_session_takes_are_refused_first_with_the_range(
+    tmp_path: Path, lights: str
 ) -> None:
-    """The --lights a band too narrow was asked with are advised within what an adaptive
-    session takes (at least 5, at most the dome's LEDs), and the advised command runs."""
+    """--lights 4 (below the start's 4 + 1) and --lights 14 (above the Nab dome's 12 LEDs) in a
+    band too narrow: the band's refusal came first, repeating the N asked ("this adaptive
+    session (--lights 14) needs 14") and advising another count, so the range was learnt only
+    from the advice. The count is refused first, with the range, and no command repeats it."""
     out = tmp_path / "s"
-    r = runner.invoke(app, ["run", str(NAB), "--out", str(out), "--adaptive", *asked])
+    args = ["run", str(NAB), "--out", str(out), "--adaptive", "--lights", lights]
+    r = runner.invoke(app, [*args, "--max-elevation-deg", "12"])
     text = said(r)
     assert r.exit_code == 2, text
-    argv = _advised(text, lead, tmp_path, "wide")
-    assert argv[argv.index("--lights") + 1] == str(lit), argv
+    assert f"--adaptive --lights {lights}: an adaptive session on this dome takes 5 to 12" in text
+    assert "rti-rig run" not in text and "band" not in text, text
+    assert not out.exists()
+
+
+def test_a_count_in_range_is_kept_in_the_band_advised_and_it_runs(tmp_path: Path) -> None:
+    """A --lights N the session can take, in a band too narrow for it: the band advised holds
+    N, the command keeps it as given, and pasted it runs (not refused for its count)."""
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(NAB), "--out", str(out), "--adaptive", "--lights", "5",
+              "--max-elevation-deg", "20"]
+    )  # fmt: skip
+    text = said(r)
+    assert r.exit_code == 2, text
+    argv = _advised(text, "Widen the band to hold 5: ", tmp_path, "wide")
+    assert argv[argv.index("--lights") + 1] == "5", argv
     r = runner.invoke(app, [*argv, "--no-verdict"])
     assert r.exit_code == 0, said(r)
-    assert len(_elevations(tmp_path / "wide")) == lit
+    assert len(_elevations(tmp_path / "wide")) == 5
+
+
+@pytest.mark.parametrize(
+    ("asked", "refused"),
+    [
+        (["--until-error", "3", "--objective", "relight"], "--until-error goes with --objective"),
+        (["--adaptive", "--lights", "6", "--objective", "foo"], "--objective foo: an adaptive"),
+    ],
+)
+def test_options_refused_on_their_own_are_refused_before_a_band_is_advised(
+    tmp_path: Path, asked: list[str], refused: str
+) -> None:
+    """A band too narrow had been refused first with a command repeating the options, which
+    pasted was refused for them ('--until-error 3 --objective relight … --max-elevation-deg
+    20'): the options' own refusal comes first, and advises no such command."""
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(NAB), "--out", str(out), *asked, "--max-elevation-deg", "12"]
+    )
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert refused in text and "rti-rig run" not in text, text
 
 
 def test_an_arm_asked_a_minimum_above_what_it_offers_too_is_advised_both_lowered(

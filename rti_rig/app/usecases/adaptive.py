@@ -1575,6 +1575,36 @@ def _arm_widen_to_hold(  # type: ignore[no-untyped-def]
     )
 
 
+def _check_lights_range(
+    lights: int | None, until_error_deg: float | None, leds: int | None
+) -> None:
+    """Refuse an adaptive ``--lights N`` no session can take, with the range it can: at least
+    one more than the start, at most a dome's LEDs (``leds``; an arm's are known later, from
+    its rig, :func:`_check_lights_within`), before any refusal advises a command.
+
+    Why: a band too narrow was refused first, repeating the N asked ("this adaptive session
+    (--lights 14) needs 14") and advising another count in its command, so the user learnt
+    only from the advice that their own --lights was out of range, and not what range was."""
+    if lights is None:
+        return
+    top = leds if leds is not None and leds > START_LIGHTS else None
+    if lights > START_LIGHTS and (top is None or lights <= top):
+        return
+    # the options as given, worded as every adaptive refusal words them (this one had built
+    # its own, "--until-error … --lights 4", without the target the user gave)
+    asked = adaptive_options(until_error_deg, lights, None)
+    if top is None:
+        raise RtiRigError(
+            f"{asked}: an adaptive session starts from {START_LIGHTS} lights "
+            f"and chooses from there; give at least {START_LIGHTS + 1}"
+        )
+    raise RtiRigError(
+        f"{asked}: an adaptive session on this dome takes {START_LIGHTS + 1} to {top} lights "
+        f"(it starts from {START_LIGHTS} and chooses the next ones from the dome's {top} LEDs); "
+        f"give a count from {START_LIGHTS + 1} to {top}"
+    )
+
+
 def open_adaptive_session(  # type: ignore[no-untyped-def]
     loaded,
     out_dir: Path,
@@ -1604,6 +1634,11 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     from rti_rig.app.config import rig_geometry
 
     geometry = rig_geometry(loaded)
+    # the options on their own first: a refusal below advises a command that repeats them, and
+    # one that repeated '--until-error 3 --objective relight' (or '--objective foo') was refused
+    # in turn when pasted
+    check_objective(objective, lights, until_error_deg)
+    check_min_lights(min_lights, lights, until_error_deg)
     offered: int | None = None
     elevations: NDArray[np.float64] | None = None  # a dome's LEDs' (°)
     if isinstance(geometry, DomeGeometry):  # a dome's lights are known from its config: before
@@ -1612,19 +1647,15 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         # --max-elevation-deg", with no value that would do)
         elevations = az_el_from_direction(geometry.directions)[1]
         offered = _held(elevations, band)
+        if len(elevations) <= START_LIGHTS:  # no --lights would do: one refusal, no circle
+            _refuse_nothing_to_choose(
+                loaded, offered, lights, until_error_deg, band, min_lights, objective, out_dir
+            )
+    _check_lights_range(lights, until_error_deg, None if elevations is None else len(elevations))
+    if offered is not None:  # --lights N is one a session can take: a band advised keeps it
         _refuse_nothing_to_choose(
             loaded, offered, lights, until_error_deg, band, min_lights, objective, out_dir
         )
-    if lights is not None and lights < START_LIGHTS + 1:
-        # the options as given, worded as every adaptive refusal words them (this one had
-        # built its own, "--until-error … --lights 4", without the target the user gave)
-        asked = adaptive_options(until_error_deg, lights, None)
-        raise RtiRigError(
-            f"{asked}: an adaptive session starts from {START_LIGHTS} lights "
-            f"and chooses from there; give at least {START_LIGHTS + 1}"
-        )
-    check_objective(objective, lights, until_error_deg)
-    check_min_lights(min_lights, lights, until_error_deg)
     if offered is not None and elevations is not None:  # a dome's (an arm's are known later)
         dome_el = elevations
 
