@@ -1930,8 +1930,10 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
     labels = (
         f"{LP_NAME} lists the lights that fired."
         if not marker.is_file()
-        else f"{LP_NAME} lists the lights the images are labelled with, NOT verified: {marker} "
-        "says why (fit and export-lp refuse this session)."
+        # the marker's path as a shell word, through rich escaped: a session folder named
+        # 'scan [v2]' had lost its '[v2]' to rich's markup (a '[/x]' ended in a MarkupError)
+        else f"{LP_NAME} lists the lights the images are labelled with, NOT verified: "
+        f"{escape(shown_path(marker))} says why (fit and export-lp refuse this session)."
     )
     out.print(
         f"{folder.images_kept} image(s) in the session; {labels}\n"

@@ -313,7 +313,9 @@ def test_an_order_shorter_than_the_firmware_says_it_is_not_verified(  # type: ig
     tmp_path: Path, rigs
 ) -> None:
     """With only the first 52 LEDs listed the dome has not run out after the last image: no
-    frame can prove the order held, so none is shot and the run says so."""
+    frame can prove the order held, so none is shot and the run says so. The session folder is
+    named 'scan [v2]': the marker's path is said whole (rich had taken '[v2]' for a style tag
+    and dropped it)."""
     cfg = tmp_path / "rig.toml"
     cfg.write_text(
         SHIPPED.read_text(encoding="utf-8").replace(
@@ -321,11 +323,12 @@ def test_an_order_shorter_than_the_firmware_says_it_is_not_verified(  # type: ig
         ),
         encoding="utf-8",
     )
-    out = tmp_path / "s"
+    out = tmp_path / "scan [v2]"
     result = runner.invoke(app, ["run", str(cfg), "--out", str(out)])
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())
     assert "end-of-run proof NOT done" in text and "not verified" in text
+    assert f"NOT verified: {out / 'LABELS_NOT_VERIFIED.txt'} says why" in text, text
     assert "lists the lights that fired" not in text  # the labels are not claimed
     assert "labelled with, NOT verified" in text and "LABELS_NOT_VERIFIED.txt" in text
     rig = rigs[-1]
