@@ -291,7 +291,11 @@ def test_until_error_stops_when_the_estimate_is_reached(
             "elevation",
         ),
         # capped without a word: 100 asked of a dome ran its every LED
-        (["--adaptive", "--lights", "100"], "--lights 100: this rig offers"),
+        # (with the range a session takes: 5, one more than its start, to the dome's 12 LEDs)
+        (
+            ["--adaptive", "--lights", "100"],
+            "--lights 100: an adaptive session on this dome takes 5 to 12",
+        ),
         # named by the options given: --adaptive had been named when only --until-error was
         (["--until-error", "2", "--lights", "4"], "--until-error 2 --lights 4: an adaptive"),
         (["--adaptive", "--lights", "4"], "--adaptive --lights 4: an adaptive"),

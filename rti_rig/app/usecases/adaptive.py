@@ -1600,8 +1600,8 @@ def _check_lights_range(
         )
     raise RtiRigError(
         f"{asked}: an adaptive session on this dome takes {START_LIGHTS + 1} to {top} lights "
-        f"(it starts from {START_LIGHTS} and chooses the next ones from the dome's {top} LEDs); "
-        f"give a count from {START_LIGHTS + 1} to {top}"
+        f"(it starts from {START_LIGHTS} and chooses the next ones from the dome's {top} LEDs): "
+        + (f"give at least {START_LIGHTS + 1}" if lights <= START_LIGHTS else f"give at most {top}")
     )
 
 
