@@ -71,10 +71,10 @@ def check_same_start(
     if _metered(manifest):
         from rti_rig.app.usecases.session import NewSessionRequest
 
-        began += " --auto-exposure"
         limit = _recorded_max_saturated(manifest)
-        if limit is not None and not _same_number(limit, NewSessionRequest.max_saturated):
-            began += f" --max-saturated {limit:g}"
+        if limit is not None and _same_number(limit, NewSessionRequest.max_saturated):
+            limit = None  # the default: said by no option
+        began = " ".join([began, *_exposure_words(True, limit)]).strip()
     folder = shell_word(str(root))
     give = "give those options or none"
     by_default = _default_count_said(began, manifest, loaded)
@@ -90,6 +90,14 @@ def check_same_start(
         f"{folder}); to shoot this request, start a new session: "
         f"{_new_session_command(asked, loaded, root)}"
     )
+
+
+def _exposure_words(auto_exposure: bool, max_saturated: float | None) -> list[str]:
+    """``--auto-exposure`` and ``--max-saturated L`` as a command gives them, for what a
+    session began with and for the new session asked: one spelling, so the two read alike
+    (each had built its own)."""
+    words = ["--auto-exposure"] if auto_exposure else []
+    return words + ([f"--max-saturated {max_saturated:g}"] if max_saturated is not None else [])
 
 
 def _new_session_command(asked: StartOptions, loaded: Any, root: Path) -> str:
@@ -112,10 +120,7 @@ def _new_session_command(asked: StartOptions, loaded: Any, root: Path) -> str:
         words += ["--lights", str(asked.lights)] if asked.lights is not None else []
         words += ["--min-lights", str(asked.min_lights)] if asked.min_lights is not None else []
         words += ["--objective", shlex.quote(asked.objective)] if asked.objective else []
-    if asked.auto_exposure:
-        words.append("--auto-exposure")
-    if asked.max_saturated is not None:
-        words += ["--max-saturated", f"{asked.max_saturated:g}"]
+    words += _exposure_words(asked.auto_exposure, asked.max_saturated)
     words.append(band_options((asked.min_elevation_deg, asked.max_elevation_deg)).strip())
     if asked.allow_no_normals:
         words.append("--allow-no-normals")
