@@ -1764,6 +1764,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     from rti_rig.app.flash_sync import flash_sync_of, refuse_options
 
     runner = manifest.get("runner") or {}
+    again = free_folder_beside(Path(req.session_dir), "again")  # the one a new run would take
     if flash_sync_of(loaded) is not None and runner.get("finish_reason") == "completed":
         # a finished session had been told only that a camera-triggered dome cannot resume
         # (so the user looked for what had interrupted it): it is complete, and says so
@@ -1778,10 +1779,9 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         raise RtiRigError(
             done + " (a camera-triggered dome cannot reshoot single images either: to shoot "
             "again, long-press the dome's start button, then rti-rig run "
-            f"{shell_word(str(config_path))} --out "
-            f"{shell_word(str(free_folder_beside(Path(req.session_dir), 'again')))})"
+            f"{shell_word(str(config_path))} --out {shell_word(str(again))})"
         )
-    refuse_options(loaded, free_folder_beside(Path(req.session_dir), "again"), **{"--resume": True})
+    refuse_options(loaded, again, **{"--resume": True})
     _refuse_image_sequence_resume(loaded, Path(req.session_dir))
     # the rig first: another rig given with the session's own options is refused as another
     # rig (its layout compared with the session's had been blamed on the options, with the
