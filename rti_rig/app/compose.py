@@ -6,7 +6,6 @@ This is the one place in the core that imports ``simulator`` (and, as backends a
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -442,7 +441,7 @@ def _session_hook(camera):  # type: ignore[no-untyped-def]
 def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
     """A recorded acquisition: a dome with exactly its lights, a camera that returns the image
     recorded for the LED fired (:mod:`rti_rig.simulator.replay`)."""
-    from rti_rig.core.lp_format import image_path
+    from rti_rig.core.lp_format import image_path, lp_name_from
     from rti_rig.simulator.replay import ReplayCamera
     from rti_rig.simulator.sim_lights import LightState, SimulatedDome
 
@@ -462,7 +461,7 @@ def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
         transfer_s=cfg.timing.transfer_s,
         # recorded as the path relative to the .lp: unambiguous where two subfolders hold a
         # file of one name (RTIBuilder's ../jpeg-exports/… climbs out of assembly-files/)
-        names=[Path(os.path.relpath(p, folder)).as_posix() for p in images],
+        names=[lp_name_from(folder, p) for p in images],
     )
     return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
 

@@ -150,8 +150,9 @@ def acquisition_lp_files(folder: Path) -> list[Path]:
 
 
 def lp_name_from(folder: Path, lp: Path) -> str:
-    """``lp`` (:func:`acquisition_lp_files`) as named from ``folder``: ``dirs.lp``,
-    ``assembly-files/proj.lp`` or ``../assembly-files/proj.lp``."""
+    """``lp`` (:func:`acquisition_lp_files`), or an image it lists, as named from ``folder``:
+    ``dirs.lp``, ``assembly-files/proj.lp`` or ``../assembly-files/proj.lp`` (``/`` on every
+    system, as a manifest records it)."""
     return Path(os.path.relpath(lp, folder)).as_posix()
 
 
