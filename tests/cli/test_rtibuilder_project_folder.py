@@ -99,6 +99,22 @@ def test_run_of_an_rtibuilder_project_folder_replays_its_one_lp_and_resumes(
     )
 
 
+def test_fit_json_records_the_lp_read_by_its_absolute_path(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """fit.json's "read" had kept the path as given ('8 images from ../assembly-files/icon.lp'),
+    which names nothing to a user reading it from elsewhere later: it is the absolute path, as
+    the manifest records its paths; "source" stays the argument as given."""
+    lp = _project(tmp_path)
+    monkeypatch.chdir(lp.parents[1] / "jpeg-exports")
+    given = "../assembly-files/icon.lp"
+    r = runner.invoke(app, ["fit", given, "--out", "fit", "--no-qa", "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    summary = json.loads((lp.parents[1] / "jpeg-exports" / "fit" / "fit.json").read_text())
+    assert summary["read"] == f"{LIGHTS} images from {lp}", summary["read"]
+    assert summary["source"] == given
+
+
 @GIVEN
 def test_check_and_plan_of_an_rtibuilder_project_folder_take_its_one_lp(
     tmp_path: Path, given: str

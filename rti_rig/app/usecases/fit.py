@@ -672,9 +672,11 @@ def load_acquisition(
     if notes is not None:
         # dropped by the reader: said once, by the files' names (``names`` are stems)
         notes.extend(png_alpha_note([p.name for p in paths], paths))
-    # the description is fit.json's "read", a record beside its raw "source" (compared as such
-    # by a batch's rerun), never printed: the path stays as it is, not a shell word
-    return frames, lights, names, f"{len(frames)} images from {lp}"
+    # the description is fit.json's "read", a record beside its raw "source" (the argument as
+    # given), never printed: not a shell word, but absolute, as the manifest records its paths
+    # (resolved, the name's bytes kept): 'fit ../s' had recorded "from ../s/lights.lp", which
+    # named nothing once read from anywhere but the folder the fit was run in
+    return frames, lights, names, f"{len(frames)} images from {Path(lp).resolve()}"
 
 
 def _mixed_depth_note(lp: Path, frames: list[Any], paths: list[Path]) -> list[str]:
