@@ -208,23 +208,6 @@ def test_lights_no_adaptive_session_takes_are_refused_first_with_the_range(
     assert not out.exists()
 
 
-def test_a_count_in_range_is_kept_in_the_band_advised_and_it_runs(tmp_path: Path) -> None:
-    """A --lights N the session can take, in a band too narrow for it: the band advised holds
-    N, the command keeps it as given, and pasted it runs (not refused for its count)."""
-    out = tmp_path / "s"
-    r = runner.invoke(
-        app, ["run", str(NAB), "--out", str(out), "--adaptive", "--lights", "5",
-              "--max-elevation-deg", "20"]
-    )  # fmt: skip
-    text = said(r)
-    assert r.exit_code == 2, text
-    argv = _advised(text, "Widen the band to hold 5: ", tmp_path, "wide")
-    assert argv[argv.index("--lights") + 1] == "5", argv
-    r = runner.invoke(app, [*argv, "--no-verdict"])
-    assert r.exit_code == 0, said(r)
-    assert len(_elevations(tmp_path / "wide")) == 5
-
-
 @pytest.mark.parametrize(
     ("asked", "refused"),
     [
