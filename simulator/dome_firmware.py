@@ -1,7 +1,9 @@
-"""An LED dome firmware emulator that speaks the drivers' bytes, with deterministic faults.
+"""An LED dome firmware emulator of rti-rig's own protocols, with deterministic faults.
 
-The emulator decodes commands and encodes replies with the very codec of the configured profile
-(``rti_rig.drivers.led_dome``), so the real driver runs unchanged against it: in-process through
+The emulator reads commands and writes replies with its own reading of
+docs/protocols/led-dome.md (:mod:`rti_rig.simulator.own_protocols`), never with the driver's
+codecs: a codec bug shared by both sides would pass every test. The real driver runs against
+it unchanged: in-process through
 :class:`InProcessDomeTransport` on a virtual clock, or over a pseudo-terminal through real
 pyserial (``rti_rig.simulator.pty_link.emulated_dome_on_pty``).
 
@@ -24,26 +26,21 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 
 from rti_rig.core.clock import Clock, SystemClock
-from rti_rig.drivers.led_dome.codec_base import DomeCodec
-from rti_rig.drivers.led_dome.messages import (
-    ERR_BAD_ARGUMENT,
-    ERR_LED_FAULT,
-    ERR_LED_OUT_OF_RANGE,
-    Ack,
-    AllOff,
-    BadRequest,
-    Command,
-    DomeIdentity,
-    Hello,
-    Light,
-    LitState,
-    Nak,
-    Query,
-    Shutter,
-)
-from rti_rig.drivers.led_dome.profiles import make_codec
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.drivers.led_dome.transport import TransportError
+from rti_rig.simulator.own_protocols import (
+    BAD_ARGUMENT,
+    LED_FAULT,
+    LED_OUT_OF_RANGE,
+    BinaryProfile,
+    BoardFacts,
+    DefaultProfile,
+    FramedProfile,
+    OwnCodec,
+    Refused,
+    Request,
+    Verb,
+)
 from rti_rig.simulator.pty_link import PtyLink, serve_on_pty, sigterm_as_ctrl_c
 
 
@@ -121,7 +118,7 @@ class DomeFirmware:
     otherwise it acknowledges and the LED stays dark (only the image can tell).
     """
 
-    codec: DomeCodec
+    codec: OwnCodec
     led_count: int = 48
     firmware_id: str = "RTIDOME-EMU"
     version: str = "1.0.0"
@@ -149,8 +146,8 @@ class DomeFirmware:
         self._booting_until = 0.0
 
     @property
-    def identity(self) -> DomeIdentity:
-        return DomeIdentity(self.firmware_id, self.version, self.led_count)
+    def identity(self) -> BoardFacts:
+        return BoardFacts(self.firmware_id, self.version, self.led_count)
 
     def wire_s(self, n_bytes: int) -> float:
         """Seconds ``n_bytes`` take on the serial line (8N1: 10 bits a byte)."""
@@ -186,7 +183,7 @@ class DomeFirmware:
             self.history.append(FirmwareEvent(now, "boot"))
             if not self.banner_on_boot:
                 return []
-            banner = self.codec.encode_banner(self.identity)
+            banner = self.codec.banner(self.identity)
             return [Output(now + self.boot_delay_s + self.wire_s(len(banner)), banner)]
 
     def on_port_opened(self) -> list[Output]:
@@ -215,7 +212,7 @@ class DomeFirmware:
                 return out
             self._rx.extend(data)
             while self._rx and self.powered:
-                parsed, consumed = self.codec.decode_command(bytes(self._rx))
+                parsed, consumed = self.codec.decode(bytes(self._rx))
                 if parsed is None:
                     if consumed:
                         del self._rx[:consumed]
@@ -227,11 +224,11 @@ class DomeFirmware:
                 faults = self.faults.at(self.commands_received)
                 kinds = {f.kind for f in faults}
                 if FaultKind.GARBLE_COMMAND in kinds:
-                    reparsed, _ = self.codec.decode_command(garble(raw))
+                    reparsed, _ = self.codec.decode(garble(raw))
                     parsed = (
                         reparsed
                         if reparsed is not None
-                        else BadRequest(raw, None, ERR_BAD_ARGUMENT, "garbled beyond framing")
+                        else Refused(raw, None, BAD_ARGUMENT, "garbled beyond framing")
                     )
                 out += self._handle(parsed, faults, len(raw))
             return out
@@ -240,7 +237,7 @@ class DomeFirmware:
 
     def _handle(
         self,
-        parsed: tuple[int | None, Command] | BadRequest,
+        parsed: Request | Refused,
         faults: Iterable[Fault],
         command_len: int,
     ) -> list[Output]:
@@ -257,13 +254,10 @@ class DomeFirmware:
         if FaultKind.RESET in by_kind:
             self.history.append(FirmwareEvent(now, "reset"))
             return self.boot()
-        if isinstance(parsed, BadRequest):
-            reply_msg: Ack | Nak = Nak(parsed.seq, parsed.code, parsed.reason)
-            cmd: Command | None = None
+        if isinstance(parsed, Refused):
+            data = self.codec.err(parsed.seq, parsed.code, parsed.text)
         else:
-            seq, cmd = parsed
-            reply_msg = self._execute(seq, cmd, now)
-        data = self.codec.encode_reply(reply_msg, cmd)
+            data = self._execute(parsed, now)
         sent = now + self.wire_s(command_len + len(data))
         if FaultKind.DROP_REPLY in by_kind:
             out: list[Output] = []
@@ -279,34 +273,30 @@ class DomeFirmware:
             out += [Output(max(o.due_s, sent + 1e-6), o.data) for o in self.boot()]
         return out
 
-    def _execute(self, seq: int | None, cmd: Command, now: float) -> Ack | Nak:
-        if isinstance(cmd, Hello):
-            return Ack(seq, self.identity)
-        if isinstance(cmd, Light):
-            if not 0 <= cmd.index < self.led_count:
-                return Nak(seq, ERR_LED_OUT_OF_RANGE, f"LED {cmd.index} of {self.led_count}")
-            if not 0 <= cmd.level <= self.max_level:
-                return Nak(seq, ERR_BAD_ARGUMENT, f"level {cmd.level}")
+    def _execute(self, req: Request, now: float) -> bytes:
+        """Run ``req`` and return the board's answer (acknowledgement or error) in bytes."""
+        if req.verb is Verb.LIGHT:
+            if not 0 <= req.index < self.led_count:
+                text = f"LED {req.index} of {self.led_count}"
+                return self.codec.err(req.seq, LED_OUT_OF_RANGE, text)
+            if not 0 <= req.level <= self.max_level:
+                return self.codec.err(req.seq, BAD_ARGUMENT, f"level {req.level}")
             self._switch_off(now, "off")
-            if cmd.index in self.dead_leds:
-                self.history.append(FirmwareEvent(now, "dead", cmd.index, cmd.level))
+            if req.index in self.dead_leds:
+                self.history.append(FirmwareEvent(now, "dead", req.index, req.level))
                 if self.reports_dead_leds:
-                    return Nak(seq, ERR_LED_FAULT, f"LED {cmd.index} open circuit")
-            until = None if not cmd.max_on_ms else now + cmd.max_on_ms / 1000.0
-            self._lit = _LitLed(cmd.index, cmd.level, now, until)
-            self.history.append(FirmwareEvent(now, "lit", cmd.index, cmd.level))
-            return Ack(seq, cmd)
-        if isinstance(cmd, AllOff):
+                    return self.codec.err(req.seq, LED_FAULT, f"LED {req.index} open circuit")
+            until = None if not req.max_on_ms else now + req.max_on_ms / 1000.0
+            self._lit = _LitLed(req.index, req.level, now, until)
+            self.history.append(FirmwareEvent(now, "lit", req.index, req.level))
+        elif req.verb is Verb.ALL_OFF:
             self._switch_off(now, "off")
-            return Ack(seq, cmd)
-        if isinstance(cmd, Shutter):
-            self.history.append(FirmwareEvent(now, "shutter", level=cmd.pulse_ms))
-            return Ack(seq, cmd)
-        if isinstance(cmd, Query):
+        elif req.verb is Verb.SHUTTER:
+            self.history.append(FirmwareEvent(now, "shutter", level=req.pulse_ms))
+        elif req.verb is Verb.QUERY:
             self._expire_watchdog()
-            lit = self._lit
-            return Ack(seq, LitState(None, 0) if lit is None else LitState(lit.index, lit.level))
-        raise TypeError(f"unhandled command {cmd!r}")
+        lit = None if self._lit is None else (self._lit.index, self._lit.level)
+        return self.codec.ok(req, self.identity, lit)
 
     def _expire_watchdog(self) -> None:
         lit = self._lit
@@ -383,10 +373,40 @@ class InProcessDomeTransport:
             raise TransportError(f"{self.name}: device disconnected")
 
 
+def own_codec_for(settings: DomeSerialSettings) -> OwnCodec:
+    """The emulator's own reading of the profile of ``settings``, with its options."""
+    if settings.profile == "default":
+        checksum = True if settings.default is None else settings.default.checksum
+        return DefaultProfile(checksum=checksum)
+    if settings.profile == "framed":
+        f = settings.framed
+        if f is None:
+            return FramedProfile(full_level=settings.max_level)
+        return FramedProfile(
+            start=f.start,
+            end=f.end,
+            separator=f.separator,
+            codes=f.codes.model_dump(),
+            index_base=f.index_base,
+            send_level=f.send_level,
+            sequence=f.sequence,
+            ok_word=f.ok_word,
+            err_word=f.err_word,
+            ready_word=f.ready_word,
+            full_level=settings.max_level,
+        )
+    if settings.profile == "binary":
+        b = settings.binary
+        return BinaryProfile() if b is None else BinaryProfile(b.start_byte, b.index_base)
+    raise ValueError(
+        f"profile '{settings.profile}' is a firmware's: its emulator is in rti_rig.simulator.domes"
+    )
+
+
 def firmware_for(settings: DomeSerialSettings, **kwargs: object) -> DomeFirmware:
-    """A firmware emulator speaking the profile of ``settings`` (same codec as the driver)."""
+    """A firmware emulator speaking the profile of ``settings`` (its own reading of the spec)."""
     kwargs.setdefault("baudrate", settings.baudrate)
-    return DomeFirmware(make_codec(settings), max_level=settings.max_level, **kwargs)  # type: ignore[arg-type]
+    return DomeFirmware(own_codec_for(settings), max_level=settings.max_level, **kwargs)  # type: ignore[arg-type]
 
 
 @contextlib.contextmanager

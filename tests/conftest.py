@@ -41,7 +41,7 @@ def shipped_dome_on_pty(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterat
     ``framed``, ``binary``) get :class:`DomeFirmware` with 48 LEDs; another project's firmware
     (``rtipy``, ``nab-rti-v1`` …) gets its own board from ``rti_rig.simulator.domes``, as the
     shipped ``emulated_*.toml`` dry runs do (``Board``: its own LEDs, baud rate, ``events``).
-    Why: the fixture had served every profile the codec-driven ``DomeFirmware``, which speaks
+    Why: the fixture had served every profile the codec-driven ``DomeFirmware``, which spoke
     the binary protocol for a scripted profile: a test "on RTIPy" met a binary board (probe:
     "Found: binary"). A profile with no serial emulator (a dome stepped by the camera's flash,
     no ``[dome.serial]``) is refused, never served something else."""
@@ -84,7 +84,8 @@ def shipped_dome_on_pty(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterat
 
 
 #: The dome protocols of rti-rig's own (docs/protocols/led-dome.md), which ``DomeFirmware``
-#: emulates with the driver's codec; every other profile is a real firmware's.
+#: emulates from that page (``rti_rig.simulator.own_protocols``); every other profile is a real
+#: firmware's.
 OWN_DOME_PROTOCOLS = ("default", "framed", "binary")
 
 

@@ -18,6 +18,7 @@ from typer.testing import CliRunner
 import rti_rig.simulator.sim_camera as sim_camera
 from rti_rig.cli import app
 from rti_rig.simulator.dome_firmware import DomeFirmware
+from rti_rig.simulator.own_protocols import Verb
 
 
 def test_an_unnamed_fault_while_metering_says_the_all_off_the_dome_acknowledged(
@@ -26,9 +27,9 @@ def test_an_unnamed_fault_while_metering_says_the_all_off_the_dome_acknowledged(
     received: list[str] = []
     real_execute = DomeFirmware._execute
 
-    def execute(self, seq, cmd, now):  # type: ignore[no-untyped-def]
-        received.append(type(cmd).__name__)
-        return real_execute(self, seq, cmd, now)
+    def execute(self, req, now):  # type: ignore[no-untyped-def]
+        received.append(req.verb)
+        return real_execute(self, req, now)
 
     def capture(self: object, exposure_s: float) -> object:
         raise TypeError("a driver's own bug")
@@ -39,8 +40,8 @@ def test_an_unnamed_fault_while_metering_says_the_all_off_the_dome_acknowledged(
     argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
     r = CliRunner().invoke(app, [*argv, "--auto-exposure"], terminal_width=400)
     text = said(r)
-    assert "Light" in received, (received, text)  # metering lit the dome
-    assert received[-1] == "AllOff", (received, text)  # and its teardown switched it off
+    assert Verb.LIGHT in received, (received, text)  # metering lit the dome
+    assert received[-1] == Verb.ALL_OFF, (received, text)  # and its teardown switched it off
     assert (
         "metering failed, and then: all-off sent and acknowledged by the dome: lights are off"
         in text.lower()

@@ -16,7 +16,7 @@ from conftest import CONFIGS, emulated_dome_as_hardware, said, shipped_dome_on_p
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.drivers.led_dome.codec_default import DefaultCodec
+from rti_rig.simulator.own_protocols import DefaultProfile
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -59,26 +59,19 @@ def test_probe_names_the_framed_protocol_of_the_shipped_hardware_dome(
         assert "set [dome.serial.framed]" in words and "index_base" in words
 
 
-class _PrintlnCodec(DefaultCodec):
-    """The default profile as a sketch sends it with ``Serial.println``: every line ends in
-    CR LF, as docs/protocols/led-dome.md allows ("replies may end in CR LF")."""
-
-    def _line(self, body: str) -> bytes:
-        return super()._line(body)[:-1] + b"\r\n"
-
-
 @pytest.mark.parametrize("checksum", [True, False], ids=["checksum", "no-checksum"])
 def test_probe_names_a_default_board_whose_lines_end_in_cr_lf(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, checksum: bool
 ) -> None:
-    """An Arduino sketch's ``Serial.println`` ends its banner in CR LF, which the driver
+    """An Arduino sketch's ``Serial.println`` ends its banner in CR LF (the emulator's
+    ``line_end``; docs/protocols/led-dome.md allows it), which the driver
     reads: the probe's banner pattern wanted a bare LF, and such a board was "No known dome
     firmware answered", its READY line among the lines heard."""
     port = "/dev/ttyACM7"
     (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
     config = emulated_dome_as_hardware(tmp_path, "emulated_dome.toml", port)
     with shipped_dome_on_pty(monkeypatch, config) as firmware:
-        firmware.codec = _PrintlnCodec(checksum=checksum)
+        firmware.codec = DefaultProfile(checksum=checksum, line_end=b"\r\n")
         r = runner.invoke(app, ["probe", port], terminal_width=400)
         words = said(r)
         assert r.exit_code == 0, words

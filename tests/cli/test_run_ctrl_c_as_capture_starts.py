@@ -25,6 +25,7 @@ import rti_rig.app.usecases.session as session_usecase
 import rti_rig.runtime.controller as controller
 from rti_rig.cli import app
 from rti_rig.simulator.dome_firmware import DomeFirmware
+from rti_rig.simulator.own_protocols import Verb
 
 
 def _dome_commands(monkeypatch: pytest.MonkeyPatch) -> list[str]:
@@ -33,9 +34,9 @@ def _dome_commands(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     received: list[str] = []
     real_execute = DomeFirmware._execute
 
-    def execute(self, seq, cmd, now):  # type: ignore[no-untyped-def]
-        received.append(type(cmd).__name__)
-        return real_execute(self, seq, cmd, now)
+    def execute(self, req, now):  # type: ignore[no-untyped-def]
+        received.append(req.verb)
+        return real_execute(self, req, now)
 
     monkeypatch.setattr(DomeFirmware, "_execute", execute)
     return received
@@ -65,7 +66,7 @@ def test_a_ctrl_c_as_the_capture_starts_switches_the_emulated_dome_off_and_close
     r, said = _run_six(out, "--auto-exposure")
     assert "opened" in seen, said
     assert seen["before"] > 0, said  # metering spoke to the dome (lit it, switched it off)
-    assert "AllOff" in received[seen["before"] :], (received, said)
+    assert Verb.ALL_OFF in received[seen["before"] :], (received, said)
     assert not seen["opened"].rig.lighting.source.link.port_open, said  # the rig was closed
     assert "Stopped (Ctrl-C) before the first image: nothing was captured" in said, said
     # what the close established of the lights, as other stops say (it had been unsaid)
@@ -101,7 +102,7 @@ def test_a_sigterm_as_the_controller_checks_the_disk_switches_the_held_dome_off_
     r, said = _run_six(out, "--auto-exposure")
     assert "opened" in seen, said
     assert seen["before"] > 0, said  # metering spoke to the dome
-    assert "AllOff" in received[seen["before"] :], (received, said)
+    assert Verb.ALL_OFF in received[seen["before"] :], (received, said)
     assert not seen["opened"].rig.lighting.source.link.port_open, said
     assert (
         "Stopped (SIGTERM) before the first image: nothing was captured or written to "
@@ -138,6 +139,6 @@ def test_a_sigterm_as_the_teardown_begins_is_not_said_as_before_the_first_image(
     assert "Emergency stop (SIGTERM)" in said and "6 image(s) kept" in said, said
     assert f"rti-rig run --resume {out}" in said, said
     # the all-off the lights' line rests on came after the teardown was cut
-    assert "AllOff" in received[received.index("capture over") :], (received, said)
+    assert Verb.ALL_OFF in received[received.index("capture over") :], (received, said)
     assert "Traceback" not in said, said
     assert r.exit_code == 143, said
