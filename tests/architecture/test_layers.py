@@ -81,3 +81,24 @@ def test_the_contract_fails_when_a_core_module_imports_a_driver(tmp_path):
     result = lint_imports(tree, PYPROJECT)
     assert result.returncode != 0
     assert "rti_rig.core.geometry -> rti_rig.drivers.led_dome.driver" in result.stdout
+
+
+@pytest.mark.slow
+def test_the_contract_fails_when_the_own_protocols_emulator_imports_a_driver_codec(tmp_path):
+    """The emulator of rti-rig's own dome protocols reads the spec, not the driver's codecs:
+    built on them, a codec bug would be on both sides of the wire and pass every test."""
+    tree = installed_layout(tmp_path / "site")
+    own = tree / "rti_rig" / "simulator" / "own_protocols.py"
+    own.write_text(
+        own.read_text(encoding="utf-8") + "\nimport rti_rig.drivers.led_dome.codec_default\n",
+        encoding="utf-8",
+    )
+    result = lint_imports(tree, PYPROJECT)
+    assert result.returncode != 0
+    assert "dome emulator reads docs/protocols/led-dome.md, not the driver's codecs" in (
+        result.stdout
+    )
+    assert "BROKEN" in result.stdout
+    assert "rti_rig.simulator.own_protocols -> rti_rig.drivers.led_dome.codec_default" in (
+        result.stdout
+    )
