@@ -123,3 +123,16 @@ def test_binary_packets_of_the_page() -> None:
     assert isinstance(refused, Refused) and refused.code == 6 and used == 7
     assert codec.decode(b"\x00\xa5\x02") == (None, 1)  # noise before a packet is skipped
     assert codec.banner(facts) == b"\xffRDY"
+
+
+def test_a_sequence_number_outside_the_profiles_range_is_refused_with_error_2() -> None:
+    """The page: ``default`` numbers 1..9999, ``binary`` 1..127 (an ack byte 0x00 or 0x80..
+    would not be an ack); a board that acknowledged them would answer what no host can match."""
+    for line in (b"0 X\n", b"10000 X\n"):
+        refused, _ = DefaultProfile(checksum=False).decode(line)
+        assert isinstance(refused, Refused) and (refused.seq, refused.code) == (None, 2), line
+    for seq in (0x00, 0x80):
+        packet = bytes([0xA5, 0x03, seq, 0, 0, 0])
+        refused, _ = BinaryProfile().decode(packet + bytes([0xA5 ^ 0x03 ^ seq]))
+        assert isinstance(refused, Refused) and refused.code == 2, seq
+        assert BinaryProfile().err(refused.seq, refused.code, refused.text) == b"\x82"
