@@ -39,7 +39,12 @@ from rti_rig.drivers.dynamixel.faults import (
     ServoStatusError,
 )
 from rti_rig.drivers.ports_present import ports_present_note
-from rti_rig.drivers.serial_ports import finish_close, identity, permission_denied_why
+from rti_rig.drivers.serial_ports import (
+    PORT_ERRORS,
+    finish_close,
+    identity,
+    permission_denied_why,
+)
 
 log = logging.getLogger("rti_rig.dynamixel.traffic")
 
@@ -73,9 +78,12 @@ class _ReleasingHandler:
     interrupted one may still provoke (it would be read as the next command's answer).
 
     A port that fails under an exchange (the USB adapter unplugged mid-session: pyserial raises
-    ``SerialException``, an ``OSError``) is a :class:`CommunicationError` naming the port, as
-    a port that cannot be opened is: it had reached the user as a Python traceback, and the
-    arm's stop could not tell a lost port from any other bug."""
+    ``SerialException``, an ``OSError``; or, from the SDK's ``clearPort`` before each packet,
+    pyserial's ``tcflush`` lets ``termios.error`` (EIO), no ``OSError``, escape) is a
+    :class:`CommunicationError` naming the port, as a port that cannot be opened is: it had
+    reached the user as a Python traceback, and the arm's stop could not tell a lost port from
+    any other bug; the ``termios.error`` one as "unexpected error: (5, 'Input/output error')"
+    (until 2026-12-02: the emulator's pty closed mid-session, as an unplugged adapter's tty)."""
 
     def __init__(self, handler: Any, port: Any, device: str = "arm") -> None:
         self._handler = handler
@@ -93,12 +101,13 @@ class _ReleasingHandler:
                 if self._interrupted:
                     self._recover()
                 return attr(*args, **kwargs)
-            except OSError as exc:  # pyserial's SerialException is one
+            except PORT_ERRORS as exc:  # SerialException is an OSError; termios.error not
                 self._port.is_using = False
                 self._interrupted = True
                 raise CommunicationError(
                     self._device,
-                    f"the port {self._port.getPortName()!r} failed ({exc}): check that the "
+                    f"the port {self._port.getPortName()!r} failed ({_port_error_text(exc)}): "
+                    "check that the "
                     "arm's USB adapter (e.g. a U2D2) is still plugged in and the servos "
                     "powered",
                 ) from exc
@@ -650,6 +659,14 @@ class DxlBus:
         result, error = self.ph.reboot(self.port, dxl_id)
         log.debug("%s: reboot %d (%d, %d)", self.device, dxl_id, result, error)
         self._check(result, error, dxl_id, "reboot", alert=False)
+
+
+def _port_error_text(exc: BaseException) -> str:
+    """A failed port's reason in the system's words: a ``termios.error`` is a bare
+    ``(errno, text)`` tuple, said as an ``OSError`` is (``[Errno 5] Input/output error``)."""
+    if isinstance(exc, OSError) or len(exc.args) != 2 or not isinstance(exc.args[0], int):
+        return str(exc)
+    return f"[Errno {exc.args[0]}] {exc.args[1]}"
 
 
 def _missing(exc: BaseException) -> bool:

@@ -88,3 +88,39 @@ def test_an_arm_adapter_unplugged_mid_session_stops_keeps_and_resumes(
     said = " ".join(r.output.split())
     assert r.exit_code == 0, said
     assert (out / "lights.lp").read_text().split()[0] == "6", said
+
+
+def test_an_adapter_gone_at_the_flush_before_a_packet_is_said_as_its_port(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The SDK flushes the port's input (``clearPort``: pyserial's ``tcflush``) before each
+    packet, and on a tty whose device is gone that raises ``termios.error`` (EIO), which is no
+    ``OSError``: it had ended the run as "unexpected error: (5, 'Input/output error')", exit 1
+    (found by closing the emulator's pty under a running session). Said now as the port lost,
+    exit 2, the images kept and the resume offered, as for a failed write."""
+    termios = pytest.importorskip("termios")
+    gone = {"after": 250}
+    handler = dynamixel_pty.EmulatedLinkPortHandler
+    real_clear = handler.clearPort
+
+    def clear(self):  # type: ignore[no-untyped-def]
+        if self._server.emulator.instructions_received >= gone["after"]:
+            raise termios.error(errno.EIO, "Input/output error")
+        return real_clear(self)
+
+    monkeypatch.setattr(handler, "clearPort", clear)
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text((CONFIGS / "simulated_arm.toml").read_text())
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app,
+        ["run", str(cfg), "--out", str(out), "--lights", "6", "--no-verdict"],
+        terminal_width=400,
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "unexpected" not in said, said
+    assert "failed ([Errno 5] Input/output error): check that the arm's USB adapter" in said, said
+    assert "the arm's park is NOT confirmed" in said and "stop were requested" not in said, said
+    assert (out / "lights.lp").read_text().split()[0] == "2", said
+    assert f"Continue with: rti-rig run --resume {out}" in said, said
