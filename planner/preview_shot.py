@@ -52,7 +52,8 @@ def preview_schedule(
     A dome uses its LED nearest the wanted direction (noted when it is farther than an `.lp`'s
     rounding); by default (``None``: :data:`PREVIEW_AZ_EL_DEG`) the nearest among its LEDs in
     the paper's band, if it has any there. An arm goes there, or the limit it would break is
-    the error.
+    the error; by default, the nearest pose it reaches within the band (noted), since the
+    default is the rig's to choose.
 
     ``band`` (``--min/--max-elevation-deg``, as ``plan`` and ``run`` take them): the preview
     keeps to it, so that a user who plans a gilded object under a 45° ceiling is not handed a
@@ -125,6 +126,20 @@ def preview_schedule(
         )
     else:
         reason = geometry.unreachable_reason(wanted)
+        nearest = _arm_default_nearest(geometry, az, el, band) if az_el_deg is None else None
+        if reason and nearest is not None:
+            # the default is the rig's to choose, as a dome's nearest LED is: it had been
+            # refused on every arm whose azimuth stops short of 135° ("give --light AZ,EL the
+            # arm can reach"), a bare `rti-rig preview RIG.toml` failing on a shipped-style arm
+            near_az, near_el = nearest
+            shot = f"; the preview's {shot_as} is shot under it" if shot_as else ""
+            notes.append(
+                f"the default preview light (az {az:g}°, el {el:g}°) is beyond the arm's reach "
+                f"({reason}): the nearest it reaches, az {near_az:g}°, el {near_el:g}°, is used"
+                f"{shot} (--light AZ,EL chooses another)"
+            )
+            az, el, reason = near_az, near_el, None
+            wanted = direction_from_az_el(az, el)
         if reason:
             # named as the user gave it, with what to do: the bare limit had left them to
             # guess that --light was the thing to change
@@ -148,3 +163,22 @@ def preview_schedule(
             "its shading says little about the relief (the paper shoots at 45–60°)"
         )
     return schedule, notes
+
+
+def _arm_default_nearest(
+    geometry: ArmGeometry, az: float, el: float, band: tuple[float, float]
+) -> tuple[float, float] | None:
+    """The pose nearest the default preview light (``az``, ``el``) that ``geometry`` reaches
+    within ``band``: the azimuth moved onto its nearer joint limit (measured round the circle),
+    the elevation into the reachable part of the band; None when no elevation of the band is
+    reachable (then the default's refusal names the band, as before)."""
+    lo = max(band[0], geometry.min_elevation_deg)
+    hi = min(band[1], geometry.max_elevation_deg, 90.0 - geometry.keep_out_half_angle_deg)
+    if lo > hi:
+        return None
+    a = (az + 180.0) % 360.0 - 180.0
+    lo_az, hi_az = geometry.min_azimuth_deg, geometry.max_azimuth_deg
+    if not lo_az <= a <= hi_az:
+        a = min((lo_az, hi_az), key=lambda limit: abs((a - limit + 180.0) % 360.0 - 180.0))
+    near = (a, min(max(el, lo), hi))
+    return None if geometry.unreachable_reason(direction_from_az_el(*near)) else near

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from conftest import CONFIGS
 from typer.testing import CliRunner
 
@@ -51,3 +52,32 @@ def test_a_ceiling_below_the_arm_is_refused_naming_the_option(tmp_path: Path) ->
         text = _refusal(tmp_path, "--max-elevation-deg", "3", *light)
         assert run_said in text, text
         assert "the arm cannot go there" not in text, text
+
+
+def test_a_default_light_beyond_the_azimuth_stops_takes_the_nearest_reachable(
+    tmp_path: Path,
+) -> None:
+    """A bare ``rti-rig preview`` on an arm whose azimuth joint turns -90°..60° (a cable, a
+    stand) had been refused: the default light, az 135°, is past its stop, and the user was
+    told to "give --light AZ,EL the arm can reach" of a light they never gave. The default is
+    the rig's to choose, as a dome's nearest LED is: the nearest pose it reaches is shot, and
+    said."""
+    text = (CONFIGS / "simulated_arm.toml").read_text()
+    text = text.replace("min_deg = -170.0", "min_deg = -90.0").replace(
+        "max_deg = 170.0", "max_deg = 60.0"
+    )
+    text = text.replace('transport = "pty"', 'transport = "inprocess"')
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text)
+    out = tmp_path / "preview"
+    r = runner.invoke(app, ["preview", str(cfg), "--out", str(out)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert (
+        "the default preview light (az 135°, el 50°) is beyond the arm's reach (azimuth "
+        "135.00° is outside the arm's range [-90°, 60°]): the nearest it reaches, az 60°, "
+        "el 50°, is used" in said
+    ), said
+    lines = (out / "lights.lp").read_text().split("\n")
+    x, y, z = (float(v) for v in lines[1].split()[1:])
+    assert (x, y, z) == pytest.approx((0.5 * 0.642788, 0.866025 * 0.642788, 0.766044), abs=2e-3)
