@@ -26,8 +26,14 @@ def schedule_from_lp(
     geometry: DomeGeometry | ArmGeometry,
     source: str,
     tolerance_deg: float = SNAP_TOLERANCE_DEG,
+    replan: str = "",
 ) -> LightSchedule:
-    """The schedule an `.lp` plan describes on this rig, in the plan's order."""
+    """The schedule an `.lp` plan describes on this rig, in the plan's order.
+
+    ``replan``: the command that plans for this rig, named where a light is not its own (the
+    CLI's, with the rig config's path; "replan with --rig" alone had left the user to spell
+    it out)."""
+    how = f": {replan}" if replan else " with --rig"
     dirs = np.array([e.direction for e in entries], dtype=np.float64)
     prov = {"plan_file": source}  # as on disk, for the manifest
     # as the user pastes it: a name that is not UTF-8 (or unprintable here) as its bytes
@@ -38,7 +44,7 @@ def schedule_from_lp(
             if reason:  # what to do, as a dome's refusal says it (it had said only why)
                 raise ScheduleError(
                     f"{named}, light {i + 1} ({e.name}): {reason}; the plan was made for "
-                    "another rig — replan with --rig for this arm"
+                    f"another rig — replan for this arm{how}"
                 )
         return LightSchedule.from_directions(
             dirs, labels=[e.name for e in entries], method="plan", provenance=prov
@@ -51,7 +57,7 @@ def schedule_from_lp(
             raise ScheduleError(
                 f"{named}, light {i + 1} ({e.name}): no LED of this dome within "
                 f"{tolerance_deg:g}° (nearest is {geometry.led_said(led)}, {off:.2f}° away); "
-                "the plan was made for another dome — replan with --rig for this one"
+                f"the plan was made for another dome — replan for this one{how}"
             )
         if led in used:
             raise ScheduleError(

@@ -1013,6 +1013,25 @@ def _refuse_rig_config_as_plan(
     )
 
 
+def _replan_command(req: NewSessionRequest, geometry: object, lights: int) -> str:
+    """The commands that plan ``lights`` lights for ``req``'s rig and run them (a free .lp
+    beside, shell words), for a plan whose lights are not this rig's; no fewer than ``plan``
+    plans, and of a dome no more than it has LEDs. Said with the preview left out: the plan's
+    own may have had one, which the user adds."""
+    from rti_rig.core.fit_minimums import NORMAL_MIN_LIGHTS
+    from rti_rig.core.rig_geometry import DomeGeometry
+
+    lights = max(lights, NORMAL_MIN_LIGHTS)  # the fewest plan plans
+    if isinstance(geometry, DomeGeometry):
+        lights = min(lights, len(geometry.directions))
+    rig, out = shell_word(str(req.rig_config)), shell_word(str(req.out_dir))
+    plan_lp = shell_word(str(free_name(Path("plan.lp"))))
+    return (
+        f"rti-rig plan --rig {rig} --lights {lights} --out {plan_lp} (add its preview, if the "
+        f"plan had one), then rti-rig run {rig} --plan {plan_lp} --out {out}"
+    )
+
+
 def new_session_schedule(  # type: ignore[no-untyped-def]
     req: NewSessionRequest, loaded, on_note: NoteSink = _ignore
 ) -> LightSchedule:
@@ -1043,7 +1062,9 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
             f"--plan {req.plan} lists {len(entries)} lights",
             f"split it into plans of at most {MAX_LIGHTS} lights, each run into its own --out",
         )
-        schedule = schedule_from_lp(entries, geometry, str(req.plan))
+        schedule = schedule_from_lp(
+            entries, geometry, str(req.plan), replan=_replan_command(req, geometry, len(entries))
+        )
         _check_determined(
             req,
             schedule,
