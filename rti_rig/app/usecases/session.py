@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.app.usecases.replay_advice import new_session_command
-from rti_rig.core.errors import ConfigError, RtiRigError
+from rti_rig.core.errors import ConfigError, RtiRigError, ScheduleError
 from rti_rig.core.out_folders import free_folder_beside, free_name
 from rti_rig.core.rig_geometry import led_fields
 from rti_rig.core.schedule import LightSchedule
@@ -1902,7 +1902,23 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     # the steps still to shoot, at their own exposures, before the port opens
     _check_steps_fit_lit(loaded, schedule, frozenset(folder.done))
     _check_disk_holds_rest(loaded, folder, Path(req.session_dir))
-    rig = checked_rig(loaded, schedule)
+    try:
+        rig = checked_rig(loaded, schedule)
+    except ScheduleError as exc:
+        if not diffs:
+            raise
+        # an accepted change (an arm's reach narrowed) that leaves the session's own lights
+        # out of reach: the list alone had said what, not what to do
+        session = Path(req.session_dir)
+        again = shell_word(str(free_folder_beside(session, "again")))
+        raise ScheduleError(
+            f"{exc}\nThe rig change accepted ({'; '.join(diffs)}) leaves these lights of "
+            f"{shown_path(session)} out of its reach: to finish the session, set "
+            f"{shown_path(loaded.path)} back as it began (its copy is in "
+            f"{shown_path(session / 'manifest.json')}, under rig.config) and resume; or shoot "
+            f"a new session on the rig as it is: rti-rig run {shell_word(str(loaded.path))} "
+            f"--out {again}"
+        ) from None
     source = None
     if "adaptive" in folder.manifest:
         from rti_rig.app.usecases.adaptive import resume_adaptive_source

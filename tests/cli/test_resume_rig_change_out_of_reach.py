@@ -1,0 +1,51 @@
+"""``run --resume --accept-rig-change`` on an arm whose reach the change narrowed, leaving the
+session's own remaining lights out of it.
+
+Found by a front-door audit: the resume listed the steps it could not run ("step 4: elevation
+... is above the arm's maximum 40°"; on a Dynamixel arm "azimuth 329.342 deg is outside the
+joint limits -10.0..170.0") and stopped there, with nothing on what to do: the session's lights
+are fixed when it begins, so only the rig as it began finishes it, or a new session runs on
+the rig as it is.
+"""
+
+from __future__ import annotations
+
+import shlex
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, cut_new_session
+from typer.testing import CliRunner
+
+from rti_rig.app.usecases.session import NewSessionRequest
+from rti_rig.cli import app
+from rti_rig.runtime.controller import FinishReason
+
+runner = CliRunner()
+
+
+def test_a_narrowed_reach_accepted_on_resume_says_how_to_go_on(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace("width = 512", "width = 64").replace("height = 512", "height = 64"))
+    out = tmp_path / "s"
+    result = cut_new_session(NewSessionRequest(cfg, out, lights=6), after_step=1)
+    assert result.finish_reason is FinishReason.CANCELLED
+    before = sorted(p.relative_to(out).as_posix() for p in out.rglob("*"))
+    cfg.write_text(cfg.read_text().replace("max_elevation_deg = 80.0", "max_elevation_deg = 40.0"))
+
+    r = runner.invoke(app, ["run", "--resume", "s", "--accept-rig-change", "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "is above the arm's maximum 40°" in said, said
+    assert "leaves these lights of s out of its reach: to finish the session, set" in said, said
+    assert "s/manifest.json, under rig.config) and resume" in said, said
+    command = said.split("or shoot a new session on the rig as it is: ", 1)[1]
+    assert command == f"rti-rig run {shlex.quote(str(cfg))} --out s-again", said
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before  # untouched
+
+    r = runner.invoke(app, [*shlex.split(command)[1:], "--lights", "6", "--no-verdict"])
+    assert r.exit_code == 0, r.output
