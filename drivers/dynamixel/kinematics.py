@@ -167,8 +167,11 @@ class ArmKinematics:
         candidates = self.azimuth_candidates(az)
         if not candidates:
             j = self.settings.azimuth
+            # in -180..180, as the limits are mostly written: "azimuth 329.342 deg is outside
+            # the joint limits -10.0..170.0" read as an arm asked past a full turn
+            shown = (az + 180.0) % 360.0 - 180.0
             return None, (
-                f"azimuth {az:.3f} deg is outside the joint limits {j.min_deg}..{j.max_deg}"
+                f"azimuth {shown:.3f} deg is outside the joint limits {j.min_deg}..{j.max_deg}"
             )
         joint_az = min(candidates, key=lambda a: abs(a - ref))
         reason = self.pose_reason(joint_az, el)

@@ -49,3 +49,26 @@ def test_a_narrowed_reach_accepted_on_resume_says_how_to_go_on(
 
     r = runner.invoke(app, [*shlex.split(command)[1:], "--lights", "6", "--no-verdict"])
     assert r.exit_code == 0, r.output
+
+
+def test_a_dynamixel_arm_s_azimuth_out_of_its_new_limits_is_said_in_their_terms(
+    tmp_path: Path,
+) -> None:
+    """The emulated Dynamixel arm, its azimuth joint narrowed to -10..170°: a light at azimuth
+    -30.7° was said as "azimuth 329.342 deg is outside the joint limits -10.0..170.0"."""
+    text = (CONFIGS / "simulated_arm.toml").read_text()
+    text = text.replace('transport = "pty"', 'transport = "inprocess"')
+    text = text.replace("width = 256", "width = 32").replace("height = 256", "height = 32")
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text)
+    out = tmp_path / "s"
+    result = cut_new_session(NewSessionRequest(cfg, out, lights=6), after_step=1)
+    assert result.finish_reason is FinishReason.CANCELLED
+    cfg.write_text(text.replace("min_deg = -170.0", "min_deg = -10.0"))
+
+    r = runner.invoke(app, ["run", "--resume", str(out), "--accept-rig-change", "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "azimuth -30.658 deg is outside the joint limits -10.0..170.0" in said, said
+    assert "329.342" not in said, said
+    assert "leaves these lights of" in said and "--out " in said, said
