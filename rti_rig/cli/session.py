@@ -1601,6 +1601,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     #: the signal of the emergency stop a handler here raised (SIGTERM, SIGHUP for a hang-up,
     #: SIGINT for a second Ctrl-C), None before one
     stopping: signal.Signals | None = None
+    #: a step of this run has begun (its light set): before it the rig is still being
+    #: connected (an arm's baud scan can take 10 s), and no image is under way to stop after
+    stepped = False
 
     def on_sigint(signum, frame):  # type: ignore[no-untyped-def]
         nonlocal ended, late_said, stopping
@@ -1671,6 +1674,14 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             # check): "Stopping after this image" read as if one were still to come, and asked
             # for a second Ctrl-C (a Ctrl-C in the teardown is the branch above)
             err.print("[yellow]Every image is in: finishing the session (lights off, records)…[/]")
+            return
+        if not stepped:
+            # "Stopping after this image" had been said while the rig was being connected,
+            # no image under way (an arm's connect, its baud scan), the connect going on
+            err.print(
+                "[yellow]Stopping before any image is taken: the rig is being connected "
+                "(Ctrl-C again to stop at once)…[/]"
+            )
             return
         err.print("[yellow]Stopping after this image (Ctrl-C again to stop at once)…[/]")
 
@@ -1759,6 +1770,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             )
 
             def on_event(event):  # type: ignore[no-untyped-def]
+                nonlocal stepped
+                if isinstance(event, StepStarted):
+                    stepped = True
                 if isinstance(event, StepCompleted):
                     progress.advance(task)
                 elif isinstance(event, Paused):
