@@ -278,10 +278,20 @@ class DynamixelArm(ReadBackCarrier):
             except Exception:
                 where = " (where could not be read)"
             unknown = f"; {self._servos_named(unread)} did not answer the read" if unread else ""
+            # a joint read off holds nothing: "holding the lamp" had been said of an arm whose
+            # elevation servo had shut down for an overload, its joint limp under the lamp
+            off = [j for j in self.settings.joints if j not in on and j not in unread]
+            held, limp = "holding the lamp", ""
+            if off:
+                held = "only partly holding the lamp"
+                limp = (
+                    f"; {self._servos_named(off)} read it off: that joint is limp, and the "
+                    "lamp's weight may move it"
+                )
             return (
-                f"but the arm is still powered and holding the lamp{where}: "
+                f"but the arm is still powered and {held}{where}: "
                 f"{self._servos_named(on)} read Torque Enable ON (left on by an earlier "
-                f"command){unknown}; {advice}"
+                f"command){limp}{unknown}; {advice}"
             )
         if unread:
             answered = [j for j in self.settings.joints if j not in unread]

@@ -52,6 +52,10 @@ def test_a_faulted_run_is_recovered_by_reboot_faulted_then_resumed(tmp_path: Pat
     ), words
     assert "Its torque is off (as read at connect)" in words, words
     assert "Nothing was commanded: the arm could not be connected" in words, words
+    # the azimuth servo still holds, the faulted elevation one is limp: not "holding the lamp"
+    assert "still powered and only partly holding the lamp" in words, words
+    assert "servo 2 (elevation) read it off: that joint is limp, and the lamp's weight" in words
+    assert "still powered and holding the lamp" not in words, words
     assert len(journal(out)) == kept
 
     # the documented recovery reboots the faulted servo, and it is cleared for good
