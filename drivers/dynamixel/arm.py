@@ -272,8 +272,21 @@ class DynamixelArm(ReadBackCarrier):
         if on:
             where = ""
             try:
-                az, el = self.kin.pose_of_ticks(*self.joint_ticks())
-                place = "at its park pose" if self._at_park() else "away from its park pose"
+                # with the Alert bit let through: a servo reporting a hardware fault still
+                # answers with its position (read with the alert checked, the pose of an arm
+                # whose elevation servo had overloaded was said "could not be read")
+                ticks = tuple(
+                    self._bus.read(j.servo_id, ct.PRESENT_POSITION, check_alert=False)
+                    for j in self.settings.joints
+                )
+                az, el = self.kin.pose_of_ticks(*ticks)
+                s = self.settings
+                park = self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg)
+                parked = all(
+                    abs(int(a) - int(b)) <= self.PARKED_TICKS
+                    for a, b in zip(ticks, park, strict=True)
+                )
+                place = "at its park pose" if parked else "away from its park pose"
                 where = f" at az {az:.1f}°, el {el:.1f}° (read back, {place})"
             except Exception:
                 where = " (where could not be read)"

@@ -56,6 +56,9 @@ def test_a_faulted_run_is_recovered_by_reboot_faulted_then_resumed(tmp_path: Pat
     assert "still powered and only partly holding the lamp" in words, words
     assert "servo 2 (elevation) read it off: that joint is limp, and the lamp's weight" in words
     assert "still powered and holding the lamp" not in words, words
+    # where it is, read past the faulted servo's Alert bit (it had been "could not be read")
+    assert "only partly holding the lamp at az " in words, words
+    assert "(read back, away from its park pose)" in words, words
     assert len(journal(out)) == kept
 
     # the documented recovery reboots the faulted servo, and it is cleared for good
