@@ -27,8 +27,11 @@ status reaches the rig's own host only once it listens, never in wall time; a pl
 ``PortHandler`` gets it after the servo's Return Delay Time (9) and its wire time.
 
 Like a real servo, a unicast Action and unicast writes *are* answered; the SDK does not read
-those replies (a pitfall the driver handles). Instruction packets are parsed by length, because
-the SDK sends them unstuffed.
+those replies (a pitfall the driver handles). The wire is read and written by
+:mod:`rti_rig.simulator.dynamixel_wire`, from the e-manual's Protocol 2.0 page, never by the
+driver's codec (a codec bug would otherwise be on both sides of the wire; an import-linter
+contract forbids it): instruction packets are taken by Length, because the SDK sends them
+unstuffed.
 """
 
 from __future__ import annotations
@@ -44,8 +47,8 @@ from typing import Any, NamedTuple
 from rti_rig.core.clock import Clock
 from rti_rig.core.shell_words import shown_path
 from rti_rig.drivers.dynamixel import control_table as ct
-from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.simulator import dynamixel_models as models
+from rti_rig.simulator import dynamixel_wire as wire
 from rti_rig.simulator.pty_link import HostBaudDevice
 
 #: The registers a servo leaves the factory with, and the field of
@@ -237,7 +240,7 @@ class EmulatedServo:
 
     def get(self, reg: ct.Register) -> int:
         raw = int.from_bytes(self.table[reg.address : reg.address + reg.size], "little")
-        return p2.to_signed(raw, reg.size) if reg.signed else raw
+        return wire.signed(raw, reg.size) if reg.signed else raw
 
     @property
     def dxl_id(self) -> int:
@@ -483,11 +486,11 @@ class EmulatedServo:
 
     # -- instructions -----------------------------------------------------------------------
     def status_error(self, number: int = 0) -> int:
-        return number | (p2.ERR_ALERT if self.hardware_error else 0)
+        return number | (wire.ALERT if self.hardware_error else 0)
 
     def read(self, address: int, length: int) -> tuple[int, bytes]:
         if length < 0 or address + length > ct.TABLE_SIZE:
-            return p2.ERR_DATA_LENGTH, b""
+            return wire.DATA_LENGTH_ERROR, b""
         self._refresh()
         return 0, bytes(self.table[address : address + length])
 
@@ -506,20 +509,20 @@ class EmulatedServo:
         item: it modelled the packets our driver sends, not the servo.)"""
         end = address + len(data)
         if not data or end > ct.TABLE_SIZE:
-            return p2.ERR_DATA_LENGTH
+            return wire.DATA_LENGTH_ERROR
         for lo, hi in READ_ONLY:
             if address < hi and end > lo:
-                return p2.ERR_ACCESS
+                return wire.ACCESS_ERROR
         if address < ct.EEPROM_END and (
             self.torque_on or any(axis.torque_on for axis in self.other_axes)
         ):
             # a two-axis body (2XL430) locks its EEPROM while either axis has torque on
             # (ct.DUAL_AXIS_MODELS: "for all axis are set to '0'")
-            return p2.ERR_ACCESS
+            return wire.ACCESS_ERROR
         for reg in ITEMS:
             covers_some = address < reg.address + reg.size and end > reg.address
             if covers_some and not address <= reg.address <= reg.address + reg.size <= end:
-                return p2.ERR_DATA_LENGTH
+                return wire.DATA_LENGTH_ERROR
 
         def covered(reg: ct.Register) -> bytes | None:
             """The bytes this Write gives ``reg``, if it covers it."""
@@ -530,7 +533,7 @@ class EmulatedServo:
         goal_bytes = covered(ct.GOAL_POSITION)
         goal: int | None = None
         if goal_bytes is not None:
-            goal = p2.to_signed(int.from_bytes(goal_bytes, "little"), 4)
+            goal = wire.signed(int.from_bytes(goal_bytes, "little"), 4)
             if self.get(ct.OPERATING_MODE) == ct.OperatingMode.POSITION:
                 lo, hi = self.get(ct.MIN_POSITION_LIMIT), self.get(ct.MAX_POSITION_LIMIT)
             else:
@@ -541,10 +544,10 @@ class EmulatedServo:
             # them does nothing at all, it is not clamped onto the limit (ROBOTIS forum,
             # "Position limit in joint mode", forum.robotis.com/t/452): refused, nothing moves
             if not lo <= goal <= hi:
-                return p2.ERR_DATA_LIMIT
+                return wire.DATA_LIMIT_ERROR
         torque_bytes = covered(ct.TORQUE_ENABLE)
         if torque_bytes is not None and torque_bytes[0] and self._shut_down:
-            return p2.ERR_RESULT_FAIL  # after a shutdown only a reboot re-enables torque
+            return wire.RESULT_FAIL  # after a shutdown only a reboot re-enables torque
         pv_bytes = covered(ct.PROFILE_VELOCITY)
         time_based = self.get(ct.DRIVE_MODE) & ct.DRIVE_MODE_TIME_BASED_PROFILE
         # e-manual, Velocity Limit(44): "maximum velocity of Goal Velocity(104) and Profile
@@ -561,7 +564,7 @@ class EmulatedServo:
             and not time_based
             and int.from_bytes(pv_bytes, "little") > self.get(ct.VELOCITY_LIMIT)
         ):
-            return p2.ERR_DATA_LIMIT
+            return wire.DATA_LIMIT_ERROR
         # every check passed: the Write takes effect
         limp = torque_bytes is not None and not torque_bytes[0] and self.torque_on
         if torque_bytes is not None:
@@ -612,7 +615,7 @@ class EmulatedServo:
 
     def action(self) -> int:
         if self._registered is None:
-            return p2.ERR_INSTRUCTION
+            return wire.INSTRUCTION_ERROR
         address, data = self._registered
         self._registered = None
         self.table[ct.REGISTERED_INSTRUCTION.address] = 0
@@ -620,7 +623,7 @@ class EmulatedServo:
 
     def clear_multi_turn(self) -> int:
         if self.is_moving():
-            return p2.ERR_RESULT_FAIL
+            return wire.RESULT_FAIL
         p = round(self.position()) % ct.TICKS_PER_REV
         self._profile = _Profile(p, p, self.clock.now(), 1.0, 1.0)
         self._back_driven = False
@@ -674,8 +677,8 @@ class DynamixelBusEmulator(HostBaudDevice):
         #: instruction packets received so far (what ``reply_faults`` counts)
         self.instructions_received = 0
         self.goal_log: list[tuple[int, int]] = []
-        self.instructions: list[p2.Packet] = []
-        self._parser = p2.PacketParser()
+        self.instructions: list[wire.Instruction] = []
+        self._parser = wire.InstructionReader()
         self._lock = threading.RLock()
         #: Called with every servo's Hardware Error Status (id -> bits) whenever one changes:
         #: one moment the chain's powered state is kept, to outlive the command
@@ -763,10 +766,10 @@ class DynamixelBusEmulator(HostBaudDevice):
             self._parser.feed(bytes(data))
             out = bytearray()
             for item in self._parser.packets():
-                if isinstance(item, p2.CrcMismatch):
+                if isinstance(item, wire.BadCrc):
                     dxl_id = item.raw[4]
                     if dxl_id in self.servos and dxl_id not in self._deaf:
-                        out += self._reply(dxl_id, p2.ERR_CRC)
+                        out += self._reply(dxl_id, wire.CRC_ERROR)
                     continue
                 self.instructions.append(item)
                 self.instructions_received += 1
@@ -826,7 +829,7 @@ class DynamixelBusEmulator(HostBaudDevice):
 
     def _reply(self, dxl_id: int, number: int = 0, params: bytes = b"") -> bytes:
         servo = self.servos[dxl_id]
-        packet = p2.status_packet(dxl_id, servo.status_error(number), params)
+        packet = wire.status_packet(dxl_id, servo.status_error(number), params)
         if self.drop_next_replies > 0:
             self.drop_next_replies -= 1
             return b""
@@ -837,14 +840,14 @@ class DynamixelBusEmulator(HostBaudDevice):
 
     def _answers(self, servo: EmulatedServo, instruction: int) -> bool:
         level = servo.get(ct.STATUS_RETURN_LEVEL)
-        if instruction == p2.INST_PING:
+        if instruction == wire.PING:
             return True
-        if instruction in (p2.INST_READ, p2.INST_SYNC_READ, p2.INST_BULK_READ):
+        if instruction in (wire.READ, wire.SYNC_READ, wire.BULK_READ):
             return level >= 1
         return level >= 2
 
-    def _targets(self, pkt: p2.Packet) -> list[EmulatedServo]:
-        if pkt.dxl_id == p2.BROADCAST_ID:
+    def _targets(self, pkt: wire.Instruction) -> list[EmulatedServo]:
+        if pkt.dxl_id == wire.BROADCAST_ID:
             ids = sorted(self.servos)
         else:
             ids = [pkt.dxl_id] if pkt.dxl_id in self.servos else []
@@ -854,13 +857,13 @@ class DynamixelBusEmulator(HostBaudDevice):
         g = ct.GOAL_POSITION.address
         if address <= g and address + len(data) >= g + 4:
             raw = int.from_bytes(data[g - address : g - address + 4], "little")
-            self.goal_log.append((dxl_id, p2.to_signed(raw, 4)))
+            self.goal_log.append((dxl_id, wire.signed(raw, 4)))
 
-    def _handle(self, pkt: p2.Packet) -> bytes:
+    def _handle(self, pkt: wire.Instruction) -> bytes:
         inst, prm = pkt.instruction, pkt.params
-        unicast = pkt.dxl_id != p2.BROADCAST_ID
+        unicast = pkt.dxl_id != wire.BROADCAST_ID
         out = bytearray()
-        if inst == p2.INST_SYNC_WRITE:
+        if inst == wire.SYNC_WRITE:
             address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
             for i in range(4, len(prm), length + 1):
                 dxl_id, data = prm[i], prm[i + 1 : i + 1 + length]
@@ -868,7 +871,7 @@ class DynamixelBusEmulator(HostBaudDevice):
                 if dxl_id in self.servos and dxl_id not in self._deaf:
                     self.servos[dxl_id].write(address, data)
             return b""
-        if inst == p2.INST_BULK_WRITE:
+        if inst == wire.BULK_WRITE:
             i = 0
             while i + 5 <= len(prm):
                 dxl_id = prm[i]
@@ -880,14 +883,14 @@ class DynamixelBusEmulator(HostBaudDevice):
                     self.servos[dxl_id].write(address, data)
                 i += 5 + length
             return b""
-        if inst == p2.INST_SYNC_READ:
+        if inst == wire.SYNC_READ:
             address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
             for dxl_id in prm[4:]:
                 if dxl_id in self.servos and dxl_id not in self._deaf:
                     err, data = self.servos[dxl_id].read(address, length)
                     out += self._reply(dxl_id, err, data)
             return bytes(out)
-        if inst == p2.INST_BULK_READ:
+        if inst == wire.BULK_READ:
             for i in range(0, len(prm) - 4, 5):
                 dxl_id = prm[i]
                 address = int.from_bytes(prm[i + 1 : i + 3], "little")
@@ -898,33 +901,33 @@ class DynamixelBusEmulator(HostBaudDevice):
             return bytes(out)
         for servo in self._targets(pkt):
             err, params = self._execute(servo, inst, prm)
-            if inst == p2.INST_PING or (unicast and self._answers(servo, inst)):
+            if inst == wire.PING or (unicast and self._answers(servo, inst)):
                 out += self._reply(servo.dxl_id, err, params)
         return bytes(out)
 
     def _execute(self, servo: EmulatedServo, inst: int, prm: bytes) -> tuple[int, bytes]:
-        if inst == p2.INST_PING:
+        if inst == wire.PING:
             model = servo.get(ct.MODEL_NUMBER)
-            return 0, p2.u16(model) + bytes([servo.get(ct.FIRMWARE_VERSION)])
-        if inst == p2.INST_READ and len(prm) == 4:
+            return 0, model.to_bytes(2, "little") + bytes([servo.get(ct.FIRMWARE_VERSION)])
+        if inst == wire.READ and len(prm) == 4:
             address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
             return servo.read(address, length)
-        if inst in (p2.INST_WRITE, p2.INST_REG_WRITE) and len(prm) >= 3:
+        if inst in (wire.WRITE, wire.REG_WRITE) and len(prm) >= 3:
             address = int.from_bytes(prm[0:2], "little")
-            if inst == p2.INST_WRITE:
+            if inst == wire.WRITE:
                 self._log_goal(servo.dxl_id, address, prm[2:])
                 return servo.write(address, prm[2:]), b""
             return servo.reg_write(address, prm[2:]), b""
-        if inst == p2.INST_ACTION:
+        if inst == wire.ACTION:
             if servo._registered is not None:
                 self._log_goal(servo.dxl_id, *servo._registered)
             return servo.action(), b""
-        if inst == p2.INST_REBOOT:
+        if inst == wire.REBOOT:
             servo.reboot()
             return 0, b""
-        if inst == p2.INST_CLEAR and prm == bytes([0x01, 0x44, 0x58, 0x4C, 0x22]):
+        if inst == wire.CLEAR and prm == bytes([0x01, 0x44, 0x58, 0x4C, 0x22]):
             return servo.clear_multi_turn(), b""
-        return p2.ERR_INSTRUCTION, b""
+        return wire.INSTRUCTION_ERROR, b""
 
 
 #: The SDK's reply window for a short status packet, ms (``LATENCY_TIMER * 2 + 2``, its
