@@ -102,3 +102,25 @@ def test_the_contract_fails_when_the_own_protocols_emulator_imports_a_driver_cod
     assert "rti_rig.simulator.own_protocols -> rti_rig.drivers.led_dome.codec_default" in (
         result.stdout
     )
+
+
+@pytest.mark.slow
+def test_the_contract_fails_when_the_dynamixel_emulator_imports_the_driver_codec(tmp_path):
+    """The emulated servos speak Protocol 2.0 from the e-manual (dynamixel_wire), not through
+    the driver's codec: built on it again, a codec bug would be on both sides of the wire."""
+    tree = installed_layout(tmp_path / "site")
+    emulator = tree / "rti_rig" / "simulator" / "dynamixel_emulator.py"
+    emulator.write_text(
+        emulator.read_text(encoding="utf-8")
+        + "\nfrom rti_rig.drivers.dynamixel import protocol2 as _p2  # noqa: F401\n",
+        encoding="utf-8",
+    )
+    result = lint_imports(tree, PYPROJECT)
+    assert result.returncode != 0
+    assert "Dynamixel emulator speaks Protocol 2.0 from the e-manual, not the driver's codec" in (
+        result.stdout
+    )
+    assert "BROKEN" in result.stdout
+    assert "rti_rig.simulator.dynamixel_emulator -> rti_rig.drivers.dynamixel.protocol2" in (
+        result.stdout
+    )
