@@ -359,11 +359,32 @@ def _keep(
     try:
         return keep_unlabelled(root, index, frame, verdict, stem)
     except OSError as exc:
-        raise SessionWriteError(
-            f"could not keep the unlabelled {stem} {index + 1} under "
-            f"{shown_path(root / UNLABELLED_DIR)}: {exc}. The session is marked {DISOWN_MARKER} "
-            "(its labels are not used); free disk space and start a new session"
-        ) from None
+        folder = root / UNLABELLED_DIR
+        path = Path(exc.filename) if isinstance(exc.filename, str) else folder
+        raise UnlabelledNotKeptError(path, exc, f"{stem} {index + 1}", folder) from None
+
+
+class UnlabelledNotKeptError(SessionWriteError):
+    """A slipped, check or proof image the disk refused under ``unlabelled/``: the file, the
+    system's reason, which image, and what to do.
+
+    Why: :func:`_keep` had raised ``SessionWriteError`` with its words alone, but that class
+    takes the file and the ``OSError``: a full disk there ended the run in "unexpected
+    TypeError … please report it" instead of these words."""
+
+    def __init__(self, path: Path, exc: OSError, image: str, folder: Path) -> None:
+        super().__init__(path, exc)
+        if self.errno_name in ("ENOSPC", "EDQUOT", "EFBIG"):
+            fix = "free space on that disk"
+        elif self.errno_name == "EROFS":
+            fix = "make that disk writable"
+        else:
+            fix = "check that disk"
+        self.args = (
+            f"{self.args[0]}: could not keep the unlabelled {image} under {shown_path(folder)}. "
+            f"The session is marked {DISOWN_MARKER} (its labels are not used); {fix} and "
+            "start a new session",
+        )
 
 
 def _disowned(root: Path, reason: str) -> str:

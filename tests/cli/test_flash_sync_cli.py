@@ -492,6 +492,44 @@ def test_a_check_frame_the_camera_fails_leaves_both_causes_named(  # type: ignor
     assert (out / "unlabelled" / "image_006.tif").is_file()
 
 
+def test_a_full_disk_under_unlabelled_is_said_with_the_file_and_what_to_do(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The slipped image's unlabelled copy refused by the disk: said with the file, the
+    system's reason and what to do. ``_keep`` had built its SessionWriteError from its words
+    alone, a call that class refuses: the run ended in "unexpected TypeError … please report
+    it"."""
+    import errno
+
+    import rti_rig.core.image_files as image_files
+
+    real = image_files.write_linear_tiff
+
+    def full_under_unlabelled(path, *args, **kwargs):  # type: ignore[no-untyped-def]
+        if Path(path).parent.name != "unlabelled":
+            return real(path, *args, **kwargs)
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+
+    monkeypatch.setattr(image_files, "write_linear_tiff", full_under_unlabelled)
+    out = tmp_path / "s"
+    config = with_fault(tmp_path, 3, "double_step")
+    result = runner.invoke(app, ["run", str(config), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    text = " ".join(result.output.split())
+    assert "TypeError" not in text and "please report it" not in text, text
+    said = (
+        f"cannot write {out / 'unlabelled' / 'image_004.tif'}: No space left on device (ENOSPC): "
+        f"could not keep the unlabelled image 4 under {out / 'unlabelled'}. The session is "
+        "marked LABELS_NOT_VERIFIED.txt (its labels are not used); free space on that disk and "
+        "start a new session"
+    )
+    assert said in text, text
+    assert (out / "LABELS_NOT_VERIFIED.txt").is_file()  # as said: fit and export-lp refuse it
+    manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
+    assert manifest["runner"]["finish_reason"] == "write-failed"
+    assert manifest["runner"]["error"] == said
+
+
 def test_refusals_give_the_run_of_the_config_actually_used(tmp_path: Path, rigs) -> None:  # type: ignore[no-untyped-def]
     """The preview refusal (and a finished session's resume) had said "rti-rig run CONFIG
     --out DIR", leaving the user to find which config: it names the one given, as one shell
