@@ -153,7 +153,10 @@ def test_an_interrupted_session_resumes_with_its_minimum(
         (["--adaptive", "--lights", "8", "--min-lights", "6"], "with --lights 8 alone"),
         (["--min-lights", "6"], "goes with --until-error"),
         # no --lights given: the advice names what to add, not an option the user did not give
-        (["--adaptive", "--min-lights", "6"], "add --until-error DEG (the target"),
+        (
+            ["--adaptive", "--min-lights", "6"],
+            "add --until-error (the target the stop claims, in degrees; 2 as the guide shows)",
+        ),
         (["--until-error", "2", "--lights", "8", "--min-lights", "9"], "above --lights 8"),
         (["--until-error", "2", "--min-lights", "0"], "give a positive number"),
         (["--until-error", "2", "--min-lights", "13"], "this rig offers 12 lights"),

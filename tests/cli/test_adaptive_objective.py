@@ -109,7 +109,7 @@ def test_the_default_objective_is_normals_and_says_so(tmp_path: Path) -> None:
         (["--until-error", "2", "--objective", "relight"], "--objective normals only"),
         (
             ["--adaptive", "--objective", "relight"],
-            "give the count with --lights (e.g. --lights 12)",
+            "give the count with --lights: rti-rig run ",
         ),
         (["--lights", "8", "--objective", "relight"], "goes with --adaptive"),
         (["--adaptive", "--lights", "8", "--objective", "psnr"], "normals or relight"),

@@ -173,3 +173,54 @@ def test_a_resume_of_a_session_whose_manifest_names_no_config_names_the_session(
     done = pasted_run(tmp_path, command.replace("RIG.toml", "rig.toml", 1))
     assert "does not say which rig config" not in done.stderr, done.stderr
     assert "is complete" in done.stderr + done.stdout, done.stderr + done.stdout
+
+
+def accepted_as_pasted(cwd: Path, command: str, out: str) -> None:
+    """``command``, pasted in ``cwd``, passes every check of its options: with its ``--out``
+    (``out``) made non-empty first, the folder is all it is refused for (a refusal of an
+    option comes before the folder's; the session itself is not run, for speed)."""
+    (cwd / out).mkdir()
+    (cwd / out / "keep.txt").write_text("x", encoding="utf-8")
+    done = pasted_run(cwd, command)
+    assert done.returncode == 2, done.stderr
+    said = " ".join(done.stderr.split())
+    assert f"{out} is not empty: refusing to write a session over existing files" in said, said
+
+
+@pytest.mark.parametrize(
+    "given", [("--until-error", "3", "--objective", "relight"), ("--objective", "relight")]
+)
+def test_a_relight_objective_without_a_count_advises_one_the_8_led_dome_takes(
+    tmp_path: Path, given: tuple[str, ...]
+) -> None:
+    """``--objective relight`` with ``--until-error`` or without ``--lights`` had advised
+    "--lights 12, say", which the 8-LED dome refuses ("give at most 8"), as an option to add
+    to a command the user had to rebuild; it is a whole command with 8."""
+    rig = eight_led_dome(tmp_path)
+    r = rti_rig(tmp_path, "run", rig, "--out", "S", "--adaptive", *given)
+    assert r.returncode == 2, r.stderr
+    command = command_after(r.stderr, "--lights: " if len(given) == 2 else "a count: ", " (or")
+    assert " --lights 8 --objective relight" in command, command
+    accepted_as_pasted(tmp_path, command, "S")
+
+
+def test_a_minimum_without_a_target_advises_a_whole_command_with_one(tmp_path: Path) -> None:
+    """``--adaptive --min-lights 6`` without ``--until-error``: "add --until-error DEG" pasted
+    was refused as no number; the advice is the run with the guide's 2° and the band given."""
+    rig = eight_led_dome(tmp_path)
+    r = rti_rig(
+        tmp_path,
+        "run",
+        rig,
+        "--out",
+        "S",
+        "--adaptive",
+        "--min-lights",
+        "6",
+        "--max-elevation-deg",
+        "60",
+    )
+    assert r.returncode == 2, r.stderr
+    command = command_after(r.stderr, "as the guide shows): ", ", or leave")
+    assert "--until-error 2 --min-lights 6 --max-elevation-deg 60" in command, command
+    accepted_as_pasted(tmp_path, command, "S")

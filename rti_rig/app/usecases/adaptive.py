@@ -39,7 +39,12 @@ from rti_rig.app.usecases.adaptive_constants import (
     decision_constants,
     describe_differences,
 )
-from rti_rig.app.usecases.run_options import adaptive_options, band_options
+from rti_rig.app.usecases.run_options import (
+    HINT_UNTIL_ERROR_DEG,
+    adaptive_options,
+    band_options,
+    run_words,
+)
 from rti_rig.core import fit_minimums
 from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.devices import Frame
@@ -1222,13 +1227,25 @@ def few_lights_note(
     return text
 
 
-def check_objective(objective: str, lights: int | None, until_error_deg: float | None) -> None:
+def check_objective(
+    objective: str,
+    lights: int | None,
+    until_error_deg: float | None,
+    run: str = "rti-rig run",
+    count: int = fit_minimums.PLAN_DEFAULT_LIGHTS,
+    band: tuple[float, float] = _FULL_BAND,
+) -> None:
     """Refuse an objective the adaptive session cannot serve, before anything is opened.
 
     ``relight`` chooses the *design* of N lights by its simulated relighting PSNR, so it needs
     ``--lights N``; ``--until-error`` is a criterion on the estimated mean *normal* error (the
     only error the session estimates and that is calibrated against measured error), so it is
-    refused with ``relight`` rather than given a relighting meaning nobody calibrated."""
+    refused with ``relight`` rather than given a relighting meaning nobody calibrated.
+
+    The way out is a whole command: ``run`` (:func:`run_words`, the rig config and the run's
+    own ``--out``) with ``count`` lights, the count the rig takes in ``band``
+    (:func:`hint_count`): "--lights 12, say" was refused on a dome of fewer LEDs in the band,
+    and a bare option left the rest of the command to find."""
     if objective not in OBJECTIVES:
         raise RtiRigError(
             f"--objective {objective}: an adaptive session chooses its lights for "
@@ -1236,43 +1253,64 @@ def check_objective(objective: str, lights: int | None, until_error_deg: float |
         )
     if objective != "relight":
         return
+    counted = f"{run} {adaptive_options(None, lights or count, None, objective)}"
+    counted += band_options(band)
     if until_error_deg is not None:
         raise RtiRigError(
             "--until-error goes with --objective normals only: it stops on the estimated mean "
             "normal error, which a session chosen for relighting does not aim at (no relighting "
-            "error estimate is calibrated). Give --objective relight a count (--lights "
-            f"{fit_minimums.PLAN_DEFAULT_LIGHTS}, say), or drop --objective for --until-error"
+            f"error estimate is calibrated). Give --objective relight a count: {counted} (or "
+            "drop --objective for --until-error)"
         )
     if lights is None:
         raise RtiRigError(
             "--objective relight chooses a design of a given number of lights by its simulated "
-            "relighting: give the count with --lights (e.g. --lights "
-            f"{fit_minimums.PLAN_DEFAULT_LIGHTS})"
+            f"relighting: give the count with --lights: {counted}"
         )
 
 
+def hint_count(geometry: object, band: tuple[float, float]) -> int:
+    """The ``--lights`` an adaptive hint gives: what a plan's hint gives on this rig in
+    ``band`` (:func:`~rti_rig.core.rig_geometry.hint_light_count`: 12, or a dome's LEDs in the
+    band), at least one more than the starting layout (an adaptive session's fewest)."""
+    from rti_rig.core.rig_geometry import hint_light_count
+
+    return max(START_LIGHTS + 1, hint_light_count(geometry, *band))
+
+
 def check_min_lights(
-    min_lights: int | None, lights: int | None, until_error_deg: float | None
+    min_lights: int | None,
+    lights: int | None,
+    until_error_deg: float | None,
+    run: str = "rti-rig run",
+    band: tuple[float, float] = _FULL_BAND,
 ) -> None:
     """Refuse a --min-lights that cannot mean anything, before anything is opened: it bounds
     the --until-error stop from below, so it needs --until-error and must not exceed
-    --lights."""
+    --lights.
+
+    ``run``: the advised command's start (:func:`run_words`); without ``--until-error`` or
+    ``--lights`` the advice is that command with the guide's target
+    (:data:`HINT_UNTIL_ERROR_DEG`): "add --until-error DEG" pasted was refused as no number."""
     if min_lights is None:
         return
+    if min_lights < 1:
+        raise RtiRigError(f"--min-lights {min_lights}: give a positive number of lights")
     if until_error_deg is None:
         # what the session does without it is said for what the user gave (an advice naming
         # --lights to a user who gave none had read as an option they had given)
+        target = adaptive_options(HINT_UNTIL_ERROR_DEG, None, min_lights) + band_options(band)
         without = (
             f"with --lights {lights} alone the session shoots {lights} lights"
             if lights is not None
-            else "add --until-error DEG (the target the stop claims), or leave --min-lights out"
+            else f"add --until-error (the target the stop claims, in degrees; "
+            f"{HINT_UNTIL_ERROR_DEG:g} as the guide shows): {run} {target}, or leave "
+            "--min-lights out"
         )
         raise RtiRigError(
             f"--min-lights {min_lights} goes with --until-error (it is the fewest lights the "
             f"stop may claim the target at); {without}"
         )
-    if min_lights < 1:
-        raise RtiRigError(f"--min-lights {min_lights}: give a positive number of lights")
     if lights is not None and min_lights > lights:
         raise RtiRigError(
             f"--min-lights {min_lights} is above --lights {lights}, the session's maximum: "
@@ -1637,8 +1675,9 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     # the options on their own first: a refusal below advises a command that repeats them, and
     # one that repeated '--until-error 3 --objective relight' (or '--objective foo') was refused
     # in turn when pasted
-    check_objective(objective, lights, until_error_deg)
-    check_min_lights(min_lights, lights, until_error_deg)
+    run = run_words(loaded.path, out_dir)
+    check_objective(objective, lights, until_error_deg, run, hint_count(geometry, band), band)
+    check_min_lights(min_lights, lights, until_error_deg, run, band)
     offered: int | None = None
     elevations: NDArray[np.float64] | None = None  # a dome's LEDs' (°)
     if isinstance(geometry, DomeGeometry):  # a dome's lights are known from its config: before

@@ -11,6 +11,21 @@ command the user pastes must read the same whichever advice printed it. (A plann
 
 from __future__ import annotations
 
+from pathlib import Path
+
+from rti_rig.core.shell_words import shell_word
+
+#: The ``--until-error`` (degrees) a hint gives a user who gave none: the target the guide
+#: (docs/guide.md §10) and the README show. Why a value: "add --until-error DEG" pasted was
+#: refused as not a number; no session has estimated anything yet when it is advised.
+HINT_UNTIL_ERROR_DEG = 2.0
+
+
+def run_words(rig_config: Path, out_dir: Path) -> str:
+    """``rti-rig run CONFIG --out OUT``, each a shell word (an advised command's start, the
+    run's own ``--out``: nothing has been written to it when a request is refused)."""
+    return f"rti-rig run {shell_word(str(rig_config))} --out {shell_word(str(out_dir))}"
+
 
 def adaptive_options(
     until_error_deg: float | None,

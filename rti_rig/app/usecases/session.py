@@ -1295,9 +1295,16 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     """Check a new session's request, open and check the rig, and prepare its folder."""
     from rti_rig.app.config import load_rig_config
     from rti_rig.app.usecases.adaptive import check_min_lights
+    from rti_rig.app.usecases.run_options import run_words
 
     check_max_saturated(req.max_saturated)
-    check_min_lights(req.min_lights, req.lights, req.until_error_deg)
+    check_min_lights(
+        req.min_lights,
+        req.lights,
+        req.until_error_deg,
+        run_words(req.rig_config, req.out_dir),
+        (req.min_elevation_deg, req.max_elevation_deg),
+    )
     loaded = load_rig_config(req.rig_config)
     for note in loaded.notes:
         on_note(Note(note, "warning"))
