@@ -24,8 +24,9 @@ from fit_sessions import make_session
 
 runner = CliRunner()
 RTI_RIG = [sys.executable, "-c", "from rti_rig.cli import main; main()"]
-#: Files whose bytes must match; fit.json and lights.dome name the source path as given
-#: (a cluster batch records it absolute, workers do not share our working directory).
+#: Files whose bytes must match; fit.json names the source path as given (a cluster batch
+#: records it absolute, workers do not share our working directory); lights.dome's label is
+#: absolute in both.
 OUTPUTS = ("normals.npy", "normals.png", "albedo.npy", "albedo.png", "fit.ptm", "fit.rti")
 
 

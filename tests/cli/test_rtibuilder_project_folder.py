@@ -104,7 +104,8 @@ def test_fit_json_records_the_lp_read_by_its_absolute_path(
 ) -> None:
     """fit.json's "read" had kept the path as given ('8 images from ../assembly-files/icon.lp'),
     which names nothing to a user reading it from elsewhere later: it is the absolute path, as
-    the manifest records its paths; "source" stays the argument as given."""
+    the manifest records its paths; "source" stays the argument as given. lights.dome's label
+    is the same absolute path."""
     lp = _project(tmp_path)
     monkeypatch.chdir(lp.parents[1] / "jpeg-exports")
     given = "../assembly-files/icon.lp"
@@ -113,6 +114,9 @@ def test_fit_json_records_the_lp_read_by_its_absolute_path(
     summary = json.loads((lp.parents[1] / "jpeg-exports" / "fit" / "fit.json").read_text())
     assert summary["read"] == f"{LIGHTS} images from {lp}", summary["read"]
     assert summary["source"] == given
+    # lights.dome's label likewise (it had kept the relative path)
+    dome = json.loads((lp.parents[1] / "jpeg-exports" / "fit" / "lights.dome").read_text())
+    assert dome["label"] == str(lp), dome["label"]
 
 
 @GIVEN

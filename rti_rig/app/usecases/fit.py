@@ -909,7 +909,9 @@ def _fit_into(  # type: ignore[no-untyped-def]
         exporters.write_relight_dome(
             out / "lights.dome",
             lights,
-            label=str(req.source),
+            # absolute, as fit.json's "read" is: the source as given ('../assembly-files/
+            # icon.lp') named nothing to a user opening the fit folder from anywhere else later
+            label=str(Path(req.source).resolve()),
             image_names=listed_image_files(req.source),
         )
     )
