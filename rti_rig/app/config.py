@@ -897,11 +897,14 @@ def rtibuilder_project_lp(folder: Path) -> Path | None:
     return lps[0] if lps else None
 
 
-def project_replayed_note(folder: Path, lp: Path) -> str:
+def project_lp_note(folder: Path, lp: Path, doing: str = "replaying") -> str:
     """What is said (and kept among the rig's notes in the manifest) of a project folder given
-    as the rig: the ``.lp`` it replays, by its full path."""
+    as the rig: the ``.lp`` taken in its place, by its full path, and what is ``doing`` with it
+    (``replaying`` for a run, ``checking`` for check, ``planning on`` for plan --rig).
+
+    Why the verb: check, which replays nothing, had said "replaying its light list"."""
     return (
-        f"{shown_path(folder)} is an RTIBuilder project: replaying its light list "
+        f"{shown_path(folder)} is an RTIBuilder project: {doing} its light list "
         f"{lp_name_from(folder, lp)} ({shell_word(lp)})"
     )
 
@@ -923,15 +926,17 @@ def _not_toml_hint(raw: bytes) -> str:
     return ""
 
 
-def load_rig_config(path: Path | str) -> LoadedRig:
-    """Read and validate a rig config TOML file (or an acquisition's `.lp`: a replay rig)."""
+def load_rig_config(path: Path | str, project_doing: str = "replaying") -> LoadedRig:
+    """Read and validate a rig config TOML file (or an acquisition's `.lp`: a replay rig;
+    ``project_doing``: what the command does with an RTIBuilder project's .lp, for its note,
+    :func:`project_lp_note`)."""
     path = Path(path)
     if path.suffix.lower() == ".lp":
         return load_replay_rig(path)
     project_lp = rtibuilder_project_lp(path)
     if project_lp is not None:
         loaded = load_replay_rig(project_lp)  # its path, in the manifest, is the .lp replayed
-        note = project_replayed_note(path, project_lp)
+        note = project_lp_note(path, project_lp, project_doing)
         return loaded.model_copy(update={"notes": (note, *loaded.notes)})
     if path.is_dir():  # an acquisition's folder, given for its .lp: say which file to give
         raise ConfigError(

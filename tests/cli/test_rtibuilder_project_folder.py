@@ -128,12 +128,15 @@ def test_check_and_plan_of_an_rtibuilder_project_folder_take_its_one_lp(
     r = runner.invoke(app, ["check", folder])
     said = " ".join(r.output.split())
     assert r.exit_code == 0 and "RESULT: PASS" in said, said
-    assert f"replaying its light list {'../' if given != '.' else ''}assembly-files/icon" in said
+    # check replays nothing: it had said "replaying its light list"
+    assert f"checking its light list {'../' if given != '.' else ''}assembly-files/icon" in said
+    assert "replaying" not in said, said
     plan = tmp_path / "plan.lp"
     r = runner.invoke(app, ["plan", "--rig", folder, "--lights", "4", "--out", str(plan)])
     said = " ".join(r.output.split())
     assert r.exit_code == 0, said
     assert "planning on its light list" in said and "on a dome of 4 LEDs" in said, said
+    assert "replaying" not in said, said
 
 
 def test_a_project_folder_with_several_lps_is_refused_naming_each_to_paste(

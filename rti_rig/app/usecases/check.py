@@ -92,7 +92,8 @@ def check_rig(
         # the check had passed the images present so far)
         refuse_if_in_use(req.rig_config.parent, "check its images")
     try:
-        loaded = load_rig_config(req.rig_config)
+        # an RTIBuilder project's .lp is checked, not replayed: its note says so
+        loaded = load_rig_config(req.rig_config, project_doing="checking")
     except AcquisitionImagesError as exc:
         if req.auto_exposure:  # refused on any replay: a usage error, said as before
             raise

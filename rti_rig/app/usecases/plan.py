@@ -18,7 +18,7 @@ from rti_rig.app.compose import arm_order_for, read_preview_image
 from rti_rig.app.config import (
     LoadedRig,
     load_rig_config,
-    project_replayed_note,
+    project_lp_note,
     rig_geometry,
     rtibuilder_project_lp,
 )
@@ -166,7 +166,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     """Check, plan and write ``req.out_file``; nothing is read before the options are checked."""
     project_lp = rtibuilder_project_lp(req.rig)
     if project_lp is not None:  # an RTIBuilder project folder: planned on its .lp, as given
-        said = project_replayed_note(req.rig, project_lp).replace("replaying", "planning on")
+        said = project_lp_note(req.rig, project_lp, "planning on")
         planned = plan_lights(replace(req, rig=project_lp))
         return replace(planned, notes=(said, *planned.notes))
     method, objective = req.method_or_default, req.objective_or_default
