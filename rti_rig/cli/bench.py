@@ -20,12 +20,12 @@ bench_app = typer.Typer(
 app.add_typer(bench_app, name="bench")
 
 
-
 def _plain(text: str) -> None:
     """Print ``text`` as it is. Why: the trade-off's progress lines and summary carry paths
     (the acquisition's, the --out folder's), and rich's markup took a folder's ``[v2]`` for a
     style tag and dropped it (a ``[/x]`` would have raised MarkupError)."""
     out.print(text, highlight=False, markup=False)
+
 
 def _find_benchmarks() -> None:
     """Make the checkout's ``benchmarks`` package importable for the installed command.
@@ -224,9 +224,7 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
             raise fail(exc) from None
     if from_lp is not None:
         try:
-            text = bench_from(
-                from_lp, out_dir, _plain, force=force
-            )
+            text = bench_from(from_lp, out_dir, _plain, force=force)
         except RtiRigError as exc:
             raise fail(exc) from None
         except ValueError as exc:
