@@ -52,8 +52,10 @@ def test_the_advised_metering_run_keeps_to_the_band(tmp_path: Path) -> None:
         ],
     )
     assert r.exit_code == 2, r.output
-    assert f"rti-rig run {cfg} --out TEST --lights 6 --max-elevation-deg 30 --auto-exposure" in (
-        said(r)
+    metering = tmp_path / "s-metering"
+    assert (
+        f"rti-rig run {cfg} --out {metering} --lights 6 --max-elevation-deg 30 --auto-exposure"
+        in said(r)
     )
     assert "then run this command again without --auto-exposure" in said(r)
     assert not (tmp_path / "s").exists()

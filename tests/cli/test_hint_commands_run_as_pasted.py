@@ -223,3 +223,21 @@ def test_a_minimum_without_a_target_advises_a_whole_command_with_one(tmp_path: P
     command = command_after(r.stderr, "as the guide shows): ", ", or leave")
     assert "--until-error 2 --min-lights 6 --max-elevation-deg 60" in command, command
     accepted_as_pasted(tmp_path, command, "S")
+
+
+def test_an_adaptive_auto_exposure_advises_a_metering_run_into_a_free_folder(
+    tmp_path: Path,
+) -> None:
+    """The metering run advised had been ``--out TEST``: pasted where a TEST folder of an
+    earlier metering run was left, it was refused; the folder named is one not there yet, and
+    pasted, the run meters ("Exposure fixed at")."""
+    rig = eight_led_dome(tmp_path)
+    (tmp_path / "TEST").mkdir()
+    (tmp_path / "TEST" / "keep.txt").write_text("x", encoding="utf-8")
+    r = rti_rig(tmp_path, "run", rig, "--out", "S", "--adaptive", "--auto-exposure")
+    assert r.returncode == 2, r.stderr
+    command = command_after(r.stderr, "Meter once with a planned run (", " prints")
+    assert " --out S-metering " in command, command
+    done = pasted_run(tmp_path, command + " --no-verdict")
+    assert done.returncode == 0, done.stderr
+    assert "Exposure fixed at" in " ".join((done.stdout + done.stderr).split())

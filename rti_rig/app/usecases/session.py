@@ -1248,10 +1248,13 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     if req.auto_exposure:
         refuse_unmeterable_rig(loaded)  # no planned run meters these either: say so first
+        # the metering run's --out a folder not there yet beside the session's ('--out TEST'
+        # pasted was refused where a TEST of an earlier metering run was left non-empty)
+        metering = shell_word(str(free_folder_beside(Path(req.out_dir), "metering")))
         raise RtiRigError(
             f"{req.adaptive_option} cannot meter the exposure: its lights are chosen as the images "
             "arrive, so there is no brightest planned light to meter at. Meter once with a "
-            f"planned run (rti-rig run {shell_word(str(req.rig_config))} --out TEST "
+            f"planned run (rti-rig run {shell_word(str(req.rig_config))} --out {metering} "
             f"{_metering_options(req, loaded)} --auto-exposure prints 'Exposure fixed at T s'), "
             "set camera.exposure_s = T in the rig config, then run this command again without "
             "--auto-exposure"
