@@ -34,6 +34,7 @@ from rti_rig.app.config import CALIBRATION_FORMAT as FORMAT
 from rti_rig.app.dead_led import dead_led_recorded
 from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.out_folders import free_folder_beside
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.core.toml_strings import toml_basic_string
@@ -167,6 +168,19 @@ def read_card_session(root: Path | str, rig_name: str | None = None) -> CardSess
         ) from None
 
 
+def _card_again(root: Path, rig: dict[str, Any]) -> str:
+    """The command that shoots the card again under every LED: the session's own rig config
+    (its manifest's ``config_path``) into a folder not there yet beside it.
+
+    Why: "rti-rig run RIG --out CARD_SESSION" had been printed, which pasted ran a rig file
+    named RIG. A manifest naming no config leaves the config to the user, said as such."""
+    out = shell_word(str(free_folder_beside(root, "again")))
+    config = rig.get("config_path")
+    if not isinstance(config, str) or not config:
+        return f"rti-rig run with the dome's rig config and --out {out}"
+    return f"rti-rig run {shell_word(config)} --out {out}"
+
+
 def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | None) -> CardSession:
     rig = manifest["rig"]
     if rig_name is not None and rig.get("name") != rig_name:
@@ -227,7 +241,7 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
     if len(steps) < 4:
         raise SessionError(
             f"{shown_path(root)}: {len(steps)} image(s); shoot the card under every LED of the "
-            "dome (rti-rig run RIG --out CARD_SESSION, with no --lights)"
+            f"dome (with no --lights): {_card_again(root, rig)}"
         )
     directions = _step_directions(root, steps)
     _refuse_unverified(root, steps, len(planned))

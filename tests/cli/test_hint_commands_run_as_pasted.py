@@ -241,3 +241,21 @@ def test_an_adaptive_auto_exposure_advises_a_metering_run_into_a_free_folder(
     done = pasted_run(tmp_path, command + " --no-verdict")
     assert done.returncode == 0, done.stderr
     assert "Exposure fixed at" in " ".join((done.stdout + done.stderr).split())
+
+
+@pytest.mark.pty
+def test_a_card_session_of_too_few_images_advises_the_card_shot_again_as_a_command(
+    tmp_path: Path,
+) -> None:
+    """``calibrate-lights`` of a card shot under 3 LEDs had said "rti-rig run RIG --out
+    CARD_SESSION", which pasted ran a rig file named RIG: it names the session's own config
+    and a folder not there yet, and pasted, that run is accepted."""
+    from card_support import card_rig
+
+    cfg = card_rig(tmp_path)
+    assert rti_rig(tmp_path, "run", cfg, "--lights", "3", "--out", "card").returncode == 0
+    r = rti_rig(tmp_path, "calibrate-lights", "card", "--rig", cfg)
+    assert r.returncode == 2, r.stderr
+    command = command_after(r.stderr, "(with no --lights): ", "\n")
+    assert command == f"rti-rig run {shlex.quote(str(cfg))} --out card-again", command
+    accepted_as_pasted(tmp_path, command, "card-again")
