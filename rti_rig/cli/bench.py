@@ -11,7 +11,11 @@ from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, print_notes, shown_path
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.out_folders import ensure_writable_folder, refuse_a_file_in_the_way
+from rti_rig.core.out_folders import (
+    ensure_writable_folder,
+    free_name,
+    refuse_a_file_in_the_way,
+)
 from rti_rig.core.shell_words import shell_word
 
 bench_app = typer.Typer(
@@ -192,6 +196,17 @@ def _check_out_folder(out_dir: Path, force: bool, acquisition: Sequence[Path] = 
     ensure_writable_folder(out_dir)
 
 
+def _nothing_written(options: str) -> str:
+    """What is said after a trade-off run without ``--out``: the same command with a folder not
+    there yet (``options``: its own, as shell words). Why: "give --out DIR" pasted as printed
+    wrote the results into a folder named DIR (a second time, refused as not empty)."""
+    keep = shell_word(free_name(Path("tradeoff"), folder=True))
+    return (
+        "(nothing written: to keep the results, run it with --out: rti-rig bench tradeoff"
+        f"{options} --out {keep})"
+    )
+
+
 def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bool) -> None:
     """The body of ``bench tradeoff``, once the command has found the benchmarks."""
     import time
@@ -231,7 +246,7 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
             raise fail(RtiRigError(str(exc))) from None
         _plain(text)
         if out_dir is None:
-            out.print("(nothing written: give --out DIR to keep the results)", highlight=False)
+            _plain(_nothing_written(f" --from {shell_word(from_lp)}"))
         return
 
     settings = TradeoffSettings.quick() if quick else TradeoffSettings()
@@ -250,4 +265,4 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
         (out_dir / "summary.md").write_text(text, encoding="utf-8")
     _plain(text)
     if out_dir is None:
-        out.print("(nothing written: give --out DIR to keep the results)", highlight=False)
+        _plain(_nothing_written(" --quick" if quick else ""))

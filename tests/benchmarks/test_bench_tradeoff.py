@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import shlex
 from pathlib import Path
 
 import numpy as np
@@ -94,6 +95,14 @@ def test_bench_writes_nothing_unless_asked(  # type: ignore[no-untyped-def]
     assert r.exit_code == 0, r.output
     assert list(tmp_path.rglob("*")) == []
     assert "nothing written" in r.output
+    # the way to keep them is the command with a folder not there yet ("give --out DIR",
+    # pasted, wrote into a folder named DIR): it writes there
+    said = " ".join(r.output.split())
+    command = said.split("run it with --out: ", 1)[1].split(")", 1)[0]
+    assert command == "rti-rig bench tradeoff --quick --out tradeoff", command
+    again = CliRunner().invoke(app, shlex.split(command)[1:])
+    assert again.exit_code == 0, again.output
+    assert (tmp_path / "tradeoff" / "results.csv").is_file()
     r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick", "--out", "my res"])
     assert r.exit_code == 0, r.output
     assert (tmp_path / "my res" / "results.csv").is_file()
