@@ -1163,7 +1163,13 @@ def _said_lp_unwritten(s: _Stop) -> str:
     listed = s.ending.lp_listed
     state = f"lists only {listed} of them" if listed else "is missing"
     if s.cannot:
-        remedy = f"`rti-rig export-lp {_arg(s.out_dir)} --out FILE.lp` writes one from the journal"
+        from rti_rig.runtime.session import LP_NAME
+
+        # a file not there yet: the session's own lights.lp where it is missing, else beside it
+        # (a session's lights.lp is never replaced); '--out FILE.lp' had been printed, which
+        # pasted wrote a file named FILE.lp
+        lp = _arg(free_name(s.out_dir / LP_NAME))
+        remedy = f"`rti-rig export-lp {_arg(s.out_dir)} --out {lp}` writes one from the journal"
     else:
         remedy = "the resume writes it again"
     return (

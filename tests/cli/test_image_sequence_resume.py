@@ -118,3 +118,33 @@ def test_a_stop_once_every_image_is_in_says_what_fit_will_say(
     assert f"{fit_it} It cannot be resumed: its camera is an image sequence" in said, said
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
     assert "the session is not finished" in " ".join(r.output.split()), r.output
+
+
+def test_a_lights_lp_its_write_failed_is_exported_by_a_command_that_pastes(
+    dome, tmp_path: Path
+) -> None:
+    """A session that cannot be resumed and whose lights.lp could not be written (a full disk)
+    is told to export one from the journal: it had said ``--out FILE.lp``, which pasted wrote a
+    file named FILE.lp; the command names the session's own lights.lp, and pasted writes it."""
+    import errno
+    import shlex
+
+    from rti_rig.core.lp_format import read_lp
+    from rti_rig.testing.disk_faults import failing_writes
+
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for i in range(6):
+        cv2.imwrite(str(frames / f"f_{i:03d}.png"), np.full((24, 32, 3), 40 + 30 * i, np.uint8))
+    config = _config(tmp_path, frames)
+    out = tmp_path / "s"
+    with failing_writes("lp", after=0, errno_code=errno.ENOSPC):
+        r = runner.invoke(app, ["run", str(config), "--out", str(out), "--lights", "6"])
+    assert r.exit_code == 2, r.output
+    said = " ".join(r.output.split())
+    assert "lights.lp could not be written and is missing" in said, said
+    command = said.split("(`", 1)[1].split("` writes one from the journal", 1)[0]
+    assert command == f"rti-rig export-lp {out} --out {out / 'lights.lp'}", command
+    done = runner.invoke(app, shlex.split(command)[1:])
+    assert done.exit_code == 0, done.output
+    assert len(read_lp(out / "lights.lp")) == 1
