@@ -115,8 +115,19 @@ class ReplayCamera:
         try:
             return recorded_frame_pixels(path)
         except (OSError, SessionError) as exc:
-            if path.is_file() and not isinstance(exc, OSError):
+            there = path.is_file()
+            if there and not isinstance(exc, OSError):
                 raise  # there, but not readable as an image: the reader's words say why
+            if there and isinstance(exc, OSError):
+                # there, but the system refused its read: its own reason, not "moved or
+                # deleted?" of a file still in its place (a permission, a failing drive's EIO)
+                raise CaptureError(
+                    self.name,
+                    f"cannot read the recorded file {shown_path(path)}: "
+                    f"{exc.strerror or exc}; make it readable (for an I/O error, check the "
+                    "drive that holds it), then resume",
+                    "capture",
+                ) from None
             raise CaptureError(
                 self.name,
                 f"cannot read the recorded file {shown_path(path)}, there when the run began "

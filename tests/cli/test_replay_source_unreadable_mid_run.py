@@ -124,3 +124,28 @@ def test_the_first_recorded_file_gone_as_it_is_kept_leaves_the_folder_to_run_aga
     r = runner.invoke(app, command)
     assert r.exit_code == 0, said(r)
     assert len(journal(tmp_path / "s")) == 4
+
+
+def test_a_recorded_file_there_but_refused_by_the_system_is_said_with_its_reason(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A recorded file still in its place whose read the system refuses (a permission, a
+    failing drive's I/O error) is said with the system's reason: it had been said to be gone,
+    "its drive unplugged, or the file moved or deleted?", of a file the user then finds there."""
+    lp = _acquisition(tmp_path / "acq")
+    refused = lp.parent / "IMG 1.JPG"
+    read = replay.recorded_frame_pixels
+
+    def refused_read(path: Path) -> np.ndarray:
+        if path == refused:
+            raise PermissionError(13, "Permission denied", str(path))
+        return read(path)
+
+    monkeypatch.setattr(replay, "recorded_frame_pixels", refused_read)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--no-verdict"])
+    text = said(r)
+    assert r.exit_code != 0, text
+    assert f"cannot read the recorded file {refused}: Permission denied" in text, text
+    assert "moved or deleted" not in text, text
+    assert [e["index"] for e in journal(out)] == [0]
