@@ -374,11 +374,15 @@ class RigConfig(_Strict):
         rehearsal of a lost status packet ran a clean check ("PASS") and rehearsed nothing."""
         if self.kind != "arm":
             for i, fault in enumerate(self.emulator.faults):
-                if fault.kind in ARM_HARDWARE_FAULTS or fault.servo_id is not None:
+                # power_lost too: the dome's firmware emulator has no such fault, and it had
+                # reached the user as a traceback ("'power_lost' is not a valid FaultKind")
+                chain = fault.kind == "power_lost"
+                if fault.kind in ARM_HARDWARE_FAULTS or chain or fault.servo_id is not None:
+                    whose = "the servo chain's" if chain else "a servo's"
                     raise ValueError(
                         f"emulator.faults[{i}]: {fault.kind}"
-                        f"{' with servo_id' if fault.servo_id is not None else ''} is a "
-                        "servo's fault, rehearsed on an emulated arm; a dome's firmware "
+                        f"{' with servo_id' if fault.servo_id is not None else ''} is "
+                        f"{whose} fault, rehearsed on an emulated arm; a dome's firmware "
                         "rehearses drop_reply, garble_reply, garble_command, delay_reply, "
                         "disconnect, reset and reset_after_reply"
                     )

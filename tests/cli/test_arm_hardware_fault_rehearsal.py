@@ -67,6 +67,15 @@ def test_a_hardware_fault_needs_one_of_the_arms_servos_and_is_refused_on_a_dome(
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "overload with servo_id is a servo's fault" in said
+    # the chain's power lost is the servos' too: it had reached the user as a traceback
+    dome.write_text(
+        (CONFIGS / "emulated_nab_rti_v1.toml").read_text()
+        + '\n[[emulator.faults]]\nat_command = 5\nkind = "power_lost"\n'
+    )
+    r = runner.invoke(app, ["check", str(dome)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "Traceback" not in said, said
+    assert "emulator.faults[0]: power_lost is the servo chain's fault" in said, said
 
 
 def test_two_servos_faulting_at_one_packet_are_both_rehearsed(
