@@ -414,9 +414,13 @@ class RigConfig(_Strict):
                     + " or ".join(str(i) for i in ids)
                 )
             if fault.kind not in ARM_HARDWARE_FAULTS and fault.servo_id is not None:
+                what = (
+                    "silences every servo of the chain"  # its supply, not one servo's
+                    if fault.kind == "power_lost"
+                    else "loses the status packet of whichever servo answers"
+                )
                 raise ValueError(
-                    f"emulator.faults[{i}].servo_id: a {fault.kind} loses the status packet "
-                    "of whichever servo answers; remove servo_id"
+                    f"emulator.faults[{i}].servo_id: a {fault.kind} {what}; remove servo_id"
                 )
 
     @model_validator(mode="after")

@@ -76,6 +76,12 @@ def test_a_hardware_fault_needs_one_of_the_arms_servos_and_is_refused_on_a_dome(
     said = " ".join(r.output.split())
     assert r.exit_code == 2 and "Traceback" not in said, said
     assert "emulator.faults[0]: power_lost is the servo chain's fault" in said, said
+    # and on an arm, a servo_id is not said to pick whose status packet is lost
+    power = '\n[[emulator.faults]]\nat_command = 5\nkind = "power_lost"\nservo_id = 1\n'
+    r = runner.invoke(app, ["check", str(_config(tmp_path, power))], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "a power_lost silences every servo of the chain; remove servo_id" in said, said
 
 
 def test_two_servos_faulting_at_one_packet_are_both_rehearsed(
