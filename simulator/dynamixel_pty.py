@@ -45,8 +45,9 @@ from typing import Any
 
 import dynamixel_sdk
 
+from rti_rig.core.clock import Clock
 from rti_rig.core.deferred_signals import signals_deferred
-from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.simulator.dynamixel_bus_time import BusTime, return_delay_s, wire_time_s
 from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
 from rti_rig.simulator.pty_link import HostBaudDevice, host_baud
 
@@ -69,6 +70,8 @@ class LinkLedger:
 
     def __init__(self) -> None:
         self.lock = threading.Lock()
+        #: notified (``lock`` held) as the emulator has handled more of what the host sent
+        self.handled = threading.Condition(self.lock)
         self.host_sent = 0
         self.device_read = 0
         self.device_sent = 0
@@ -85,13 +88,6 @@ class LinkLedger:
         )
 
 
-#: Bits one byte takes on the wire: start bit, 8 data bits, stop bit (ROBOTIS e-manual, X
-#: series specifications, Physical Connection: "8bit, 1stop, No Parity").
-BITS_PER_BYTE = 10
-#: Return Delay Time (9) unit, seconds (e-manual, X-series control table: 2 [μsec]).
-RETURN_DELAY_UNIT_S = 2e-6
-
-
 def real_time_replies(
     emulator: DynamixelBusEmulator, reply: bytes, baud: int | None, heard: int = 0
 ) -> list[tuple[float, bytes]]:
@@ -105,15 +101,13 @@ def real_time_replies(
     Why: replies to a plain ``PortHandler`` had come after a fixed 0.5 ms whatever the servo's
     Return Delay Time, and at no wire speed, so a host rehearsing against the served pty met
     a faster bus than its own (a 15-byte status takes 2.6 ms at the factory 57600 baud)."""
-    byte_s = BITS_PER_BYTE / baud if baud else 0.0
     out: list[tuple[float, bytes]] = []
     i = 0
     while i + 7 <= len(reply):
         n = 7 + int.from_bytes(reply[i + 5 : i + 7], "little")  # header, id, LEN, then LEN
         packet = reply[i : i + n]
-        servo = emulator.servos.get(reply[i + 4])
-        delay = servo.get(ct.RETURN_DELAY_TIME) * RETURN_DELAY_UNIT_S if servo else 0.0
-        wire = (len(packet) + (heard if not out else 0)) * byte_s
+        delay = return_delay_s(emulator.servos, reply[i + 4])
+        wire = wire_time_s(len(packet) + (heard if not out else 0), baud)
         out.append((delay + wire, packet))
         i += n
     if i < len(reply):  # not a whole packet: sent as it is, at once
@@ -172,15 +166,17 @@ class PtyServoServer:
         self._thread.start()
         return self.device_path
 
-    def port_handler(self) -> EmulatedLinkPortHandler:
-        """The SDK's ``PortHandler`` on this pty, with causal reply timeouts (module docstring).
+    def port_handler(self, clock: Clock | None = None) -> EmulatedLinkPortHandler:
+        """The SDK's ``PortHandler`` on this pty, with causal reply timeouts (module docstring),
+        charging ``clock`` (the emulator's unless given) with the bus's time
+        (:class:`~rti_rig.simulator.dynamixel_bus_time.BusTime`).
 
         From the first call on, replies follow the ledger (held until the host listens)."""
         if self.device_path is None:
             raise RuntimeError("start() the server before asking for its port")
         if self.ledger is None:
             self.ledger = LinkLedger()
-        return EmulatedLinkPortHandler(self.device_path, self)
+        return EmulatedLinkPortHandler(self.device_path, self, clock)
 
     def send(self, data: bytes) -> None:
         """Put status bytes on the wire (call with the ledger's lock held)."""
@@ -215,6 +211,7 @@ class PtyServoServer:
             if ledger is not None:
                 with ledger.lock:
                     ledger.device_read += len(data)
+                    ledger.handled.notify_all()
                     if reply and ledger.listening:
                         self.send(reply)
                     elif reply:
@@ -273,13 +270,22 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
     """``dynamixel_sdk.PortHandler`` whose reply timeout is causal, not wall time.
 
     Everything else is the SDK's own (pyserial on the pty, baud checks, packet timing
-    bookkeeping). Counts every byte in and out in the server's :class:`LinkLedger`."""
+    bookkeeping). Counts every byte in and out in the server's :class:`LinkLedger`.
 
-    def __init__(self, port_name: str, server: PtyServoServer) -> None:
+    ``clock`` (the emulator's unless given) is charged the bus's time as the host meets it
+    (:class:`~rti_rig.simulator.dynamixel_bus_time.BusTime`): the ledger hands a status over as
+    soon as the host listens, and a dry run had paid no wire time nor Return Delay Time."""
+
+    def __init__(self, port_name: str, server: PtyServoServer, clock: Clock | None = None) -> None:
         super().__init__(port_name)
         assert server.ledger is not None
         self._server = server
         self._ledger = server.ledger
+        self.bus_time = BusTime(
+            clock if clock is not None else server.emulator.clock,
+            server.emulator.servos,
+            self.getBaudRate,
+        )
 
     def _listen(self) -> None:
         ledger = self._ledger
@@ -332,6 +338,7 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
             ledger.listening = False
             self._server.emulator.take_late()  # arrived before the clear: discarded too
         self._take_waiting()
+        self.bus_time.cleared()
 
     def _take_waiting(self) -> None:
         """Read and drop what has arrived, counted as consumed (as one step: see
@@ -360,10 +367,27 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
         with signals_deferred():
             with ledger.lock:
                 ledger.listening = False
+            self.bus_time.sent(bytes(packet))  # the servos act once its last byte is in
             n = super().writePort(packet)
             with ledger.lock:
                 ledger.host_sent += int(n or 0)
+        self._handled()
         return n
+
+    def _handled(self) -> None:
+        """Wait until the emulator has handled every byte sent (bounded by
+        :data:`LOST_LINK_S`), as the in-process port's write does.
+
+        Why: the emulator reads the clock as it handles an instruction, and the host charges
+        the clock with the bus's time (the next instruction's bytes, a poll's sleep) right
+        after a write it reads no status for (a Sync Write): the two raced, so a goal started
+        a few milliseconds late or not, and a dry run's session time varied from run to run
+        (30.14 or 30.17 s for one plan). Waiting on the thread's notice costs no busy loop."""
+        ledger = self._ledger
+        with ledger.handled:
+            ledger.handled.wait_for(
+                lambda: ledger.device_read >= ledger.host_sent, timeout=LOST_LINK_S
+            )
 
     def readPort(self, length: int) -> bytes:
         """The SDK's read and its count as one step (see :meth:`writePort`)."""
@@ -372,6 +396,7 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
             data = super().readPort(length)
             with self._ledger.lock:
                 self._ledger.host_got += len(data)
+        self.bus_time.heard(bytes(data))
         return data
 
     def isPacketTimeout(self) -> bool:
