@@ -1,7 +1,9 @@
 """docs/planning.md says how long the shipped simulated arm's dry run of a uniform plan takes on
 the real rig ("17 s for 6 lights, 29 s for 12 …"), a figure a reader uses to choose a light
 count. No test read it: walking the page found 30 s for 12 lights where the run said 29.3 s
-(the arm's move order had changed since). The 12-light plan is checked, through the CLI."""
+(the arm's move order had changed since). The 12-light plan is checked, through the CLI, to
+the tenth of a second the page gives (the bus's wire time and Return Delay Time, 2.5 % of
+the session, had hidden within whole seconds)."""
 
 from __future__ import annotations
 
@@ -22,7 +24,9 @@ ARM = CONFIGS / "simulated_arm.toml"
 def _said_seconds(lights: int) -> float:
     """The seconds planning.md gives for a uniform plan of ``lights`` on the simulated arm."""
     text = " ".join(PLANNING.read_text(encoding="utf-8").split())
-    found = re.search(r"\(uniform: no preview\) reports (\d+) s for 6 lights, (\d+) s for 12", text)
+    found = re.search(
+        r"\(uniform: no preview\) reports (\d+\.\d) s for 6 lights, (\d+\.\d) s for 12", text
+    )
     assert found, "planning.md's arm dry-run times are gone"
     return float(found.group({6: 1, 12: 2}[lights]))
 
@@ -42,5 +46,7 @@ def test_planning_md_gives_the_simulated_arms_time_for_a_12_light_uniform_plan(
     )
     assert r.exit_code == 0, r.output
     rig_s = json.loads((out / "manifest.json").read_text(encoding="utf-8"))["timing"]["rig_time_s"]
-    # whole seconds on the page; the arm's clock is simulated, so the figure is the same each run
-    assert abs(_said_seconds(12) - rig_s) <= 0.5, (_said_seconds(12), rig_s)
+    # tenths of a second on the page (whole seconds had hidden the bus's 2.5 %: 29 s said,
+    # 29.3 s without the wire time, 30.1 s with it); the arm's clock is simulated, so the
+    # figure is the same each run (on freshly powered servos, as every test's are)
+    assert abs(_said_seconds(12) - rig_s) <= 0.05, (_said_seconds(12), rig_s)
