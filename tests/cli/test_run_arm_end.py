@@ -108,7 +108,9 @@ def test_a_completed_run_says_the_arm_parked_where_read_back_and_its_moving_time
     )
     parking = re.search(r"s, and parking it (\d+\.\d) s", said)
     assert parking is not None, said
-    assert after_last > 0.5 and float(parking[1]) == pytest.approx(after_last, abs=0.1), said
+    # the rest beyond the park (said to the tenth) is the teardown's few exchanges on the bus,
+    # lamp off, stop, read-back and close (0.06 s at simulated_arm.toml's 57600 baud)
+    assert after_last > 0.5 and -0.05 <= after_last - float(parking[1]) < 0.15, said
     if shipped == "virtual_arm.toml":  # the rig bench tradeoff times its arm column on
         _the_benchmark_times_the_arm_as_run_does(out)
 
