@@ -947,7 +947,7 @@ class InProcessPort:
     :mod:`rti_rig.simulator.dynamixel_pty`.)
 
     ``clock`` (the emulator's unless given) is charged what a real half-duplex bus takes
-    (:class:`~rti_rig.simulator.dynamixel_wire.BusTime`): each instruction's wire time at the
+    (:class:`~rti_rig.simulator.dynamixel_bus_time.BusTime`): each instruction's wire time at the
     port's baud rate as it is written, each status's Return Delay Time and wire time as it is
     read. Why: replies had come in no time, and a dry run's session time was about 2.5 %
     short of the same schedule on a real bus at 57600 baud."""
