@@ -418,7 +418,10 @@ def step_candidates(
     takes the next when one is refused.
 
     ``edge_set``: the :class:`EdgeImages` of these ``crops`` and ``usable`` already made (else
-    made here).
+    made here). ``lights`` (unit vectors, one per image): the sides' shift is then measured
+    between the medians of their images lit alike (:func:`lit_alike`) where at least
+    :data:`STEP_MIN_IMAGES` pairs are; a capture order that sweeps the hemisphere (the arm's)
+    lights the two sides from different halves, and their shading edges differ as well.
     """
     n = crops.shape[0]
     if edge_set is None:
