@@ -418,10 +418,11 @@ def step_candidates(
     takes the next when one is refused.
 
     ``edge_set``: the :class:`EdgeImages` of these ``crops`` and ``usable`` already made (else
-    made here). ``lights`` (unit vectors, one per image): the sides' shift is then measured
-    between the medians of their images lit alike (:func:`lit_alike`) where at least
-    :data:`STEP_MIN_IMAGES` pairs are; a capture order that sweeps the hemisphere (the arm's)
-    lights the two sides from different halves, and their shading edges differ as well.
+    made here). ``lights`` (unit vectors, one per image): the two sides are then the medians
+    of their images lit alike (:func:`lit_alike`) where at least :data:`STEP_MIN_IMAGES`
+    pairs are, for the shift and each image's label alike; a capture order that sweeps the
+    hemisphere (the arm's) lights the two sides from different halves, and their shading
+    edges differ as well.
     """
     n = crops.shape[0]
     if edge_set is None:
@@ -496,18 +497,15 @@ def step_candidates(
             return None
         return before, after
 
-    def sides_shift(
-        before: list[int], after: list[int], ref_a: NDArray, ref_b: NDArray
-    ) -> tuple[tuple[float, float], float]:
-        """The after side's shift against the before side: between the medians of their
-        images lit alike (:func:`lit_alike`) where ``lights`` are given and enough pairs
-        are, else between the two sides' medians."""
+    def side_medians(before: list[int], after: list[int]) -> tuple[NDArray, NDArray]:
+        """The two sides' median edge images: of their images lit alike (:func:`lit_alike`)
+        where ``lights`` are given and at least :data:`STEP_MIN_IMAGES` pairs are, else of
+        every image of each side. The shift is measured between them, each image is
+        labelled against the first, and the two must agree better moved back."""
         pairs = lit_alike(lights, before, after) if lights is not None else []
         if len(pairs) >= STEP_MIN_IMAGES:
-            a = median_of([i for i, _ in pairs])
-            b = median_of([j for _, j in pairs])
-            return local_phase_correlation(a, b, window)
-        return local_phase_correlation(ref_a, ref_b, window)
+            return median_of([i for i, _ in pairs]), median_of([j for _, j in pairs])
+        return median_of(before), median_of(after)
 
     def judged(first: int | None) -> Step | None:
         """The step the split before ``first`` refines to, if the images bear it out."""
@@ -521,8 +519,8 @@ def step_candidates(
             if split is None:
                 return None
             before, after = split
-            ref_a, ref_b = median_of(before), median_of(after)
-            (dx, dy), response = sides_shift(before, after, ref_a, ref_b)
+            ref_a, ref_b = side_medians(before, after)
+            (dx, dy), response = local_phase_correlation(ref_a, ref_b, window)
             if not np.isfinite(dx) or response < MIN_RESPONSE or np.hypot(dx, dy) <= STEP_PX:
                 return None
             labels = moved_labels(ref_a, dx, dy)
