@@ -1102,11 +1102,14 @@ def _confirmed_step(
         # part its flat faces hold the median over every pixel (_where_a_move_shows)
         if edges is None:
             edges = _where_a_move_shows(crop_arr)
-        ratio = min(
-            undone / as_is,
-            _step_residual(undone_stack, fit_half, lt, step.first, pad, edges)
-            / _step_residual(as_is_stack, fit_as_is, lt, step.first, pad, edges),
-        )
+        ratios = [
+            _ratio(undone, as_is),
+            _ratio(
+                _step_residual(undone_stack, fit_half, lt, step.first, pad, edges),
+                _step_residual(as_is_stack, fit_as_is, lt, step.first, pad, edges),
+            ),
+        ]
+        ratio = min((r for r in ratios if np.isfinite(r)), default=float("inf"))
         if ratio <= DRIFT_CONFIRM:
             if best is None or ratio < best[0]:
                 best = (ratio, step)
@@ -1258,6 +1261,12 @@ def _moved_from(crop_arr: NDArray, step: Step) -> NDArray:
     for i in range(step.first, len(crop_arr)):
         moved[i] = move_back(moved[i], *step.shift)
     return moved
+
+
+def _ratio(undone: float, as_is: float) -> float:
+    """``undone / as_is``, NaN where the residual as captured is none (0 or NaN: no pixel
+    to measure), so that no ratio is made of it."""
+    return undone / as_is if np.isfinite(as_is) and as_is > 0 else float("nan")
 
 
 #: The share of the crop's pixels, those of its strongest edges, a step's residual is also

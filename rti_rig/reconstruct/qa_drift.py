@@ -364,7 +364,8 @@ def lit_alike(
     px, response 0.60."""
     if not before or not after:
         return []
-    cos = lights[before] @ lights[after].T
+    # a light not known (NaN) is lit like none
+    cos = np.nan_to_num(lights[before] @ lights[after].T, nan=-1.0)
     limit = float(np.cos(np.radians(LIT_ALIKE_DEG)))
     pairs: list[tuple[int, int]] = []
     used_a: set[int] = set()
