@@ -138,11 +138,24 @@ def arm_band_note(
         )
         if typed or value != default
     )
+    cone = f"{arm.keep_out_half_angle_deg:g}° keep-out cone around the camera"
+    written = arm.configured_max_elevation_deg
+    if written is not None and written > top:
+        # the config's own limit, said as written: "its elevation limits 0°..75°" of a config
+        # saying 90° read as if the config had been misread
+        why = (
+            f"its elevation joint may turn to {written:g}° as configured "
+            f"([arm.dynamixel.elevation] max_deg), but above {top:g}° the lamp would be "
+            f"inside the {cone}"
+        )
+    else:
+        why = (
+            f"its elevation limits {arm.min_elevation_deg:g}°..{arm.max_elevation_deg:g}° and "
+            f"the {cone}"
+        )
     return (
-        f"{asked}: the arm reaches elevations {arm.min_elevation_deg:g}°..{top:g}° (its "
-        f"elevation limits {arm.min_elevation_deg:g}°..{arm.max_elevation_deg:g}° and the "
-        f"{arm.keep_out_half_angle_deg:g}° keep-out cone around the camera), so the lights "
-        f"are spread over {lo:g}°..{hi:g}° only"
+        f"{asked}: the arm reaches elevations {arm.min_elevation_deg:g}°..{top:g}° ({why}), "
+        f"so the lights are spread over {lo:g}°..{hi:g}° only"
     )
 
 

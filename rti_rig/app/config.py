@@ -1542,14 +1542,18 @@ def rig_geometry(rig: LoadedRig) -> DomeGeometry | ArmGeometry:
     assert arm is not None
     if arm.dynamixel is not None and cfg.backend != "simulated":
         dxl = arm.dynamixel
+        cone_top = 90.0 - dxl.keep_out_half_angle_deg
         return ArmGeometry(
             min_elevation_deg=max(0.0, dxl.elevation.min_deg),
-            max_elevation_deg=min(dxl.elevation.max_deg, 90.0 - dxl.keep_out_half_angle_deg),
+            max_elevation_deg=min(dxl.elevation.max_deg, cone_top),
             keep_out_half_angle_deg=dxl.keep_out_half_angle_deg,
             park_azimuth_deg=dxl.park_azimuth_deg,
             park_elevation_deg=dxl.park_elevation_deg,
             min_azimuth_deg=max(-180.0, dxl.azimuth.min_deg),
             max_azimuth_deg=min(180.0, dxl.azimuth.max_deg),
+            configured_max_elevation_deg=(
+                dxl.elevation.max_deg if dxl.elevation.max_deg > cone_top else None
+            ),
         )
     return ArmGeometry(
         min_elevation_deg=arm.min_elevation_deg,

@@ -111,7 +111,10 @@ def rig_identity(loaded: LoadedRig) -> dict[str, Any]:
     else:
         ident["lights"] = "one lamp on an arm"
         ident["arm_reach"] = {
-            k: round(float(v), 6) for k, v in dataclasses.asdict(geometry).items()
+            k: round(float(v), 6)
+            for k, v in dataclasses.asdict(geometry).items()
+            # words only (the config's own limit past the keep-out cone): the reach is the same
+            if k != "configured_max_elevation_deg"
         }
     cam = cfg.camera
     ident["camera_size"] = f"{cam.width}×{cam.height}"

@@ -6,7 +6,7 @@ elevations minus a keep-out cone around the camera. Both come from the rig confi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -166,6 +166,12 @@ class ArmGeometry:
     #: Azimuth range of the arm's base joint, in (-180, 180] terms (a cable stops a full turn).
     min_azimuth_deg: float = -180.0
     max_azimuth_deg: float = 180.0
+    #: The elevation joint's upper limit as the config writes it, when the keep-out cone stops
+    #: the arm below it (``max_elevation_deg`` is then ``90 - keep_out_half_angle_deg``); None
+    #: otherwise. Why: a note said "its elevation limits 0°..75°" of a config saying 90°, as if
+    #: the config had been misread. Only words use it: it is left out of comparisons and of the
+    #: rig's identity (the reach itself is unchanged).
+    configured_max_elevation_deg: float | None = field(default=None, compare=False)
 
     @property
     def park_direction(self) -> NDArray[np.float64]:

@@ -95,3 +95,20 @@ def test_the_default_band_is_not_said_to_be_cut(tmp_path: Path) -> None:
         r = runner.invoke(app, argv)
         assert r.exit_code == 0, said(r)
         assert "the arm reaches" not in said(r), said(r)
+
+
+def test_a_dynamixel_arm_s_configured_limit_is_said_as_written(tmp_path: Path) -> None:
+    """The shipped Dynamixel arm's config lets its elevation joint turn to 90°; the 15° keep-out
+    cone stops the lamp at 75°. The note had said "its elevation limits 0°..75°", as if the
+    config's 90° had been misread: it says the config's limit and why less is used."""
+    arm = str(CONFIGS / "simulated_arm.toml")
+    out = tmp_path / "p.lp"
+    argv = ["plan", "--rig", arm, "--lights", "8", "--method", "uniform", "--out", str(out)]
+    r = runner.invoke(app, [*argv, "--max-elevation-deg", "90"])
+    text = said(r)
+    assert r.exit_code == 0, text
+    assert "the arm reaches elevations 0°..75° " in text, text
+    assert "(its elevation joint may turn to 90° as configured ([arm.dynamixel.elevation] " in text
+    assert "max_deg), but above 75° the lamp would be inside the 15° keep-out cone" in text
+    assert "elevation limits 0°..75°" not in text, text
+    assert "so the lights are spread over 0°..75° only" in text, text
