@@ -1417,7 +1417,12 @@ def _moving_clause(rig, folder) -> str:  # type: ignore[no-untyped-def]
     ``light_s`` (from a step's start until its lamp is on, i.e. the move and the lamp-on; all
     runs' images), then this run's park at its end as timed on the rig's clock; "" for a
     dome. Why: only the total was said, and on an arm the moves are the part a faster profile
-    or a better light order would cut."""
+    or a better light order would cut.
+
+    "(and switching its lamp on)" is said only of a lamp rti-rig switches (a simulated arm's,
+    or ``lamp = "servo_led"``): it had been said of a ``lamp = "software"`` lamp, whose switch
+    is outside the servo bus and which no command of rti-rig reaches."""
+    from rti_rig.app.usecases.safe_state import software_lamp
     from rti_rig.runtime.lighting import ArmLighting
 
     if not isinstance(rig.lighting, ArmLighting) or not folder.committed:
@@ -1438,7 +1443,8 @@ def _moving_clause(rig, folder) -> str:  # type: ignore[no-untyped-def]
         if runs <= 1
         else f", and {what} at this run's end {park:.1f} s"
     )
-    return f"; of which moving the arm (and switching its lamp on) {moving:.1f} s{parked}"
+    lamp = "" if software_lamp(rig.lighting) else " (and switching its lamp on)"
+    return f"; of which moving the arm{lamp} {moving:.1f} s{parked}"
 
 
 def _execute(opened, handover: HandOver | None = None) -> bool:  # type: ignore[no-untyped-def]
