@@ -117,6 +117,15 @@ class RebootOutcome:
         )
 
 
+def _no_reply(exc: Exception) -> bool:
+    """Whether ``exc`` is a servo's silence (no status within its reply window), after which
+    nothing is known of it: its supply may be gone (torque off, the joint limp) as well as a
+    cable, the servo still powered and holding. A corrupted reply or an error number came from
+    a powered servo. Read from the SDK's result name in the message, as the Status Return
+    Level check does (the bus raises one :class:`CommunicationError` for both)."""
+    return isinstance(exc, CommunicationError) and "COMM_RX_TIMEOUT" in exc.message
+
+
 def _fault_names(status: int) -> str:
     return ", ".join(f.name.lower().replace("_", " ") for f in ct.decode_hardware_error(status))
 
@@ -1003,6 +1012,10 @@ class DynamixelArm(ReadBackCarrier):
                 + (
                     " (the arm may sag)"
                     if isinstance(exc, HardwareFaultError) and exc.torque_on is False
+                    else " — no reply: unpowered, it is limp and the arm may sag; powered, it "
+                    "may still be moving to its last goal, a pose checked safe before it was "
+                    "sent; look at the arm before touching it"
+                    if _no_reply(exc)
                     else " — it may still be moving to its last goal, a pose checked safe "
                     "before it was sent; switch the arm's power off if it does not stop"
                 )
@@ -1017,6 +1030,7 @@ class DynamixelArm(ReadBackCarrier):
                 sid,
                 isinstance(exc, HardwareFaultError),
                 exc.torque_on if isinstance(exc, HardwareFaultError) else None,
+                _no_reply(exc),
             )
             for sid, exc in failed
         )

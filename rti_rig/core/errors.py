@@ -78,12 +78,16 @@ class UnheldJoint:
 
     ``fault``: the servo answered with a hardware fault (an overload, overheating…), for which
     a servo may shut itself down, torque off; ``torque_on``: its Torque Enable as read after
-    that fault (None: not read, or no fault was read: a servo that did not answer)."""
+    that fault (None: not read, or no fault was read: a servo that did not answer);
+    ``no_reply``: the servo sent no status at all (its reply window ran out), so nothing is
+    known of it: it may be unpowered (the chain's supply gone: torque off, the joint limp) as
+    well as powered and holding its last goal."""
 
     joint: str
     servo_id: int
     fault: bool
     torque_on: bool | None = None
+    no_reply: bool = False
 
 
 class StopIncomplete(DeviceError):

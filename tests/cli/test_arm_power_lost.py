@@ -53,6 +53,18 @@ def test_a_chain_that_loses_its_power_is_said_after_one_servos_allowance(
     assert r.exit_code != 0 and "Traceback" not in said, said
     assert "has stopped answering: its cable, the chain of cables to it, or the servos' " in said
     assert "but late" not in said, said  # no slow link: a silent one
+    # silent servos, their supply perhaps gone: limp or holding, not known; it had been said
+    # "a servo no command reaches keeps its last goal under torque" beside that very error
+    assert "— no reply: unpowered, it is limp and the arm may sag; powered, it may " in said
+    assert "look at the arm before touching it" in said, said
+    assert "keeps its last goal under torque, so the arm may hold" not in said, said
+    if command == "run":
+        assert (
+            "the azimuth servo (id 1) and the elevation servo (id 2) give no reply, so nothing "
+            "is known of them: unpowered, a servo is limp and the arm may sag; powered, it "
+            "keeps its last goal under torque" in said
+        ), said
+        assert "look at the arm before touching it, support the arm and switch its " in said
     (port,) = ports
     waited_s = (port.silent_ms - port.silent_at_loss) / 1000  # type: ignore[attr-defined]
     # the first silent servo's allowance (34 + 500 + 500 ms), then the SDK's window for the

@@ -167,7 +167,11 @@ def not_sent_sentence(
         for joint in faulted:
             known.append(_faulted_joint_said(joint))
             may_sag = may_sag or joint.torque_on is not True
-        if not faulted or any(not j.fault for j in unheld):
+        silent = [j for j in unheld if not j.fault and j.no_reply]
+        if silent:
+            known.append(_silent_joints_said(silent))
+            may_sag = True
+        if not (faulted or silent) or any(not (j.fault or j.no_reply) for j in unheld):
             known.append(
                 "a servo no command reaches keeps its last goal under torque, so the arm may "
                 "hold there or still be moving to it"
@@ -177,6 +181,8 @@ def not_sent_sentence(
         if may_sag
         else "switch the arm's power supply off"
     )
+    if stop_unsent and any(j.no_reply for j in unheld):
+        power_off = "look at the arm before touching it, " + power_off
     said += ": " + ", and ".join(known) + "; " + power_off
     if software_lamp:
         said += (
@@ -184,6 +190,19 @@ def not_sent_sentence(
             "so switch it off yourself too)"
         )
     return said
+
+
+def _silent_joints_said(joints: list[UnheldJoint]) -> str:
+    """What is known of servos that gave no reply to the stop: nothing. Why: "a servo no command
+    reaches keeps its last goal under torque" had been said beside an error blaming a lost
+    power supply, of servos that, unpowered, are limp (the arm free to sag)."""
+    servos = " and ".join(f"the {j.joint} servo (id {j.servo_id})" for j in joints)
+    verb, them = ("gives", "it") if len(joints) == 1 else ("give", "them")
+    return (
+        f"{servos} {verb} no reply, so nothing is known of {them}: unpowered, a servo is limp and "
+        "the arm may sag; powered, it keeps its last goal under torque, and the arm may hold "
+        "there or still be moving to it"
+    )
 
 
 def _faulted_joint_said(joint: UnheldJoint) -> str:
