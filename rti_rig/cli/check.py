@@ -121,9 +121,15 @@ def check(
                 lambda text: err.print(text, markup=False, highlight=False),
             )
     except CheckStopped as exc:
+        # what the walk had verified before the stop (it had been dropped: a check stopped
+        # at pose 6 of 8 said only that it had stopped), then the teardown and the stop
+        for line in exc.walk:
+            out.print(line, highlight=False, markup=False)
         for failure in exc.teardown_failures:
             err.print(f"[red]teardown problem:[/] {escape(failure)}")
         err.print(f"[red]Check stopped ({escape(exc.why)}):[/] {escape(exc.lights)}.")
+        if exc.todo:
+            err.print(exc.todo + ".", highlight=False, markup=False)
         raise typer.Exit(code=stop_exit_code(exc.signum)) from None
     except EmergencyStop as exc:  # stopped outside a self-test (loading, a camera's check)
         err.print(f"[red]Check stopped ({escape(str(exc))}):[/] check the rig's lights.")

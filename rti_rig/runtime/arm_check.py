@@ -71,6 +71,8 @@ class ArmSelfTestReport:
     #: the walk was ended by a stop (Ctrl-C, SIGTERM), not by an error: a stopped check does
     #: not park, by the user's choice (decided on here, not on how ``aborted`` begins)
     stopped_by_user: bool = False
+    #: the stop's own words ("Ctrl-C"), as a move it cut short recorded them
+    stop: str | None = None
     teardown_failures: list[str] = field(default_factory=list)
     elapsed_s: float = 0.0
     #: what may be said of an arm whose connect failed (:func:`not_connected_sentence`)
@@ -116,11 +118,28 @@ class ArmSelfTestReport:
             and (self.park_confirmed if self.park_wanted else not self.parked)
         )
 
-    def lines(self) -> list[str]:
+    def stopped_lines(self) -> list[str]:
+        """What a walk stopped by the user (Ctrl-C, SIGTERM) had verified: its heading, the
+        poses visited (the one under way when the stop came said as not verified), their move
+        times and the lamp's flashes; where the arm was left is said by the stop's own line.
+
+        Why: a stopped check printed none of the poses it had already verified, only that it
+        had stopped: a user who stopped it at pose 6 of 8 could not tell what had passed."""
+        return self._walk_lines()
+
+    def _walk_lines(self) -> list[str]:
         # the heading says how far the walk got: "arm: 3 poses" had been printed of a walk
         # stopped at pose 3 of 8, and "arm: 0 poses" with an empty table of one never started
         label, done = arm_label(self.name), len(self.checks)
-        if not done:
+        verified = sum(c.ok for c in self.checks)
+        if self.stopped_by_user and not done:
+            out = [f"{label}: {self.aborted} before its first pose: no pose verified"]
+        elif self.stopped_by_user:
+            out = [
+                f"{label}: {self.aborted} at pose {done} of {self.planned}; "
+                f"{verified} verified within {self.tolerance_deg:g}°"
+            ]
+        elif not done:
             out = [f"{label}: no pose visited (see ABORTED below)"]
         elif done < self.planned:
             out = [
@@ -133,6 +152,13 @@ class ArmSelfTestReport:
             out.append("  pose               asked az/el       reached az/el     error   move")
         for c in self.checks:
             az, el = c.asked_az_el
+            if c.reached_az_el is None and self.stopped_by_user and c.message == self.stop:
+                # the move the stop cut short: not a failure of the arm
+                out.append(
+                    f"  {c.label:18s} {az:7.2f}°/{el:5.2f}°  not verified: {self.aborted} "
+                    "during this move"
+                )
+                continue
             if c.reached_az_el is None:
                 said = "see ABORTED below" if c.message == self.aborted else c.message
                 out.append(f"  {c.label:18s} {az:7.2f}°/{el:5.2f}°  FAIL {said}")
@@ -152,6 +178,10 @@ class ArmSelfTestReport:
                 f"lamp: flashed at {poses} on servo {self.lamp_servo}'s LED, on and off each "
                 "answered by the servo"
             )
+        return out
+
+    def lines(self) -> list[str]:
+        out = self._walk_lines()
         if self.aborted and self.not_connected:
             # no stop or hold to speak of (it had said "stopped where it was" of an arm whose
             # port could not even be opened)
@@ -316,7 +346,7 @@ def arm_self_test(
             t0 = clock.now()
             try:
                 reached = np.asarray(carrier.move_to(d), dtype=np.float64)
-            except Exception as exc:
+            except BaseException as exc:  # a stop too: the pose it cut short is said as such
                 report.checks.append(PoseCheck(label, _az_el(d), None, None, None, False, str(exc)))
                 raise
             move_s = clock.now() - t0
@@ -342,6 +372,7 @@ def arm_self_test(
     except BaseException as exc:  # a stop (signal): goes on up, with what the teardown found
         report.aborted = f"stopped ({exc})"
         report.stopped_by_user = True
+        report.stop = str(exc)
         if isinstance(exc, EmergencyStop):  # declared there; check reads it of a stop
             exc.self_test_report = report
         raise

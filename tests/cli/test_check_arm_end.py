@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, inprocess_arm_config, servo_fault
+from conftest import CONFIGS, inprocess_arm_config, pasted, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -143,6 +143,9 @@ def test_a_stopped_check_whose_stop_failed_is_not_said_left_where_it_stopped(
         in said
     ), said
     assert "left where it stopped" not in said and "left at az" not in said, said
+    # the park command, once the arm is made safe: not "To park it" of an arm that may be moving
+    assert "Once the arm is safe (the lines above say how), park it with rti-rig check " in said
+    assert "To park it" not in said, said
 
 
 def test_a_park_that_returns_off_its_pose_is_not_said_parked(
@@ -186,3 +189,54 @@ def test_a_check_aborted_by_an_overload_says_not_parked_once(
         "NOT parked: not attempted after the error above; the stop did not hold every joint "
         "(see the teardown above): its position is not read as where it is left" in said
     ), said
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_check_stopped_by_ctrl_c_says_the_poses_it_verified_and_how_to_park(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C as the arm moves to its 4th pose: the three poses it had reached and measured
+    are listed, the 4th as cut short (not a failure), where the arm was left (read back), and
+    the command that parks it, pasteable (a config in a folder with a space). A stopped check
+    had printed none of its verified poses and no way to park the arm."""
+    folder = tmp_path / "my rigs"
+    folder.mkdir()
+    cfg = folder / "arm.toml"
+    cfg.write_text(inprocess_arm_config(tmp_path).read_text())
+    rigs = _built_rigs(monkeypatch)
+    import rti_rig.app.usecases.check as check_usecase
+
+    real_self_test = check_usecase.arm_self_test
+    moves: list[int] = []
+
+    def self_test(carrier: Any, *args: Any, **kwargs: Any) -> Any:
+        real_move = carrier.move_to
+
+        def move_to(direction: np.ndarray) -> np.ndarray:
+            moves.append(1)
+            if len(moves) == 4:  # the user's Ctrl-C, through the check's own handler
+                signal.raise_signal(signal.SIGINT)
+            return real_move(direction)
+
+        carrier.move_to = move_to
+        return real_self_test(carrier, *args, **kwargs)
+
+    monkeypatch.setattr(check_usecase, "arm_self_test", self_test)
+    r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130 and "Traceback" not in said, said
+    assert "arm: stopped (Ctrl-C) at pose 4 of 8; 3 verified within 1°" in said, said
+    rows = re.findall(r"(low|high|middle), az -?\d+° .*? (ok|not verified)", r.output)
+    assert [verdict for _, verdict in rows] == ["ok", "ok", "ok", "not verified"], r.output
+    assert "not verified: stopped (Ctrl-C) during this move" in said, said
+    assert "RESULT" not in said and "ABORTED" not in said, said
+    found = AT.search(said)
+    assert found and "(read back; the check was stopped (Ctrl-C)" in said, said
+    (rig,) = rigs
+    at = direction_from_az_el(float(found[1]), float(found[2]))
+    assert float(angle_between_deg(at, _truth(rig))) < 0.2, said
+    hint = re.search(
+        r"To park it: rti-rig check (.+?) \(it walks the poses again, then parks\)", said
+    )
+    assert hint is not None, said
+    assert pasted(hint[1].encode()) == str(cfg).encode(), said

@@ -28,7 +28,7 @@ from rti_rig.core.devices import (
 from rti_rig.core.errors import DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry
 from rti_rig.core.shell_words import shell_word, shown_path
-from rti_rig.runtime.arm_check import arm_self_test
+from rti_rig.runtime.arm_check import ArmSelfTestReport, arm_self_test
 from rti_rig.runtime.controller import EmergencyStop
 from rti_rig.runtime.dome_policy import self_test
 from rti_rig.runtime.lighting import ArmLighting, DomeLighting
@@ -39,7 +39,12 @@ class CheckStopped(Exception):
     """The check was stopped (SIGTERM, Ctrl-C) part-way; the rig was torn down first."""
 
     def __init__(
-        self, stop: EmergencyStop, lights: str, teardown_failures: tuple[str, ...] = ()
+        self,
+        stop: EmergencyStop,
+        lights: str,
+        teardown_failures: tuple[str, ...] = (),
+        walk: tuple[str, ...] = (),
+        todo: str | None = None,
     ) -> None:
         super().__init__(f"check stopped ({stop}): {lights}")
         #: the words said of the stop, and the signal it came from (the exit code's)
@@ -48,6 +53,11 @@ class CheckStopped(Exception):
         self.lights = lights
         #: what the teardown could not do (an arm's lamp off, stop), to be said first
         self.teardown_failures = teardown_failures
+        #: what an arm's walk had verified before the stop (its poses, as the report's table)
+        self.walk = walk
+        #: the command that parks an arm the stop left unparked, as a sentence; None when
+        #: there is none to give (parked, never connected, or park_after_session off)
+        self.todo = todo
 
 
 @dataclass(frozen=True)
@@ -163,8 +173,35 @@ def check_rig(
                 not_sent=report.not_sent if report else None,
                 unheld=report.unheld if report else None,
             )
-            raise CheckStopped(exc, lights, failures) from None
+            walk = tuple(report.stopped_lines()) if report else ()
+            raise CheckStopped(
+                exc, lights, failures, walk, _park_todo(report, req.rig_config)
+            ) from None
         raise RtiRigError(f"{shown_path(req.rig_config)}: no self-test for this kind of lighting")
+
+
+def _park_todo(report: ArmSelfTestReport | None, rig_config: Path) -> str | None:
+    """How to park an arm a stopped check left unparked: the check again, its config as shell
+    words (a pasteable command, as ``run``'s end gives), which walks its poses and parks;
+    after a stop that did not hold every joint, once the arm is made safe first.
+
+    Why: a check stopped by Ctrl-C said where the arm was left and no way to park it, and
+    rti-rig has no other command that parks. None where there is nothing to give: the arm
+    parked, never connected (nothing moved), or ``park_after_session`` is off (the check
+    would not park it either)."""
+    from rti_rig.runtime.lighting import park_check
+
+    if report is None or report.end is None or not report.park_wanted:
+        return None
+    if report.end.outcome == "parked":
+        return None
+    check = park_check(str(rig_config))
+    if not report.stopped:
+        return (
+            "Once the arm is safe (the lines above say how), park it with "
+            f"{check} (it walks the poses again, then parks)"
+        )
+    return f"To park it: {check} (it walks the poses again, then parks)"
 
 
 def _refuse_undimmable(loaded: Any, intensity: float) -> None:
