@@ -22,7 +22,7 @@ from __future__ import annotations
 from typing import Any
 
 from rti_rig.core.clock import Clock
-from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.simulator import dynamixel_table as tbl
 
 #: Bits one byte takes on the wire: start bit, 8 data bits, stop bit (ROBOTIS e-manual, X
 #: series specifications, Physical Connection: "8bit, 1stop, No Parity").
@@ -43,7 +43,7 @@ def return_delay_s(servos: dict[int, Any], dxl_id: int) -> float:
     """Servo ``dxl_id``'s Return Delay Time (9) as its table holds it now, seconds (0 for an
     id not on the bus)."""
     servo = servos.get(dxl_id)
-    return servo.get(ct.RETURN_DELAY_TIME) * RETURN_DELAY_UNIT_S if servo is not None else 0.0
+    return servo.get(tbl.RETURN_DELAY_TIME) * RETURN_DELAY_UNIT_S if servo is not None else 0.0
 
 
 class BusTime:

@@ -48,8 +48,8 @@ from typing import Any, NamedTuple
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.shell_words import shown_path
-from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.simulator import dynamixel_models as models
+from rti_rig.simulator import dynamixel_table as tbl
 from rti_rig.simulator import dynamixel_wire as wire
 from rti_rig.simulator.dynamixel_bus_time import BusTime
 from rti_rig.simulator.pty_link import HostBaudDevice
@@ -57,36 +57,34 @@ from rti_rig.simulator.pty_link import HostBaudDevice
 #: The registers a servo leaves the factory with, and the field of
 #: :class:`~rti_rig.simulator.dynamixel_models.FactoryTable` that holds each one's value.
 FACTORY_REGISTERS = (
-    (ct.BAUD_RATE, "baud_rate"),
-    (ct.RETURN_DELAY_TIME, "return_delay_time"),
-    (ct.DRIVE_MODE, "drive_mode"),
-    (ct.OPERATING_MODE, "operating_mode"),
-    (ct.SECONDARY_ID, "secondary_id"),
-    (ct.PROTOCOL_TYPE, "protocol_type"),
-    (ct.HOMING_OFFSET, "homing_offset"),
-    (ct.MOVING_THRESHOLD, "moving_threshold"),
-    (ct.TEMPERATURE_LIMIT, "temperature_limit"),
-    (ct.MAX_VOLTAGE_LIMIT, "max_voltage_limit"),
-    (ct.MIN_VOLTAGE_LIMIT, "min_voltage_limit"),
-    (ct.PWM_LIMIT, "pwm_limit"),
-    (ct.CURRENT_LIMIT, "current_limit"),
-    (ct.VELOCITY_LIMIT, "velocity_limit"),
-    (ct.MAX_POSITION_LIMIT, "max_position_limit"),
-    (ct.MIN_POSITION_LIMIT, "min_position_limit"),
-    (ct.SHUTDOWN, "shutdown"),
-    (ct.STATUS_RETURN_LEVEL, "status_return_level"),
+    (tbl.BAUD_RATE, "baud_rate"),
+    (tbl.RETURN_DELAY_TIME, "return_delay_time"),
+    (tbl.DRIVE_MODE, "drive_mode"),
+    (tbl.OPERATING_MODE, "operating_mode"),
+    (tbl.SECONDARY_ID, "secondary_id"),
+    (tbl.PROTOCOL_TYPE, "protocol_type"),
+    (tbl.HOMING_OFFSET, "homing_offset"),
+    (tbl.MOVING_THRESHOLD, "moving_threshold"),
+    (tbl.TEMPERATURE_LIMIT, "temperature_limit"),
+    (tbl.MAX_VOLTAGE_LIMIT, "max_voltage_limit"),
+    (tbl.MIN_VOLTAGE_LIMIT, "min_voltage_limit"),
+    (tbl.PWM_LIMIT, "pwm_limit"),
+    (tbl.CURRENT_LIMIT, "current_limit"),
+    (tbl.VELOCITY_LIMIT, "velocity_limit"),
+    (tbl.MAX_POSITION_LIMIT, "max_position_limit"),
+    (tbl.MIN_POSITION_LIMIT, "min_position_limit"),
+    (tbl.SHUTDOWN, "shutdown"),
+    (tbl.STATUS_RETURN_LEVEL, "status_return_level"),
 )
-#: Read-only address ranges [start, end) of the X-series table.
-READ_ONLY = ((0, 7), (69, 71), (120, 148))
 DEFAULT_FIRMWARE = 46
 
 #: A servo's own errors by the name ``[[emulator.faults]]`` gives them: their bits of Hardware
 #: Error Status (70) (ROBOTIS e-manual, X-series control table).
 HARDWARE_FAULT_BITS = {
-    "overload": ct.HardwareFault.OVERLOAD,
-    "overheating": ct.HardwareFault.OVERHEATING,
-    "input_voltage": ct.HardwareFault.INPUT_VOLTAGE,
-    "electrical_shock": ct.HardwareFault.ELECTRICAL_SHOCK,
+    "overload": tbl.OVERLOAD_ERROR,
+    "overheating": tbl.OVERHEATING_ERROR,
+    "input_voltage": tbl.INPUT_VOLTAGE_ERROR,
+    "electrical_shock": tbl.ELECTRICAL_SHOCK_ERROR,
 }
 #: Seconds a servo answers nothing after it acknowledged a Reboot instruction, while it
 #: restarts. The e-manual (Protocol 2.0, Reboot) gives the status packet but no restart time;
@@ -97,9 +95,6 @@ RESTART_S = 0.4
 #: Largest deviation from Goal Position (ticks) at which Moving Status says In-Position: the
 #: e-manual's "predefined value" is not published for the X series, so this is an assumption.
 IN_POSITION_TICKS = 1
-#: The control-table items the emulator names (``control_table``), each written whole or not
-#: at all (Data Length Error otherwise): a Write may span several of them.
-ITEMS = tuple(r for r in vars(ct).values() if isinstance(r, ct.Register))
 #: Drive Mode (address 10) bit 3 and the firmware that brought it (ROBOTIS e-manual, X series).
 TORQUE_ON_BY_GOAL_UPDATE = 0x08
 TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE = 45
@@ -108,11 +103,11 @@ PROTOCOL_2 = 2
 
 
 def _ticks_per_s(velocity_units: int) -> float:
-    return velocity_units * ct.RPM_PER_VELOCITY_UNIT / 60.0 * ct.TICKS_PER_REV
+    return velocity_units * tbl.RPM_PER_VELOCITY_UNIT / 60.0 * tbl.TICKS_PER_REV
 
 
 def _ticks_per_s2(acceleration_units: int) -> float:
-    return acceleration_units * ct.REV_MIN2_PER_ACCEL_UNIT / 3600.0 * ct.TICKS_PER_REV
+    return acceleration_units * tbl.REV_MIN2_PER_ACCEL_UNIT / 3600.0 * tbl.TICKS_PER_REV
 
 
 @dataclass
@@ -179,7 +174,7 @@ class EmulatedServo:
         model_number: int,
         clock: Clock,
         *,
-        operating_mode: int = ct.OperatingMode.POSITION,
+        operating_mode: int = tbl.POSITION_MODE,
         present_ticks: int = 2048,
         min_position: int | None = None,
         max_position: int | None = None,
@@ -196,10 +191,19 @@ class EmulatedServo:
         self.clock = clock
         self.factory = models.factory_table(model_number)
         f = self.factory
-        self.table = bytearray(ct.TABLE_SIZE)
-        self._set(ct.MODEL_NUMBER, model_number)
-        self._set(ct.FIRMWARE_VERSION, firmware)
-        self._set(ct.ID, dxl_id)
+        #: the model's control-table items (:mod:`rti_rig.simulator.dynamixel_table`), each
+        #: written whole or not at all (Data Length Error otherwise): a Write may span several
+        self.items = tbl.control_table(model_number)
+        #: address ranges [start, end) of its read-only (Access R) items
+        self.read_only = tuple(
+            (i.address, i.address + i.size) for i in self.items if not i.writable
+        )
+        self.table = bytearray(tbl.TABLE_SIZE)
+        for item in self.items:  # the table's Initial Values common to every model
+            if item.initial is not None:
+                self._set(item, item.initial)
+        self._set(tbl.FIRMWARE_VERSION, firmware)
+        self._set(tbl.ID, dxl_id)
         for reg, attr in FACTORY_REGISTERS:
             value = getattr(f, attr)
             if value is not None:  # None: the model lacks it (no Current Limit on an XL430)
@@ -207,13 +211,13 @@ class EmulatedServo:
         for address, (size, value) in f.extra.items():
             self.table[address : address + size] = value.to_bytes(size, "little")
         # configured for the rig (Operating Mode and limits are EEPROM: set before delivery)
-        self._set(ct.OPERATING_MODE, int(operating_mode))
+        self._set(tbl.OPERATING_MODE, int(operating_mode))
         if max_position is not None:
-            self._set(ct.MAX_POSITION_LIMIT, max_position)
+            self._set(tbl.MAX_POSITION_LIMIT, max_position)
         if min_position is not None:
-            self._set(ct.MIN_POSITION_LIMIT, min_position)
-        self._set(ct.PRESENT_TEMPERATURE, 30)
-        self._set(ct.GOAL_POSITION, present_ticks)
+            self._set(tbl.MIN_POSITION_LIMIT, min_position)
+        self._set(tbl.PRESENT_TEMPERATURE, 30)
+        self._set(tbl.GOAL_POSITION, present_ticks)
         self._profile = _Profile(present_ticks, present_ticks, clock.now(), 1.0, 1.0)
         #: True while the motion is the load's (a limp joint falling), not a profile's
         self._back_driven = False
@@ -231,31 +235,31 @@ class EmulatedServo:
         self.sag_ticks_per_s = 0.0
         #: the writable RAM area (Torque Enable .. Goal Position) as at power-on, restored by a
         #: Reboot (:meth:`reboot`)
-        self._ram_at_power_on = bytes(self.table[ct.EEPROM_END : ct.REALTIME_TICK.address])
+        self._ram_at_power_on = bytes(self.table[tbl.EEPROM_END : tbl.REALTIME_TICK.address])
         self.set_input_voltage(
             f.recommended_supply_decivolts if supply_decivolts is None else supply_decivolts
         )
 
     # -- table helpers ----------------------------------------------------------------------
-    def _set(self, reg: ct.Register, value: int) -> None:
+    def _set(self, reg: tbl.Item, value: int) -> None:
         raw = int(value) & ((1 << (8 * reg.size)) - 1)
         self.table[reg.address : reg.address + reg.size] = raw.to_bytes(reg.size, "little")
 
-    def get(self, reg: ct.Register) -> int:
+    def get(self, reg: tbl.Item) -> int:
         raw = int.from_bytes(self.table[reg.address : reg.address + reg.size], "little")
         return wire.signed(raw, reg.size) if reg.signed else raw
 
     @property
     def dxl_id(self) -> int:
-        return self.table[ct.ID.address]
+        return self.table[tbl.ID.address]
 
     @property
     def torque_on(self) -> bool:
-        return self.table[ct.TORQUE_ENABLE.address] == 1
+        return self.table[tbl.TORQUE_ENABLE.address] == 1
 
     @property
     def hardware_error(self) -> int:
-        return self.table[ct.HARDWARE_ERROR_STATUS.address]
+        return self.table[tbl.HARDWARE_ERROR_STATUS.address]
 
     def position(self, now: float | None = None) -> float:
         """Present position in ticks (float) at emulator time ``now``."""
@@ -270,18 +274,18 @@ class EmulatedServo:
         # under its load (:meth:`_go_limp`) moves, but runs no profile
         profile = self._profile.moving(now) and not self._back_driven
         present = round(self._profile.position(now))
-        self._set(ct.PRESENT_POSITION, present)
+        self._set(tbl.PRESENT_POSITION, present)
         units = round(
-            self._profile.velocity(now) / (ct.RPM_PER_VELOCITY_UNIT / 60 * ct.TICKS_PER_REV)
+            self._profile.velocity(now) / (tbl.RPM_PER_VELOCITY_UNIT / 60 * tbl.TICKS_PER_REV)
         )
-        self._set(ct.PRESENT_VELOCITY, units)
+        self._set(tbl.PRESENT_VELOCITY, units)
         # e-manual, Moving (122): set when |Present Velocity| exceeds Moving Threshold (24),
         # and always while a profile is in progress after a Goal Position update
         # (ROBOTIS-GIT/emanual _includes/en/dxl/x/moving.md @ d45c8b26). It had been the
         # emulator's motion alone, so a joint sagging with its torque off, slower than the
         # threshold, read Moving = 1 and "profile ongoing", which no servo reports.
-        moving = profile or abs(units) > self.get(ct.MOVING_THRESHOLD)
-        self._set(ct.MOVING, 1 if moving else 0)
+        moving = profile or abs(units) > self.get(tbl.MOVING_THRESHOLD)
+        self._set(tbl.MOVING, 1 if moving else 0)
         # e-manual, Moving Status (123): bit 1 "Profile Ongoing", bit 0 "In-Position: Whether
         # or not the DYNAMIXEL has arrived to the desired Goal Position(116)", set "when the
         # positional deviation is smaller than a predefined value" (ROBOTIS-GIT/emanual
@@ -290,9 +294,9 @@ class EmulatedServo:
         # has not arrived: In-Position had been set whenever no profile ran. The predefined
         # deviation is not published for the X series: IN_POSITION_TICKS is assumed. The
         # velocity-profile bits (4-5) are not modelled.
-        arrived = not moving and abs(present - self.get(ct.GOAL_POSITION)) <= IN_POSITION_TICKS
-        self._set(ct.MOVING_STATUS, (0x02 if profile else 0) | (0x01 if arrived else 0))
-        self._set(ct.REALTIME_TICK, int(now * 1000) % 32768)
+        arrived = not moving and abs(present - self.get(tbl.GOAL_POSITION)) <= IN_POSITION_TICKS
+        self._set(tbl.MOVING_STATUS, (0x02 if profile else 0) | (0x01 if arrived else 0))
+        self._set(tbl.REALTIME_TICK, int(now * 1000) % 32768)
 
     def _freeze(self) -> None:
         now = self.clock.now()
@@ -338,12 +342,12 @@ class EmulatedServo:
         on the XL330-M288, which does (e-manual ``docs/en/dxl/x/xl330-m288.md``, Shutdown
         Initial Value 53; the Shutdown include marks its Input Voltage Error "(default)")."""
         bits &= 0xFF
-        self.table[ct.HARDWARE_ERROR_STATUS.address] |= bits
-        if bits & self.get(ct.SHUTDOWN):
+        self.table[tbl.HARDWARE_ERROR_STATUS.address] |= bits
+        if bits & self.get(tbl.SHUTDOWN):
             self._shut_down = True
             was_on = self.torque_on
             self._freeze()
-            self.table[ct.TORQUE_ENABLE.address] = 0
+            self.table[tbl.TORQUE_ENABLE.address] = 0
             if was_on:
                 self._go_limp()
 
@@ -355,9 +359,9 @@ class EmulatedServo:
         is set (and Torque Enable cleared if Shutdown selects it): here through
         :meth:`inject_hardware_error`. A supply back inside the limits clears nothing (the bit
         stays until a Reboot; not verified for a passed cause, as the module docstring says)."""
-        self._set(ct.PRESENT_INPUT_VOLTAGE, decivolts)
-        if not self.get(ct.MIN_VOLTAGE_LIMIT) <= decivolts <= self.get(ct.MAX_VOLTAGE_LIMIT):
-            self.inject_hardware_error(ct.HardwareFault.INPUT_VOLTAGE)
+        self._set(tbl.PRESENT_INPUT_VOLTAGE, decivolts)
+        if not self.get(tbl.MIN_VOLTAGE_LIMIT) <= decivolts <= self.get(tbl.MAX_VOLTAGE_LIMIT):
+            self.inject_hardware_error(tbl.INPUT_VOLTAGE_ERROR)
 
     def reboot(self) -> None:
         """A restart, as at power-on: the RAM area back to its initial values, EEPROM kept.
@@ -379,11 +383,11 @@ class EmulatedServo:
             self._freeze()  # a limp joint's motion is its load's: a reboot does not stop it
         # it answers nothing while it restarts (the Reboot's own status went out first)
         self.restarting_until = self.clock.now() + self.restart_s
-        self.table[ct.EEPROM_END : ct.REALTIME_TICK.address] = self._ram_at_power_on
-        self._set(ct.GOAL_POSITION, round(self.position()))
+        self.table[tbl.EEPROM_END : tbl.REALTIME_TICK.address] = self._ram_at_power_on
+        self._set(tbl.GOAL_POSITION, round(self.position()))
         self._registered = None
         # a supply still outside the limits is met again by the restarted servo
-        self.set_input_voltage(self.get(ct.PRESENT_INPUT_VOLTAGE))
+        self.set_input_voltage(self.get(tbl.PRESENT_INPUT_VOLTAGE))
         if was_on and not self.torque_on:
             self._go_limp()  # a reboot under torque drops the joint it held
 
@@ -402,11 +406,11 @@ class EmulatedServo:
         self._refresh()
         rest = self._profile.goal
         table = bytearray(self.table)
-        table[ct.PRESENT_POSITION.address : ct.PRESENT_POSITION.address + 4] = (
+        table[tbl.PRESENT_POSITION.address : tbl.PRESENT_POSITION.address + 4] = (
             round(rest) & 0xFFFFFFFF
         ).to_bytes(4, "little")
         return {
-            "model_number": self.get(ct.MODEL_NUMBER),
+            "model_number": self.get(tbl.MODEL_NUMBER),
             "table": table.hex(),
             "rest_ticks": rest,
             "shut_down": self._shut_down,
@@ -431,9 +435,9 @@ class EmulatedServo:
             )
         except (KeyError, TypeError, ValueError, IndexError):
             return False
-        if len(table) != ct.TABLE_SIZE or model != self.get(ct.MODEL_NUMBER):
+        if len(table) != tbl.TABLE_SIZE or model != self.get(tbl.MODEL_NUMBER):
             return False
-        if int.from_bytes(table[ct.ID.address : ct.ID.address + 1], "little") != self.dxl_id:
+        if int.from_bytes(table[tbl.ID.address : tbl.ID.address + 1], "little") != self.dxl_id:
             return False
         if not math.isfinite(rest):
             return False
@@ -461,8 +465,8 @@ class EmulatedServo:
         if self.torque_on and self.sag_to is not None:
             rest = self.sag_to
         return {
-            "model_number": self.get(ct.MODEL_NUMBER),
-            "eeprom": bytes(self.table[: ct.EEPROM_END]).hex(),
+            "model_number": self.get(tbl.MODEL_NUMBER),
+            "eeprom": bytes(self.table[: tbl.EEPROM_END]).hex(),
             "rest_ticks": rest,
         }
 
@@ -476,14 +480,14 @@ class EmulatedServo:
             model = int(state["model_number"])
         except (KeyError, TypeError, ValueError):
             return False
-        if len(eeprom) != ct.EEPROM_END or model != self.get(ct.MODEL_NUMBER):
+        if len(eeprom) != tbl.EEPROM_END or model != self.get(tbl.MODEL_NUMBER):
             return False
-        if eeprom[ct.ID.address] != self.dxl_id or not math.isfinite(rest):
+        if eeprom[tbl.ID.address] != self.dxl_id or not math.isfinite(rest):
             return False
-        self.table[: ct.EEPROM_END] = eeprom
+        self.table[: tbl.EEPROM_END] = eeprom
         self._profile = _Profile(rest, rest, self.clock.now(), 1.0, 1.0)
         self._back_driven = False
-        self._set(ct.GOAL_POSITION, round(rest))
+        self._set(tbl.GOAL_POSITION, round(rest))
         self._refresh()
         return True
 
@@ -492,7 +496,7 @@ class EmulatedServo:
         return number | (wire.ALERT if self.hardware_error else 0)
 
     def read(self, address: int, length: int) -> tuple[int, bytes]:
-        if length < 0 or address + length > ct.TABLE_SIZE:
+        if length < 0 or address + length > tbl.TABLE_SIZE:
             return wire.DATA_LENGTH_ERROR, b""
         self._refresh()
         return 0, bytes(self.table[address : address + length])
@@ -511,36 +515,36 @@ class EmulatedServo:
         any Write that did not hold the Goal Position alone, and accepted half of any other
         item: it modelled the packets our driver sends, not the servo.)"""
         end = address + len(data)
-        if not data or end > ct.TABLE_SIZE:
+        if not data or end > tbl.TABLE_SIZE:
             return wire.DATA_LENGTH_ERROR
-        for lo, hi in READ_ONLY:
+        for lo, hi in self.read_only:
             if address < hi and end > lo:
                 return wire.ACCESS_ERROR
-        if address < ct.EEPROM_END and (
+        if address < tbl.EEPROM_END and (
             self.torque_on or any(axis.torque_on for axis in self.other_axes)
         ):
             # a two-axis body (2XL430) locks its EEPROM while either axis has torque on
-            # (ct.DUAL_AXIS_MODELS: "for all axis are set to '0'")
+            # (tbl.DUAL_AXIS_MODELS: "for all axis are set to '0'")
             return wire.ACCESS_ERROR
-        for reg in ITEMS:
+        for reg in self.items:
             covers_some = address < reg.address + reg.size and end > reg.address
             if covers_some and not address <= reg.address <= reg.address + reg.size <= end:
                 return wire.DATA_LENGTH_ERROR
 
-        def covered(reg: ct.Register) -> bytes | None:
+        def covered(reg: tbl.Item) -> bytes | None:
             """The bytes this Write gives ``reg``, if it covers it."""
             if address <= reg.address and reg.address + reg.size <= end:
                 return data[reg.address - address : reg.address - address + reg.size]
             return None
 
-        goal_bytes = covered(ct.GOAL_POSITION)
+        goal_bytes = covered(tbl.GOAL_POSITION)
         goal: int | None = None
         if goal_bytes is not None:
             goal = wire.signed(int.from_bytes(goal_bytes, "little"), 4)
-            if self.get(ct.OPERATING_MODE) == ct.OperatingMode.POSITION:
-                lo, hi = self.get(ct.MIN_POSITION_LIMIT), self.get(ct.MAX_POSITION_LIMIT)
+            if self.get(tbl.OPERATING_MODE) == tbl.POSITION_MODE:
+                lo, hi = self.get(tbl.MIN_POSITION_LIMIT), self.get(tbl.MAX_POSITION_LIMIT)
             else:
-                lo, hi = -ct.EXTENDED_TICK_LIMIT, ct.EXTENDED_TICK_LIMIT
+                lo, hi = -tbl.EXTENDED_TICK_LIMIT, tbl.EXTENDED_TICK_LIMIT
             # e-manual, Min/Max Position Limit (48, 52): "Provided Goal Position(116) values
             # must be within the configured position limit range" (ROBOTIS-GIT/emanual
             # _includes/en/dxl/x/position_limit.md @ f9dea50c); an XL430 given a goal outside
@@ -548,11 +552,11 @@ class EmulatedServo:
             # "Position limit in joint mode", forum.robotis.com/t/452): refused, nothing moves
             if not lo <= goal <= hi:
                 return wire.DATA_LIMIT_ERROR
-        torque_bytes = covered(ct.TORQUE_ENABLE)
+        torque_bytes = covered(tbl.TORQUE_ENABLE)
         if torque_bytes is not None and torque_bytes[0] and self._shut_down:
             return wire.RESULT_FAIL  # after a shutdown only a reboot re-enables torque
-        pv_bytes = covered(ct.PROFILE_VELOCITY)
-        time_based = self.get(ct.DRIVE_MODE) & ct.DRIVE_MODE_TIME_BASED_PROFILE
+        pv_bytes = covered(tbl.PROFILE_VELOCITY)
+        time_based = self.get(tbl.DRIVE_MODE) & tbl.DRIVE_MODE_TIME_BASED_PROFILE
         # e-manual, Velocity Limit(44): "maximum velocity of Goal Velocity(104) and Profile
         # Velocity(112)"; the control-table include adds "Values for Goal Velocity and
         # Profile Velocity cannot be set to values exceeding the Velocity Limit ... Data
@@ -565,7 +569,7 @@ class EmulatedServo:
         if (
             pv_bytes is not None
             and not time_based
-            and int.from_bytes(pv_bytes, "little") > self.get(ct.VELOCITY_LIMIT)
+            and int.from_bytes(pv_bytes, "little") > self.get(tbl.VELOCITY_LIMIT)
         ):
             return wire.DATA_LIMIT_ERROR
         # every check passed: the Write takes effect
@@ -578,24 +582,24 @@ class EmulatedServo:
                 # modelled: torque-on holds the present position (goal := present). Not
                 # verified against the e-manual; the driver writes goal := present first anyway
                 self._freeze()
-                self._set(ct.GOAL_POSITION, round(self.position()))
-        mode_before = self.get(ct.OPERATING_MODE)
+                self._set(tbl.GOAL_POSITION, round(self.position()))
+        mode_before = self.get(tbl.OPERATING_MODE)
         self.table[address:end] = data
         if limp:
             self._go_limp()
-        if self.get(ct.OPERATING_MODE) != mode_before:
-            self._set(ct.PROFILE_VELOCITY, 0)
-            self._set(ct.PROFILE_ACCELERATION, 0)
+        if self.get(tbl.OPERATING_MODE) != mode_before:
+            self._set(tbl.PROFILE_VELOCITY, 0)
+            self._set(tbl.PROFILE_ACCELERATION, 0)
         if goal is not None:
             if (
                 not self.torque_on
                 and not self._shut_down
-                and self.get(ct.DRIVE_MODE) & TORQUE_ON_BY_GOAL_UPDATE
-                and self.get(ct.FIRMWARE_VERSION) >= TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE
+                and self.get(tbl.DRIVE_MODE) & TORQUE_ON_BY_GOAL_UPDATE
+                and self.get(tbl.FIRMWARE_VERSION) >= TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE
             ):
                 # e-manual, Drive Mode bit 3 "Torque On by Goal Update" (firmware 45+): a goal
                 # written while Torque Enable is 0 switches torque on, and the servo moves to it
-                self.table[ct.TORQUE_ENABLE.address] = 1
+                self.table[tbl.TORQUE_ENABLE.address] = 1
             self._start_move(goal)  # with the profile this Write may have set too
         return 0
 
@@ -603,8 +607,8 @@ class EmulatedServo:
         if not self.torque_on:
             return
         now = self.clock.now()
-        v_units = self.get(ct.PROFILE_VELOCITY) or self.get(ct.VELOCITY_LIMIT) or 1
-        a_units = self.get(ct.PROFILE_ACCELERATION)
+        v_units = self.get(tbl.PROFILE_VELOCITY) or self.get(tbl.VELOCITY_LIMIT) or 1
+        a_units = self.get(tbl.PROFILE_ACCELERATION)
         a = _ticks_per_s2(a_units) if a_units else math.inf
         self._profile = _Profile(
             self._profile.position(now), float(goal), now, _ticks_per_s(v_units), a
@@ -613,7 +617,7 @@ class EmulatedServo:
 
     def reg_write(self, address: int, data: bytes) -> int:
         self._registered = (address, bytes(data))
-        self.table[ct.REGISTERED_INSTRUCTION.address] = 1
+        self.table[tbl.REGISTERED_INSTRUCTION.address] = 1
         return 0
 
     def action(self) -> int:
@@ -621,16 +625,16 @@ class EmulatedServo:
             return wire.INSTRUCTION_ERROR
         address, data = self._registered
         self._registered = None
-        self.table[ct.REGISTERED_INSTRUCTION.address] = 0
+        self.table[tbl.REGISTERED_INSTRUCTION.address] = 0
         return self.write(address, data)
 
     def clear_multi_turn(self) -> int:
         if self.is_moving():
             return wire.RESULT_FAIL
-        p = round(self.position()) % ct.TICKS_PER_REV
+        p = round(self.position()) % tbl.TICKS_PER_REV
         self._profile = _Profile(p, p, self.clock.now(), 1.0, 1.0)
         self._back_driven = False
-        self._set(ct.GOAL_POSITION, p)
+        self._set(tbl.GOAL_POSITION, p)
         return 0
 
 
@@ -761,9 +765,9 @@ class DynamixelBusEmulator(HostBaudDevice):
                 if now < servo.restarting_until  # restarting after a Reboot
                 or (
                     self.host_baud is not None
-                    and ct.BAUD_CODES.get(servo.get(ct.BAUD_RATE)) != self.host_baud
+                    and tbl.BAUD_CODES.get(servo.get(tbl.BAUD_RATE)) != self.host_baud
                 )
-                or servo.get(ct.PROTOCOL_TYPE) != PROTOCOL_2
+                or servo.get(tbl.PROTOCOL_TYPE) != PROTOCOL_2
                 or self._unpowered(self.instructions_received + 1)
             }
             self._parser.feed(bytes(data))
@@ -842,7 +846,7 @@ class DynamixelBusEmulator(HostBaudDevice):
         return packet
 
     def _answers(self, servo: EmulatedServo, instruction: int) -> bool:
-        level = servo.get(ct.STATUS_RETURN_LEVEL)
+        level = servo.get(tbl.STATUS_RETURN_LEVEL)
         if instruction == wire.PING:
             return True
         if instruction in (wire.READ, wire.SYNC_READ, wire.BULK_READ):
@@ -857,7 +861,7 @@ class DynamixelBusEmulator(HostBaudDevice):
         return [self.servos[i] for i in ids if i not in self._deaf]
 
     def _log_goal(self, dxl_id: int, address: int, data: bytes) -> None:
-        g = ct.GOAL_POSITION.address
+        g = tbl.GOAL_POSITION.address
         if address <= g and address + len(data) >= g + 4:
             raw = int.from_bytes(data[g - address : g - address + 4], "little")
             self.goal_log.append((dxl_id, wire.signed(raw, 4)))
@@ -910,8 +914,8 @@ class DynamixelBusEmulator(HostBaudDevice):
 
     def _execute(self, servo: EmulatedServo, inst: int, prm: bytes) -> tuple[int, bytes]:
         if inst == wire.PING:
-            model = servo.get(ct.MODEL_NUMBER)
-            return 0, model.to_bytes(2, "little") + bytes([servo.get(ct.FIRMWARE_VERSION)])
+            model = servo.get(tbl.MODEL_NUMBER)
+            return 0, model.to_bytes(2, "little") + bytes([servo.get(tbl.FIRMWARE_VERSION)])
         if inst == wire.READ and len(prm) == 4:
             address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
             return servo.read(address, length)
@@ -1072,9 +1076,9 @@ def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> Dynam
         kin.ticks_of_pose(settings.park_azimuth_deg, settings.elevation.min_deg)[1]
     )
     elevation.sag_ticks_per_s = (
-        SAG_DEG_PER_S * ct.TICKS_PER_REV / 360.0 * settings.elevation.gear_ratio
+        SAG_DEG_PER_S * tbl.TICKS_PER_REV / 360.0 * settings.elevation.gear_ratio
     )
-    dual = [s for s in servos if s.get(ct.MODEL_NUMBER) in ct.DUAL_AXIS_MODELS]
+    dual = [s for s in servos if s.get(tbl.MODEL_NUMBER) in tbl.DUAL_AXIS_MODELS]
     if len(dual) == 2:  # both joints on one two-axis servo (a 2XL430 pan-tilt)
         dual[0].other_axes, dual[1].other_axes = [dual[1]], [dual[0]]
     return DynamixelBusEmulator(servos, clock)
@@ -1181,7 +1185,7 @@ def served_arm(
     hand"). The park pose is, by validation, reachable and outside the cone."""
     from rti_rig.simulator.dynamixel_pty import PtyServoServer
 
-    codes = {rate: code for code, rate in ct.BAUD_CODES.items()}
+    codes = {rate: code for code, rate in tbl.BAUD_CODES.items()}
     if baudrate not in codes:
         raise ValueError(
             f"baud rate {baudrate}: an X-series servo's Baud Rate (8) is one of "
@@ -1189,7 +1193,7 @@ def served_arm(
         )
     emulator = emulator_for_arm(settings, clock)
     for servo in emulator.servos.values():
-        servo._set(ct.BAUD_RATE, codes[baudrate])
+        servo._set(tbl.BAUD_RATE, codes[baudrate])
     for fault in faults:
         emulator.add_fault(fault.at, fault.kind, fault.servo_id, fault.delay_s)
     with PtyServoServer(emulator) as server:
@@ -1312,10 +1316,10 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
         "off where its Shutdown selects it); repeatable",
     )
     args = parser.parse_args(argv)
-    if args.baud not in ct.BAUD_CODES.values():
+    if args.baud not in tbl.BAUD_CODES.values():
         parser.error(
             f"--baud {args.baud}: an X-series servo runs at one of "
-            + ", ".join(str(r) for r in ct.BAUD_CODES.values())
+            + ", ".join(str(r) for r in tbl.BAUD_CODES.values())
         )
     try:
         settings, where = arm_settings_of(args.config)

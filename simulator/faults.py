@@ -115,14 +115,14 @@ class ServoFaultCarrier:
         return getattr(self.inner, name)
 
     def move_to(self, direction: np.ndarray) -> np.ndarray:
-        from rti_rig.drivers.dynamixel.control_table import HardwareFault
+        from rti_rig.simulator import dynamixel_table as tbl
 
         if self.plan.due():
             kind = self.plan.kind
             if kind == "servo-overload":
-                self.emulator.inject_hardware_error(self.servo_id, HardwareFault.OVERLOAD)
+                self.emulator.inject_hardware_error(self.servo_id, tbl.OVERLOAD_ERROR)
             elif kind == "servo-overheating":
-                self.emulator.inject_hardware_error(self.servo_id, HardwareFault.OVERHEATING)
+                self.emulator.inject_hardware_error(self.servo_id, tbl.OVERHEATING_ERROR)
             elif kind == "servo-corrupt-crc":
                 self.emulator.corrupt_next_replies = 3
             elif kind == "servo-silence":

@@ -47,7 +47,7 @@ from typing import Any
 
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.core.state_files import replace_text
-from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.simulator import dynamixel_table as tbl
 
 #: Overrides where the state files are kept (a test's own folder, say).
 STATE_DIR_ENV = "RTI_RIG_EMULATOR_STATE_DIR"
@@ -108,7 +108,7 @@ class LatchedErrors:
         the file stays, errors or none, until it is deleted (the power cycle). A file that
         cannot be written is a warning, as :meth:`_unkept` says why."""
         errors = {
-            str(k): int(bytes.fromhex(v["table"])[ct.HARDWARE_ERROR_STATUS.address])
+            str(k): int(bytes.fromhex(v["table"])[tbl.HARDWARE_ERROR_STATUS.address])
             for k, v in sorted(states.items())
         }
         self._save(
