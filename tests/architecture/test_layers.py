@@ -124,3 +124,26 @@ def test_the_contract_fails_when_the_dynamixel_emulator_imports_the_driver_codec
     assert "rti_rig.simulator.dynamixel_emulator -> rti_rig.drivers.dynamixel.protocol2" in (
         result.stdout
     )
+
+
+@pytest.mark.slow
+def test_the_contract_fails_when_the_dynamixel_emulator_imports_the_driver_table(tmp_path):
+    """The emulated servos name their registers from their own e-manual tables
+    (simulator/dynamixel_table.py), not the driver's control_table: built on it again, a
+    register-map bug would be on both sides of the wire."""
+    tree = installed_layout(tmp_path / "site")
+    emulator = tree / "rti_rig" / "simulator" / "dynamixel_emulator.py"
+    emulator.write_text(
+        emulator.read_text(encoding="utf-8")
+        + "\nfrom rti_rig.drivers.dynamixel import control_table as _ct  # noqa: F401\n",
+        encoding="utf-8",
+    )
+    result = lint_imports(tree, PYPROJECT)
+    assert result.returncode != 0
+    assert "Dynamixel emulator reads its control tables from the e-manual, not the driver's" in (
+        result.stdout
+    )
+    assert "BROKEN" in result.stdout
+    assert "rti_rig.simulator.dynamixel_emulator -> rti_rig.drivers.dynamixel.control_table" in (
+        result.stdout
+    )
