@@ -77,6 +77,8 @@ FACTORY_REGISTERS = (
     (tbl.STATUS_RETURN_LEVEL, "status_return_level"),
 )
 DEFAULT_FIRMWARE = 46
+#: Factory Reset (0x06) Param 1: reset all, all but the ID, all but the ID and the Baud Rate
+FACTORY_RESET_OPTIONS = (0xFF, 0x01, 0x02)
 
 #: A servo's own errors by the name ``[[emulator.faults]]`` gives them: their bits of Hardware
 #: Error Status (70) (ROBOTIS e-manual, X-series control table).
@@ -637,6 +639,36 @@ class EmulatedServo:
         self._set(tbl.GOAL_POSITION, p)
         return 0
 
+    def factory_reset(self, option: int) -> None:
+        """The Factory Reset instruction (0x06): the control table back to the model's
+        factory Initial Values, then a restart; ``option`` 0xFF resets everything, 0x01 all
+        but the ID, 0x02 all but the ID and the Baud Rate.
+
+        e-manual, Protocol 2.0, Factory Reset: "Instruction that resets the Control Table to
+        its initial factory default settings", "a device is rebooted", Param 1 "0xFF : Reset
+        all 0x01 : Reset all except ID 0x02 : Reset all except ID and Baudrate"
+        (ROBOTIS-GIT/emanual docs/en/dxl/protocol2.md @
+        01179568a085cfc99bdad6e880e43fa871bd318a). So the rig's configuration goes too: the
+        Operating Mode and the position limits a connect wrote are the factory's again (3 and
+        0..4,095), as on a real servo; the Firmware Version, not a setting, stays. The caller
+        (:meth:`DynamixelBusEmulator._execute`) refuses 0xFF sent to the broadcast ID, as the
+        page says. Why: the emulator had answered it with an Instruction Error, which no X
+        servo (firmware 42 and later) does, so a tool that resets a servo could not be tried."""
+        fresh = EmulatedServo(
+            self.dxl_id if option in (0x01, 0x02) else tbl.ID.initial or 1,
+            self.get(tbl.MODEL_NUMBER),
+            self.clock,
+            present_ticks=round(self.position()),
+            firmware=self.get(tbl.FIRMWARE_VERSION),
+            supply_decivolts=self.get(tbl.PRESENT_INPUT_VOLTAGE),
+        )
+        eeprom = bytearray(fresh.table[: tbl.EEPROM_END])
+        if option == 0x02:
+            eeprom[tbl.BAUD_RATE.address] = self.table[tbl.BAUD_RATE.address]
+        self.table[: tbl.EEPROM_END] = eeprom
+        self._ram_at_power_on = fresh._ram_at_power_on
+        self.reboot()
+
 
 class DynamixelBusEmulator(HostBaudDevice):
     """Several servos on one bus: bytes in, status bytes out (thread-safe).
@@ -907,12 +939,17 @@ class DynamixelBusEmulator(HostBaudDevice):
                     out += self._reply(dxl_id, err, data)
             return bytes(out)
         for servo in self._targets(pkt):
-            err, params = self._execute(servo, inst, prm)
+            answering = servo.dxl_id  # a Factory Reset's status goes out before the restart
+            err, params = self._execute(servo, inst, prm, broadcast=not unicast)
             if inst == wire.PING or (unicast and self._answers(servo, inst)):
-                out += self._reply(servo.dxl_id, err, params)
+                out += self._reply(answering, err, params)
+        if inst == wire.FACTORY_RESET:  # a reset of everything brings the ID back to 1
+            self.servos = {s.dxl_id: s for s in self.servos.values()}
         return bytes(out)
 
-    def _execute(self, servo: EmulatedServo, inst: int, prm: bytes) -> tuple[int, bytes]:
+    def _execute(
+        self, servo: EmulatedServo, inst: int, prm: bytes, broadcast: bool = False
+    ) -> tuple[int, bytes]:
         if inst == wire.PING:
             model = servo.get(tbl.MODEL_NUMBER)
             return 0, model.to_bytes(2, "little") + bytes([servo.get(tbl.FIRMWARE_VERSION)])
@@ -934,6 +971,10 @@ class DynamixelBusEmulator(HostBaudDevice):
             return 0, b""
         if inst == wire.CLEAR and prm == bytes([0x01, 0x44, 0x58, 0x4C, 0x22]):
             return servo.clear_multi_turn(), b""
+        if inst == wire.FACTORY_RESET and len(prm) == 1 and prm[0] in FACTORY_RESET_OPTIONS:
+            if not (broadcast and prm[0] == 0xFF):  # "will NOT be activated" (Protocol 2.0)
+                servo.factory_reset(prm[0])
+            return 0, b""
         return wire.INSTRUCTION_ERROR, b""
 
 
