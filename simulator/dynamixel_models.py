@@ -78,7 +78,7 @@ def _page(model: str) -> str:
     return f"docs/en/dxl/x/{model}.md"
 
 
-#: Model Number -> factory table, one per model in ``control_table.MODEL_NAMES``.
+#: Model Number -> factory table, one per model in ``dynamixel_table.MODEL_NAMES``.
 FACTORY_TABLES: dict[int, FactoryTable] = {
     t.model_number: t
     for t in (

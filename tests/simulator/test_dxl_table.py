@@ -111,3 +111,33 @@ def test_the_driver_and_the_emulator_agree_on_models_baud_codes_and_error_bits()
         tbl.RPM_PER_VELOCITY_UNIT,
         tbl.REV_MIN2_PER_ACCEL_UNIT,
     )
+
+
+def test_every_factory_table_has_a_control_table_and_a_servo_starts_from_its_initial_values():
+    """The emulated servo starts from its table's published Initial Values, RAM included
+    (Indirect Address 1 = 224, Velocity P Gain 100, Status Return Level 2), read back through
+    the real SDK; they had been zero wherever the driver named no register."""
+    import dynamixel_sdk as sdk
+
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.simulator.dynamixel_emulator import (
+        DynamixelBusEmulator,
+        EmulatedServo,
+        InProcessPort,
+    )
+    from rti_rig.simulator.dynamixel_models import FACTORY_TABLES
+
+    assert set(FACTORY_TABLES) == set(tbl.MODEL_NAMES)
+    clock = VirtualClock()
+    port = InProcessPort(DynamixelBusEmulator([EmulatedServo(1, 1060, clock)], clock))
+    assert port.openPort() and port.setBaudRate(57600)
+    ph = sdk.PacketHandler(2.0)
+    for item, value in (
+        (tbl.control_table(1060)[0], 1060),
+        (tbl.VELOCITY_P_GAIN, 100),
+        (tbl.STATUS_RETURN_LEVEL, 2),
+        (_by_address(1060)[168], 224),
+        (_by_address(1060)[632], 661),
+    ):
+        read = {1: ph.read1ByteTxRx, 2: ph.read2ByteTxRx}[item.size]
+        assert read(port, 1, item.address) == (value, sdk.COMM_SUCCESS, 0), item.name
