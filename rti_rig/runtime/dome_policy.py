@@ -1821,6 +1821,10 @@ class SelfTestReport:
     #: The rig config checked, as one shell word ("": not known), for the session its advice
     #: names: the advice had said ``rti-rig fit S --out FOLDER``, no command that ran pasted.
     rig_config: str = ""
+    #: At what level the walk lit each LED, as the report says it ("": not said, a walk of
+    #: no dome policy). Why: a dome that cannot dim is walked fully on, not at the check's
+    #: intensity, and a PASS had not said which of the two it established.
+    level_said: str = ""
 
     @property
     def failed(self) -> list[LedCheck]:
@@ -1908,6 +1912,8 @@ class SelfTestReport:
                 f"LEDs stepped: {len(self.checks)}, {self._passed_as()}: {passed}"
                 + f", failed: {len(self.failed)} in {self.elapsed_s:.2f} s on the rig's clock"
             )
+            if self.level_said and self.checks:
+                out.append(f"  {self.level_said}")
             if self.light_confirmed and not self.senses_current and passed:
                 out.append(
                     "  whether each LED lights cannot be sensed by this firmware (it measures "
@@ -2021,6 +2027,33 @@ def _ended_by_slow_boot(error: BaseException | None) -> bool:
     return False
 
 
+def _walk_level(source: DiscreteLightSource, intensity: float) -> tuple[float, str]:
+    """The intensity the check's walk lights each LED at, and the words that say it.
+
+    A link that cannot dim (the ``framed`` profile with ``send_level = false``, every on/off
+    firmware) is walked fully on: the only level its light command can ask for. Why: the walk
+    had asked every LED of a framed dome without levels for 0.2, which its driver refuses
+    ("configured without intensity"), and the check failed each LED of a working dome. The
+    thermal and duty limits still hold: :meth:`DomePolicy.light` applies them at any level."""
+    if not isinstance(source, DomePolicy):
+        return intensity, ""
+    if source.link.can_dim:
+        scaled = (
+            " (each scaled by its intensity_correction)"
+            if source.settings.intensity_correction is not None
+            else ""
+        )
+        return intensity, f"each LED lit at intensity {intensity:g}{scaled}"
+    instead = "" if intensity >= 1.0 else f", not the check's {intensity:g}"
+    codec = getattr(source.link, "codec", None)
+    if getattr(codec, "profile", None) == "framed":
+        why = "the framed profile with send_level = false sends no level in its light frames"
+    else:
+        firmware = source.link.firmware_name or "dome's"
+        why = f"the {firmware} firmware's light command carries no level"
+    return 1.0, f"each LED lit fully on (intensity 1{instead}): {why}"
+
+
 def self_test(
     source: DiscreteLightSource,
     clock: Clock,
@@ -2042,6 +2075,7 @@ def self_test(
     report.light_confirmed = True if link is None else link.light_confirmed
     report.senses_current = True if link is None else link.senses_led_current
     report.simulated = isinstance(source, KnownStateLightSource)
+    intensity, report.level_said = _walk_level(source, intensity)
     if isinstance(source, DomePolicy):
         source.lights_images = False  # an LED lost to a reboot spoils no image here
     try:
