@@ -52,6 +52,10 @@ class FaultKind(StrEnum):
     DISCONNECT = "disconnect"  # USB drop as the command arrives: not executed, board unpowered
     RESET = "reset"  # brown-out reset as the command arrives: not executed, banner
     RESET_AFTER_REPLY = "reset_after_reply"  # executed and acknowledged, then a reset
+    #: executed, its reply preceded by a stray CR LF (an Arduino sketch's Serial.println()
+    #: after its banner, or a host line ending echoed back); line profiles only (default,
+    #: framed): on the binary link those bytes would be two acknowledgements
+    BLANK_LINE_BEFORE_REPLY = "blank_line_before_reply"
 
 
 @dataclass(frozen=True)
@@ -265,6 +269,8 @@ class DomeFirmware:
             out = [Output(sent, garble(data))]
         elif FaultKind.DELAY_REPLY in by_kind:
             out = [Output(sent + by_kind[FaultKind.DELAY_REPLY].delay_s, data)]
+        elif FaultKind.BLANK_LINE_BEFORE_REPLY in by_kind:
+            out = [Output(sent, b"\r\n" + data)]
         else:
             out = [Output(sent, data)]
         if FaultKind.RESET_AFTER_REPLY in by_kind:

@@ -72,6 +72,11 @@ class DefaultCodec:
             return None, 0, None
         line = buf[:end].rstrip(b"\r")
         consumed = end + 1
+        if not line:
+            # a stray line ending (an Arduino's Serial.println() after its banner, a CR LF
+            # host line ending echoed back): no reply, skipped; a line of anything else is
+            # still read, and refused if garbled
+            return None, consumed, None
         if self.checksum:
             star = line.rfind(b"*")
             if star < 0 or len(line) - star != 3:
@@ -99,7 +104,7 @@ class DefaultCodec:
         if error is not None:
             return Garbled(bytes(buf[:consumed]), error), consumed
         if line is None:
-            return None, 0
+            return None, consumed  # more bytes needed, or a blank line dropped
         tokens = line.decode("ascii").split()
         try:
             return _parse_reply(tokens), consumed
@@ -115,7 +120,7 @@ class DefaultCodec:
         if error is not None:
             return BadRequest(bytes(buf[:consumed]), None, ERR_BAD_CHECKSUM, error), consumed
         if line is None:
-            return None, 0
+            return None, consumed
         tokens = line.decode("ascii").split()
         seq: int | None = None
         try:

@@ -395,6 +395,8 @@ class LedDomeDriver(PortOpening):
         while self._rx:
             reply, consumed = self.codec.decode_reply(bytes(self._rx), pending)
             if consumed:
+                if reply is None:  # filler the profile skips (a blank line, whitespace)
+                    traffic_log.debug("%s: skipped %r", self.device, bytes(self._rx[:consumed]))
                 del self._rx[:consumed]
             if reply is not None:
                 return reply

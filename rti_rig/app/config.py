@@ -232,6 +232,7 @@ class EmulatorFault(_Strict):
         "disconnect",
         "reset",
         "reset_after_reply",
+        "blank_line_before_reply",
         "overload",
         "overheating",
         "input_voltage",
@@ -384,7 +385,18 @@ class RigConfig(_Strict):
                         f"{' with servo_id' if fault.servo_id is not None else ''} is "
                         f"{whose} fault, rehearsed on an emulated arm; a dome's firmware "
                         "rehearses drop_reply, garble_reply, garble_command, delay_reply, "
-                        "disconnect, reset and reset_after_reply"
+                        "disconnect, reset, reset_after_reply and blank_line_before_reply"
+                    )
+                serial = self.dome.serial if self.dome is not None else None
+                if fault.kind == "blank_line_before_reply" and (
+                    serial is None or serial.profile not in ("default", "framed")
+                ):
+                    # a CR LF is two acknowledgement bytes on the binary link, and a
+                    # described firmware's board has no such fault: refused, not ignored
+                    raise ValueError(
+                        f"emulator.faults[{i}]: blank_line_before_reply is a stray CR LF "
+                        "before a reply of a line profile's firmware; set [dome.serial] "
+                        "profile to 'default' or 'framed', or remove the fault"
                     )
             return
         if not self.emulator.faults:
