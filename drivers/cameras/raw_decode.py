@@ -20,7 +20,7 @@ import sys
 import tempfile
 import threading
 from collections.abc import Iterator
-from contextlib import contextmanager, suppress
+from contextlib import AbstractContextManager, contextmanager, nullcontext, suppress
 from pathlib import Path
 from typing import Any
 
@@ -278,19 +278,26 @@ def libraw_opened(path: Path | str) -> Iterator[tuple[str, str | io.BytesIO]]:
         os.close(fd)
 
 
-def _source(source: Path | str | bytes) -> tuple[Path | None, str, Any]:
-    """(the file read, None for bytes; the name LibRaw prints it by; what ``rawpy.imread``
-    is given) for :func:`decode_raw`'s ``source``."""
+#: What a RAW that went before LibRaw read it is said to be.
+_GONE = "RAW file not found (moved or deleted before it was read)"
+
+
+def _source(
+    source: Path | str | bytes,
+) -> tuple[Path | None, AbstractContextManager[tuple[str, str | io.BytesIO]]]:
+    """(the file read, None for bytes; the opening of what ``rawpy.imread`` is given, as the
+    name LibRaw prints it by and the path or buffer) for :func:`decode_raw`'s ``source``.
+
+    Why an opening (:func:`libraw_opened`), not the bytes: a RAW whose path is not UTF-8 had
+    been read whole into memory for each decode (:func:`libraw_source`), a second copy of a
+    25 MB file beside the frame decoded from it; through ``/dev/fd/N`` LibRaw reads it from
+    disk, as it reads every other file."""
     if isinstance(source, bytes | bytearray):
-        return None, LIBRAW_BUFFER_NAME, io.BytesIO(bytes(source))
+        return None, nullcontext((LIBRAW_BUFFER_NAME, io.BytesIO(bytes(source))))
     path = Path(source)
-    gone = "RAW file not found (moved or deleted before it was read)"
     if not path.is_file():
-        raise RawFileMissingError(path, gone)
-    try:
-        return (path, *libraw_source(path))
-    except FileNotFoundError:
-        raise RawFileMissingError(path, gone) from None
+        raise RawFileMissingError(path, _GONE)
+    return path, libraw_opened(path)
 
 
 def _iso_from_tiff(source: Path | str | bytes) -> float:
@@ -583,7 +590,7 @@ def decode_raw(
     ``metadata["decode"]`` is the provenance the session journals for each image.
     """
     settings = settings or RawDecodeSettings()
-    read, printed_name, handle = _source(source)
+    read, opening = _source(source)
     printed: list[str] = []  # LibRaw's own lines, kept off the terminal (libraw_printed)
     blind = None if read is None else read_blind(read)
     if blind is not None:  # before LibRaw, which decodes such a file without a word
@@ -594,6 +601,7 @@ def decode_raw(
         )
     try:
         with (
+            opening as (printed_name, handle),
             libraw_printed(printed_name, printed),
             rawpy.imread(handle) as raw,
         ):
@@ -615,6 +623,10 @@ def decode_raw(
             )
             other = raw.other
             colours_sensed = int(raw.num_colors)
+    except FileNotFoundError:  # gone between the check and its opening
+        if read is None:
+            raise
+        raise RawFileMissingError(read, _GONE) from None
     except rawpy.LibRawFileUnsupportedError as exc:
         # a body newer than the bundled LibRaw (a new Canon CR3 or Fujifilm RAF, say) gives
         # this, a truncated download a data or I/O error: "is it a complete download?" had
