@@ -1,16 +1,18 @@
-"""What every dome protocol profile's codec offers, on both sides of the wire.
+"""What every dome protocol profile's codec offers: the host's side of the wire.
 
-A codec is pure: it turns messages into bytes and parses bytes from the front of a buffer,
-returning how many bytes it consumed, so that transports and the emulator own all I/O. Each
-profile implements both sides (host and firmware) so that the emulator speaks exactly the bytes
-the driver expects, and a byte-exact test covers both directions.
+A codec is pure: it turns commands into bytes and parses replies from the front of a buffer,
+returning how many bytes it consumed, so that the transport owns all I/O. It is the host's side
+only: the emulated board reads and writes the wire from docs/protocols/led-dome.md on its own
+(``rti_rig.simulator.own_protocols``), and the codecs' tests hold the page's bytes. Why: the
+codecs had a firmware side too, used by their own test alone, which accepted what the page
+refuses (sequence 0; 128 on the binary link, whose ack byte reads as an error).
 """
 
 from __future__ import annotations
 
 from typing import Protocol
 
-from rti_rig.drivers.led_dome.messages import BadRequest, Command, DomeIdentity, Reply
+from rti_rig.drivers.led_dome.messages import Command, Reply
 
 
 class DomeCodec(Protocol):
@@ -40,19 +42,6 @@ class DomeCodec(Protocol):
         an answer (binary replies have a length that depends on it).
         """
         ...
-
-    # firmware side
-    def decode_command(
-        self, buf: bytes
-    ) -> tuple[tuple[int | None, Command] | BadRequest | None, int]:
-        """Parse one command from the front of ``buf``: ((seq, command) | BadRequest, consumed)."""
-        ...
-
-    def encode_reply(self, reply: Reply, cmd: Command | None) -> bytes:
-        """Bytes of an Ack, Nak or Banner; ``cmd`` is the command being answered."""
-        ...
-
-    def encode_banner(self, identity: DomeIdentity) -> bytes: ...
 
 
 def xor_checksum(data: bytes) -> int:

@@ -21,12 +21,9 @@ from collections.abc import Callable
 
 from rti_rig.drivers.led_dome.codec_base import xor_checksum
 from rti_rig.drivers.led_dome.messages import (
-    ERR_BAD_CHECKSUM,
-    ERR_UNKNOWN_COMMAND,
     ERROR_CODES,
     Ack,
     AllOff,
-    BadRequest,
     Banner,
     Command,
     DomeIdentity,
@@ -124,76 +121,6 @@ class BinaryCodec:
         if xor_checksum(chunk[:-1]) != chunk[-1]:
             return Garbled(chunk, "payload checksum mismatch"), size
         return Ack(chunk[0], parse(chunk)), size
-
-    # ------------------------------------------------------------ firmware side
-
-    def decode_command(
-        self, buf: bytes
-    ) -> tuple[tuple[int | None, Command] | BadRequest | None, int]:
-        start = buf.find(bytes([self.start_byte]))
-        if start < 0:
-            return None, len(buf)  # line noise: a real firmware skips it silently
-        if start > 0:
-            return None, start
-        if len(buf) < PACKET_LEN:
-            return None, 0
-        pkt = bytes(buf[:PACKET_LEN])
-        if xor_checksum(pkt[:-1]) != pkt[-1]:
-            return BadRequest(pkt, None, ERR_BAD_CHECKSUM, "checksum mismatch"), PACKET_LEN
-        op, seq, arg, level = pkt[1], pkt[2], (pkt[3] << 8) | pkt[4], pkt[5]
-        cmd: Command
-        if op == OP_HELLO:
-            cmd = Hello()
-        elif op == OP_LIGHT:
-            if arg < self.index_base:
-                return BadRequest(pkt, seq, 2, "LED below index base"), PACKET_LEN
-            cmd = Light(arg - self.index_base, level)
-        elif op == OP_ALL_OFF:
-            cmd = AllOff()
-        elif op == OP_SHUTTER:
-            cmd = Shutter(arg)
-        elif op == OP_QUERY:
-            cmd = Query()
-        else:
-            return BadRequest(pkt, seq, ERR_UNKNOWN_COMMAND, f"op 0x{op:02X}"), PACKET_LEN
-        return (seq, cmd), PACKET_LEN
-
-    def encode_reply(self, reply: Reply, cmd: Command | None) -> bytes:
-        if isinstance(reply, Banner):
-            return BANNER
-        if isinstance(reply, Nak):
-            if not 1 <= reply.code <= 0x3F:
-                raise ValueError(f"error code {reply.code} does not fit the binary nak")
-            return bytes([0x80 | reply.code])
-        if isinstance(reply, Ack):
-            seq = reply.seq or 0
-            echo = reply.echo
-            if isinstance(echo, DomeIdentity):
-                major, _, minor = echo.version.partition(".")
-                code = _firmware_code(echo.firmware_id)
-                n = echo.led_count
-                body = bytes(
-                    [seq, int(major), int(minor.split(".")[0] or 0), n >> 8, n & 0xFF, code]
-                )
-                return body + bytes([xor_checksum(body)])
-            if isinstance(echo, LitState):
-                idx = NO_LED if echo.index is None else echo.index + self.index_base
-                body = bytes([seq, idx >> 8, idx & 0xFF, echo.level])
-                return body + bytes([xor_checksum(body)])
-            return bytes([seq])
-        raise TypeError(f"cannot encode {reply!r}")
-
-    def encode_banner(self, identity: DomeIdentity) -> bytes:
-        return BANNER
-
-
-def _firmware_code(firmware_id: str) -> int:
-    """Binary firmwares identify themselves by one byte; ids look like ``binary-0x2A``."""
-    _, _, tail = firmware_id.rpartition("0x")
-    try:
-        return int(tail, 16) & 0xFF
-    except ValueError:
-        return 0
 
 
 def _identity(chunk: bytes) -> DomeIdentity:

@@ -17,12 +17,8 @@ from __future__ import annotations
 
 from rti_rig.drivers.led_dome.codec_base import xor_checksum
 from rti_rig.drivers.led_dome.messages import (
-    ERR_BAD_ARGUMENT,
-    ERR_BAD_CHECKSUM,
-    ERR_UNKNOWN_COMMAND,
     Ack,
     AllOff,
-    BadRequest,
     Banner,
     Command,
     DomeIdentity,
@@ -105,61 +101,10 @@ class DefaultCodec:
             return Garbled(bytes(buf[:consumed]), error), consumed
         if line is None:
             return None, consumed  # more bytes needed, or a blank line dropped
-        tokens = line.decode("ascii").split()
         try:
-            return _parse_reply(tokens), consumed
+            return _parse_reply(line.decode("ascii")), consumed
         except (ValueError, IndexError) as exc:
             return Garbled(bytes(buf[:consumed]), f"unreadable reply ({exc})"), consumed
-
-    # ------------------------------------------------------------ firmware side
-
-    def decode_command(
-        self, buf: bytes
-    ) -> tuple[tuple[int | None, Command] | BadRequest | None, int]:
-        line, consumed, error = self._take_line(buf)
-        if error is not None:
-            return BadRequest(bytes(buf[:consumed]), None, ERR_BAD_CHECKSUM, error), consumed
-        if line is None:
-            return None, consumed
-        tokens = line.decode("ascii").split()
-        seq: int | None = None
-        try:
-            seq = int(tokens[0])
-            return (seq, _parse_command(tokens[1:])), consumed
-        except _UnknownVerb as exc:
-            return BadRequest(line, seq, ERR_UNKNOWN_COMMAND, str(exc)), consumed
-        except (ValueError, IndexError) as exc:
-            return BadRequest(line, seq, ERR_BAD_ARGUMENT, f"bad arguments ({exc})"), consumed
-
-    def encode_reply(self, reply: Reply, cmd: Command | None) -> bytes:
-        if isinstance(reply, Ack):
-            echo = reply.echo
-            if isinstance(echo, DomeIdentity):
-                tail = f"ID {echo.firmware_id} {echo.version} {echo.led_count}"
-            elif isinstance(echo, LitState):
-                idx = -1 if echo.index is None else echo.index
-                tail = f"Q {idx} {echo.level}"
-            elif echo is None:
-                raise ValueError("the default profile always echoes the executed command")
-            else:
-                tail = _command_body(echo)
-            return self._line(f"OK {reply.seq} {tail}")
-        if isinstance(reply, Nak):
-            seq = 0 if reply.seq is None else reply.seq
-            text = "_".join(reply.text.split()) or "-"
-            return self._line(f"ERR {seq} {reply.code} {text}")
-        if isinstance(reply, Banner):
-            if reply.identity is None:
-                return self._line("READY")
-            return self.encode_banner(reply.identity)
-        raise TypeError(f"cannot encode {reply!r}")
-
-    def encode_banner(self, identity: DomeIdentity) -> bytes:
-        return self._line(f"READY {identity.firmware_id} {identity.version} {identity.led_count}")
-
-
-class _UnknownVerb(ValueError):
-    pass
 
 
 def _command_body(cmd: Command | DomeIdentity | LitState) -> str:
@@ -177,46 +122,80 @@ def _command_body(cmd: Command | DomeIdentity | LitState) -> str:
     raise TypeError(f"not a command: {cmd!r}")
 
 
-def _nonneg(token: str) -> int:
-    value = int(token)
-    if value < 0:
-        raise ValueError(f"negative value {value}")
-    return value
+def _decimal(token: str, *, signed: bool = False) -> int:
+    """A number field as the profile writes it: decimal ASCII digits, a ``-`` first only where
+    ``signed`` (the query's ``-1``).
+
+    Why: ``int`` also reads ``+7``, `` 7`` and ``1_0``, so a reply damaged on a link without
+    a checksum could still read as numbers, and other numbers than were sent."""
+    digits = token[1:] if signed and token.startswith("-") else token
+    if not (digits.isascii() and digits.isdigit()):
+        raise ValueError(f"{token!r} is no decimal number")
+    return int(token)
+
+
+def _seq(token: str, *, error: bool = False) -> int:
+    """A reply's sequence number: 1..9999, or 0 in an error too damaged to read it by."""
+    seq = _decimal(token)
+    if not (0 if error else 1) <= seq <= SEQ_MAX:
+        raise ValueError(f"sequence number {seq} outside 1..{SEQ_MAX}")
+    return seq
 
 
 def _parse_command(tokens: list[str]) -> Command:
+    """The command a reply echoes, its arguments exactly as many as the verb takes."""
     verb, args = tokens[0], tokens[1:]
     if verb == "ID" and not args:
         return Hello()
     if verb == "L" and len(args) in (2, 3):
-        max_on = _nonneg(args[2]) if len(args) == 3 else None
-        return Light(_nonneg(args[0]), _nonneg(args[1]), max_on)
+        max_on = _decimal(args[2]) if len(args) == 3 else None
+        return Light(_decimal(args[0]), _decimal(args[1]), max_on)
     if verb == "X" and not args:
         return AllOff()
     if verb == "S" and len(args) == 1:
-        return Shutter(_nonneg(args[0]))
+        return Shutter(_decimal(args[0]))
     if verb == "Q" and not args:
         return Query()
     if verb in {"ID", "L", "X", "S", "Q"}:
         raise ValueError(f"wrong number of arguments for {verb}")
-    raise _UnknownVerb(f"unknown verb {verb!r}")
+    raise ValueError(f"unknown verb {verb!r}")
 
 
-def _parse_reply(tokens: list[str]) -> Reply:
+def _parse_reply(text: str) -> Reply:
+    """One reply line (its checksum, if any, removed), read as the page writes it: fields
+    separated by one space, each field's count and numbers exact; anything else is garbled.
+
+    Why: the line had been split on any run of whitespace and its numbers read by ``int``,
+    extra fields ignored, so without a checksum a damaged ``OK 10 Q 12 200`` (``200`` ->
+    ``20 ``) read as level 20 lit, and ``... 48`` -> ``4 `` as a board of 4 LEDs."""
+    tokens = text.split(" ")
+    if "" in tokens:
+        raise ValueError("fields not separated by one space")
     head = tokens[0]
     if head == "READY":
         if len(tokens) == 1:
             return Banner(None)
-        return Banner(DomeIdentity(tokens[1], tokens[2], int(tokens[3])))
+        if len(tokens) != 4:
+            raise ValueError("a banner carries an id, a version and a count")
+        return Banner(DomeIdentity(tokens[1], tokens[2], _decimal(tokens[3])))
     if head == "ERR":
-        return Nak(int(tokens[1]) or None, int(tokens[2]), " ".join(tokens[3:]).replace("_", " "))
+        if len(tokens) != 4:
+            raise ValueError("an error carries a sequence number, a code and one word")
+        seq = _seq(tokens[1], error=True)
+        return Nak(seq or None, _decimal(tokens[2]), tokens[3].replace("_", " "))
     if head != "OK":
         raise ValueError(f"unknown reply {head!r}")
-    seq = int(tokens[1])
+    seq = _seq(tokens[1])
     verb, args = tokens[2], tokens[3:]
     if verb == "ID":
-        return Ack(seq, DomeIdentity(args[0], args[1], int(args[2])))
+        if len(args) != 3:
+            raise ValueError("an identity carries a name, a version and a count")
+        return Ack(seq, DomeIdentity(args[0], args[1], _decimal(args[2])))
     if verb == "Q":
-        idx = int(args[0])
-        return Ack(seq, LitState(None if idx < 0 else idx, int(args[1])))
+        if len(args) != 2:
+            raise ValueError("a lit state carries an index and a level")
+        idx = _decimal(args[0], signed=True)
+        if idx < -1:
+            raise ValueError(f"LED index {idx}")
+        return Ack(seq, LitState(None if idx < 0 else idx, _decimal(args[1])))
     return Ack(seq, _parse_command([verb, *args]))

@@ -22,11 +22,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rti_rig.drivers.led_dome.messages import (
-    ERR_BAD_ARGUMENT,
-    ERR_UNKNOWN_COMMAND,
     Ack,
     AllOff,
-    BadRequest,
     Banner,
     Command,
     DomeIdentity,
@@ -123,7 +120,7 @@ class FramedCodec:
         return str(index + self.spec.index_base)
 
     def _index_in(self, token: str) -> int:
-        value = int(token) - self.spec.index_base
+        value = _nonneg(token) - self.spec.index_base
         if value < 0:
             raise ValueError(f"LED number {token} below the index base {self.spec.index_base}")
         return value
@@ -184,81 +181,38 @@ class FramedCodec:
             return Garbled(bytes(buf[:consumed]), f"unreadable reply ({exc})"), consumed
 
     def _parse_reply(self, fields: list[str]) -> Reply:
+        """One frame's fields, read as the page writes them: each reply's fields exactly as
+        many as it carries and its numbers decimal digits; anything else is garbled.
+
+        Why: extra fields had been ignored and numbers read by ``int``, so on this link,
+        which has no checksum, a damaged frame could read as another valid reply."""
         s = self.spec
         head, rest = fields[0], fields[1:]
         if head == s.ready_word:
             if not rest:
                 return Banner(None)
-            return Banner(DomeIdentity(rest[0], rest[1], int(rest[2])))
+            if len(rest) != 3:
+                raise ValueError("a banner carries an id, a version and a count")
+            return Banner(DomeIdentity(rest[0], rest[1], _nonneg(rest[2])))
         seq: int | None = None
         if head in (s.ok_word, s.err_word) and self.has_sequence:
-            seq, rest = int(rest[0]), rest[1:]
+            seq, rest = _seq(rest[0], error=head == s.err_word), rest[1:]
         if head == s.err_word:
-            return Nak(seq or None, int(rest[0]), s.separator.join(rest[1:]))
+            return Nak(seq or None, _nonneg(rest[0]), s.separator.join(rest[1:]))
         if head != s.ok_word:
             raise ValueError(f"unknown reply word {head!r}")
         verb = self._verb_of_code.get(rest[0])
         if verb == "hello":
-            return Ack(seq, DomeIdentity(rest[1], rest[2], int(rest[3])))
+            if len(rest) != 4:
+                raise ValueError("an identity carries a name, a version and a count")
+            return Ack(seq, DomeIdentity(rest[1], rest[2], _nonneg(rest[3])))
         if verb == "query":
-            idx = int(rest[1])
-            return Ack(seq, LitState(None if idx < 0 else idx - s.index_base, int(rest[2])))
+            if len(rest) != 3:
+                raise ValueError("a lit state carries an index and a level")
+            if rest[1] == "-1":
+                return Ack(seq, LitState(None, _nonneg(rest[2])))
+            return Ack(seq, LitState(self._index_in(rest[1]), _nonneg(rest[2])))
         return Ack(seq, self._parse_args(rest))
-
-    # ------------------------------------------------------------ firmware side
-
-    def decode_command(
-        self, buf: bytes
-    ) -> tuple[tuple[int | None, Command] | BadRequest | None, int]:
-        fields, consumed, error = self._take_frame(buf)
-        if error is not None:
-            return BadRequest(bytes(buf[:consumed]), None, ERR_BAD_ARGUMENT, error), consumed
-        if fields is None:
-            return None, consumed
-        seq: int | None = None
-        try:
-            if self.has_sequence:
-                seq = int(fields[1])
-                fields = [fields[0], *fields[2:]]
-            return (seq, self._parse_args(fields)), consumed
-        except _UnknownCode as exc:
-            return BadRequest(bytes(buf[:consumed]), seq, ERR_UNKNOWN_COMMAND, str(exc)), consumed
-        except (ValueError, IndexError) as exc:
-            reason = f"bad arguments ({exc})"
-            return BadRequest(bytes(buf[:consumed]), seq, ERR_BAD_ARGUMENT, reason), consumed
-
-    def encode_reply(self, reply: Reply, cmd: Command | None) -> bytes:
-        s = self.spec
-        seq_field = (
-            [str(reply.seq or 0)]
-            if self.has_sequence and not isinstance(reply, Banner | Garbled)
-            else []
-        )
-        if isinstance(reply, Ack):
-            echo = reply.echo
-            if isinstance(echo, DomeIdentity):
-                tail = [s.codes["hello"], echo.firmware_id, echo.version, str(echo.led_count)]
-            elif isinstance(echo, LitState):
-                idx = "-1" if echo.index is None else self._index_out(echo.index)
-                tail = [s.codes["query"], idx, str(echo.level)]
-            elif echo is None:
-                raise ValueError("the framed profile always echoes the executed command")
-            else:
-                tail = self._args(echo)
-            return self._frame([s.ok_word, *seq_field, *tail])
-        if isinstance(reply, Nak):
-            text = reply.text.replace(s.separator, " ").replace(s.end, " ").replace(s.start, " ")
-            return self._frame([s.err_word, *seq_field, str(reply.code), text])
-        if isinstance(reply, Banner):
-            if reply.identity is None:
-                return self._frame([s.ready_word])
-            return self.encode_banner(reply.identity)
-        raise TypeError(f"cannot encode {reply!r}")
-
-    def encode_banner(self, identity: DomeIdentity) -> bytes:
-        return self._frame(
-            [self.spec.ready_word, identity.firmware_id, identity.version, str(identity.led_count)]
-        )
 
 
 class _UnknownCode(ValueError):
@@ -266,7 +220,19 @@ class _UnknownCode(ValueError):
 
 
 def _nonneg(token: str) -> int:
-    value = int(token)
-    if value < 0:
-        raise ValueError(f"negative value {value}")
-    return value
+    """A number field as the firmware writes it: decimal ASCII digits.
+
+    Why: ``int`` also reads ``+7``, `` 7`` and ``1_0``, so a frame damaged on this link,
+    which has no checksum, could still read as numbers, and other numbers than were sent
+    (``<OK,1,9,RTIDOME,1.2.0, 8>``, the count ``48`` damaged, as a board of 8 LEDs)."""
+    if not (token.isascii() and token.isdigit()):
+        raise ValueError(f"{token!r} is no decimal number")
+    return int(token)
+
+
+def _seq(token: str, *, error: bool = False) -> int:
+    """A reply's sequence number: 1..9999, or 0 in an error too damaged to read it by."""
+    seq = _nonneg(token)
+    if not (0 if error else 1) <= seq <= SEQ_MAX:
+        raise ValueError(f"sequence number {seq} outside 1..{SEQ_MAX}")
+    return seq

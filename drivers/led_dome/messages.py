@@ -1,7 +1,7 @@
 """The verbs a host says to a dome and the answers a dome gives, independent of bytes.
 
-Every profile's codec turns these values into bytes and back, on both sides of the wire (the
-host driver and the firmware emulator), so one set of dataclasses keeps both sides honest: a
+Every profile's codec turns the commands into bytes and the board's bytes into replies (the
+host's side only: the emulated board reads the wire from the protocol page on its own), so a
 byte-exact test of a profile is a table of (message, bytes) pairs.
 """
 
@@ -122,16 +122,6 @@ class Garbled:
 
 
 Reply = Ack | Nak | Banner | Garbled
-
-
-@dataclass(frozen=True)
-class BadRequest:
-    """Firmware side: bytes that are not a valid command. ``seq`` when it could be read."""
-
-    raw: bytes
-    seq: int | None
-    code: int
-    reason: str
 
 
 # Error codes shared by every profile (binary carries them in 6 bits).

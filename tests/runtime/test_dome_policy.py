@@ -21,7 +21,7 @@ from rti_rig.drivers.led_dome import DomeSerialSettings
 from rti_rig.drivers.led_dome.codec_default import DefaultCodec
 from rti_rig.drivers.led_dome.codec_framed import FramedCodec
 from rti_rig.drivers.led_dome.driver import LedDomeDriver
-from rti_rig.drivers.led_dome.messages import Ack, AllOff, DomeIdentity, Hello
+from rti_rig.drivers.led_dome.messages import AllOff, Hello
 from rti_rig.runtime.dome_policy import (
     DomeLedError,
     DomeLinkError,
@@ -315,22 +315,27 @@ def test_wrong_echo_is_caught_and_the_light_resent():
 
 
 #: Profiles without a checksum, a boot banner in each, and a handshake reply with a damaged
-#: byte in it that still makes a well-formed reply (the framed one is the emulator's garble).
+#: byte in it that still makes a well-formed reply (the framed one is the emulator's garble),
+#: then the board's replies to the resent handshake and the all-off (docs/protocols/led-dome.md)
+FRAMED_REPLIES = (b"<OK,2,9,RTIDOME-EMU,1.0.0,4>", b"<OK,3,0>")
 UNCHECKED = {
     "framed, name": (
         FramedCodec(),
         b"<READY,RTIDOME-EMU,1.0.0,4>",
         b"<OK,1,9,RTIDOM\x04-EMU,1.0.0,4>",
+        FRAMED_REPLIES,
     ),
     "framed, version": (
         FramedCodec(),
         b"<READY,RTIDOME-EMU,1.0.0,4>",
         b"<OK,1,9,RTIDOME-EMU,1.\x7f.0,4>",
+        FRAMED_REPLIES,
     ),
     "default without checksum, name": (
         DefaultCodec(checksum=False),
         b"READY RTIDOME-EMU 1.0.0 4\n",
         b"OK 1 ID RTIDOM\x04-EMU 1.0.0 4\n",
+        (b"OK 2 ID RTIDOME-EMU 1.0.0 4\n", b"OK 3 X\n"),
     ),
 }
 
@@ -340,13 +345,12 @@ def test_a_handshake_reply_with_a_control_byte_in_the_identity_is_garbled_and_re
     """A profile without a checksum cannot see a damaged byte, but no firmware names itself
     with control bytes: such a reply is garbled, resent, and the board's real name is what
     connect keeps. It had been accepted as firmware 'RTIDOM\\x04-EMU'."""
-    codec, banner, damaged = UNCHECKED[case]
-    identity = DomeIdentity("RTIDOME-EMU", "1.0.0", 4)
+    codec, banner, damaged, (hello, off) = UNCHECKED[case]
     transport = ScriptedTransport(
         [
             (codec.encode_command(1, Hello()), damaged),
-            (codec.encode_command(2, Hello()), codec.encode_reply(Ack(2, identity), Hello())),
-            (codec.encode_command(3, AllOff()), codec.encode_reply(Ack(3, AllOff()), AllOff())),
+            (codec.encode_command(2, Hello()), hello),
+            (codec.encode_command(3, AllOff()), off),
         ]
     )
     transport.open = lambda: setattr(transport, "pending", banner)  # its own profile's banner
@@ -354,6 +358,44 @@ def test_a_handshake_reply_with_a_control_byte_in_the_identity_is_garbled_and_re
     dome.connect()
     assert dome.info is not None
     assert (dome.info.firmware_id, dome.info.version) == ("RTIDOME-EMU", "1.0.0")
+    assert dome.stats.recovered == ["handshake: garbled"]
+    assert transport.script == []
+
+
+@pytest.mark.parametrize(
+    ("codec", "damaged", "hello", "off"),
+    [
+        (
+            DefaultCodec(checksum=False),
+            b"OK 1 ID RTIDOME-EMU 1.0.0 4 \n",  # its count 48's '8' damaged into a space
+            b"OK 2 ID RTIDOME-EMU 1.0.0 48\n",
+            b"OK 3 X\n",
+        ),
+        (
+            FramedCodec(),
+            b"<OK,1,9,RTIDOME-EMU,1.0.0, 8>",  # its '4' damaged into a space
+            b"<OK,2,9,RTIDOME-EMU,1.0.0,48>",
+            b"<OK,3,0>",
+        ),
+    ],
+    ids=["default without checksum", "framed"],
+)
+def test_a_handshake_reply_whose_count_is_damaged_is_garbled_and_resent(codec, damaged, hello, off):
+    """A link without a checksum: the count's damaged byte had still made numbers (its fields
+    split on any run of spaces, or read by ``int``, which skips a space), and the board of 48
+    LEDs was taken for one of 4, or 8. Such a reply is garbled now, and resent."""
+    transport = ScriptedTransport(
+        [
+            (codec.encode_command(1, Hello()), damaged),
+            (codec.encode_command(2, Hello()), hello),
+            (codec.encode_command(3, AllOff()), off),
+        ]
+    )
+    banner = b"READY RTIDOME-EMU 1.0.0 48\n" if b"\n" in hello else b"<READY,RTIDOME-EMU,1.0.0,48>"
+    transport.open = lambda: setattr(transport, "pending", banner)  # its own profile's banner
+    dome = DomePolicy(LedDomeDriver(transport, codec), VirtualClock())
+    dome.connect()
+    assert dome.info is not None and dome.info.led_count == 48
     assert dome.stats.recovered == ["handshake: garbled"]
     assert transport.script == []
 
