@@ -2062,7 +2062,9 @@ def self_test(
     settle_s: float = 0.05,
     leds: Sequence[int] | None = None,
 ) -> SelfTestReport:
-    """Handshake, then light each LED in turn (confirming with the firmware when it can).
+    """Handshake, then light each LED in turn (confirming with the firmware when it can), at
+    ``intensity``, or fully on where the link cannot dim (:func:`_walk_level`, said in the
+    report's ``level_said``).
 
     Connects and closes ``source`` itself. An error about one LED is recorded and the test moves
     on; any other error aborts the walk (the dome is switched off in every case).
