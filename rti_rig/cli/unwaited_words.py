@@ -80,12 +80,16 @@ class WordsWriter:
         self._thread.start()
 
     def write(self, stream: Any, text: str) -> None:
+        # measured before any count is read: each ``+=`` below then has no call between its
+        # read and its store, where a signal handler that speaks (the lock is re-entrant: it
+        # does not keep the main thread's own handler out) would have its count overwritten
+        n = len(text)
         with self._count_lock:  # the check and the queueing as one against close()
             if self._open():
-                if self._queued - self._written + len(text) > self._limit:
-                    self._dropped += len(text)
+                if self._queued - self._written + n > self._limit:
+                    self._dropped += n
                     return
-                self._queued += len(text)
+                self._queued += n
                 self._queue((stream, text))
                 return
         stream.write(text)  # a forked child, a closed writer: as before

@@ -15,6 +15,8 @@ import io
 import threading
 from typing import Any
 
+import pytest
+
 from rti_rig.cli.unwaited_words import WordsWriter
 
 #: Far beyond what either step takes on a loaded machine: only a broken writer waits this long.
@@ -128,6 +130,63 @@ def test_words_beyond_the_limit_are_dropped_counted_and_said() -> None:
         assert writer.unwritten() == 0
         assert stream.getvalue() == "12345678\n"
         assert "note: 4 characters of output were dropped" in notes.getvalue()
+    finally:
+        release.set()
+        writer.close(DEADLINE_S)
+
+
+class _SpokenOver(str):
+    """A word whose every measuring runs ``say``: a signal handler that speaks, landing at a
+    call ``write`` makes to measure it (a call is where Python runs a pending handler; which
+    call a real one meets is chance, so each gets one)."""
+
+    say: Any = None
+
+    def __len__(self) -> int:
+        if self.say is not None:
+            self.say()
+        return super().__len__()
+
+
+@pytest.mark.parametrize("kept", [True, False], ids=["queued", "dropped"])
+def test_a_handler_speaking_inside_a_write_has_its_characters_counted(kept: bool) -> None:
+    """The count lock is re-entrant (a handler in the main thread must not deadlock on it), so
+    it does not keep that handler out of the main thread's own ``+=``: a handler landing
+    between the read of a count and its store (at ``len(text)``, measured there) had its
+    characters overwritten. Queued, the held count then ran negative (``unwritten()`` below
+    zero, the limit overrun by them); dropped, the note said fewer characters than were
+    lost."""
+    release = threading.Event()
+
+    class Stalled(io.StringIO):
+        def write(self, text: str) -> int:
+            release.wait(DEADLINE_S)
+            return super().write(text)
+
+    notes, stream = io.StringIO(), Stalled()
+    limit = 100 if kept else 10
+    writer = WordsWriter(notes_to=notes, limit=limit)
+    try:
+        handlers = "Stopping after this image\n"  # 26: beyond the limit of 10 too
+        spoke: list[str] = []
+
+        def handler_speaks() -> None:
+            spoke.append(handlers)
+            writer.write(stream, handlers)
+
+        word = _SpokenOver("the main thread's word\n")  # 23
+        word.say = handler_speaks
+        writer.write(stream, word)
+        word.say = None
+        said = len("".join(spoke)) + len(word)
+        assert spoke and writer.unwritten() == said
+        release.set()
+        assert writer.drain(DEADLINE_S)
+        assert writer.unwritten() == 0
+        if kept:
+            assert stream.getvalue() == "".join(spoke) + word
+        else:
+            assert f"note: {said} characters" in notes.getvalue(), notes.getvalue()
     finally:
         release.set()
         writer.close(DEADLINE_S)
