@@ -8,11 +8,16 @@ read from the page itself, so a page and an emulator that part ways fail here.
 
 from __future__ import annotations
 
+import importlib.util
 from pathlib import Path
+from typing import Any
 
 import pytest
 
-from rti_rig.simulator.dome_firmware import DomeFirmware
+from rti_rig.drivers.led_dome.messages import Ack, AllOff, Light, LitState, Nak
+from rti_rig.drivers.led_dome.profiles import make_codec
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.simulator.dome_firmware import DomeFirmware, firmware_for
 from rti_rig.simulator.own_protocols import (
     BinaryProfile,
     BoardFacts,
@@ -136,3 +141,57 @@ def test_a_sequence_number_outside_the_profiles_range_is_refused_with_error_2() 
         refused, _ = BinaryProfile().decode(packet + bytes([0xA5 ^ 0x03 ^ seq]))
         assert isinstance(refused, Refused) and refused.code == 2, seq
         assert BinaryProfile().err(refused.seq, refused.code, refused.text) == b"\x82"
+
+
+def _codec_fixtures() -> Any:
+    """``tests/drivers/led_dome/test_dome_codecs.py``, the page's normative byte-exact
+    fixtures, loaded by its path (a test module, not a package's)."""
+    path = Path(__file__).resolve().parents[1] / "drivers" / "led_dome" / "test_dome_codecs.py"
+    spec = importlib.util.spec_from_file_location("_dome_codec_fixtures", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+_FIXTURES = _codec_fixtures()
+
+
+@pytest.mark.parametrize(
+    ("profile", "row"),
+    [
+        pytest.param(profile, row, id=f"{profile}-{i}")
+        for profile, script in (
+            ("default", _FIXTURES.DEFAULT_SCRIPT),
+            ("framed", _FIXTURES.FRAMED_SCRIPT),
+            ("binary", _FIXTURES.BINARY_SCRIPT),
+        )
+        for i, row in enumerate(script)
+    ],
+)
+def test_the_emulator_answers_every_fixture_exchange_as_the_fixture_says(
+    profile: str, row: tuple[Any, ...]
+) -> None:
+    """The page names the codec tests' scripted exchanges its normative examples: a board
+    (RTIDOME 1.2.0, 48 LEDs, LED 3 dead) sent each command's bytes answers the reply's bytes,
+    the state a query reports set first by the script's own light or all-off. An error's text
+    is the board's own (the page fixes only its seq and code)."""
+    settings = DomeSerialSettings(port="loop://", profile=profile)
+    firmware = firmware_for(settings, firmware_id="RTIDOME", version="1.2.0", dead_leds={3})
+    firmware.boot()
+    script = {"default": _FIXTURES.DEFAULT_SCRIPT, "framed": _FIXTURES.FRAMED_SCRIPT}.get(
+        profile, _FIXTURES.BINARY_SCRIPT
+    )
+    _, cmd, cmd_bytes, reply, reply_bytes = row
+    echo = getattr(reply, "echo", None)
+    if isinstance(echo, LitState):  # the state the query reads, set by the script
+        wanted = Light if echo.index is not None else AllOff
+        before = next(r for r in script if isinstance(r[1], wanted) and isinstance(r[3], Ack))
+        firmware.receive(before[2])
+    answered = b"".join(out.data for out in firmware.receive(cmd_bytes))
+    if isinstance(reply, Nak):
+        heard, used = make_codec(settings).decode_reply(answered, cmd)
+        assert used == len(answered) and isinstance(heard, Nak), answered
+        assert (heard.seq, heard.code) == (reply.seq, reply.code), answered
+    else:
+        assert answered == reply_bytes
