@@ -179,7 +179,7 @@ def main() -> int:
             "settle time excluded. The emulator integrates the same trapezoid, so this checks "
             "the driver loop and the kinematics, not the physics. The executed time also counts "
             "the bus (each poll's instruction and status bytes at 57600 baud and the servos' "
-            "0.5 ms Return Delay Time, `simulator/dynamixel_wire.py`), which the model leaves "
+            "0.5 ms Return Delay Time, `simulator/dynamixel_bus_time.py`), which the model leaves "
             "out.",
             "",
             "| N | model (s) | executed in emulator (s) | difference |",
