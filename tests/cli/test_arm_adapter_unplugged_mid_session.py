@@ -25,13 +25,17 @@ pytestmark = [
     pytest.mark.pty,
 ]
 
+#: instructions into the session when the adapter goes: after the second image (140–210 do,
+#: since each poll pays the bus's time and a move takes fewer; 250 had before, and fell after
+#: the third image once the bus's time was charged). One number for both tests: the second
+#: had kept 250 when the first was moved on
+AFTER_SECOND_IMAGE = 180
+
 
 def test_an_arm_adapter_unplugged_mid_session_stops_keeps_and_resumes(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    #: instructions into the session when the adapter goes: after the second image (140–210
-    #: do, since each poll pays the bus's time and a move takes fewer; 250 had before)
-    gone: dict[str, int | bool] = {"after": 180, "now": False}
+    gone: dict[str, int | bool] = {"after": AFTER_SECOND_IMAGE, "now": False}
     handler = dynamixel_pty.EmulatedLinkPortHandler
     real_write, real_open = handler.writePort, handler.openPort
 
@@ -100,7 +104,7 @@ def test_an_adapter_gone_at_the_flush_before_a_packet_is_said_as_its_port(
     (found by closing the emulator's pty under a running session). Said now as the port lost,
     exit 2, the images kept and the resume offered, as for a failed write."""
     termios = pytest.importorskip("termios")
-    gone = {"after": 250}
+    gone = {"after": AFTER_SECOND_IMAGE}
     handler = dynamixel_pty.EmulatedLinkPortHandler
     real_clear = handler.clearPort
 
