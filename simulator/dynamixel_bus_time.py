@@ -23,15 +23,13 @@ from typing import Any
 
 from rti_rig.core.clock import Clock
 from rti_rig.simulator import dynamixel_table as tbl
+from rti_rig.simulator import dynamixel_wire as wire
 
 #: Bits one byte takes on the wire: start bit, 8 data bits, stop bit (ROBOTIS e-manual, X
 #: series specifications, Physical Connection: "8bit, 1stop, No Parity").
 BITS_PER_BYTE = 10
 #: Return Delay Time (9) unit, seconds (e-manual, X-series control table: 2 [μsec]).
 RETURN_DELAY_UNIT_S = 2e-6
-#: A Protocol 2.0 packet's header and reserved byte. Byte stuffing keeps ``FF FF FD`` out of a
-#: packet's body, so each occurrence in the stream starts a packet.
-HEADER = b"\xff\xff\xfd\x00"
 
 
 def wire_time_s(n_bytes: int, baud: int | None) -> float:
@@ -55,7 +53,10 @@ class BusTime:
         self.clock = clock
         self._servos = servos
         self._baud = baud
-        self._tail = bytearray()  # the end of what was read, a header maybe cut in two
+        #: what was read of a packet's first 7 bytes (header, ID, Length), not yet whole
+        self._head = bytearray()
+        #: bytes still to come of the packet being read, by its Length
+        self._left = 0
 
     def sent(self, data: bytes) -> None:
         """The host wrote ``data``: its bytes cross the wire before any servo acts on them."""
@@ -67,14 +68,43 @@ class BusTime:
         after its own delay, as the e-manual's Sync Read describes)."""
         if not data:
             return
+        self.clock.sleep(self._delays_begun(data) + wire_time_s(len(data), self._baud()))
+
+    def _delays_begun(self, data: bytes) -> float:
+        """The Return Delay Time of each status packet that begins in ``data``, the packets
+        taken by their Length as the emulator's codec takes them
+        (:class:`~rti_rig.simulator.dynamixel_wire.InstructionReader`).
+
+        Why by Length: a packet's CRC is not stuffed, so ``FF FF FD 00`` can end one (a
+        status whose parameters end ``FF FF``, a negative Present Velocity, with CRC
+        0x00FD); found by the header alone, it had been read as a packet that took the next
+        status's header as its ID, and that servo's delay went uncharged."""
         delay = 0.0
-        buf = self._tail + data
-        while (i := buf.find(HEADER)) >= 0 and i + 5 <= len(buf):
-            delay += return_delay_s(self._servos, buf[i + 4])
-            del buf[: i + 5]
-        self._tail = buf[-(len(HEADER)) :] if len(buf) > len(HEADER) else buf
-        self.clock.sleep(delay + wire_time_s(len(data), self._baud()))
+        buf = self._head + data
+        while buf:
+            if self._left:
+                n = min(self._left, len(buf))
+                del buf[:n]
+                self._left -= n
+                continue
+            start = buf.find(wire.HEADER)
+            if start < 0:
+                del buf[: max(0, len(buf) - (len(wire.HEADER) - 1))]  # a header cut in two
+                break
+            del buf[:start]
+            if len(buf) < 7:
+                break
+            dxl_id, length = buf[4], buf[5] | buf[6] << 8
+            if dxl_id > wire.BROADCAST_ID or dxl_id == 0xFD or length < 3:
+                del buf[: len(wire.HEADER)]  # not a packet, as the codec skips it
+                continue
+            delay += return_delay_s(self._servos, dxl_id)
+            self._left = length
+            del buf[:7]
+        self._head = buf
+        return delay
 
     def cleared(self) -> None:
         """The host discarded what had arrived: a packet cut short there starts no other."""
-        self._tail.clear()
+        self._head.clear()
+        self._left = 0

@@ -142,3 +142,24 @@ def test_the_pty_port_s_write_is_handled_before_the_host_moves_the_clock_on() ->
     ticks, now = _moved_after_a_sync_write("pty")
     assert (ticks, now) == _moved_after_a_sync_write("inprocess")
     assert ticks > 2048 + 20  # it moved for the 0.2 s, at about 150 ticks a second
+
+
+@pytest.mark.parametrize("chunk", [1, 3, 64])
+def test_a_status_ending_like_a_header_starts_no_packet(chunk: int) -> None:
+    """A packet's CRC is not stuffed: servo 1's status with parameters ending ``FF FF``
+    (a negative Present Velocity's high bytes) and CRC 0x00FD ends in ``FF FF FD 00``. Read by
+    the header alone, that was a packet whose ID was servo 2's next header byte, and servo 2's
+    Return Delay Time went uncharged; taken by Length, as the emulator's codec reads, each of
+    the two statuses pays its own, in whatever pieces the host reads them."""
+    from rti_rig.simulator import dynamixel_wire as wire
+    from rti_rig.simulator.dynamixel_bus_time import BusTime
+
+    first = wire.status_packet(1, 0, bytes([163, 83, 0xFF, 0xFF]))
+    assert first.endswith(wire.HEADER)  # the case: a header-like run at its very end
+    stream = first + wire.status_packet(2, 0, bytes([1, 2, 3, 4]))
+    clock = VirtualClock()
+    emu = _emulator(clock)
+    bus = BusTime(clock, emu.servos, lambda: None)  # no baud: the delays alone
+    for i in range(0, len(stream), chunk):
+        bus.heard(stream[i : i + chunk])
+    assert clock.now() == pytest.approx(2 * FACTORY_DELAY_S, rel=1e-9)
