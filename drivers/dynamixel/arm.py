@@ -289,13 +289,7 @@ class DynamixelArm(ReadBackCarrier):
                     for j in self.settings.joints
                 )
                 az, el = self.kin.pose_of_ticks(*ticks)
-                s = self.settings
-                park = self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg)
-                parked = all(
-                    abs(int(a) - int(b)) <= self.PARKED_TICKS
-                    for a, b in zip(ticks, park, strict=True)
-                )
-                place = "at its park pose" if parked else "away from its park pose"
+                place = "at its park pose" if self._at_park(ticks) else "away from its park pose"
                 where = f" at az {az:.1f}°, el {el:.1f}° (read back, {place})"
             except Exception:
                 where = " (where could not be read)"
@@ -620,11 +614,12 @@ class DynamixelArm(ReadBackCarrier):
             joint.servo_id,
         )
 
-    def _at_park(self) -> bool:
-        """Whether the arm reads back within :attr:`PARKED_TICKS` of its park pose."""
+    def _at_park(self, present: tuple[int, ...] | None = None) -> bool:
+        """Whether the arm reads back within :attr:`PARKED_TICKS` of its park pose (``present``:
+        ticks already read, as past a faulted servo's Alert bit; else read now)."""
         s = self.settings
         park = self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg)
-        present = self.joint_ticks()
+        present = self.joint_ticks() if present is None else present
         return (
             max(abs(int(a) - int(b)) for a, b in zip(present, park, strict=True))
             <= self.PARKED_TICKS
