@@ -41,7 +41,7 @@ def test_a_narrowed_reach_accepted_on_resume_says_how_to_go_on(
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "is above the arm's maximum 40°" in said, said
-    assert "leaves these lights of s out of its reach: to finish the session, set" in said, said
+    assert "leaves these steps of s unable to run on it: to finish the session, set" in said, said
     assert "s/manifest.json, under rig.config) and resume" in said, said
     command = said.split("or shoot a new session on the rig as it is: ", 1)[1]
     assert command == f"rti-rig run {shlex.quote(str(cfg))} --out s-again", said
@@ -71,4 +71,4 @@ def test_a_dynamixel_arm_s_azimuth_out_of_its_new_limits_is_said_in_their_terms(
     assert r.exit_code == 2, said
     assert "azimuth -30.658 deg is outside the joint limits -10.0..170.0" in said, said
     assert "329.342" not in said, said
-    assert "leaves these lights of" in said and "--out " in said, said
+    assert "leaves these steps of" in said and "--out " in said, said

@@ -1918,12 +1918,14 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         if not diffs:
             raise
         # an accepted change (an arm's reach narrowed) that leaves the session's own lights
-        # out of reach: the list alone had said what, not what to do
+        # out of reach: the list alone had said what, not what to do. Said as steps that
+        # cannot run, not "out of its reach": the refusal may be a narrower camera's exposure
+        # range or a timed firmware's window, a change as accepted
         session = Path(req.session_dir)
         again = shell_word(str(free_folder_beside(session, "again")))
         raise ScheduleError(
-            f"{exc}\nThe rig change accepted ({'; '.join(diffs)}) leaves these lights of "
-            f"{shown_path(session)} out of its reach: to finish the session, set "
+            f"{exc}\nThe rig change accepted ({'; '.join(diffs)}) leaves these steps of "
+            f"{shown_path(session)} unable to run on it: to finish the session, set "
             f"{shown_path(loaded.path)} back as it began (its copy is in "
             f"{shown_path(session / 'manifest.json')}, under rig.config) and resume; or shoot "
             f"a new session on the rig as it is: rti-rig run {shell_word(str(loaded.path))} "
