@@ -552,6 +552,26 @@ def _csv_hint(line: str) -> str:
     )
 
 
+def _heading_hint(line: str) -> str:
+    """What to say of a line that holds no number at all where a count or a light goes: a
+    title (``LP file``, ``RTI dome A``) or a row of column headings (``image x y z``, as a
+    spreadsheet or a script's table writes above the lights): "" for any other line, and for
+    one naming an image file (a light line that lost its numbers).
+
+    Why: such a line had been refused as "x component 'x' is not a number" or "expected 'name
+    x y z', found 2 field(s)", a reason with nothing to do; the fix is one edit, said here,
+    and a line marked with '#' is read as a comment (:func:`parse_lp`)."""
+    tokens = line.split()
+    if not tokens or any(_is_number(t.strip(",;")) for t in tokens):
+        return ""
+    if any(t.lower().endswith(_IMAGE_ENDINGS) for t in tokens):
+        return ""
+    return (
+        " (a title or a row of column headings? an .lp has none: delete the line, or start "
+        "it with '#' to keep it as a comment)"
+    )
+
+
 def _parse_float(token: str, source: str, lineno: int, axis: str, line: str = "") -> float:
     try:
         value = float(token)
@@ -730,7 +750,7 @@ def parse_lp(
                     " (a spreadsheet's column headings? an .lp has none: a count line, then "
                     "'image-name x y z' per image, separated by spaces or tabs)"
                     if _csv_hint(first)
-                    else ""
+                    else _heading_hint(first)
                 ),
             ) from None
         if declared <= 0:
@@ -756,7 +776,14 @@ def parse_lp(
             raise LpFormatError(
                 source,
                 lineno,
-                f"expected 'name x y z', found {len(tokens)} field(s): {line!r}" + _csv_hint(line),
+                f"expected 'name x y z', found {len(tokens)} field(s): {line!r}"
+                + (_csv_hint(line) or _heading_hint(line)),
+            )
+        if hint := _heading_hint(line):
+            # a heading row ('image x y z', 'filename\tlx\tly\tlz'): no light, and no number to
+            # blame (it had been told "x component 'x' is not a number" and nothing to do)
+            raise LpFormatError(
+                source, lineno, f"expected 'name x y z', found no number: {line!r}{hint}"
             )
         # Like relight: the last three fields are the vector, the rest is the name.
         name = " ".join(tokens[:-3])
