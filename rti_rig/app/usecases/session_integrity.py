@@ -19,8 +19,8 @@ import numpy as np
 
 from rti_rig.app.usecases.uneven_lights import with_uneven_lights
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.lp_format import lp_files_in, read_lp
-from rti_rig.core.shell_words import shell_word
+from rti_rig.core.lp_format import image_path, lp_files_in, read_lp
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.reconstruct.qa import (
     BLACK_ADVICE,
     FLAT_ADVICE,
@@ -510,8 +510,23 @@ def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
             continue
         led, image = step.get("led"), step.get("image")
         if isinstance(led, int) and 0 <= led < len(entries) and isinstance(image, str):
-            names[Path(image).stem] = entries[led].name
+            names[Path(image).stem] = _recorded_file_shown(Path(lp_file).parent, entries[led].name)
     return names
+
+
+def _recorded_file_shown(lp_dir: Path, name: str) -> str:
+    """The file an `.lp` line ``name`` was replayed from, as a user finds it: relative to the
+    `.lp`'s folder, with ``/``, through :func:`shown_path`; the name as written where it was
+    read from outside that folder.
+
+    Why: the name as the `.lp` writes it had been shown: ``C:\\RTI\\image01.jpg``, a path on
+    the machine that wrote the file (read here beside the `.lp`), and ``jpg\\image01.jpg``,
+    which a shell reads as ``jpgimage01.jpg``."""
+    found = image_path(lp_dir, name)
+    try:
+        return shown_path(found.relative_to(lp_dir).as_posix())
+    except ValueError:
+        return shown_path(name)
 
 
 #: How a session that did not finish ended, as the manifest's finish_reason records it.
