@@ -614,9 +614,10 @@ def _refuse_extra_columns(tokens: list[str], line: str, source: str, lineno: int
     Why the hint says what the line has: it had asked "an extra column after the name?" of
     ``a.jpg 0.6 0 0.8 1.0`` too, whose extra number is the last; which one is extra is named
     only where exactly one run of three is a unit vector (the light's direction)."""
-    if len(tokens) < 5 or not tokens[0].lower().endswith(_IMAGE_ENDINGS):
+    if len(tokens) < 5:
         return
-    if any(_is_number(t) for t in tokens[1:-3]):
+    named_image = tokens[0].lower().endswith(_IMAGE_ENDINGS)
+    if (named_image and any(_is_number(t) for t in tokens[1:-3])) or _columns_after_light(tokens):
         raise LpFormatError(
             source,
             lineno,
@@ -626,17 +627,35 @@ def _refuse_extra_columns(tokens: list[str], line: str, source: str, lineno: int
         )
 
 
+def _columns_after_light(tokens: list[str]) -> bool:
+    """Whether a line whose first field is no image file name (a dome's ``led01``, ``img_a``)
+    has columns after its light: every field after the first is a number, the last three are
+    no unit vector and exactly one earlier run of three is (``img_a 0 0 1 255 255 255``, a
+    colour after the direction).
+
+    Why: read the way relight reads a line (the last three fields the vector), such a line had
+    been taken as the image ``img_a 0 0 1`` lit from (255, 255, 255) normalised, every light
+    of the file from one direction, with only a note of the vectors' length; a name with a
+    number in it whose last three fields are the unit vector (``scan 2 0 0 1``) still reads."""
+    after = tokens[1:]
+    if not all(_is_number(t) for t in after):
+        return False
+    units = [i for i in range(len(after) - 2) if _is_unit(after[i : i + 3])]
+    return len(units) == 1 and units[0] != len(after) - 3
+
+
+def _is_unit(fields: list[str]) -> bool:
+    """Whether three number fields are a unit vector, within :data:`UNIT_TOLERANCE`."""
+    return abs(math.sqrt(sum(float(t) ** 2 for t in fields)) - 1.0) <= UNIT_TOLERANCE
+
+
 def _extra_columns_hint(after: list[str]) -> str:
     """What the fields after an image name are, and which are extra where the line shows it
     (exactly one run of three numbers is a unit vector)."""
     if not all(_is_number(t) for t in after):
         return f"{len(after)} fields after the name where an .lp line has 3 numbers"
     said = f"{len(after)} numbers after the name where an .lp line has 3"
-    units = [
-        i
-        for i in range(len(after) - 2)
-        if abs(math.sqrt(sum(float(t) ** 2 for t in after[i : i + 3])) - 1.0) <= UNIT_TOLERANCE
-    ]
+    units = [i for i in range(len(after) - 2) if _is_unit(after[i : i + 3])]
     if len(units) != 1:
         return said
     i = units[0]
