@@ -28,7 +28,7 @@ the decode then happen in the dark. Held lit until the image was in hand, a RAW 
 Wi-Fi 9 s after the pulse ran into the dome's ``max_on_s`` = 8 s and the good shot was lost.
 
 With a trigger, a file's own capture time (a RAW's LibRaw timestamp: EXIF DateTimeOriginal or
-the TIFF DateTime; a TIFF's EXIF DateTimeOriginal; whole seconds on the camera's clock) is
+the TIFF DateTime; a TIFF's or JPEG's EXIF DateTimeOriginal; whole seconds on the camera's clock) is
 checked against the pulses: the first
 image after ``connect`` anchors the camera clock to its pulse, and each later file must have
 been shot as long after the last image as its pulse came after that image's pulse, within
@@ -89,6 +89,7 @@ from rti_rig.drivers.cameras.image_io import (
     tiff_extra_samples,
     to_linear_uint16,
 )
+from rti_rig.drivers.cameras.jpeg_exif import jpeg_datetime_original
 from rti_rig.drivers.cameras.raw_decode import (
     DECODER,
     DamagedRawError,
@@ -138,7 +139,7 @@ CLOCK_FILE = ".folder_watch_clock.json"
 #: counts the images it concerns)
 NO_CAPTURE_TIME = (
     "the watched folder's file holds no capture time (no EXIF DateTimeOriginal: a PNG, or a "
-    "TIFF or RAW saved without it), so it was not checked against the shutter pulses: a late "
+    "JPEG, TIFF or RAW saved without it), so it was not checked against the shutter pulses: a late "
     "or extra file in the folder would have been taken as this light's image unseen"
 )
 
@@ -268,8 +269,9 @@ def _identity(path: Path) -> tuple[int, int, int, int] | None:
 def capture_time(path: Path) -> float | None:
     """The capture time of ``path``, in seconds on the camera's clock (only differences are
     meaningful): a RAW's as LibRaw reads it (EXIF DateTimeOriginal, or the TIFF DateTime), a
-    TIFF's EXIF DateTimeOriginal; None when LibRaw or tifffile cannot open the file, it holds
-    no time (LibRaw then gives the epoch) or it is neither (a PNG: OpenCV reads no EXIF)."""
+    TIFF's or a JPEG's EXIF DateTimeOriginal; None when LibRaw or tifffile cannot open the
+    file, it holds no time (LibRaw then gives the epoch) or it is none of them (a PNG: OpenCV
+    reads no EXIF)."""
     return _read_capture_time(path)[1]
 
 
@@ -283,6 +285,9 @@ def _read_capture_time(path: Path) -> tuple[bool, float | None]:
     every later file then out of step."""
     if path.suffix.lower() in TIFF_SUFFIXES:
         return _tiff_capture_time(path)
+    if path.suffix.lower() in JPEG_SUFFIXES:
+        final, stamp = jpeg_datetime_original(path)
+        return final, _exif_time(stamp)
     if not is_raw_file(path):
         return True, None
     try:

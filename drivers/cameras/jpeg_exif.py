@@ -1,0 +1,125 @@
+"""A JPEG's EXIF capture time (DateTimeOriginal), read from its APP1 segment with the TIFF
+reads of :mod:`~rti_rig.drivers.cameras.tiff_ifd` (pure reads of the header segments, no
+decoding).
+
+Why: a watched folder of a camera's JPEGs (``eight_bit_response = "srgb"``) read no capture
+time from them, so each image was said to come from a file that "holds no capture time (no EXIF
+DateTimeOriginal ...)" while every camera JPEG holds one, and a late or extra JPEG was never
+checked against the shutter pulses. RAWs (LibRaw) and TIFFs (tifffile) had theirs read.
+
+Source: JPEG (ITU-T T.81, B.1.1: markers, segment lengths), JFIF/Exif 2.3 (APP1 "Exif\\0\\0"
+then a TIFF whose IFD0 points at the Exif IFD, tag 0x8769; DateTimeOriginal is tag 0x9003,
+ASCII "YYYY:MM:DD HH:MM:SS").
+"""
+
+from __future__ import annotations
+
+import io
+import struct
+from pathlib import Path
+
+from rti_rig.drivers.cameras.tiff_ifd import (
+    Entry,
+    Layout,
+    read_count,
+    read_entries,
+    read_header,
+    read_values,
+)
+
+#: how much of a file's head is read for its header segments: an Exif APP1 is at most 64 KiB
+#: and comes first (after a JFIF APP0 at most); a file with more before it is not searched on
+HEAD_BYTES = 256 * 1024
+#: markers with no length (TEM, RSTn) and those that end the header segments (SOS, EOI)
+_NO_LENGTH = {0x01, *range(0xD0, 0xD8)}
+_END_OF_HEADER = {0xDA, 0xD9}
+
+EXIF_IFD_TAG = 0x8769
+DATE_TIME_ORIGINAL_TAG = 0x9003
+
+
+def jpeg_datetime_original(path: Path) -> tuple[bool, str | None]:
+    """(whether waiting cannot change the answer, the EXIF DateTimeOriginal as written).
+
+    False while the file's head is not all written (shorter than its segments say, or zeros
+    still: a network share sets the size first), so the caller waits for it as for a RAW;
+    True with None for a file that is no JPEG or whose header holds no such time."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(HEAD_BYTES)
+    except OSError:
+        return False, None
+    if len(head) < 4 or not any(head[:4]):
+        return False, None
+    if head[:2] != b"\xff\xd8":
+        return True, None  # no JPEG: waiting will not make it one
+    exif = _exif_segment(head)
+    if exif is None:
+        return len(head) >= HEAD_BYTES, None  # cut short: more may come
+    if exif == b"":
+        return True, None
+    return True, _datetime_original(exif)
+
+
+def _exif_segment(head: bytes) -> bytes | None:
+    """The TIFF of ``head``'s Exif APP1 segment; ``b""`` when its header segments are all
+    there and hold none (or are damaged); None when they run past ``head`` (not all written)."""
+    pos = 2
+    while True:
+        if pos + 2 > len(head):
+            return None
+        if head[pos] != 0xFF:
+            return b""  # not a marker where one must be: damaged, never mended by waiting
+        marker = head[pos + 1]
+        if marker == 0xFF:  # fill byte before a marker (T.81 B.1.1.2)
+            pos += 1
+            continue
+        if marker in _END_OF_HEADER:
+            return b""
+        if marker in _NO_LENGTH:
+            pos += 2
+            continue
+        if pos + 4 > len(head):
+            return None
+        length = int.from_bytes(head[pos + 2 : pos + 4], "big")
+        if length < 2:
+            return b""
+        end = pos + 2 + length
+        if end > len(head):
+            return None
+        body = head[pos + 4 : end]
+        if marker == 0xE1 and body.startswith(b"Exif\0\0"):
+            return body[6:] or b""
+        pos = end
+
+
+def _datetime_original(tiff: bytes) -> str | None:
+    """The DateTimeOriginal of an Exif TIFF (IFD0 -> Exif IFD -> 0x9003), None where absent
+    or damaged."""
+    f = io.BytesIO(tiff)
+    found = read_header(f)
+    if found is None:
+        return None
+    layout, ifd0 = found
+    at = _entry(f, layout, ifd0, EXIF_IFD_TAG)
+    if at is None:
+        return None
+    pointer = read_values(f, layout, at, len(tiff), 1)
+    if not pointer:
+        return None
+    stamp = _entry(f, layout, pointer[0], DATE_TIME_ORIGINAL_TAG)
+    if stamp is None or stamp.type != 2 or not 0 < stamp.count <= 64:
+        return None
+    if stamp.count <= layout.offset_size:
+        raw = stamp.field[: stamp.count]
+    else:
+        (offset,) = struct.unpack(layout.order + layout.offset_code, stamp.field)
+        raw = tiff[offset : offset + stamp.count]
+    return raw.decode("ascii", "replace").rstrip("\x00") or None
+
+
+def _entry(f: io.BytesIO, layout: Layout, offset: int, tag: int) -> Entry | None:
+    count = read_count(f, layout, offset)
+    if not count or count > 4096:
+        return None
+    return next((e for e in read_entries(f, layout, offset, count) if e.tag == tag), None)

@@ -1,0 +1,115 @@
+"""A camera's JPEGs in a watched folder (``eight_bit_response = "srgb"``) are checked against
+the shutter pulses by their EXIF DateTimeOriginal, through `rti-rig run` on the shipped
+folder-watch example (its dome firmware emulated on a pty, its camera a thread that saves a
+JPEG into the watched folder for each shutter pulse the board saw).
+
+Why: a JPEG's capture time was never read (only a RAW's and a TIFF's were): every image was
+said to come from a file that "holds no capture time (no EXIF DateTimeOriginal ...)" though
+each held one, and an extra JPEG that came after a pulse (an earlier shot the tethering
+program saved late) was taken as that light's image, its own shot then as the next light's.
+"""
+
+from __future__ import annotations
+
+import shutil
+import struct
+import sys
+import threading
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from conftest import CONFIGS, shipped_dome_on_pty
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+WATCH_CONFIG = CONFIGS / "example_dome_48_folder_watch.toml"
+#: the camera clock's reading at the board clock's zero (only differences are checked)
+CAMERA_EPOCH = 1_780_000_000.0
+
+
+def _config(tmp_path: Path, tether: Path) -> Path:
+    """The shipped example beside its .lp, watching ``tether`` for the camera's JPEGs."""
+    shutil.copy(CONFIGS / "example_dome_48.lp", tmp_path / "example_dome_48.lp")
+    text = WATCH_CONFIG.read_text()
+    for old, new in [
+        ('folder = "~/Pictures/rti-tether"', f'folder = "{tether}"'),
+        ("timeout_s = 15.0", 'timeout_s = 4.0\neight_bit_response = "srgb"'),
+        ("width = 6000", "width = 32"),
+        ("height = 4000", "height = 32"),
+    ]:
+        assert old in text
+        text = text.replace(old, new)
+    text = (
+        text[: text.index("patterns = ")]
+        + 'patterns = ["*.JPG"]\n'
+        + text[text.index("\n", text.index("patterns = ")) + 1 :]
+    )
+    cfg = tmp_path / "watch.toml"
+    cfg.write_text(text)
+    return cfg
+
+
+def _jpeg(level: int, taken: float) -> bytes:
+    """A camera JPEG of one grey ``level`` whose Exif IFD holds DateTimeOriginal ``taken``."""
+    ok, encoded = cv2.imencode(".jpg", np.full((32, 32, 3), level, np.uint8))
+    assert ok
+    stamp = time.strftime("%Y:%m:%d %H:%M:%S", time.gmtime(taken)).encode() + b"\0"
+    # big-endian TIFF: IFD0 (one entry: the Exif IFD at 26), Exif IFD (DateTimeOriginal at 44)
+    tiff = b"MM\0*" + struct.pack(">I", 8)
+    tiff += struct.pack(">H", 1) + struct.pack(">HHII", 0x8769, 4, 1, 26) + struct.pack(">I", 0)
+    tiff += struct.pack(">H", 1) + struct.pack(">HHII", 0x9003, 2, 20, 44) + struct.pack(">I", 0)
+    app1 = b"Exif\0\0" + tiff + stamp
+    segment = b"\xff\xe1" + struct.pack(">H", len(app1) + 2) + app1
+    data = encoded.tobytes()
+    return data[:2] + segment + data[2:]
+
+
+def test_an_extra_jpeg_after_a_pulse_is_set_aside_by_its_capture_time(tmp_path, monkeypatch):
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = _config(tmp_path, tether)
+    own: dict[int, bytes] = {}
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        stop = threading.Event()
+
+        def tethering_program() -> None:
+            saved = 0
+            while not stop.is_set():
+                pulses = [e.time_s for e in list(firmware.history) if e.what == "shutter"]
+                if len(pulses) > saved:
+                    saved += 1
+                    taken = CAMERA_EPOCH + pulses[-1]
+                    if saved == 2:  # a shot from a minute before, saved late, comes first
+                        (tether / "IMG_0100.JPG").write_bytes(_jpeg(250, taken - 60))
+                        stop.wait(0.3)
+                    own[saved] = _jpeg(40 * saved, taken)
+                    (tether / f"IMG_{saved:04d}.JPG").write_bytes(own[saved])
+                stop.wait(0.01)
+
+        thread = threading.Thread(target=tethering_program, daemon=True)
+        thread.start()
+        out = tmp_path / "s"
+        try:
+            r = CliRunner().invoke(
+                app, ["run", str(cfg), "--out", str(out), "--lights", "3", "--no-verdict"]
+            )
+        finally:
+            stop.set()
+            thread.join(5)
+        lit_at_end = firmware.lit
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    assert lit_at_end is None and "lights are off" in said, said
+    assert "holds no capture time" not in said, said
+    for k in (1, 2, 3):  # each light's image is the shot of its own pulse
+        assert (out / "raw" / f"image_{k:03d}.jpg").read_bytes() == own[k], k
+    assert [p.name for p in (out / "strays").iterdir()] == ["image_002-IMG_0100.JPG"], said
