@@ -89,9 +89,10 @@ from rti_rig.drivers.cameras.image_io import (
     tiff_extra_samples,
     to_linear_uint16,
 )
-from rti_rig.drivers.cameras.jpeg_exif import jpeg_datetime_original
+from rti_rig.drivers.cameras.jpeg_exif import jpeg_datetime_original, jpeg_orientation
 from rti_rig.drivers.cameras.raw_decode import (
     DECODER,
+    ORIENTATION_NAMES,
     DamagedRawError,
     MonochromeRawError,
     RawDecodeError,
@@ -1773,8 +1774,20 @@ class FolderWatchCamera:
             file_exposure, gain = None, s.gain
             metadata = {"source_file": str(path), "bit_depth": 8 * image.dtype.itemsize}
             metadata.update(exposure_stats(pixels, white, s.decode.underexposed_level))
-            if alpha_note:
-                metadata["notices"] = [alpha_note]
+            notices = [alpha_note] if alpha_note else []
+            if path.suffix.lower() in JPEG_SUFFIXES:
+                turned = jpeg_orientation(path)
+                if turned not in (None, 1):
+                    notices.append(
+                        f"the camera was rotated (Orientation tag {turned}: "
+                        f"{ORIENTATION_NAMES.get(turned, 'not a known value')}): rti-rig keeps "
+                        "the JPEG's pixels as stored, so these images are not turned upright as "
+                        "a viewer shows the watched folder's files; the .lp light directions "
+                        "are in the same (stored) frame, so fitting is unaffected "
+                        "(docs/cameras.md)"
+                    )
+            if notices:
+                metadata["notices"] = notices
         if file_exposure is not None and s.exposure_tolerance is not None:
             rel = abs(file_exposure - exposure_s) / exposure_s
             if rel > s.exposure_tolerance:

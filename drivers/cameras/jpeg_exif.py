@@ -1,6 +1,6 @@
-"""A JPEG's EXIF capture time (DateTimeOriginal), read from its APP1 segment with the TIFF
-reads of :mod:`~rti_rig.drivers.cameras.tiff_ifd` (pure reads of the header segments, no
-decoding).
+"""A JPEG's EXIF capture time (DateTimeOriginal) and Orientation, read from its APP1 segment
+with the TIFF reads of :mod:`~rti_rig.drivers.cameras.tiff_ifd` (pure reads of the header
+segments, no decoding).
 
 Why: a watched folder of a camera's JPEGs (``eight_bit_response = "srgb"``) read no capture
 time from them, so each image was said to come from a file that "holds no capture time (no EXIF
@@ -36,6 +36,7 @@ _END_OF_HEADER = {0xDA, 0xD9}
 
 EXIF_IFD_TAG = 0x8769
 DATE_TIME_ORIGINAL_TAG = 0x9003
+ORIENTATION_TAG = 274
 
 
 def jpeg_datetime_original(path: Path) -> tuple[bool, str | None]:
@@ -44,6 +45,33 @@ def jpeg_datetime_original(path: Path) -> tuple[bool, str | None]:
     False while the file's head is not all written (shorter than its segments say, or zeros
     still: a network share sets the size first), so the caller waits for it as for a RAW;
     True with None for a file that is no JPEG or whose header holds no such time."""
+    final, exif = _exif_tiff(path)
+    return final, (_datetime_original(exif) if exif else None)
+
+
+def jpeg_orientation(path: Path) -> int | None:
+    """The EXIF Orientation (IFD0 tag 274) of a whole JPEG, None where it has none.
+
+    Why: OpenCV reads a JPEG as stored (``IMREAD_UNCHANGED``), as every reader of a session
+    does, so a JPEG from a camera held on its side is recorded sideways beside the upright
+    picture a viewer shows of the folder's file; the RAW path said so of a rotated RAW, the
+    JPEG path said nothing."""
+    exif = _exif_tiff(path)[1]
+    if not exif:
+        return None
+    f = io.BytesIO(exif)
+    found = read_header(f)
+    if found is None:
+        return None
+    layout, ifd0 = found
+    entry = _entry(f, layout, ifd0, ORIENTATION_TAG)
+    value = None if entry is None else read_values(f, layout, entry, len(exif), 1)
+    return int(value[0]) if value else None
+
+
+def _exif_tiff(path: Path) -> tuple[bool, bytes | None]:
+    """(whether waiting cannot change the answer, the TIFF of the JPEG's Exif APP1 segment or
+    None)."""
     try:
         with path.open("rb") as f:
             head = f.read(HEAD_BYTES)
@@ -56,9 +84,7 @@ def jpeg_datetime_original(path: Path) -> tuple[bool, str | None]:
     exif = _exif_segment(head)
     if exif is None:
         return len(head) >= HEAD_BYTES, None  # cut short: more may come
-    if exif == b"":
-        return True, None
-    return True, _datetime_original(exif)
+    return True, exif or None
 
 
 def _exif_segment(head: bytes) -> bytes | None:

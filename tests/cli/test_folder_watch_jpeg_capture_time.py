@@ -7,6 +7,9 @@ Why: a JPEG's capture time was never read (only a RAW's and a TIFF's were): ever
 said to come from a file that "holds no capture time (no EXIF DateTimeOriginal ...)" though
 each held one, and an extra JPEG that came after a pulse (an earlier shot the tethering
 program saved late) was taken as that light's image, its own shot then as the next light's.
+Nor was a JPEG's EXIF Orientation read: a camera held on its side gave images recorded as stored
+(sideways beside the folder's file a viewer turns upright) with not a word, where a rotated
+RAW's are said to be kept in sensor orientation.
 """
 
 from __future__ import annotations
@@ -58,22 +61,24 @@ def _config(tmp_path: Path, tether: Path) -> Path:
     return cfg
 
 
-def _jpeg(level: int, taken: float) -> bytes:
-    """A camera JPEG of one grey ``level`` whose Exif IFD holds DateTimeOriginal ``taken``."""
+def _jpeg(level: int, taken: float, orientation: int = 1) -> bytes:
+    """A camera JPEG of one grey ``level`` whose IFD0 holds ``orientation`` and whose Exif IFD
+    holds DateTimeOriginal ``taken``."""
     ok, encoded = cv2.imencode(".jpg", np.full((32, 32, 3), level, np.uint8))
     assert ok
     stamp = time.strftime("%Y:%m:%d %H:%M:%S", time.gmtime(taken)).encode() + b"\0"
-    # big-endian TIFF: IFD0 (one entry: the Exif IFD at 26), Exif IFD (DateTimeOriginal at 44)
-    tiff = b"MM\0*" + struct.pack(">I", 8)
-    tiff += struct.pack(">H", 1) + struct.pack(">HHII", 0x8769, 4, 1, 26) + struct.pack(">I", 0)
-    tiff += struct.pack(">H", 1) + struct.pack(">HHII", 0x9003, 2, 20, 44) + struct.pack(">I", 0)
+    # big-endian TIFF: IFD0 (Orientation; the Exif IFD at 38), Exif IFD (DateTimeOriginal at 56)
+    tiff = b"MM\0*" + struct.pack(">I", 8) + struct.pack(">H", 2)
+    tiff += struct.pack(">HHIHH", 274, 3, 1, orientation, 0)
+    tiff += struct.pack(">HHII", 0x8769, 4, 1, 38) + struct.pack(">I", 0)
+    tiff += struct.pack(">H", 1) + struct.pack(">HHII", 0x9003, 2, 20, 56) + struct.pack(">I", 0)
     app1 = b"Exif\0\0" + tiff + stamp
     segment = b"\xff\xe1" + struct.pack(">H", len(app1) + 2) + app1
     data = encoded.tobytes()
     return data[:2] + segment + data[2:]
 
 
-def test_an_extra_jpeg_after_a_pulse_is_set_aside_by_its_capture_time(tmp_path, monkeypatch):
+def test_an_extra_jpeg_after_a_pulse_is_set_aside_and_a_rotated_one_is_said(tmp_path, monkeypatch):
     tether = tmp_path / "tether"
     tether.mkdir()
     cfg = _config(tmp_path, tether)
@@ -91,7 +96,7 @@ def test_an_extra_jpeg_after_a_pulse_is_set_aside_by_its_capture_time(tmp_path, 
                     if saved == 2:  # a shot from a minute before, saved late, comes first
                         (tether / "IMG_0100.JPG").write_bytes(_jpeg(250, taken - 60))
                         stop.wait(0.3)
-                    own[saved] = _jpeg(40 * saved, taken)
+                    own[saved] = _jpeg(40 * saved, taken, orientation=6)  # held on its side
                     (tether / f"IMG_{saved:04d}.JPG").write_bytes(own[saved])
                 stop.wait(0.01)
 
@@ -113,3 +118,8 @@ def test_an_extra_jpeg_after_a_pulse_is_set_aside_by_its_capture_time(tmp_path, 
     for k in (1, 2, 3):  # each light's image is the shot of its own pulse
         assert (out / "raw" / f"image_{k:03d}.jpg").read_bytes() == own[k], k
     assert [p.name for p in (out / "strays").iterdir()] == ["image_002-IMG_0100.JPG"], said
+    assert (
+        "the camera was rotated (Orientation tag 6: rotate 90° CW to view): rti-rig keeps the "
+        "JPEG's pixels as stored" in said
+    ), said
+    assert "fitting is unaffected (docs/cameras.md) [3 of 3 images]" in said, said
