@@ -1758,11 +1758,16 @@ class FolderWatchCamera:
                     f"may write its JPEG first, so match only the RAW (keep {raw} in patterns "
                     "in [camera.device])"
                     if raw
-                    else "save RAW or 16-bit TIFF, or set eight_bit_response = 'srgb'"
+                    # the key's table named: "set eight_bit_response" alone left the owner
+                    # to guess which of the config's tables takes it
+                    else "save RAW or 16-bit TIFF, or, for a camera's sRGB JPEGs, add "
+                    'eight_bit_response = "srgb" under [camera.device] in the rig config'
                 )
                 raise CaptureError(
                     self.name,
-                    f"{watched.name} is 8-bit (gamma-encoded), not linear data: {fix}",
+                    f"{watched.name} is 8-bit (gamma-encoded), not linear data: {fix}; "
+                    f"{watched.name} is left in {shown_path(s.folder)}, and no image was "
+                    "recorded for this light",
                     "decode",
                 )
             image, alpha_note = self._without_alpha(path, watched, image)

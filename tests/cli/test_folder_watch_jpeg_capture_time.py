@@ -9,7 +9,8 @@ each held one, and an extra JPEG that came after a pulse (an earlier shot the te
 program saved late) was taken as that light's image, its own shot then as the next light's.
 Nor was a JPEG's EXIF Orientation read: a camera held on its side gave images recorded as stored
 (sideways beside the folder's file a viewer turns upright) with not a word, where a rotated
-RAW's are said to be kept in sensor orientation.
+RAW's are said to be kept in sensor orientation. And a JPEG refused as 8-bit (the example's
+default) is told with the table of the key that takes it, and where the shot was left.
 """
 
 from __future__ import annotations
@@ -24,10 +25,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from conftest import CONFIGS, shipped_dome_on_pty
+from conftest import CONFIGS, shipped_dome_on_pty, tethered_run
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.core.shell_words import shown_path
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -39,13 +41,14 @@ WATCH_CONFIG = CONFIGS / "example_dome_48_folder_watch.toml"
 CAMERA_EPOCH = 1_780_000_000.0
 
 
-def _config(tmp_path: Path, tether: Path) -> Path:
-    """The shipped example beside its .lp, watching ``tether`` for the camera's JPEGs."""
+def _config(tmp_path: Path, tether: Path, eight_bit: bool = True) -> Path:
+    """The shipped example beside its .lp, watching ``tether`` for the camera's JPEGs (taken
+    as sRGB where ``eight_bit``, else refused as the example's default does)."""
     shutil.copy(CONFIGS / "example_dome_48.lp", tmp_path / "example_dome_48.lp")
     text = WATCH_CONFIG.read_text()
     for old, new in [
         ('folder = "~/Pictures/rti-tether"', f'folder = "{tether}"'),
-        ("timeout_s = 15.0", 'timeout_s = 4.0\neight_bit_response = "srgb"'),
+        ("timeout_s = 15.0", "timeout_s = 4.0" + ('\neight_bit_response = "srgb"' * eight_bit)),
         ("width = 6000", "width = 32"),
         ("height = 4000", "height = 32"),
     ]:
@@ -123,3 +126,19 @@ def test_an_extra_jpeg_after_a_pulse_is_set_aside_and_a_rotated_one_is_said(tmp_
         "JPEG's pixels as stored" in said
     ), said
     assert "fitting is unaffected (docs/cameras.md) [3 of 3 images]" in said, said
+
+
+def test_a_refused_jpeg_names_the_key_its_table_and_where_the_shot_is_left(tmp_path, monkeypatch):
+    """The refusal of an 8-bit file said "set eight_bit_response = 'srgb'", not in which
+    table, nor that the shot is still in the folder (the run had just said "Nothing was
+    captured")."""
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = _config(tmp_path, tether, eight_bit=False)
+    files = [("IMG_0001.JPG", _jpeg(100, CAMERA_EPOCH))]
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, files, tmp_path / "s")
+    assert r.exit_code == 2 and "Traceback" not in said, said
+    assert not lit_at_end and "lights are off" in said, said
+    assert 'add eight_bit_response = "srgb" under [camera.device] in the rig config' in said, said
+    assert f"IMG_0001.JPG is left in {shown_path(tether)}" in said, said
+    assert (tether / "IMG_0001.JPG").read_bytes() == files[0][1]
