@@ -83,13 +83,17 @@ from rti_rig.core.image_files import (
 )
 from rti_rig.core.shell_words import shown_path
 from rti_rig.drivers.cameras.dng_tags import IfdState, ifd_state
+from rti_rig.drivers.cameras.exif_tags import (
+    jpeg_datetime_original,
+    jpeg_orientation,
+    tiff_orientation,
+)
 from rti_rig.drivers.cameras.image_io import (
     ImageReadError,
     read_image_file,
     tiff_extra_samples,
     to_linear_uint16,
 )
-from rti_rig.drivers.cameras.jpeg_exif import jpeg_datetime_original, jpeg_orientation
 from rti_rig.drivers.cameras.raw_decode import (
     DECODER,
     ORIENTATION_NAMES,
@@ -1780,17 +1784,24 @@ class FolderWatchCamera:
             metadata = {"source_file": str(path), "bit_depth": 8 * image.dtype.itemsize}
             metadata.update(exposure_stats(pixels, white, s.decode.underexposed_level))
             notices = [alpha_note] if alpha_note else []
-            if path.suffix.lower() in JPEG_SUFFIXES:
-                turned = jpeg_orientation(path)
-                if turned not in (None, 1):
-                    notices.append(
-                        f"the camera was rotated (Orientation tag {turned}: "
-                        f"{ORIENTATION_NAMES.get(turned, 'not a known value')}): rti-rig keeps "
-                        "the JPEG's pixels as stored, so these images are not turned upright as "
-                        "a viewer shows the watched folder's files; the .lp light directions "
-                        "are in the same (stored) frame, so fitting is unaffected "
-                        "(docs/cameras.md)"
-                    )
+            suffix = path.suffix.lower()
+            turned = (
+                jpeg_orientation(path)
+                if suffix in JPEG_SUFFIXES
+                else tiff_orientation(path)
+                if suffix in TIFF_SUFFIXES
+                else None
+            )
+            if turned not in (None, 1):
+                kind = "JPEG" if suffix in JPEG_SUFFIXES else "TIFF"
+                notices.append(
+                    f"the camera was rotated (Orientation tag {turned}: "
+                    f"{ORIENTATION_NAMES.get(turned, 'not a known value')}): rti-rig keeps "
+                    f"the {kind}'s pixels as stored, so these images are not turned upright as "
+                    "a viewer shows the watched folder's files; the .lp light directions "
+                    "are in the same (stored) frame, so fitting is unaffected "
+                    "(docs/cameras.md)"
+                )
             if notices:
                 metadata["notices"] = notices
         if file_exposure is not None and s.exposure_tolerance is not None:

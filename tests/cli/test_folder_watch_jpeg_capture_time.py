@@ -25,7 +25,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from conftest import CONFIGS, shipped_dome_on_pty, tethered_run
+from conftest import CONFIGS, folder_watch_config, shipped_dome_on_pty, tethered_run
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -142,3 +142,28 @@ def test_a_refused_jpeg_names_the_key_its_table_and_where_the_shot_is_left(tmp_p
     assert 'add eight_bit_response = "srgb" under [camera.device] in the rig config' in said, said
     assert f"IMG_0001.JPG is left in {shown_path(tether)}" in said, said
     assert (tether / "IMG_0001.JPG").read_bytes() == files[0][1]
+
+
+def test_a_rotated_16_bit_tiff_is_said_kept_as_stored(tmp_path, monkeypatch):
+    """A 16-bit TIFF saved with its camera's Orientation 8 (tifffile reads it as stored, as
+    OpenCV reads a JPEG) gets the rotated-camera notice; it had been recorded with none."""
+    import io
+
+    import tifffile
+
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0, tiffs=True)
+    buffer = io.BytesIO()
+    tifffile.imwrite(
+        buffer, np.full((32, 32, 3), 20000, np.uint16), extratags=[(274, 3, 1, 8, True)]
+    )
+    files = [(f"IMG_{k:04d}.tif", buffer.getvalue()) for k in (1, 2)]
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, files, tmp_path / "s")
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    assert not lit_at_end and "lights are off" in said, said
+    assert (
+        "the camera was rotated (Orientation tag 8: rotate 90° CCW to view): rti-rig keeps the "
+        "TIFF's pixels as stored" in said
+    ), said
+    assert "fitting is unaffected (docs/cameras.md) [2 of 2 images]" in said, said

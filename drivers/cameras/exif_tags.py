@@ -1,6 +1,6 @@
-"""A JPEG's EXIF capture time (DateTimeOriginal) and Orientation, read from its APP1 segment
-with the TIFF reads of :mod:`~rti_rig.drivers.cameras.tiff_ifd` (pure reads of the header
-segments, no decoding).
+"""A JPEG's EXIF capture time (DateTimeOriginal) and Orientation, read from its APP1 segment,
+and a TIFF's Orientation, with the TIFF reads of :mod:`~rti_rig.drivers.cameras.tiff_ifd`
+(pure reads of the header segments and IFD0, no decoding).
 
 Why: a watched folder of a camera's JPEGs (``eight_bit_response = "srgb"``) read no capture
 time from them, so each image was said to come from a file that "holds no capture time (no EXIF
@@ -66,6 +66,31 @@ def jpeg_orientation(path: Path) -> int | None:
     layout, ifd0 = found
     entry = _entry(f, layout, ifd0, ORIENTATION_TAG)
     value = None if entry is None else read_values(f, layout, entry, len(exif), 1)
+    return int(value[0]) if value else None
+
+
+def tiff_orientation(path: Path) -> int | None:
+    """The Orientation (IFD0 tag 274) of a TIFF, None where it has none or cannot be read.
+
+    Why: tifffile reads a TIFF as stored, as OpenCV reads a JPEG, so a TIFF saved with its
+    camera's Orientation is recorded as stored, sideways where the camera was turned."""
+    try:
+        with path.open("rb") as f:
+            size = path.stat().st_size
+            found = read_header(f)
+            if found is None:
+                return None
+            layout, ifd0 = found
+            count = read_count(f, layout, ifd0)
+            if not count or count > 4096:
+                return None
+            entry = next(
+                (e for e in read_entries(f, layout, ifd0, count) if e.tag == ORIENTATION_TAG),
+                None,
+            )
+            value = None if entry is None else read_values(f, layout, entry, size, 1)
+    except OSError:
+        return None
     return int(value[0]) if value else None
 
 
