@@ -214,6 +214,11 @@ class PlanRequest:
     #: the options typed
     min_elevation_given: bool = False
     max_elevation_given: bool = False
+    #: the rig config and a free folder as shell words, for the ``rti-rig preview`` command a
+    #: note offers (the caller knows them; the planner does not): ``RIG --out P`` pasted as
+    #: printed had been refused as no rig file, or made a folder named P
+    rig_said: str = "RIG.toml"
+    preview_folder_said: str = "preview"
 
     def check(self) -> PlanMethod:
         """Refuse what cannot be planned, before any work; returns the method to plan with."""
@@ -541,8 +546,8 @@ def _note_preview_outside_band(
     side = "above" if el > hi else "below"
     report.notes.append(
         f"the preview's light is at {el:.1f}° elevation, {side} this plan's {flag}: the "
-        f"preview was shot under a light the plan keeps out (`rti-rig preview RIG --out P "
-        f"{flag}` shoots one within the band)"
+        f"preview was shot under a light the plan keeps out (`rti-rig preview {req.rig_said} "
+        f"--out {req.preview_folder_said} {flag}` shoots one within the band)"
     )
 
 

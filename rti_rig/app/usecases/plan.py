@@ -251,6 +251,8 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             signal_noise=signal_noise,
             material=req.material,
             arm_order=arm_order,
+            rig_said=_config_shown(req.rig),
+            preview_folder_said=_run_folder(req.out_file, "preview"),
         )
     )
     # every planner picks among the rig's lights in the band: where those cannot determine a
