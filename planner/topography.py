@@ -343,6 +343,20 @@ def _rgb01(preview: NDArray) -> NDArray[np.float32]:
     )
 
 
+def _declared_size(shape: list[object]) -> tuple[int, int]:
+    """The (H, W) a model's image input declares (N, C, H, W) where both are fixed numbers,
+    else MiDaS v2.1 small's 256×256.
+
+    Why: ``plan --depth-model`` has no option for the input size, and a Depth Anything export
+    (518×518) or a MiDaS at 384×384 was refused with "check input_size", a setting the command
+    line does not offer; the model says its size itself."""
+    if len(shape) == 4:
+        h, w = shape[2], shape[3]
+        if isinstance(h, int) and isinstance(w, int) and h > 0 and w > 0:
+            return h, w
+    return DepthModelSpec().input_size
+
+
 def depth_from_onnx(
     preview: NDArray,
     model_path: Path,
@@ -358,7 +372,7 @@ def depth_from_onnx(
     """
     import onnxruntime as ort
 
-    spec = spec or DepthModelSpec()
+    given = spec is not None
     path = Path(model_path)
     if not path.is_file():
         raise ConfigError(path, None, "depth model file not found; pass an existing .onnx file")
@@ -366,21 +380,27 @@ def depth_from_onnx(
         session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     except Exception as exc:  # onnxruntime raises its own exception types
         raise ConfigError(path, None, f"onnxruntime cannot load this model: {exc}") from exc
-    rgb = _rgb01(preview)
-    ih, iw = spec.input_size
-    x = cv2.resize(rgb, (iw, ih), interpolation=cv2.INTER_AREA)
-    x = (x - np.asarray(spec.mean, np.float32)) / np.asarray(spec.std, np.float32)
-    x = np.ascontiguousarray(x.transpose(2, 0, 1)[None].astype(np.float32))
     inputs = session.get_inputs()
     if len(inputs) != 1:
         raise ConfigError(
             path, None, f"expected a model with one image input, it has {len(inputs)}"
         )
+    spec = spec or DepthModelSpec(input_size=_declared_size(inputs[0].shape))
+    rgb = _rgb01(preview)
+    ih, iw = spec.input_size
+    x = cv2.resize(rgb, (iw, ih), interpolation=cv2.INTER_AREA)
+    x = (x - np.asarray(spec.mean, np.float32)) / np.asarray(spec.std, np.float32)
+    x = np.ascontiguousarray(x.transpose(2, 0, 1)[None].astype(np.float32))
     try:
         out = session.run(None, {inputs[0].name: x})[0]
     except Exception as exc:
+        declared = "×".join(str(d) for d in inputs[0].shape)
         raise ConfigError(
-            path, None, f"running the model on a {ih}×{iw} input failed ({exc}); check input_size"
+            path,
+            None,
+            f"running the model on a 1×3×{ih}×{iw} float32 image failed ({exc}); its input is "
+            f"declared {declared} {inputs[0].type}: rti-rig feeds one RGB image, as MiDaS, "
+            "Depth Anything and LeReS exports take it" + ("; check input_size" if given else ""),
         ) from exc
     out = np.asarray(out, dtype=np.float64)
     out = out.reshape(out.shape[-2:]) if out.ndim >= 2 and np.prod(out.shape[:-2]) == 1 else out
