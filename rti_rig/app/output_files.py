@@ -67,8 +67,15 @@ def check_output_file(
     over it): a folder that cannot had been found only once the work was done.
     """
     if out_file.is_dir():
-        raise RtiRigError(f"{option} {out_file} is a folder: give the name of the file to write")
+        raise RtiRigError(
+            f"{option} {shown_path(out_file)} is a folder: give the name of the file to write"
+        )
     parent = out_file.parent
+    if not parent.is_dir() and parent.exists():  # "folder X does not exist" was said of a file
+        raise RtiRigError(
+            f"{option} {shown_path(out_file)}: {shown_path(parent)} is a file, not a folder; "
+            "give the new file's name in a folder"
+        )
     if not parent.is_dir():
         raise RtiRigError(
             f"{option} {shown_path(out_file)}: folder {shown_path(parent)} does not exist; create "
@@ -90,6 +97,14 @@ def check_output_file(
                 f"{option} {shown_path(out_file)} would replace a file of the session in "
                 f"{shown_path(folder)}; a session's files are never overwritten: write it elsewhere"
             )
+    if not out_file.is_file():
+        # the file is written as a temporary one renamed over it: --force onto /dev/full said
+        # "Planned 12 lights → /dev/full" and left a plan where the device had been
+        raise RtiRigError(
+            f"{option} {shown_path(out_file)} is not a regular file (a device, a pipe or a "
+            "socket), which the file written would replace, even with --force; give the name "
+            "of a file"
+        )
     if not force:
         raise RtiRigError(f"{option} {shown_path(out_file)} exists; use --force to replace it")
     ensure_file_writable(out_file, option)
