@@ -344,7 +344,9 @@ def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | N
 
 
 #: Two images, one each side of a split, are lit alike when their lights lie within this
-#: angle (degrees) of each other: 48 lights on the hemisphere lie about 30 degrees apart.
+#: angle (degrees) of each other: 48 lights on the hemisphere lie about 19 degrees from their
+#: nearest (the virtual arm's 48: 18.2-19.1), so an image's nearest neighbours pair, and no
+#: light from the other half of the hemisphere does.
 LIT_ALIKE_DEG = 30.0
 
 
