@@ -220,8 +220,10 @@ def test_a_minimum_without_a_target_advises_a_whole_command_with_one(tmp_path: P
         "60",
     )
     assert r.returncode == 2, r.stderr
-    command = command_after(r.stderr, "as the guide shows): ", ", or leave")
-    assert "--until-error 2 --min-lights 6 --max-elevation-deg 60" in command, command
+    # the command ends the message: printed before ", or leave --min-lights out", its last
+    # word read "60," up to the comma
+    command = command_after(r.stderr, "as the guide shows): ", "\n")
+    assert command.endswith("--until-error 2 --min-lights 6 --max-elevation-deg 60"), command
     accepted_as_pasted(tmp_path, command, "S")
 
 

@@ -1303,9 +1303,10 @@ def check_min_lights(
         without = (
             f"with --lights {lights} alone the session shoots {lights} lights"
             if lights is not None
-            else f"add --until-error (the target the stop claims, in degrees; "
-            f"{HINT_UNTIL_ERROR_DEG:g} as the guide shows): {run} {target}, or leave "
-            "--min-lights out"
+            # the command last: printed before ", or leave", its last word read "6," selected
+            # to the comma, which pasted was refused as no whole number
+            else "leave --min-lights out, or add --until-error (the target the stop claims, in "
+            f"degrees; {HINT_UNTIL_ERROR_DEG:g} as the guide shows): {run} {target}"
         )
         raise RtiRigError(
             f"--min-lights {min_lights} goes with --until-error (it is the fewest lights the "
