@@ -199,11 +199,13 @@ def _check_out_folder(out_dir: Path, force: bool, acquisition: Sequence[Path] = 
 def _nothing_written(options: str) -> str:
     """What is said after a trade-off run without ``--out``: the same command with a folder not
     there yet (``options``: its own, as shell words). Why: "give --out DIR" pasted as printed
-    wrote the results into a folder named DIR (a second time, refused as not empty)."""
+    wrote the results into a folder named DIR (a second time, refused as not empty). The
+    command ends the line: closed by a parenthesis, its last word selected to the line's end
+    read ``tradeoff)``, which a shell refuses."""
     keep = shell_word(free_name(Path("tradeoff"), folder=True))
     return (
-        "(nothing written: to keep the results, run it with --out: rti-rig bench tradeoff"
-        f"{options} --out {keep})"
+        "nothing written; to keep the results, run it with --out: rti-rig bench tradeoff"
+        f"{options} --out {keep}"
     )
 
 
