@@ -625,6 +625,14 @@ def _refuse_extra_columns(tokens: list[str], line: str, source: str, lineno: int
             f"({_extra_columns_hint(tokens[1:])}; an .lp line is the image name and the "
             "light's x y z only)",
         )
+    if not named_image and (reading := _name_or_column(tokens)):
+        raise LpFormatError(
+            source,
+            lineno,
+            f"{line.strip()!r} reads two ways: {reading}; an .lp cannot quote a name, so if the "
+            "name holds a space, replace the space (and rename its image), or else delete the "
+            "column after the light",
+        )
 
 
 def _columns_after_light(tokens: list[str]) -> bool:
@@ -642,6 +650,46 @@ def _columns_after_light(tokens: list[str]) -> bool:
         return False
     units = [i for i in range(len(after) - 2) if _is_unit(after[i : i + 3])]
     return len(units) == 1 and units[0] != len(after) - 3
+
+
+#: A zero-padded whole number (``01``, ``007``): how a name numbers its lights, never how a
+#: vector's component is written.
+_PADDED = re.compile(r"^[+-]?0\d+$")
+
+
+def _name_or_column(tokens: list[str]) -> str:
+    """The two readings of a line whose first field is no image file name, every field after
+    it a number, and both its last three and an earlier run of three a unit vector: a name
+    with numbers in it (``led01 0`` from (0, 1, 0)) or a column after the light (``led01``
+    from (0, 0, 1), intensity 0); "" for any other line.
+
+    Why: ``led01 0 0 1 0`` (an LED's intensity 0) had been read relight's way, the light
+    ``led01 0`` from (0, 1, 0), with nothing noted: the unit vector at the end was taken as
+    telling a name from a column, but here both runs are unit vectors and nothing in the line
+    says which is meant. ``scan 2 0 0 1`` (only the last three a unit vector) still reads, and
+    so does ``led 01 0 0 1``: a zero-padded ``01`` is a name's number, which no writer of a
+    vector's component writes."""
+    after = tokens[1:]
+    if len(after) < 4 or not all(_is_number(t) for t in after):
+        return ""
+    last = len(after) - 3
+    if not _is_unit(after[last:]):
+        return ""
+    earlier = [
+        i
+        for i in range(last)
+        if _is_unit(after[i : i + 3]) and not any(_PADDED.match(t) for t in after[i : i + 3])
+    ]
+    if not earlier:
+        return ""
+    i = earlier[0]
+    as_name = f"the light {' '.join(tokens[: last + 1])!r} from ({', '.join(after[last:])})"
+    later = after[i + 3 :]
+    as_column = (
+        f"the light {' '.join(tokens[: i + 1])!r} from ({', '.join(after[i : i + 3])}) with "
+        f"{' '.join(later)} after it"
+    )
+    return f"{as_name}, or {as_column}"
 
 
 def _is_unit(fields: list[str]) -> bool:
@@ -720,6 +768,51 @@ def _without_dos_eof(text: str) -> str:
     return stripped.rstrip(DOS_EOF + " \t\r\n") if stripped.endswith(DOS_EOF) else text
 
 
+#: Words that may follow the number on a count line (``2 lights``, ``48 LEDs``): read as the
+#: count alone, since they say what is counted and nothing else.
+_COUNT_WORDS = frozenset(
+    ("light", "lights", "led", "leds", "image", "images", "direction", "directions",
+     "entries", "entry", "photos", "shots", "lamps")
+)  # fmt: skip
+
+
+def _count_with_words(tokens: list[str]) -> bool:
+    """Whether a first line is a whole number followed by words and no number (``2 lights``,
+    ``48 LEDs in dome A``): a count line with words, never a light (which ends in numbers),
+    nor a light that lost its numbers (``1 image01.jpg``, left to the light's own error)."""
+    if len(tokens) < 2 or not re.fullmatch(r"[+-]?\d+", tokens[0]):
+        return False
+    rest = tokens[1:]
+    return not any(_is_number(t) or t.lower().endswith(_IMAGE_ENDINGS) for t in rest)
+
+
+def _count_line_words(
+    first: str, tokens: list[str], source: str, lineno: int, notes: list[str]
+) -> list[str]:
+    """The count of a count line with a count word after it (``2 lights``, ``48 LEDs``), said
+    in ``notes``; any other words refused, saying what the first line must be.
+
+    Why: ``2 lights`` had been read as a light line and refused as "expected 'name x y z',
+    found 2 field(s)", with nothing to do. One count word says only what is counted, so it is
+    read (and noted: relight's parseLP reads the line with ``QString::toInt``, which refuses
+    it); other words may say anything (``48 of 50 LEDs``), so the user says the count."""
+    word = tokens[1].strip(":,.;").lower() if len(tokens) == 2 else ""
+    if word in _COUNT_WORDS:
+        notes.append(
+            f"{shown_path(source)}, line {lineno}: count line {first!r} read as the count "
+            f"{tokens[0]}; relight reads only a number alone there (write '{tokens[0]}')"
+        )
+        return tokens[:1]
+    raise LpFormatError(
+        source,
+        lineno,
+        f"count line {first!r} holds words after its number: the first line of an .lp is the "
+        f"number of lights alone (e.g. '{tokens[0]}'), or, without a count line, the first "
+        "light 'name x y z'; delete the words, or start the line with '#' and write the count "
+        "on a line of its own",
+    )
+
+
 def parse_lp(
     text: str,
     source: str = "<lp>",
@@ -757,6 +850,8 @@ def parse_lp(
     declared: int | None = None
     first_no, first = content[0]
     first_tokens = first.split()
+    if _count_with_words(first_tokens):
+        first_tokens = _count_line_words(first, first_tokens, source, first_no, notes)
     if len(first_tokens) == 1:
         try:
             declared = int(first_tokens[0])
@@ -804,7 +899,11 @@ def parse_lp(
             raise LpFormatError(
                 source, lineno, f"expected 'name x y z', found no number: {line!r}{hint}"
             )
-        # Like relight: the last three fields are the vector, the rest is the name.
+        # As relight's parseLP reads a line (cnr-isti-vclab/relight, src/lp.cpp at commit
+        # 74b352a02e66: the last three fields are the vector, the fields before them joined
+        # with single spaces are the name), where the line is not refused above or here.
+        # Older relight (its QRegExp-split parseLP) refused any line of other than 4 fields,
+        # so a name with spaces reads in only some relight versions.
         name = " ".join(tokens[:-3])
         _refuse_extra_columns(tokens, line, source, lineno)
         x, y, z = (

@@ -47,3 +47,23 @@ def test_a_name_ending_in_a_number_before_its_light_still_reads(tmp_path: Path) 
     out = tmp_path / "plan.lp"
     r = runner.invoke(app, ["plan", "--rig", str(lp), "--lights", "4", "--out", str(out)])
     assert r.exit_code == 0, said(r)
+
+
+def test_a_line_that_reads_as_a_name_or_as_a_column_is_refused_saying_both(
+    tmp_path: Path,
+) -> None:
+    """``led01 0 0 1 0`` (an LED at intensity 0): its last three fields and the three before
+    the last are both unit vectors, so it is the light ``led01 0`` from (0, 1, 0) or ``led01``
+    from (0, 0, 1) with a column after it; it had been read the first way, unsaid."""
+    lp = tmp_path / "dome.lp"
+    lines = [f"{line} 0.85" for line in LIGHTS]
+    lines[0] = "led01 0 0 1 0"
+    lp.write_text("\n".join(["4", *lines]) + "\n")
+    out = tmp_path / "plan.lp"
+    r = runner.invoke(app, ["plan", "--rig", str(lp), "--lights", "4", "--out", str(out)])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert f"{lp}, line 2: 'led01 0 0 1 0' reads two ways" in text, text
+    assert "'led01 0' from (0, 1, 0)" in text and "'led01' from (0, 0, 1)" in text, text
+    assert "delete the column after the light" in text, text
+    assert "Traceback" not in r.output and not out.exists()
