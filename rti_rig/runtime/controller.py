@@ -11,7 +11,7 @@ from __future__ import annotations
 import signal
 import time
 from collections.abc import Callable, Iterable
-from contextlib import AbstractContextManager
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import TYPE_CHECKING, Any, Protocol
@@ -705,16 +705,43 @@ def _teardown_held(cancel: CancelToken) -> tuple[_Entered, BaseException | None]
     a run still under way). Caught here, the hold set all the same, it is raised once the
     teardown is done, the manifest naming it, as a stop in the last step is. Once the hold's
     handlers are in place a signal is only held: nothing raises between here and the
-    ``with`` that exits it."""
-    stopped: BaseException | None = None
-    while True:
+    ``with`` that exits it.
+
+    The tries are bounded (:data:`_HOLD_TRIES`): an exception that recurs on every try (not a
+    stop but a fault in setting the hold) had spun here for ever, the devices never made safe;
+    after the last the teardown runs unheld, the first exception raised at its end. A second
+    stop caught here is added to the first's notes (it had been dropped without a trace)."""
+    caught: list[BaseException] = []
+    for _ in range(_HOLD_TRIES):
         try:
             cancel.capture_over()
             hold = signals_deferred()
             hold.__enter__()
-            return _Entered(hold), stopped
+            return _Entered(hold), _first_noted(caught)
         except BaseException as exc:  # a stop's handler, as the hold was being set: again
-            stopped = stopped or exc
+            caught.append(exc)
+    # never held: the teardown runs all the same (a stop now leaves it, as before the hold)
+    return _Entered(nullcontext()), _first_noted(caught)
+
+
+#: How many times :func:`_teardown_held` tries to set the teardown's hold: each stop a user
+#: can send (Ctrl-C, a second Ctrl-C, SIGTERM, a hang-up) may land in one try, with room over.
+_HOLD_TRIES = 8
+
+
+def _first_noted(caught: list[BaseException]) -> BaseException | None:
+    """The first exception caught, each later one in its notes (as a hold's own delivery
+    notes the stops it delivered after the first); None if none was. Only the first can be
+    raised, and it names the run's end; the rest are kept for a traceback or a log."""
+    if not caught:
+        return None
+    first = caught[0]
+    for later in caught[1:]:
+        if later is not first:
+            first.add_note(
+                f"also raised as the teardown's hold was being set: {type(later).__name__}: {later}"
+            )
+    return first
 
 
 def _stop_recorded_as(exc: BaseException) -> tuple[FinishReason, str]:

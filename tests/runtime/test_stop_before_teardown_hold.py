@@ -110,3 +110,67 @@ def _handlers_put_back() -> Iterator[None]:
     yield
     for s, h in before.items():
         signal.signal(s, h)
+
+
+def _run_with_capture_over(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, raising: Any) -> Any:
+    """A session of STEPS whose teardown's ``capture_over`` raises what ``raising(n)`` gives
+    on its n-th call (None: it returns); the all-off calls seen and the folder."""
+    rig = build_rig(load_rig_config(write_config(tmp_path, SMALL_DOME)))
+    calls = {"n": 0}
+    real_over = CancelToken.capture_over
+
+    def capture_over(self: CancelToken) -> None:
+        calls["n"] += 1
+        exc = raising(calls["n"])
+        if exc is not None:
+            raise exc
+        real_over(self)
+
+    safe_calls: list[bool] = []
+    real_safe = rig.lighting.safe
+
+    def safe(*, emergency: bool = False) -> Any:
+        safe_calls.append(emergency)
+        return real_safe(emergency=emergency)
+
+    monkeypatch.setattr(rig.lighting, "safe", safe)
+    monkeypatch.setattr(CancelToken, "capture_over", capture_over)
+    out = tmp_path / "s"
+    run = lambda: run_session(  # noqa: E731
+        rig, plan_uniform(rig.geometry, STEPS), SessionFolder.create(out, STEPS)
+    )
+    return run, calls, safe_calls, out, rig
+
+
+def test_a_fault_recurring_as_the_teardown_hold_is_set_is_tried_a_bounded_number_of_times(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Before, every exception there was tried again without limit: one that always recurs
+    spun for ever, the lights never switched off. It recurs here 1000 times (then stops, so
+    that the unbounded loop ends in a failure rather than a hang)."""
+    run, calls, safe_calls, out, rig = _run_with_capture_over(
+        tmp_path, monkeypatch, lambda n: RuntimeError("hold fault") if n <= 1000 else None
+    )
+    with pytest.raises(RuntimeError, match="hold fault"):
+        run()
+    assert calls["n"] == controller._HOLD_TRIES, calls  # bounded, not the 1001 to get through
+    assert safe_calls == [False]  # the teardown ran all the same: the all-off was sent
+    runner = json.loads((out / "manifest.json").read_text())["runner"]
+    assert runner["finish_reason"] == "error" and "hold fault" in runner["error"], runner
+    assert rig.lighting.source.lit is None
+
+
+def test_a_second_stop_as_the_teardown_hold_is_set_is_noted_on_the_first(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Before, a second stop caught there was dropped without a trace: the first is raised
+    (it names the run's end), the second in its notes."""
+    stops = {1: EmergencyStop(signal.SIGTERM), 2: KeyboardInterrupt("second Ctrl-C")}
+    run, _calls, safe_calls, out, _rig = _run_with_capture_over(tmp_path, monkeypatch, stops.get)
+    with pytest.raises(EmergencyStop) as raised:
+        run()
+    notes = getattr(raised.value, "__notes__", [])
+    assert any("KeyboardInterrupt" in n and "second Ctrl-C" in n for n in notes), notes
+    assert safe_calls == [True]
+    runner = json.loads((out / "manifest.json").read_text())["runner"]
+    assert runner["finish_reason"] == "emergency-stop", runner
