@@ -1597,6 +1597,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         EmergencyStop,
         LightOffForCamera,
         Paused,
+        Preparing,
         StepCompleted,
         StepStarted,
     )
@@ -1616,6 +1617,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     #: a step of this run has begun (its light set): before it the rig is still being
     #: connected (an arm's baud scan can take 10 s), and no image is under way to stop after
     stepped = False
+    #: what the run is doing before its first step (a :class:`Preparing` phase, or "paused"),
+    #: said by a first Ctrl-C there; None until the controller says (the rig's opening)
+    before_first: str | None = None
 
     def on_sigint(signum, frame):  # type: ignore[no-untyped-def]
         nonlocal ended, late_said, stopping
@@ -1690,8 +1694,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         if not stepped:
             # "Stopping after this image" had been said while the rig was being connected,
             # no image under way (an arm's connect, its baud scan), the connect going on
+            doing = _BEFORE_FIRST_STEP.get(before_first or "", _BEFORE_FIRST_STEP["lights"])
             err.print(
-                "[yellow]Stopping before any image is taken: the rig is being connected "
+                f"[yellow]Stopping before any image is taken: {doing} "
                 "(Ctrl-C again to stop at once)…[/]"
             )
             return
@@ -1782,9 +1787,13 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             )
 
             def on_event(event):  # type: ignore[no-untyped-def]
-                nonlocal stepped
+                nonlocal stepped, before_first
                 if isinstance(event, StepStarted):
                     stepped = True
+                elif isinstance(event, Preparing):
+                    before_first = event.phase
+                elif isinstance(event, Paused) and not stepped:
+                    before_first = "paused"
                 if isinstance(event, StepCompleted):
                     progress.advance(task)
                 elif isinstance(event, Paused):
@@ -1871,6 +1880,18 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             put_back(previous)
     with _ctrl_c_ignored(previous.get(signal.SIGINT) if over else None):
         return _summarise(opened, result, resume_hint(), dry)
+
+
+#: What a first Ctrl-C before the run's first step is told is under way, by the controller's
+#: :class:`~rti_rig.runtime.controller.Preparing` phase ("paused": a SIGUSR1 pause before it).
+#: Why: "the rig is being connected" had been said of every wait there alike.
+_BEFORE_FIRST_STEP = {
+    "lights": "the rig is being connected",
+    "camera": "the camera is being connected",
+    "card": "the camera's card is being listed",
+    "ready": "the rig is connected, its first image about to begin",
+    "paused": "the capture is paused before its first image",
+}
 
 
 #: What a Ctrl-C once the capture has ended (returned, raised or been stopped) is told.

@@ -237,7 +237,21 @@ class DeviceSays:
     text: str
 
 
-Event = StepStarted | StepCompleted | Paused | LightOffForCamera | DeviceSays
+@dataclass(frozen=True)
+class Preparing:
+    """What the run is doing before its first step, as each part begins: ``phase`` is
+    ``"lights"`` (the dome's port, the arm's connect and baud scan), ``"camera"`` (its
+    connect), ``"card"`` (a card camera listing its card) or ``"ready"`` (all connected, the
+    first step next).
+
+    Why: a first Ctrl-C there stops before any image, and the CLI says what it waits for;
+    it had said "the rig is being connected" during the camera's connect, a card's listing
+    (minutes on a full card) and a pause before the first step alike."""
+
+    phase: str
+
+
+Event = StepStarted | StepCompleted | Paused | LightOffForCamera | DeviceSays | Preparing
 
 
 class StepSource(Protocol):
@@ -822,14 +836,18 @@ def run_session(
         rig.bind_session(folder.root)
         # a lost port's reopening is said as the product speaks, between the bar's redraws
         rig.lighting.listen(lambda text: emit(DeviceSays(rig.lighting.name, text)))
+        emit(Preparing("lights"))
         rig.lighting.connect()
+        emit(Preparing("camera"))
         rig.camera.connect()
         rig.lighting.off()
         # a card camera lists its card, to tell a picture taken before the first shot (only
         # a capture session does: `check` and `preview` never wait for it)
         if list_card and isinstance(rig.camera, CardListingCamera):
             name = str(rig.camera.name)
+            emit(Preparing("card"))
             rig.camera.list_card(lambda text: emit(DeviceSays(name, text)))
+        emit(Preparing("ready"))
         planned = [
             *(step_exposure(rig, schedule.steps[i]) for i in todo if source is None),
             *((cam.exposure_s, *(s.exposure_s or 0.0 for s in schedule.steps)) if source else ()),

@@ -19,7 +19,9 @@ from conftest import said as unwrapped
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.runtime.controller import CancelToken
 from rti_rig.runtime.lighting import ArmLighting
+from rti_rig.simulator.sim_camera import SimulatedCamera
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
 
@@ -40,6 +42,69 @@ def test_a_ctrl_c_as_the_arm_connects_is_not_said_as_after_this_image(
     said = unwrapped(r)
     assert "Stopping after this image" not in said, said
     assert "Stopping before any image is taken: the rig is being connected" in said, said
+    assert "Session cancelled." in said and "Nothing was captured: " in said, said
+    assert r.exit_code == 130, said
+    assert not any(out.glob("image_*"))
+
+
+def _ctrl_c() -> None:
+    os.kill(os.getpid(), signal.SIGINT)  # the user's Ctrl-C, here and now
+
+
+def _camera_connect(monkeypatch: pytest.MonkeyPatch) -> None:
+    real = SimulatedCamera.connect
+
+    def connect(self: SimulatedCamera) -> None:
+        _ctrl_c()
+        real(self)
+
+    monkeypatch.setattr(SimulatedCamera, "connect", connect)
+
+
+def _card_listed(monkeypatch: pytest.MonkeyPatch) -> None:
+    def list_card(self: SimulatedCamera, say: object) -> None:  # a card camera's listing
+        _ctrl_c()
+
+    monkeypatch.setattr(SimulatedCamera, "list_card", list_card, raising=False)
+
+
+def _paused_before_the_first(monkeypatch: pytest.MonkeyPatch) -> None:
+    real_connect = SimulatedCamera.connect
+    real_wait = CancelToken.wait_while_paused
+
+    def connect(self: SimulatedCamera) -> None:  # a SIGUSR1 as the rig connects: paused
+        os.kill(os.getpid(), signal.SIGUSR1)
+        real_connect(self)
+
+    def wait_while_paused(self: CancelToken, poll_s: float = 0.05) -> None:
+        _ctrl_c()  # while the pause waits
+        real_wait(self, poll_s)
+
+    monkeypatch.setattr(SimulatedCamera, "connect", connect)
+    monkeypatch.setattr(CancelToken, "wait_while_paused", wait_while_paused)
+
+
+@pytest.mark.parametrize(
+    ("arrange", "doing"),
+    [
+        (_camera_connect, "the camera is being connected"),
+        (_card_listed, "the camera's card is being listed"),
+        (_paused_before_the_first, "the capture is paused before its first image"),
+    ],
+    ids=["camera-connect", "card-listing", "paused-before-the-first-step"],
+)
+def test_a_ctrl_c_before_the_first_step_says_what_is_under_way(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, arrange: object, doing: str
+) -> None:
+    """Before, each was told "the rig is being connected" (said of any wait before the first
+    step), though the rig's lights had answered and the wait was the camera's or a pause's."""
+    arrange(monkeypatch)  # type: ignore[operator]
+    out = tmp_path / "s"
+    argv = ["run", str(CONFIGS / "emulated_dome.toml"), "--lights", "6", "--out", str(out)]
+    r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
+    said = unwrapped(r)
+    assert f"Stopping before any image is taken: {doing} (Ctrl-C again" in said, said
+    assert "being connected" not in said.replace(doing, ""), said
     assert "Session cancelled." in said and "Nothing was captured: " in said, said
     assert r.exit_code == 130, said
     assert not any(out.glob("image_*"))
