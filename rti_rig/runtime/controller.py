@@ -503,23 +503,22 @@ def _wait_dark(rig: Rig, until: float, cancelled: Callable[[], bool] | None) -> 
         clock.sleep(left if cancelled is None else min(left, DARK_POLL_S))
 
 
-def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
-    """Raise :class:`ScheduleError` listing every step the rig cannot run, before anything moves."""
+def validate_schedule(
+    rig: Rig, schedule: LightSchedule, shot: frozenset[int] = frozenset()
+) -> None:
+    """Raise :class:`ScheduleError` listing every step the rig cannot run, before anything moves.
+
+    ``shot``: the steps (0-based) a resumed session has already taken, not checked. Why: they
+    are history, shot on the rig as it was; a rig change accepted on resume (an arm's reach
+    narrowed, an LED taken out) that left only those out of reach had refused the resume of
+    steps it could all run."""
     if len(schedule) == 0:
         raise ScheduleError("the schedule has no steps")
     if len(schedule) > MAX_LIGHTS:
         raise ScheduleError(
             f"{len(schedule)} steps: `.lp` readers accept at most {MAX_LIGHTS} images per session"
         )
-    cam = rig.camera_config
-    problems = []
-    for i, step in enumerate(schedule.steps):
-        reason = rig.lighting.problem(step)
-        exp = step_exposure(rig, step)
-        if reason is None and not cam.min_exposure_s <= exp <= cam.max_exposure_s:
-            reason = f"exposure {exp} s outside [{cam.min_exposure_s}, {cam.max_exposure_s}] s"
-        if reason:
-            problems.append(f"step {i + 1}{_step_named(step)}: {reason}")
+    problems = schedule_problems(rig, schedule, [i for i in range(len(schedule)) if i not in shot])
     if problems:
         shown = "\n  ".join(problems[:10])
         more = f"\n  ... and {len(problems) - 10} more" if len(problems) > 10 else ""
@@ -527,6 +526,22 @@ def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
             f"the schedule cannot run on rig '{rig.name}' "
             f"({len(problems)} problem(s)); nothing has moved:\n  {shown}{more}"
         )
+
+
+def schedule_problems(rig: Rig, schedule: LightSchedule, steps: Iterable[int]) -> list[str]:
+    """What stops each of ``steps`` (0-based) of ``schedule`` running on ``rig``, one line a
+    step ("step 4 (LED 7 …): …"); empty if all can run."""
+    cam = rig.camera_config
+    problems = []
+    for i in steps:
+        step = schedule.steps[i]
+        reason = rig.lighting.problem(step)
+        exp = step_exposure(rig, step)
+        if reason is None and not cam.min_exposure_s <= exp <= cam.max_exposure_s:
+            reason = f"exposure {exp} s outside [{cam.min_exposure_s}, {cam.max_exposure_s}] s"
+        if reason:
+            problems.append(f"step {i + 1}{_step_named(step)}: {reason}")
+    return problems
 
 
 def _step_named(step: LightStep) -> str:
@@ -787,7 +802,9 @@ def run_session(
     With ``source`` the steps are the source's decisions, step by step (adaptive acquisition);
     ``schedule`` is then the starting layout recorded in the manifest, checked like any other.
     """
-    validate_schedule(rig, schedule)
+    # a resume's steps already shot are not checked again (an accepted rig change may have
+    # left them out of its reach): an adaptive run's starting layout is no list of its steps
+    validate_schedule(rig, schedule, frozenset(folder.done) if source is None else frozenset())
     total = len(schedule) if source is None else source.total
     if folder.total_steps != total:
         raise ScheduleError("session folder was sized for another schedule")

@@ -675,6 +675,9 @@ class SessionFolder:
         self.resume: ResumeState | None = None
         self.rig_identity: dict[str, Any] | None = None
         self.rig_change: list[str] | None = None
+        #: the steps already shot that the rig as changed could not take (one line each, as
+        #: the schedule check says them): kept, shot on the rig as it was; recorded in the run
+        self.shot_beyond_change: list[str] | None = None
         #: what reading the run's input files tolerated (a `.lp` light clamped at the horizon, a
         #: count line that disagreed): recorded in the manifest, so the session says what it
         #: was shot from and what was assumed about it, not only the terminal that ran it
@@ -892,6 +895,12 @@ class SessionFolder:
                 run["lost_since_capture"] = self.resume.lost_since_capture
             if self.rig_change:
                 run["rig_change"] = self.rig_change
+            if self.shot_beyond_change:
+                run["shot_before_rig_change"] = {
+                    "note": "shot on the rig as it was before this run's rig_change, which "
+                    "could not take them; kept, lights.lp lists the lights that fired",
+                    "steps": self.shot_beyond_change,
+                }
             if self.rig_identity is not None:
                 self.manifest.setdefault("rig", {})["identity"] = self.rig_identity
             new_path = (header.get("rig") or {}).get("config_path")

@@ -72,3 +72,37 @@ def test_a_dynamixel_arm_s_azimuth_out_of_its_new_limits_is_said_in_their_terms(
     assert "azimuth -30.658 deg is outside the joint limits -10.0..170.0" in said, said
     assert "329.342" not in said, said
     assert "leaves these steps of" in said and "--out " in said, said
+
+
+def test_a_reach_narrowed_only_where_images_were_shot_resumes_keeping_them(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The arm's band narrowed to 20..60° after 4 of 6 images (shot at 37.7°, 18.2°, 9.3° and
+    65.5°; the two left at 27.5° and 49.5°): before, the resume checked the whole schedule and
+    refused steps 2-4, already on disk. The steps left are checked, the ones shot kept, said
+    and recorded as shot on the rig as it was, and lights.lp lists the lights that fired."""
+    import json
+
+    monkeypatch.chdir(tmp_path)
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace("width = 512", "width = 64").replace("height = 512", "height = 64"))
+    out = tmp_path / "s"
+    result = cut_new_session(NewSessionRequest(cfg, out, lights=6), after_step=3)
+    assert result.finish_reason is FinishReason.CANCELLED
+    lp_before = (out / "lights.lp").read_text().splitlines()
+    assert len(lp_before) == 5  # its count, then the four images shot
+    narrowed = cfg.read_text().replace("min_elevation_deg = 5.0", "min_elevation_deg = 20.0")
+    cfg.write_text(narrowed.replace("max_elevation_deg = 80.0", "max_elevation_deg = 60.0"))
+
+    r = runner.invoke(app, ["run", "--resume", "s", "--accept-rig-change", "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "3 image(s) already shot could not be taken on the rig as changed (step 2" in said, said
+    assert "they are kept, shot on the rig as it was" in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["runner"]["finish_reason"] == "completed", manifest["runner"]
+    kept = manifest["runs"][-1]["shot_before_rig_change"]["steps"]
+    assert [line.split(" ", 2)[1] for line in kept] == ["2:", "3:", "4:"], kept
+    lp = (out / "lights.lp").read_text().splitlines()
+    assert lp[0].strip() == "6" and lp[1:5] == lp_before[1:], lp  # the lights that fired

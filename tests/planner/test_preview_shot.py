@@ -375,7 +375,7 @@ def test_the_rig_is_closed_whatever_interrupts_the_start(
         uc.checked_rig(loaded, None)
     assert rig.closed
     rig.closed = False
-    monkeypatch.setattr(uc, "validate_schedule", lambda r, s: None)
+    monkeypatch.setattr(uc, "validate_schedule", lambda r, s, shot=frozenset(): None)
     monkeypatch.setattr(SessionFolder, "create", interrupted)
     with pytest.raises(KeyboardInterrupt):
         uc._open_new(loaded, [], tmp_path / "new", False, 0.001, uc._ignore)  # type: ignore[arg-type]

@@ -239,7 +239,7 @@ def test_a_resume_that_fails_to_open_releases_the_folder(
         str(out),
     ]
 
-    def failing_check(loaded, schedule):  # type: ignore[no-untyped-def]
+    def failing_check(loaded, schedule, shot=frozenset()):  # type: ignore[no-untyped-def]
         raise SessionError("the rig's check failed")
 
     with monkeypatch.context() as m:

@@ -361,26 +361,33 @@ def too_few_to_fit(n: int, schedule: LightSchedule | None = None) -> Note | None
     return None if said is None else Note(said, "warning")
 
 
-def checked_rig(loaded, schedule: LightSchedule) -> Rig:  # type: ignore[no-untyped-def]
+def checked_rig(  # type: ignore[no-untyped-def]
+    loaded, schedule: LightSchedule, shot: frozenset[int] = frozenset()
+) -> Rig:
     """The rig, opened, with ``schedule`` checked against it before anything moves.
+
+    ``shot``: a resume's steps already taken (0-based), not checked: history, shot on the rig
+    as it was (:func:`~rti_rig.runtime.controller.validate_schedule`).
 
     The rig is closed (lights off, arm stopped) if the check fails, whatever the exception.
     """
     from rti_rig.app.compose import build_rig
 
-    _check_timed_window(loaded, schedule)  # before the port opens
+    _check_timed_window(loaded, schedule, shot)  # before the port opens
     rig = build_rig(loaded)
     try:
-        validate_schedule(rig, schedule)
+        validate_schedule(rig, schedule, shot)
     except BaseException:
         rig.close_said()  # its failures said, never in place of the error raised
         raise
     return rig
 
 
-def _check_timed_window(loaded, schedule: LightSchedule) -> None:  # type: ignore[no-untyped-def]
+def _check_timed_window(  # type: ignore[no-untyped-def]
+    loaded, schedule: LightSchedule, shot: frozenset[int] = frozenset()
+) -> None:
     """Refuse a plan's own exposures that a timed firmware's on-window cannot hold (the config's
-    exposure_s is checked when the config loads)."""
+    exposure_s is checked when the config loads); ``shot``, a resume's steps taken, aside."""
     from rti_rig.app.config import timed_exposure_limit
     from rti_rig.core.errors import ScheduleError
 
@@ -390,7 +397,9 @@ def _check_timed_window(loaded, schedule: LightSchedule) -> None:  # type: ignor
     over = [
         f"step {i + 1}: exposure {step.exposure_s:g} s"
         for i, step in enumerate(schedule.steps)
-        if step.exposure_s is not None and step.exposure_s > limit.max_exposure_s + 1e-9
+        if i not in shot
+        and step.exposure_s is not None
+        and step.exposure_s > limit.max_exposure_s + 1e-9
     ]
     if over:
         raise ScheduleError(
@@ -1912,8 +1921,11 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     # the steps still to shoot, at their own exposures, before the port opens
     _check_steps_fit_lit(loaded, schedule, frozenset(folder.done))
     _check_disk_holds_rest(loaded, folder, Path(req.session_dir))
+    # the steps still to shoot only: the ones shot are history (an adaptive run's layout is
+    # its start, no list of its steps)
+    shot = frozenset(folder.done) if "adaptive" not in folder.manifest else frozenset()
     try:
-        rig = checked_rig(loaded, schedule)
+        rig = checked_rig(loaded, schedule, shot)
     except ScheduleError as exc:
         if not diffs:
             raise
@@ -1931,6 +1943,8 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
             f"a new session on the rig as it is: rti-rig run {shell_word(str(loaded.path))} "
             f"--out {again}"
         ) from None
+    if diffs and shot:
+        _say_shot_beyond(rig, schedule, folder, shot, on_note)
     source = None
     if "adaptive" in folder.manifest:
         from rti_rig.app.usecases.adaptive import resume_adaptive_source
@@ -1942,6 +1956,35 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
             raise
     return OpenedSession(
         rig, schedule, folder, Path(req.session_dir), resumed=True, source=source, request=req
+    )
+
+
+def _say_shot_beyond(  # type: ignore[no-untyped-def]
+    rig, schedule: LightSchedule, folder, shot: frozenset[int], on_note: NoteSink
+) -> None:
+    """Say, and record in this run's manifest entry, the images already shot that the rig as
+    changed could not take (an arm's reach narrowed, an LED taken out): kept, as shot on the
+    rig as it was; ``lights.lp`` lists the lights that fired for them.
+
+    Why: the resume had refused such a session whole; going on, the images kept beside ones
+    the rig could no longer take must be told as what they are, not left to look like the
+    changed rig's work."""
+    from rti_rig.runtime.controller import schedule_problems
+
+    beyond = schedule_problems(rig, schedule, sorted(shot))
+    if not beyond:
+        return
+    folder.shot_beyond_change = beyond
+    shown = "; ".join(beyond[:5]) + (f"; ... and {len(beyond) - 5} more" if len(beyond) > 5 else "")
+    on_note(
+        Note(
+            f"{len(beyond)} image(s) already shot could not be taken on the rig as changed "
+            f"({shown}): they are kept, shot on the rig as it was (its config in "
+            f"{shown_path(folder.root / 'manifest.json')}, under rig.config; lights.lp lists "
+            "the lights that fired for them); only the steps still to shoot were checked "
+            "against the change (recorded in the manifest's run as shot_before_rig_change)",
+            "warning",
+        )
     )
 
 
