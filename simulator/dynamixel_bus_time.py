@@ -11,7 +11,12 @@ had paid none of it: the session time it reported was about 2.5 % short of the s
 on a bus at 57600 baud. :class:`BusTime` charges it, on the host's side of the port, as the
 host meets it: an instruction's bytes as it writes them (before the servos act on it), each
 status's Return Delay Time and bytes as it reads them. A status the host never reads (dropped
-by ``clearPort``) is not charged: the host did not wait for it.
+by ``clearPort``) is not charged: the host did not wait for it. A status that never comes (a
+silent servo, a chain without power, a status lost on the wire) costs the host its whole
+reply window (the SDK's ``setPacketTimeout``: the status's bytes at the baud rate plus
+``LATENCY_TIMER * 2 + 2`` ms, 34 ms and more at 57600), and a late one its lateness or the
+window, the shorter (:meth:`BusTime.window_opened`, :meth:`BusTime.waited`): they had cost the
+clock nothing, so a dry run with faults reported a session shorter than the real bus.
 
 Not modelled: the USB-serial adapter's latency (an FTDI's latency timer holds a short status up
 to 16 ms by default, 1 ms once set low), which a host on real hardware adds to each read.
@@ -57,6 +62,8 @@ class BusTime:
         self._head = bytearray()
         #: bytes still to come of the packet being read, by its Length
         self._left = 0
+        #: the clock's time when the host's reply window opened (None: no window open)
+        self._window_from: float | None = None
 
     def sent(self, data: bytes) -> None:
         """The host wrote ``data``: its bytes cross the wire before any servo acts on them."""
@@ -103,6 +110,25 @@ class BusTime:
             del buf[:7]
         self._head = buf
         return delay
+
+    def window_opened(self) -> None:
+        """The host opened its reply window (the SDK's ``setPacketTimeout``): what it then
+        waits is counted from now, as the SDK counts it."""
+        self._window_from = self.clock.now()
+
+    def waited(self, ms: float, gave_up: bool) -> None:
+        """The host waited until ``ms`` after its window opened: the whole window when it
+        ``gave_up`` on a status that never came (or came after it), a late status's lateness
+        when it came within. Only what the clock has not yet run since the window opened
+        (the bytes read meanwhile) is charged; a window given up is closed, so a host asking
+        again after its end pays nothing more."""
+        if self._window_from is None:
+            return
+        left = self._window_from + ms / 1000.0 - self.clock.now()
+        if left > 0:
+            self.clock.sleep(left)
+        if gave_up:
+            self._window_from = None
 
     def cleared(self) -> None:
         """The host discarded what had arrived: a packet cut short there starts no other."""

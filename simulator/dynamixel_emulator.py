@@ -978,9 +978,8 @@ class DynamixelBusEmulator(HostBaudDevice):
         return wire.INSTRUCTION_ERROR, b""
 
 
-#: The SDK's reply window for a short status packet, ms (``LATENCY_TIMER * 2 + 2``, its
-#: ``PortHandler.setPacketTimeout`` without the bytes' wire time: a window in wall time, which
-#: the in-process port's replies never wait; the bus's time is charged to the clock instead).
+#: The SDK's reply window beyond the status's bytes, ms (``LATENCY_TIMER * 2 + 2``, its
+#: ``PortHandler.setPacketTimeout``, which adds the bytes' wire time at the baud rate).
 SDK_REPLY_WINDOW_MS = 34.0
 
 
@@ -988,7 +987,8 @@ class InProcessPort:
     """A stand-in for ``dynamixel_sdk.PortHandler`` wired straight to an emulator.
 
     Replies are produced synchronously on write, so "no more bytes" means "timed out": silence
-    costs no wall time. (The pty transport gives the same guarantee with a causal timeout: see
+    costs no wall time, but the clock is charged the reply window a real host waits for it, a
+    late status its lateness. (The pty transport gives the same guarantee with a causal timeout: see
     :mod:`rti_rig.simulator.dynamixel_pty`.)
 
     ``clock`` (the emulator's unless given) is charged what a real half-duplex bus takes
@@ -1008,10 +1008,6 @@ class InProcessPort:
         self._rx = bytearray()
         self.tx_log: list[bytes] = []
         self.packet_timeout = SDK_REPLY_WINDOW_MS
-        #: ms of reply windows that ran out: what a real port would have spent waiting for
-        #: statuses that never came in time (silence costs no wall time here), so the cost of a
-        #: silent chain to the driver can be told without a clock
-        self.silent_ms = 0.0
         self.bus_time = BusTime(
             clock if clock is not None else emulator.clock, emulator.servos, self.getBaudRate
         )
@@ -1060,22 +1056,28 @@ class InProcessPort:
         return len(data)
 
     def setPacketTimeout(self, packet_length: int) -> None:
-        # the SDK's window (ms): only a ``delay_reply`` status is measured against it
-        self.packet_timeout = SDK_REPLY_WINDOW_MS
+        """The SDK's window (ms), as it computes it: ``packet_length`` bytes at the baud rate
+        plus :data:`SDK_REPLY_WINDOW_MS`; the clock's wait for a status counts from here."""
+        self.packet_timeout = packet_length * 10_000.0 / self.baudrate + SDK_REPLY_WINDOW_MS
+        self.bus_time.window_opened()
 
     def setPacketTimeoutMillis(self, msec: float) -> None:
         self.packet_timeout = msec
+        self.bus_time.window_opened()
 
     def isPacketTimeout(self) -> bool:
+        """Whether the host's window ran out: no status came (the clock is charged the whole
+        window, as a real host waits it out), or a late one comes after it (likewise); one
+        late but within the window is read after its lateness, charged to the clock."""
         if self._rx:
             return False
         late = self.emulator.take_late()
         if late is None:
-            self.silent_ms += self.packet_timeout
+            self.bus_time.waited(self.packet_timeout, gave_up=True)
             return True
         self._rx += late[1]  # it comes: within the host's window, or after it
         over = late[0] * 1000.0 > self.packet_timeout
-        self.silent_ms += self.packet_timeout if over else 0.0
+        self.bus_time.waited(self.packet_timeout if over else late[0] * 1000.0, gave_up=over)
         return over
 
 

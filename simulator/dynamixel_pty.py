@@ -399,7 +399,19 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
         self.bus_time.heard(bytes(data))
         return data
 
+    def setPacketTimeout(self, packet_length: Any) -> None:
+        """The SDK's window; the clock's wait for a status counts from here."""
+        super().setPacketTimeout(packet_length)
+        self.bus_time.window_opened()
+
+    def setPacketTimeoutMillis(self, msec: Any) -> None:
+        super().setPacketTimeoutMillis(msec)
+        self.bus_time.window_opened()
+
     def isPacketTimeout(self) -> bool:
+        """Causal (module docstring); the clock is charged what a real host waits: its whole
+        window for a status that never comes or comes after it, a late one's lateness when it
+        comes within (they had cost the clock nothing)."""
         self._listen()
         with self._ledger.lock:
             over = self._ledger.quiet()
@@ -409,7 +421,10 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
                 # the host's window if that is the longer, else just after it ends
                 self._server.send(late[1])
                 over = late[0] * 1000.0 > self.packet_timeout
+                if not over:
+                    self.bus_time.waited(late[0] * 1000.0, gave_up=False)
         if over or self.getTimeSinceStart() > max(self.packet_timeout, LOST_LINK_S * 1000.0):
+            self.bus_time.waited(self.packet_timeout, gave_up=True)
             self.packet_timeout = 0
             return True
         # a reply is on its way: sleep (GIL released) until bytes arrive, briefly

@@ -163,3 +163,42 @@ def test_a_status_ending_like_a_header_starts_no_packet(chunk: int) -> None:
     for i in range(0, len(stream), chunk):
         bus.heard(stream[i : i + chunk])
     assert clock.now() == pytest.approx(2 * FACTORY_DELAY_S, rel=1e-9)
+
+
+#: The SDK's reply window for a Ping at 57600 baud, s: ``setPacketTimeout(11)``, 11 bytes' wire
+#: time plus ``LATENCY_TIMER * 2 + 2`` ms (dynamixel_sdk's PortHandler), about 35.9 ms.
+PING_WINDOW_57600_S = 11 * 10 / 57600 + 0.034
+
+
+@pytest.mark.parametrize("kind", ["inprocess", "pty"])
+@pytest.mark.parametrize("fault", ["silent", "drop_reply", "power_lost", "delay_reply:0.2"])
+def test_a_status_that_never_comes_in_time_costs_the_host_its_whole_reply_window(
+    kind: str, fault: str
+) -> None:
+    """A real host waits out the SDK's window before it gives up; it had cost the clock the
+    instruction's bytes alone, so a dry run with faults was shorter than the real bus."""
+    with _port(kind, 57600) as (port, emu, clock):
+        if fault == "silent":
+            emu.silent_ids.add(1)
+        else:
+            name, _, delay = fault.partition(":")
+            emu.add_fault(emu.instructions_received + 1, name, delay_s=float(delay or 1.0))
+        before = clock.now()
+        _, result, _ = sdk.PacketHandler(2.0).ping(port, 1)
+        assert result == sdk.COMM_RX_TIMEOUT
+        spent = clock.now() - before
+    assert spent == pytest.approx(PING_BYTES * 10 / 57600 + PING_WINDOW_57600_S, rel=1e-9)
+
+
+@pytest.mark.parametrize("kind", ["inprocess", "pty"])
+def test_a_status_late_within_the_window_costs_the_host_its_lateness(kind: str) -> None:
+    """A ``delay_reply`` status 20 ms late, within the window: the host reads it that much
+    later (it had cost the clock nothing more than an answer in time)."""
+    with _port(kind, 57600) as (port, emu, clock):
+        emu.add_fault(emu.instructions_received + 1, "delay_reply", delay_s=0.02)
+        before = clock.now()
+        model, result, _ = sdk.PacketHandler(2.0).ping(port, 1)
+        assert (model, result) == (1060, sdk.COMM_SUCCESS)
+        spent = clock.now() - before
+    wire = (PING_BYTES + PING_STATUS_BYTES) * 10 / 57600
+    assert spent == pytest.approx(wire + 0.02 + FACTORY_DELAY_S, rel=1e-9)

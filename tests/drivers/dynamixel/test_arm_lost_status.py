@@ -157,10 +157,10 @@ def test_after_a_silent_servo_a_slow_but_live_one_keeps_the_slow_links_allowance
     for i in (1, 2, 3):
         bus.ping(i)
     emu.silent_ids.add(1)  # its cable alone pulled
-    before = port.silent_ms
+    before = clock.now()
     with pytest.raises(CommunicationError, match="has stopped answering"):
         bus.read(1, ct.PRESENT_POSITION)
-    assert port.silent_ms - before > 2 * PATIENT_REPLY_MS  # the allowance, once
+    assert (clock.now() - before) * 1000 > 2 * PATIENT_REPLY_MS  # the allowance, once
     assert bus.link_silent
     emu.add_fault(emu.instructions_received + 1, "delay_reply", delay_s=0.2)
     assert bus.read(2, ct.TORQUE_ENABLE) in (0, 1)  # late, waited for, answered
