@@ -33,7 +33,7 @@ from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.shell_words import shell_word
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
-from rti_rig.drivers.dynamixel.bus import DxlBus, resends_said
+from rti_rig.drivers.dynamixel.bus import DxlBus, no_reply, resends_said
 from rti_rig.drivers.dynamixel.faults import (
     CommunicationError,
     ConfigMismatchError,
@@ -121,9 +121,9 @@ def _no_reply(exc: Exception) -> bool:
     """Whether ``exc`` is a servo's silence (no status within its reply window), after which
     nothing is known of it: its supply may be gone (torque off, the joint limp) as well as a
     cable, the servo still powered and holding. A corrupted reply or an error number came from
-    a powered servo. Read from the SDK's result name in the message, as the Status Return
-    Level check does (the bus raises one :class:`CommunicationError` for both)."""
-    return isinstance(exc, CommunicationError) and "COMM_RX_TIMEOUT" in exc.message
+    a powered servo. Told by the bus's result code (:func:`no_reply`), as the Status Return
+    Level check tells it; it had been found in the message's words."""
+    return no_reply(exc)
 
 
 def _fault_names(status: int) -> str:
@@ -388,7 +388,7 @@ class DynamixelArm(ReadBackCarrier):
         try:
             level = self._bus.read(sid, ct.STATUS_RETURN_LEVEL, check_alert=False)
         except CommunicationError as exc:
-            if "COMM_RX_TIMEOUT" not in exc.message:
+            if not no_reply(exc):
                 raise
             raise CommunicationError(
                 self.name,
@@ -396,6 +396,7 @@ class DynamixelArm(ReadBackCarrier):
                 f"Level (address 68) is most likely 0 (answer pings only); {fix}",
                 exc.command,
                 sid,
+                exc.result,
             ) from exc
         if level < 2:
             raise ConfigMismatchError(
@@ -441,6 +442,7 @@ class DynamixelArm(ReadBackCarrier):
                 "AX and MX servos ship, answers none of these pings)",
                 exc.command,
                 joint.servo_id,
+                exc.result,
             )
         if joint.servo_id in found:
             return exc  # it answers a broadcast: a flaky line, said as the SDK said it
@@ -463,6 +465,7 @@ class DynamixelArm(ReadBackCarrier):
                     f"(address 8) to {self.settings.baudrate} with Dynamixel Wizard 2.0",
                     exc.command,
                     joint.servo_id,
+                    exc.result,
                 )
             message = (
                 f"no servo with id {joint.servo_id} answers at {self.settings.baudrate} baud, "
@@ -481,7 +484,7 @@ class DynamixelArm(ReadBackCarrier):
                 f"set servo_id in [arm.dynamixel.{role}] to the id of the {role} servo "
                 "(Dynamixel Wizard 2.0 shows and changes ids; no two servos may share one)"
             )
-        return CommunicationError(self.name, message, exc.command, joint.servo_id)
+        return CommunicationError(self.name, message, exc.command, joint.servo_id, exc.result)
 
     def _at_other_rate(  # type: ignore[no-untyped-def]
         self, joint, exc: CommunicationError, rate: int, found: dict[int, int]
@@ -502,6 +505,7 @@ class DynamixelArm(ReadBackCarrier):
             "set the servos' Baud Rate, address 8, with Dynamixel Wizard 2.0)",
             exc.command,
             joint.servo_id,
+            exc.result,
         )
 
     def _role(self, joint) -> str:  # type: ignore[no-untyped-def]
@@ -1162,6 +1166,7 @@ class DynamixelArm(ReadBackCarrier):
                         "and on, check its cable, then connect again",
                         "reboot",
                         joint.servo_id,
+                        exc.result,
                     ) from exc
             self.clock.sleep(self.REBOOT_POLL_S)
 

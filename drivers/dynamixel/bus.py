@@ -66,6 +66,12 @@ def comm_text(ph: Any, result: int) -> str:
     return f"{COMM_NAMES.get(result, result)}: {ph.getTxRxResult(result)}"
 
 
+def no_reply(exc: BaseException) -> bool:
+    """Whether ``exc`` is the bus's "no status within the reply window" (the SDK's
+    ``COMM_RX_TIMEOUT``), by its result code: not a corrupted status, not a port's failure."""
+    return isinstance(exc, CommunicationError) and exc.result == sdk.COMM_RX_TIMEOUT
+
+
 class _ReleasingHandler:
     """The SDK's packet handler, made safe to interrupt.
 
@@ -305,6 +311,7 @@ class DxlBus:
                     "read the port in time; close what loads it and run the command again",
                     command,
                     dxl_id,
+                    result,
                 )
             if result == sdk.COMM_RX_TIMEOUT and dxl_id in self.answered:
                 # it answered at this id and rate before: "check id and baud rate" had sent a
@@ -317,6 +324,7 @@ class DxlBus:
                     "them (the id and baud rate were right)",
                     command,
                     dxl_id,
+                    result,
                 )
             raise CommunicationError(
                 self.device,
@@ -324,6 +332,7 @@ class DxlBus:
                 "X-series servos ship at 57600)",
                 command,
                 dxl_id,
+                result,
             )
         self.answered.add(dxl_id)
         if error & 0x7F:
@@ -608,7 +617,7 @@ class DxlBus:
         )
         if result != sdk.COMM_SUCCESS:
             raise CommunicationError(
-                self.device, comm_text(self.ph, result), f"write {reg.name}", dxl_id
+                self.device, comm_text(self.ph, result), f"write {reg.name}", dxl_id, result
             )
         self.drain_reply()
 
@@ -632,7 +641,10 @@ class DxlBus:
         log.debug("%s: sync write %s %s (%d)", self.device, reg.name, dict(values), result)
         if result != sdk.COMM_SUCCESS:
             raise CommunicationError(
-                self.device, comm_text(self.ph, result), f"sync write {reg.name} {dict(values)}"
+                self.device,
+                comm_text(self.ph, result),
+                f"sync write {reg.name} {dict(values)}",
+                result=result,
             )
 
     def broadcast_write(self, reg: ct.Register, value: int) -> None:
@@ -644,7 +656,10 @@ class DxlBus:
         log.debug("%s: broadcast write %s = %d (%d)", self.device, reg.name, value, result)
         if result != sdk.COMM_SUCCESS:
             raise CommunicationError(
-                self.device, comm_text(self.ph, result), f"broadcast write {reg.name}"
+                self.device,
+                comm_text(self.ph, result),
+                f"broadcast write {reg.name}",
+                result=result,
             )
 
     def action(self) -> None:
@@ -652,7 +667,9 @@ class DxlBus:
         self._commanding()
         result = self.ph.action(self.port, p2.BROADCAST_ID)
         if result != sdk.COMM_SUCCESS:
-            raise CommunicationError(self.device, comm_text(self.ph, result), "action")
+            raise CommunicationError(
+                self.device, comm_text(self.ph, result), "action", result=result
+            )
 
     def reboot(self, dxl_id: int) -> None:
         self._commanding()

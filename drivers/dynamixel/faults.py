@@ -27,7 +27,24 @@ class StopIncompleteError(DynamixelError, StopIncomplete):
 
 
 class CommunicationError(DynamixelError):
-    """No reply, or a corrupted reply (timeout, CRC): cabling, power, id or baud rate."""
+    """No reply, or a corrupted reply (timeout, CRC): cabling, power, id or baud rate.
+
+    ``result``: the SDK's communication result code the bus met (``COMM_RX_TIMEOUT``,
+    ``COMM_RX_CORRUPT``, ...), None for a port that failed or would not open. Why a field: a
+    servo's silence (nothing known of it, its supply perhaps gone) had been told from a
+    corrupted status (a powered servo) by finding "COMM_RX_TIMEOUT" in the message, which a
+    reworded message would silently break (:func:`~rti_rig.drivers.dynamixel.bus.no_reply`)."""
+
+    def __init__(
+        self,
+        device: str,
+        message: str,
+        command: str | None = None,
+        servo_id: int | None = None,
+        result: int | None = None,
+    ) -> None:
+        self.result = result
+        super().__init__(device, message, command, servo_id)
 
 
 class ServoStatusError(DynamixelError):

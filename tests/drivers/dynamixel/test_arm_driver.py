@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dynamixel_sdk as sdk
 import numpy as np
 import pytest
 from dxl_support import arm_settings
@@ -306,7 +307,9 @@ def test_a_faulted_servo_whose_torque_cannot_be_read_is_not_called_held() -> Non
 
     def read(dxl_id, reg, check_alert=True):  # type: ignore[no-untyped-def]
         if reg is ct.TORQUE_ENABLE:
-            raise CommunicationError("arm", "COMM_RX_TIMEOUT", f"read {reg.name}", dxl_id)
+            raise CommunicationError(
+                "arm", "COMM_RX_TIMEOUT", f"read {reg.name}", dxl_id, sdk.COMM_RX_TIMEOUT
+            )
         return real_read(dxl_id, reg, check_alert)
 
     arm._bus.read = read  # type: ignore[method-assign]

@@ -7,6 +7,7 @@ idempotent, so it is sent once more (as reads were). The shipped arm config rehe
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -177,3 +178,35 @@ def test_after_a_silent_servo_a_slow_but_live_one_keeps_the_slow_links_allowance
         emu.add_fault(emu.instructions_received + k, "delay_reply", delay_s=2.0)
     with pytest.raises(CommunicationError, match="but late"):
         bus.read(3, ct.PRESENT_POSITION)
+
+
+@pytest.mark.parametrize(("damage", "silent"), [("corrupt", False), ("drop", True)])
+def test_a_stop_tells_a_damaged_status_from_silence_by_the_bus_result(
+    damage: str, silent: bool
+) -> None:
+    """Statuses that come with a bad CRC (COMM_RX_CORRUPT) came from a powered servo; only
+    none at all (COMM_RX_TIMEOUT) is said as silence, "unpowered, it is limp". Told by the
+    error's result code, which it carries: it had been found in the message's words."""
+    import dynamixel_sdk as sdk
+
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.drivers.dynamixel.arm import DynamixelArm
+    from rti_rig.drivers.dynamixel.bus import no_reply
+    from rti_rig.drivers.dynamixel.faults import StopIncompleteError
+    from rti_rig.drivers.dynamixel.settings import ArmSettings
+    from rti_rig.simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
+
+    table = tomllib.loads((CONFIGS / "simulated_arm.toml").read_text())
+    settings = ArmSettings.model_validate(table["arm"]["dynamixel"])
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    arm = DynamixelArm(settings, InProcessPort(emu), clock)
+    arm.connect()
+    setattr(emu, f"{damage}_next_replies", 10_000)  # every status from now on
+    with pytest.raises(StopIncompleteError) as stop:
+        arm.stop()
+    assert stop.value.unheld and all(j.no_reply is silent for j in stop.value.unheld)
+    cause = stop.value.__cause__
+    expected = sdk.COMM_RX_TIMEOUT if silent else sdk.COMM_RX_CORRUPT
+    assert getattr(cause, "result", None) == expected and no_reply(cause) is silent
+    assert ("— no reply: unpowered" in str(stop.value)) is silent, stop.value
