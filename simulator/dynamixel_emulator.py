@@ -691,7 +691,14 @@ class DynamixelBusEmulator(HostBaudDevice):
     """
 
     def __init__(self, servos: Iterable[EmulatedServo], clock: Clock) -> None:
-        self.servos = {s.dxl_id: s for s in servos}
+        #: every servo on the bus, in chain order, whatever its ID: two may share one (an ID
+        #: written to another's, a Factory Reset to ID 1), and both hear and answer it
+        self.chain: list[EmulatedServo] = list(servos)
+        #: the servos by their ID (Control Table ID (7)) as it is now: the first in the chain
+        #: of any that share one (:meth:`_rekey`); one dict for the emulator's lifetime, held
+        #: by the ports' bus time
+        self.servos: dict[int, EmulatedServo] = {}
+        self._rekey()
         self.clock = clock
         self.silent_ids: set[int] = set()
         #: The host's line speed, where the transport knows it (set with the port's baud
@@ -699,7 +706,8 @@ class DynamixelBusEmulator(HostBaudDevice):
         #: answers nothing, as a real one does: a config with the wrong baud rate fails here
         #: as on the rig (it had passed `check`).
         self.host_baud: int | None = None
-        self._deaf: set[int] = set()
+        #: the servos that hear nothing of the packets being handled
+        self._deaf: set[EmulatedServo] = set()
         self.corrupt_next_replies = 0
         self.drop_next_replies = 0
         self.reply_faults: dict[int, str] = {}
@@ -791,10 +799,11 @@ class DynamixelBusEmulator(HostBaudDevice):
             # 2.0 into DYNAMIXEL Protocol 1.0 ... Protocol Type(13)") and does not answer these
             # packets: it had answered them, so a servo set to 1.0 passed `check` here
             now = self.clock.now()
-            self._deaf = self.silent_ids | {
-                i
-                for i, servo in self.servos.items()
-                if now < servo.restarting_until  # restarting after a Reboot
+            self._deaf = {
+                servo
+                for servo in self.chain
+                if servo.dxl_id in self.silent_ids
+                or now < servo.restarting_until  # restarting after a Reboot
                 or (
                     self.host_baud is not None
                     and tbl.BAUD_CODES.get(servo.get(tbl.BAUD_RATE)) != self.host_baud
@@ -806,14 +815,17 @@ class DynamixelBusEmulator(HostBaudDevice):
             out = bytearray()
             for item in self._parser.packets():
                 if isinstance(item, wire.BadCrc):
-                    dxl_id = item.raw[4]
-                    if dxl_id in self.servos and dxl_id not in self._deaf:
-                        out += self._reply(dxl_id, wire.CRC_ERROR)
+                    out += self._at_once(
+                        [
+                            self._reply(s.dxl_id, wire.CRC_ERROR, servo=s)
+                            for s in self._on(item.raw[4])
+                        ]
+                    )
                     continue
                 self.instructions.append(item)
                 self.instructions_received += 1
                 if self._unpowered(self.instructions_received):
-                    self._deaf = set(self.servos)  # this packet and every later one unheard
+                    self._deaf = set(self.chain)  # this packet and every later one unheard
                 for dxl_id, kind in self.hardware_faults.get(self.instructions_received, ()):
                     if dxl_id in self.servos:
                         # the servo's own error, as it meets it (an overload under load): its
@@ -821,6 +833,7 @@ class DynamixelBusEmulator(HostBaudDevice):
                         self.servos[dxl_id].inject_hardware_error(int(HARDWARE_FAULT_BITS[kind]))
                 fault = self.reply_faults.get(self.instructions_received)
                 reply = self._handle(item)
+                self._rekey()  # an ID written, a Factory Reset: the servo answers at its new ID
                 if reply and fault == "drop_reply":
                     reply = b""  # the servo acted; its status was lost on the wire
                 elif reply and fault == "garble_reply":
@@ -866,8 +879,15 @@ class DynamixelBusEmulator(HostBaudDevice):
             if kind == "delay_reply":
                 self.reply_delays[at] = delay_s
 
-    def _reply(self, dxl_id: int, number: int = 0, params: bytes = b"") -> bytes:
-        servo = self.servos[dxl_id]
+    def _reply(
+        self,
+        dxl_id: int,
+        number: int = 0,
+        params: bytes = b"",
+        servo: EmulatedServo | None = None,
+    ) -> bytes:
+        """Servo ``servo``'s (the one at ``dxl_id`` unless given) status, sent as ``dxl_id``."""
+        servo = servo if servo is not None else self.servos[dxl_id]
         packet = wire.status_packet(dxl_id, servo.status_error(number), params)
         if self.drop_next_replies > 0:
             self.drop_next_replies -= 1
@@ -885,12 +905,42 @@ class DynamixelBusEmulator(HostBaudDevice):
             return level >= 1
         return level >= 2
 
+    def _rekey(self) -> None:
+        """:attr:`servos` by each servo's ID as its table holds it now (in place).
+
+        Why: the map had been built once, and again only after a Factory Reset, by a dict
+        comprehension: a servo whose ID (7) was written kept answering at its old ID, and a
+        Factory Reset 0xFF (ID back to 1) on a bus where another servo has ID 1 dropped one
+        of the two from the bus."""
+        by_id: dict[int, EmulatedServo] = {}
+        for servo in self.chain:
+            by_id.setdefault(servo.dxl_id, servo)
+        self.servos.clear()
+        self.servos.update(by_id)
+
+    def _on(self, dxl_id: int) -> list[EmulatedServo]:
+        """The servos that hear a packet to ``dxl_id`` (several if they share it)."""
+        return [s for s in self.chain if s.dxl_id == dxl_id and s not in self._deaf]
+
+    @staticmethod
+    def _at_once(statuses: list[bytes]) -> bytes:
+        """What the host reads of the statuses sent at once by servos sharing one ID.
+
+        ROBOTIS e-manual, Protocol 2.0, ID: "Each connected DYNAMIXEL must have a unique ID
+        number. If DYNAMIXELs with the same ID are connected, packet collision and network
+        problems will occur." Both drive the half-duplex line together, each after its own
+        Return Delay Time, and the bytes the host reads are neither's: modelled as the first
+        status with its CRC damaged (the SDK's COMM_RX_CORRUPT, a retry meets it again), not
+        as the bit-level sum of the two, which the manual does not give."""
+        sent = [s for s in statuses if s]
+        if len(sent) < 2:
+            return b"".join(sent)
+        return sent[0][:-1] + bytes([sent[0][-1] ^ 0xFF])
+
     def _targets(self, pkt: wire.Instruction) -> list[EmulatedServo]:
         if pkt.dxl_id == wire.BROADCAST_ID:
-            ids = sorted(self.servos)
-        else:
-            ids = [pkt.dxl_id] if pkt.dxl_id in self.servos else []
-        return [self.servos[i] for i in ids if i not in self._deaf]
+            return sorted((s for s in self.chain if s not in self._deaf), key=lambda s: s.dxl_id)
+        return self._on(pkt.dxl_id)
 
     def _log_goal(self, dxl_id: int, address: int, data: bytes) -> None:
         g = tbl.GOAL_POSITION.address
@@ -907,8 +957,8 @@ class DynamixelBusEmulator(HostBaudDevice):
             for i in range(4, len(prm), length + 1):
                 dxl_id, data = prm[i], prm[i + 1 : i + 1 + length]
                 self._log_goal(dxl_id, address, data)
-                if dxl_id in self.servos and dxl_id not in self._deaf:
-                    self.servos[dxl_id].write(address, data)
+                for servo in self._on(dxl_id):
+                    servo.write(address, data)
             return b""
         if inst == wire.BULK_WRITE:
             i = 0
@@ -918,33 +968,45 @@ class DynamixelBusEmulator(HostBaudDevice):
                 length = int.from_bytes(prm[i + 3 : i + 5], "little")
                 data = prm[i + 5 : i + 5 + length]
                 self._log_goal(dxl_id, address, data)
-                if dxl_id in self.servos and dxl_id not in self._deaf:
-                    self.servos[dxl_id].write(address, data)
+                for servo in self._on(dxl_id):
+                    servo.write(address, data)
                 i += 5 + length
             return b""
         if inst == wire.SYNC_READ:
             address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
             for dxl_id in prm[4:]:
-                if dxl_id in self.servos and dxl_id not in self._deaf:
-                    err, data = self.servos[dxl_id].read(address, length)
-                    out += self._reply(dxl_id, err, data)
+                out += self._at_once(
+                    [
+                        self._reply(dxl_id, *s.read(address, length), servo=s)
+                        for s in self._on(dxl_id)
+                    ]
+                )
             return bytes(out)
         if inst == wire.BULK_READ:
             for i in range(0, len(prm) - 4, 5):
                 dxl_id = prm[i]
                 address = int.from_bytes(prm[i + 1 : i + 3], "little")
                 length = int.from_bytes(prm[i + 3 : i + 5], "little")
-                if dxl_id in self.servos and dxl_id not in self._deaf:
-                    err, data = self.servos[dxl_id].read(address, length)
-                    out += self._reply(dxl_id, err, data)
+                out += self._at_once(
+                    [
+                        self._reply(dxl_id, *s.read(address, length), servo=s)
+                        for s in self._on(dxl_id)
+                    ]
+                )
             return bytes(out)
+        statuses: dict[int, list[bytes]] = {}  # by the ID each goes out as
         for servo in self._targets(pkt):
-            answering = servo.dxl_id  # a Factory Reset's status goes out before the restart
+            # a status goes out as the ID the packet reached: a Factory Reset's before the
+            # restart, an ID write's before the new ID takes over (the host's SDK takes a
+            # status only from the ID it asked)
+            answering = servo.dxl_id
             err, params = self._execute(servo, inst, prm, broadcast=not unicast)
             if inst == wire.PING or (unicast and self._answers(servo, inst)):
-                out += self._reply(answering, err, params)
-        if inst == wire.FACTORY_RESET:  # a reset of everything brings the ID back to 1
-            self.servos = {s.dxl_id: s for s in self.servos.values()}
+                statuses.setdefault(answering, []).append(
+                    self._reply(answering, err, params, servo=servo)
+                )
+        for same_id in statuses.values():
+            out += self._at_once(same_id)
         return bytes(out)
 
     def _execute(
