@@ -598,7 +598,8 @@ class FolderWatchCamera:
             f"; {'; '.join(parts)}: the camera's file numbers may have started again (a new or "
             "formatted card, a counter reset, or its wrap from IMG_9999 to IMG_0001) onto an "
             "earlier shoot's names. A name is used once, so such a file is never taken as a "
-            f"light's image: move the files already in {self.settings.folder} elsewhere (the "
+            f"light's image: move the files already in {shown_path(self.settings.folder)}"
+            " elsewhere (the "
             "session keeps its own images in its raw/ folder), or point folder in "
             "[camera.device] at an empty folder"
         )
@@ -796,9 +797,11 @@ class FolderWatchCamera:
                         "then continue with 'rti-rig run --resume SESSION'"
                     )
                 none = (
-                    f"no other new file matching {list(s.patterns)} came to {s.folder} within "
+                    f"no other new file matching {list(s.patterns)} came to {shown_path(s.folder)}"
+                    " within "
                     if lead
-                    else f"no new file matching {list(s.patterns)} in {s.folder} within "
+                    else f"no new file matching {list(s.patterns)} in {shown_path(s.folder)}"
+                    " within "
                 )
                 raise CaptureError(
                     self.name,
@@ -925,7 +928,8 @@ class FolderWatchCamera:
                     said += (
                         f"; {', '.join(pending.out_of_step)} "
                         f"{'were' if len(pending.out_of_step) > 1 else 'was'} not used and "
-                        f"left in {self.settings.folder}" + self._off_step_said(pending, late)
+                        f"left in {shown_path(self.settings.folder)}"
+                        + self._off_step_said(pending, late)
                     )
                     said += self._before_connect_said(pending)
                 said += self._before_first_said(pending)
@@ -961,13 +965,14 @@ class FolderWatchCamera:
             if len(pending.out_of_step) > MAX_OUT_OF_STEP:
                 raise CaptureError(
                     self.name,
-                    f"{', '.join(pending.out_of_step)} came into {self.settings.folder} after "
+                    f"{', '.join(pending.out_of_step)} came into {shown_path(self.settings.folder)}"
+                    " after "
                     "this light's pulse, but none was shot in step with the pulses (its capture "
                     "time against the last image's, within "
                     f"{CAPTURE_TIME_RESOLUTION_S + self.settings.shutter_lag_s:g} s: "
                     "shutter_lag_s plus the 1 s of EXIF times): is the camera's clock being "
                     "set meanwhile, or another camera saving there? They are left in "
-                    f"{self.settings.folder}; no image was recorded for this light",
+                    f"{shown_path(self.settings.folder)}; no image was recorded for this light",
                     "check capture time",
                 )
 
@@ -1154,7 +1159,8 @@ class FolderWatchCamera:
                 else ": the camera's clock was set back since (a time-zone or daylight-saving "
                 "change on the camera?) or an older picture was copied into the folder. "
             )
-            + f"Not used, left in {self.settings.folder}. If the camera's clock was set "
+            + f"Not used, left in {shown_path(self.settings.folder)}"
+            ". If the camera's clock was set "
             f"back, {way_out}"
         )
 
@@ -1360,7 +1366,7 @@ class FolderWatchCamera:
         return CaptureError(
             self.name,
             f"{message}: {path.name} {why}, so waiting will not help; it is left in "
-            f"{self.settings.folder}, and no image was recorded for this light"
+            f"{shown_path(self.settings.folder)}, and no image was recorded for this light"
             + (f". {advice}" if advice else ""),
             "decode",
         )
@@ -1449,7 +1455,8 @@ class FolderWatchCamera:
                     raise CaptureError(
                         self.name,
                         f"{message}. The file is whole ({whole}), so waiting will not "
-                        f"help; it is left in {s.folder}, and no image was recorded for this "
+                        f"help; it is left in {shown_path(s.folder)}"
+                        ", and no image was recorded for this "
                         "light",
                         "decode",
                     ) from exc
@@ -1644,7 +1651,10 @@ class FolderWatchCamera:
         still in the watched folder, but a resume takes every file already there as seen (an
         older file is never a light's image): it will not use it, and shoots the light again.
         """
-        head = f"{path.name} came into {self.settings.folder} and was taken as this light's image"
+        head = (
+            f"{path.name} came into {shown_path(self.settings.folder)} and was taken as this "
+            "light's image"
+        )
         if isinstance(exc, FileNotFoundError) and not path.exists():
             return CaptureError(
                 self.name,
