@@ -37,6 +37,7 @@ from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, SessionError
 from rti_rig.core.image_files import linear_to_srgb8, read_image_any
 from rti_rig.core.shell_words import shown_path
+from rti_rig.drivers.cameras.file_colour import file_colour, file_colour_notice
 
 WHITE = 65535
 
@@ -169,6 +170,12 @@ class ReplayCamera:
             # ("copy": the user's file, never moved, wherever it lies)
             name = self._names[lit] if self._names is not None else path.name
             metadata["originals"] = [{"path": source, "name": name, "copy": True}]
+            if pixels.ndim == 3:  # what the recorded file says of its colours, as said
+                colour = file_colour(path)
+                metadata["file_colour"] = colour.as_dict()
+                said = file_colour_notice(colour, "the replayed files")
+                if said:
+                    metadata["notices"] = [said]
         return Frame(
             pixels=pixels,
             exposure_s=exposure_s,

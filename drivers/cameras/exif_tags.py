@@ -174,3 +174,38 @@ def _entry(f: io.BytesIO, layout: Layout, offset: int, tag: int) -> Entry | None
     if not count or count > 4096:
         return None
     return next((e for e in read_entries(f, layout, offset, count) if e.tag == tag), None)
+
+
+COLOR_SPACE_TAG = 0xA001
+INTEROPERABILITY_IFD_TAG = 0xA005
+INTEROPERABILITY_INDEX_TAG = 0x0001
+
+
+def jpeg_exif_colour(path: Path) -> tuple[int | None, str | None]:
+    """(the Exif ColorSpace, the InteroperabilityIndex) of a JPEG, each None where absent.
+
+    Why: a camera set to Adobe RGB writes ColorSpace 0xFFFF ("uncalibrated") and names the
+    space only by InteroperabilityIndex "R03" (Exif 2.3, 4.6.5; DCF 2.0), so both are read."""
+    exif = _exif_tiff(path)[1]
+    if not exif:
+        return None, None
+    f = io.BytesIO(exif)
+    found = read_header(f)
+    if found is None:
+        return None, None
+    layout, ifd0 = found
+    at = _entry(f, layout, ifd0, EXIF_IFD_TAG)
+    pointer = None if at is None else read_values(f, layout, at, len(exif), 1)
+    if not pointer:
+        return None, None
+    space = _entry(f, layout, pointer[0], COLOR_SPACE_TAG)
+    value = None if space is None else read_values(f, layout, space, len(exif), 1)
+    colorspace = int(value[0]) if value else None
+    interop = _entry(f, layout, pointer[0], INTEROPERABILITY_IFD_TAG)
+    where = None if interop is None else read_values(f, layout, interop, len(exif), 1)
+    if not where:
+        return colorspace, None
+    index = _entry(f, layout, where[0], INTEROPERABILITY_INDEX_TAG)
+    if index is None or index.type != 2 or not 0 < index.count <= 4:
+        return colorspace, None
+    return colorspace, index.field[: index.count].decode("ascii", "replace").rstrip("\0") or None

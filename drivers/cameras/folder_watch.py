@@ -88,6 +88,7 @@ from rti_rig.drivers.cameras.exif_tags import (
     jpeg_orientation,
     tiff_orientation,
 )
+from rti_rig.drivers.cameras.file_colour import file_colour, file_colour_notice
 from rti_rig.drivers.cameras.image_io import (
     ImageReadError,
     read_image_file,
@@ -1794,6 +1795,15 @@ class FolderWatchCamera:
             metadata = {"source_file": str(path), "bit_depth": 8 * image.dtype.itemsize}
             metadata.update(exposure_stats(pixels, white, s.decode.underexposed_level))
             notices = [alpha_note] if alpha_note else []
+            # what the file says of its colours, recorded as said (every file had been
+            # declared sRGB, an Adobe RGB JPEG or a ProPhoto TIFF too)
+            # (a grey image has no primaries to say: its TIFF says linear grey)
+            colour = file_colour(path) if pixels.ndim == 3 else None
+            if colour is not None:
+                metadata["file_colour"] = colour.as_dict()
+                said = file_colour_notice(colour)
+                if said:
+                    notices.append(said)
             suffix = path.suffix.lower()
             turned = (
                 jpeg_orientation(path)

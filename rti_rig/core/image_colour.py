@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import struct
+from collections.abc import Mapping
 from typing import Any, Literal
 
 #: the sRGB primaries adapted to D50 (Bradford), in the s15Fixed16 values the ICC's and
@@ -223,3 +224,41 @@ LINEAR_COLOUR_WORDS: dict[str, str] = {
     "mosaic": "CFA mosaic, linear, one colour per pixel, said in the ImageDescription, with no "
     "ICC profile",
 }
+
+
+def file_colour_kind(file_colour: Mapping[str, str] | None) -> Literal["srgb", "assumed", "other"]:
+    """How a non-RAW image's colours stand by what its file said (``file_colour``: the
+    ``space``, ``name`` and ``said_by`` its camera driver read; absent for a camera that writes
+    no file, whose frames are linear sRGB by construction): ``"srgb"`` said so, ``"assumed"``
+    the file said nothing (taken as sRGB, and said to be assumed), ``"other"`` another space,
+    kept as it is (never declared sRGB)."""
+    space = (file_colour or {}).get("space")
+    if space in (None, "srgb"):
+        return "srgb"
+    return "assumed" if space == "untagged" else "other"
+
+
+#: the words for a file that said nothing, of the JPEGs and of the linear TIFFs
+ASSUMED_JPEG_WORDS = (
+    "assumed sRGB (the file does not say): tagged sRGB (Exif ColorSpace 1 and an sRGB ICC "
+    "profile) as read"
+)
+ASSUMED_LINEAR_WORDS = (
+    f"{LINEAR_SRGB}, assumed sRGB (the file does not say), said in the ImageDescription and "
+    "tagged with a linear-sRGB ICC profile"
+)
+
+
+def other_space_words(file_colour: Mapping[str, str]) -> tuple[str, str, str]:
+    """(the JPEGs' words, the linear TIFFs' words, the TIFF's ImageDescription head) for
+    images whose file said another space than sRGB: its primaries kept, not converted, and
+    no sRGB tag anywhere."""
+    name = file_colour.get("name", "another space")
+    said = file_colour.get("said_by", "")
+    source = f"the source file is {name}, said by {said}; not converted"
+    return (
+        f"{name} primaries through the sRGB curve, NOT sRGB (untagged: {source})",
+        f"linear {name} primaries, NOT sRGB ({source}), said in the ImageDescription, with "
+        "no ICC profile",
+        f"linear {name} primaries, NOT sRGB ({source})",
+    )

@@ -59,13 +59,17 @@ from rti_rig.core.devices import Frame
 from rti_rig.core.errors import SessionError
 from rti_rig.core.fit_minimums import PLAN_DEFAULT_LIGHTS
 from rti_rig.core.image_colour import (
+    ASSUMED_JPEG_WORDS,
+    ASSUMED_LINEAR_WORDS,
     JPEG_COLOUR_WORDS,
     LINEAR_CAMERA_RGB,
     LINEAR_COLOUR_WORDS,
     LINEAR_GREY,
     LINEAR_SRGB,
     decode_colour,
+    file_colour_kind,
     icc_profile,
+    other_space_words,
 )
 from rti_rig.core.image_files import (
     MOSAIC_TIFF_LABEL,
@@ -134,6 +138,10 @@ class StepRecord:
     #: per channel, white balance, colour, orientation, source file); empty for non-RAW cameras
     decode: dict[str, Any] = field(default_factory=dict)
     notices: list[str] = field(default_factory=list)
+    #: what a non-RAW camera file said of its colour space (``space``, ``name``, ``said_by``:
+    #: :mod:`~rti_rig.drivers.cameras.file_colour`); empty for a RAW, a camera that writes no
+    #: file, and sessions written before 2026-12-02 (all then declared sRGB)
+    file_colour: dict[str, str] = field(default_factory=dict)
     #: an adaptive session's decision for this step and its evidence (None: a fixed schedule)
     decision: dict[str, Any] | None = None
     #: each time the step's light was switched off while a busy camera was awaited past the
@@ -1016,6 +1024,8 @@ class SessionFolder:
             current = self.root / tif
             description, icc = linear_tiff_labels(decode, frame)
             colour = decode_colour(decode)
+            if not decode and file_colour_kind(_file_colour(frame)) == "other":
+                colour = "camera"  # another space's primaries: never tagged sRGB
             jpeg_writer = write_srgb_jpeg if colour == "srgb" else write_untagged_jpeg
             # the pixels' checksum is taken while the files are encoded and written (hashing
             # releases the GIL): about 0.4 s of CPU for a 24 MP frame, overlapped, not added
@@ -1052,6 +1062,7 @@ class SessionFolder:
             },
             decode=decode,
             notices=[str(n) for n in frame.metadata.get("notices") or []],
+            file_colour=_file_colour(frame),
             strays=strays,
             **record_fields,
         )
@@ -1289,15 +1300,25 @@ def image_colour(records: list[StepRecord], root: Path | None = None) -> dict[st
     (the manifest had called them linear sRGB, tagged, while the file said linear grey)."""
     jpeg: dict[str, list[str]] = {}
     linear: dict[str, list[str]] = {}
+    jpeg_words, linear_words = dict(JPEG_COLOUR_WORDS), dict(LINEAR_COLOUR_WORDS)
     for r in records:
         colour = decode_colour(r.decode)
+        if colour == "srgb" and not r.decode:
+            # what the camera's file said: sRGB, nothing (assumed), or another space
+            kind = file_colour_kind(r.file_colour)
+            if kind == "assumed":
+                colour = "assumed"
+                jpeg_words[colour], linear_words[colour] = ASSUMED_JPEG_WORDS, ASSUMED_LINEAR_WORDS
+            elif kind == "other":
+                colour = f"other: {r.file_colour.get('name')} ({r.file_colour.get('said_by')})"
+                jpeg_words[colour], linear_words[colour], _ = other_space_words(r.file_colour)
         jpeg.setdefault(colour, []).append(Path(r.image).stem)
         if colour == "srgb" and not r.decode and root is not None and _grey_tiff(root, r):
             colour = "grey"
         linear.setdefault(colour, []).append(Path(r.image).stem)
     return {
-        "jpeg": _colour_words(JPEG_COLOUR_WORDS, jpeg),
-        "linear": _colour_words(LINEAR_COLOUR_WORDS, linear),
+        "jpeg": _colour_words(jpeg_words, jpeg),
+        "linear": _colour_words(linear_words, linear),
     }
 
 
@@ -1633,7 +1654,27 @@ def linear_tiff_labels(decode: dict[str, Any], frame: Frame) -> tuple[str, bytes
     writer's rule)."""
     description = _tiff_description(decode, frame.white_level, grey=frame.pixels.ndim == 2)
     icc = icc_profile("linear") if decode_colour(decode) == "srgb" else None
+    if not decode and frame.pixels.ndim == 3:
+        # a camera file's own word on its colours: assumed sRGB said so, another space
+        # said and left untagged (it had been declared, and tagged, linear sRGB)
+        said = _file_colour(frame)
+        kind = file_colour_kind(said)
+        white = f", white level {frame.white_level}" if frame.white_level else ""
+        if kind == "assumed":
+            description = (
+                f"rti-rig: {LINEAR_SRGB}, assumed sRGB (the file does not say), 16-bit{white} "
+                "(the camera's own, not a RAW's)"
+            )
+        elif kind == "other":
+            description = f"rti-rig: {other_space_words(said)[2]}, 16-bit{white}"
+            icc = None
     return description, icc
+
+
+def _file_colour(frame: Frame) -> dict[str, str]:
+    """What the frame's camera file said of its colour space (empty: nothing recorded)."""
+    said = frame.metadata.get("file_colour") or {}
+    return {str(k): str(v) for k, v in said.items()} if isinstance(said, dict) else {}
 
 
 def _tiff_description(

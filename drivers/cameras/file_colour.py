@@ -1,0 +1,182 @@
+"""What an image file says of its colour space: an embedded ICC profile's description, else
+the Exif ColorSpace (with the Interoperability index that names Adobe RGB), else nothing.
+
+Why: every JPEG or TIFF not from a RAW was declared sRGB, and a session's linear TIFFs were
+tagged with an sRGB profile and the manifest said "linear sRGB", of an Adobe RGB JPEG or a
+ProPhoto TIFF (Lightroom's default export) too. Read here, the session says what the file
+said, or that the file says nothing and sRGB was assumed.
+
+Sources: ICC.1:2001-04 (v2) and ICC.1:2010 (v4), 7.2 header (128 bytes) and 7.3 tag table,
+10.5 ``desc`` (textDescriptionType: count then ASCII) and v4 10.13 ``mluc`` (records of
+UTF-16BE); ICC.1:2010 Annex B.4 (a JPEG's APP2 ``ICC_PROFILE\\0``, sequence number and count,
+then the chunk); Exif 2.3 (CIPA DC-008-2012) 4.6.5: ColorSpace tag 0xA001, 1 = sRGB, 0xFFFF =
+uncalibrated; Interoperability IFD pointer 0xA005, InteroperabilityIndex tag 0x0001, "R98" =
+sRGB (DCF basic), "R03" = Adobe RGB (DCF 2.0 option file, CIPA DC-009-2010); TIFF tag 34675
+InterColorProfile (TIFF/EP, ISO 12234-2).
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Literal
+
+from rti_rig.drivers.cameras.exif_tags import HEAD_BYTES, jpeg_exif_colour
+
+Space = Literal["srgb", "adobe_rgb", "prophoto", "display_p3", "other", "untagged"]
+
+#: the names the session gives the known spaces (their published names)
+SPACE_NAMES: dict[str, str] = {
+    "srgb": "sRGB",
+    "adobe_rgb": "Adobe RGB (1998)",
+    "prophoto": "ProPhoto RGB (ROMM RGB)",
+    "display_p3": "Display P3",
+}
+EXIF_SRGB = 1
+EXIF_UNCALIBRATED = 0xFFFF
+
+
+@dataclass(frozen=True)
+class FileColour:
+    """``space``: which one; ``name``: its name (an unknown profile's own description);
+    ``said_by``: where the file says it ("" when it says nothing)."""
+
+    space: Space
+    name: str
+    said_by: str
+
+    def as_dict(self) -> dict[str, str]:
+        return asdict(self)
+
+
+UNTAGGED = FileColour("untagged", "sRGB", "")
+
+
+def file_colour(path: Path) -> FileColour:
+    """What ``path`` (a JPEG or a TIFF; any other file, or one that will not parse, is
+    untagged) says of its colour space. An ICC profile is what colour-managed software obeys,
+    so it wins over the Exif ColorSpace."""
+    suffix = path.suffix.lower()
+    try:
+        if suffix in (".tif", ".tiff"):
+            icc, colorspace, interop = _tiff_tags(path)
+        elif suffix in (".jpg", ".jpeg", ".jpe"):
+            with path.open("rb") as f:
+                icc = jpeg_icc_profile(f.read(HEAD_BYTES))
+            colorspace, interop = jpeg_exif_colour(path)
+        else:
+            return UNTAGGED
+    except (OSError, ValueError, struct.error):
+        return UNTAGGED
+    if icc:
+        description = icc_description(icc)
+        if description:
+            space = space_of_description(description)
+            name = SPACE_NAMES.get(space, description)
+            return FileColour(space, name, f"its ICC profile {description!r}")
+    if colorspace == EXIF_SRGB:
+        return FileColour("srgb", "sRGB", "its Exif ColorSpace 1 (sRGB)")
+    if colorspace == EXIF_UNCALIBRATED and interop == "R03":
+        return FileColour(
+            "adobe_rgb",
+            SPACE_NAMES["adobe_rgb"],
+            "its Exif ColorSpace 0xFFFF with InteroperabilityIndex R03 (DCF Adobe RGB)",
+        )
+    if colorspace == EXIF_UNCALIBRATED:
+        return FileColour(
+            "other",
+            "an uncalibrated space (not sRGB, not named)",
+            "its Exif ColorSpace 0xFFFF (uncalibrated)",
+        )
+    return UNTAGGED
+
+
+def space_of_description(description: str) -> Space:
+    """The known space an ICC profile's description names ("other" for none)."""
+    d = "".join(description.lower().split())
+    if "srgb" in d:
+        return "srgb"
+    if "adobergb" in d:
+        return "adobe_rgb"
+    if "prophoto" in d or "romm" in d:
+        return "prophoto"
+    if "displayp3" in d:
+        return "display_p3"
+    return "other"
+
+
+def icc_description(icc: bytes) -> str | None:
+    """The profile description (tag ``desc``) of an ICC profile, v2 or v4; None if absent."""
+    if len(icc) < 132:
+        return None
+    (count,) = struct.unpack_from(">I", icc, 128)
+    for i in range(min(count, 256)):
+        sig, offset, size = struct.unpack_from(">4sII", icc, 132 + 12 * i)
+        if sig != b"desc":
+            continue
+        body = icc[offset : offset + size]
+        if body[:4] == b"desc":
+            (n,) = struct.unpack_from(">I", body, 8)
+            return body[12 : 12 + n].split(b"\0")[0].decode("latin-1").strip() or None
+        if body[:4] == b"mluc":
+            records, record_size = struct.unpack_from(">II", body, 8)
+            if records and record_size >= 12:
+                length, at = struct.unpack_from(">II", body, 20)
+                return body[at : at + length].decode("utf-16-be", "replace").strip() or None
+        return None
+    return None
+
+
+def jpeg_icc_profile(head: bytes) -> bytes | None:
+    """The ICC profile of a JPEG's APP2 ``ICC_PROFILE`` chunks, joined in sequence order;
+    None for none (or when its header segments run past ``head``)."""
+    chunks: dict[int, bytes] = {}
+    pos = 2
+    if head[:2] != b"\xff\xd8":
+        return None
+    while pos + 4 <= len(head) and head[pos] == 0xFF and head[pos + 1] not in (0xDA, 0xD9):
+        length = int.from_bytes(head[pos + 2 : pos + 4], "big")
+        body = head[pos + 4 : pos + 2 + length]
+        if head[pos + 1] == 0xE2 and body.startswith(b"ICC_PROFILE\0") and len(body) > 14:
+            chunks[body[12]] = body[14:]
+        pos += 2 + length
+    return b"".join(chunks[k] for k in sorted(chunks)) or None
+
+
+def _tiff_tags(path: Path) -> tuple[bytes | None, int | None, str | None]:
+    """(InterColorProfile, Exif ColorSpace, InteroperabilityIndex) of a TIFF's first page."""
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(path) as tif:
+            tags = tif.pages[0].tags
+            icc_tag = tags.get(34675)
+            exif_tag = tags.get(34665)
+            icc = bytes(icc_tag.value) if icc_tag is not None else None
+            exif = exif_tag.value if exif_tag is not None else {}
+    except tifffile.TiffFileError as exc:
+        raise ValueError(str(exc)) from exc
+    exif = exif if isinstance(exif, dict) else {}
+    interop = exif.get("InteroperabilityTag")
+    index = interop.get("InteroperabilityIndex") if isinstance(interop, dict) else None
+    colorspace = exif.get("ColorSpace")
+    return icc, int(colorspace) if colorspace is not None else None, index
+
+
+def file_colour_notice(colour: FileColour, whose: str = "the camera's files") -> str | None:
+    """The session notice for a file that is not said to be sRGB (None for sRGB): what was
+    assumed, or that the colours are another space's, recorded as such and not converted."""
+    if colour.space == "srgb":
+        return None
+    if colour.space == "untagged":
+        return (
+            f"{whose} say no colour space (no ICC profile, no Exif ColorSpace): "
+            "assumed sRGB (the file does not say); the manifest's image_colour says so"
+        )
+    return (
+        f"{whose} are {colour.name} (said by {colour.said_by}), not sRGB: rti-rig "
+        "does not convert them, so the session's images keep that space's primaries, read "
+        "through the sRGB curve (8-bit) or as linear (16-bit), and carry no sRGB tag; the "
+        "manifest's image_colour says so. For sRGB images, export or shoot sRGB"
+    )

@@ -1,0 +1,80 @@
+"""Tiny image files that say their colour space, the bytes written here from the published
+layouts (for the file-colour tests of the driver and of the CLI).
+
+Sources: ICC.1:2001-04 (v2), 6.1 header (128 bytes: size, CMM, version, class ``mntr``,
+colour space ``RGB ``, PCS ``XYZ ``, date, ``acsp``...), 6.2 tag table (count, then signature,
+offset, size), 6.5.17 textDescriptionType (``desc``, reserved, ASCII count, ASCII with its
+NUL, Unicode code and count, ScriptCode code, count and 67 bytes); ICC.1:2010 (v4) 10.13
+multiLocalizedUnicodeType (``mluc``, reserved, record count, record size 12, then language,
+country, length and offset of UTF-16BE text); ICC.1:2010 Annex B.4 (JPEG APP2: ``ICC_PROFILE``
+NUL, chunk number, chunk count, data); Exif 2.3 (CIPA DC-008-2012) 4.6.5 and 4.6.3: Exif IFD
+pointer 0x8769, ColorSpace 0xA001 (SHORT; 1 sRGB, 0xFFFF uncalibrated), Interoperability IFD
+pointer 0xA005, InteroperabilityIndex 0x0001 (ASCII count 4; "R03" Adobe RGB, DCF 2.0).
+"""
+
+from __future__ import annotations
+
+import struct
+
+import cv2
+import numpy as np
+
+
+def icc_profile(description: str, version4: bool = False) -> bytes:
+    """An RGB display profile holding only its description tag (enough for a reader of the
+    description; no colour-managed viewer is asked to use it)."""
+    if version4:
+        text = description.encode("utf-16-be")
+        body = (
+            b"mluc\0\0\0\0"
+            + struct.pack(">II", 1, 12)
+            + b"enUS"
+            + struct.pack(">II", len(text), 28)
+        )
+        body += text
+    else:
+        a = description.encode("ascii") + b"\0"
+        body = b"desc\0\0\0\0" + struct.pack(">I", len(a)) + a + b"\0" * 8 + b"\0\0\0" + b"\0" * 67
+    body += b"\0" * (-len(body) % 4)
+    table = struct.pack(">I", 1) + struct.pack(">4sII", b"desc", 128 + 16, len(body))
+    size = 128 + len(table) + len(body)
+    header = (
+        struct.pack(">I", size)
+        + b"\0\0\0\0"
+        + (bytes((4, 0x20, 0, 0)) if version4 else bytes((2, 0x10, 0, 0)))
+        + b"mntrRGB XYZ "
+        + b"\0" * 12
+        + b"acsp"
+        + b"\0" * 88
+    )
+    assert len(header) == 128
+    return header + table + body
+
+
+def exif_colour(colorspace: int, interop: bytes | None = None) -> bytes:
+    """An APP1 Exif body (big-endian TIFF): IFD0 -> Exif IFD (ColorSpace, and with ``interop``
+    a pointer to an Interoperability IFD holding that InteroperabilityIndex)."""
+    tiff = b"MM\0*" + struct.pack(">I", 8)
+    tiff += struct.pack(">H", 1) + struct.pack(">HHII", 0x8769, 4, 1, 26) + b"\0\0\0\0"
+    n = 2 if interop else 1
+    tiff += struct.pack(">H", n) + struct.pack(">HHIHH", 0xA001, 3, 1, colorspace, 0)
+    if interop:
+        tiff += struct.pack(">HHII", 0xA005, 4, 1, 26 + 2 + 12 * n + 4)
+    tiff += b"\0\0\0\0"
+    if interop:
+        tiff += struct.pack(">H", 1) + struct.pack(">HHI4s", 0x0001, 2, 4, interop) + b"\0\0\0\0"
+    return b"Exif\0\0" + tiff
+
+
+def jpeg(level: int = 120, exif: bytes | None = None, icc: bytes | None = None) -> bytes:
+    """A 16x16 grey-level colour JPEG with the segments given after its SOI."""
+    ok, encoded = cv2.imencode(".jpg", np.full((16, 16, 3), level, np.uint8))
+    assert ok
+    data = encoded.tobytes()
+    segments = b""
+    if exif is not None:
+        segments += b"\xff\xe1" + struct.pack(">H", len(exif) + 2) + exif
+    if icc is not None:
+        app2 = b"ICC_PROFILE\0" + bytes((1, 1)) + icc
+        segments += b"\xff\xe2" + struct.pack(">H", len(app2) + 2) + app2
+    return data[:2] + segments + data[2:]
