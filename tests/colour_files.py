@@ -15,6 +15,7 @@ pointer 0xA005, InteroperabilityIndex 0x0001 (ASCII count 4; "R03" Adobe RGB, DC
 from __future__ import annotations
 
 import struct
+import zlib
 
 import cv2
 import numpy as np
@@ -78,3 +79,22 @@ def jpeg(level: int = 120, exif: bytes | None = None, icc: bytes | None = None) 
         app2 = b"ICC_PROFILE\0" + bytes((1, 1)) + icc
         segments += b"\xff\xe2" + struct.pack(">H", len(app2) + 2) + app2
     return data[:2] + segments + data[2:]
+
+
+def png(srgb: bool = False, icc: bytes | None = None) -> bytes:
+    """A 16x16 colour PNG with an ``sRGB`` chunk and/or an ``iCCP`` chunk after its IHDR
+    (ISO/IEC 15948, 5.3 chunk layout: length, type, data, CRC-32 of type and data; 11.3.3.3
+    iCCP: profile name, NUL, compression method 0, zlib stream; 11.3.3.5 sRGB: one byte)."""
+    ok, encoded = cv2.imencode(".png", np.full((16, 16, 3), 120, np.uint8))
+    assert ok
+    data = encoded.tobytes()
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return (
+            struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+        )
+
+    extra = chunk(b"sRGB", b"\0") if srgb else b""
+    if icc is not None:
+        extra += chunk(b"iCCP", b"profile\0\0" + zlib.compress(icc))
+    return data[:33] + extra + data[33:]  # after the signature (8) and IHDR (25)

@@ -18,6 +18,7 @@ InterColorProfile (TIFF/EP, ISO 12234-2).
 from __future__ import annotations
 
 import struct
+import zlib
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Literal
@@ -35,6 +36,8 @@ SPACE_NAMES: dict[str, str] = {
 }
 EXIF_SRGB = 1
 EXIF_UNCALIBRATED = 0xFFFF
+#: what :func:`_png_colour` gives for a PNG's ``sRGB`` chunk (no Exif value: a marker only)
+PNG_SRGB_CHUNK = -1
 
 
 @dataclass(frozen=True)
@@ -65,10 +68,15 @@ def file_colour(path: Path) -> FileColour:
             with path.open("rb") as f:
                 icc = jpeg_icc_profile(f.read(HEAD_BYTES))
             colorspace, interop = jpeg_exif_colour(path)
+        elif suffix == ".png":
+            with path.open("rb") as f:
+                icc, colorspace, interop = *_png_colour(f.read(HEAD_BYTES)), None
         else:
             return UNTAGGED
-    except (OSError, ValueError, struct.error):
+    except (OSError, ValueError, struct.error, zlib.error):
         return UNTAGGED
+    if colorspace == PNG_SRGB_CHUNK and not icc:
+        return FileColour("srgb", "sRGB", "its PNG sRGB chunk")
     if icc:
         description = icc_description(icc)
         if description:
@@ -142,6 +150,27 @@ def jpeg_icc_profile(head: bytes) -> bytes | None:
             chunks[body[12]] = body[14:]
         pos += 2 + length
     return b"".join(chunks[k] for k in sorted(chunks)) or None
+
+
+def _png_colour(head: bytes) -> tuple[bytes | None, int | None]:
+    """(the ICC profile of a PNG's ``iCCP`` chunk, :data:`PNG_SRGB_CHUNK` for an ``sRGB``
+    chunk) from the chunks before its image data (PNG, ISO/IEC 15948, 11.3.3.3 iCCP: a name,
+    NUL, compression 0, zlib data; 11.3.3.5 sRGB)."""
+    if head[:8] != b"\x89PNG\r\n\x1a\n":
+        return None, None
+    icc, srgb, pos = None, None, 8
+    while pos + 8 <= len(head):
+        length, kind = struct.unpack_from(">I4s", head, pos)
+        data = head[pos + 8 : pos + 8 + length]
+        if kind == b"IDAT" or kind == b"IEND":
+            break
+        if kind == b"sRGB":
+            srgb = PNG_SRGB_CHUNK
+        elif kind == b"iCCP":
+            name_end = data.index(b"\0")
+            icc = zlib.decompress(data[name_end + 2 :])
+        pos += 12 + length
+    return icc, srgb
 
 
 def _tiff_tags(path: Path) -> tuple[bytes | None, int | None, str | None]:

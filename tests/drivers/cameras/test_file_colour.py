@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from colour_files import exif_colour, icc_profile, jpeg
+from colour_files import exif_colour, icc_profile, jpeg, png
 
 from rti_rig.drivers.cameras.file_colour import file_colour
 
@@ -53,3 +53,18 @@ def test_a_tiff_says_its_space_by_its_icc_profile(tmp_path: Path) -> None:
     found = file_colour(tagged)
     assert (found.space, found.name) == ("prophoto", "ProPhoto RGB (ROMM RGB)")
     assert file_colour(bare).space == "untagged"
+
+
+@pytest.mark.parametrize(
+    ("data", "space"),
+    [
+        (png(srgb=True), "srgb"),
+        (png(icc=icc_profile("Adobe RGB (1998)")), "adobe_rgb"),
+        (png(), "untagged"),
+    ],
+)
+def test_a_png_says_its_space(tmp_path: Path, data: bytes, space: str) -> None:
+    """A PNG's sRGB chunk or iCCP profile is read too (a watched folder takes PNGs)."""
+    path = tmp_path / "shot.png"
+    path.write_bytes(data)
+    assert file_colour(path).space == space
