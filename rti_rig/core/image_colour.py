@@ -252,13 +252,18 @@ ASSUMED_LINEAR_WORDS = (
 def other_space_words(file_colour: Mapping[str, str]) -> tuple[str, str, str]:
     """(the JPEGs' words, the linear TIFFs' words, the TIFF's ImageDescription head) for
     images whose file said another space than sRGB: its primaries kept, not converted, and
-    no sRGB tag anywhere."""
+    no sRGB tag anywhere. Nor are they said to be linear in that space: an 8-bit file's
+    values are undone by the sRGB curve and a 16-bit one's taken as stored, not by that
+    space's own curve (Adobe RGB's gamma 563/256, ProPhoto's 1.8)."""
     name = file_colour.get("name", "another space")
     said = file_colour.get("said_by", "")
     source = f"the source file is {name}, said by {said}; not converted"
+    pixels = (
+        f"{name} primaries, NOT sRGB, made linear as if sRGB-encoded (8-bit) or taken as "
+        f"linear as stored (16-bit), not by that space's own curve ({source})"
+    )
     return (
         f"{name} primaries through the sRGB curve, NOT sRGB (untagged: {source})",
-        f"linear {name} primaries, NOT sRGB ({source}), said in the ImageDescription, with "
-        "no ICC profile",
-        f"linear {name} primaries, NOT sRGB ({source})",
+        f"{pixels}, said in the ImageDescription, with no ICC profile",
+        pixels,
     )

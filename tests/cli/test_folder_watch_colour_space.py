@@ -56,12 +56,12 @@ def test_adobe_rgb_and_untagged_jpegs_are_said_as_they_are(tmp_path, monkeypatch
         json.loads((out / "manifest.json").read_text())["steps"], key=lambda s: s["index"]
     )
     adobe, bare = Path(first["image"]).stem, Path(second["image"]).stem
-    assert "linear Adobe RGB (1998) primaries, NOT sRGB" in colour["linear"], colour
+    assert "Adobe RGB (1998) primaries, NOT sRGB" in colour["linear"], colour
     assert "assumed sRGB (the file does not say)" in colour["linear"], colour
     assert colour["linear"].index(adobe) > colour["linear"].index("Adobe RGB"), colour
     assert "Adobe RGB (1998) primaries through the sRGB curve, NOT sRGB" in colour["jpeg"]
     icc, description = _linear(out, adobe)
-    assert icc is None and "linear Adobe RGB (1998) primaries, NOT sRGB" in description
+    assert icc is None and "Adobe RGB (1998) primaries, NOT sRGB" in description
     assert "InteroperabilityIndex R03" in description, description
     icc, description = _linear(out, bare)
     assert icc is not None and "assumed sRGB (the file does not say)" in description
@@ -83,7 +83,7 @@ def test_a_prophoto_16_bit_tiff_is_not_declared_srgb(tmp_path, monkeypatch):
     r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, files, out)
     assert r.exit_code == 0 and "Traceback" not in said and not lit_at_end, said
     colour = json.loads((out / "manifest.json").read_text())["image_colour"]
-    assert colour["linear"].startswith("linear ProPhoto RGB (ROMM RGB) primaries, NOT sRGB")
+    assert colour["linear"].startswith("ProPhoto RGB (ROMM RGB) primaries, NOT sRGB")
     assert "linear sRGB" not in colour["linear"], colour
     step = json.loads((out / "manifest.json").read_text())["steps"][0]
     icc, description = _linear(out, Path(step["image"]).stem)
