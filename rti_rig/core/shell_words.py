@@ -29,9 +29,10 @@ def shown_path(path: object) -> str:
 def shell_word(path: object) -> str:
     """``path`` as one shell word naming it, for a command the user is told to run: quoted
     where it holds a space or a shell's special character (``shlex.quote``), and as ``$'...'``
-    (bash, zsh, ksh, BusyBox and POSIX.1-2024 sh) where stdout or stderr cannot print it, each
-    byte of the name outside printable ASCII written ``\\xHH``: the bytes the file system holds,
-    whatever the terminal's encoding, so the word pasted back names the same folder.
+    (bash, zsh, ksh, BusyBox and POSIX.1-2024 sh) where it holds a control character or stdout
+    or stderr cannot print it, each byte of the name outside printable ASCII written
+    ``\\xHH``: the bytes the file system holds, whatever the terminal's encoding, so the word
+    pasted back names the same folder.
 
     Only for text shown to a user: a real subprocess gets its arguments as a list, unquoted."""
     text = str(path)
@@ -41,7 +42,17 @@ def shell_word(path: object) -> str:
 
 
 def _printable_as_is(text: str) -> bool:
-    """Whether both standard streams' encodings hold every character of ``text``."""
+    """Whether ``text`` can be shown as it is: every character printable (no control
+    character, DEL, C1 code or invisible format character) and held by both standard
+    streams' encodings.
+
+    Why printable too: a tab or newline in a name pasted back is not the name (the shell
+    splits the word or the line), ``\x01`` shows as nothing or ``^A``, and an escape
+    sequence in a file name printed raw is executed by the terminal (recolouring, moving
+    the cursor, retitling the window) instead of being shown; ``$'...'`` says each such
+    byte as ``\\xHH``, which the shell reads back as the bytes on disk."""
+    if not text.isprintable():
+        return False
     for stream in (sys.stdout, sys.stderr):
         try:
             text.encode(getattr(stream, "encoding", None) or "utf-8")
