@@ -134,9 +134,9 @@ class OptimalMethod:
             label, chosen = ctx.starts[0]
             report.start_layout, report.swaps = label, 0
             report.expected[label] = objective.cost(chosen)
+            report.kept_layout_why = f"{n} lights leave no redundancy for a shadow or a highlight"
             report.notes.append(
-                f"{n} lights leave no redundancy for a shadow or a highlight: the homogeneous "
-                f"layout ({label}) is kept"
+                f"{report.kept_layout_why}: the homogeneous layout ({label}) is kept"
             )
             return chosen
         search = binned_objective(objective)
@@ -148,13 +148,26 @@ class OptimalMethod:
         report.expected.update(res.start_costs)
         report.expected["optimal"] = res.cost
         if n >= MANY_LIGHTS and ctx.objective == "normals" and res.swaps > 0:
-            glossy = "" if ctx.material == "glossy" else "; for gilding, --material glossy helped"
-            report.notes.append(
-                f"from {MANY_LIGHTS} lights the planner gained little over an even layout in "
-                "the tests (docs/research/planner.md): for brushed metal at 20 lights or more, "
-                f"--method uniform --min-elevation-deg 10 did better{glossy}"
-            )
+            report.notes.append(_even_layout_note(ctx))
         return res.chosen
+
+
+def _even_layout_note(ctx: MethodContext) -> str:
+    """The note that an even layout did better in the tests, offering only what the user did
+    not choose: the 10° floor where no ``--min-elevation-deg`` was typed, ``--material glossy``
+    where another material was, and the even layout as a whole command (``ctx.uniform_said``)
+    where the caller gave one.
+
+    Why: "--method uniform --min-elevation-deg 10 did better" was said to a user who had set
+    ``--min-elevation-deg 55``, as options to splice into a command rather than one to paste."""
+    layout = "an even layout" if ctx.min_elevation_given else "an even layout from a 10° floor"
+    said = f" ({ctx.uniform_said})" if ctx.uniform_said else ""
+    glossy = "" if ctx.material == "glossy" else "; for gilding, --material glossy helped"
+    return (
+        f"from {MANY_LIGHTS} lights the planner gained little over an even layout in "
+        "the tests (docs/research/planner.md): for brushed metal at 20 lights or more, "
+        f"{layout} did better{said}{glossy}"
+    )
 
 
 UNIFORM = register_method(UniformMethod())

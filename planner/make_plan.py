@@ -219,6 +219,9 @@ class PlanRequest:
     #: printed had been refused as no rig file, or made a folder named P
     rig_said: str = "RIG.toml"
     preview_folder_said: str = "preview"
+    #: the ``rti-rig plan`` command for an even layout of this rig (the caller's words, as
+    #: ``rig_said``), for the note that offers one
+    uniform_said: str = ""
 
     def check(self) -> PlanMethod:
         """Refuse what cannot be planned, before any work; returns the method to plan with."""
@@ -391,6 +394,8 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
         req.objective,
         req.max_elevation_deg,
         cut,
+        req.min_elevation_given,
+        req.uniform_said,
     )
     chosen = method.prepare(ctx)
     if surface is not None:

@@ -54,6 +54,11 @@ class MethodContext:
     #: The elevation ceiling, and whether it cuts the rig's range above the floor.
     max_elevation_deg: float
     ceiling_cuts: bool
+    #: whether ``--min-elevation-deg`` was typed, and the whole ``rti-rig plan`` command for
+    #: an even layout of this rig (shell words, a free ``--out``; no floor where one was
+    #: typed): advice offers only what the user did not choose, as a command that pastes
+    min_elevation_given: bool = False
+    uniform_said: str = ""
 
 
 class PlanMethod(Protocol):

@@ -44,6 +44,9 @@ class PlanReport:
     expected_meaning: str | None = None
     start_layout: str | None = None
     swaps: int | None = None
+    #: why the method kept its start layout without searching (``optimal`` at 3 lights), for
+    #: the plan's one-line summary to say what was done instead of "(optimal, normals)"
+    kept_layout_why: str | None = None
     #: pixel rows the objective scores and the rows the exchange search swept, when it swept a
     #: binned stand-in (:mod:`rti_rig.planner.pixel_bins`)
     search_pixels: tuple[int, int] | None = None

@@ -245,7 +245,7 @@ def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:
     for line in planned.report.lines():
         out.print(line, highlight=False, markup=False)
     out.print(  # the path as it is: a folder named "coin [draft]" is no markup
-        f"Planned {len(planned.schedule)} lights ({planned.method}, {planned.objective}) → "
+        f"Planned {len(planned.schedule)} lights ({_how_planned(planned)}) → "
         f"{shown_path(request.out_file)}",
         markup=False,
         highlight=False,
@@ -258,6 +258,19 @@ def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:
             raise fail(exc) from None
         done["drawn"] = True
         out.print(f"Map of the plan → {escape(shown_path(request.figure))}")
+
+
+def _how_planned(planned: Any) -> str:
+    """The method and objective as the summary says them, or, where the method kept its start
+    layout unsearched, that layout and why.
+
+    Why: ``--method optimal --lights 3`` keeps the uniform layout (three lights leave no
+    redundancy to trade), and the summary said "(optimal, normals)" as if it had searched."""
+    report = planned.report
+    why, layout = report.kept_layout_why, report.start_layout
+    if why is None or layout is None:
+        return f"{planned.method}, {planned.objective}"
+    return f"the {layout} layout, not optimised: {why}"
 
 
 def _stopped(why: str, request: PlanLightsRequest, before: Stamp, done: dict[str, Any]) -> str:

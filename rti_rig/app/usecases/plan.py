@@ -253,6 +253,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             arm_order=arm_order,
             rig_said=_config_shown(req.rig),
             preview_folder_said=_run_folder(req.out_file, "preview"),
+            uniform_said=_uniform_command(req),
         )
     )
     # every planner picks among the rig's lights in the band: where those cannot determine a
@@ -420,6 +421,24 @@ def _run_folder(plan_file: Path, name: str = "planned") -> str:
     """A folder for a ``run`` that a ``plan`` message offers, as a shell word: ``name`` beside
     the plan file, ``-2``… added if taken (``--out DIR`` pasted had made DIR)."""
     return shell_word(str(free_name(Path(plan_file).parent / name, folder=True)))
+
+
+def _uniform_command(req: PlanLightsRequest) -> str:
+    """The ``rti-rig plan`` command for an even layout of ``req``'s rig and count, as the
+    note on many optimised lights offers it: the band typed kept (a 10° floor only where none
+    was typed), and a free ``.lp`` beside the plan.
+
+    Why: the note said "--method uniform --min-elevation-deg 10 did better" even to a user
+    who had set ``--min-elevation-deg 55``, and as options, not a command to paste."""
+    floor = req.min_elevation_deg if req.min_elevation_given else 10.0
+    floor_said = f" --min-elevation-deg {floor:g}"
+    ceiling = f" --max-elevation-deg {req.max_elevation_deg:g}" if req.max_elevation_given else ""
+    out_file = Path(req.out_file)
+    even = free_name(out_file.with_name(f"{out_file.stem}-uniform{out_file.suffix or '.lp'}"))
+    return (
+        f"rti-rig plan --rig {shell_word(str(req.rig))} --lights {req.lights} --method uniform"
+        f"{floor_said}{ceiling} --out {shell_word(str(even))}"
+    )
 
 
 def run_plan_command(rig: Path, plan_file: Path) -> str:
