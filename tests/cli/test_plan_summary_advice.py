@@ -11,10 +11,10 @@ import shlex
 from pathlib import Path
 
 import pytest
+from conftest import CONFIGS
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from tests.conftest import CONFIGS
 
 DOME = CONFIGS / "simulated_dome.toml"
 
