@@ -232,6 +232,9 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             if differs is not None:
                 notes.append(differs)
         image = read_preview_image(source.image)
+        turned = preview_orientation_note(source.image)
+        if turned is not None:
+            notes.append(turned)
         # its alpha or transparency key dropped, said as run and fit say it of an acquisition
         notes.extend(png_alpha_note([source.image.name], [source.image]))
     schedule, report = plan(
@@ -289,6 +292,36 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     if (misnamed := lp_name_note(Path(req.out_file), run_reads_it=True)) is not None:
         notes.append(misnamed)
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
+
+
+def preview_orientation_note(image: Path) -> str | None:
+    """What to say of a JPEG or TIFF preview whose EXIF/TIFF Orientation is not 1; None for
+    one upright as stored, another format, or no tag.
+
+    Why: the preview is planned in its stored pixel order, as a session's JPEGs and TIFFs are
+    recorded (folder_watch keeps them as stored and says so), so the plan's lights and the
+    session's images share one frame; a phone preview marked "rotate 90°" had been planned
+    sideways to the picture a viewer shows, with not a word."""
+    from rti_rig.drivers.cameras.exif_tags import jpeg_orientation, tiff_orientation
+
+    suffix = image.suffix.lower()
+    if suffix in (".jpg", ".jpeg"):
+        kind, turned = "JPEG", jpeg_orientation(image)
+    elif suffix in (".tif", ".tiff"):
+        kind, turned = "TIFF", tiff_orientation(image)
+    else:
+        return None
+    if turned in (None, 1):
+        return None
+    from rti_rig.drivers.cameras.raw_decode import ORIENTATION_NAMES
+
+    return (
+        f"the preview {shown_path(image.name)} is marked as taken turned (Orientation tag "
+        f"{turned}: {ORIENTATION_NAMES.get(turned, 'not a known value')}): it is planned in "
+        f"its {kind}'s stored pixel order, not turned upright as a viewer shows it, as a "
+        "session's JPEGs and TIFFs are recorded; the plan holds for a session shot with the "
+        "camera held as it was for this preview (docs/cameras.md)"
+    )
 
 
 def preview_light_said(
