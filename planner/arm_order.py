@@ -15,6 +15,7 @@ from what ran, in the order it ran.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -24,6 +25,11 @@ from rti_rig.core.arm_motion import move_time_matrix, sequence_time_s
 
 #: Largest stop count solved exactly.
 EXACT_MAX = 12
+
+#: ``progress(done, total)``: the heuristic's steps (each seed's descent, then each kick) as
+#: they finish. Why: at 1000 stops the search takes a minute or more, and ``plan`` had shown
+#: nothing in that time.
+Progress = Callable[[int, int], None]
 
 
 def path_time_s(order: list[int] | NDArray, cost: NDArray[np.float64]) -> float:
@@ -240,54 +246,74 @@ def _double_bridge(nodes: list[int], rng: np.random.Generator) -> list[int]:
 
 
 def heuristic_order(
-    cost: NDArray[np.float64], seeds: int = 4, kicks: int | None = None, seed: int = 0
+    cost: NDArray[np.float64],
+    seeds: int = 4,
+    kicks: int | None = None,
+    seed: int = 0,
+    progress: Progress | None = None,
 ) -> list[int]:
     """Nearest neighbour from the ``seeds`` stops nearest the start, 2-opt + Or-opt, then
-    iterated local search (double-bridge kicks, keep if better). Deterministic for a seed."""
+    iterated local search (double-bridge kicks, keep if better). Deterministic for a seed;
+    ``progress`` is told each step done (it does not change the order)."""
     n = cost.shape[0] - 1
     if n == 0:
         return []
     firsts = list(np.argsort(cost[0, 1:])[: max(1, min(seeds, n))])
+    kicks = (max(20, 2000 // n) if kicks is None else kicks) if n >= 8 else 0
+    total = len(firsts) + kicks
     best, best_t = None, np.inf
-    for f in firsts:
+    for done, f in enumerate(firsts, 1):
         cand = improve(_nearest_neighbour(cost, int(f)), cost)
         t = path_time_s(cand, cost)
         if t < best_t:
             best, best_t = cand, t
+        if progress is not None:
+            progress(done, total)
     assert best is not None
     if n < 8:
         return best
     rng = np.random.default_rng(seed)
     nodes = [0, *[i + 1 for i in best]]
-    kicks = max(20, 2000 // n) if kicks is None else kicks
-    for _ in range(kicks):
+    for k in range(kicks):
         cand = _local_search(_double_bridge(nodes, rng), cost)
         t = path_time_s([x - 1 for x in cand[1:]], cost)
         if t < best_t - 1e-12:
             nodes, best_t = cand, t
+        if progress is not None:
+            progress(len(firsts) + k + 1, total)
     return [x - 1 for x in nodes[1:]]
 
 
-def order_from_matrix(cost: NDArray[np.float64]) -> list[int]:
-    """Exact when at most :data:`EXACT_MAX` stops, heuristic beyond."""
+def order_from_matrix(cost: NDArray[np.float64], progress: Progress | None = None) -> list[int]:
+    """Exact when at most :data:`EXACT_MAX` stops (a few ms: no progress), heuristic beyond."""
     n = cost.shape[0] - 1
     if n <= EXACT_MAX:
         return held_karp(cost)
-    return heuristic_order(cost)
+    return heuristic_order(cost, progress=progress)
 
 
-def order_for_arm(directions: ArrayLike, start: ArrayLike | None, settings: Any) -> list[int]:
+def order_for_arm(
+    directions: ArrayLike, start: ArrayLike | None, settings: Any, progress: Progress | None = None
+) -> list[int]:
     """Permutation of ``range(len(directions))`` minimising total move time from ``start``
     (the lamp's current direction; ``None`` = the park pose).
 
     When the azimuth joint spans more than a turn (multi-turn), the move time depends on the
     path, so two orders are computed (azimuth fixed near the start, and azimuth the short way
-    round) and the one whose driver-faithful :func:`sequence_time_s` is lower is returned."""
+    round) and the one whose driver-faithful :func:`sequence_time_s` is lower is returned;
+    ``progress`` then counts both searches' steps as one."""
     dirs = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
-    order = order_from_matrix(move_time_matrix(dirs, settings, start))
-    if settings.azimuth.max_deg - settings.azimuth.min_deg <= 360.0 or len(dirs) < 2:
+    twice = settings.azimuth.max_deg - settings.azimuth.min_deg > 360.0 and len(dirs) >= 2
+
+    def part(first: bool) -> Progress | None:
+        if progress is None or not twice:
+            return progress
+        return lambda done, total: progress(done + (0 if first else total), 2 * total)
+
+    order = order_from_matrix(move_time_matrix(dirs, settings, start), part(True))
+    if not twice:
         return order
-    other = order_from_matrix(move_time_matrix(dirs, settings, start, cyclic=True))
+    other = order_from_matrix(move_time_matrix(dirs, settings, start, cyclic=True), part(False))
     t_fixed = sequence_time_s(dirs[order], settings, start)
     t_cyclic = sequence_time_s(dirs[other], settings, start)
     return other if t_cyclic < t_fixed else order

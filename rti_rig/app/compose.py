@@ -506,8 +506,9 @@ def _build_simulated(loaded: LoadedRig, clock: Clock | None) -> Rig:
     return Rig(loaded=loaded, geometry=geometry, lighting=lighting, camera=camera, clock=clock)
 
 
-def arm_order_for(loaded: LoadedRig):  # type: ignore[no-untyped-def]
-    """The move-time-optimal stop order for an arm, else None (a dome).
+def arm_order_for(loaded: LoadedRig, progress=None):  # type: ignore[no-untyped-def]
+    """The move-time-optimal stop order for an arm, else None (a dome); ``progress(done,
+    total)`` is told the order search's steps (:data:`rti_rig.planner.arm_order.Progress`).
 
     The move-time model is the arm that runs: an emulated or hardware arm's servos
     (``[arm.dynamixel]``), or the simulated arm's ``[arm]`` speed, acceleration and limits
@@ -522,7 +523,7 @@ def arm_order_for(loaded: LoadedRig):  # type: ignore[no-untyped-def]
     settings = simulated_arm_motion(loaded)
     if settings is None:
         settings = arm.dynamixel
-    return lambda directions, start: order_for_arm(directions, start, settings)
+    return lambda directions, start: order_for_arm(directions, start, settings, progress)
 
 
 def simulated_arm_motion(loaded: LoadedRig):  # type: ignore[no-untyped-def]

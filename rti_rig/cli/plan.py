@@ -238,7 +238,7 @@ def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:
     from rti_rig.app.usecases.plan import draw_plan_figure, plan_lights
 
     try:
-        planned = done["planned"] = plan_lights(request)
+        planned = done["planned"] = _plan_showing_progress(request, plan_lights)
     except RtiRigError as exc:
         raise fail(exc) from None
     print_notes(planned.notes)
@@ -258,6 +258,40 @@ def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:
             raise fail(exc) from None
         done["drawn"] = True
         out.print(f"Map of the plan → {escape(shown_path(request.figure))}")
+
+
+def _plan_showing_progress(request: PlanLightsRequest, plan_lights: Any) -> Any:
+    """``plan_lights(request)`` with a progress bar (on stderr, left as it ended) for an arm's
+    stop-order search, shown from its first step: none for a dome, or an arm's order solved
+    exactly (a few ms).
+
+    Why: ``plan --rig rig_configs/simulated_arm.toml --lights 1000`` searched for over a
+    minute with nothing on screen; the run's capture has had a bar, the plan had none."""
+    from dataclasses import replace
+
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    bar = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=err,
+    )
+    task: Any = None
+
+    def told(done: int, total: int) -> None:
+        nonlocal task
+        if task is None:
+            bar.start()
+            task = bar.add_task("ordering the arm's stops for the least move time", total=total)
+        bar.update(task, completed=done, total=total)
+
+    try:
+        return plan_lights(replace(request, order_progress=told))
+    finally:
+        if task is not None:
+            bar.stop()
 
 
 def _how_planned(planned: Any) -> str:

@@ -9,6 +9,7 @@ meaning "a dome with exactly these lights".
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -88,6 +89,9 @@ class PlanLightsRequest:
     #: Plan lights that cannot determine a normal (one plane, bunched at the zenith) with a
     #: warning, in place of the refusal: a ring of low lights for a relightable PTM/HSH only.
     allow_no_normals: bool = False
+    #: ``(done, total)`` of an arm's stop-order search as it goes (a minute or more at 1000
+    #: stops, which ``plan`` had passed in silence); None: not told
+    order_progress: Callable[[int, int], None] | None = None
 
     @property
     def method_or_default(self) -> str:
@@ -208,7 +212,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         geometry, entries = _bare_lp_dome(req.rig, notes)
     else:
         geometry = rig_geometry(loaded)
-        arm_order = arm_order_for(loaded)
+        arm_order = arm_order_for(loaded, req.order_progress)
     if (
         not req.lights_given
         and isinstance(geometry, DomeGeometry)
