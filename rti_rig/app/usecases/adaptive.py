@@ -1234,6 +1234,7 @@ def check_objective(
     run: str = "rti-rig run",
     count: int = fit_minimums.PLAN_DEFAULT_LIGHTS,
     band: tuple[float, float] = _FULL_BAND,
+    in_band: int | None = None,
 ) -> None:
     """Refuse an objective the adaptive session cannot serve, before anything is opened.
 
@@ -1245,7 +1246,9 @@ def check_objective(
     The way out is a whole command: ``run`` (:func:`run_words`, the rig config and the run's
     own ``--out``) with ``count`` lights, the count the rig takes in ``band``
     (:func:`hint_count`): "--lights 12, say" was refused on a dome of fewer LEDs in the band,
-    and a bare option left the rest of the command to find."""
+    and a bare option left the rest of the command to find. ``in_band``: a dome's LEDs in
+    ``band`` (None on an arm); a band holding fewer than ``count`` gets no command, which
+    pasted would be refused for that band in turn: the refusal says so instead."""
     if objective not in OBJECTIVES:
         raise RtiRigError(
             f"--objective {objective}: an adaptive session chooses its lights for "
@@ -1255,6 +1258,11 @@ def check_objective(
         return
     counted = f"{run} {adaptive_options(None, lights or count, None, objective)}"
     counted += band_options(band)
+    if in_band is not None and in_band < (lights or count):
+        counted = (
+            f"--lights, in a band holding that many of the dome's LEDs (the band asked holds "
+            f"{in_band})"
+        )
     if until_error_deg is not None:
         raise RtiRigError(
             "--until-error goes with --objective normals only: it stops on the estimated mean "
@@ -1677,7 +1685,14 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     # one that repeated '--until-error 3 --objective relight' (or '--objective foo') was refused
     # in turn when pasted
     run = run_words(loaded.path, out_dir)
-    check_objective(objective, lights, until_error_deg, run, hint_count(geometry, band), band)
+    in_band = (
+        _held(az_el_from_direction(geometry.directions)[1], band)
+        if isinstance(geometry, DomeGeometry)
+        else None
+    )
+    check_objective(
+        objective, lights, until_error_deg, run, hint_count(geometry, band), band, in_band
+    )
     check_min_lights(min_lights, lights, until_error_deg, run, band)
     offered: int | None = None
     elevations: NDArray[np.float64] | None = None  # a dome's LEDs' (°)
