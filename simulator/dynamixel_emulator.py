@@ -2,23 +2,24 @@
 ``dynamixel_sdk`` runs unchanged against them (over a pty or an in-process port).
 
 What is modelled: the control table as bytes, starting from each model's factory table as the
-ROBOTIS e-manual publishes it (:mod:`rti_rig.simulator.dynamixel_models`, cited per model: the
-XL330's Shutdown 0x35, Velocity Limits, voltage limits, ...); EEPROM locked while torque is
-on, read-only registers, position limits in position mode, Profile Velocity refused above the
+ROBOTIS e-manual publishes it (:mod:`rti_rig.simulator.dynamixel_table`, its registers and
+Initial Values, and :mod:`rti_rig.simulator.dynamixel_models`, cited per model: the XL330's
+Shutdown 0x35, Velocity Limits, voltage limits, ...); EEPROM locked while torque is on,
+read-only registers, position limits in position mode, Profile Velocity refused above the
 Velocity Limit (Data Limit Error), the supply checked against the Min/Max Voltage Limit,
-Operating Mode changes resetting the profile;
-Ping/Read/Write/Reg Write/Action/Reboot/Clear/Sync Read/Sync Write/Bulk Read/Bulk Write,
-Status Return Level, the Alert bit, motion under Profile Velocity/Acceleration (trapezoid in
-*emulator time* read from an injected clock, so a dry run with a ``VirtualClock`` never waits)
-and fault injection: hardware errors (Alert in every status; torque off and motion frozen only
-for the errors the Shutdown register selects, as the e-manual says), corrupted CRC on replies,
-and silent (disconnected) servos; a servo at another baud rate, or switched to Protocol 1.0
-(Protocol Type 13 = 1), answers nothing. A Hardware Error Status bit stays set until a Reboot (not
-verified for a non-shutdown error whose cause has passed), also between rti-rig commands: a
-rig's emulated chain is modelled as staying powered, each servo's control table (torque, goal,
-RAM, EEPROM, latched errors) and resting pose kept in a small state file
-(:mod:`rti_rig.simulator.servo_latch`, :meth:`EmulatedServo.powered_state`; delete it to
-"power-cycle" the servos).
+Operating Mode changes resetting the profile; Ping/Read/Write/Reg Write/Action/Factory
+Reset/Reboot/Clear/Sync Read/Sync Write/Bulk Read/Bulk Write, Status Return Level, the Alert
+bit, motion under Profile Velocity/Acceleration (trapezoid in *emulator time* read from an
+injected clock, so a dry run with a ``VirtualClock`` never waits) and fault injection: hardware
+errors (Alert in every status; torque off and motion frozen only for the errors the Shutdown
+register selects, as the e-manual says), corrupted CRC on replies, and silent (disconnected)
+servos, or a whole chain whose supply is lost (``power_lost``); a servo at another baud rate,
+or switched to Protocol 1.0 (Protocol Type 13 = 1), answers nothing. A Hardware Error Status
+bit stays set until a Reboot (not verified for a non-shutdown error whose cause has passed),
+also between rti-rig commands: a rig's emulated chain is modelled as staying powered, each
+servo's control table (torque, goal, RAM, EEPROM, latched errors) and resting pose kept in a
+small state file (:mod:`rti_rig.simulator.servo_latch`, :meth:`EmulatedServo.powered_state`;
+delete it to "power-cycle" the servos).
 
 Deliberate simplifications: a new goal during a move restarts the profile from the present
 position at zero velocity (the firmware blends); no load, current or temperature dynamics.

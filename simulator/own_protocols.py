@@ -1,8 +1,9 @@
 """The firmware side of rti-rig's own dome protocols, written from docs/protocols/led-dome.md alone.
 
-Why a reading of its own: the driver's codecs (``rti_rig.drivers.led_dome.codec_*``) encode and
-decode both sides of the wire, and an emulator built on them would share every one of their
-bugs, invisible to any test that drives the real driver against it. This module parses command
+Why a reading of its own: the driver's codecs (``rti_rig.drivers.led_dome.codec_*``) had
+encoded and decoded both sides of the wire (they are the host's side alone now), and an emulator
+built on them shared every one of their bugs, invisible to any test that drives the real driver
+against it. This module parses command
 bytes and writes reply bytes as a firmware author would, from the page's tables and examples
 (the byte-exact fixtures it names are the normative examples), and it imports nothing of the
 driver's wire format: ``tests/architecture`` holds an import-linter contract that forbids it.
