@@ -102,7 +102,7 @@ class BusTime:
             if len(buf) < 7:
                 break
             dxl_id, length = buf[4], buf[5] | buf[6] << 8
-            if dxl_id > wire.BROADCAST_ID or dxl_id == 0xFD or length < 3:
+            if not wire.begins_packet(dxl_id, length):
                 del buf[: len(wire.HEADER)]  # not a packet, as the codec skips it
                 continue
             delay += return_delay_s(self._servos, dxl_id)

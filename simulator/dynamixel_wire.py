@@ -149,6 +149,14 @@ class BadCrc:
         return self.raw[4]
 
 
+def begins_packet(dxl_id: int, length: int) -> bool:
+    """Whether a header followed by ``dxl_id`` and ``length`` can begin a packet: no packet
+    carries ID 253 (0xFD, it would read as a header) or 255, and Length counts at least the
+    Instruction (or a status's Error) and the CRC. One rule for every reader of the stream
+    (this module's :class:`InstructionReader`, the bus time's status reader)."""
+    return dxl_id <= BROADCAST_ID and dxl_id != 0xFD and length >= 3
+
+
 class InstructionReader:
     """The reception order of the e-manual, over a byte stream: ``feed`` bytes, then take
     :meth:`packets`.
@@ -176,7 +184,7 @@ class InstructionReader:
                 return out
             dxl_id = self._buf[4]
             length = self._buf[5] | self._buf[6] << 8
-            if dxl_id > BROADCAST_ID or dxl_id == 0xFD or length < 3:
+            if not begins_packet(dxl_id, length):
                 del self._buf[: len(HEADER)]  # not a packet: look for the next header
                 continue
             if len(self._buf) < 7 + length:
