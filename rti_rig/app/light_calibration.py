@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 
 from rti_rig.app.config import CALIBRATION_FORMAT as FORMAT
 from rti_rig.app.dead_led import dead_led_recorded
+from rti_rig.app.usecases.run_options import run_words
 from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.out_folders import free_folder_beside
@@ -174,11 +175,11 @@ def _card_again(root: Path, rig: dict[str, Any]) -> str:
 
     Why: "rti-rig run RIG --out CARD_SESSION" had been printed, which pasted ran a rig file
     named RIG. A manifest naming no config leaves the config to the user, said as such."""
-    out = shell_word(str(free_folder_beside(root, "again")))
+    again = free_folder_beside(root, "again")
     config = rig.get("config_path")
     if not isinstance(config, str) or not config:
-        return f"rti-rig run with the dome's rig config and --out {out}"
-    return f"rti-rig run {shell_word(config)} --out {out}"
+        return f"rti-rig run with the dome's rig config and --out {shell_word(str(again))}"
+    return run_words(Path(config), again)
 
 
 def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | None) -> CardSession:

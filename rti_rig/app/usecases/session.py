@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.app.usecases.replay_advice import new_session_command
+from rti_rig.app.usecases.run_options import run_words
 from rti_rig.core.errors import ConfigError, RtiRigError, ScheduleError
 from rti_rig.core.out_folders import free_folder_beside, free_name
 from rti_rig.core.rig_geometry import led_fields
@@ -1259,11 +1260,11 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
         refuse_unmeterable_rig(loaded)  # no planned run meters these either: say so first
         # the metering run's --out a folder not there yet beside the session's ('--out TEST'
         # pasted was refused where a TEST of an earlier metering run was left non-empty)
-        metering = shell_word(str(free_folder_beside(Path(req.out_dir), "metering")))
+        metering = free_folder_beside(Path(req.out_dir), "metering")
         raise RtiRigError(
             f"{req.adaptive_option} cannot meter the exposure: its lights are chosen as the images "
             "arrive, so there is no brightest planned light to meter at. Meter once with a "
-            f"planned run (rti-rig run {shell_word(str(req.rig_config))} --out {metering} "
+            f"planned run ({run_words(Path(req.rig_config), metering)} "
             f"{_metering_options(req, loaded)} --auto-exposure prints 'Exposure fixed at T s'), "
             "set camera.exposure_s = T in the rig config, then run this command again without "
             "--auto-exposure"
@@ -1307,7 +1308,6 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     """Check a new session's request, open and check the rig, and prepare its folder."""
     from rti_rig.app.config import load_rig_config
     from rti_rig.app.usecases.adaptive import check_min_lights
-    from rti_rig.app.usecases.run_options import run_words
 
     check_max_saturated(req.max_saturated)
     check_min_lights(
@@ -1934,14 +1934,13 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         # cannot run, not "out of its reach": the refusal may be a narrower camera's exposure
         # range or a timed firmware's window, a change as accepted
         session = Path(req.session_dir)
-        again = shell_word(str(free_folder_beside(session, "again")))
+        again = free_folder_beside(session, "again")
         raise ScheduleError(
             f"{exc}\nThe rig change accepted ({'; '.join(diffs)}) leaves these steps of "
             f"{shown_path(session)} unable to run on it: to finish the session, set "
             f"{shown_path(loaded.path)} back as it began (its copy is in "
             f"{shown_path(session / 'manifest.json')}, under rig.config) and resume; or shoot "
-            f"a new session on the rig as it is: rti-rig run {shell_word(str(loaded.path))} "
-            f"--out {again}"
+            f"a new session on the rig as it is: {run_words(loaded.path, again)}"
         ) from None
     if diffs and shot:
         _say_shot_beyond(rig, schedule, folder, shot, on_note)
