@@ -116,10 +116,9 @@ class ReplayCamera:
         try:
             return recorded_frame_pixels(path)
         except (OSError, SessionError) as exc:
-            there = path.is_file()
-            if there and not isinstance(exc, OSError):
-                raise  # there, but not readable as an image: the reader's words say why
-            if there and isinstance(exc, OSError):
+            if path.is_file():
+                if not isinstance(exc, OSError):
+                    raise  # there, but not readable as an image: the reader's words say why
                 # there, but the system refused its read: its own reason, not "moved or
                 # deleted?" of a file still in its place (a permission, a failing drive's EIO)
                 raise CaptureError(
