@@ -83,67 +83,45 @@ def test_the_contract_fails_when_a_core_module_imports_a_driver(tmp_path):
     assert "rti_rig.core.geometry -> rti_rig.drivers.led_dome.driver" in result.stdout
 
 
-@pytest.mark.slow
-def test_the_contract_fails_when_the_own_protocols_emulator_imports_a_driver_codec(tmp_path):
-    """The emulator of rti-rig's own dome protocols reads the spec, not the driver's codecs:
-    built on them, a codec bug would be on both sides of the wire and pass every test."""
-    tree = installed_layout(tmp_path / "site")
-    own = tree / "rti_rig" / "simulator" / "own_protocols.py"
-    own.write_text(
-        own.read_text(encoding="utf-8") + "\nimport rti_rig.drivers.led_dome.codec_default\n",
-        encoding="utf-8",
-    )
-    result = lint_imports(tree, PYPROJECT)
-    assert result.returncode != 0
-    assert "dome emulator reads docs/protocols/led-dome.md, not the driver's codecs" in (
-        result.stdout
-    )
-    assert "BROKEN" in result.stdout
-    assert "rti_rig.simulator.own_protocols -> rti_rig.drivers.led_dome.codec_default" in (
-        result.stdout
-    )
+#: The emulators' contracts, each with the import that breaks it: (module file under the
+#: installed tree, the line appended, the contract's name, the edge import-linter reports).
+EMULATOR_BREAKS = [
+    (
+        # the own dome protocols' emulator reads the spec, not the driver's codecs
+        "rti_rig/simulator/own_protocols.py",
+        "import rti_rig.drivers.led_dome.codec_default",
+        "dome emulator reads docs/protocols/led-dome.md, not the driver's codecs",
+        "rti_rig.simulator.own_protocols -> rti_rig.drivers.led_dome.codec_default",
+    ),
+    (
+        # the emulated servos speak Protocol 2.0 from the e-manual (dynamixel_wire)
+        "rti_rig/simulator/dynamixel_emulator.py",
+        "from rti_rig.drivers.dynamixel import protocol2 as _p2  # noqa: F401",
+        "Dynamixel emulator speaks Protocol 2.0 from the e-manual, not the driver's codec",
+        "rti_rig.simulator.dynamixel_emulator -> rti_rig.drivers.dynamixel.protocol2",
+    ),
+    (
+        # ... and name their registers from their own tables (dynamixel_table)
+        "rti_rig/simulator/dynamixel_bus_time.py",
+        "from rti_rig.drivers.dynamixel import control_table as _ct  # noqa: F401",
+        "Dynamixel emulator reads its control tables from the e-manual, not the driver's",
+        "rti_rig.simulator.dynamixel_bus_time -> rti_rig.drivers.dynamixel.control_table",
+    ),
+]
 
 
 @pytest.mark.slow
-def test_the_contract_fails_when_the_dynamixel_emulator_imports_the_driver_codec(tmp_path):
-    """The emulated servos speak Protocol 2.0 from the e-manual (dynamixel_wire), not through
-    the driver's codec: built on it again, a codec bug would be on both sides of the wire."""
+def test_the_emulator_contracts_fail_when_an_emulator_imports_the_drivers_wire(tmp_path):
+    """Each emulator is written from the device's published behaviour, not the driver's
+    codec or register map: built on them again, a bug there would be on both sides of the
+    wire and pass every driver test against the emulator. One tree, each contract broken by
+    its own import, one run of the linter (each run takes seconds)."""
     tree = installed_layout(tmp_path / "site")
-    emulator = tree / "rti_rig" / "simulator" / "dynamixel_emulator.py"
-    emulator.write_text(
-        emulator.read_text(encoding="utf-8")
-        + "\nfrom rti_rig.drivers.dynamixel import protocol2 as _p2  # noqa: F401\n",
-        encoding="utf-8",
-    )
+    for module, line, _, _ in EMULATOR_BREAKS:
+        path = tree / module
+        path.write_text(path.read_text(encoding="utf-8") + f"\n{line}\n", encoding="utf-8")
     result = lint_imports(tree, PYPROJECT)
     assert result.returncode != 0
-    assert "Dynamixel emulator speaks Protocol 2.0 from the e-manual, not the driver's codec" in (
-        result.stdout
-    )
-    assert "BROKEN" in result.stdout
-    assert "rti_rig.simulator.dynamixel_emulator -> rti_rig.drivers.dynamixel.protocol2" in (
-        result.stdout
-    )
-
-
-@pytest.mark.slow
-def test_the_contract_fails_when_the_dynamixel_emulator_imports_the_driver_table(tmp_path):
-    """The emulated servos name their registers from their own e-manual tables
-    (simulator/dynamixel_table.py), not the driver's control_table: built on it again, a
-    register-map bug would be on both sides of the wire."""
-    tree = installed_layout(tmp_path / "site")
-    emulator = tree / "rti_rig" / "simulator" / "dynamixel_emulator.py"
-    emulator.write_text(
-        emulator.read_text(encoding="utf-8")
-        + "\nfrom rti_rig.drivers.dynamixel import control_table as _ct  # noqa: F401\n",
-        encoding="utf-8",
-    )
-    result = lint_imports(tree, PYPROJECT)
-    assert result.returncode != 0
-    assert "Dynamixel emulator reads its control tables from the e-manual, not the driver's" in (
-        result.stdout
-    )
-    assert "BROKEN" in result.stdout
-    assert "rti_rig.simulator.dynamixel_emulator -> rti_rig.drivers.dynamixel.control_table" in (
-        result.stdout
-    )
+    for _, _, contract, edge in EMULATOR_BREAKS:
+        assert f"{contract} BROKEN" in result.stdout, (contract, result.stdout)
+        assert edge in result.stdout, (edge, result.stdout)
