@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 import serial
 from conftest import CONFIGS
-from typer.testing import CliRunner
+from typer.testing import CliRunner, Result
 
 from rti_rig.cli import app
 from rti_rig.simulator import dynamixel_pty
@@ -30,6 +30,19 @@ pytestmark = [
 #: the third image once the bus's time was charged). One number for both tests: the second
 #: had kept 250 when the first was moved on
 AFTER_SECOND_IMAGE = 180
+
+
+def _run_six_lights(tmp_path: Path, out: Path) -> tuple[Result, str]:
+    """``rti-rig run`` of 6 lights on a copy of the shipped simulated arm into ``out``: the
+    result and its words on one line."""
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text((CONFIGS / "simulated_arm.toml").read_text())
+    r = CliRunner().invoke(
+        app,
+        ["run", str(cfg), "--out", str(out), "--lights", "6", "--no-verdict"],
+        terminal_width=400,
+    )
+    return r, " ".join(r.output.split())
 
 
 def test_an_arm_adapter_unplugged_mid_session_stops_keeps_and_resumes(
@@ -54,15 +67,8 @@ def test_an_arm_adapter_unplugged_mid_session_stops_keeps_and_resumes(
 
     monkeypatch.setattr(handler, "writePort", write)
     monkeypatch.setattr(handler, "openPort", open_port)
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text((CONFIGS / "simulated_arm.toml").read_text())
     out = tmp_path / "s"
-    r = CliRunner().invoke(
-        app,
-        ["run", str(cfg), "--out", str(out), "--lights", "6", "--no-verdict"],
-        terminal_width=400,
-    )
-    said = " ".join(r.output.split())
+    r, said = _run_six_lights(tmp_path, out)
     assert r.exit_code == 2, said
     assert "arm: the port '" in said, said
     assert "failed (write failed: [Errno 5] Input/output error): check that the arm's USB " in said
@@ -114,15 +120,8 @@ def test_an_adapter_gone_at_the_flush_before_a_packet_is_said_as_its_port(
         return real_clear(self)
 
     monkeypatch.setattr(handler, "clearPort", clear)
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text((CONFIGS / "simulated_arm.toml").read_text())
     out = tmp_path / "s"
-    r = CliRunner().invoke(
-        app,
-        ["run", str(cfg), "--out", str(out), "--lights", "6", "--no-verdict"],
-        terminal_width=400,
-    )
-    said = " ".join(r.output.split())
+    r, said = _run_six_lights(tmp_path, out)
     assert r.exit_code == 2, said
     assert "unexpected" not in said, said
     assert "failed ([Errno 5] Input/output error): check that the arm's USB adapter" in said, said
