@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 import signal
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -43,6 +44,36 @@ def _built_rigs(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
     return rigs
 
 
+def _signal_at_move(
+    monkeypatch: pytest.MonkeyPatch,
+    n: int,
+    sig: signal.Signals,
+    before: Callable[[], object] | None = None,
+) -> None:
+    """Has the check's arm self-test raise ``sig`` as the arm begins its ``n``-th move (the
+    check's own handler takes it), ``before`` done first (a servo silenced, say)."""
+    import rti_rig.app.usecases.check as check_usecase
+
+    real_self_test = check_usecase.arm_self_test
+    moves: list[int] = []
+
+    def self_test(carrier: Any, *args: Any, **kwargs: Any) -> Any:
+        real_move = carrier.move_to
+
+        def move_to(direction: np.ndarray) -> np.ndarray:
+            moves.append(1)
+            if len(moves) == n:
+                if before is not None:
+                    before()
+                signal.raise_signal(sig)
+            return real_move(direction)
+
+        carrier.move_to = move_to
+        return real_self_test(carrier, *args, **kwargs)
+
+    monkeypatch.setattr(check_usecase, "arm_self_test", self_test)
+
+
 def _truth(rig: Any) -> np.ndarray:
     """Where the lamp really is: the emulated servos' present positions, or the simulation's."""
     emulator = getattr(rig, "emulator", None)
@@ -60,28 +91,7 @@ def test_a_check_stopped_by_sigterm_says_where_the_arm_is_left(
 ) -> None:
     path = inprocess_arm_config(tmp_path) if "inprocess" in config else CONFIGS / config
     rigs = _built_rigs(monkeypatch)
-    moves: list[int] = []
-
-    def sigterm_at_third_move(carrier: Any) -> None:
-        real_move = carrier.move_to
-
-        def move_to(direction: np.ndarray) -> np.ndarray:
-            moves.append(1)
-            if len(moves) == 3:  # the user's SIGTERM, through the check's own handler
-                signal.raise_signal(signal.SIGTERM)
-            return real_move(direction)
-
-        carrier.move_to = move_to
-
-    import rti_rig.app.usecases.check as check_usecase
-
-    real_self_test = check_usecase.arm_self_test
-
-    def self_test(carrier: Any, *args: Any, **kwargs: Any) -> Any:
-        sigterm_at_third_move(carrier)
-        return real_self_test(carrier, *args, **kwargs)
-
-    monkeypatch.setattr(check_usecase, "arm_self_test", self_test)
+    _signal_at_move(monkeypatch, 3, signal.SIGTERM)  # the user's, through the check's handler
     r = CliRunner().invoke(app, ["check", str(path)], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 143, said
@@ -108,25 +118,7 @@ def test_a_stopped_check_whose_stop_failed_is_not_said_left_where_it_stopped(
     joint, which may still be moving to its last goal. The arm's sentence had said "left where
     it stopped" beside "the stop did not hold every joint"."""
     rigs = _built_rigs(monkeypatch)
-    import rti_rig.app.usecases.check as check_usecase
-
-    real_self_test = check_usecase.arm_self_test
-    moves: list[int] = []
-
-    def self_test(carrier: Any, *args: Any, **kwargs: Any) -> Any:
-        real_move = carrier.move_to
-
-        def move_to(direction: np.ndarray) -> np.ndarray:
-            moves.append(1)
-            if len(moves) == 3:
-                rigs[0].emulator.silent_ids.add(1)
-                signal.raise_signal(signal.SIGTERM)
-            return real_move(direction)
-
-        carrier.move_to = move_to
-        return real_self_test(carrier, *args, **kwargs)
-
-    monkeypatch.setattr(check_usecase, "arm_self_test", self_test)
+    _signal_at_move(monkeypatch, 3, signal.SIGTERM, lambda: rigs[0].emulator.silent_ids.add(1))
     r = CliRunner().invoke(app, ["check", str(inprocess_arm_config(tmp_path))], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 143, said
@@ -204,24 +196,7 @@ def test_a_check_stopped_by_ctrl_c_says_the_poses_it_verified_and_how_to_park(
     cfg = folder / "arm.toml"
     cfg.write_text(inprocess_arm_config(tmp_path).read_text())
     rigs = _built_rigs(monkeypatch)
-    import rti_rig.app.usecases.check as check_usecase
-
-    real_self_test = check_usecase.arm_self_test
-    moves: list[int] = []
-
-    def self_test(carrier: Any, *args: Any, **kwargs: Any) -> Any:
-        real_move = carrier.move_to
-
-        def move_to(direction: np.ndarray) -> np.ndarray:
-            moves.append(1)
-            if len(moves) == 4:  # the user's Ctrl-C, through the check's own handler
-                signal.raise_signal(signal.SIGINT)
-            return real_move(direction)
-
-        carrier.move_to = move_to
-        return real_self_test(carrier, *args, **kwargs)
-
-    monkeypatch.setattr(check_usecase, "arm_self_test", self_test)
+    _signal_at_move(monkeypatch, 4, signal.SIGINT)  # the user's Ctrl-C, through its handler
     r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 130 and "Traceback" not in said, said
