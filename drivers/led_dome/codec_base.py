@@ -50,3 +50,26 @@ def xor_checksum(data: bytes) -> int:
     for b in data:
         value ^= b
     return value
+
+
+def decimal(token: str, *, signed: bool = False) -> int:
+    """A number field of a text profile's reply as the page writes it: decimal ASCII digits, a
+    ``-`` first only where ``signed`` (the default profile's query ``-1``).
+
+    Why: ``int`` also reads ``+7``, `` 7`` and ``1_0``, so a reply damaged on a link without
+    a checksum (``framed``, or ``default`` with ``checksum = false``) could still read as
+    numbers, and other numbers than were sent (``<OK,1,9,RTIDOME,1.2.0, 8>``, the count
+    ``48`` damaged, as a board of 8 LEDs)."""
+    digits = token[1:] if signed and token.startswith("-") else token
+    if not (digits.isascii() and digits.isdigit()):
+        raise ValueError(f"{token!r} is no decimal number")
+    return int(token)
+
+
+def reply_seq(token: str, seq_max: int, *, error: bool = False) -> int:
+    """A text profile's reply sequence number: 1..``seq_max``, or 0 in an error too damaged to
+    read it by."""
+    seq = decimal(token)
+    if not (0 if error else 1) <= seq <= seq_max:
+        raise ValueError(f"sequence number {seq} outside 1..{seq_max}")
+    return seq

@@ -15,7 +15,7 @@ on port open, and reveals a reset in the middle of a session.
 
 from __future__ import annotations
 
-from rti_rig.drivers.led_dome.codec_base import xor_checksum
+from rti_rig.drivers.led_dome.codec_base import decimal, reply_seq, xor_checksum
 from rti_rig.drivers.led_dome.messages import (
     Ack,
     AllOff,
@@ -122,38 +122,18 @@ def _command_body(cmd: Command | DomeIdentity | LitState) -> str:
     raise TypeError(f"not a command: {cmd!r}")
 
 
-def _decimal(token: str, *, signed: bool = False) -> int:
-    """A number field as the profile writes it: decimal ASCII digits, a ``-`` first only where
-    ``signed`` (the query's ``-1``).
-
-    Why: ``int`` also reads ``+7``, `` 7`` and ``1_0``, so a reply damaged on a link without
-    a checksum could still read as numbers, and other numbers than were sent."""
-    digits = token[1:] if signed and token.startswith("-") else token
-    if not (digits.isascii() and digits.isdigit()):
-        raise ValueError(f"{token!r} is no decimal number")
-    return int(token)
-
-
-def _seq(token: str, *, error: bool = False) -> int:
-    """A reply's sequence number: 1..9999, or 0 in an error too damaged to read it by."""
-    seq = _decimal(token)
-    if not (0 if error else 1) <= seq <= SEQ_MAX:
-        raise ValueError(f"sequence number {seq} outside 1..{SEQ_MAX}")
-    return seq
-
-
 def _parse_command(tokens: list[str]) -> Command:
     """The command a reply echoes, its arguments exactly as many as the verb takes."""
     verb, args = tokens[0], tokens[1:]
     if verb == "ID" and not args:
         return Hello()
     if verb == "L" and len(args) in (2, 3):
-        max_on = _decimal(args[2]) if len(args) == 3 else None
-        return Light(_decimal(args[0]), _decimal(args[1]), max_on)
+        max_on = decimal(args[2]) if len(args) == 3 else None
+        return Light(decimal(args[0]), decimal(args[1]), max_on)
     if verb == "X" and not args:
         return AllOff()
     if verb == "S" and len(args) == 1:
-        return Shutter(_decimal(args[0]))
+        return Shutter(decimal(args[0]))
     if verb == "Q" and not args:
         return Query()
     if verb in {"ID", "L", "X", "S", "Q"}:
@@ -177,25 +157,25 @@ def _parse_reply(text: str) -> Reply:
             return Banner(None)
         if len(tokens) != 4:
             raise ValueError("a banner carries an id, a version and a count")
-        return Banner(DomeIdentity(tokens[1], tokens[2], _decimal(tokens[3])))
+        return Banner(DomeIdentity(tokens[1], tokens[2], decimal(tokens[3])))
     if head == "ERR":
         if len(tokens) != 4:
             raise ValueError("an error carries a sequence number, a code and one word")
-        seq = _seq(tokens[1], error=True)
-        return Nak(seq or None, _decimal(tokens[2]), tokens[3].replace("_", " "))
+        seq = reply_seq(tokens[1], SEQ_MAX, error=True)
+        return Nak(seq or None, decimal(tokens[2]), tokens[3].replace("_", " "))
     if head != "OK":
         raise ValueError(f"unknown reply {head!r}")
-    seq = _seq(tokens[1])
+    seq = reply_seq(tokens[1], SEQ_MAX)
     verb, args = tokens[2], tokens[3:]
     if verb == "ID":
         if len(args) != 3:
             raise ValueError("an identity carries a name, a version and a count")
-        return Ack(seq, DomeIdentity(args[0], args[1], _decimal(args[2])))
+        return Ack(seq, DomeIdentity(args[0], args[1], decimal(args[2])))
     if verb == "Q":
         if len(args) != 2:
             raise ValueError("a lit state carries an index and a level")
-        idx = _decimal(args[0], signed=True)
+        idx = decimal(args[0], signed=True)
         if idx < -1:
             raise ValueError(f"LED index {idx}")
-        return Ack(seq, LitState(None if idx < 0 else idx, _decimal(args[1])))
+        return Ack(seq, LitState(None if idx < 0 else idx, decimal(args[1])))
     return Ack(seq, _parse_command([verb, *args]))

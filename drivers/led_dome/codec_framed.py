@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from rti_rig.drivers.led_dome.codec_base import decimal, reply_seq
 from rti_rig.drivers.led_dome.messages import (
     Ack,
     AllOff,
@@ -120,7 +121,7 @@ class FramedCodec:
         return str(index + self.spec.index_base)
 
     def _index_in(self, token: str) -> int:
-        value = _nonneg(token) - self.spec.index_base
+        value = decimal(token) - self.spec.index_base
         if value < 0:
             raise ValueError(f"LED number {token} below the index base {self.spec.index_base}")
         return value
@@ -149,14 +150,14 @@ class FramedCodec:
             if self.has_level:
                 if len(args) != 2:
                     raise ValueError("light needs an LED and a level")
-                return Light(self._index_in(args[0]), _nonneg(args[1]))
+                return Light(self._index_in(args[0]), decimal(args[1]))
             if len(args) != 1:
                 raise ValueError("light needs an LED")
             return Light(self._index_in(args[0]), self.spec.full_level)
         if verb == "shutter":
             if len(args) != 1:
                 raise ValueError("shutter needs a pulse length")
-            return Shutter(_nonneg(args[0]))
+            return Shutter(decimal(args[0]))
         if args:
             raise ValueError(f"{verb} takes no arguments")
         return {"hello": Hello(), "all_off": AllOff(), "query": Query()}[verb]
@@ -193,46 +194,27 @@ class FramedCodec:
                 return Banner(None)
             if len(rest) != 3:
                 raise ValueError("a banner carries an id, a version and a count")
-            return Banner(DomeIdentity(rest[0], rest[1], _nonneg(rest[2])))
+            return Banner(DomeIdentity(rest[0], rest[1], decimal(rest[2])))
         seq: int | None = None
         if head in (s.ok_word, s.err_word) and self.has_sequence:
-            seq, rest = _seq(rest[0], error=head == s.err_word), rest[1:]
+            seq, rest = reply_seq(rest[0], SEQ_MAX, error=head == s.err_word), rest[1:]
         if head == s.err_word:
-            return Nak(seq or None, _nonneg(rest[0]), s.separator.join(rest[1:]))
+            return Nak(seq or None, decimal(rest[0]), s.separator.join(rest[1:]))
         if head != s.ok_word:
             raise ValueError(f"unknown reply word {head!r}")
         verb = self._verb_of_code.get(rest[0])
         if verb == "hello":
             if len(rest) != 4:
                 raise ValueError("an identity carries a name, a version and a count")
-            return Ack(seq, DomeIdentity(rest[1], rest[2], _nonneg(rest[3])))
+            return Ack(seq, DomeIdentity(rest[1], rest[2], decimal(rest[3])))
         if verb == "query":
             if len(rest) != 3:
                 raise ValueError("a lit state carries an index and a level")
             if rest[1] == "-1":
-                return Ack(seq, LitState(None, _nonneg(rest[2])))
-            return Ack(seq, LitState(self._index_in(rest[1]), _nonneg(rest[2])))
+                return Ack(seq, LitState(None, decimal(rest[2])))
+            return Ack(seq, LitState(self._index_in(rest[1]), decimal(rest[2])))
         return Ack(seq, self._parse_args(rest))
 
 
 class _UnknownCode(ValueError):
     pass
-
-
-def _nonneg(token: str) -> int:
-    """A number field as the firmware writes it: decimal ASCII digits.
-
-    Why: ``int`` also reads ``+7``, `` 7`` and ``1_0``, so a frame damaged on this link,
-    which has no checksum, could still read as numbers, and other numbers than were sent
-    (``<OK,1,9,RTIDOME,1.2.0, 8>``, the count ``48`` damaged, as a board of 8 LEDs)."""
-    if not (token.isascii() and token.isdigit()):
-        raise ValueError(f"{token!r} is no decimal number")
-    return int(token)
-
-
-def _seq(token: str, *, error: bool = False) -> int:
-    """A reply's sequence number: 1..9999, or 0 in an error too damaged to read it by."""
-    seq = _nonneg(token)
-    if not (0 if error else 1) <= seq <= SEQ_MAX:
-        raise ValueError(f"sequence number {seq} outside 1..{SEQ_MAX}")
-    return seq
