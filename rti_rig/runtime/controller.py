@@ -803,8 +803,10 @@ def run_session(
     ``schedule`` is then the starting layout recorded in the manifest, checked like any other.
     """
     # a resume's steps already shot are not checked again (an accepted rig change may have
-    # left them out of its reach): an adaptive run's starting layout is no list of its steps
-    validate_schedule(rig, schedule, frozenset(folder.done) if source is None else frozenset())
+    # left them out of its reach); an adaptive run's schedule is its starting layout, step i
+    # its step i, so its lights shot are left aside alike (each step it decides is checked
+    # before it moves)
+    validate_schedule(rig, schedule, frozenset(folder.done))
     total = len(schedule) if source is None else source.total
     if folder.total_steps != total:
         raise ScheduleError("session folder was sized for another schedule")

@@ -106,3 +106,64 @@ def test_a_reach_narrowed_only_where_images_were_shot_resumes_keeping_them(
     assert [line.split(" ", 2)[1] for line in kept] == ["2:", "3:", "4:"], kept
     lp = (out / "lights.lp").read_text().splitlines()
     assert lp[0].strip() == "6" and lp[1:5] == lp_before[1:], lp  # the lights that fired
+
+
+def test_an_adaptive_session_narrowed_where_it_shot_resumes_keeping_them(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``run --adaptive`` on the arm, cut after 5 of 8 lights (its start at 14.4°, 20.7°,
+    21.1°, 53.3°, then one chosen at 51.2°), the reach narrowed to 25..50°: before, the resume
+    checked the whole starting layout and refused steps 1-4, already on disk, where a planned
+    session's resume keeps them. The lights shot are kept and said, the rest is chosen within
+    the new reach, and the choice is deterministic: a copy resumed, cut again and resumed with
+    no flag (which re-decides the steps taken since the change, and refuses any decided
+    otherwise) ends with the same lights."""
+    import json
+    import shutil
+
+    import numpy as np
+    from conftest import decisions, journal
+
+    from rti_rig.app.usecases.session import ResumeRequest, open_resumed_session
+    from rti_rig.app.usecases.session import run_opened_session as run_it
+    from rti_rig.runtime.controller import CancelToken, StepCompleted
+
+    monkeypatch.chdir(tmp_path)
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace("width = 512", "width = 64").replace("height = 512", "height = 64"))
+    out = tmp_path / "s"
+    result = cut_new_session(NewSessionRequest(cfg, out, lights=8, adaptive=True), after_step=4)
+    assert result.finish_reason is FinishReason.CANCELLED
+    shot = journal(out)
+    shutil.copytree(out, tmp_path / "copy")
+    narrowed = cfg.read_text().replace("min_elevation_deg = 5.0", "min_elevation_deg = 25.0")
+    cfg.write_text(narrowed.replace("max_elevation_deg = 80.0", "max_elevation_deg = 50.0"))
+
+    r = runner.invoke(app, ["run", "--resume", "s", "--accept-rig-change", "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "5 image(s) already shot could not be taken on the rig as changed (step 1" in said
+    assert "step 5: elevation 51.18° is above the arm's maximum 50°" in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["runner"]["finish_reason"] == "completed", manifest["runner"]
+    assert len(manifest["runs"][-1]["shot_before_rig_change"]["steps"]) == 5
+    steps = journal(out)
+    assert len(steps) == 8 and steps[:5] == shot  # kept as recorded
+    elevations = np.degrees(np.arcsin([s["planned_direction"][2] for s in steps[5:]]))
+    assert np.all((elevations >= 25.0) & (elevations <= 50.0)), elevations
+
+    cancel = CancelToken()  # the copy: accepted, cut after one light more, resumed again
+
+    def cut(event: object) -> None:
+        if isinstance(event, StepCompleted) and event.index == 5:
+            cancel.cancel()
+
+    copy = tmp_path / "copy"
+    run_it(open_resumed_session(ResumeRequest(copy, accept_rig_change=True)), cancel, cut)
+    r = runner.invoke(app, ["run", "--resume", "copy", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    again = journal(copy)
+    key = [(s["led"], s["planned_direction"]) for s in steps]
+    assert [(s["led"], s["planned_direction"]) for s in again] == key
+    assert decisions(copy) == decisions(out)

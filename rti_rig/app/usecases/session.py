@@ -20,7 +20,7 @@ from rti_rig.app.usecases.run_options import run_words
 from rti_rig.core.errors import ConfigError, RtiRigError, ScheduleError
 from rti_rig.core.out_folders import free_folder_beside, free_name
 from rti_rig.core.rig_geometry import led_fields
-from rti_rig.core.schedule import LightSchedule
+from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.controller import (
     CancelToken,
@@ -1921,9 +1921,11 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     # the steps still to shoot, at their own exposures, before the port opens
     _check_steps_fit_lit(loaded, schedule, frozenset(folder.done))
     _check_disk_holds_rest(loaded, folder, Path(req.session_dir))
-    # the steps still to shoot only: the ones shot are history (an adaptive run's layout is
-    # its start, no list of its steps)
-    shot = frozenset(folder.done) if "adaptive" not in folder.manifest else frozenset()
+    # the steps still to shoot only: the ones shot are history. An adaptive run's schedule is
+    # its starting layout, whose step i is the session's step i: its lights already shot are
+    # history too (it had checked its whole start, and refused a change that left only those
+    # out of reach); the steps it decides are each checked before they move
+    shot = frozenset(folder.done)
     try:
         rig = checked_rig(loaded, schedule, shot)
     except ScheduleError as exc:
@@ -1970,7 +1972,7 @@ def _say_shot_beyond(  # type: ignore[no-untyped-def]
     changed rig's work."""
     from rti_rig.runtime.controller import schedule_problems
 
-    beyond = schedule_problems(rig, schedule, sorted(shot))
+    beyond = schedule_problems(rig, _as_shot(schedule, folder), sorted(shot))
     if not beyond:
         return
     folder.shot_beyond_change = beyond
@@ -1985,6 +1987,20 @@ def _say_shot_beyond(  # type: ignore[no-untyped-def]
             "warning",
         )
     )
+
+
+def _as_shot(schedule: LightSchedule, folder) -> LightSchedule:  # type: ignore[no-untyped-def]
+    """The session's steps as they were shot, to check against a changed rig: the schedule's,
+    and past an adaptive session's starting layout the lights it chose, as its records keep
+    them (its schedule holds no step beyond the start)."""
+    done = folder.done  # an adaptive session's: steps 0..n-1, none missing (refuse_broken_run)
+    if len(done) <= len(schedule):
+        return schedule
+    chosen = (
+        LightStep(tuple(done[i].planned_direction), led=done[i].led)
+        for i in range(len(schedule), len(done))
+    )
+    return LightSchedule((*schedule.steps, *chosen), method=schedule.method)
 
 
 def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> OpenedSession:
