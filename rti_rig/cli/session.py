@@ -47,6 +47,7 @@ from rti_rig.core.fit_minimums import FIT_MINIMUMS, NORMAL_ERROR_LIMIT_DEG, NORM
 from rti_rig.core.out_folders import fit_beside, free_folder_beside, free_name
 
 if TYPE_CHECKING:
+    from rti_rig.app.usecases.session import OpenedSession
     from rti_rig.runtime.run_ending import RunEnding
 
 #: ``--max-saturated`` of ``run`` and ``preview``: None when not given (only metering reads it,
@@ -1693,10 +1694,17 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             return
         if not stepped:
             # "Stopping after this image" had been said while the rig was being connected,
-            # no image under way (an arm's connect, its baud scan), the connect going on
-            doing = _BEFORE_FIRST_STEP.get(before_first or "", _BEFORE_FIRST_STEP["lights"])
+            # no image under way (an arm's connect, its baud scan), the connect going on; a
+            # resumed run's images already there are no "any image" still to take
+            kept = len(opened.folder.done)
+            what = (
+                f"image {_first_new_image(opened)} is taken (the {kept} already in the "
+                "session are kept)"
+                if kept
+                else "any image is taken"
+            )
             err.print(
-                f"[yellow]Stopping before any image is taken: {doing} "
+                f"[yellow]Stopping before {what}: {_preparing(opened, before_first)} "
                 "(Ctrl-C again to stop at once)…[/]"
             )
             return
@@ -1736,6 +1744,13 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         if cancel.paused:
             cancel.resume()
             err.print("[green]Resuming.[/]")
+        elif not stepped:  # no image under way to pause after: the rig is still connecting
+            cancel.pause()
+            first = _first_new_image(opened)
+            err.print(
+                f"[yellow]Pausing before image {first} is taken: "
+                f"{_preparing(opened, before_first)}; SIGUSR1 again resumes.[/]"
+            )
         else:
             cancel.pause()
             err.print("[yellow]Pausing after this image; SIGUSR1 again resumes.[/]")
@@ -1882,16 +1897,33 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         return _summarise(opened, result, resume_hint(), dry)
 
 
-#: What a first Ctrl-C before the run's first step is told is under way, by the controller's
-#: :class:`~rti_rig.runtime.controller.Preparing` phase ("paused": a SIGUSR1 pause before it).
+#: What a first Ctrl-C or SIGUSR1 before the run's first step is told is under way, by the
+#: controller's :class:`~rti_rig.runtime.controller.Preparing` phase ("paused": a SIGUSR1
+#: pause before it); ``{first}`` is the run's first image (:func:`_preparing`).
 #: Why: "the rig is being connected" had been said of every wait there alike.
 _BEFORE_FIRST_STEP = {
     "lights": "the rig is being connected",
     "camera": "the camera is being connected",
     "card": "the camera's card is being listed",
-    "ready": "the rig is connected, its first image about to begin",
-    "paused": "the capture is paused before its first image",
+    "ready": "the rig is connected, {first} about to begin",
+    "paused": "the capture is paused before {first}",
 }
+
+
+def _first_new_image(opened: OpenedSession) -> int:
+    """The number (1-based) of the first image this run takes: a resumed session's first step
+    not yet on disk, a new one's 1."""
+    done = opened.folder.done
+    return next((i + 1 for i in range(opened.total_steps) if i not in done), 1)
+
+
+def _preparing(opened: OpenedSession, phase: str | None) -> str:
+    """What is under way before this run's first step, in :data:`_BEFORE_FIRST_STEP`'s words.
+    A resumed run's first image is named by its number: "its first image" had been said of a
+    session that held images."""
+    first = f"image {_first_new_image(opened)}" if opened.folder.done else "its first image"
+    said = _BEFORE_FIRST_STEP.get(phase or "", _BEFORE_FIRST_STEP["lights"])
+    return said.format(first=first)
 
 
 #: What a Ctrl-C once the capture has ended (returned, raised or been stopped) is told.
