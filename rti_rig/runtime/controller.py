@@ -800,13 +800,16 @@ def run_session(
     preview's one image).
 
     With ``source`` the steps are the source's decisions, step by step (adaptive acquisition);
-    ``schedule`` is then the starting layout recorded in the manifest, checked like any other.
+    ``schedule`` is then the starting layout recorded in the manifest, checked where the
+    session is opened (each step the source decides is checked before it moves).
     """
     # a resume's steps already shot are not checked again (an accepted rig change may have
-    # left them out of its reach); an adaptive run's schedule is its starting layout, step i
-    # its step i, so its lights shot are left aside alike (each step it decides is checked
-    # before it moves)
-    validate_schedule(rig, schedule, frozenset(folder.done))
+    # left them out of its reach). An adaptive run's steps are its source's decisions, each
+    # checked before it moves, below: its starting layout as recorded is not what a resume on
+    # a changed rig shoots (the start is placed again on the rig as it is), and is checked
+    # where the session is opened
+    skip = frozenset(folder.done) if source is None else frozenset(range(len(schedule)))
+    validate_schedule(rig, schedule, skip)
     total = len(schedule) if source is None else source.total
     if folder.total_steps != total:
         raise ScheduleError("session folder was sized for another schedule")

@@ -167,3 +167,34 @@ def test_an_adaptive_session_narrowed_where_it_shot_resumes_keeping_them(
     key = [(s["led"], s["planned_direction"]) for s in steps]
     assert [(s["led"], s["planned_direction"]) for s in again] == key
     assert decisions(copy) == decisions(out)
+
+
+def test_an_adaptive_start_left_to_shoot_is_placed_on_the_narrowed_reach(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same session cut within its start (3 of its 4 lights shot; the fourth recorded at
+    53.3°), the reach narrowed to 25..50°: the resume places what is left of the start on the
+    arm as it is now, and had refused the recorded 53.3°, a light it would not have taken."""
+    import numpy as np
+    from conftest import journal
+
+    monkeypatch.chdir(tmp_path)
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace("width = 512", "width = 64").replace("height = 512", "height = 64"))
+    out = tmp_path / "s"
+    result = cut_new_session(NewSessionRequest(cfg, out, lights=8, adaptive=True), after_step=2)
+    assert result.finish_reason is FinishReason.CANCELLED
+    shot = journal(out)
+    narrowed = cfg.read_text().replace("min_elevation_deg = 5.0", "min_elevation_deg = 25.0")
+    cfg.write_text(narrowed.replace("max_elevation_deg = 80.0", "max_elevation_deg = 50.0"))
+
+    r = runner.invoke(app, ["run", "--resume", "s", "--accept-rig-change", "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "53.28" not in said, said
+    assert "3 image(s) already shot could not be taken on the rig as changed (step 1" in said
+    steps = journal(out)
+    assert len(steps) == 8 and steps[:3] == shot
+    elevations = np.degrees(np.arcsin([s["planned_direction"][2] for s in steps[3:]]))
+    assert np.all((elevations >= 25.0) & (elevations <= 50.0)), elevations

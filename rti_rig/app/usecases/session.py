@@ -1921,42 +1921,57 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     # the steps still to shoot, at their own exposures, before the port opens
     _check_steps_fit_lit(loaded, schedule, frozenset(folder.done))
     _check_disk_holds_rest(loaded, folder, Path(req.session_dir))
-    # the steps still to shoot only: the ones shot are history. An adaptive run's schedule is
-    # its starting layout, whose step i is the session's step i: its lights already shot are
-    # history too (it had checked its whole start, and refused a change that left only those
-    # out of reach); the steps it decides are each checked before they move
+    # the steps still to shoot only: the ones shot are history (a change accepted that left
+    # only those out of reach had refused the resume). An adaptive session's recorded layout
+    # is not checked here: its start is placed again on the rig as it is now, and what is
+    # left of that is checked once its step source is built, below (the layout recorded had
+    # refused a light the resume would not take)
+    adaptive = "adaptive" in folder.manifest
     shot = frozenset(folder.done)
     try:
-        rig = checked_rig(loaded, schedule, shot)
+        rig = checked_rig(loaded, schedule, frozenset(range(len(schedule))) if adaptive else shot)
     except ScheduleError as exc:
-        if not diffs:
-            raise
-        # an accepted change (an arm's reach narrowed) that leaves the session's own lights
-        # out of reach: the list alone had said what, not what to do. Said as steps that
-        # cannot run, not "out of its reach": the refusal may be a narrower camera's exposure
-        # range or a timed firmware's window, a change as accepted
-        session = Path(req.session_dir)
-        again = free_folder_beside(session, "again")
-        raise ScheduleError(
-            f"{exc}\nThe rig change accepted ({'; '.join(diffs)}) leaves these steps of "
-            f"{shown_path(session)} unable to run on it: to finish the session, set "
-            f"{shown_path(loaded.path)} back as it began (its copy is in "
-            f"{shown_path(session / 'manifest.json')}, under rig.config) and resume; or shoot "
-            f"a new session on the rig as it is: {run_words(loaded.path, again)}"
-        ) from None
-    if diffs and shot:
-        _say_shot_beyond(rig, schedule, folder, shot, on_note)
+        raise _refused_on_changed_rig(exc, diffs, loaded, req) from None
     source = None
-    if "adaptive" in folder.manifest:
+    if adaptive:
         from rti_rig.app.usecases.adaptive import resume_adaptive_source
 
         try:
             source = resume_adaptive_source(rig, folder, req.objective)
+            # the start's lights still to shoot; each light chosen after it is checked
+            # before it moves (run_session)
+            validate_schedule(rig, source.start_schedule(), shot)
+        except ScheduleError as exc:
+            rig.close_said()
+            raise _refused_on_changed_rig(exc, diffs, loaded, req) from None
         except BaseException:
             rig.close_said()  # its failures said, never in place of the error raised
             raise
+    if diffs and shot:
+        _say_shot_beyond(rig, schedule, folder, shot, on_note)
     return OpenedSession(
         rig, schedule, folder, Path(req.session_dir), resumed=True, source=source, request=req
+    )
+
+
+def _refused_on_changed_rig(  # type: ignore[no-untyped-def]
+    exc: ScheduleError, diffs: list[str], loaded, req: ResumeRequest
+) -> ScheduleError:
+    """The refusal of a resume whose steps still to shoot cannot run: with an accepted change
+    (an arm's reach narrowed) that leaves the session's own lights out of reach, what to do
+    too (the list alone had said what, not what to do). Said as steps that cannot run, not
+    "out of its reach": the refusal may be a narrower camera's exposure range or a timed
+    firmware's window, a change as accepted."""
+    if not diffs:
+        return exc
+    session = Path(req.session_dir)
+    again = free_folder_beside(session, "again")
+    return ScheduleError(
+        f"{exc}\nThe rig change accepted ({'; '.join(diffs)}) leaves these steps of "
+        f"{shown_path(session)} unable to run on it: to finish the session, set "
+        f"{shown_path(loaded.path)} back as it began (its copy is in "
+        f"{shown_path(session / 'manifest.json')}, under rig.config) and resume; or shoot "
+        f"a new session on the rig as it is: {run_words(loaded.path, again)}"
     )
 
 
