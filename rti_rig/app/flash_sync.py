@@ -19,8 +19,11 @@ Everything that would fire the camera outside the sequence steps the dome too, s
 
 from __future__ import annotations
 
+import errno
 import json
+import tempfile
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
@@ -165,7 +168,7 @@ class SlipGuard:
                     f"firmware's last, {self._led(last)}: the dome reached the end of "
                     "its sequence one image early, so it stepped twice earlier, where the check "
                     "did not see it. The labels in lights.lp from that step on are WRONG: do not "
-                    f"use this session. Image {index + 1} is kept, unlabelled, as {kept}.",
+                    f"use this session. {kept.said('Image ' + str(index + 1))}.",
                 )
                 + f" {rewind}"
             )
@@ -180,14 +183,14 @@ class SlipGuard:
                     f"image {index + 1} was not lit by {self._led(index)} of the dome's order — "
                     f"{what}: {verdict.reason}. A slip in the first images is seen only some "
                     f"images later, so images {first}–{index} in lights.lp may be mislabelled: "
-                    f"do not use this session. Image {index + 1} is kept, unlabelled, as {kept}.",
+                    f"do not use this session. {kept.said('Image ' + str(index + 1))}.",
                 )
                 + f" {rewind}"
             )
         before = f"images 1–{index}" if index > 1 else ("image 1" if index == 1 else "no image")
         raise LightSlipError(
             f"image {index + 1} was not lit by {self._led(index)} of the dome's order — {what}: "
-            f"{verdict.reason}. The image is kept, unlabelled, as {kept}; lights.lp lists "
+            f"{verdict.reason}. {kept.said('The image')}; lights.lp lists "
             f"{before} only. {rewind}"
         )
 
@@ -202,7 +205,7 @@ class SlipGuard:
             return self.geometry.led_said(index)
         return f"LED {index}"
 
-    def _after_dark(self, index: int, verdict: Any, kept: str, root: Path, rewind: str) -> str:
+    def _after_dark(self, index: int, verdict: Any, kept: Kept, root: Path, rewind: str) -> str:
         """What a dark image was, from one more frame (:meth:`SequenceChecker.judge_after_dark`).
 
         A missed pulse and a dead LED both give a dark image, but a missed pulse leaves the
@@ -226,7 +229,7 @@ class SlipGuard:
         )
         if self.shoot is None:
             return (
-                f"{head}: {either}. The image is kept, unlabelled, as {kept}; lights.lp lists "
+                f"{head}: {either}. {kept.said('The image')}; lights.lp lists "
                 f"{listed} only. {rewind_either}"
             )
         try:
@@ -234,7 +237,7 @@ class SlipGuard:
         except DeviceError as exc:  # the dark image's own message is what matters: say both
             return (
                 f"{head}: {either}; the frame that would tell them apart could not be shot "
-                f"({exc}). The image is kept, unlabelled, as {kept}; lights.lp lists {listed} "
+                f"({exc}). {kept.said('The image')}; lights.lp lists {listed} "
                 f"only. Look at {led} during a flash and check the camera's PC-sync cable. "
                 f"{rewind_either}"
             )
@@ -245,7 +248,7 @@ class SlipGuard:
             "residuals": None if residuals is None else {str(p): r for p, r in residuals.items()},
         }
         check = _keep(root, index + 1, frame, record, stem="check")
-        shot = f"the frame shot after it to tell, kept unlabelled as {check},"
+        shot = f"the frame shot after it to tell ({check.said('it')})"
         end = self.settings.firmware_led_count == n and index == n - 1
         due, nxt = (residuals or {}).get(index), (residuals or {}).get(index + 1)
         dead = missed = False
@@ -271,7 +274,7 @@ class SlipGuard:
         if dead:
             return (
                 f"image {k} is dark: {led} did not light (dead LED?); the dome stepped on: "
-                f"{why}. Image {k}: {verdict.reason}; it is kept, unlabelled, as {kept}. The "
+                f"{why}. Image {k}: {verdict.reason}; {kept.said('it')}. The "
                 f"session's other images are good as far as the per-image check can tell: "
                 f"lights.lp lists {listed}, each matched to its LED (the run stopped before its "
                 f"end-of-run proof, so {DISOWN_MARKER} stays in the session). Repair or replace "
@@ -283,11 +286,11 @@ class SlipGuard:
             return (
                 f"{head}: missed step — the flash pulse did not reach the dome, which therefore "
                 f"did not step: {why}. Check the camera's PC-sync cable and flash-contact "
-                f"setting. The image is kept, unlabelled, as {kept}; lights.lp lists {listed} "
+                f"setting. {kept.said('The image')}; lights.lp lists {listed} "
                 f"only. {rewind}"
             )
         return (
-            f"{head}: {either}; {why}. The image is kept, unlabelled, as {kept}; lights.lp "
+            f"{head}: {either}; {why}. {kept.said('The image')}; lights.lp "
             f"lists {listed} only. Look at {led} during a flash and check the camera's "
             f"PC-sync cable. {rewind_either}"
         )
@@ -321,10 +324,7 @@ class SlipGuard:
             marker = Path(root) / DISOWN_MARKER
             if marker.read_text(encoding="utf-8").strip() == NOT_PROVEN.strip():
                 marker.unlink()  # proven: only the "not yet proven" reason was in it
-            return [
-                f"end-of-run proof passed: {proof.reason}. The proof frame is kept, "
-                f"unlabelled, as {kept}"
-            ]
+            return [f"end-of-run proof passed: {proof.reason}. {kept.said('The proof frame')}"]
         what = (
             "cannot verify the dome's order"
             if proof.kind == "cannot-verify"
@@ -335,7 +335,7 @@ class SlipGuard:
                 root,
                 f"end-of-run proof failed — {what}: {proof.reason}. The labels in lights.lp may "
                 "be mislabelled (every image from the unseen slip on): do not use this session. "
-                f"The proof frame is kept, unlabelled, as {kept}.",
+                f"{kept.said('The proof frame')}.",
             )
             + " The dome's count no longer matches the session: long-press its start button to "
             "rewind it, then start a new session"
@@ -351,40 +351,74 @@ NOT_PROVEN = (
 )
 
 
+@dataclass(frozen=True)
+class Kept:
+    """Where a slipped, check or proof frame went: ``where`` (shown as a shell word), or None
+    when no disk took it; ``note`` says why it is not under ``unlabelled/`` and what to do.
+
+    Why: a disk that refused ``unlabelled/`` had ended the run in that write error alone: the
+    slip (which image, missed or double step) was never said, and the frame, in memory only,
+    was lost with it."""
+
+    where: str | None
+    note: str = ""
+
+    def said(self, subject: str) -> str:
+        """``subject`` (``The image``, ``Image 4``, ``it``) with where it is kept, or why not."""
+        if self.where is None:
+            return f"{subject} could not be kept anywhere: {self.note}"
+        return f"{subject} is kept, unlabelled, as {self.where}{self.note}"
+
+
 def _keep(
     root: Path, index: int, frame: Frame, verdict: dict[str, Any], stem: str = "image"
-) -> str:
-    """:func:`keep_unlabelled`, with a write failure as a named error (the session is already
-    marked as not proven, so its labels are not used either way)."""
+) -> Kept:
+    """:func:`keep_unlabelled`; if the session's disk refuses it, the same files in a folder of
+    the system's temporary directory (another disk, often), said with the refusal and what to
+    do; if that fails too, both refusals and where the camera's own file is, if it has one.
+    Never raises for the disk: the slip that called this must still be said."""
     try:
-        return keep_unlabelled(root, index, frame, verdict, stem)
+        return Kept(keep_unlabelled(root, index, frame, verdict, stem))
     except OSError as exc:
-        folder = root / UNLABELLED_DIR
-        path = Path(exc.filename) if isinstance(exc.filename, str) else folder
-        raise UnlabelledNotKeptError(path, exc, f"{stem} {index + 1}", folder) from None
-
-
-class UnlabelledNotKeptError(SessionWriteError):
-    """A slipped, check or proof image the disk refused under ``unlabelled/``: the file, the
-    system's reason, which image, and what to do.
-
-    Why: :func:`_keep` had raised ``SessionWriteError`` with its words alone, but that class
-    takes the file and the ``OSError``: a full disk there ended the run in "unexpected
-    TypeError … please report it" instead of these words."""
-
-    def __init__(self, path: Path, exc: OSError, image: str, folder: Path) -> None:
-        super().__init__(path, exc)
-        if self.errno_name in ("ENOSPC", "EDQUOT", "EFBIG"):
-            fix = "free space on that disk"
-        elif self.errno_name == "EROFS":
-            fix = "make that disk writable"
-        else:
-            fix = "check that disk"
-        self.args = (
-            f"{self.args[0]}: could not keep the unlabelled {image} under {shown_path(folder)}. "
-            f"The session is marked {DISOWN_MARKER} (its labels are not used); {fix} and "
-            "start a new session",
+        refused = _refusal(root / UNLABELLED_DIR, exc)
+        fix = _fix_for(exc)
+    aside = Path(tempfile.gettempdir()) / f"rti-rig-unlabelled-{Path(root).name}"
+    try:
+        rel = keep_unlabelled(aside, index, frame, verdict, stem, folder=aside)
+    except OSError as exc2:
+        originals = [
+            str(Path(item["path"]).relative_to(root))
+            if Path(item["path"]).is_relative_to(root)
+            else str(item["path"])
+            for item in frame.metadata.get("originals") or []
+        ]
+        camera = (
+            f"the camera's own file stays as {', '.join(shown_path(Path(o)) for o in originals)}"
+            if originals
+            else "the frame was in memory only and is lost"
         )
+        return Kept(None, f"{refused}; nor aside: {_refusal(aside, exc2)}; {camera}")
+    kept = aside / Path(rel).name
+    return Kept(
+        shown_path(kept),
+        f" (outside the session: {refused}; {fix}, then move {stem}_{index + 1:03d}* from "
+        f"{shown_path(aside)} into {shown_path(root / UNLABELLED_DIR)}, before the temporary "
+        "folder is emptied)",
+    )
+
+
+def _refusal(folder: Path, exc: OSError) -> str:
+    """``cannot write FILE: reason (ENOSPC)``, as a session's write error says it."""
+    path = Path(exc.filename) if isinstance(exc.filename, str) else folder
+    return str(SessionWriteError(path, exc))
+
+
+def _fix_for(exc: OSError) -> str:
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+        return "free space on that disk"
+    if exc.errno == errno.EROFS:
+        return "make that disk writable"
+    return "check that disk"
 
 
 def _disowned(root: Path, reason: str) -> str:
@@ -395,7 +429,12 @@ def _disowned(root: Path, reason: str) -> str:
 
 
 def keep_unlabelled(
-    root: Path, index: int, frame: Frame, verdict: dict[str, Any], stem: str = "image"
+    root: Path,
+    index: int,
+    frame: Frame,
+    verdict: dict[str, Any],
+    stem: str = "image",
+    folder: Path | None = None,
 ) -> str:
     """Write a slipped (or proof) image under ``unlabelled/`` (linear TIFF, sRGB JPEG, the
     verdict), its files labelled and tagged as a session's of the same decode are."""
@@ -407,7 +446,7 @@ def keep_unlabelled(
         write_untagged_jpeg,
     )
 
-    folder = root / UNLABELLED_DIR
+    folder = root / UNLABELLED_DIR if folder is None else folder
     folder.mkdir(parents=True, exist_ok=True)
     base = f"{stem}_{index + 1:03d}"
     tif = folder / f"{base}.tif"
@@ -425,7 +464,7 @@ def keep_unlabelled(
     writer = write_srgb_jpeg if srgb else write_untagged_jpeg
     writer(folder / f"{base}.jpg", linear_to_srgb8(frame.pixels, frame.white_level))
     (folder / f"{base}.json").write_text(json.dumps(verdict, indent=1) + "\n", encoding="utf-8")
-    return f"{UNLABELLED_DIR}/{base}.tif"
+    return f"{folder.name}/{base}.tif"
 
 
 def emulated_flash_sync_camera(loaded, geometry: DomeGeometry, clock: Clock):  # type: ignore[no-untyped-def]

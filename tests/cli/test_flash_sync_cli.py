@@ -492,42 +492,66 @@ def test_a_check_frame_the_camera_fails_leaves_both_causes_named(  # type: ignor
     assert (out / "unlabelled" / "image_006.tif").is_file()
 
 
-def test_a_full_disk_under_unlabelled_is_said_with_the_file_and_what_to_do(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+@pytest.mark.parametrize("aside_too", [False, True])
+def test_a_full_disk_under_unlabelled_still_says_the_slip_and_keeps_the_frame_aside(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, aside_too: bool
 ) -> None:
-    """The slipped image's unlabelled copy refused by the disk: said with the file, the
-    system's reason and what to do. ``_keep`` had built its SessionWriteError from its words
-    alone, a call that class refuses: the run ended in "unexpected TypeError … please report
-    it"."""
+    """The slipped image's unlabelled copy refused by the disk: the slip (which image, which
+    step) is still said, the stop a slip gets; the frame is kept in the temporary folder, said
+    with the refusal and what to do, or, if that is refused too, said lost with both refusals.
+    The refusal alone had been said ("cannot write …/unlabelled/image_004.tif … start a new
+    session"): the double step at image 4 never named, and the frame gone with the run."""
     import errno
+    import tempfile
 
     import rti_rig.core.image_files as image_files
 
     real = image_files.write_linear_tiff
+    refused = {"unlabelled", "rti-rig-unlabelled-s"} if aside_too else {"unlabelled"}
 
     def full_under_unlabelled(path, *args, **kwargs):  # type: ignore[no-untyped-def]
-        if Path(path).parent.name != "unlabelled":
+        if Path(path).parent.name not in refused:
             return real(path, *args, **kwargs)
         raise OSError(errno.ENOSPC, "No space left on device", str(path))
 
     monkeypatch.setattr(image_files, "write_linear_tiff", full_under_unlabelled)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
     out = tmp_path / "s"
-    config = with_fault(tmp_path, 3, "double_step")
+    config = with_fault(tmp_path, 4, "double_step")
     result = runner.invoke(app, ["run", str(config), "--out", str(out)])
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())
-    assert "TypeError" not in text and "please report it" not in text, text
-    said = (
-        f"cannot write {out / 'unlabelled' / 'image_004.tif'}: No space left on device (ENOSPC): "
-        f"could not keep the unlabelled image 4 under {out / 'unlabelled'}. The session is "
-        "marked LABELS_NOT_VERIFIED.txt (its labels are not used); free space on that disk and "
-        "start a new session"
+    assert "Traceback" not in text and "please report it" not in text, text
+    assert f"image 4 was not lit by {led(3)} of the dome's order — double step" in text, text
+    refusal = (
+        f"cannot write {out / 'unlabelled' / 'image_004.tif'}: No space left on device (ENOSPC)"
     )
+    aside = tmp_path / "tmp" / "rti-rig-unlabelled-s"
+    if aside_too:
+        said = (
+            f"Image 4 could not be kept anywhere: {refusal}; nor aside: cannot write "
+            f"{aside / 'image_004.tif'}: No space left on device (ENOSPC); the frame was in "
+            "memory only and is lost"
+        )
+        assert not (aside / "image_004.tif").exists()
+    else:
+        said = (
+            f"Image 4 is kept, unlabelled, as {aside / 'image_004.tif'} (outside the "
+            f"session: {refusal}; free space on that disk, then move image_004* from {aside} "
+            f"into {out / 'unlabelled'}, before the temporary folder is emptied)."
+        )
+        kept = aside / "image_004"
+        assert kept.with_suffix(".tif").is_file() and kept.with_suffix(".json").is_file()
+        assert (
+            tifffile.imread(kept.with_suffix(".tif")).shape[:2]
+            == tifffile.imread(out / "linear" / "image_001.tif").shape[:2]
+        )
     assert said in text, text
-    assert (out / "LABELS_NOT_VERIFIED.txt").is_file()  # as said: fit and export-lp refuse it
+    assert len(read_lp(out / "lights.lp")) == 3
     manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
-    assert manifest["runner"]["finish_reason"] == "write-failed"
-    assert manifest["runner"]["error"] == said
+    assert manifest["runner"]["finish_reason"] == "error"
+    assert said in manifest["runner"]["error"]
 
 
 def test_refusals_give_the_run_of_the_config_actually_used(tmp_path: Path, rigs) -> None:  # type: ignore[no-untyped-def]
