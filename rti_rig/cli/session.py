@@ -1166,11 +1166,21 @@ def _said_lp_unwritten(s: _Stop) -> str:
     if s.cannot:
         from rti_rig.runtime.session import LP_NAME
 
-        # a file not there yet: the session's own lights.lp where it is missing, else beside it
-        # (a session's lights.lp is never replaced); '--out FILE.lp' had been printed, which
-        # pasted wrote a file named FILE.lp
-        lp = _arg(free_name(s.out_dir / LP_NAME))
+        # a file not there yet: the session's own lights.lp where it is missing, else a file
+        # beside the session folder (a session's lights.lp is never replaced). It had been
+        # lights-2.lp inside the session: relight-cli given the folder reads the first .lp by
+        # name, case ignored (export._relight_reads), lights-2.lp before lights.lp, while fit and
+        # RTIBuilder read lights.lp: one folder, two listings. '--out FILE.lp' had been
+        # printed before that, which pasted wrote a file named FILE.lp
+        own = s.out_dir / LP_NAME
+        missing = not own.exists()
+        lp = _arg(own if missing else free_name(s.out_dir.with_name(f"{s.out_dir.name}.lp")))
         remedy = f"`rti-rig export-lp {_arg(s.out_dir)} --out {lp}` writes one from the journal"
+        if not missing:
+            remedy += (
+                f", beside the session: its own {LP_NAME} is never replaced, and a second .lp "
+                "inside it is the one relight-cli reads first"
+            )
     else:
         remedy = "the resume writes it again"
     return (

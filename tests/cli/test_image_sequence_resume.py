@@ -148,3 +148,38 @@ def test_a_lights_lp_its_write_failed_is_exported_by_a_command_that_pastes(
     done = runner.invoke(app, shlex.split(command)[1:])
     assert done.exit_code == 0, done.output
     assert len(read_lp(out / "lights.lp")) == 1
+
+
+def test_a_lights_lp_left_short_is_exported_beside_the_session_never_inside_it(
+    dome, tmp_path: Path
+) -> None:
+    """lights.lp there but short of the journal (its second write refused): the export advised
+    is a file beside the session. It had been ``lights-2.lp`` inside it, which relight-cli given
+    the folder reads first (the first .lp by name, case ignored) while fit and RTIBuilder read
+    lights.lp: one folder, two listings. The session's lights.lp is left as it was."""
+    import errno
+    import shlex
+
+    from rti_rig.core.lp_format import read_lp
+    from rti_rig.testing.disk_faults import failing_writes
+
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for i in range(6):
+        cv2.imwrite(str(frames / f"f_{i:03d}.png"), np.full((24, 32, 3), 40 + 30 * i, np.uint8))
+    config = _config(tmp_path, frames)
+    out = tmp_path / "s"
+    with failing_writes("lp", after=1, errno_code=errno.ENOSPC):
+        r = runner.invoke(app, ["run", str(config), "--out", str(out), "--lights", "6"])
+    assert r.exit_code == 2, r.output
+    said = " ".join(r.output.split())
+    assert "lights.lp could not be written and lists only 1 of them" in said, said
+    command = said.split("(`", 1)[1].split("` writes one from the journal", 1)[0]
+    assert command == f"rti-rig export-lp {out} --out {tmp_path / 's.lp'}", command
+    assert "a second .lp inside it is the one relight-cli reads first" in said, said
+    own = (out / "lights.lp").read_bytes()
+    done = runner.invoke(app, shlex.split(command)[1:])
+    assert done.exit_code == 0, done.output
+    assert len(read_lp(tmp_path / "s.lp")) == 2
+    assert (out / "lights.lp").read_bytes() == own  # never replaced
+    assert sorted(p.name for p in out.glob("*.lp")) == ["lights.lp"]
