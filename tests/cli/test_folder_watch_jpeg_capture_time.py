@@ -126,6 +126,18 @@ def test_an_extra_jpeg_after_a_pulse_is_set_aside_and_a_rotated_one_is_said(tmp_
         "JPEG's pixels as stored" in said
     ), said
     assert "fitting is unaffected (docs/cameras.md) [3 of 3 images]" in said, said
+    # the stray is never one of the session's lights: export-lp (JPEGs and --linear) lists the
+    # three images with the lights lights.lp gives them, read back by the tolerant reader
+    from rti_rig.core.lp_format import read_lp
+
+    fired = [e.direction for e in read_lp(out / "lights.lp")]
+    for args, names in (([], "image_{:03d}.jpg"), (["--linear"], "linear/image_{:03d}.tif")):
+        lp = tmp_path / f"export{len(args)}.lp"
+        done = CliRunner().invoke(app, ["export-lp", str(out), "--out", str(lp), *args])
+        assert done.exit_code == 0, done.output
+        entries = read_lp(lp)
+        assert [e.name for e in entries] == [names.format(k) for k in (1, 2, 3)], entries
+        assert [e.direction for e in entries] == fired
 
 
 def test_a_refused_jpeg_names_the_key_its_table_and_where_the_shot_is_left(tmp_path, monkeypatch):
