@@ -1178,8 +1178,8 @@ def _said_lp_unwritten(s: _Stop) -> str:
         remedy = f"`rti-rig export-lp {_arg(s.out_dir)} --out {lp}` writes one from the journal"
         if not missing:
             remedy += (
-                f", beside the session: its own {LP_NAME} is never replaced, and a second .lp "
-                "inside it is the one relight-cli reads first"
+                f", beside the session: its own {LP_NAME} is never replaced, and lights-2.lp "
+                "inside it would be the .lp relight-cli reads first"
             )
     else:
         remedy = "the resume writes it again"

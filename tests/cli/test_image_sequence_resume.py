@@ -176,7 +176,7 @@ def test_a_lights_lp_left_short_is_exported_beside_the_session_never_inside_it(
     assert "lights.lp could not be written and lists only 1 of them" in said, said
     command = said.split("(`", 1)[1].split("` writes one from the journal", 1)[0]
     assert command == f"rti-rig export-lp {out} --out {tmp_path / 's.lp'}", command
-    assert "a second .lp inside it is the one relight-cli reads first" in said, said
+    assert "lights-2.lp inside it would be the .lp relight-cli reads first" in said, said
     own = (out / "lights.lp").read_bytes()
     done = runner.invoke(app, shlex.split(command)[1:])
     assert done.exit_code == 0, done.output
