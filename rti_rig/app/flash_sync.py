@@ -377,12 +377,15 @@ def _keep(
     the system's temporary directory (another disk, often), said with the refusal and what to
     do; if that fails too, both refusals and where the camera's own file is, if it has one.
     Never raises for the disk: the slip that called this must still be said."""
+    folder = root / UNLABELLED_DIR
+    before = set(folder.iterdir()) if folder.is_dir() else set()
     try:
         return Kept(keep_unlabelled(root, index, frame, verdict, stem))
     except OSError as exc:
-        refused = _refusal(root / UNLABELLED_DIR, exc)
+        refused = _refusal(folder, exc)
         fix = _fix_for(exc)
-    aside = Path(tempfile.gettempdir()) / f"rti-rig-unlabelled-{Path(root).name}"
+    # a folder of its own: another session of the same name may have left one there
+    aside = free_name(Path(tempfile.gettempdir()) / f"rti-rig-unlabelled-{root.name}", folder=True)
     try:
         rel = keep_unlabelled(aside, index, frame, verdict, stem, folder=aside)
     except OSError as exc2:
@@ -398,12 +401,14 @@ def _keep(
             else "the frame was in memory only and is lost"
         )
         return Kept(None, f"{refused}; nor aside: {_refusal(aside, exc2)}; {camera}")
-    kept = aside / Path(rel).name
+    # what the refused attempt left under unlabelled/ (its TIFF, say, without its JPEG and
+    # verdict) is a part of what is whole aside: removed, so that the move said has no clash
+    for partial in (set(folder.iterdir()) if folder.is_dir() else set()) - before:
+        partial.unlink(missing_ok=True)
     return Kept(
-        shown_path(kept),
-        f" (outside the session: {refused}; {fix}, then move {stem}_{index + 1:03d}* from "
-        f"{shown_path(aside)} into {shown_path(root / UNLABELLED_DIR)}, before the temporary "
-        "folder is emptied)",
+        shown_path(aside / Path(rel).name),
+        f" (outside the session: {refused}; {fix}, then move the files of {shown_path(aside)} "
+        f"into {shown_path(folder)}, before the temporary folder is emptied)",
     )
 
 

@@ -492,31 +492,39 @@ def test_a_check_frame_the_camera_fails_leaves_both_causes_named(  # type: ignor
     assert (out / "unlabelled" / "image_006.tif").is_file()
 
 
-@pytest.mark.parametrize("aside_too", [False, True])
+@pytest.mark.parametrize("refused", ["tiff", "tiff, aside too", "jpeg"])
 def test_a_full_disk_under_unlabelled_still_says_the_slip_and_keeps_the_frame_aside(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, aside_too: bool
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, refused: str
 ) -> None:
     """The slipped image's unlabelled copy refused by the disk: the slip (which image, which
-    step) is still said, the stop a slip gets; the frame is kept in the temporary folder, said
-    with the refusal and what to do, or, if that is refused too, said lost with both refusals.
-    The refusal alone had been said ("cannot write …/unlabelled/image_004.tif … start a new
-    session"): the double step at image 4 never named, and the frame gone with the run."""
+    step) is still said, the stop a slip gets; the frame is kept in a folder of its own in the
+    temporary directory, said with the refusal and what to do (a part written under
+    unlabelled/ before the refusal is removed, so the move said does not clash), or, if that
+    is refused too, said lost with both refusals. The refusal alone had been said ("cannot
+    write …/unlabelled/image_004.tif … start a new session"): the double step at image 4 never
+    named, and the frame gone with the run."""
     import errno
     import tempfile
 
     import rti_rig.core.image_files as image_files
 
-    real = image_files.write_linear_tiff
-    refused = {"unlabelled", "rti-rig-unlabelled-s"} if aside_too else {"unlabelled"}
+    tmp = tmp_path / "tmp"
+    old = tmp / "rti-rig-unlabelled-s" / "image_004.tif"  # another session's, named alike
+    old.parent.mkdir(parents=True)
+    old.write_bytes(b"another session's")
+    aside = tmp / "rti-rig-unlabelled-s-2"
+    folders = {"unlabelled", aside.name} if refused == "tiff, aside too" else {"unlabelled"}
+    writers = ["write_srgb_jpeg", "write_untagged_jpeg"] if refused == "jpeg" else []
+    for name in writers or ["write_linear_tiff"]:
+        real = getattr(image_files, name)
 
-    def full_under_unlabelled(path, *args, **kwargs):  # type: ignore[no-untyped-def]
-        if Path(path).parent.name not in refused:
-            return real(path, *args, **kwargs)
-        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        def full_under_unlabelled(path, *args, _real=real, **kwargs):  # type: ignore[no-untyped-def]
+            if Path(path).parent.name not in folders:
+                return _real(path, *args, **kwargs)
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
 
-    monkeypatch.setattr(image_files, "write_linear_tiff", full_under_unlabelled)
-    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
-    (tmp_path / "tmp").mkdir()
+        monkeypatch.setattr(image_files, name, full_under_unlabelled)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp))
     out = tmp_path / "s"
     config = with_fault(tmp_path, 4, "double_step")
     result = runner.invoke(app, ["run", str(config), "--out", str(out)])
@@ -524,11 +532,9 @@ def test_a_full_disk_under_unlabelled_still_says_the_slip_and_keeps_the_frame_as
     text = " ".join(result.output.split())
     assert "Traceback" not in text and "please report it" not in text, text
     assert f"image 4 was not lit by {led(3)} of the dome's order — double step" in text, text
-    refusal = (
-        f"cannot write {out / 'unlabelled' / 'image_004.tif'}: No space left on device (ENOSPC)"
-    )
-    aside = tmp_path / "tmp" / "rti-rig-unlabelled-s"
-    if aside_too:
+    file = "image_004.jpg" if refused == "jpeg" else "image_004.tif"
+    refusal = f"cannot write {out / 'unlabelled' / file}: No space left on device (ENOSPC)"
+    if refused == "tiff, aside too":
         said = (
             f"Image 4 could not be kept anywhere: {refusal}; nor aside: cannot write "
             f"{aside / 'image_004.tif'}: No space left on device (ENOSPC); the frame was in "
@@ -538,16 +544,18 @@ def test_a_full_disk_under_unlabelled_still_says_the_slip_and_keeps_the_frame_as
     else:
         said = (
             f"Image 4 is kept, unlabelled, as {aside / 'image_004.tif'} (outside the "
-            f"session: {refusal}; free space on that disk, then move image_004* from {aside} "
+            f"session: {refusal}; free space on that disk, then move the files of {aside} "
             f"into {out / 'unlabelled'}, before the temporary folder is emptied)."
         )
         kept = aside / "image_004"
-        assert kept.with_suffix(".tif").is_file() and kept.with_suffix(".json").is_file()
+        assert all(kept.with_suffix(x).is_file() for x in (".tif", ".jpg", ".json"))
         assert (
-            tifffile.imread(kept.with_suffix(".tif")).shape[:2]
-            == tifffile.imread(out / "linear" / "image_001.tif").shape[:2]
+            tifffile.imread(kept.with_suffix(".tif")).shape
+            == tifffile.imread(out / "linear" / "image_001.tif").shape
         )
+        assert list((out / "unlabelled").glob("image_004*")) == []  # no part left to clash
     assert said in text, text
+    assert old.read_bytes() == b"another session's"  # never overwritten
     assert len(read_lp(out / "lights.lp")) == 3
     manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
     assert manifest["runner"]["finish_reason"] == "error"
