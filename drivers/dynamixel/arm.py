@@ -778,11 +778,14 @@ class DynamixelArm(ReadBackCarrier):
         )
 
     def _check_command(self) -> str:
-        """The check that parks this arm, its rig config named as shell words so that it
-        pastes and runs (a bare 'rti-rig check' is refused for its missing config); quoted
-        bare only for an arm opened without a rig config (the manual tools)."""
+        """The command that parks this arm and moves nothing else (``check --park-only``; the
+        plain check walks every self-test pose first), its rig config named as shell words so
+        that it pastes and runs (a bare 'rti-rig check' is refused for its missing config);
+        quoted with a placeholder only for an arm opened without a rig config (manual tools)."""
         config = self._bus.config
-        return f"rti-rig check {shell_word(config)}" if config else "'rti-rig check'"
+        if not config:
+            return "'rti-rig check RIG_CONFIG --park-only'"
+        return f"rti-rig check {shell_word(config)} --park-only"
 
     def _torque_record(self, off_sent: bool, on: list[Any], unknown: list[Any]) -> TorqueAtClose:
         """The close's :class:`TorqueAtClose` from Torque Enable as read back."""

@@ -79,6 +79,16 @@ def check(
             "moves and no torque is switched on; run check again afterwards.",
         ),
     ] = False,
+    park_only: Annotated[
+        bool,
+        typer.Option(
+            "--park-only",
+            help="Instead of the walk: connect the arm, switch its lamp off, move it to the "
+            "config's park pose and close it as its torque_policy says; nothing else moves. "
+            "Ctrl-C stops the park and holds the arm where it is. Refused for a dome or a "
+            "replay (no park pose).",
+        ),
+    ] = False,
     auto_exposure: Annotated[
         bool,
         typer.Option(
@@ -105,6 +115,24 @@ def check(
     from rti_rig.app.usecases.check import CheckRequest, CheckStopped, check_rig
     from rti_rig.runtime.controller import EmergencyStop
 
+    if park_only:
+        given = [
+            name
+            for name, on in (
+                ("--reboot-faulted", reboot_faulted),
+                ("--intensity", intensity is not None),
+                ("--auto-exposure", auto_exposure),
+            )
+            if on
+        ]
+        if given:
+            raise fail(
+                RtiRigError(
+                    f"--park-only parks the arm and does nothing else: drop {' and '.join(given)}"
+                )
+            )
+        _park_only(rig_config)
+        return
     if reboot_faulted:
         _reboot_faulted(rig_config)
         return
@@ -153,6 +181,37 @@ def _reboot_faulted(rig_config: Path) -> None:
 
     try:
         report = reboot_faulted(rig_config, on_start=looking)
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    for line in report.lines():
+        out.print(line, highlight=False, markup=False)
+    if not report.ok:
+        raise typer.Exit(code=1)
+
+
+def _park_only(rig_config: Path) -> None:
+    """``check --park-only``: park the arm, say where it was left (read back); exit 1 unless
+    it parked, as a stop's code after a Ctrl-C or SIGTERM."""
+    from rti_rig.app.usecases.park import ParkStopped, park_arm
+    from rti_rig.runtime.controller import EmergencyStop
+
+    def parking() -> None:
+        shown = escape(shown_path(rig_config))
+        out.print(f"Parking {shown}'s arm (Ctrl-C stops it where it is)…")
+
+    try:
+        with stop_on_signals():
+            report = park_arm(rig_config, on_start=parking)
+    except ParkStopped as exc:
+        for failure in exc.teardown_failures:
+            err.print(f"[red]teardown problem:[/] {escape(failure)}")
+        err.print(f"[red]Park stopped ({escape(exc.why)}):[/] {escape(exc.lights)}.")
+        if exc.todo:
+            err.print(exc.todo + ".", highlight=False, markup=False)
+        raise typer.Exit(code=stop_exit_code(exc.signum)) from None
+    except EmergencyStop as exc:  # before anything was built (loading the config)
+        err.print(f"[red]Park stopped ({escape(str(exc))}):[/] nothing was sent to the arm.")
+        raise typer.Exit(code=stop_exit_code(exc.signum)) from None
     except RtiRigError as exc:
         raise fail(exc) from None
     for line in report.lines():

@@ -300,13 +300,18 @@ class DomeLighting:
 
 
 def park_check(config: str | None) -> str:
-    """The command that parks an arm after a failure: ``rti-rig check CONFIG``, the config's
-    path as shell words, so that it pastes and runs; ``'rti-rig check'`` only where no config
-    is known (an arm built without one, as in unit tests).
+    """The command that parks an arm and does nothing else: ``rti-rig check CONFIG
+    --park-only``, the config's path as shell words, so that it pastes and runs;
+    ``'rti-rig check RIG_CONFIG --park-only'`` only where no config is known (an arm built
+    without one, as in unit tests).
 
     Why: the run's end said "park it with 'rti-rig check'", a command that, pasted, is refused
-    for its missing RIG_CONFIG, while the error above it named the config in full."""
-    return f"rti-rig check {shell_word(config)}" if config else "'rti-rig check'"
+    for its missing RIG_CONFIG, while the error above it named the config in full; and the
+    plain check it then named walks every self-test pose before it parks, eight moves near the
+    object for a user who asked for one."""
+    if not config:
+        return "'rti-rig check RIG_CONFIG --park-only'"
+    return f"rti-rig check {shell_word(config)} --park-only"
 
 
 class ArmLighting:

@@ -211,7 +211,8 @@ def test_a_check_stopped_by_ctrl_c_says_the_poses_it_verified_and_how_to_park(
     at = direction_from_az_el(float(found[1]), float(found[2]))
     assert float(angle_between_deg(at, _truth(rig))) < 0.2, said
     hint = re.search(
-        r"To park it: rti-rig check (.+?) \(it walks the poses again, then parks\)", said
+        r"To park it: rti-rig check (.+?) --park-only \(it moves to the park pose, nothing else\)",
+        said,
     )
     assert hint is not None, said
     assert pasted(hint[1].encode()) == str(cfg).encode(), said

@@ -51,7 +51,8 @@ def torque_line(cfg: Path) -> str:
     return (
         "arm: torque stays on: the arm is not at its park pose, and torque_policy = "
         '"release_on_close" releases it only there, where it cannot drop onto the object. Park '
-        f"it with rti-rig check {shell_word(cfg)} before switching off the servos' power."
+        f"it with rti-rig check {shell_word(cfg)} --park-only before switching off the "
+        "servos' power."
     )
 
 

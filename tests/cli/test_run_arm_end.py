@@ -225,7 +225,7 @@ def test_a_fault_that_blocks_the_park_is_said_once(tmp_path: Path) -> None:
     assert (
         "Support the lamp and switch the arm's power off first (a joint the stop did not hold "
         "may still be moving, or sag); then clear the fault (its error says how), switch the "
-        f"power back on and park it with rti-rig check {shell_word(cfg)} " in said
+        f"power back on and park it with rti-rig check {shell_word(cfg)} --park-only " in said
     ), said
     assert pasted(shell_word(cfg).encode()) == bytes(cfg)
     assert said.count("clear the obstruction") == 1, said  # in the error, said last

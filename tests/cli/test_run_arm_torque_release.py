@@ -160,7 +160,9 @@ def test_a_torque_kept_on_at_the_close_is_in_the_manifest(
     assert said.count(KEPT) == 1, said
     # the check that parks it names the rig config, ready to paste (a bare 'rti-rig check'
     # is refused for its missing config)
-    assert f"Park it with rti-rig check {shell_word(cfg)} before switching off" in said, said
+    assert (
+        f"Park it with rti-rig check {shell_word(cfg)} --park-only before switching off" in said
+    ), said
     assert end["outcome"] == "left" and end["azimuth_deg"] is not None, end
     assert end["torque"] is None, end  # nothing released: no release note
     assert end["torque_at_close"] == {
@@ -189,7 +191,7 @@ def test_a_kept_torque_read_back_off_is_not_said_to_hold(
     code, said, end, cfg = _run_unparked(tmp_path)
     assert code == 0, said
     assert "torque stays on" not in said, said
-    assert f"and park it with rti-rig check {shell_word(cfg)}." in said, said
+    assert f"and park it with rti-rig check {shell_word(cfg)} --park-only." in said, said
     assert (
         "Torque Enable reads back ON from servo 1 (azimuth); reads back OFF (limp) from servo 2 "
         "(elevation)" in said

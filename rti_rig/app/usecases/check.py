@@ -181,14 +181,14 @@ def check_rig(
 
 
 def _park_todo(report: ArmSelfTestReport | None, rig_config: Path) -> str | None:
-    """How to park an arm a stopped check left unparked: the check again, its config as shell
-    words (a pasteable command, as ``run``'s end gives), which walks its poses and parks;
-    after a stop that did not hold every joint, once the arm is made safe first.
+    """How to park an arm a stopped check left unparked: ``rti-rig check CONFIG --park-only``,
+    its config as shell words (a pasteable command, as ``run``'s end gives), which parks and
+    moves nothing else; after a stop that did not hold every joint, once the arm is made safe.
 
-    Why: a check stopped by Ctrl-C said where the arm was left and no way to park it, and
-    rti-rig has no other command that parks. None where there is nothing to give: the arm
-    parked, never connected (nothing moved), or ``park_after_session`` is off (the check
-    would not park it either)."""
+    Why: a check stopped by Ctrl-C said where the arm was left and no way to park it; then it
+    advised the check again, which walks every pose before it parks. None where there is
+    nothing to give: the arm parked, never connected (nothing moved), or
+    ``park_after_session`` is off (the check would not park it either)."""
     from rti_rig.runtime.lighting import park_check
 
     if report is None or report.end is None or not report.park_wanted:
@@ -199,9 +199,9 @@ def _park_todo(report: ArmSelfTestReport | None, rig_config: Path) -> str | None
     if not report.stopped:
         return (
             "Once the arm is safe (the lines above say how), park it with "
-            f"{check} (it walks the poses again, then parks)"
+            f"{check} (it moves to the park pose, nothing else)"
         )
-    return f"To park it: {check} (it walks the poses again, then parks)"
+    return f"To park it: {check} (it moves to the park pose, nothing else)"
 
 
 def _refuse_undimmable(loaded: Any, intensity: float) -> None:

@@ -1,0 +1,147 @@
+"""Use case: park an arm and do nothing else (``rti-rig check RIG --park-only``).
+
+Why: a check or run stopped with the arm mid-pose advised "park it with rti-rig check RIG",
+which walks every self-test pose again before it parks: eight moves near the object when the
+user asked for one. This connects the arm (as every command does: limits checked, goal set to
+where it stands, torque on), switches the lamp off, stops, moves to the config's park pose
+and closes with the config's ``torque_policy`` (the teardown of a session, with no session):
+nothing else moves. A stop (Ctrl-C, SIGTERM) during the park holds the arm where it stands,
+torque on, as a session's park does, and is said as such.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from rti_rig.app.compose import build_rig
+from rti_rig.app.config import load_rig_config
+from rti_rig.app.usecases.safe_state import lights_state
+from rti_rig.core.deferred_signals import signals_deferred
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.shell_words import shell_word, shown_path
+from rti_rig.runtime.controller import EmergencyStop
+from rti_rig.runtime.lighting import ArmLighting, attempt_all, park_check
+
+#: what a park stopped while its rig was being built may say of the arm: no byte was sent
+ARM_NOT_REACHED = "nothing was sent to the arm: the park stopped before connecting it"
+
+
+class ParkStopped(Exception):
+    """The park was stopped (SIGTERM, Ctrl-C); the arm was made safe first (lamp off, stop,
+    held where the stop found it)."""
+
+    def __init__(
+        self,
+        stop: EmergencyStop,
+        lights: str,
+        teardown_failures: tuple[str, ...] = (),
+        todo: str | None = None,
+    ) -> None:
+        super().__init__(f"park stopped ({stop}): {lights}")
+        self.why, self.signum = str(stop), stop.signum
+        #: what is known of the arm after the teardown (read back; never "parked" unless so)
+        self.lights = lights
+        self.teardown_failures = teardown_failures
+        #: the command that parks it, as a sentence; None when it parked or was never reached
+        self.todo = todo
+
+
+@dataclass(frozen=True)
+class ParkReport:
+    """What ``check --park-only`` established (``.lines()``, ``.ok``)."""
+
+    #: where the arm was left, as read back, and what its lamp-off and stop established
+    lights: str
+    parked: bool
+    teardown_failures: tuple[str, ...] = ()
+    #: the connect's error, when the arm could not be connected (nothing was moved then)
+    aborted: str | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.parked and not self.teardown_failures and self.aborted is None
+
+    def lines(self) -> list[str]:
+        out = [f"teardown problem: {f}" for f in self.teardown_failures]
+        if self.aborted is not None:
+            out.append(f"arm: not parked: its connect failed: {self.aborted}")
+        out.append(f"arm: {self.lights}")
+        out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
+        return out
+
+
+def refuse_unparkable(loaded: object, rig_config: Path) -> None:
+    """Refuse ``--park-only`` for a rig that has no arm to park (a dome, a replay): a dome has
+    no park pose, and its all-off is what ``rti-rig check`` ends with."""
+    config = loaded.config  # type: ignore[attr-defined]
+    if config.arm is not None and config.backend != "replay":
+        return
+    what = (
+        "a replayed acquisition (nothing to move)"
+        if config.backend == "replay"
+        else "a dome, which has no park pose"
+    )
+    raise RtiRigError(
+        f"{shown_path(rig_config)}: --park-only parks an arm; this rig config describes {what}. "
+        f"To check it (a dome ends with every LED switched off): rti-rig check "
+        f"{shell_word(str(rig_config))}"
+    )
+
+
+def park_arm(rig_config: Path, on_start: Callable[[], None] | None = None) -> ParkReport:
+    """Connect the arm of ``rig_config``, lamp off, stop, park, close (torque as the config's
+    ``torque_policy`` says), and say where it was left, as read back.
+
+    ``on_start`` is called once the config is known to have an arm, before anything opens.
+    Raises :class:`ParkStopped` after a Ctrl-C or SIGTERM, the arm made safe first."""
+    loaded = load_rig_config(rig_config)
+    refuse_unparkable(loaded, rig_config)
+    if on_start is not None:
+        on_start()
+    try:
+        built = build_rig(loaded)
+    except EmergencyStop as exc:
+        raise ParkStopped(exc, ARM_NOT_REACHED) from None
+    with built as rig:
+        lighting = rig.lighting
+        if not isinstance(lighting, ArmLighting):  # the config's arm built something else
+            raise RtiRigError(f"{shown_path(rig_config)}: --park-only found no arm to park")
+        # the park is what was asked for, whatever park_after_session says of a session's end
+        lighting.park_after_session = True
+        stop: EmergencyStop | None = None
+        aborted: str | None = None
+        try:
+            lighting.connect()
+        except EmergencyStop as exc:  # Ctrl-C while connecting: made safe, not parked
+            stop = exc
+        except Exception as exc:  # a servo fault, a silent servo: said, nothing moved
+            aborted = str(exc)
+        failures: list[str] = []
+        try:
+            # the whole teardown before a stop is acted on (the park's own hold lets a stop
+            # end the park, the arm held where it stands)
+            with signals_deferred():
+                if aborted is None:
+                    failures += lighting.safe(emergency=stop is not None)
+                failures += attempt_all([("close", lighting.close)])
+        except EmergencyStop as exc:  # held during the teardown, delivered now
+            stop = stop or exc
+        lights = lights_state(rig, bool(failures))
+        end = lighting.end
+        parked = end is not None and end.outcome == "parked"
+        if stop is not None:
+            raise ParkStopped(stop, lights, tuple(failures), _todo(lighting, parked, rig_config))
+        return ParkReport(lights, parked, tuple(failures), aborted)
+
+
+def _todo(lighting: ArmLighting, parked: bool, rig_config: Path) -> str | None:
+    """How to park an arm a stopped park left where it was: this command again (after making
+    it safe, if the stop did not hold every joint); None if it parked or was never reached."""
+    if parked or lighting.end is None:
+        return None
+    command = park_check(str(rig_config))
+    if lighting.unheld or "stop" in lighting.not_sent:
+        return f"Once the arm is safe (the lines above say how), park it with {command}"
+    return f"To park it: {command}"
