@@ -849,6 +849,12 @@ class DynamixelBusEmulator(HostBaudDevice):
             self._errors_changed()  # a fault raised or a Reboot among these packets
             return bytes(out)
 
+    def supply_lost(self) -> bool:
+        """Whether the chain's supply has gone (``power_lost``) by now: its RAM is lost, and
+        nothing of its powered state outlives this command (the next meets it at power-on)."""
+        with self._lock:
+            return self._unpowered(self.instructions_received)
+
     def _unpowered(self, packet: int) -> bool:
         """Whether the chain's supply is gone (``power_lost``) by the ``packet``-th packet."""
         return self.power_lost_at is not None and packet >= self.power_lost_at

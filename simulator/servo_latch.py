@@ -121,6 +121,20 @@ class LatchedErrors:
             hardware_error_status={k: v for k, v in errors.items() if v},
         )
 
+    def forget_powered(self) -> None:
+        """The chain lost its supply: delete the powered state's file (the power cycle), so
+        the next command meets the servos at power-on, never as still powered. A file that
+        cannot be deleted is a warning, as :meth:`_unkept` says."""
+        try:
+            self.path.unlink(missing_ok=True)
+        except OSError as exc:
+            self._unkept(
+                self.path,
+                "loss of power",
+                "the next command on this rig may meet them as still powered",
+                exc,
+            )
+
     def load_eeprom(self) -> dict[int, dict[str, Any]]:
         """Each servo's EEPROM and rest pose as kept through a power cycle
         (``EmulatedServo.eeprom_state``); {} if none or unreadable (a factory-fresh chain)."""

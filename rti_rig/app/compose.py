@@ -346,9 +346,19 @@ def _keep_powered_state(loaded: LoadedRig, emulator: DynamixelBusEmulator) -> La
 
 
 def _keep_state(latch: LatchedErrors, emulator: DynamixelBusEmulator) -> None:
-    """Keep the chain's powered state and, apart, what outlives a power cycle (EEPROM)."""
-    latch.save_state(emulator.powered_state())
+    """Keep the chain's powered state and, apart, what outlives a power cycle (EEPROM); a
+    chain whose supply went (``power_lost``) keeps only the latter, as a power cycle does.
+
+    Why: after a ``power_lost`` rehearsal the state file still said the servos were powered
+    (torque on, the goal held, any error latched), so the next command met a holding arm that
+    had in fact lost its supply: a stale claim a real chain cannot make (its RAM is "reset to
+    initial values when the power is reset", ROBOTIS e-manual, X-series control table, Area).
+    A held joint falls to its stop without power (:meth:`EmulatedServo.eeprom_state`)."""
     latch.save_eeprom(emulator.eeprom_state())
+    if emulator.supply_lost():
+        latch.forget_powered()
+    else:
+        latch.save_state(emulator.powered_state())
 
 
 def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:

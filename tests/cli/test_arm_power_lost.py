@@ -71,3 +71,31 @@ def test_a_chain_that_loses_its_power_is_said_after_one_servos_allowance(
     # others (34 ms, a short drain and a retry: about 0.1 s each); it had been 1.03 s each
     print(f"{command}: {waited_s:.2f} s on the clock from the loss to the error")
     assert 1.0 < waited_s < 1.9, said  # two allowances would be over 2 s
+
+
+def test_a_chain_that_lost_its_power_is_not_kept_as_powered_for_the_next_command(
+    tmp_path: Path,
+) -> None:
+    """After a ``power_lost`` rehearsal the next command meets the chain at power-on (torque
+    off, the RAM at its initial values), its EEPROM kept: the state file had still said the
+    servos were powered, torque on, and the next command met a holding arm."""
+    from rti_rig.drivers.dynamixel import control_table as ct
+    from rti_rig.simulator.servo_latch import LatchedErrors
+
+    fault = f'\n[[emulator.faults]]\nat_command = {LOSS_AT["check"]}\nkind = "power_lost"\n'
+    cfg = inprocess_arm_config(tmp_path, fault)
+    r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code != 0 and "Traceback" not in r.output, r.output
+    latch = LatchedErrors(cfg)
+    assert latch.load_state() == {}, "kept as still powered"
+    assert not latch.path.exists()
+    kept = latch.load_eeprom()
+    assert sorted(kept) == [1, 2], kept  # what outlives a power cycle is still kept
+    # the next command's chain, built as compose builds it: at power-on, torque off
+    cfg.write_text(cfg.read_text().replace(fault, ""))
+    from rti_rig.app.compose import build_rig
+    from rti_rig.app.config import load_rig_config
+
+    with build_rig(load_rig_config(cfg)) as rig:
+        torque = [s.get(ct.TORQUE_ENABLE) for s in rig.emulator.servos.values()]
+    assert torque == [0, 0], torque
