@@ -207,6 +207,9 @@ class EmulatedServo:
                 self._set(item, item.initial)
         self._set(tbl.FIRMWARE_VERSION, firmware)
         self._set(tbl.ID, dxl_id)
+        #: the ID this servo was built with (the config's): what its kept state is matched by
+        #: when the next command builds the chain again, whatever ID its table holds by then
+        self.built_id = dxl_id
         for reg, attr in FACTORY_REGISTERS:
             value = getattr(f, attr)
             if value is not None:  # None: the model lacks it (no Current Limit on an XL430)
@@ -413,6 +416,7 @@ class EmulatedServo:
             round(rest) & 0xFFFFFFFF
         ).to_bytes(4, "little")
         return {
+            "built_id": self.built_id,
             "model_number": self.get(tbl.MODEL_NUMBER),
             "table": table.hex(),
             "rest_ticks": rest,
@@ -440,7 +444,7 @@ class EmulatedServo:
             return False
         if len(table) != tbl.TABLE_SIZE or model != self.get(tbl.MODEL_NUMBER):
             return False
-        if int.from_bytes(table[tbl.ID.address : tbl.ID.address + 1], "little") != self.dxl_id:
+        if not self._is_mine(state, table[tbl.ID.address]):
             return False
         if not math.isfinite(rest):
             return False
@@ -451,6 +455,16 @@ class EmulatedServo:
         self._registered = reg
         self._refresh()
         return True
+
+    def _is_mine(self, state: dict[str, Any], kept_id: int) -> bool:
+        """Whether a kept record is this servo's: the one built with the same ID (the ID its
+        table then held, ``kept_id``, may differ: an ID written, a Factory Reset to 1, kept as
+        the EEPROM keeps it); a record from before ``built_id`` was kept, by that ID alone."""
+        built = state.get("built_id")
+        try:
+            return int(built) == self.built_id if built is not None else kept_id == self.dxl_id
+        except (TypeError, ValueError):
+            return False
 
     def eeprom_state(self) -> dict[str, Any]:
         """What this servo keeps through a power cycle: its EEPROM area (ID, baud rate,
@@ -468,6 +482,7 @@ class EmulatedServo:
         if self.torque_on and self.sag_to is not None:
             rest = self.sag_to
         return {
+            "built_id": self.built_id,
             "model_number": self.get(tbl.MODEL_NUMBER),
             "eeprom": bytes(self.table[: tbl.EEPROM_END]).hex(),
             "rest_ticks": rest,
@@ -485,7 +500,7 @@ class EmulatedServo:
             return False
         if len(eeprom) != tbl.EEPROM_END or model != self.get(tbl.MODEL_NUMBER):
             return False
-        if eeprom[tbl.ID.address] != self.dxl_id or not math.isfinite(rest):
+        if not self._is_mine(state, eeprom[tbl.ID.address]) or not math.isfinite(rest):
             return False
         self.table[: tbl.EEPROM_END] = eeprom
         self._profile = _Profile(rest, rest, self.clock.now(), 1.0, 1.0)
@@ -754,31 +769,46 @@ class DynamixelBusEmulator(HostBaudDevice):
                 self.on_errors_changed(now)
 
     def powered_state(self) -> dict[int, dict[str, Any]]:
-        """Every servo's :meth:`EmulatedServo.powered_state`, by id."""
+        """Every servo's :meth:`EmulatedServo.powered_state`, by its place in the chain.
+
+        Why by place, not ID: two servos may share an ID (one written to another's, a Factory
+        Reset to 1), and a map by ID had kept the first alone: the second's state was lost."""
         with self._lock:
-            return {i: s.powered_state() for i, s in self.servos.items()}
+            return {place: s.powered_state() for place, s in enumerate(self.chain)}
 
     def restore_powered(self, states: dict[int, dict[str, Any]]) -> None:
         """Give each servo the state an earlier command left it (see
         :meth:`EmulatedServo.restore_powered`); one not on this bus is left alone."""
         with self._lock:
-            for dxl_id, state in states.items():
-                if dxl_id in self.servos:
-                    self.servos[dxl_id].restore_powered(state)
+            for key, state in states.items():
+                servo = self._kept_servo(key, state)
+                if servo is not None:
+                    servo.restore_powered(state)
+            self._rekey()  # an ID kept as changed is where the servo answers
             self._errors_seen = self.hardware_errors()
 
     def eeprom_state(self) -> dict[int, dict[str, Any]]:
-        """Every servo's :meth:`EmulatedServo.eeprom_state`, by id."""
+        """Every servo's :meth:`EmulatedServo.eeprom_state`, by its place in the chain (see
+        :meth:`powered_state`)."""
         with self._lock:
-            return {i: s.eeprom_state() for i, s in self.servos.items()}
+            return {place: s.eeprom_state() for place, s in enumerate(self.chain)}
 
     def restore_eeprom(self, states: dict[int, dict[str, Any]]) -> None:
         """Power the chain on with the EEPROM each servo kept through a power cycle (see
         :meth:`EmulatedServo.restore_eeprom`); one not on this bus is left alone."""
         with self._lock:
-            for dxl_id, state in states.items():
-                if dxl_id in self.servos:
-                    self.servos[dxl_id].restore_eeprom(state)
+            for key, state in states.items():
+                servo = self._kept_servo(key, state)
+                if servo is not None:
+                    servo.restore_eeprom(state)
+            self._rekey()
+
+    def _kept_servo(self, key: int, state: dict[str, Any]) -> EmulatedServo | None:
+        """The servo a kept record is for: the chain's ``key``-th (a record with its
+        ``built_id``), else, a record kept by ID before, the servo at ID ``key``."""
+        if "built_id" in state:
+            return self.chain[key] if 0 <= key < len(self.chain) else None
+        return self.servos.get(key)
 
     def inject_hardware_error(self, dxl_id: int, fault: int) -> None:
         with self._lock:

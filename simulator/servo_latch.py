@@ -107,10 +107,13 @@ class LatchedErrors:
         """Record every servo's powered state now (atomically): the chain stays powered, so
         the file stays, errors or none, until it is deleted (the power cycle). A file that
         cannot be written is a warning, as :meth:`_unkept` says why."""
-        errors = {
-            str(k): int(bytes.fromhex(v["table"])[tbl.HARDWARE_ERROR_STATUS.address])
-            for k, v in sorted(states.items())
-        }
+        # by the ID each servo answers at (the states go by place in the chain), two sharing
+        # an ID being one entry with both servos' bits
+        errors: dict[str, int] = {}
+        for v in states.values():
+            table = bytes.fromhex(v["table"])
+            key = str(table[tbl.ID.address])
+            errors[key] = errors.get(key, 0) | table[tbl.HARDWARE_ERROR_STATUS.address]
         self._save(
             self.path,
             states,

@@ -90,7 +90,7 @@ def test_a_chain_that_lost_its_power_is_not_kept_as_powered_for_the_next_command
     assert latch.load_state() == {}, "kept as still powered"
     assert not latch.path.exists()
     kept = latch.load_eeprom()
-    assert sorted(kept) == [1, 2], kept  # what outlives a power cycle is still kept
+    assert len(kept) == 2, kept  # what outlives a power cycle is still kept, each servo
     # the next command's chain, built as compose builds it: at power-on, torque off
     cfg.write_text(cfg.read_text().replace(fault, ""))
     from rti_rig.app.compose import build_rig

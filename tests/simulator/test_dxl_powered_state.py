@@ -77,3 +77,28 @@ def test_an_eeprom_file_that_cannot_be_written_is_named_in_its_warning(
     assert str(latch.path) not in said, said
     assert latch.load_state() == states  # the powered state's file, written as before
     assert json.loads(latch.path.read_text())["hardware_error_status"] == {}
+
+
+def test_two_servos_sharing_an_id_are_both_kept(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The second servo of a chain whose ID was written to the first's (both answer at 1) is
+    kept too, its ID and its latched overload with it: the state had been kept by ID, and the
+    second servo met the next command at power-on, at its old ID with no error."""
+    from rti_rig.simulator import dynamixel_table as tbl
+    from rti_rig.simulator.dynamixel_emulator import HARDWARE_FAULT_BITS, DynamixelBusEmulator
+
+    monkeypatch.setenv(STATE_DIR_ENV, str(tmp_path))
+    overload = int(HARDWARE_FAULT_BITS["overload"])
+    chain = [EmulatedServo(1, 1060, VirtualClock()), EmulatedServo(2, 1060, VirtualClock())]
+    assert chain[1].write(tbl.ID.address, b"\x01") == 0
+    chain[1].inject_hardware_error(overload)
+    latch = LatchedErrors(tmp_path / "arm.toml")
+    latch.save_state(DynamixelBusEmulator(chain, VirtualClock()).powered_state())
+    assert json.loads(latch.path.read_text())["hardware_error_status"] == {"1": overload}
+    fresh = [EmulatedServo(1, 1060, VirtualClock()), EmulatedServo(2, 1060, VirtualClock())]
+    bus = DynamixelBusEmulator(fresh, VirtualClock())
+    bus.restore_powered(latch.load_state())
+    assert [s.dxl_id for s in fresh] == [1, 1]
+    assert [s.hardware_error for s in fresh] == [0, overload]
+    assert list(bus.servos) == [1] and bus.servos[1] is fresh[0]
