@@ -411,7 +411,14 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
     def isPacketTimeout(self) -> bool:
         """Causal (module docstring); the clock is charged what a real host waits: its whole
         window for a status that never comes or comes after it, a late one's lateness when it
-        comes within (they had cost the clock nothing)."""
+        comes within (they had cost the clock nothing).
+
+        Given up at :data:`LOST_LINK_S` of wall time (a broken link: the emulator never went
+        quiet), the clock is still charged the window, not the lost-link limit: the SDK's own
+        ``isPacketTimeout`` (dynamixel_sdk 4.1 port_handler.py) gives up once
+        ``getTimeSinceStart() > packet_timeout``, the window ``setPacketTimeout`` opened, so
+        that is all a real host waits; the limit is this emulator's bound on a test, not bus
+        time."""
         self._listen()
         with self._ledger.lock:
             over = self._ledger.quiet()
