@@ -232,8 +232,25 @@ def relight_listing_order(image_names: Sequence[str]) -> list[int]:
     folder's ``*.jpg`` with a ``QDir``, whose default sort is ``Name | IgnoreCase``: by the
     lower-cased file name (the name itself breaking ties); its ``DomePanel::loadDome``
     (``relightlab/domepanel.cpp``) then gives image ``i`` the dome's direction ``i``.
+
+    The names are compared as Qt compares them: QDir's sort (``qdir.cpp``, ``qt_cmp_si``:
+    ``fileName().toLower()``, then ``QString::compare``) orders by UTF-16 code units, not by
+    code points. Why: a name with a character beyond U+FFFF (an emoji, stored as a surrogate
+    pair from 0xD800) sorts there before one with a character from U+E000 to U+FFFF (full-width
+    forms such as ``ｉｍｇ``, private-use glyphs), where Python's code-point order put it after:
+    those images had been given each other's lights in relight.
     """
-    return sorted(range(len(image_names)), key=lambda i: (image_names[i].lower(), image_names[i]))
+    return sorted(range(len(image_names)), key=lambda i: _qt_name_key(image_names[i]))
+
+
+def _qt_name_key(name: str) -> tuple[bytes, bytes]:
+    """The key QDir's ``Name | IgnoreCase`` sort orders ``name`` by: its lower case as UTF-16
+    code units (big-endian bytes compare as the units do), then the name itself, alike (a
+    name read with ``surrogateescape``, not UTF-8 on disk, keeps its lone surrogates)."""
+    return (
+        name.lower().encode("utf-16-be", "surrogatepass"),
+        name.encode("utf-16-be", "surrogatepass"),
+    )
 
 
 def write_relight_dome(

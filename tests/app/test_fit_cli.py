@@ -354,22 +354,34 @@ def test_lights_dome_pairs_each_image_with_its_light_as_relight_lists_them(
     (``src/dome.cpp``: ``directions`` as ``{"x", "y", "z"}`` objects). An acquisition whose
     ``.lp`` lists ``img1.jpg`` … ``img10.jpg`` … in shooting order (relight lists ``img1``,
     ``img10``, ``img11``, …, ``img2``) had its lights.dome written in the ``.lp``'s order, so
-    relight gave most images another image's light."""
+    relight gave most images another image's light. QDir compares the lower-cased names by
+    UTF-16 code units (``qdir.cpp``, ``qt_cmp_si``: ``QString::compare``): a name with an emoji
+    (a surrogate pair from 0xD800) comes before a full-width ``ｉmg`` (0xFF49), where Python's
+    code-point order had put it after, and the two images were given each other's lights."""
     import shutil
 
-    from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+    from rti_rig.core.lp_format import LpEntry, read_lp
 
     session = clean[0]
     folder = tmp_path / "acq"
     (folder / "linear").mkdir(parents=True)
     entries = []
-    for k, e in enumerate(read_lp(session / "lights.lp"), start=1):
+    lights = read_lp(session / "lights.lp")
+    unicode_names = ["\uff49mg.jpg", "\U0001f506.jpg"]  # full-width 'ｉmg', an emoji
+    for k, e in enumerate(lights, start=1):
+        name = f"Img{k}.jpg" if k <= len(lights) - 2 else unicode_names[k - len(lights) + 1]
         shutil.copy(
-            session / "linear" / f"{Path(e.name).stem}.tif", folder / "linear" / f"Img{k}.tif"
+            session / "linear" / f"{Path(e.name).stem}.tif",
+            folder / "linear" / f"{Path(name).stem}.tif",
         )
-        entries.append(LpEntry(f"Img{k}.jpg", e.direction))
+        entries.append(LpEntry(name, e.direction))
     assert len(entries) >= 12  # so that name order is not shooting order
-    write_lp(folder / "dirs.lp", entries)
+    # written by hand: the .lp writer keeps to ASCII names, relight and rti-rig read UTF-8
+    text = f"{len(entries)}\n" + "".join(
+        f"{e.name} {e.direction[0]:.6f} {e.direction[1]:.6f} {e.direction[2]:.6f}\n"
+        for e in entries
+    )
+    (folder / "dirs.lp").write_text(text, encoding="utf-8")
     out = tmp_path / "out"
     lean = ["--no-qa", "--no-ptm", "--no-hsh", "--model", "ps"]
     r = runner.invoke(app, ["fit", str(folder / "dirs.lp"), "--out", str(out), *lean])
@@ -377,8 +389,9 @@ def test_lights_dome_pairs_each_image_with_its_light_as_relight_lists_them(
     dome = json.loads((out / "lights.dome").read_text(encoding="utf-8"))
     got = np.array([[d["x"], d["y"], d["z"]] for d in dome["directions"]])
     light_of = {e.name: np.array(e.direction) for e in entries}
-    listed = sorted(light_of, key=str.lower)  # QDir's Name | IgnoreCase
-    assert listed[:3] == ["Img1.jpg", "Img10.jpg", "Img11.jpg"]
+    ascii_listed = sorted((n for n in light_of if n.isascii()), key=str.lower)  # IgnoreCase
+    assert ascii_listed[:3] == ["Img1.jpg", "Img10.jpg", "Img11.jpg"]
+    listed = [*ascii_listed, "\U0001f506.jpg", "\uff49mg.jpg"]  # UTF-16: 0xD83D < 0xFF49
     expected = np.array([light_of[name] for name in listed])
     np.testing.assert_allclose(got, expected, atol=1e-6)
 
