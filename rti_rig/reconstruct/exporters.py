@@ -246,9 +246,15 @@ def relight_listing_order(image_names: Sequence[str]) -> list[int]:
 def _qt_name_key(name: str) -> tuple[bytes, bytes]:
     """The key QDir's ``Name | IgnoreCase`` sort orders ``name`` by: its lower case as UTF-16
     code units (big-endian bytes compare as the units do), then the name itself, alike (a
-    name read with ``surrogateescape``, not UTF-8 on disk, keeps its lone surrogates)."""
+    name read with ``surrogateescape``, not UTF-8 on disk, keeps its lone surrogates).
+
+    Each character is lowered on its own, as ``QString::toLower`` maps them: Python's
+    ``str.lower`` writes a capital sigma that ends a word as the final ``ς`` (Unicode's
+    Final_Sigma context), Qt as ``σ``, so ``ΑΣ_1.jpg`` had been listed before ``ασ.jpg``,
+    where relight lists it after."""
+    lowered = "".join(c.lower() for c in name)
     return (
-        name.lower().encode("utf-16-be", "surrogatepass"),
+        lowered.encode("utf-16-be", "surrogatepass"),
         name.encode("utf-16-be", "surrogatepass"),
     )
 

@@ -357,7 +357,9 @@ def test_lights_dome_pairs_each_image_with_its_light_as_relight_lists_them(
     relight gave most images another image's light. QDir compares the lower-cased names by
     UTF-16 code units (``qdir.cpp``, ``qt_cmp_si``: ``QString::compare``): a name with an emoji
     (a surrogate pair from 0xD800) comes before a full-width ``ｉmg`` (0xFF49), where Python's
-    code-point order had put it after, and the two images were given each other's lights."""
+    code-point order had put it after, and the two images were given each other's lights.
+    ``QString::toLower`` lowers each character alone: ``ΑΣ_1.jpg`` is ``ασ_1.jpg`` to it and
+    comes after ``ασ.jpg``, where Python's ``str.lower`` (final sigma, ``ας_1``) put it before."""
     import shutil
 
     from rti_rig.core.lp_format import LpEntry, read_lp
@@ -367,9 +369,11 @@ def test_lights_dome_pairs_each_image_with_its_light_as_relight_lists_them(
     (folder / "linear").mkdir(parents=True)
     entries = []
     lights = read_lp(session / "lights.lp")
-    unicode_names = ["\uff49mg.jpg", "\U0001f506.jpg"]  # full-width 'ｉmg', an emoji
+    # full-width 'ｉmg', an emoji, Greek capitals ending in a sigma, lower-case Greek
+    unicode_names = ["\uff49mg.jpg", "\U0001f506.jpg", "\u0391\u03a3_1.jpg", "\u03b1\u03c3.jpg"]
     for k, e in enumerate(lights, start=1):
-        name = f"Img{k}.jpg" if k <= len(lights) - 2 else unicode_names[k - len(lights) + 1]
+        n = len(lights) - len(unicode_names)
+        name = f"Img{k}.jpg" if k <= n else unicode_names[k - n - 1]
         shutil.copy(
             session / "linear" / f"{Path(e.name).stem}.tif",
             folder / "linear" / f"{Path(name).stem}.tif",
@@ -391,7 +395,10 @@ def test_lights_dome_pairs_each_image_with_its_light_as_relight_lists_them(
     light_of = {e.name: np.array(e.direction) for e in entries}
     ascii_listed = sorted((n for n in light_of if n.isascii()), key=str.lower)  # IgnoreCase
     assert ascii_listed[:3] == ["Img1.jpg", "Img10.jpg", "Img11.jpg"]
-    listed = [*ascii_listed, "\U0001f506.jpg", "\uff49mg.jpg"]  # UTF-16: 0xD83D < 0xFF49
+    # Greek (0x03B1) before the emoji (0xD83D) before the full-width letter (0xFF49), by UTF-16
+    # code units; 'ασ.jpg' before 'ΑΣ_1.jpg', lowered 'ασ_1.jpg' ('.' 0x2E before '_' 0x5F)
+    listed = [*ascii_listed, "\u03b1\u03c3.jpg", "\u0391\u03a3_1.jpg"]
+    listed += ["\U0001f506.jpg", "\uff49mg.jpg"]
     expected = np.array([light_of[name] for name in listed])
     np.testing.assert_allclose(got, expected, atol=1e-6)
 
