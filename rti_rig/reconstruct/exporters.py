@@ -57,6 +57,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core import opencv_files
+from rti_rig.core.qt_names import qt_name_key
 from rti_rig.core.shell_words import shown_path
 from rti_rig.reconstruct.errors import ReconstructionError
 
@@ -233,30 +234,12 @@ def relight_listing_order(image_names: Sequence[str]) -> list[int]:
     lower-cased file name (the name itself breaking ties); its ``DomePanel::loadDome``
     (``relightlab/domepanel.cpp``) then gives image ``i`` the dome's direction ``i``.
 
-    The names are compared as Qt compares them: QDir's sort (``qdir.cpp``, ``qt_cmp_si``:
-    ``fileName().toLower()``, then ``QString::compare``) orders by UTF-16 code units, not by
-    code points. Why: a name with a character beyond U+FFFF (an emoji, stored as a surrogate
-    pair from 0xD800) sorts there before one with a character from U+E000 to U+FFFF (full-width
-    forms such as ``ｉｍｇ``, private-use glyphs), where Python's code-point order put it after:
-    those images had been given each other's lights in relight.
+    The names are compared as Qt compares them (:func:`~rti_rig.core.qt_names.qt_name_key`).
+    Why: by code points and ``str.lower``, an emoji-named image had been listed after a
+    full-width ``ｉmg`` one and ``ΑΣ_1.jpg`` before ``ασ.jpg``, where relight lists them the
+    other way round: those images had been given each other's lights in relight.
     """
-    return sorted(range(len(image_names)), key=lambda i: _qt_name_key(image_names[i]))
-
-
-def _qt_name_key(name: str) -> tuple[bytes, bytes]:
-    """The key QDir's ``Name | IgnoreCase`` sort orders ``name`` by: its lower case as UTF-16
-    code units (big-endian bytes compare as the units do), then the name itself, alike (a
-    name read with ``surrogateescape``, not UTF-8 on disk, keeps its lone surrogates).
-
-    Each character is lowered on its own, as ``QString::toLower`` maps them: Python's
-    ``str.lower`` writes a capital sigma that ends a word as the final ``ς`` (Unicode's
-    Final_Sigma context), Qt as ``σ``, so ``ΑΣ_1.jpg`` had been listed before ``ασ.jpg``,
-    where relight lists it after."""
-    lowered = "".join(c.lower() for c in name)
-    return (
-        lowered.encode("utf-16-be", "surrogatepass"),
-        name.encode("utf-16-be", "surrogatepass"),
-    )
+    return sorted(range(len(image_names)), key=lambda i: qt_name_key(image_names[i]))
 
 
 def write_relight_dome(

@@ -281,6 +281,12 @@ def test_export_lp_outside_the_session_says_where_its_names_resolve(tmp_path: Pa
     said = " ".join(r.output.split())
     assert "move that folder's lights.lp out too" in said
     assert f"rti-rig export-lp {session} --out {session / 'lights.lp'}` writes it again" in said
+    # relight-cli's QDir compares lowered names by UTF-16 code units (Qt's qdir.cpp,
+    # qt_cmp_si): the ligature 'ﬁ' (0xFB01) comes after 'l', so lights.lp is still read first
+    # (str.casefold had read 'ﬁnal.lp' as 'final.lp' and said nothing else needed moving)
+    r = runner.invoke(app, ["export-lp", str(session), "--out", str(tmp_path / "\ufb01nal.lp")])
+    assert r.exit_code == 0, r.output
+    assert "move that folder's lights.lp out too" in " ".join(r.output.split()), r.output
     r = runner.invoke(app, ["fit", str(outside), "--out", str(tmp_path / "f"), "--no-qa"])
     assert r.exit_code == 2
     text = " ".join(r.output.split())

@@ -14,6 +14,7 @@ from pathlib import Path
 from rti_rig.app.output_files import check_output_file, lp_name_note
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import LpEntry, write_lp
+from rti_rig.core.qt_names import qt_name_key
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
@@ -182,10 +183,13 @@ def _relight_reads(root: Path, new: str) -> str:
 
 def _relight_order(root: Path, new: str) -> list[str]:
     """The ``.lp`` files at the top of ``root``, ``new`` among them, in the order relight-cli
-    lists them (by name, case ignored: :func:`_relight_reads`); the first is the one it reads."""
+    lists them (by name, case ignored: :func:`_relight_reads`, compared as Qt compares them:
+    :func:`~rti_rig.core.qt_names.qt_name_key`); the first is the one it reads. Why Qt's key:
+    ``str.casefold`` read an export named ``ﬁnal.lp`` (a ligature, 0xFB01) as ``final.lp``,
+    before lights.lp, and said relight-cli would read it, where Qt lists lights.lp first."""
     names = {p.name for p in root.iterdir() if p.suffix.lower() == ".lp" and p.is_file()}
     names.add(new)
-    return sorted(names, key=lambda n: (n.casefold(), n))
+    return sorted(names, key=qt_name_key)
 
 
 def relight_move_advice(root: Path, new: str) -> str:
