@@ -43,14 +43,19 @@ PNG_SRGB_CHUNK = -1
 @dataclass(frozen=True)
 class FileColour:
     """``space``: which one; ``name``: its name (an unknown profile's own description);
-    ``said_by``: where the file says it ("" when it says nothing)."""
+    ``said_by``: where the file says it ("" when it says nothing); ``linear_curve``: its ICC
+    profile's tone curve is the identity (gamma 1.0: a linear file, as a session's own linear
+    TIFFs are, whose values no curve must be undone from)."""
 
     space: Space
     name: str
     said_by: str
+    linear_curve: bool = False
 
     def as_dict(self) -> dict[str, str]:
-        return asdict(self)
+        said = asdict(self)
+        del said["linear_curve"]  # said in the conversion's record (colour_convert)
+        return said
 
 
 UNTAGGED = FileColour("untagged", "sRGB", "")
@@ -82,7 +87,9 @@ def file_colour(path: Path) -> FileColour:
         if description:
             space = space_of_description(description)
             name = SPACE_NAMES.get(space, description)
-            return FileColour(space, name, f"its ICC profile {description!r}")
+            return FileColour(
+                space, name, f"its ICC profile {description!r}", icc_curve_is_linear(icc)
+            )
     if colorspace == EXIF_SRGB:
         return FileColour("srgb", "sRGB", "its Exif ColorSpace 1 (sRGB)")
     if colorspace == EXIF_UNCALIBRATED and interop == "R03":
@@ -134,6 +141,29 @@ def icc_description(icc: bytes) -> str | None:
                 return body[at : at + length].decode("utf-16-be", "replace").strip() or None
         return None
     return None
+
+
+def icc_curve_is_linear(icc: bytes) -> bool:
+    """Whether an ICC profile's red tone curve (``rTRC``) is the identity: a ``curv`` of no
+    entries or of one gamma 1.0 (u8Fixed8 0x0100), or a ``para`` of function type 0 with
+    gamma 1.0 (ICC.1:2010 10.5 curveType, 10.16 parametricCurveType). A table, or no rTRC,
+    is not (the named space's own curve then applies)."""
+    if len(icc) < 132:
+        return False
+    (count,) = struct.unpack_from(">I", icc, 128)
+    for i in range(min(count, 256)):
+        sig, offset, size = struct.unpack_from(">4sII", icc, 132 + 12 * i)
+        if sig != b"rTRC":
+            continue
+        body = icc[offset : offset + size]
+        if body[:4] == b"curv" and len(body) >= 12:
+            (n,) = struct.unpack_from(">I", body, 8)
+            return n == 0 or (n == 1 and body[12:14] == b"\x01\x00")
+        if body[:4] == b"para" and len(body) >= 16:
+            kind, gamma = struct.unpack_from(">H2xi", body, 8)
+            return kind == 0 and gamma == 0x10000
+        return False
+    return False
 
 
 def jpeg_icc_profile(head: bytes) -> bytes | None:
