@@ -82,6 +82,12 @@ from rti_rig.core.image_files import (
     tiff_extent,
 )
 from rti_rig.core.shell_words import shown_path
+from rti_rig.drivers.cameras.colour_convert import (
+    clipped_notice,
+    converted_notice,
+    needs_conversion,
+    to_linear_srgb,
+)
 from rti_rig.drivers.cameras.dng_tags import IfdState, ifd_state
 from rti_rig.drivers.cameras.exif_tags import (
     jpeg_datetime_original,
@@ -1787,21 +1793,35 @@ class FolderWatchCamera:
                 )
             image, alpha_note = self._without_alpha(path, watched, image)
             response = "linear" if s.eight_bit_response == "refuse" else s.eight_bit_response
-            try:
-                pixels, white = to_linear_uint16(image, response, order="rgb")
-            except ValueError as exc:
-                raise CaptureError(self.name, f"{watched.name}: {exc}", "decode") from exc
+            # what the file says of its colours (every file had been declared sRGB, an Adobe
+            # RGB JPEG or a ProPhoto TIFF too); a grey image has no primaries to say: its TIFF
+            # says linear grey
+            colour = file_colour(path) if image.ndim == 3 and image.shape[2] >= 3 else None
+            notices = [alpha_note] if alpha_note else []
+            converted = None
+            if colour is not None and needs_conversion(colour, image.dtype):
+                # its own curve undone and its primaries made sRGB's: a 16-bit file had been
+                # taken as linear whatever its curve (a ProPhoto TIFF's gamma 1.8)
+                encoded = image.dtype == np.uint16 or response == "srgb"
+                converted = to_linear_srgb(image, colour, encoded=encoded)
+            if converted is not None:
+                pixels, white = converted.pixels, 65535
+            else:
+                try:
+                    pixels, white = to_linear_uint16(image, response, order="rgb")
+                except ValueError as exc:
+                    raise CaptureError(self.name, f"{watched.name}: {exc}", "decode") from exc
             file_exposure, gain = None, s.gain
             metadata = {"source_file": str(path), "bit_depth": 8 * image.dtype.itemsize}
             metadata.update(exposure_stats(pixels, white, s.decode.underexposed_level))
-            notices = [alpha_note] if alpha_note else []
-            # what the file says of its colours, recorded as said (every file had been
-            # declared sRGB, an Adobe RGB JPEG or a ProPhoto TIFF too)
-            # (a grey image has no primaries to say: its TIFF says linear grey)
-            colour = file_colour(path) if pixels.ndim == 3 else None
             if colour is not None:
                 metadata["file_colour"] = colour.as_dict()
                 said = file_colour_notice(colour)
+                if converted is not None:
+                    metadata["file_colour"].update(converted.record)
+                    said = converted_notice(colour) if colour.space != "srgb" else None
+                    if converted.clipped:
+                        notices.append(clipped_notice(colour))
                 if said:
                     notices.append(said)
             suffix = path.suffix.lower()

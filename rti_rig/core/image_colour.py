@@ -226,16 +226,40 @@ LINEAR_COLOUR_WORDS: dict[str, str] = {
 }
 
 
-def file_colour_kind(file_colour: Mapping[str, str] | None) -> Literal["srgb", "assumed", "other"]:
+def file_colour_kind(
+    file_colour: Mapping[str, str] | None,
+) -> Literal["srgb", "assumed", "other", "converted"]:
     """How a non-RAW image's colours stand by what its file said (``file_colour``: the
     ``space``, ``name`` and ``said_by`` its camera driver read; absent for a camera that writes
     no file, whose frames are linear sRGB by construction): ``"srgb"`` said so, ``"assumed"``
-    the file said nothing (taken as sRGB, and said to be assumed), ``"other"`` another space,
-    kept as it is (never declared sRGB)."""
-    space = (file_colour or {}).get("space")
+    the file said nothing (taken as sRGB, and said to be assumed), ``"converted"`` another
+    known space converted to linear sRGB (its record's ``primaries`` says so:
+    :mod:`~rti_rig.drivers.cameras.colour_convert`), ``"other"`` another space, kept as it
+    is (never declared sRGB)."""
+    said = file_colour or {}
+    space = said.get("space")
     if space in (None, "srgb"):
         return "srgb"
+    if str(said.get("primaries", "")).startswith("converted"):
+        return "converted"
     return "assumed" if space == "untagged" else "other"
+
+
+def converted_words(file_colour: Mapping[str, str]) -> tuple[str, str, str]:
+    """(the JPEGs' words, the linear TIFFs' words, the TIFF's ImageDescription head) for
+    images converted to sRGB from the space their file said: sRGB now, and from what."""
+    name = file_colour.get("name", "another space")
+    source = (
+        f"converted from {name}, said by {file_colour.get('said_by', '')}: its curve undone "
+        "and its primaries converted by the specs' matrices, colours outside sRGB clipped "
+        "(each step's file_colour counts them)"
+    )
+    return (
+        f"sRGB, {source}; tagged (Exif ColorSpace 1 and an sRGB ICC profile)",
+        f"{LINEAR_SRGB}, {source}; said in the ImageDescription and tagged with a linear-sRGB "
+        "ICC profile",
+        f"{LINEAR_SRGB}, {source}",
+    )
 
 
 #: the words for a file that said nothing, of the JPEGs and of the linear TIFFs

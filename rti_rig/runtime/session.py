@@ -66,6 +66,7 @@ from rti_rig.core.image_colour import (
     LINEAR_COLOUR_WORDS,
     LINEAR_GREY,
     LINEAR_SRGB,
+    converted_words,
     decode_colour,
     file_colour_kind,
     icc_profile,
@@ -1312,6 +1313,9 @@ def image_colour(records: list[StepRecord], root: Path | None = None) -> dict[st
             elif kind == "other":
                 colour = f"other: {r.file_colour.get('name')} ({r.file_colour.get('said_by')})"
                 jpeg_words[colour], linear_words[colour], _ = other_space_words(r.file_colour)
+            elif kind == "converted":
+                colour = f"from: {r.file_colour.get('name')} ({r.file_colour.get('said_by')})"
+                jpeg_words[colour], linear_words[colour], _ = converted_words(r.file_colour)
         jpeg.setdefault(colour, []).append(Path(r.image).stem)
         if colour == "srgb" and not r.decode and root is not None and _grey_tiff(root, r):
             colour = "grey"
@@ -1668,6 +1672,8 @@ def linear_tiff_labels(decode: dict[str, Any], frame: Frame) -> tuple[str, bytes
         elif kind == "other":
             description = f"rti-rig: {other_space_words(said)[2]}, 16-bit{white}"
             icc = None
+        elif kind == "converted":
+            description = f"rti-rig: {converted_words(said)[2]}, 16-bit{white}"
     return description, icc
 
 

@@ -56,25 +56,31 @@ def test_adobe_rgb_and_untagged_jpegs_are_said_as_they_are(tmp_path, monkeypatch
         json.loads((out / "manifest.json").read_text())["steps"], key=lambda s: s["index"]
     )
     adobe, bare = Path(first["image"]).stem, Path(second["image"]).stem
-    assert "Adobe RGB (1998) primaries, NOT sRGB" in colour["linear"], colour
+    assert "converted from Adobe RGB (1998)" in colour["linear"], colour
     assert "assumed sRGB (the file does not say)" in colour["linear"], colour
     assert colour["linear"].index(adobe) > colour["linear"].index("Adobe RGB"), colour
-    assert "Adobe RGB (1998) primaries through the sRGB curve, NOT sRGB" in colour["jpeg"]
+    assert "sRGB, converted from Adobe RGB (1998)" in colour["jpeg"], colour
     icc, description = _linear(out, adobe)
-    assert icc is None and "Adobe RGB (1998) primaries, NOT sRGB" in description
+    assert icc is not None and "converted from Adobe RGB (1998)" in description
     assert "InteroperabilityIndex R03" in description, description
+    assert "gamma 563/256" in first["file_colour"]["curve_undone"], first
     icc, description = _linear(out, bare)
     assert icc is not None and "assumed sRGB (the file does not say)" in description
-    assert "the camera's files are Adobe RGB (1998)" in said, said
+    # grey 90 stays grey; undone by Adobe RGB's gamma 563/256, not by the sRGB curve
+    grey = tifffile.imread(out / first["linear_image"])[8, 8]
+    assert np.allclose(grey, (90 / 255) ** (563 / 256) * 65535, atol=3), grey
+    assert "the camera's files are Adobe RGB (1998) (said by" in said, said
+    assert "converted its primaries to sRGB's" in said, said
     assert "assumed sRGB (the file does not say)" in said, said
 
 
-def test_a_prophoto_16_bit_tiff_is_not_declared_srgb(tmp_path, monkeypatch):
+def test_a_prophoto_16_bit_tiff_is_made_linear_srgb(tmp_path, monkeypatch):
+    """Lightroom's default export, ProPhoto at gamma 1.8, had been taken as linear: its grey
+    20000 is 7743 once ROMM RGB's curve is undone (ISO 22028-2: E'^1.8)."""
     tether = tmp_path / "tether"
     tether.mkdir()
     cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0, tiffs=True)
     buffer = io.BytesIO()
-    # Lightroom's default TIFF export: 16-bit, its ProPhoto profile embedded
     tifffile.imwrite(
         buffer, np.full((32, 32, 3), 20000, np.uint16), iccprofile=icc_profile("ProPhoto RGB")
     )
@@ -83,9 +89,14 @@ def test_a_prophoto_16_bit_tiff_is_not_declared_srgb(tmp_path, monkeypatch):
     r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, files, out)
     assert r.exit_code == 0 and "Traceback" not in said and not lit_at_end, said
     colour = json.loads((out / "manifest.json").read_text())["image_colour"]
-    assert colour["linear"].startswith("ProPhoto RGB (ROMM RGB) primaries, NOT sRGB")
-    assert "linear sRGB" not in colour["linear"], colour
+    assert colour["linear"].startswith("linear sRGB"), colour
+    assert "converted from ProPhoto RGB (ROMM RGB)" in colour["linear"], colour
     step = json.loads((out / "manifest.json").read_text())["steps"][0]
+    assert "gamma 1.8" in step["file_colour"]["curve_undone"], step
+    assert step["file_colour"]["out_of_gamut_clipped"] == "0 of 1024 pixels", step
     icc, description = _linear(out, Path(step["image"]).stem)
-    assert icc is None and "ProPhoto" in description and "sRGB (IEC" not in description
+    assert icc is not None and "converted from ProPhoto RGB (ROMM RGB)" in description
     assert "its ICC profile 'ProPhoto RGB'" in description, description
+    pixels = tifffile.imread(out / step["linear_image"])
+    want = (20000 / 65535) ** 1.8 * 65535
+    assert np.allclose(pixels, want, atol=2), (pixels[0, 0], want)
