@@ -18,6 +18,11 @@ planner (adaptive or not) can be rehearsed on real data. What the session then h
   session's linear TIFF, encoded as the session encodes it, is pixel-identical to the decoded
   source JPEG. The session's JPEG is a re-encoding (quality 95) and is not byte-identical
   (the source's bytes are its copy in ``raw/``).
+* **Sources in another known space** (an Adobe RGB, ProPhoto or Display P3 file, or a 16-bit
+  file said to be sRGB-encoded): their curve is undone and their primaries converted to sRGB's
+  (:mod:`~rti_rig.drivers.cameras.colour_convert`), so the frames the fits read are linear
+  sRGB as the session says; the byte-for-byte copies under ``raw/`` are untouched. Untagged or
+  sRGB sources (and rti-rig's own linear TIFFs, whose profile is linear) are replayed as above.
 
 Exposure is not modelled: the recorded image is returned whatever exposure is asked (it is
 noted in the frame's metadata). Capturing advances the injected clock as a camera would.
@@ -37,7 +42,14 @@ from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, SessionError
 from rti_rig.core.image_files import linear_to_srgb8, read_image_any
 from rti_rig.core.shell_words import shown_path
-from rti_rig.drivers.cameras.file_colour import file_colour, file_colour_notice
+from rti_rig.drivers.cameras.colour_convert import (
+    Converted,
+    clipped_notice,
+    converted_notice,
+    needs_conversion,
+    to_linear_srgb,
+)
+from rti_rig.drivers.cameras.file_colour import FileColour, file_colour, file_colour_notice
 
 WHITE = 65535
 
@@ -63,12 +75,27 @@ def _srgb8_to_linear16() -> NDArray[np.uint16]:
 SRGB8_TO_LINEAR16 = _srgb8_to_linear16()
 
 
-def recorded_frame_pixels(path: Path) -> NDArray[np.uint16]:
-    """The recorded image as a linear 16-bit frame (see the module docstring)."""
-    img = read_image_any(path)
+def recorded_frame_pixels(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
+    """The recorded image's values as its file stores them (8- or 16-bit, RGB order): made
+    linear by :func:`linear_frame`, by what the file says of its colours."""
+    return read_image_any(path)
+
+
+def linear_frame(
+    img: NDArray[np.uint8] | NDArray[np.uint16], colour: FileColour | None
+) -> tuple[NDArray[np.uint16], Converted | None]:
+    """The recorded values as a linear 16-bit frame (see the module docstring), and the
+    conversion made (None: none). A file in a known space other than sRGB, or a 16-bit one
+    said to be sRGB-encoded, is converted by its own curve and primaries (an Adobe RGB JPEG
+    had been undone by the sRGB curve, a ProPhoto TIFF taken as linear); an sRGB or untagged
+    8-bit one goes through :data:`SRGB8_TO_LINEAR16`, a 16-bit one untagged or with a linear
+    profile (a session's own) is taken as stored, so those replay pixel-identical."""
+    if colour is not None and needs_conversion(colour, img.dtype):
+        converted = to_linear_srgb(img, colour)
+        return converted.pixels, converted
     if img.dtype == np.uint8:
-        return SRGB8_TO_LINEAR16[img]
-    return img.astype(np.uint16, copy=False)
+        return SRGB8_TO_LINEAR16[img], None
+    return img.astype(np.uint16, copy=False), None
 
 
 class LitLed(Protocol):
@@ -146,7 +173,9 @@ class ReplayCamera:
             source = None
         else:
             path = self._images[lit]
-            pixels = self._recorded(path)
+            stored = self._recorded(path)
+            colour = file_colour(path) if stored.ndim == 3 else None
+            pixels, converted = linear_frame(stored, colour)
             if pixels.shape[:2] != self._shape[:2]:
                 raise CaptureError(
                     self.name,
@@ -169,12 +198,20 @@ class ReplayCamera:
             # ("copy": the user's file, never moved, wherever it lies)
             name = self._names[lit] if self._names is not None else path.name
             metadata["originals"] = [{"path": source, "name": name, "copy": True}]
-            if pixels.ndim == 3:  # what the recorded file says of its colours, as said
-                colour = file_colour(path)
+            if colour is not None:  # what the recorded file says of its colours, as said
                 metadata["file_colour"] = colour.as_dict()
                 said = file_colour_notice(colour, "the replayed files")
+                notices = []
+                if converted is not None:
+                    metadata["file_colour"].update(converted.record)
+                    if colour.space != "srgb":
+                        said = converted_notice(colour, "the replayed files")
+                    if converted.clipped:
+                        notices.append(clipped_notice(colour))
                 if said:
-                    metadata["notices"] = [said]
+                    notices.insert(0, said)
+                if notices:
+                    metadata["notices"] = notices
         return Frame(
             pixels=pixels,
             exposure_s=exposure_s,

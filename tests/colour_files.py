@@ -67,9 +67,16 @@ def exif_colour(colorspace: int, interop: bytes | None = None) -> bytes:
     return b"Exif\0\0" + tiff
 
 
-def jpeg(level: int = 120, exif: bytes | None = None, icc: bytes | None = None) -> bytes:
-    """A 16x16 grey-level colour JPEG with the segments given after its SOI."""
-    ok, encoded = cv2.imencode(".jpg", np.full((16, 16, 3), level, np.uint8))
+def jpeg(
+    level: int = 120,
+    exif: bytes | None = None,
+    icc: bytes | None = None,
+    rgb: np.ndarray | None = None,
+) -> bytes:
+    """A 16x16 grey-level colour JPEG (or of the ``rgb`` pixels given, RGB order) with the
+    segments given after its SOI."""
+    pixels = np.full((16, 16, 3), level, np.uint8) if rgb is None else rgb[..., ::-1]
+    ok, encoded = cv2.imencode(".jpg", pixels, [cv2.IMWRITE_JPEG_QUALITY, 100])
     assert ok
     data = encoded.tobytes()
     segments = b""

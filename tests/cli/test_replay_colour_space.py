@@ -1,17 +1,22 @@
-"""A replay (`rti-rig run ACQ/dirs.lp --out S`) of files that say another colour space records
-them in it: the session's images of an Adobe RGB acquisition are not declared sRGB.
+"""A replay (`rti-rig run ACQ/dirs.lp --out S`) of files that say another colour space
+converts them to linear sRGB for the session's frames: an Adobe RGB acquisition's grey is
+undone by Adobe RGB's gamma 563/256 (not the sRGB curve), its green, outside sRGB, is clipped
+and counted, the manifest says so, and the recorded files are kept byte for byte.
 
-Why: a replay's images were all declared sRGB, whatever their files said (the manifest's
-"linear sRGB", a linear-sRGB ICC profile in every linear TIFF). Files built in
-:mod:`colour_files` (sources cited there).
+Why: a replay's 8-bit frames were undone by the sRGB curve whatever their file said, and
+their Adobe RGB primaries kept under a session that fits and exports them as sRGB. Files
+built in :mod:`colour_files` (sources cited there).
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 from pathlib import Path
 
+import cv2
+import numpy as np
 import tifffile
 from colour_files import icc_profile, jpeg
 from typer.testing import CliRunner
@@ -19,14 +24,16 @@ from typer.testing import CliRunner
 from rti_rig.cli import app
 
 
-def test_a_replay_of_adobe_rgb_jpegs_is_said_adobe_rgb(tmp_path: Path) -> None:
+def test_a_replay_of_adobe_rgb_jpegs_is_converted_to_linear_srgb(tmp_path: Path) -> None:
     acq = tmp_path / "acq"
     acq.mkdir()
     lines = []
     profile = icc_profile("Adobe RGB (1998)")
     for k in range(8):  # eight lights on a ring at 45 degrees' elevation
         name = f"image{k + 1:02d}.jpg"
-        (acq / name).write_bytes(jpeg(60 + 10 * k, icc=profile))
+        rgb = np.full((16, 16, 3), 60 + 10 * k, np.uint8)
+        rgb[:8, :8] = (0, 200, 0)  # Adobe RGB's green: outside sRGB's gamut
+        (acq / name).write_bytes(jpeg(icc=profile, rgb=rgb))
         a = 2 * math.pi * k / 8
         r = math.sqrt(0.5)
         lines.append(f"{name} {r * math.cos(a):.6f} {r * math.sin(a):.6f} {r:.6f}")
@@ -39,9 +46,35 @@ def test_a_replay_of_adobe_rgb_jpegs_is_said_adobe_rgb(tmp_path: Path) -> None:
     assert r.exit_code == 0 and "Traceback" not in said, said
     manifest = json.loads((out / "manifest.json").read_text())
     colour = manifest["image_colour"]
-    assert colour["linear"].startswith("Adobe RGB (1998) primaries, NOT sRGB"), colour
-    assert colour["jpeg"].startswith("Adobe RGB (1998) primaries through the sRGB curve"), colour
-    with tifffile.TiffFile(out / manifest["steps"][0]["linear_image"]) as tif:
-        assert tif.pages[0].tags.get(34675) is None  # no sRGB profile on Adobe RGB pixels
-        assert "its ICC profile 'Adobe RGB (1998)'" in tif.pages[0].description
-    assert "the replayed files are Adobe RGB (1998)" in said, said
+    assert colour["linear"].startswith("linear sRGB"), colour
+    assert "converted from Adobe RGB (1998), said by its ICC profile" in colour["linear"]
+    assert colour["jpeg"].startswith("sRGB, converted from Adobe RGB (1998)"), colour
+    step = manifest["steps"][0]
+    assert "gamma 563/256" in step["file_colour"]["curve_undone"], step
+    clipped, of = step["file_colour"]["out_of_gamut_clipped"].split(" of ")
+    assert int(clipped) >= 64 and of == "256 pixels", step  # the green square, its JPEG fringe
+    with tifffile.TiffFile(out / step["linear_image"]) as tif:
+        assert tif.pages[0].tags.get(34675) is not None  # linear sRGB, tagged so
+        assert "converted from Adobe RGB (1998)" in tif.pages[0].description
+        pixels = tif.asarray()
+    source = cv2.imread(str(acq / "image01.jpg"))[..., ::-1].astype(float) / 255
+    # Adobe RGB's curve, then its published RGB-to-XYZ matrix (Adobe RGB (1998) 4.3.4.1) and
+    # sRGB's published XYZ-to-RGB (IEC 61966-2-1, 5.2): the sRGB curve gives ~9% more
+    adobe_to_xyz = [
+        [0.57667, 0.18556, 0.18823],
+        [0.29734, 0.62736, 0.07529],
+        [0.02703, 0.07069, 0.99134],
+    ]
+    xyz_to_srgb = [[3.2406, -1.5372, -0.4986], [-0.9689, 1.8758, 0.0415], [0.0557, -0.2040, 1.0570]]
+    want = np.clip(
+        source[12, 12] ** (563 / 256) @ np.transpose(np.dot(xyz_to_srgb, adobe_to_xyz)), 0, 1
+    )
+    assert np.allclose(pixels[12, 12], want * 65535, atol=12), (pixels[12, 12], want * 65535)
+    assert pixels[4, 4, 0] == 0 and pixels[4, 4, 2] == 0  # the green's negatives clipped
+    assert "some colours of the Adobe RGB (1998) files lie outside sRGB" in said, said
+    assert "[8 of 8 images]" in said, said
+    kept = sorted((out / "raw").glob("*"))[0]  # the recorded file, untouched
+    assert (
+        hashlib.sha256(kept.read_bytes()).digest()
+        == hashlib.sha256((acq / "image01.jpg").read_bytes()).digest()
+    ), kept
