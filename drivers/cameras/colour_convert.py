@@ -125,6 +125,10 @@ def decode_curve(v: NDArray[np.float64], curve: Curve) -> NDArray[np.float64]:
     return v
 
 
+#: rows converted at a time (bounds the float working set to a band of the frame)
+_ROWS = 256
+
+
 @dataclass(frozen=True)
 class Converted:
     """The frame's pixels in linear sRGB (uint16, white 65535) and what was done to them, in
@@ -156,15 +160,19 @@ def to_linear_srgb(image: NDArray, colour: FileColour, *, encoded: bool = True) 
     curve: Curve = space.curve if encoded and not colour.linear_curve else "linear"
     top = 255 if image.dtype == np.uint8 else 65535
     lut = decode_curve(np.arange(top + 1, dtype=np.float64) / top, curve).astype(np.float32)
-    linear = lut[image[..., :3]]
+    matrix = to_srgb_matrix(colour.space).astype(np.float32).T
+    half = np.float32(0.5 / 65535)  # beyond half a code: out of gamut, not rounding
+    pixels = np.empty((*image.shape[:2], 3), np.uint16)
     clipped = 0
-    if colour.space != "srgb":
-        matrix = to_srgb_matrix(colour.space).astype(np.float32)
-        linear = linear @ matrix.T
-        half = np.float32(0.5 / 65535)  # beyond half a code: out of gamut, not rounding
-        out = (linear < -half) | (linear > 1 + half)
-        clipped = int(np.count_nonzero(out.any(axis=-1)))
-    pixels = np.rint(np.clip(linear, 0.0, 1.0) * 65535).astype(np.uint16)
+    for row in range(0, image.shape[0], _ROWS):  # in bands: a 24 MP frame's floats in one
+        linear = lut[image[row : row + _ROWS, :, :3]]  # piece had held about 1 GB
+        if colour.space != "srgb":
+            linear = linear @ matrix
+            out = (linear < -half) | (linear > 1 + half)
+            clipped += int(np.count_nonzero(out.any(axis=-1)))
+        np.clip(linear, 0.0, 1.0, out=linear)
+        linear *= 65535
+        pixels[row : row + _ROWS] = np.rint(linear, out=linear)
     curve_words = (
         "none: linear, as its ICC profile's curve (gamma 1.0) says"
         if colour.linear_curve
@@ -182,7 +190,7 @@ def to_linear_srgb(image: NDArray, colour: FileColour, *, encoded: bool = True) 
         ),
         "out_of_gamut_clipped": f"{clipped} of {image.shape[0] * image.shape[1]} pixels",
     }
-    return Converted(np.ascontiguousarray(pixels), record, clipped)
+    return Converted(pixels, record, clipped)
 
 
 def converted_notice(colour: FileColour, whose: str = "the camera's files") -> str:
