@@ -368,6 +368,46 @@ class RigConfig(_Strict):
             f"light gains out of them instead: {IMAGE_GAINS_REMEDY})"
         )
 
+    def _dome_fault_has_a_link(self, i: int, kind: str) -> None:
+        """Refuse a dome's command fault where no firmware emulator receives commands.
+
+        Why: the faults are keyed by the n-th command the firmware emulator on the serial link
+        receives; the camera-stepped cceh/rti dome has no link (its emulator is stepped by the
+        flash signal) and a simulated dome has no firmware, so a rehearsed reset or lost reply
+        was ignored and ``check`` said PASS: nothing had been rehearsed."""
+        dome = self.dome
+        if dome is None or (dome.serial is not None and self.backend == "emulated"):
+            return
+        if dome.flash_sync is not None:
+            raise ValueError(
+                f"emulator.faults[{i}]: {kind} is a fault of a serial link's reply or "
+                f"command, and this dome ({dome.flash_sync.firmware}) has none: the camera's "
+                "flash signal steps it. Rehearse its faults as [[emulator.sync_faults]] "
+                "(at_image = N, kind = 'missed_pulse' or 'double_step'), or remove this one"
+            )
+        raise ValueError(
+            f"emulator.faults[{i}]: {kind} is rehearsed by an emulated dome's firmware on its "
+            "serial link (backend = 'emulated' with a [dome.serial]), and this rig has none; "
+            "remove the fault, or rehearse it on rig_configs/emulated_dome.toml"
+        )
+
+    def _sync_faults_have_a_flash_dome(self) -> None:
+        """Refuse flash-pulse faults on a rig whose camera steps no dome.
+
+        Why: only the emulated camera-triggered dome's camera reads them; on a serial dome
+        ``[[emulator.sync_faults]]`` were ignored and ``check`` said PASS, nothing rehearsed."""
+        if not self.emulator.sync_faults:
+            return
+        dome = self.dome
+        if dome is not None and dome.flash_sync is not None and self.backend == "emulated":
+            return
+        raise ValueError(
+            f"emulator.sync_faults[0]: {self.emulator.sync_faults[0].kind} is a flash pulse "
+            "of a camera-triggered dome ([dome.flash_sync], backend = 'emulated'), and no "
+            "camera steps this rig's lights; rehearse a serial dome's faults as "
+            "[[emulator.faults]] (at_command = N, kind = 'reset', 'drop_reply', …), or remove it"
+        )
+
     def _arm_faults_are_replies(self) -> None:
         """Refuse, naming the key, an arm's fault the emulated servos cannot rehearse.
 
@@ -387,6 +427,7 @@ class RigConfig(_Strict):
                         "rehearses drop_reply, garble_reply, garble_command, delay_reply, "
                         "disconnect, reset, reset_after_reply and blank_line_before_reply"
                     )
+                self._dome_fault_has_a_link(i, fault.kind)
                 serial = self.dome.serial if self.dome is not None else None
                 if fault.kind == "blank_line_before_reply" and (
                     serial is None or serial.profile not in ("default", "framed")
@@ -492,6 +533,7 @@ class RigConfig(_Strict):
                 f"they need kind = 'dome' and backend = 'emulated'{self._real_unevenness()}"
             )
         self._arm_faults_are_replies()
+        self._sync_faults_have_a_flash_dome()
         if self.backend in ("simulated", "emulated"):
             from rti_rig.simulator.scenes import MIN_SIZE_PX
 

@@ -1,0 +1,60 @@
+"""A rehearsed dome fault is refused where nothing would rehearse it, naming file and key.
+
+``[[emulator.faults]]`` are keyed by the n-th command a serial dome's firmware emulator
+receives, ``[[emulator.sync_faults]]`` by the n-th flash pulse of a camera-triggered dome. Each
+kind was ignored on the other's rig: a ``reset`` on the camera-stepped cceh/rti dome (it has no
+serial link) or a ``missed_pulse`` on the serial MiniRTI ran a clean ``check`` and said
+``RESULT: PASS``, so the user believed a fault rehearsed that never happened.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+RESET = '\n[[emulator.faults]]\nat_command = 3\nkind = "reset"\n'
+MISSED = '\n[[emulator.sync_faults]]\nat_image = 2\nkind = "missed_pulse"\n'
+
+
+@pytest.mark.parametrize(
+    ("shipped", "extra", "words"),
+    [
+        (
+            "emulated_cceh_rti.toml",
+            RESET,
+            "emulator.faults[0]: reset is a fault of a serial link's reply or command, and "
+            "this dome (cceh-rti) has none: the camera's flash signal steps it. Rehearse its "
+            "faults as [[emulator.sync_faults]]",
+        ),
+        (
+            "simulated_dome.toml",
+            RESET,
+            "emulator.faults[0]: reset is rehearsed by an emulated dome's firmware on its "
+            "serial link",
+        ),
+        (
+            "emulated_minirti.toml",
+            MISSED,
+            "emulator.sync_faults[0]: missed_pulse is a flash pulse of a camera-triggered "
+            "dome ([dome.flash_sync], backend = 'emulated'), and no camera steps this rig's "
+            "lights; rehearse a serial dome's faults as [[emulator.faults]]",
+        ),
+    ],
+)
+def test_a_fault_nothing_would_rehearse_is_refused(
+    tmp_path: Path, shipped: str, extra: str, words: str
+) -> None:
+    config = tmp_path / "rig.toml"
+    config.write_text((CONFIGS / shipped).read_text() + extra)
+    r = runner.invoke(app, ["check", str(config)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "Traceback" not in said, said
+    assert "PASS" not in said
+    assert f"{config}: {words}" in said, said
