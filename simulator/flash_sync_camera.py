@@ -13,7 +13,10 @@ Faults at chosen exposures (1-based, in the order the camera shoots):
 * ``missed_pulse``: the sync signal never reaches the dome (a loose PC-sync cable, a camera in
   a mode that does not fire its flash contact): the image is dark and the dome does not step;
 * ``double_step``: the contact bounces open and closed again after the firmware's 2 ms
-  debounce: the dome steps twice.
+  debounce: the dome steps twice;
+* ``power_cycle``: the dome's supply drops and comes back just before the exposure: its
+  firmware starts again from LED 0 (:meth:`CcehRtiFirmware.power_cycle`), so the image is lit
+  by LED 0 and the dome steps on from there.
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ from rti_rig.core.devices import Frame
 from rti_rig.simulator.domes.cceh_rti import CcehRtiFirmware
 from rti_rig.simulator.sim_camera import Renderer, SimulatedCamera
 
-SYNC_FAULTS = ("missed_pulse", "double_step")
+SYNC_FAULTS = ("missed_pulse", "double_step", "power_cycle")
 #: A bounce long enough to pass the firmware's 2 ms debounce (3 ticks of 1.024 ms, and more).
 BOUNCE_OPEN_S = 0.0035
 BOUNCE_CLOSED_AGAIN_S = 0.007
@@ -98,6 +101,8 @@ class FlashSyncCamera:
         t0 = self._clock.now()
         t1 = t0 + exposure_s
         kind = self._faults.get(n)
+        if kind == "power_cycle":
+            self.dome.power_cycle(t0)
         if kind == "double_step":
             self.dome.flash_edge(t0, True)
             self.dome.flash_edge(t0 + BOUNCE_OPEN_S, False)

@@ -383,7 +383,8 @@ class RigConfig(_Strict):
                 f"emulator.faults[{i}]: {kind} is a fault of a serial link's reply or "
                 f"command, and this dome ({dome.flash_sync.firmware}) has none: the camera's "
                 "flash signal steps it. Rehearse its faults as [[emulator.sync_faults]] "
-                "(at_image = N, kind = 'missed_pulse' or 'double_step'), or remove this one"
+                "(at_image = N, kind = 'missed_pulse', 'double_step' or 'power_cycle'), or "
+                "remove this one"
             )
         raise ValueError(
             f"emulator.faults[{i}]: {kind} is rehearsed by an emulated dome's firmware on its "

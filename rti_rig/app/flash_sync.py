@@ -74,13 +74,14 @@ class FlashSyncSettings(BaseModel):
 
 
 class SyncFaultConfig(BaseModel):
-    """``[[emulator.sync_faults]]``: a flash pulse lost, or bounced into a double step, at the
-    n-th exposure (1-based) of an emulated camera-triggered dome."""
+    """``[[emulator.sync_faults]]``: a flash pulse lost, or bounced into a double step, or the
+    dome's power cycled just before it, at the n-th exposure (1-based) of an emulated
+    camera-triggered dome."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     at_image: int = Field(gt=0)
-    kind: Literal["missed_pulse", "double_step"]
+    kind: Literal["missed_pulse", "double_step", "power_cycle"]
 
 
 def flash_sync_of(loaded) -> FlashSyncSettings | None:  # type: ignore[no-untyped-def]

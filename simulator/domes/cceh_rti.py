@@ -123,6 +123,23 @@ class CcehRtiFirmware:
         self.pilot_on = False
         self.events.append((t_act, "start (long press): index -> 0"))
 
+    def power_cycle(self, t: float) -> None:
+        """The dome's supply lost and back at ``t`` (a loose barrel jack, a brown-out).
+
+        Why: ``led_index`` is a static the C runtime zeroes at every start, and ``main()``
+        switches the outputs off, releases the camera line and programs ``LED_595_MASK[0]``
+        (cceh/rti ``firmware/rti.cpp`` at f647d3f): the board forgets how far the run got,
+        and its next flash lights LED 0 again, whatever image the host is at."""
+        self.advance(t)
+        self._set_lit(t, frozenset())
+        self.led_index = 0
+        self.programmed = frozenset({0})
+        self._last_edge_tick = None
+        self._timeout_at = None
+        self.camera_trigger = False
+        self.pilot_on = False
+        self.events.append((t, "power cycle: boot, index -> 0"))
+
     def short_press(self, t: float) -> None:
         """Toggle the pilot light (every LED), leaving its pattern in the shift register."""
         self.advance(t)

@@ -75,6 +75,20 @@ def test_long_press_rewinds_and_the_pilot_light_leaves_every_led_programmed() ->
     assert len(fw.lit_at(7.05)) == LED_COUNT
 
 
+def test_a_power_cycle_forgets_the_count_and_the_next_flash_lights_led_0() -> None:
+    """``led_index`` is zeroed and LED 0 programmed at every start (firmware/rti.cpp), even
+    with a flash timeout pending and a pilot pattern programmed before the power went."""
+    fw = CcehRtiFirmware()
+    for k in range(3):
+        fw.pulse(float(k), 0.1)
+    fw.short_press(3.0)  # pilot on: every LED lit and programmed
+    fw.power_cycle(4.0)
+    assert fw.lit_at(4.0) == set() and fw.led_index == 0
+    fw.pulse(5.0, 0.1)
+    fw.pulse(6.0, 0.1)
+    assert fw.lit_at(5.05) == {0} and fw.lit_at(6.05) == {1}
+
+
 def _camera(faults=(), exposure_s=0.05):  # type: ignore[no-untyped-def]
     clock = VirtualClock()
     dirs = direction_from_az_el(45 + 360 * np.arange(8) / 8, np.full(8, 40.0))
