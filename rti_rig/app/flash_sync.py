@@ -159,6 +159,8 @@ class SlipGuard:
         )
         if verdict.dark:
             raise LightSlipError(self._after_dark(index, verdict, kept, Path(root), rewind))
+        if verdict.kind == "restarted":
+            raise LightSlipError(self._restarted(index, verdict.reason, kept))
         last = self.settings.firmware_led_count - 1
         if verdict.fitted and verdict.best_position == index - 1 and index == last:
             # the firmware re-lights its last LED once its order is exhausted: it got there early
@@ -193,6 +195,21 @@ class SlipGuard:
             f"image {index + 1} was not lit by {self._led(index)} of the dome's order — {what}: "
             f"{verdict.reason}. {kept.said('The image')}; lights.lp lists "
             f"{before} only. {rewind}"
+        )
+
+    def _restarted(self, index: int, reason: str, kept: str) -> str:
+        """The words for an image lit by the order's first LED far into the run.
+
+        Why: the firmware starts its order again from LED 0 whenever its power comes back (a
+        loose supply jack, a brown-out); the images before were lit as labelled (each was
+        checked), so they are kept as they are, and only the dome must be rewound."""
+        before = f"images 1–{index}" if index > 1 else "image 1"
+        return (
+            f"image {index + 1} was {reason}: the dome started its order again (its power was "
+            "cut and came back, or its start button was pressed). The image is kept, "
+            f"unlabelled, as {kept}; lights.lp lists {before} only, each matched to its LED. "
+            "Check the dome's power supply and its plug, then long-press its start button to "
+            "rewind it and start a new session"
         )
 
     def _led(self, index: int) -> str:

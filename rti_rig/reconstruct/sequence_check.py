@@ -78,6 +78,9 @@ SHIFT_MARGIN = 0.05
 LOOKBACK = 8
 
 OK, MISSED, DOUBLE = "ok", "missed-step", "double-step"
+#: Lit by the first LED of the order far into the run: the dome's firmware started again (its
+#: power cycled: cceh/rti's ``led_index`` is zeroed and LED 0 programmed at every start).
+RESTARTED = "restarted"
 
 
 @dataclass(frozen=True)
@@ -86,7 +89,8 @@ class SequenceVerdict:
 
     ``kind`` is ``ok``, ``missed-step`` (lit by the previous LED: the dome is behind; or dark,
     with ``dark`` set: a missed pulse or a dead LED, which only the next frame tells apart)
-    or ``double-step`` (lit by the next LED: the dome is ahead). ``residuals`` are the relative
+    or ``double-step`` (lit by the next LED: the dome is ahead) or ``restarted`` (lit by the
+    order's first LED: the firmware started again from it). ``residuals`` are the relative
     residuals per order position tried; ``fitted`` says whether the neighbour test ran.
     """
 
@@ -169,7 +173,7 @@ class SequenceChecker:
                 dark=True,
             )
         verdict = self._neighbour_test(index, img, ratio)
-        if verdict.slip:
+        if verdict.slip and verdict.kind != RESTARTED:
             verdict = self._locate_start(verdict, img)
         else:
             verdict = self._shift_test(index, img, ratio) or verdict
@@ -231,6 +235,10 @@ class SequenceChecker:
         if len(self._images) < self.min_fit_images or index >= len(self.order):
             return none
         positions = [p for p in (index - 1, index, index + 1) if 0 <= p < len(self.order)]
+        # the first LED too: a dome whose power cycled starts its order again there, and every
+        # image from then on is labelled with an LED far from the one that lit it (a check of
+        # the neighbours alone accepted them all)
+        positions += [0] if index >= 2 else []
         residuals = self._residuals(img, positions)
         if residuals is None:
             return none
@@ -240,8 +248,8 @@ class SequenceChecker:
             return SequenceVerdict(
                 index, OK, "matches its LED", best, True, residuals, brightness_ratio=ratio
             )
-        kind = DOUBLE if best == index + 1 else MISSED
-        which = "next" if best == index + 1 else "previous"
+        kind = DOUBLE if best == index + 1 else MISSED if best == index - 1 else RESTARTED
+        which = {DOUBLE: "next", MISSED: "previous", RESTARTED: "first"}[kind]
         return SequenceVerdict(
             index,
             kind,

@@ -1,0 +1,62 @@
+"""The camera-triggered cceh/rti dome whose power is cut and comes back mid-run.
+
+Its firmware zeroes ``led_index`` and programs LED 0 at every start (``firmware/rti.cpp``), so
+after a power cut the next flash lights LED 0 whatever image the host is at, and every image
+from then on is lit by an LED far from its label. The per-image check compared each image
+with its LED's neighbours only: on a 12-LED order with the power cycled before image 6, the
+run finished, labelling images 6–12 with LEDs 5–11 that lit none of them (only the missing
+end-of-run proof said the labels were unverified, not why).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.app.config import load_rig_config, rig_geometry
+from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
+
+runner = CliRunner()
+
+#: The first two rings of the shipped order (12 LEDs): a short run that still gets a fit.
+TWO_RINGS = """rings = [
+  { elevation_deg = 79.4, count = 4, azimuth_offset_deg = 45.0 },
+  { elevation_deg = 62.0, count = 8, azimuth_offset_deg = 45.0 },
+]"""
+
+
+def test_a_power_cycle_mid_run_stops_at_its_image_and_keeps_the_ones_before(
+    tmp_path: Path,
+) -> None:
+    shipped = (CONFIGS / "emulated_cceh_rti.toml").read_text(encoding="utf-8")
+    text = re.sub(r"rings = \[\n.*?\n\]", TWO_RINGS, shipped, count=1, flags=re.S)
+    assert text != shipped
+    config = tmp_path / "rig.toml"
+    config.write_text(
+        text + '\n[[emulator.sync_faults]]\nat_image = 6\nkind = "power_cycle"\n',
+        encoding="utf-8",
+    )
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(config), "--out", str(out)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "Traceback" not in said, said
+    geometry = rig_geometry(load_rig_config(config))
+    assert (
+        f"image 6 was lit by the first LED of the order, {geometry.led_said(0)}, not "
+        f"{geometry.led_said(5)}" in said
+    ), said
+    assert "the dome started its order again (its power was cut and came back" in said
+    assert "lights.lp lists images 1–5 only" in said and "Check the dome's power supply" in said
+    # no link, no all-off: the words must not say the lights are off
+    assert "That lights are off is not confirmed: look at the dome" in said
+    assert "lights are off." not in said
+    # nothing lost: images 1-5 labelled with their LEDs, image 6 kept unlabelled
+    lp = read_lp(out / "lights.lp")
+    assert [Path(e.name).name for e in lp] == [f"image_{k:03d}.jpg" for k in range(1, 6)]
+    np.testing.assert_allclose([e.direction for e in lp], geometry.directions[:5], atol=1e-4)
+    assert (out / "unlabelled" / "image_006.tif").exists()
