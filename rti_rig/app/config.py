@@ -388,7 +388,7 @@ class RigConfig(_Strict):
             )
         raise ValueError(
             f"emulator.faults[{i}]: {kind} is rehearsed by an emulated dome's firmware on its "
-            "serial link (backend = 'emulated' with a [dome.serial]), and this rig has none; "
+            "serial link (backend = 'emulated' with a [dome.serial]), and this rig is not one; "
             "remove the fault, or rehearse it on rig_configs/emulated_dome.toml"
         )
 

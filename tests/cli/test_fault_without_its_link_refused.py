@@ -37,7 +37,7 @@ MISSED = '\n[[emulator.sync_faults]]\nat_image = 2\nkind = "missed_pulse"\n'
             "simulated_dome.toml",
             RESET,
             "emulator.faults[0]: reset is rehearsed by an emulated dome's firmware on its "
-            "serial link",
+            "serial link (backend = 'emulated' with a [dome.serial]), and this rig is not one",
         ),
         (
             "emulated_minirti.toml",
