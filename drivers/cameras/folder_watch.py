@@ -113,6 +113,7 @@ from rti_rig.drivers.cameras.raw_decode import (
     exposure_stats,
     libraw_opened,
     libraw_printed,
+    orientation_words,
 )
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
 from rti_rig.drivers.cameras.tiff_structure import (
@@ -1834,10 +1835,11 @@ class FolderWatchCamera:
             )
             if turned not in (None, 1):
                 kind = "JPEG" if suffix in JPEG_SUFFIXES else "TIFF"
+                happened, undone = orientation_words(turned)
                 notices.append(
-                    f"the camera was rotated (Orientation tag {turned}: "
+                    f"{happened} (Orientation tag {turned}: "
                     f"{ORIENTATION_NAMES.get(turned, 'not a known value')}): rti-rig keeps "
-                    f"the {kind}'s pixels as stored, so these images are not turned upright as "
+                    f"the {kind}'s pixels as stored, so these images are not {undone} as "
                     "a viewer shows the watched folder's files; the .lp light directions "
                     "are in the same (stored) frame, so fitting is unaffected "
                     "(docs/cameras.md)"

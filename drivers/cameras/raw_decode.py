@@ -352,11 +352,24 @@ ORIENTATION_NAMES = {
     2: "mirrored horizontally",
     3: "rotated 180°",
     4: "mirrored vertically",
-    5: "transposed",
+    5: "mirrored across the top-left to bottom-right diagonal (transposed)",
     6: "rotate 90° CW to view",
-    7: "transversed",
+    7: "mirrored across the top-right to bottom-left diagonal (transversed)",
     8: "rotate 90° CCW to view",
 }
+#: The Orientation values whose picture is mirrored, not only turned: 2 and 4 across an axis,
+#: 5 and 7 across a diagonal (a flip and a quarter turn). Why: a mirrored file had been said
+#: to come from a rotated camera, which a user would fix by turning, never by flipping.
+MIRRORED_ORIENTATIONS = frozenset({2, 4, 5, 7})
+
+
+def orientation_words(tag: int | None) -> tuple[str, str]:
+    """What an Orientation ``tag`` other than 1 says of a file, and what a viewer does to it:
+    ("the camera was rotated", "turned upright") or, for a mirrored value,
+    ("the picture is marked mirrored", "flipped back")."""
+    if tag in MIRRORED_ORIENTATIONS:
+        return "the picture is marked mirrored", "flipped back"
+    return "the camera was rotated", "turned upright"
 
 
 def srgb_from_camera(cam_xyz: NDArray[np.float64]) -> NDArray[np.float64] | None:
@@ -750,10 +763,11 @@ def decode_raw(
     if orientation["camera_rotated"]:
         tag = orientation["orientation_tag"]
         meaning = orientation["orientation_tag_meaning"] or orientation["flip_meaning"]
+        happened, undone = orientation_words(tag)
         notices.append(
-            f"the camera was rotated (Orientation tag {tag}: {meaning}): rti-rig keeps "
+            f"{happened} (Orientation tag {tag}: {meaning}): rti-rig keeps "
             "sensor orientation, as the camera's RAW data and JPEG previews are stored, so "
-            "these images are not turned upright; the .lp light directions are in the same "
+            f"these images are not {undone}; the .lp light directions are in the same "
             "(sensor) frame, so fitting is unaffected (docs/cameras.md)"
         )
     if printed:

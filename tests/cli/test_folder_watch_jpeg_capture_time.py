@@ -156,9 +156,21 @@ def test_a_refused_jpeg_names_the_key_its_table_and_where_the_shot_is_left(tmp_p
     assert (tether / "IMG_0001.JPG").read_bytes() == files[0][1]
 
 
-def test_a_rotated_16_bit_tiff_is_said_kept_as_stored(tmp_path, monkeypatch):
+@pytest.mark.parametrize(
+    ("tag", "words"),
+    [
+        (8, "the camera was rotated (Orientation tag 8: rotate 90° CCW to view)"),
+        (
+            7,
+            "the picture is marked mirrored (Orientation tag 7: mirrored across the top-right "
+            "to bottom-left diagonal (transversed))",
+        ),
+    ],
+)
+def test_a_rotated_16_bit_tiff_is_said_kept_as_stored(tmp_path, monkeypatch, tag, words):
     """A 16-bit TIFF saved with its camera's Orientation 8 (tifffile reads it as stored, as
-    OpenCV reads a JPEG) gets the rotated-camera notice; it had been recorded with none."""
+    OpenCV reads a JPEG) gets the rotated-camera notice; it had been recorded with none. A
+    mirrored one (7) is said mirrored: it had been said to come from a rotated camera."""
     import io
 
     import tifffile
@@ -168,14 +180,11 @@ def test_a_rotated_16_bit_tiff_is_said_kept_as_stored(tmp_path, monkeypatch):
     cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0, tiffs=True)
     buffer = io.BytesIO()
     tifffile.imwrite(
-        buffer, np.full((32, 32, 3), 20000, np.uint16), extratags=[(274, 3, 1, 8, True)]
+        buffer, np.full((32, 32, 3), 20000, np.uint16), extratags=[(274, 3, 1, tag, True)]
     )
     files = [(f"IMG_{k:04d}.tif", buffer.getvalue()) for k in (1, 2)]
     r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, files, tmp_path / "s")
     assert r.exit_code == 0 and "Traceback" not in said, said
     assert not lit_at_end and "lights are off" in said, said
-    assert (
-        "the camera was rotated (Orientation tag 8: rotate 90° CCW to view): rti-rig keeps the "
-        "TIFF's pixels as stored" in said
-    ), said
+    assert f"{words}: rti-rig keeps the TIFF's pixels as stored" in said, said
     assert "fitting is unaffected (docs/cameras.md) [2 of 2 images]" in said, said

@@ -84,6 +84,28 @@ def test_a_turned_preview_is_said_planned_as_stored(
     assert "stored pixel order" in said
 
 
+@pytest.mark.parametrize(
+    ("name", "data", "words"),
+    [
+        ("selfie.jpg", _jpeg(2), "Orientation tag 2: mirrored horizontally"),
+        (
+            "scan.tif",
+            _tiff(5),
+            "Orientation tag 5: mirrored across the top-left to bottom-right diagonal",
+        ),
+    ],
+)
+def test_a_mirrored_preview_is_said_mirrored_not_turned(
+    tmp_path: Path, name: str, data: bytes, words: str
+) -> None:
+    """Orientations 2, 4, 5 and 7 flip the picture: they had been said "taken turned" (and 5
+    and 7 only "transposed"), which a user would undo by turning the camera, not flipping."""
+    said = _plan(tmp_path, name, data)
+    assert f"the preview {name} is marked as mirrored ({words}" in said, said
+    assert "not flipped back as a viewer shows it" in said, said
+    assert "taken turned" not in said, said
+
+
 def test_an_upright_preview_says_nothing_of_it(tmp_path: Path) -> None:
     said = _plan(tmp_path, "upright.jpg", _jpeg(1))
     assert "taken turned" not in said

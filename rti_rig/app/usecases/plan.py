@@ -317,12 +317,19 @@ def preview_orientation_note(image: Path) -> str | None:
         return None
     if turned in (None, 1):
         return None
-    from rti_rig.drivers.cameras.raw_decode import ORIENTATION_NAMES
+    from rti_rig.drivers.cameras.raw_decode import (
+        MIRRORED_ORIENTATIONS,
+        ORIENTATION_NAMES,
+        orientation_words,
+    )
 
+    mirrored = turned in MIRRORED_ORIENTATIONS
     return (
-        f"the preview {shown_path(image.name)} is marked as taken turned (Orientation tag "
+        f"the preview {shown_path(image.name)} is marked as "
+        f"{'mirrored' if mirrored else 'taken turned'} (Orientation tag "
         f"{turned}: {ORIENTATION_NAMES.get(turned, 'not a known value')}): it is planned in "
-        f"its {kind}'s stored pixel order, not turned upright as a viewer shows it, as a "
+        f"its {kind}'s stored pixel order, not {orientation_words(turned)[1]}"
+        " as a viewer shows it, as a "
         "session's JPEGs and TIFFs are recorded; the plan holds for a session shot with the "
         "camera held as it was for this preview (docs/cameras.md)"
     )
