@@ -668,9 +668,16 @@ def _name_or_column(tokens: list[str]) -> str:
     telling a name from a column, but here both runs are unit vectors and nothing in the line
     says which is meant. ``scan 2 0 0 1`` (only the last three a unit vector) still reads, and
     so does ``led 01 0 0 1``: a zero-padded ``01`` is a name's number, which no writer of a
-    vector's component writes."""
-    after = tokens[1:]
-    if len(after) < 4 or not all(_is_number(t) for t in after):
+    vector's component writes.
+
+    The name is every field before the line's closing run of numbers, so a name with spaces
+    (``my scan 2 0 0 1 0``) reads two ways as ``led01 0 0 1 0`` does: it had been read as the
+    light ``my scan 2 0`` with nothing noted."""
+    k = len(tokens)
+    while k > 1 and _is_number(tokens[k - 1]):
+        k -= 1
+    after = tokens[k:]
+    if len(after) < 4:
         return ""
     last = len(after) - 3
     if not _is_unit(after[last:]):
@@ -683,10 +690,10 @@ def _name_or_column(tokens: list[str]) -> str:
     if not earlier:
         return ""
     i = earlier[0]
-    as_name = f"the light {' '.join(tokens[: last + 1])!r} from ({', '.join(after[last:])})"
+    as_name = f"the light {' '.join(tokens[: k + last])!r} from ({', '.join(after[last:])})"
     later = after[i + 3 :]
     as_column = (
-        f"the light {' '.join(tokens[: i + 1])!r} from ({', '.join(after[i : i + 3])}) with "
+        f"the light {' '.join(tokens[: k + i])!r} from ({', '.join(after[i : i + 3])}) with "
         f"{' '.join(later)} after it"
     )
     return f"{as_name}, or {as_column}"
@@ -779,11 +786,19 @@ _COUNT_WORDS = frozenset(
 def _count_with_words(tokens: list[str]) -> bool:
     """Whether a first line is a whole number followed by words and no number (``2 lights``,
     ``48 LEDs in dome A``): a count line with words, never a light (which ends in numbers),
-    nor a light that lost its numbers (``1 image01.jpg``, left to the light's own error)."""
+    nor a light that lost its numbers (``1 image01.jpg``, left to the light's own error).
+
+    Numbers among the words (``2 of 3 lights``) keep it a count line unless the line ends in
+    three numbers, as a light does (``2 lights 0 0 1`` is a light named ``2 lights``): it had
+    been read as the light ``2`` and refused as "x component 'of' is not a number"."""
     if len(tokens) < 2 or not re.fullmatch(r"[+-]?\d+", tokens[0]):
         return False
     rest = tokens[1:]
-    return not any(_is_number(t) or t.lower().endswith(_IMAGE_ENDINGS) for t in rest)
+    if any(t.lower().endswith(_IMAGE_ENDINGS) for t in rest):
+        return False
+    if all(_is_number(t) for t in rest):
+        return False
+    return len(tokens) < 4 or not all(_is_number(t) for t in tokens[-3:])
 
 
 def _count_line_words(

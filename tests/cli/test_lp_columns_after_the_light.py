@@ -49,21 +49,30 @@ def test_a_name_ending_in_a_number_before_its_light_still_reads(tmp_path: Path) 
     assert r.exit_code == 0, said(r)
 
 
+@pytest.mark.parametrize(
+    ("line", "as_name", "as_column"),
+    [
+        ("led01 0 0 1 0", "'led01 0' from (0, 1, 0)", "'led01' from (0, 0, 1)"),
+        ("my scan 2 0 0 1 0", "'my scan 2 0' from (0, 1, 0)", "'my scan 2' from (0, 0, 1)"),
+    ],
+    ids=["name", "name-with-spaces"],
+)
 def test_a_line_that_reads_as_a_name_or_as_a_column_is_refused_saying_both(
-    tmp_path: Path,
+    tmp_path: Path, line: str, as_name: str, as_column: str
 ) -> None:
     """``led01 0 0 1 0`` (an LED at intensity 0): its last three fields and the three before
     the last are both unit vectors, so it is the light ``led01 0`` from (0, 1, 0) or ``led01``
-    from (0, 0, 1) with a column after it; it had been read the first way, unsaid."""
+    from (0, 0, 1) with a column after it; it had been read the first way, unsaid. So had a
+    name with spaces before the numbers (``my scan 2 0 0 1 0``, read as ``my scan 2 0``)."""
     lp = tmp_path / "dome.lp"
     lines = [f"{line} 0.85" for line in LIGHTS]
-    lines[0] = "led01 0 0 1 0"
+    lines[0] = line
     lp.write_text("\n".join(["4", *lines]) + "\n")
     out = tmp_path / "plan.lp"
     r = runner.invoke(app, ["plan", "--rig", str(lp), "--lights", "4", "--out", str(out)])
     text = said(r)
     assert r.exit_code == 2, text
-    assert f"{lp}, line 2: 'led01 0 0 1 0' reads two ways" in text, text
-    assert "'led01 0' from (0, 1, 0)" in text and "'led01' from (0, 0, 1)" in text, text
+    assert f"{lp}, line 2: '{line}' reads two ways" in text, text
+    assert as_name in text and as_column in text, text
     assert "delete the column after the light" in text, text
     assert "Traceback" not in r.output and not out.exists()

@@ -34,14 +34,17 @@ def test_a_count_word_after_the_number_reads_as_the_count(tmp_path: Path, count:
     assert f"count line {count!r} read as the count 4" in text, text
 
 
+@pytest.mark.parametrize("count", ["4 lights in dome A", "4 of 5 lights"])
 def test_other_words_after_the_number_are_refused_saying_what_the_line_must_be(
-    tmp_path: Path,
+    tmp_path: Path, count: str
 ) -> None:
+    """``4 of 5 lights`` (a number among the words) had been read as the light ``4`` and
+    refused as "x component 'of' is not a number"."""
     lp = tmp_path / "dome.lp"
-    lp.write_text("\n".join(["4 lights in dome A", *LIGHTS]) + "\n")
+    lp.write_text("\n".join([count, *LIGHTS]) + "\n")
     out = tmp_path / "plan.lp"
     code, text = _plan(lp, out)
     assert code == 2, text
-    assert f"{lp}, line 1: count line '4 lights in dome A' holds words" in text, text
+    assert f"{lp}, line 1: count line {count!r} holds words" in text, text
     assert "the number of lights alone (e.g. '4')" in text, text
     assert not out.exists()
