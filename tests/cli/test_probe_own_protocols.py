@@ -16,7 +16,7 @@ from conftest import CONFIGS, emulated_dome_as_hardware, said, shipped_dome_on_p
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.simulator.own_protocols import DefaultProfile
+from rti_rig.simulator.own_protocols import BoardFacts, DefaultProfile
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -79,4 +79,31 @@ def test_probe_names_a_default_board_whose_lines_end_in_cr_lf(
         assert 'profile = "default" baudrate = 115200' in words, words
         assert ("checksum = false" in words) is not checksum, words
         assert "it announced RTIDOME-EMU 1.0.0 with 48 LEDs" in words
+        assert firmware.commands_received == 0  # it only listened
+
+
+@pytest.mark.parametrize("checksum", [True, False], ids=["checksum", "no-checksum"])
+def test_probe_names_a_default_board_whose_banner_has_an_extra_field_and_says_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, checksum: bool
+) -> None:
+    """A banner with a field after the LED count (a board revision) reads as damaged to the
+    codec: the probe had said "No known dome firmware answered" and named nothing."""
+
+    class WithRevision(DefaultProfile):
+        def banner(self, facts: BoardFacts) -> bytes:
+            return self._line(f"READY {facts.firmware_id} {facts.version} {facts.led_count} rev-B")
+
+    port = "/dev/ttyACM7"
+    (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
+    config = emulated_dome_as_hardware(tmp_path, "emulated_dome.toml", port)
+    with shipped_dome_on_pty(monkeypatch, config) as firmware:
+        firmware.codec = WithRevision(checksum=checksum)
+        r = runner.invoke(app, ["probe", port], terminal_width=400)
+        words = said(r)
+        assert r.exit_code == 0, words
+        assert "No known dome firmware" not in words and "Traceback" not in words
+        assert 'profile = "default" baudrate = 115200' in words, words
+        assert ("checksum = false" in words) is not checksum, words
+        assert "carries 1 field(s) more than rti-rig's default protocol's" in words, words
+        assert "('rev-B')" in words and "end the firmware's banner at the LED count" in words
         assert firmware.commands_received == 0  # it only listened

@@ -999,7 +999,42 @@ def _own_protocol_found(result: ProbeResult, text: str, baud: int) -> bool:
                 notes.append(_OWN_UNHEARD[profile])
             result.note = "; ".join(notes) or None
             return True
+        if (extra := _banner_extra_fields(profile, match.group())) is not None:
+            fields, checksum = extra
+            result.profile, result.baudrate = profile, baud
+            if profile == "default" and not checksum:
+                result.extra_lines = ["[dome.serial.default]", "checksum = false"]
+            result.note = (
+                f"its banner {match.group().strip()!r} carries {len(fields)} field(s) more than "
+                f"rti-rig's {profile} protocol's id, version and LED count "
+                f"({', '.join(repr(f) for f in fields)}), which rti-rig reads as a damaged "
+                "banner: end the firmware's banner at the LED count, as "
+                "docs/protocols/led-dome.md writes it, then run rti-rig check"
+            )
+            return True
     return False
+
+
+def _banner_extra_fields(profile: str, banner: str) -> tuple[list[str], bool] | None:
+    """The fields after the LED count of an own-protocol banner that otherwise reads (an id,
+    a version and a whole number count after ``READY``), and whether it ended in a checksum;
+    None for any other banner.
+
+    Why: a board whose banner had one field more (a board revision, a build date) was told
+    "No known dome firmware answered", its READY line among the lines heard, not named."""
+    text = banner.strip()
+    checksum = False
+    if profile == "default":
+        if re.search(r"\*[0-9A-F]{2}$", text):
+            text, checksum = text[:-3], True
+        fields = text.split(" ")
+    elif profile == "framed":
+        fields = text.strip("<>").split(",")
+    else:
+        return None
+    if len(fields) <= 4 or fields[0] != "READY" or not fields[3].isdigit():
+        return None
+    return fields[4:], checksum
 
 
 def probe(request: ProbeRequest, result: ProbeResult | None = None) -> ProbeResult:
