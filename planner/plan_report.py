@@ -53,6 +53,9 @@ class PlanReport:
     kmeans_distinct_normals: int | None = None
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
+    #: the arm's stop-order search (after the lights are chosen), None on a dome: ``seconds``
+    #: is the choosing alone
+    order_seconds: float | None = None
 
     def light_said(self) -> str | None:
         """The preview light's origin as the reader is told it."""
@@ -107,5 +110,11 @@ class PlanReport:
                 f"all {every}"
             )
         out.extend(self.notes)
-        out.append(f"planned in {self.seconds:.2f} s")
+        if self.order_seconds is None:
+            out.append(f"planned in {self.seconds:.2f} s")
+        else:
+            out.append(
+                f"planned in {self.seconds + self.order_seconds:.2f} s ({self.seconds:.2f} s "
+                f"choosing the lights, {self.order_seconds:.2f} s ordering the arm's stops)"
+            )
         return out
