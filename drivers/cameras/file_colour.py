@@ -121,25 +121,32 @@ def space_of_description(description: str) -> Space:
     return "other"
 
 
-def icc_description(icc: bytes) -> str | None:
-    """The profile description (tag ``desc``) of an ICC profile, v2 or v4; None if absent."""
+def icc_tag(icc: bytes, signature: bytes) -> bytes | None:
+    """The body of the tag ``signature`` in an ICC profile's tag table (ICC.1:2010 7.3: a
+    count, then signature, offset and size of each tag); None if the profile has none."""
     if len(icc) < 132:
         return None
     (count,) = struct.unpack_from(">I", icc, 128)
     for i in range(min(count, 256)):
         sig, offset, size = struct.unpack_from(">4sII", icc, 132 + 12 * i)
-        if sig != b"desc":
-            continue
-        body = icc[offset : offset + size]
-        if body[:4] == b"desc":
-            (n,) = struct.unpack_from(">I", body, 8)
-            return body[12 : 12 + n].split(b"\0")[0].decode("latin-1").strip() or None
-        if body[:4] == b"mluc":
-            records, record_size = struct.unpack_from(">II", body, 8)
-            if records and record_size >= 12:
-                length, at = struct.unpack_from(">II", body, 20)
-                return body[at : at + length].decode("utf-16-be", "replace").strip() or None
+        if sig == signature:
+            return icc[offset : offset + size]
+    return None
+
+
+def icc_description(icc: bytes) -> str | None:
+    """The profile description (tag ``desc``) of an ICC profile, v2 or v4; None if absent."""
+    body = icc_tag(icc, b"desc")
+    if body is None:
         return None
+    if body[:4] == b"desc":
+        (n,) = struct.unpack_from(">I", body, 8)
+        return body[12 : 12 + n].split(b"\0")[0].decode("latin-1").strip() or None
+    if body[:4] == b"mluc":
+        records, record_size = struct.unpack_from(">II", body, 8)
+        if records and record_size >= 12:
+            length, at = struct.unpack_from(">II", body, 20)
+            return body[at : at + length].decode("utf-16-be", "replace").strip() or None
     return None
 
 
@@ -148,21 +155,15 @@ def icc_curve_is_linear(icc: bytes) -> bool:
     entries or of one gamma 1.0 (u8Fixed8 0x0100), or a ``para`` of function type 0 with
     gamma 1.0 (ICC.1:2010 10.5 curveType, 10.16 parametricCurveType). A table, or no rTRC,
     is not (the named space's own curve then applies)."""
-    if len(icc) < 132:
+    body = icc_tag(icc, b"rTRC")
+    if body is None:
         return False
-    (count,) = struct.unpack_from(">I", icc, 128)
-    for i in range(min(count, 256)):
-        sig, offset, size = struct.unpack_from(">4sII", icc, 132 + 12 * i)
-        if sig != b"rTRC":
-            continue
-        body = icc[offset : offset + size]
-        if body[:4] == b"curv" and len(body) >= 12:
-            (n,) = struct.unpack_from(">I", body, 8)
-            return n == 0 or (n == 1 and body[12:14] == b"\x01\x00")
-        if body[:4] == b"para" and len(body) >= 16:
-            kind, gamma = struct.unpack_from(">H2xi", body, 8)
-            return kind == 0 and gamma == 0x10000
-        return False
+    if body[:4] == b"curv" and len(body) >= 12:
+        (n,) = struct.unpack_from(">I", body, 8)
+        return n == 0 or (n == 1 and body[12:14] == b"\x01\x00")
+    if body[:4] == b"para" and len(body) >= 16:
+        kind, gamma = struct.unpack_from(">H2xi", body, 8)
+        return kind == 0 and gamma == 0x10000
     return False
 
 
