@@ -17,6 +17,7 @@ from rti_rig.drivers.cameras.colour_convert import (
     decode_curve,
     needs_conversion,
     rgb_to_xyz,
+    to_srgb_matrix,
 )
 from rti_rig.drivers.cameras.file_colour import file_colour
 
@@ -54,3 +55,24 @@ def test_a_session_s_own_linear_tiff_is_taken_as_stored(tmp_path: Path) -> None:
     assert not needs_conversion(file_colour(linear), np.dtype(np.uint16))
     assert needs_conversion(file_colour(encoded), np.dtype(np.uint16))
     assert not needs_conversion(file_colour(encoded), np.dtype(np.uint8))
+
+
+@pytest.mark.parametrize(
+    ("space", "published"),
+    [
+        # CSS Color Module Level 4, 18 (sample code): lin_P3 to XYZ, then XYZ to lin_sRGB
+        (
+            "display_p3",
+            [[1.2249, -0.2247, 0.0], [-0.0420, 1.0419, 0.0], [-0.0197, -0.0786, 1.0979]],
+        ),
+        # the same spec's lin_ProPhoto to XYZ (D50), Bradford D50 to D65, XYZ to lin_sRGB
+        (
+            "prophoto",
+            [[2.0344, -0.7276, -0.3067], [-0.2288, 1.2317, -0.0029], [-0.0086, -0.1533, 1.1618]],
+        ),
+    ],
+)
+def test_the_whole_conversion_matches_a_published_one(space: str, published: list) -> None:
+    """Primaries, white adaptation and sRGB's inverse together (the per-space matrices above
+    do not reach the Bradford step nor the inversion)."""
+    assert np.allclose(to_srgb_matrix(space), published, atol=6e-4)
