@@ -14,6 +14,15 @@ Two things there are not Python's ``sorted(key=str.lower)``:
 
 One key for every place that says what relight will list, so that none of them guesses its
 own order.
+
+Which Qt: this is Qt 5's ``qt_cmp_si`` (``filename_cache = fileName().toLower()``). Qt 6.8's
+(the ``qdir.cpp`` read lists with ``QDirListing``; since which 6.x is not checked here) instead
+compares ``fileName()`` by ``QString::compare(..., Qt::CaseInsensitive)``, each UTF-16 unit
+simply case-folded (``ucstricmp``, ``foldCase``), and relight's CMakeLists builds with Qt 6
+unless ``USE_QT_5``. The two orders agree on every name whose characters lower and fold
+alike (ASCII, accented letters, Greek capitals, the tests' names) and differ on the few that
+do not (``ς`` and ``ſ`` fold to ``σ`` and ``s`` but lower to themselves; Cherokee lower case
+folds to upper): for those no one order is right for every relight build.
 """
 
 from __future__ import annotations
