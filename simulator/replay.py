@@ -136,7 +136,7 @@ class ReplayCamera:
     def close(self) -> None:
         self._connected = False
 
-    def _recorded(self, path: Path) -> NDArray[np.uint16]:
+    def _recorded(self, path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
         """The recorded image at ``path``; one gone since the run began (its drive unplugged,
         the file moved or deleted) is the camera's failure, naming the file and what brings
         it back (it had been a bare "cannot read image …: there is no such file")."""
