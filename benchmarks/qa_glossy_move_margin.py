@@ -94,7 +94,7 @@ def main() -> None:
 
     from benchmarks.qa_step_margin import _config
     from rti_rig.cli import app
-    from rti_rig.reconstruct.qa import EDGE_NOISE_FACTOR, GLOSSY_EDGE_NOISE_FACTOR
+    from rti_rig.reconstruct.qa import DRIFT_PX, EDGE_NOISE_FACTOR, GLOSSY_EDGE_NOISE_FACTOR
 
     base = args.keep or Path(tempfile.mkdtemp(prefix="qa_glossy_move_margin_"))
     print(f"OpenCV {cv2.__version__}; image_{MOVED_IMAGE:03d} rolled {MOVE} px on the moved rows")
@@ -119,7 +119,7 @@ def main() -> None:
                 got = _row(session, root / f"fit_{kind}")
                 dist = np.hypot(*got["dev"].T)
                 factor = GLOSSY_EDGE_NOISE_FACTOR if got["trusted"] else EDGE_NOISE_FACTOR
-                bar = max(1.0, factor * got["spread"])
+                bar = max(DRIFT_PX, factor * got["spread"])  # as the QA sets it
                 others = np.delete(dist, MOVED_IMAGE - 1)
                 other = float(np.nanmax(others)) if np.isfinite(others).any() else float("nan")
                 print(
