@@ -268,7 +268,8 @@ class FolderWatchSettings(_Strict):
     eight_bit_response: Literal["refuse", "linear", "srgb"] = Field(
         "refuse",
         description="8-bit files (JPEG, PNG) are gamma-encoded: refuse them, or "
-        "linearise with the inverse sRGB curve, or take them as linear",
+        "linearise with the curve the file says (the sRGB curve, or Adobe RGB's or ProPhoto's "
+        "where its profile or Exif says that space), or take them as linear",
     )
     decode: RawDecodeSettings = RawDecodeSettings()
 
