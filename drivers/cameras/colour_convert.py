@@ -142,8 +142,10 @@ class Converted:
 def needs_conversion(colour: FileColour | None, dtype: np.dtype) -> bool:
     """Whether a file of ``colour`` and ``dtype`` is converted: a known space other than sRGB,
     or a 16-bit sRGB file whose profile is not linear (its curve undone). An 8-bit sRGB file
-    keeps its readers' own sRGB tables (the same curve); an unknown or unsaid space is left."""
-    if colour is None or colour.space not in SPACES:
+    keeps its readers' own sRGB tables (the same curve); an unknown or unsaid space is left.
+    Only 8- and 16-bit values are: a float or 32-bit file goes on to its reader's refusal of
+    its pixel type (its values had indexed the curve's table: a traceback ended the run)."""
+    if colour is None or colour.space not in SPACES or dtype not in (np.uint8, np.uint16):
         return False
     return colour.space != "srgb" or (dtype == np.uint16 and not colour.linear_curve)
 

@@ -100,3 +100,24 @@ def test_a_prophoto_16_bit_tiff_is_made_linear_srgb(tmp_path, monkeypatch):
     pixels = tifffile.imread(out / step["linear_image"])
     want = (20000 / 65535) ** 1.8 * 65535
     assert np.allclose(pixels, want, atol=2), (pixels[0, 0], want)
+
+
+def test_a_float_tiff_in_a_known_space_is_refused_by_its_pixel_type(tmp_path, monkeypatch):
+    """A 32-bit float TIFF (Photoshop's, Lightroom's HDR merge) with its ProPhoto profile is
+    refused as any float TIFF is, naming its pixel type: taken for conversion by its profile,
+    its floats had indexed the curve's table and a Python traceback ended the run."""
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0, tiffs=True)
+    buffer = io.BytesIO()
+    tifffile.imwrite(
+        buffer,
+        np.full((32, 32, 3), 0.3, np.float32),
+        photometric="rgb",
+        iccprofile=icc_profile("ProPhoto RGB"),
+    )
+    files = [(f"IMG_{k:04d}.tif", buffer.getvalue()) for k in (1, 2)]
+    out = tmp_path / "s"
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, files, out)
+    assert r.exit_code != 0 and "Traceback" not in said and not lit_at_end, said
+    assert "unsupported pixel type float32" in said, said
