@@ -197,19 +197,21 @@ class SlipGuard:
             f"{before} only. {rewind}"
         )
 
-    def _restarted(self, index: int, reason: str, kept: str) -> str:
+    def _restarted(self, index: int, reason: str, kept: Kept) -> str:
         """The words for an image lit by the order's first LED far into the run.
 
         Why: the firmware starts its order again from LED 0 whenever its power comes back (a
-        loose supply jack, a brown-out); the images before were lit as labelled (each was
-        checked), so they are kept as they are, and only the dome must be rewound."""
+        loose supply jack, a brown-out); the images before it stay in lights.lp as the other
+        slips leave them, and the dome must be rewound. Said with :meth:`Kept.said`: the
+        message had printed the record itself (``Kept(where=...)``), and claimed every image
+        before "matched to its LED" where the first ones, shot before a fit, were never
+        compared with one."""
         before = f"images 1–{index}" if index > 1 else "image 1"
         return (
             f"image {index + 1} was {reason}: the dome started its order again (its power was "
-            "cut and came back, or its start button was pressed). The image is kept, "
-            f"unlabelled, as {kept}; lights.lp lists {before} only, each matched to its LED. "
-            "Check the dome's power supply and its plug, then long-press its start button to "
-            "rewind it and start a new session"
+            f"cut and came back, or its start button was pressed). {kept.said('The image')}; "
+            f"lights.lp lists {before} only. Check the dome's power supply and its plug, then "
+            "long-press its start button to rewind it and start a new session"
         )
 
     def _led(self, index: int) -> str:

@@ -30,12 +30,19 @@ TWO_RINGS = """rings = [
 ]"""
 
 
+def _two_rings(scene: str = 'name = "relief"\nseed = 0') -> str:
+    """The shipped config cut to its first two rings, its scene line replaced by ``scene``."""
+    shipped = (CONFIGS / "emulated_cceh_rti.toml").read_text(encoding="utf-8")
+    text = re.sub(r"rings = \[\n.*?\n\]", TWO_RINGS, shipped, count=1, flags=re.S)
+    text = text.replace('name = "relief"\nseed = 0', scene)
+    assert text != shipped and scene in text
+    return text
+
+
 def test_a_power_cycle_mid_run_stops_at_its_image_and_keeps_the_ones_before(
     tmp_path: Path,
 ) -> None:
-    shipped = (CONFIGS / "emulated_cceh_rti.toml").read_text(encoding="utf-8")
-    text = re.sub(r"rings = \[\n.*?\n\]", TWO_RINGS, shipped, count=1, flags=re.S)
-    assert text != shipped
+    text = _two_rings()
     config = tmp_path / "rig.toml"
     config.write_text(
         text + '\n[[emulator.sync_faults]]\nat_image = 6\nkind = "power_cycle"\n',
@@ -51,6 +58,8 @@ def test_a_power_cycle_mid_run_stops_at_its_image_and_keeps_the_ones_before(
         f"{geometry.led_said(5)}" in said
     ), said
     assert "the dome started its order again (its power was cut and came back" in said
+    assert "The image is kept, unlabelled, as unlabelled/image_006.tif;" in said, said
+    assert "Kept(" not in said and "each matched to its LED" not in said, said
     assert "lights.lp lists images 1–5 only" in said and "Check the dome's power supply" in said
     # no link, no all-off: the words must not say the lights are off
     assert "That lights are off is not confirmed: look at the dome" in said
@@ -60,3 +69,4 @@ def test_a_power_cycle_mid_run_stops_at_its_image_and_keeps_the_ones_before(
     assert [Path(e.name).name for e in lp] == [f"image_{k:03d}.jpg" for k in range(1, 6)]
     np.testing.assert_allclose([e.direction for e in lp], geometry.directions[:5], atol=1e-4)
     assert (out / "unlabelled" / "image_006.tif").exists()
+
