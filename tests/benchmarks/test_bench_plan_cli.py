@@ -34,3 +34,20 @@ def test_a_run_plan_of_the_front_door_reads_its_own_report(tmp_path) -> None:
     )
     assert run.planned_s > 0 and run.wall_s > run.planned_s
     assert len(run.plan_sha256) == 64 and (tmp_path / "plan.lp").is_file()
+
+
+@pytest.mark.parametrize(
+    ("report", "seconds"),
+    [
+        ("expected RMS normal error 2.1°\nplanned in 0.24 s\n", 0.24),
+        (
+            "planned in 1.10 s (0.85 s choosing the lights, 0.25 s ordering the arm's stops)",
+            0.85,
+        ),
+    ],
+    ids=["dome", "arm"],
+)
+def test_planned_in_is_the_search_alone_as_the_table_says(report: str, seconds: float) -> None:
+    """The table's "planned in" is the search, not the arm's order: an arm plan's report says
+    the whole and its parts, and the whole had been read."""
+    assert planning_time.planned_seconds(report) == seconds
