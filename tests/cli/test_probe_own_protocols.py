@@ -59,6 +59,27 @@ def test_probe_names_the_framed_protocol_of_the_shipped_hardware_dome(
         assert "set [dome.serial.framed]" in words and "index_base" in words
 
 
+def _probe_a_default_board(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, codec: DefaultProfile, checksum: bool
+) -> str:
+    """What ``rti-rig probe`` says of the shipped emulated dome's board speaking ``codec``,
+    checked for what every default board's probe must say (named, its checksum setting, and
+    nothing sent to it)."""
+    port = "/dev/ttyACM7"
+    (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
+    config = emulated_dome_as_hardware(tmp_path, "emulated_dome.toml", port)
+    with shipped_dome_on_pty(monkeypatch, config) as firmware:
+        firmware.codec = codec
+        r = runner.invoke(app, ["probe", port], terminal_width=400)
+        words = said(r)
+        assert r.exit_code == 0, words
+        assert "No known dome firmware" not in words and "Traceback" not in words
+        assert 'profile = "default" baudrate = 115200' in words, words
+        assert ("checksum = false" in words) is not checksum, words
+        assert firmware.commands_received == 0  # it only listened
+    return words
+
+
 @pytest.mark.parametrize("checksum", [True, False], ids=["checksum", "no-checksum"])
 def test_probe_names_a_default_board_whose_lines_end_in_cr_lf(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, checksum: bool
@@ -67,19 +88,16 @@ def test_probe_names_a_default_board_whose_lines_end_in_cr_lf(
     ``line_end``; docs/protocols/led-dome.md allows it), which the driver
     reads: the probe's banner pattern wanted a bare LF, and such a board was "No known dome
     firmware answered", its READY line among the lines heard."""
-    port = "/dev/ttyACM7"
-    (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
-    config = emulated_dome_as_hardware(tmp_path, "emulated_dome.toml", port)
-    with shipped_dome_on_pty(monkeypatch, config) as firmware:
-        firmware.codec = DefaultProfile(checksum=checksum, line_end=b"\r\n")
-        r = runner.invoke(app, ["probe", port], terminal_width=400)
-        words = said(r)
-        assert r.exit_code == 0, words
-        assert "No known dome firmware" not in words and "Traceback" not in words
-        assert 'profile = "default" baudrate = 115200' in words, words
-        assert ("checksum = false" in words) is not checksum, words
-        assert "it announced RTIDOME-EMU 1.0.0 with 48 LEDs" in words
-        assert firmware.commands_received == 0  # it only listened
+    codec = DefaultProfile(checksum=checksum, line_end=b"\r\n")
+    words = _probe_a_default_board(tmp_path, monkeypatch, codec, checksum)
+    assert "it announced RTIDOME-EMU 1.0.0 with 48 LEDs" in words
+
+
+class _WithRevision(DefaultProfile):
+    """A default board whose banner has a field after the LED count (a board revision)."""
+
+    def banner(self, facts: BoardFacts) -> bytes:
+        return self._line(f"READY {facts.firmware_id} {facts.version} {facts.led_count} rev-B")
 
 
 @pytest.mark.parametrize("checksum", [True, False], ids=["checksum", "no-checksum"])
@@ -88,22 +106,8 @@ def test_probe_names_a_default_board_whose_banner_has_an_extra_field_and_says_it
 ) -> None:
     """A banner with a field after the LED count (a board revision) reads as damaged to the
     codec: the probe had said "No known dome firmware answered" and named nothing."""
-
-    class WithRevision(DefaultProfile):
-        def banner(self, facts: BoardFacts) -> bytes:
-            return self._line(f"READY {facts.firmware_id} {facts.version} {facts.led_count} rev-B")
-
-    port = "/dev/ttyACM7"
-    (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
-    config = emulated_dome_as_hardware(tmp_path, "emulated_dome.toml", port)
-    with shipped_dome_on_pty(monkeypatch, config) as firmware:
-        firmware.codec = WithRevision(checksum=checksum)
-        r = runner.invoke(app, ["probe", port], terminal_width=400)
-        words = said(r)
-        assert r.exit_code == 0, words
-        assert "No known dome firmware" not in words and "Traceback" not in words
-        assert 'profile = "default" baudrate = 115200' in words, words
-        assert ("checksum = false" in words) is not checksum, words
-        assert "carries 1 field(s) more than rti-rig's default protocol's" in words, words
-        assert "('rev-B')" in words and "end the firmware's banner at the LED count" in words
-        assert firmware.commands_received == 0  # it only listened
+    words = _probe_a_default_board(
+        tmp_path, monkeypatch, _WithRevision(checksum=checksum), checksum
+    )
+    assert "carries 1 field(s) more than rti-rig's default protocol's" in words, words
+    assert "('rev-B')" in words and "end the firmware's banner at the LED count" in words
