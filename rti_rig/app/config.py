@@ -379,12 +379,17 @@ class RigConfig(_Strict):
         if dome is None or (dome.serial is not None and self.backend == "emulated"):
             return
         if dome.flash_sync is not None:
+            # on a hardware rig the sync faults are refused too: advise them only where they run
+            rehearse = (
+                "Rehearse its faults as [[emulator.sync_faults]] (at_image = N, kind = "
+                "'missed_pulse', 'double_step' or 'power_cycle'), or remove this one"
+                if self.backend == "emulated"
+                else f"Nothing is rehearsed on backend = '{self.backend}': remove it"
+            )
             raise ValueError(
                 f"emulator.faults[{i}]: {kind} is a fault of a serial link's reply or "
                 f"command, and this dome ({dome.flash_sync.firmware}) has none: the camera's "
-                "flash signal steps it. Rehearse its faults as [[emulator.sync_faults]] "
-                "(at_image = N, kind = 'missed_pulse', 'double_step' or 'power_cycle'), or "
-                "remove this one"
+                f"flash signal steps it. {rehearse}"
             )
         raise ValueError(
             f"emulator.faults[{i}]: {kind} is rehearsed by an emulated dome's firmware on its "
@@ -402,11 +407,24 @@ class RigConfig(_Strict):
         dome = self.dome
         if dome is not None and dome.flash_sync is not None and self.backend == "emulated":
             return
+        fault = f"emulator.sync_faults[0]: {self.emulator.sync_faults[0].kind}"
+        if dome is not None and dome.flash_sync is not None:
+            # a real camera-triggered dome: its camera does step it, nothing emulates the pulse
+            raise ValueError(
+                f"{fault} is rehearsed by the emulated camera-triggered dome (backend = "
+                f"'emulated'), and this rig's backend is '{self.backend}': nothing emulates "
+                "its flash pulses; remove it"
+            )
+        if dome is None:
+            raise ValueError(
+                f"{fault} is a flash pulse of a camera-triggered dome ([dome.flash_sync], "
+                "backend = 'emulated'), and an arm has none; remove it"
+            )
         raise ValueError(
-            f"emulator.sync_faults[0]: {self.emulator.sync_faults[0].kind} is a flash pulse "
-            "of a camera-triggered dome ([dome.flash_sync], backend = 'emulated'), and no "
-            "camera steps this rig's lights; rehearse a serial dome's faults as "
-            "[[emulator.faults]] (at_command = N, kind = 'reset', 'drop_reply', …), or remove it"
+            f"{fault} is a flash pulse of a camera-triggered dome ([dome.flash_sync], backend = "
+            "'emulated'), and no camera steps this rig's lights; rehearse a serial dome's "
+            "faults as [[emulator.faults]] (at_command = N, kind = 'reset', 'drop_reply', …), "
+            "or remove it"
         )
 
     def _arm_faults_are_replies(self) -> None:

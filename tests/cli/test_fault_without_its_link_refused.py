@@ -46,13 +46,42 @@ MISSED = '\n[[emulator.sync_faults]]\nat_image = 2\nkind = "missed_pulse"\n'
             "dome ([dome.flash_sync], backend = 'emulated'), and no camera steps this rig's "
             "lights; rehearse a serial dome's faults as [[emulator.faults]]",
         ),
+        (
+            "hardware cceh",
+            MISSED,
+            "emulator.sync_faults[0]: missed_pulse is rehearsed by the emulated camera-triggered "
+            "dome (backend = 'emulated'), and this rig's backend is 'hardware': nothing "
+            "emulates its flash pulses; remove it",
+        ),
+        (
+            "hardware cceh",
+            RESET,
+            "emulator.faults[0]: reset is a fault of a serial link's reply or command, and "
+            "this dome (cceh-rti) has none: the camera's flash signal steps it. Nothing is "
+            "rehearsed on backend = 'hardware': remove it",
+        ),
+        (
+            "simulated_arm.toml",
+            MISSED,
+            "emulator.sync_faults[0]: missed_pulse is a flash pulse of a camera-triggered dome "
+            "([dome.flash_sync], backend = 'emulated'), and an arm has none; remove it",
+        ),
     ],
 )
 def test_a_fault_nothing_would_rehearse_is_refused(
     tmp_path: Path, shipped: str, extra: str, words: str
 ) -> None:
+    """The case 'hardware cceh': the shipped emulated cceh/rti config made a real rig, as its
+    header says (a rehearsal's fault left in it): its camera does step the dome, and the fault had
+    been sent on to [[emulator.sync_faults]], refused there too."""
     config = tmp_path / "rig.toml"
-    config.write_text((CONFIGS / shipped).read_text() + extra)
+    if shipped == "hardware cceh":
+        text = (CONFIGS / "emulated_cceh_rti.toml").read_text()
+        text = text.replace('backend = "emulated"', 'backend = "hardware"')
+        text += '\n[camera.device]\nkind = "gphoto2"\n'
+    else:
+        text = (CONFIGS / shipped).read_text()
+    config.write_text(text + extra)
     r = runner.invoke(app, ["check", str(config)], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 2 and "Traceback" not in said, said
