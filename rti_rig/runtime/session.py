@@ -687,6 +687,10 @@ class SessionFolder:
         #: the steps already shot that the rig as changed could not take (one line each, as
         #: the schedule check says them): kept, shot on the rig as it was; recorded in the run
         self.shot_beyond_change: list[str] | None = None
+        #: an adaptive session's starting layout as recorded before a resume on a changed rig
+        #: placed what was left of it again (the manifest's ``schedule`` then says the lights
+        #: that fire): kept in the run, so the layout the session began with is not lost
+        self.schedule_before_change: dict[str, Any] | None = None
         #: what reading the run's input files tolerated (a `.lp` light clamped at the horizon, a
         #: count line that disagreed): recorded in the manifest, so the session says what it
         #: was shot from and what was assumed about it, not only the terminal that ran it
@@ -910,6 +914,8 @@ class SessionFolder:
                     "could not take them; kept, lights.lp lists the lights that fired",
                     "steps": self.shot_beyond_change,
                 }
+            if self.schedule_before_change is not None:
+                run["schedule_before_rig_change"] = self.schedule_before_change
             if self.rig_identity is not None:
                 self.manifest.setdefault("rig", {})["identity"] = self.rig_identity
             new_path = (header.get("rig") or {}).get("config_path")

@@ -175,6 +175,8 @@ def test_an_adaptive_start_left_to_shoot_is_placed_on_the_narrowed_reach(
     """The same session cut within its start (3 of its 4 lights shot; the fourth recorded at
     53.3°), the reach narrowed to 25..50°: the resume places what is left of the start on the
     arm as it is now, and had refused the recorded 53.3°, a light it would not have taken."""
+    import json
+
     import numpy as np
     from conftest import journal
 
@@ -198,3 +200,10 @@ def test_an_adaptive_start_left_to_shoot_is_placed_on_the_narrowed_reach(
     assert len(steps) == 8 and steps[:3] == shot
     elevations = np.degrees(np.arcsin([s["planned_direction"][2] for s in steps[3:]]))
     assert np.all((elevations >= 25.0) & (elevations <= 50.0)), elevations
+    # the manifest's schedule is the start as shot (it had kept the 53.3° that never fired);
+    # the start recorded before the change is kept in the run
+    manifest = json.loads((out / "manifest.json").read_text())
+    start = [s["direction"] for s in manifest["schedule"]["steps"]]
+    assert start == [s["planned_direction"] for s in steps[:4]], (start, steps[:4])
+    before = manifest["runs"][-1]["schedule_before_rig_change"]["steps"]
+    assert round(float(np.degrees(np.arcsin(before[3]["direction"][2]))), 1) == 53.3, before

@@ -1938,9 +1938,10 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
 
         try:
             source = resume_adaptive_source(rig, folder, req.objective)
+            schedule = _start_as_placed(schedule, source.start_schedule(), shot, folder)
             # the start's lights still to shoot; each light chosen after it is checked
             # before it moves (run_session)
-            validate_schedule(rig, source.start_schedule(), shot)
+            validate_schedule(rig, schedule, shot)
         except ScheduleError as exc:
             rig.close_said()
             raise _refused_on_changed_rig(exc, diffs, loaded, req) from None
@@ -1952,6 +1953,27 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     return OpenedSession(
         rig, schedule, folder, Path(req.session_dir), resumed=True, source=source, request=req
     )
+
+
+def _start_as_placed(  # type: ignore[no-untyped-def]
+    recorded: LightSchedule, placed: LightSchedule, shot: frozenset[int], folder
+) -> LightSchedule:
+    """An adaptive session's starting layout as this resume shoots it: its steps shot as
+    recorded, the rest as the rig as it is now places them (``placed``). Where that differs
+    from the layout recorded (an accepted rig change), the manifest's ``schedule`` is made this
+    one and the one recorded is kept in the run (``schedule_before_rig_change``).
+
+    Why: after a change of reach the manifest still gave a start light at 53.3° that never
+    fired, while lights.lp and the journal said 36.2°; a tool reading the manifest's schedule
+    (or the next resume's check of the steps shot) read a light that was not the session's."""
+    steps = tuple(
+        recorded.steps[i] if i in shot else placed.steps[i] for i in range(len(placed.steps))
+    )
+    now = LightSchedule(steps, method=recorded.method, provenance=recorded.provenance)
+    if now.to_dict() != folder.manifest["schedule"]:
+        folder.schedule_before_change = folder.manifest["schedule"]
+        folder.manifest["schedule"] = now.to_dict()
+    return now
 
 
 def _refused_on_changed_rig(  # type: ignore[no-untyped-def]
