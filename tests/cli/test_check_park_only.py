@@ -176,13 +176,26 @@ def test_a_fault_during_the_park_is_not_called_parked(
             ["check", str(CONFIGS / "simulated_dome.toml"), "--park-only"],
             "--park-only parks an arm; this rig config describes a dome, which has no park pose",
         ),
+        (  # an .lp replayed, no rig config and no LED: said as what it is
+            ["check", "{acq}", "--park-only"],
+            "{acq}: --park-only parks an arm; this is a replayed acquisition (a .lp and its "
+            "images), with nothing to move. To check it: rti-rig check {acq}",
+        ),
         (
             ["check", str(CONFIGS / "simulated_arm.toml"), "--park-only", "--reboot-faulted"],
             "--park-only parks the arm and does nothing else: drop --reboot-faulted",
         ),
     ],
-    ids=["dome", "with-reboot"],
+    ids=["dome", "replay", "with-reboot"],
 )
-def test_park_only_refused_where_there_is_nothing_to_park(argv: list[str], words: str) -> None:
-    code, said = _invoke(*argv)
+def test_park_only_refused_where_there_is_nothing_to_park(
+    argv: list[str], words: str, tmp_path: Path
+) -> None:
+    import cv2
+
+    acq = tmp_path / "dirs.lp"  # a replay: its .lp and the one image it lists
+    acq.write_text("1\nimg.jpg 0 0 1\n")
+    cv2.imwrite(str(tmp_path / "img.jpg"), np.zeros((8, 8, 3), np.uint8))
+    code, said = _invoke(*(a.replace("{acq}", str(acq)) for a in argv))
+    words = words.replace("{acq}", str(acq))
     assert code == 2 and words in said and "Parking" not in said, said

@@ -78,15 +78,19 @@ def refuse_unparkable(loaded: object, rig_config: Path) -> None:
     config = loaded.config  # type: ignore[attr-defined]
     if config.arm is not None and config.backend != "replay":
         return
-    what = (
-        "a replayed acquisition (nothing to move)"
+    # a replay's own words: it had been called a rig config, and told that its check ends
+    # "with every LED switched off", of an .lp and its images that have no LED
+    what, ends = (
+        ("is a replayed acquisition (a .lp and its images), with nothing to move", "")
         if config.backend == "replay"
-        else "a dome, which has no park pose"
+        else (
+            "rig config describes a dome, which has no park pose",
+            " (its check ends with every LED switched off)",
+        )
     )
     raise RtiRigError(
-        f"{shown_path(rig_config)}: --park-only parks an arm; this rig config describes {what}. "
-        f"To check it (a dome ends with every LED switched off): rti-rig check "
-        f"{shell_word(str(rig_config))}"
+        f"{shown_path(rig_config)}: --park-only parks an arm; this {what}. To check it{ends}: "
+        f"rti-rig check {shell_word(str(rig_config))}"
     )
 
 
