@@ -44,7 +44,7 @@ from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free)
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, NORMAL_ERROR_LIMIT_DEG, NORMAL_NOISE
-from rti_rig.core.out_folders import fit_beside, free_folder_beside, free_name
+from rti_rig.core.out_folders import file_beside, fit_beside, free_folder_beside, free_name
 
 if TYPE_CHECKING:
     from rti_rig.app.usecases.session import OpenedSession
@@ -1174,7 +1174,7 @@ def _said_lp_unwritten(s: _Stop) -> str:
         # printed before that, which pasted wrote a file named FILE.lp
         own = s.out_dir / LP_NAME
         missing = not own.exists()
-        lp = _arg(own if missing else free_name(s.out_dir.with_name(f"{s.out_dir.name}.lp")))
+        lp = _arg(own if missing else file_beside(s.out_dir, ".lp"))
         remedy = f"`rti-rig export-lp {_arg(s.out_dir)} --out {lp}` writes one from the journal"
         if not missing:
             remedy += (

@@ -147,6 +147,15 @@ def free_folder_beside(root: Path, tag: str) -> Path:
     return free_name(root.with_name(f"{root.name}-{tag}"), folder=True)
 
 
+def file_beside(root: Path, suffix: str) -> Path:
+    """A file that does not exist yet beside folder ``root``, named ``ROOT{suffix}`` (``-2``…
+    added before the suffix if taken): what a hint has a command write about session ``root``
+    outside it. A session given as ``.`` or ``..`` is named by its absolute path (``run
+    --resume .`` from inside it had ended in a ValueError: '.' has no name to add to)."""
+    root = _named(root)
+    return free_name(root.with_name(f"{root.name}{suffix}"))
+
+
 def _named(path: Path) -> Path:
     """``path``, or its absolute, normalised form where it has no name to add to (``.``,
     ``..``, ``a/..``, the root ``/`` excepted: it has none either way)."""

@@ -120,16 +120,12 @@ def test_a_stop_once_every_image_is_in_says_what_fit_will_say(
     assert "the session is not finished" in " ".join(r.output.split()), r.output
 
 
-def test_a_lights_lp_its_write_failed_is_exported_by_a_command_that_pastes(
-    dome, tmp_path: Path
-) -> None:
-    """A session that cannot be resumed and whose lights.lp could not be written (a full disk)
-    is told to export one from the journal: it had said ``--out FILE.lp``, which pasted wrote a
-    file named FILE.lp; the command names the session's own lights.lp, and pasted writes it."""
+def _run_with_lp_refused(tmp_path: Path, after: int, out: str) -> tuple[Path, str]:
+    """A 6-image run of the image-sequence dome into ``out`` (the argument as given; the
+    session is ``tmp_path/s``) whose lights.lp writes are refused (ENOSPC) after ``after`` of
+    them: the session, and what the run said, as one line."""
     import errno
-    import shlex
 
-    from rti_rig.core.lp_format import read_lp
     from rti_rig.testing.disk_faults import failing_writes
 
     frames = tmp_path / "frames"
@@ -137,11 +133,23 @@ def test_a_lights_lp_its_write_failed_is_exported_by_a_command_that_pastes(
     for i in range(6):
         cv2.imwrite(str(frames / f"f_{i:03d}.png"), np.full((24, 32, 3), 40 + 30 * i, np.uint8))
     config = _config(tmp_path, frames)
-    out = tmp_path / "s"
-    with failing_writes("lp", after=0, errno_code=errno.ENOSPC):
-        r = runner.invoke(app, ["run", str(config), "--out", str(out), "--lights", "6"])
+    with failing_writes("lp", after=after, errno_code=errno.ENOSPC):
+        r = runner.invoke(app, ["run", str(config), "--out", out, "--lights", "6"])
     assert r.exit_code == 2, r.output
-    said = " ".join(r.output.split())
+    return tmp_path / "s", " ".join(r.output.split())
+
+
+def test_a_lights_lp_its_write_failed_is_exported_by_a_command_that_pastes(
+    dome, tmp_path: Path
+) -> None:
+    """A session that cannot be resumed and whose lights.lp could not be written (a full disk)
+    is told to export one from the journal: it had said ``--out FILE.lp``, which pasted wrote a
+    file named FILE.lp; the command names the session's own lights.lp, and pasted writes it."""
+    import shlex
+
+    from rti_rig.core.lp_format import read_lp
+
+    out, said = _run_with_lp_refused(tmp_path, 0, str(tmp_path / "s"))
     assert "lights.lp could not be written and is missing" in said, said
     command = said.split("(`", 1)[1].split("` writes one from the journal", 1)[0]
     assert command == f"rti-rig export-lp {out} --out {out / 'lights.lp'}", command
@@ -150,32 +158,28 @@ def test_a_lights_lp_its_write_failed_is_exported_by_a_command_that_pastes(
     assert len(read_lp(out / "lights.lp")) == 1
 
 
+@pytest.mark.parametrize("given", ["path", "dot"])
 def test_a_lights_lp_left_short_is_exported_beside_the_session_never_inside_it(
-    dome, tmp_path: Path
+    dome, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, given: str
 ) -> None:
     """lights.lp there but short of the journal (its second write refused): the export advised
     is a file beside the session. It had been ``lights-2.lp`` inside it, which relight-cli given
     the folder reads first (the first .lp by name, case ignored) while fit and RTIBuilder read
-    lights.lp: one folder, two listings. The session's lights.lp is left as it was."""
-    import errno
+    lights.lp: one folder, two listings. The session's lights.lp is left as it was. A session
+    given as ``--out .`` (run from inside it) is named by its absolute path: the hint had ended
+    in a ValueError there ('.' has no name to add '.lp' to)."""
     import shlex
 
     from rti_rig.core.lp_format import read_lp
-    from rti_rig.testing.disk_faults import failing_writes
 
-    frames = tmp_path / "frames"
-    frames.mkdir()
-    for i in range(6):
-        cv2.imwrite(str(frames / f"f_{i:03d}.png"), np.full((24, 32, 3), 40 + 30 * i, np.uint8))
-    config = _config(tmp_path, frames)
-    out = tmp_path / "s"
-    with failing_writes("lp", after=1, errno_code=errno.ENOSPC):
-        r = runner.invoke(app, ["run", str(config), "--out", str(out), "--lights", "6"])
-    assert r.exit_code == 2, r.output
-    said = " ".join(r.output.split())
+    (tmp_path / "s").mkdir()
+    if given == "dot":
+        monkeypatch.chdir(tmp_path / "s")
+    out, said = _run_with_lp_refused(tmp_path, 1, "." if given == "dot" else str(tmp_path / "s"))
     assert "lights.lp could not be written and lists only 1 of them" in said, said
     command = said.split("(`", 1)[1].split("` writes one from the journal", 1)[0]
-    assert command == f"rti-rig export-lp {out} --out {tmp_path / 's.lp'}", command
+    shown = "." if given == "dot" else str(out)
+    assert command == f"rti-rig export-lp {shown} --out {tmp_path / 's.lp'}", command
     assert "lights-2.lp inside it would be the .lp relight-cli reads first" in said, said
     own = (out / "lights.lp").read_bytes()
     done = runner.invoke(app, shlex.split(command)[1:])
