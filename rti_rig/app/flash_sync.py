@@ -409,18 +409,18 @@ def _keep(
     try:
         rel = keep_unlabelled(aside, index, frame, verdict, stem, folder=aside)
     except OSError as exc2:
-        originals = [
-            str(Path(item["path"]).relative_to(root))
-            if Path(item["path"]).is_relative_to(root)
-            else str(item["path"])
-            for item in frame.metadata.get("originals") or []
+        # what is left of the frame, said where it is: a TIFF written under unlabelled/ before
+        # its JPEG was refused holds the whole frame (it had been said "in memory only and
+        # is lost" beside it), and the camera's own file, if it has one
+        left = sorted((set(folder.iterdir()) if folder.is_dir() else set()) - before)
+        left += sorted(aside.iterdir()) if aside.is_dir() else []  # a folder of its own
+        originals = [Path(item["path"]) for item in frame.metadata.get("originals") or []]
+        still = [
+            *([f"what was written of it stays as {_paths(left)}"] if left else []),
+            *([f"the camera's own file stays as {_paths(originals)}"] if originals else []),
         ]
-        camera = (
-            f"the camera's own file stays as {', '.join(shown_path(Path(o)) for o in originals)}"
-            if originals
-            else "the frame was in memory only and is lost"
-        )
-        return Kept(None, f"{refused}; nor aside: {_refusal(aside, exc2)}; {camera}")
+        where = "; ".join(still) or "the frame was in memory only and is lost"
+        return Kept(None, f"{refused}; nor aside: {_refusal(aside, exc2)}; {where}")
     # what the refused attempt left under unlabelled/ (its TIFF, say, without its JPEG and
     # verdict) is a part of what is whole aside: removed, so that the move said has no clash
     for partial in (set(folder.iterdir()) if folder.is_dir() else set()) - before:
@@ -430,6 +430,11 @@ def _keep(
         f" (outside the session: {refused}; {fix}, then move the files of {shown_path(aside)} "
         f"into {shown_path(folder)}, before the temporary folder is emptied)",
     )
+
+
+def _paths(paths: list[Path]) -> str:
+    """``paths`` as shell words, comma-separated."""
+    return ", ".join(shown_path(p) for p in paths)
 
 
 def _refusal(folder: Path, exc: OSError) -> str:

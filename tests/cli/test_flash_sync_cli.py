@@ -492,7 +492,7 @@ def test_a_check_frame_the_camera_fails_leaves_both_causes_named(  # type: ignor
     assert (out / "unlabelled" / "image_006.tif").is_file()
 
 
-@pytest.mark.parametrize("refused", ["tiff", "tiff, aside too", "jpeg"])
+@pytest.mark.parametrize("refused", ["tiff", "tiff, aside too", "jpeg", "jpeg, aside too"])
 def test_a_full_disk_under_unlabelled_still_says_the_slip_and_keeps_the_frame_aside(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, refused: str
 ) -> None:
@@ -513,8 +513,8 @@ def test_a_full_disk_under_unlabelled_still_says_the_slip_and_keeps_the_frame_as
     old.parent.mkdir(parents=True)
     old.write_bytes(b"another session's")
     aside = tmp / "rti-rig-unlabelled-s-2"
-    folders = {"unlabelled", aside.name} if refused == "tiff, aside too" else {"unlabelled"}
-    writers = ["write_srgb_jpeg", "write_untagged_jpeg"] if refused == "jpeg" else []
+    folders = {"unlabelled", aside.name} if refused.endswith("aside too") else {"unlabelled"}
+    writers = ["write_srgb_jpeg", "write_untagged_jpeg"] if refused.startswith("jpeg") else []
     for name in writers or ["write_linear_tiff"]:
         real = getattr(image_files, name)
 
@@ -532,7 +532,7 @@ def test_a_full_disk_under_unlabelled_still_says_the_slip_and_keeps_the_frame_as
     text = " ".join(result.output.split())
     assert "Traceback" not in text and "please report it" not in text, text
     assert f"image 4 was not lit by {led(3)} of the dome's order — double step" in text, text
-    file = "image_004.jpg" if refused == "jpeg" else "image_004.tif"
+    file = "image_004.jpg" if refused.startswith("jpeg") else "image_004.tif"
     refusal = f"cannot write {out / 'unlabelled' / file}: No space left on device (ENOSPC)"
     if refused == "tiff, aside too":
         said = (
@@ -541,6 +541,14 @@ def test_a_full_disk_under_unlabelled_still_says_the_slip_and_keeps_the_frame_as
             "memory only and is lost"
         )
         assert not (aside / "image_004.tif").exists()
+    elif refused == "jpeg, aside too":  # the TIFF written under unlabelled/ holds the frame
+        said = (
+            f"Image 4 could not be kept anywhere: {refusal}; nor aside: cannot write "
+            f"{aside / 'image_004.jpg'}: No space left on device (ENOSPC); what was written of "
+            f"it stays as {out / 'unlabelled' / 'image_004.tif'}, {aside / 'image_004.tif'}"
+        )
+        assert "is lost" not in text, text
+        assert (out / "unlabelled" / "image_004.tif").is_file()
     else:
         said = (
             f"Image 4 is kept, unlabelled, as {aside / 'image_004.tif'} (outside the "
