@@ -16,6 +16,7 @@ from rti_rig.core.deferred_signals import hangup_as_sigterm, signal_handlers
 from rti_rig.core.errors import RtiRigError
 
 if TYPE_CHECKING:
+    from rti_rig.app.usecases.check import CheckStopped
     from rti_rig.app.usecases.probe import ProbeResult
 
 
@@ -149,16 +150,7 @@ def check(
                 lambda text: err.print(text, markup=False, highlight=False),
             )
     except CheckStopped as exc:
-        # what the walk had verified before the stop (it had been dropped: a check stopped
-        # at pose 6 of 8 said only that it had stopped), then the teardown and the stop
-        for line in exc.walk:
-            out.print(line, highlight=False, markup=False)
-        for failure in exc.teardown_failures:
-            err.print(f"[red]teardown problem:[/] {escape(failure)}")
-        err.print(f"[red]Check stopped ({escape(exc.why)}):[/] {escape(exc.lights)}.")
-        if exc.todo:
-            err.print(exc.todo + ".", highlight=False, markup=False)
-        raise typer.Exit(code=stop_exit_code(exc.signum)) from None
+        _said_stopped("Check", exc)
     except EmergencyStop as exc:  # stopped outside a self-test (loading, a camera's check)
         err.print(f"[red]Check stopped ({escape(str(exc))}):[/] check the rig's lights.")
         raise typer.Exit(code=stop_exit_code(exc.signum)) from None
@@ -203,12 +195,7 @@ def _park_only(rig_config: Path) -> None:
         with stop_on_signals():
             report = park_arm(rig_config, on_start=parking)
     except ParkStopped as exc:
-        for failure in exc.teardown_failures:
-            err.print(f"[red]teardown problem:[/] {escape(failure)}")
-        err.print(f"[red]Park stopped ({escape(exc.why)}):[/] {escape(exc.lights)}.")
-        if exc.todo:
-            err.print(exc.todo + ".", highlight=False, markup=False)
-        raise typer.Exit(code=stop_exit_code(exc.signum)) from None
+        _said_stopped("Park", exc)
     except EmergencyStop as exc:  # before anything was built (loading the config)
         err.print(f"[red]Park stopped ({escape(str(exc))}):[/] nothing was sent to the arm.")
         raise typer.Exit(code=stop_exit_code(exc.signum)) from None
@@ -218,6 +205,21 @@ def _park_only(rig_config: Path) -> None:
         out.print(line, highlight=False, markup=False)
     if not report.ok:
         raise typer.Exit(code=1)
+
+
+def _said_stopped(what: str, exc: CheckStopped) -> NoReturn:
+    """Say a stopped check's or park's end (``what``: ``Check``, ``Park``) and exit as the stop
+    does: what the walk had verified before it (a check stopped at pose 6 of 8 had said only
+    that it had stopped), the teardown's failures, what is known of the lights, and the
+    command that parks an arm left unparked."""
+    for line in exc.walk:
+        out.print(line, highlight=False, markup=False)
+    for failure in exc.teardown_failures:
+        err.print(f"[red]teardown problem:[/] {escape(failure)}")
+    err.print(f"[red]{what} stopped ({escape(exc.why)}):[/] {escape(exc.lights)}.")
+    if exc.todo:
+        err.print(exc.todo + ".", highlight=False, markup=False)
+    raise typer.Exit(code=stop_exit_code(exc.signum)) from None
 
 
 def _probe_stopped(why: str, signum: signal.Signals, result: ProbeResult) -> NoReturn:

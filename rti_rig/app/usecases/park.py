@@ -17,6 +17,7 @@ from pathlib import Path
 
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
+from rti_rig.app.usecases.check import CheckStopped
 from rti_rig.app.usecases.safe_state import lights_state
 from rti_rig.core.deferred_signals import signals_deferred
 from rti_rig.core.errors import RtiRigError
@@ -28,9 +29,11 @@ from rti_rig.runtime.lighting import ArmLighting, attempt_all, park_check
 ARM_NOT_REACHED = "nothing was sent to the arm: the park stopped before connecting it"
 
 
-class ParkStopped(Exception):
+class ParkStopped(CheckStopped):
     """The park was stopped (SIGTERM, Ctrl-C); the arm was made safe first (lamp off, stop,
-    held where the stop found it)."""
+    held where the stop found it). A check's stop with no walk: ``lights`` what is known of
+    the arm after the teardown (read back; never "parked" unless so), ``todo`` the command
+    that parks it, None when it parked or was never reached."""
 
     def __init__(
         self,
@@ -39,13 +42,8 @@ class ParkStopped(Exception):
         teardown_failures: tuple[str, ...] = (),
         todo: str | None = None,
     ) -> None:
-        super().__init__(f"park stopped ({stop}): {lights}")
-        self.why, self.signum = str(stop), stop.signum
-        #: what is known of the arm after the teardown (read back; never "parked" unless so)
-        self.lights = lights
-        self.teardown_failures = teardown_failures
-        #: the command that parks it, as a sentence; None when it parked or was never reached
-        self.todo = todo
+        super().__init__(stop, lights, teardown_failures, todo=todo)
+        self.args = (f"park stopped ({stop}): {lights}",)
 
 
 @dataclass(frozen=True)
