@@ -343,6 +343,26 @@ def _signal_handlers_left_as_found() -> Iterator[None]:
         pytest.fail("the test left signal handlers changed: " + "; ".join(leaked))
 
 
+def built_rigs(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
+    """The rigs ``rti-rig check`` (its walk, ``--park-only``) builds from here on, each
+    appended as built (``build_rig`` wrapped where the check and the park use it): a test
+    reads the rig's lighting after the command, as the command left it."""
+    import rti_rig.app.compose as compose
+    import rti_rig.app.usecases.check as check_usecase
+    import rti_rig.app.usecases.park as park_usecase
+
+    rigs: list[Any] = []
+    real_build = compose.build_rig
+
+    def build(*args: Any, **kwargs: Any) -> Any:
+        rigs.append(real_build(*args, **kwargs))
+        return rigs[-1]
+
+    for module in (compose, check_usecase, park_usecase):
+        monkeypatch.setattr(module, "build_rig", build)
+    return rigs
+
+
 @pytest.fixture
 def dome_config_path() -> Path:
     return CONFIGS / "simulated_dome.toml"

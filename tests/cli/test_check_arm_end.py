@@ -18,30 +18,13 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, inprocess_arm_config, pasted, servo_fault
+from conftest import CONFIGS, built_rigs, inprocess_arm_config, pasted, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
 
 AT = re.compile(r"left at az (-?[\d.]+)°, el (-?[\d.]+)°")
-
-
-def _built_rigs(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
-    """The rigs ``rti-rig check`` builds from here on (build_rig wrapped where it is used)."""
-    import rti_rig.app.compose as compose
-    import rti_rig.app.usecases.check as check_usecase
-
-    rigs: list[Any] = []
-    real_build = compose.build_rig
-
-    def build(*args: Any, **kwargs: Any) -> Any:
-        rigs.append(real_build(*args, **kwargs))
-        return rigs[-1]
-
-    monkeypatch.setattr(compose, "build_rig", build)
-    monkeypatch.setattr(check_usecase, "build_rig", build)
-    return rigs
 
 
 def _signal_at_move(
@@ -90,7 +73,7 @@ def test_a_check_stopped_by_sigterm_says_where_the_arm_is_left(
     config: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     path = inprocess_arm_config(tmp_path) if "inprocess" in config else CONFIGS / config
-    rigs = _built_rigs(monkeypatch)
+    rigs = built_rigs(monkeypatch)
     _signal_at_move(monkeypatch, 3, signal.SIGTERM)  # the user's, through the check's handler
     r = CliRunner().invoke(app, ["check", str(path)], terminal_width=400)
     said = " ".join(r.output.split())
@@ -117,7 +100,7 @@ def test_a_stopped_check_whose_stop_failed_is_not_said_left_where_it_stopped(
     """SIGTERM as the azimuth servo stops answering: the teardown's stop cannot hold that
     joint, which may still be moving to its last goal. The arm's sentence had said "left where
     it stopped" beside "the stop did not hold every joint"."""
-    rigs = _built_rigs(monkeypatch)
+    rigs = built_rigs(monkeypatch)
     _signal_at_move(monkeypatch, 3, signal.SIGTERM, lambda: rigs[0].emulator.silent_ids.add(1))
     r = CliRunner().invoke(app, ["check", str(inprocess_arm_config(tmp_path))], terminal_width=400)
     said = " ".join(r.output.split())
@@ -145,7 +128,7 @@ def test_a_park_that_returns_off_its_pose_is_not_said_parked(
 ) -> None:
     """The emulated arm's park returns without moving (as a goal the servos ignored would): the
     check had said "parked" and PASS of an arm it had left at its last pose."""
-    rigs = _built_rigs(monkeypatch)
+    rigs = built_rigs(monkeypatch)
     import rti_rig.app.usecases.check as check_usecase
 
     real_self_test = check_usecase.arm_self_test
@@ -195,7 +178,7 @@ def test_a_check_stopped_by_ctrl_c_says_the_poses_it_verified_and_how_to_park(
     folder.mkdir()
     cfg = folder / "arm.toml"
     cfg.write_text(inprocess_arm_config(tmp_path).read_text())
-    rigs = _built_rigs(monkeypatch)
+    rigs = built_rigs(monkeypatch)
     _signal_at_move(monkeypatch, 4, signal.SIGINT)  # the user's Ctrl-C, through its handler
     r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
     said = " ".join(r.output.split())

@@ -17,28 +17,10 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, inprocess_arm_config
+from conftest import CONFIGS, built_rigs, inprocess_arm_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-
-
-def _built_rigs(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
-    """The rigs the commands build from here on (build_rig wrapped where it is used)."""
-    import rti_rig.app.compose as compose
-    import rti_rig.app.usecases.check as check_usecase
-    import rti_rig.app.usecases.park as park_usecase
-
-    rigs: list[Any] = []
-    real_build = compose.build_rig
-
-    def build(*args: Any, **kwargs: Any) -> Any:
-        rigs.append(real_build(*args, **kwargs))
-        return rigs[-1]
-
-    for module in (compose, check_usecase, park_usecase):
-        monkeypatch.setattr(module, "build_rig", build)
-    return rigs
 
 
 def _invoke(*argv: str) -> tuple[int, str]:
@@ -88,7 +70,7 @@ def test_the_park_a_stopped_check_advises_parks_and_moves_nothing_else(
     folder.mkdir()
     cfg = folder / "arm.toml"
     cfg.write_text(inprocess_arm_config(tmp_path).read_text())
-    rigs = _built_rigs(monkeypatch)
+    rigs = built_rigs(monkeypatch)
     _ctrl_c_at_move(monkeypatch, 4)
     code, said = _invoke("check", str(cfg))
     assert code == 130, said
@@ -124,7 +106,7 @@ def test_a_stop_during_the_park_holds_the_arm_and_says_so(
     with monkeypatch.context() as stopped_check:  # the arm left away from its park pose
         _ctrl_c_at_move(stopped_check, 4)
         assert _invoke("check", str(cfg))[0] == 130
-    rigs = _built_rigs(monkeypatch)
+    rigs = built_rigs(monkeypatch)
     real_park = DynamixelArm.park
 
     def park(self: Any, *args: Any, **kwargs: Any) -> Any:
@@ -155,7 +137,7 @@ def test_a_fault_during_the_park_is_not_called_parked(
     from rti_rig.simulator.dynamixel_emulator import HARDWARE_FAULT_BITS
 
     cfg = inprocess_arm_config(tmp_path)
-    rigs = _built_rigs(monkeypatch)
+    rigs = built_rigs(monkeypatch)
     real_park = DynamixelArm.park
 
     def park(self: Any, *args: Any, **kwargs: Any) -> Any:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import shlex
 from pathlib import Path
+from typing import Any
 
 import pytest
 from conftest import CONFIGS, cut_new_session
@@ -108,6 +109,29 @@ def test_a_reach_narrowed_only_where_images_were_shot_resumes_keeping_them(
     assert lp[0].strip() == "6" and lp[1:5] == lp_before[1:], lp  # the lights that fired
 
 
+def _adaptive_cut_then_narrowed(
+    tmp_path: Path, after_step: int, copy: Path | None = None
+) -> list[dict[str, Any]]:
+    """``run --adaptive`` of 8 lights on the virtual arm (64 px frames) into ``tmp_path/s``,
+    cut after step ``after_step``, copied to ``copy`` if given; then the config's reach
+    narrowed from 5..80° to 25..50°. The journal's records of the steps shot."""
+    import shutil
+
+    from conftest import journal
+
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace("width = 512", "width = 64").replace("height = 512", "height = 64"))
+    out = tmp_path / "s"
+    request = NewSessionRequest(cfg, out, lights=8, adaptive=True)
+    assert cut_new_session(request, after_step=after_step).finish_reason is FinishReason.CANCELLED
+    if copy is not None:
+        shutil.copytree(out, copy)
+    narrowed = cfg.read_text().replace("min_elevation_deg = 5.0", "min_elevation_deg = 25.0")
+    cfg.write_text(narrowed.replace("max_elevation_deg = 80.0", "max_elevation_deg = 50.0"))
+    return journal(out)
+
+
 def test_an_adaptive_session_narrowed_where_it_shot_resumes_keeping_them(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -119,7 +143,6 @@ def test_an_adaptive_session_narrowed_where_it_shot_resumes_keeping_them(
     no flag (which re-decides the steps taken since the change, and refuses any decided
     otherwise) ends with the same lights."""
     import json
-    import shutil
 
     import numpy as np
     from conftest import decisions, journal
@@ -129,16 +152,8 @@ def test_an_adaptive_session_narrowed_where_it_shot_resumes_keeping_them(
     from rti_rig.runtime.controller import CancelToken, StepCompleted
 
     monkeypatch.chdir(tmp_path)
-    text = (CONFIGS / "virtual_arm.toml").read_text()
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text.replace("width = 512", "width = 64").replace("height = 512", "height = 64"))
     out = tmp_path / "s"
-    result = cut_new_session(NewSessionRequest(cfg, out, lights=8, adaptive=True), after_step=4)
-    assert result.finish_reason is FinishReason.CANCELLED
-    shot = journal(out)
-    shutil.copytree(out, tmp_path / "copy")
-    narrowed = cfg.read_text().replace("min_elevation_deg = 5.0", "min_elevation_deg = 25.0")
-    cfg.write_text(narrowed.replace("max_elevation_deg = 80.0", "max_elevation_deg = 50.0"))
+    shot = _adaptive_cut_then_narrowed(tmp_path, after_step=4, copy=tmp_path / "copy")
 
     r = runner.invoke(app, ["run", "--resume", "s", "--accept-rig-change", "--no-verdict"])
     said = " ".join(r.output.split())
@@ -181,15 +196,8 @@ def test_an_adaptive_start_left_to_shoot_is_placed_on_the_narrowed_reach(
     from conftest import journal
 
     monkeypatch.chdir(tmp_path)
-    text = (CONFIGS / "virtual_arm.toml").read_text()
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text.replace("width = 512", "width = 64").replace("height = 512", "height = 64"))
     out = tmp_path / "s"
-    result = cut_new_session(NewSessionRequest(cfg, out, lights=8, adaptive=True), after_step=2)
-    assert result.finish_reason is FinishReason.CANCELLED
-    shot = journal(out)
-    narrowed = cfg.read_text().replace("min_elevation_deg = 5.0", "min_elevation_deg = 25.0")
-    cfg.write_text(narrowed.replace("max_elevation_deg = 80.0", "max_elevation_deg = 50.0"))
+    shot = _adaptive_cut_then_narrowed(tmp_path, after_step=2)
 
     r = runner.invoke(app, ["run", "--resume", "s", "--accept-rig-change", "--no-verdict"])
     said = " ".join(r.output.split())
