@@ -805,9 +805,8 @@ def run_session(
     """
     # a resume's steps already shot are not checked again (an accepted rig change may have
     # left them out of its reach). An adaptive run's steps are its source's decisions, each
-    # checked before it moves, below: its starting layout as recorded is not what a resume on
-    # a changed rig shoots (the start is placed again on the rig as it is), and is checked
-    # where the session is opened
+    # checked before it moves, below; its starting layout is checked where the session is
+    # opened (a resume's as placed again on the rig as it is, its lights shot left aside)
     skip = frozenset(folder.done) if source is None else frozenset(range(len(schedule)))
     validate_schedule(rig, schedule, skip)
     total = len(schedule) if source is None else source.total
