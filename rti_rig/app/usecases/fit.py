@@ -71,6 +71,8 @@ from rti_rig.core.out_folders import (
 from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.core.tiff_rows import TiffRows
+from rti_rig.drivers.cameras.colour_convert import needs_conversion, to_linear_srgb
+from rti_rig.drivers.cameras.file_colour import FileColour, file_colour
 from rti_rig.reconstruct import exporters, signal_check
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.qa import ImageCheck, QAReport, assess
@@ -210,9 +212,66 @@ def read_image(path: Path) -> Any:
     if path.suffix.lower() in (".tif", ".tiff"):
         rows = TiffRows(path)  # read a band at a time, never whole
         _check_tiff_type(path, rows)
+        colour = _colour_to_convert(path, rows.shape, rows.dtype)
+        if colour is not None:
+            return _converted_rows(rows, colour, str(path))[0]
         if rows.dtype == np.uint16:
             return rows  # type: ignore[return-value]
-    return _decoded_rows(_decode(path), str(path))
+    img = _decode(path)
+    colour = _colour_to_convert(path, img.shape, img.dtype)
+    if colour is not None:
+        return _converted_rows(img, colour, str(path))[0]
+    return _decoded_rows(img, str(path))
+
+
+#: rows of a frame converted to linear sRGB at a time (colour_convert's own band): the
+#: float working set stays a band's, never a 24 MP frame's (about 1 GB in one piece)
+_COLOUR_ROWS = 256
+
+
+def _colour_to_convert(path: Path, shape: tuple[int, ...], dtype: Any) -> FileColour | None:
+    """What ``path`` says of its colours where its pixels are converted to linear sRGB (a
+    known space other than sRGB, or 16-bit sRGB-encoded: :func:`needs_conversion`, the rule
+    of the watched folder and the replay); None where they are read as before (8-bit sRGB
+    or untagged through the sRGB table, 16-bit linear as they are, an unknown space as it
+    is, said by :func:`colour_notes`). Grey files have no primaries to convert."""
+    if len(shape) != 3 or shape[2] != 3:
+        return None
+    colour = file_colour(path)
+    return colour if needs_conversion(colour, np.dtype(dtype)) else None
+
+
+def _convert_into(
+    source: Any, colour: FileColour, fd: int, offset: int
+) -> tuple[dict[str, str], int]:
+    """``source`` (rows of an H×W×3 image as its file stores them) converted to linear sRGB
+    a band at a time and written, uint16, at ``offset`` of ``fd``; the conversion's record
+    (:func:`to_linear_srgb`'s, counted over the whole frame) and its clipped pixels."""
+    height, width = source.shape[0], source.shape[1]
+    row_bytes = width * 3 * 2
+    clipped, record = 0, {}
+    for row in range(0, height, _COLOUR_ROWS):
+        band = to_linear_srgb(np.asarray(source[row : row + _COLOUR_ROWS]), colour)
+        data = memoryview(band.pixels.reshape(-1).view(np.uint8))
+        if os.pwrite(fd, data, offset + row * row_bytes) != len(data):
+            raise OSError(errno.ENOSPC, "short write of converted rows to a temporary file")
+        clipped += band.clipped
+        record = band.record
+    record = {
+        **colour.as_dict(),
+        **record,
+        "out_of_gamut_clipped": f"{clipped} of {height * width} pixels",
+    }
+    return record, clipped
+
+
+def _converted_rows(source: Any, colour: FileColour, name: str) -> tuple[RawRows, dict[str, str]]:
+    """``source`` converted to linear sRGB into a temporary file of its own, read back by
+    rows (:func:`_decoded_rows`'s way), and the conversion's record."""
+    store = DecodedStore()
+    record, _ = _convert_into(source, colour, store.fileno(), 0)
+    shape = (source.shape[0], source.shape[1], 3)
+    return RawRows(store, 0, shape, np.dtype(np.uint16), None, name=name), record
 
 
 def _check_tiff_type(path: Path, rows: TiffRows) -> None:
@@ -277,7 +336,11 @@ def _decode(path: Path, into: np.ndarray | None = None) -> np.ndarray:
 _SRGB_TO_LINEAR16 = _srgb_to_linear16(np.arange(256, dtype=np.uint8))
 
 
-def _open_frames(paths: list[Path], label: str) -> list[Any]:
+def _open_frames(
+    paths: list[Path],
+    label: str,
+    said: dict[int, tuple[FileColour, dict[str, str] | None]] | None = None,
+) -> list[Any]:
     """Row-readable frames (uint16 linear) of ``paths``, each decoded at most once.
 
     Uncompressed 16-bit TIFFs (what sessions write) are read in place a band of rows at a
@@ -285,7 +348,10 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     decoded once, in parallel, into an unlinked temporary file and read back as
     :class:`RawRows`: every later pass (pixel sample, fit, QA) reads rows, never decodes, and
     nothing holds the acquisition in memory. 8-bit images are kept 8-bit there and linearised
-    on read.
+    on read. A colour image whose file says a space other than sRGB (or a 16-bit sRGB-encoded
+    one) is converted to linear sRGB a band of rows at a time as it is stored
+    (:func:`_convert_into`); ``said`` gets each colour image's :class:`FileColour` and the
+    conversion's record (None where it was read as before), by index.
     """
     frames: list[Any] = [None] * len(paths)
     pending = []
@@ -298,6 +364,14 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
         if path.suffix.lower() in (".tif", ".tiff"):
             rows = TiffRows(path)
             _check_tiff_type(path, rows)
+            colour = _colour_to_convert(path, rows.shape, rows.dtype)
+            if colour is not None:  # read a band at a time, converted, never whole
+                frames[i], record = _converted_rows(rows, colour, str(path))
+                if said is not None:
+                    said[i] = (colour, record)
+                continue
+            if said is not None and rows.ndim == 3:
+                said[i] = (file_colour(path), None)
             if rows.dtype == np.uint16 and rows.reads_in_place:
                 frames[i] = rows
                 continue
@@ -313,13 +387,17 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     stores: dict[np.dtype[Any], tuple[DecodedStore, list[int]]] = {}
     claim = threading.Lock()
 
+    def place_bytes(dtype: np.dtype[Any], nbytes: int) -> tuple[DecodedStore, int]:
+        """The store of ``dtype`` and the offset reserved there for ``nbytes``."""
+        with claim:
+            store, end = stores.setdefault(dtype, (DecodedStore(), [0]))
+            offset = end[0]
+            end[0] += nbytes
+        return store, offset
+
     def place(img: np.ndarray) -> tuple[DecodedStore, int]:
         """The store of ``img``'s type and the offset reserved there for it."""
-        with claim:
-            store, end = stores.setdefault(img.dtype, (DecodedStore(), [0]))
-            offset = end[0]
-            end[0] += img.nbytes
-        return store, offset
+        return place_bytes(img.dtype, img.nbytes)
 
     buffers = threading.local()  # one decode buffer per thread, reused image after image
 
@@ -336,6 +414,17 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
                 f"but {paths[i].name} is {_layout_words(img.shape)}; an acquisition has one "
                 "image size and kind (replace those images, or list only the others)"
             )
+        colour = _colour_to_convert(paths[i], img.shape, img.dtype)
+        if colour is not None:
+            # converted a band at a time into the 16-bit store: linear sRGB, no table on read
+            store, offset = place_bytes(np.dtype(np.uint16), img.shape[0] * img.shape[1] * 6)
+            record, _ = _convert_into(img, colour, store.fileno(), offset)
+            frames[i] = RawRows(store, offset, img.shape, np.dtype(np.uint16), name=str(paths[i]))
+            if said is not None:
+                said[i] = (colour, record)
+            return
+        if said is not None and img.ndim == 3:
+            said[i] = (file_colour(paths[i]), None)
         store, offset = place(img)
         os.pwrite(store.fileno(), memoryview(img.reshape(-1).view(np.uint8)), offset)
         lut = _SRGB_TO_LINEAR16 if img.dtype == np.uint8 else None
@@ -657,12 +746,22 @@ def acquisition_inputs(source: Path, files: dict[str, Path] | None = None) -> di
 
 
 def load_acquisition(
-    source: Path, notes: list[str] | None = None
+    source: Path,
+    notes: list[str] | None = None,
+    colours: dict[str, dict[str, str]] | None = None,
 ) -> tuple[list[Any], np.ndarray, list[str], str]:
     """Frames (row-readable, uint16 linear), lights (N, 3), image names, and a description
-    of what was read; the .lp reader's notes are appended to ``notes``."""
+    of what was read; the .lp reader's notes, and what the fit did of the files' colour
+    spaces, are appended to ``notes``; ``colours`` gets each colour image's record by name
+    (fit.json's ``image_colour``)."""
     lp, lights, paths, names = acquisition_files(source, notes)
-    frames = _open_frames(paths, str(lp))
+    said: dict[int, tuple[FileColour, dict[str, str] | None]] = {}
+    frames = _open_frames(paths, str(lp), said)
+    if colours is not None:
+        for i, (colour, record) in sorted(said.items()):
+            colours[names[i]] = record or {**colour.as_dict(), "read_as": _read_as(frames[i])}
+    if notes is not None:
+        notes.extend(colour_notes(lp, said, len(paths)))
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
         raise FitInputError(f"images of {shown_path(lp)} differ in shape: {sorted(shapes)}")
@@ -677,6 +776,55 @@ def load_acquisition(
     # (resolved, the name's bytes kept): 'fit ../s' had recorded "from ../s/lights.lp", which
     # named nothing once read from anywhere but the folder the fit was run in
     return frames, lights, names, f"{len(frames)} images from {Path(lp).resolve()}"
+
+
+def _read_as(frame: Any) -> str:
+    """How the fit read a colour image it did not convert (fit.json's ``image_colour``)."""
+    if _stored_8_bit(frame):
+        return "8-bit, decoded through the sRGB curve"
+    return "16-bit, taken as linear (no curve undone, primaries kept)"
+
+
+def colour_notes(
+    lp: Path, said: dict[int, tuple[FileColour, dict[str, str] | None]], n: int
+) -> list[str]:
+    """What the fit says of the files' colour spaces: the images converted to linear sRGB
+    (by space), those whose colours sRGB cannot show (clipped, counted), and those of a space
+    rti-rig does not know (fitted as they are); nothing of sRGB or untagged files, read as
+    the fit always read them. Why: an acquisition's 8-bit files were taken as sRGB and
+    16-bit ones as linear whatever the file said, an Adobe RGB JPEG or a ProPhoto TIFF
+    (Lightroom's default export) fitted with another space's curve and primaries, silently,
+    where a session of the same files converts them and says so."""
+    by_name: dict[str, tuple[FileColour, list[int], int]] = {}
+    for i, (colour, record) in sorted(said.items()):
+        if record is None and colour.space != "other":
+            continue
+        key = f"{colour.space} {colour.name} {colour.said_by} {record is None}"
+        c, images, clipped = by_name.get(key, (colour, [], 0))
+        clipped_here = 0 if record is None else int(record["out_of_gamut_clipped"].split()[0])
+        by_name[key] = (c, [*images, i], clipped + (clipped_here > 0))
+    notes = []
+    for key, (colour, images, clipped) in by_name.items():
+        count = f"{len(images)} of {n} image(s) of {shown_path(lp)}"
+        if key.endswith("True"):
+            notes.append(
+                f"{count} are {colour.name} (said by {colour.said_by}), a space rti-rig does "
+                "not convert: fitted as they are (8-bit through the sRGB curve, 16-bit as "
+                "linear), their colours that space's; for a fit in sRGB, export them as sRGB"
+            )
+            continue
+        notes.append(
+            f"{count} are {colour.name} (said by {colour.said_by}): the fit undid its curve "
+            "and converted its primaries to linear sRGB's before fitting (the files are "
+            "untouched); fit.json's image_colour says what was done to each"
+        )
+        if clipped:
+            notes.append(
+                f"some colours of {clipped} of those {colour.name} image(s) lie outside sRGB's "
+                "gamut and were clipped to it for the fit (fit.json's image_colour counts "
+                "the pixels of each)"
+            )
+    return notes
 
 
 def _mixed_depth_note(lp: Path, frames: list[Any], paths: list[Path]) -> list[str]:
@@ -802,7 +950,8 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     refuse_out_inside_a_session(req.out_dir)
     notes: list[str] = []
     inputs = acquisition_inputs(req.source)  # before reading: a later change is a change
-    frames, lights, names, what = load_acquisition(req.source, notes)
+    colours: dict[str, dict[str, str]] = {}
+    frames, lights, names, what = load_acquisition(req.source, notes, colours)
     said_at = len(notes)  # the repeated lights' note goes here, once what was fitted is known
     release_free_memory()  # the decode buffers
     out = req.out_dir
@@ -820,7 +969,17 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     )
     try:
         result = _fit_into(
-            req, out, frames, lights, names, what, notes, bands, checksums, inputs=inputs
+            req,
+            out,
+            frames,
+            lights,
+            names,
+            what,
+            notes,
+            bands,
+            checksums,
+            inputs=inputs,
+            colours=colours,
         )
     except BaseException as exc:
         stop.set()  # a failed or interrupted fit does not wait for the checksums
@@ -890,6 +1049,7 @@ def _fit_into(  # type: ignore[no-untyped-def]
     checksums: Future[None] | None = None,
     *,
     inputs: dict[str, Any] | None = None,
+    colours: dict[str, dict[str, str]] | None = None,
 ) -> FitResult:
     """Every output of :func:`run_fit` written into the prepared ``out`` (``checksums``: the
     session's files being checksummed meanwhile, awaited before the QA; ``inputs``: the record
@@ -949,6 +1109,9 @@ def _fit_into(  # type: ignore[no-untyped-def]
         "export_encoding": req.export_encoding,
         "warnings": result.warnings,
         "input_notes": result.notes,
+        # what each colour image's file says of its space and what the fit did of it
+        # (converted to linear sRGB, with its clipped pixels; or how it was read as it is)
+        "image_colour": colours or None,
         "files": [p.name for p in result.files],
         "verdict": result.qa.verdict if result.qa else None,
         INPUTS_KEY: inputs,

@@ -1,0 +1,112 @@
+"""`rti-rig fit ACQ/dirs.lp` of files that say another colour space fits them in linear sRGB:
+a ProPhoto 16-bit TIFF's gamma 1.8 is undone (read in place, converted a band at a time), an
+Adobe RGB JPEG's gamma 563/256 (not the sRGB curve), and fit.json and the notes say so.
+
+Why: an acquisition's 8-bit files were taken as sRGB and its 16-bit ones as linear whatever
+the file said, where a session of the same files (a watched folder, a replay) converts them.
+Each test fits the tagged files and, beside them, the same grey levels linearised here by the
+specs' published curves (ROMM RGB, ISO 22028-2: E'^1.8; Adobe RGB (1998) 4.3.1.2: V^2.19921875)
+in files that say nothing: a grey has the same primaries in every space (white stays white),
+so the two fits agree only if the tagged files' curves were undone. Files built in
+:mod:`colour_files` (sources cited there).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import tifffile
+from colour_files import icc_profile, jpeg
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+
+def _directions() -> list[tuple[float, float, float]]:
+    """Eight lights on two rings (30 and 60 degrees' elevation), alternating."""
+    out = []
+    for k in range(8):
+        a, el = 2 * math.pi * k / 8, math.radians(30 + 30 * (k % 2))
+        out.append((math.cos(el) * math.cos(a), math.cos(el) * math.sin(a), math.sin(el)))
+    return out
+
+
+def _acquisition(folder: Path, write: Callable[[Path, float], None], suffix: str) -> Path:
+    """An .lp of 8 grey images, each at the level a matte flat object gives its light
+    (``write(path, level)``, level in 0..1 of the encoded range)."""
+    folder.mkdir()
+    lines = []
+    for k, d in enumerate(_directions()):
+        name = f"image{k + 1:02d}{suffix}"
+        write(folder / name, 0.15 + 0.6 * d[2])
+        lines.append(f"{name} {d[0]:.6f} {d[1]:.6f} {d[2]:.6f}")
+    (folder / "dirs.lp").write_text(f"{len(lines)}\n" + "\n".join(lines) + "\n")
+    return folder / "dirs.lp"
+
+
+def _fit(lp: Path, out: Path) -> tuple[np.ndarray, dict, str]:
+    r = CliRunner().invoke(
+        app, ["fit", str(lp), "--out", str(out), "--no-qa", "--model", "ps"], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    return np.load(out / "albedo.npy"), json.loads((out / "fit.json").read_text()), said
+
+
+def test_a_prophoto_16_bit_tiff_acquisition_is_fitted_in_linear_srgb(tmp_path: Path) -> None:
+    profile = icc_profile("ProPhoto RGB")
+
+    def tagged(path: Path, level: float) -> None:
+        pixels = np.full((16, 16, 3), round(level * 65535), np.uint16)
+        tifffile.imwrite(path, pixels, iccprofile=profile)
+
+    def linearised(path: Path, level: float) -> None:  # E' >= 1/32 here: E'^1.8
+        encoded = round(level * 65535) / 65535
+        tifffile.imwrite(path, np.full((16, 16, 3), round(encoded**1.8 * 65535), np.uint16))
+
+    albedo, record, said = _fit(_acquisition(tmp_path / "a", tagged, ".tif"), tmp_path / "fa")
+    want, _, _ = _fit(_acquisition(tmp_path / "b", linearised, ".tif"), tmp_path / "fb")
+    assert np.allclose(albedo, want, rtol=2e-3), (albedo[8, 8], want[8, 8])
+    step = record["image_colour"]["image01"]
+    assert step["space"] == "prophoto" and "gamma 1.8" in step["curve_undone"], step
+    assert step["out_of_gamut_clipped"] == "0 of 256 pixels", step
+    assert "8 of 8 image(s) of" in said and "are ProPhoto RGB (ROMM RGB)" in said, said
+    assert any("converted its primaries to linear sRGB" in n for n in record["input_notes"])
+
+
+def test_an_adobe_rgb_jpeg_acquisition_is_not_read_through_the_srgb_curve(
+    tmp_path: Path,
+) -> None:
+    profile = icc_profile("Adobe RGB (1998)")
+    levels: dict[str, int] = {}
+
+    def tagged(path: Path, level: float) -> None:
+        levels[path.stem] = round(level * 120)  # dark greys: where the two curves differ most
+        path.write_bytes(jpeg(level=levels[path.stem], icc=profile))
+
+    def linearised(path: Path, level: float) -> None:
+        code = levels[path.stem]
+        value = round((code / 255) ** (563 / 256) * 65535)
+        tifffile.imwrite(path.with_suffix(".tif"), np.full((16, 16, 3), value, np.uint16))
+
+    albedo, record, said = _fit(_acquisition(tmp_path / "a", tagged, ".jpg"), tmp_path / "fa")
+    want, _, _ = _fit(_acquisition(tmp_path / "b", linearised, ".tif"), tmp_path / "fb")
+    # an 8-bit JPEG of one grey level decodes to that level within a code or so
+    assert np.allclose(albedo, want, rtol=0.03), (albedo[8, 8], want[8, 8])
+    step = record["image_colour"]["image01"]
+    assert step["space"] == "adobe_rgb" and "563/256" in step["curve_undone"], step
+    assert "are Adobe RGB (1998) (said by its ICC profile" in said, said
+
+
+def test_srgb_and_untagged_files_are_read_as_before_and_said_so(tmp_path: Path) -> None:
+    def untagged(path: Path, level: float) -> None:
+        path.write_bytes(jpeg(level=round(level * 200)))
+
+    _, record, said = _fit(_acquisition(tmp_path / "a", untagged, ".jpg"), tmp_path / "fa")
+    step = record["image_colour"]["image01"]
+    assert step["space"] == "untagged" and step["read_as"].startswith("8-bit, decoded through")
+    assert "converted" not in said and not record["input_notes"], said
