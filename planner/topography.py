@@ -17,10 +17,13 @@ Three routes lead from a preview photo to a relief (a height field up to an unkn
 Assumptions about the preview (what :func:`linear_luminance` converts): ``uint8`` is sRGB and is
 linearised with the sRGB transfer curve; ``uint16`` and floating point are already linear
 (RAW decoded with gamma 1, docs/conventions.md "Linear data"); ``uint16`` is scaled by 65535
-and floats are used as they are. Colour is reduced to Rec. 709 luminance. Everything downstream
-works on a preview downsampled early to at most :data:`PLANNING_SIDE_PX` pixels on its long
-side: planning needs the distribution of normals, not their detail, and a 24-megapixel preview
-would otherwise cost seconds.
+and floats are used as they are. A preview file that says another space (Adobe RGB, ProPhoto,
+Display P3) or is 16-bit sRGB-encoded reaches here already converted to linear sRGB ``uint16``:
+the plan's use case converts it (:func:`rti_rig.app.usecases.plan.preview_in_its_space`, the
+camera drivers' conversion, which the planner may not import). Colour is reduced to Rec. 709
+luminance. Everything downstream works on a preview downsampled early to at most
+:data:`PLANNING_SIDE_PX` pixels on its long side: planning needs the distribution of normals,
+not their detail, and a 24-megapixel preview would otherwise cost seconds.
 """
 
 from __future__ import annotations

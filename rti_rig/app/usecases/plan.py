@@ -235,7 +235,9 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             differs = given_light_differs(req.preview, az_el, rig_lp)
             if differs is not None:
                 notes.append(differs)
-        image = read_preview_image(source.image)
+        image, colour_note = preview_in_its_space(source.image, read_preview_image(source.image))
+        if colour_note is not None:
+            notes.append(colour_note)
         turned = preview_orientation_note(source.image)
         if turned is not None:
             notes.append(turned)
@@ -296,6 +298,38 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     if (misnamed := lp_name_note(Path(req.out_file), run_reads_it=True)) is not None:
         notes.append(misnamed)
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
+
+
+def preview_in_its_space(path: Path, image: np.ndarray) -> tuple[np.ndarray, str | None]:
+    """The preview's pixels in linear sRGB where its file says a space other than sRGB (or is
+    16-bit sRGB-encoded), converted as a session's frames are
+    (:func:`~rti_rig.drivers.cameras.colour_convert.to_linear_srgb`), and what to say of it;
+    as read otherwise (the planner then takes 8-bit as sRGB and 16-bit as linear). Why: a
+    preview's brightness was read through the sRGB curve (8-bit) or as linear (16-bit)
+    whatever its file said: a ProPhoto TIFF's gamma 1.8 was taken for the light itself, and
+    the relief and the light estimated from it were of flattened shading. A RAW preview
+    (decoded linear camera RGB) and a grey one are left as they are."""
+    from rti_rig.core.image_files import is_camera_raw
+    from rti_rig.drivers.cameras.colour_convert import needs_conversion, to_linear_srgb
+    from rti_rig.drivers.cameras.file_colour import file_colour
+
+    if is_camera_raw(path) or image.ndim != 3 or image.shape[2] not in (3, 4):
+        return image, None
+    colour = file_colour(path)
+    if colour.space == "other":
+        return image, (
+            f"preview {shown_path(path)} is {colour.name} (said by {colour.said_by}), a space "
+            "rti-rig does not convert: its brightness is read as if sRGB (8-bit through the "
+            "sRGB curve, 16-bit as linear); for a plan from its true shading, export it as sRGB"
+        )
+    if not needs_conversion(colour, image.dtype):
+        return image, None
+    converted = to_linear_srgb(image, colour)
+    return converted.pixels, (
+        f"preview {shown_path(path)} is {colour.name} (said by {colour.said_by}): its brightness "
+        f"is read in linear sRGB, {converted.record['curve_undone']} undone and its primaries "
+        "converted to sRGB's"
+    )
 
 
 def preview_orientation_note(image: Path) -> str | None:
