@@ -110,3 +110,17 @@ def test_srgb_and_untagged_files_are_read_as_before_and_said_so(tmp_path: Path) 
     step = record["image_colour"]["image01"]
     assert step["space"] == "untagged" and step["read_as"].startswith("8-bit, decoded through")
     assert "converted" not in said and not record["input_notes"], said
+
+
+def test_a_converted_jpeg_is_not_called_a_16_bit_file_taken_as_linear(tmp_path: Path) -> None:
+    profile = icc_profile("Adobe RGB (1998)")
+
+    def mixed(path: Path, level: float) -> None:  # one Adobe RGB JPEG among untagged ones
+        tagged = path.stem == "image08"
+        path.write_bytes(jpeg(level=round(level * 200), icc=profile if tagged else None))
+
+    _, record, said = _fit(_acquisition(tmp_path / "a", mixed, ".jpg"), tmp_path / "fa")
+    assert record["image_colour"]["image08"]["space"] == "adobe_rgb", record["image_colour"]
+    assert "1 of 8 image(s) of" in said and "are Adobe RGB (1998)" in said, said
+    # converted into 16-bit linear sRGB, it is no 16-bit file whose reading is a guess
+    assert "mixes" not in said, said

@@ -2,7 +2,9 @@
 
 Input: a session folder (``lights.lp`` and ``linear/*.tif`` 16-bit linear, as
 :mod:`rti_rig.runtime.session` writes it) or any ``.lp`` with its images beside it (16-bit TIFF
-used as linear; 8-bit JPEG/PNG decoded from sRGB). Uncompressed TIFFs are read a band of rows
+used as linear; 8-bit JPEG/PNG decoded from sRGB; a colour file that says Adobe RGB, ProPhoto or
+Display P3, or a 16-bit sRGB-encoded one, converted to linear sRGB as a session's frames are,
+:mod:`rti_rig.drivers.cameras.colour_convert`). Uncompressed TIFFs are read a band of rows
 at a time in place (:class:`rti_rig.core.tiff_rows.TiffRows`); compressed ones and JPEG/PNG are
 decoded once into a temporary file and read back by rows (:class:`rti_rig.core.raw_rows.RawRows`).
 The stack is never held, as floats or otherwise; one streamed pass computes every output.
@@ -766,8 +768,12 @@ def load_acquisition(
     if len(shapes) != 1:
         raise FitInputError(f"images of {shown_path(lp)} differ in shape: {sorted(shapes)}")
     if notes is not None and not any(p.parent.name == "linear" for p in paths):
-        # (a session's linear/ with stand-ins is said by acquisition_files)
-        notes.extend(_mixed_depth_note(lp, frames, paths))
+        # (a session's linear/ with stand-ins is said by acquisition_files); a converted
+        # file's reading is its own file's, said by colour_notes, neither of the two guesses
+        guessed = [i for i in range(len(paths)) if said.get(i, (None, None))[1] is None]
+        notes.extend(
+            _mixed_depth_note(lp, [frames[i] for i in guessed], [paths[i] for i in guessed])
+        )
     if notes is not None:
         # dropped by the reader: said once, by the files' names (``names`` are stems)
         notes.extend(png_alpha_note([p.name for p in paths], paths))
