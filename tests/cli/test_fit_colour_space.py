@@ -116,11 +116,17 @@ def test_a_converted_jpeg_is_not_called_a_16_bit_file_taken_as_linear(tmp_path: 
     profile = icc_profile("Adobe RGB (1998)")
 
     def mixed(path: Path, level: float) -> None:  # one Adobe RGB JPEG among untagged ones
+        rgb = np.full((16, 16, 3), round(level * 200), np.uint8)
         tagged = path.stem == "image08"
-        path.write_bytes(jpeg(level=round(level * 200), icc=profile if tagged else None))
+        if tagged:
+            rgb[:8, :8] = (0, 200, 0)  # Adobe RGB's green: outside sRGB's gamut
+        path.write_bytes(jpeg(rgb=rgb, icc=profile if tagged else None))
 
     _, record, said = _fit(_acquisition(tmp_path / "a", mixed, ".jpg"), tmp_path / "fa")
     assert record["image_colour"]["image08"]["space"] == "adobe_rgb", record["image_colour"]
     assert "1 of 8 image(s) of" in said and "are Adobe RGB (1998)" in said, said
+    clipped = record["image_colour"]["image08"]["out_of_gamut_clipped"].split(" of ")
+    assert int(clipped[0]) >= 64 and clipped[1] == "256 pixels", clipped  # the green square
+    assert "some colours of 1 of those Adobe RGB (1998) image(s) lie outside sRGB's" in said
     # converted into 16-bit linear sRGB, it is no 16-bit file whose reading is a guess
     assert "mixes" not in said, said
