@@ -15,7 +15,7 @@ from what ran, in the order it ran.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
@@ -25,6 +25,25 @@ from rti_rig.core.arm_motion import move_time_matrix, sequence_time_s
 
 #: Largest stop count solved exactly.
 EXACT_MAX = 12
+
+#: Largest stop count whose 2-opt and Or-opt try every reversal and insertion point. Beyond it
+#: they try only moves that make an edge to one of a stop's :data:`NEIGHBOURS` nearest stops
+#: (neighbour lists, built once). Why: the exhaustive passes cost O(N^2) per move found, and the
+#: whole search grew as N^2.4 (50 s at 1000 stops); below this size it is cheap (under 0.6 s)
+#: and the orders stay exactly the ones it gave.
+FULL_SEARCH_MAX = 200
+
+#: Neighbour-list length for the passes above :data:`FULL_SEARCH_MAX`. Bentley (1992, "Fast
+#: algorithms for geometric traveling salesman problems", ORSA J. Computing 4(4)) and Johnson
+#: & McGeoch (1997, "The traveling salesman problem: a case study in local optimization") keep
+#: 2-opt and Or-opt to each city's 8-20 nearest neighbours at a fraction of a percent in tour
+#: length; ``python -m benchmarks.arm_order`` measures it against the exhaustive passes here.
+NEIGHBOURS = 12
+
+#: Rows (segment starts) first evaluated at once by the neighbour-list passes: the first
+#: improving move is usually near where the last was, so evaluating every remaining row each
+#: time (as the exhaustive passes do) would make each move cost O(N).
+_CHUNK = 32
 
 #: ``progress(done, total)``: the heuristic's steps (each seed's descent, then each kick) as
 #: they finish. Why: at 1000 stops the search takes a minute or more, and ``plan`` had shown
@@ -73,30 +92,69 @@ def held_karp(cost: NDArray[np.float64]) -> list[int]:
 
 
 def _nearest_neighbour(cost: NDArray[np.float64], first: int) -> list[int]:
+    """Greedy path from stop ``first``: always the nearest stop not yet visited (the lowest
+    index among equal times). One numpy argmin per step: the Python ``min`` over a set it
+    replaced took about a second per seed at 1000 stops."""
     n = cost.shape[0] - 1
-    left = set(range(n))
+    visited = np.zeros(n, dtype=bool)
     order = [first]
-    left.remove(first)
-    while left:
-        here = order[-1] + 1
-        nxt = min(left, key=lambda k: cost[here, k + 1])
+    visited[first] = True
+    for _ in range(n - 1):
+        row = np.where(visited, np.inf, cost[order[-1] + 1, 1:])
+        nxt = int(np.argmin(row))
         order.append(nxt)
-        left.remove(nxt)
+        visited[nxt] = True
     return order
 
 
-def _two_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bool]:
+def neighbour_lists(cost: NDArray[np.float64], k: int = NEIGHBOURS) -> NDArray[np.intp]:
+    """Each matrix node's ``k`` nearest stops (matrix nodes >= 1, itself excluded), by the
+    time both ways, nearest first; row 0 is the start's. Built once per search."""
+    both = cost + cost.T
+    both[:, 0] = np.inf
+    np.fill_diagonal(both, np.inf)
+    k = max(1, min(k, cost.shape[0] - 2))
+    near = np.argpartition(both, k - 1, axis=1)[:, :k]
+    keys = np.take_along_axis(both, near, axis=1)
+    return np.take_along_axis(near, np.argsort(keys, axis=1, kind="stable"), axis=1)
+
+
+def _positions(arr: NDArray[np.intp]) -> NDArray[np.intp]:
+    """``pos[node]`` = the node's index in the path ``arr``."""
+    pos = np.empty(len(arr), dtype=np.intp)
+    pos[arr] = np.arange(len(arr))
+    return pos
+
+
+def _chunks(start: int, stop: int, near: bool) -> Iterator[tuple[int, int]]:
+    """Row ranges to evaluate: all at once for the exhaustive passes; for the neighbour-list
+    ones :data:`_CHUNK` rows first, each next range twice as long (the caller stops at the
+    first range that has a move). Why doubling: a move is usually found in the first rows, and
+    a pass that finds none scans all in a few numpy calls rather than N / 64 of them."""
+    if not near:
+        yield start, stop
+        return
+    size = _CHUNK
+    while start < stop:
+        yield start, min(start + size, stop)
+        start, size = start + size, 2 * size
+
+
+def _two_opt(
+    nodes: list[int], cost: NDArray[np.float64], near: NDArray[np.intp] | None = None
+) -> tuple[list[int], bool]:
     """One pass of 2-opt on an open path of matrix nodes (``nodes[0]`` is the fixed start).
 
     Deltas are exact for asymmetric costs (the reversed segment's inner edges are summed both
     ways with prefix sums). The segment starts are examined in path order: at the first that a
     reversal shortens, its best reversal is made and the same start examined again; the deltas
     of every remaining start and end are evaluated at once (:func:`_first_reversal`), with the
-    same arithmetic as one start at a time."""
+    same arithmetic as one start at a time. With neighbour lists ``near``, only the reversals
+    that join a stop to one of its neighbours (or reverse the tail) are tried."""
     improved = False
     i = 1
     while True:
-        move = _first_reversal(np.asarray(nodes), cost, i)
+        move = _first_reversal(np.asarray(nodes), cost, i, near)
         if move is None:
             return nodes, improved
         i, k = move
@@ -105,56 +163,69 @@ def _two_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bo
 
 
 def _first_reversal(
-    arr: NDArray[np.intp], cost: NDArray[np.float64], start: int
+    arr: NDArray[np.intp],
+    cost: NDArray[np.float64],
+    start: int,
+    near: NDArray[np.intp] | None = None,
 ) -> tuple[int, int] | None:
     """The first segment start ``i`` (from path position ``start`` on) whose best reversal of
     ``arr[i..k]`` shortens the path, as (i, k), or None.
 
     Row ``r`` is the start ``i = start + r`` (after ``a = arr[i - 1]``, first stop ``b``);
-    column ``k`` the segment's last stop ``c = arr[k]`` (``k > i``), followed by ``d``."""
+    column ``k`` the segment's last stop ``c = arr[k]`` (``k > i``), followed by ``d``. Every
+    ``k`` is a column, or with neighbour lists only those making ``a -> c`` or ``b -> d`` an
+    edge to a neighbour, and the path's end."""
     m = len(arr)
-    ii = np.arange(start, m - 1)
-    if len(ii) == 0:
-        return None
     fwd = np.concatenate([[0.0], np.cumsum(cost[arr[:-1], arr[1:]])])
     bwd = np.concatenate([[0.0], np.cumsum(cost[arr[1:], arr[:-1]])])
-    a, b = arr[ii - 1], arr[ii]
-    ks = np.arange(m)
-    c = arr[ks]
     flat, width = np.ravel(cost), cost.shape[1]  # (rows × ends) lookups by flat index
-    delta = (
-        flat[a[:, None] * width + c[None, :]]
-        - cost[a, b][:, None]
-        + (bwd[ks][None, :] - bwd[ii][:, None])
-        - (fwd[ks][None, :] - fwd[ii][:, None])
-    )
-    has_d = ks + 1 < m
-    d = arr[np.minimum(ks + 1, m - 1)]
-    delta = delta + np.where(
-        has_d[None, :], flat[b[:, None] * width + d[None, :]] - cost[c, d][None, :], 0.0
-    )
-    delta[ks[None, :] <= ii[:, None]] = np.inf  # a segment ends after it starts
-    best = np.argmin(delta, axis=1)
-    found = np.flatnonzero(delta[np.arange(len(ii)), best] < -1e-12)
-    if len(found) == 0:
-        return None
-    r = int(found[0])
-    return int(ii[r]), int(best[r])
+    pos = _positions(arr) if near is not None else None
+    for lo, hi in _chunks(start, m - 1, near is not None):
+        ii = np.arange(lo, hi)
+        a, b = arr[ii - 1], arr[ii]
+        if near is None or pos is None:
+            ks = np.broadcast_to(np.arange(m), (len(ii), m))
+        else:
+            ks = np.concatenate(
+                [pos[near[a]], pos[near[b]] - 1, np.full((len(ii), 1), m - 1)], axis=1
+            )
+        c = arr[ks]
+        delta = (
+            flat[a[:, None] * width + c]
+            - cost[a, b][:, None]
+            + (bwd[ks] - bwd[ii][:, None])
+            - (fwd[ks] - fwd[ii][:, None])
+        )
+        has_d = ks + 1 < m
+        d = arr[np.minimum(ks + 1, m - 1)]
+        delta = delta + np.where(has_d, flat[b[:, None] * width + d] - flat[c * width + d], 0.0)
+        delta[ks <= ii[:, None]] = np.inf  # a segment ends after it starts
+        rows = np.arange(len(ii))
+        best = np.argmin(delta, axis=1)
+        found = np.flatnonzero(delta[rows, best] < -1e-12)
+        if len(found):
+            r = int(found[0])
+            return int(ii[r]), int(ks[r, best[r]])
+    return None
 
 
-def _or_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bool]:
+def _or_opt(
+    nodes: list[int], cost: NDArray[np.float64], near: NDArray[np.intp] | None = None
+) -> tuple[list[int], bool]:
     """One pass of Or-opt: move a segment of 1-3 stops elsewhere, forwards or reversed.
 
     Exact deltas (edges removed and added, plus the inner edges' change when reversed). The
     segments are examined in path order and the first that can move is moved (then the same
     place is examined again); the deltas of every remaining segment and insertion point are
-    evaluated at once, with the same arithmetic as one at a time."""
+    evaluated at once, with the same arithmetic as one at a time. With neighbour lists
+    ``near``, only insertions next to a neighbour of the segment's ends (or at either end of
+    the path) are tried."""
     improved = False
     m = len(nodes)
     for seg in (1, 2, 3):
         i = 1
         while i + seg <= m:
-            move = _first_segment_move(np.asarray(nodes), cost, seg, i)
+            move = _first_segment_move(np.asarray(nodes), cost, seg, i, near)
             if move is None:
                 break
             i, pos, rev = move
@@ -167,75 +238,103 @@ def _or_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], boo
 
 
 def _first_segment_move(
-    arr: NDArray[np.intp], cost: NDArray[np.float64], seg: int, start: int
+    arr: NDArray[np.intp],
+    cost: NDArray[np.float64],
+    seg: int,
+    start: int,
+    near: NDArray[np.intp] | None = None,
 ) -> tuple[int, int, bool] | None:
     """The first segment (from path position ``start`` on) of ``seg`` stops that an Or-opt
     move shortens, as (position, insertion index into the path without it, reversed), or None.
 
     Row ``r`` is the segment at position ``i = start + r``; column ``jj`` inserts it after the
-    ``jj``-th stop of the path without it (``x``), before the next (``y``, none at the end)."""
+    ``jj``-th stop of the path without it (``x``), before the next (``y``, none at the end).
+    Every ``jj`` is a column, or with neighbour lists only those putting a neighbour of the
+    segment's first or last stop just before or after it, and the path's two ends."""
     m = len(arr)
-    ii = np.arange(start, m - seg + 1)
-    if len(ii) == 0:
-        return None
-    first, last = arr[ii], arr[ii + seg - 1]
-    p = arr[ii - 1]
-    has_q = ii + seg < m
-    q = arr[np.minimum(ii + seg, m - 1)]
-    removed = cost[p, first] + np.where(has_q, cost[last, q], 0.0)
-    bridged = np.where(has_q, cost[p, q], 0.0)
-    inner_f = np.zeros(len(ii))
-    inner_b = np.zeros(len(ii))
-    for t in range(seg - 1):
-        inner_f = inner_f + cost[arr[ii + t], arr[ii + t + 1]]
-        inner_b = inner_b + cost[arr[ii + t + 1], arr[ii + t]]
-    # the path without the segment: rest[jj] = arr[jj] before it, arr[jj + seg] after it
     n_rest = m - seg
-    jj = np.arange(n_rest)[None, :]
-    after = jj >= ii[:, None]
-    x = np.where(after, arr[np.minimum(jj + seg, m - 1)], arr[jj])
-    yj = jj + 1
-    has_y = yj < n_rest
-    y = np.where(yj >= ii[:, None], arr[np.minimum(yj + seg, m - 1)], arr[np.minimum(yj, m - 1)])
-    y_safe = np.where(has_y, y, 0)
-    # the (rows × insertion points) lookups as flat indices into the matrix (the same entries;
-    # 2-D fancy indexing with broadcast index arrays was half of this function's time)
+    pos = _positions(arr) if near is not None else None
     flat, width = np.ravel(cost), cost.shape[1]
-    xw = x * width
-    opened = np.where(has_y, flat[xw + y_safe], 0.0)
-    rows = np.arange(len(ii))
-    best_delta = np.full(len(ii), -1e-12)
-    best_pos = np.full(len(ii), -1)
-    best_rev = np.zeros(len(ii), dtype=bool)
-    for rev, a, b, inner in ((False, first, last, inner_f), (True, last, first, inner_b)):
-        added = flat[xw + a[:, None]] + np.where(has_y, flat[b[:, None] * width + y_safe], 0.0)
-        delta = (bridged - removed)[:, None] + (added - opened) + (inner - inner_f)[:, None]
-        delta[rows, ii - 1] = np.inf  # that is where the segment came from
-        j = np.argmin(delta, axis=1)
-        dj = delta[rows, j]
-        better = dj < best_delta
-        best_delta = np.where(better, dj, best_delta)
-        best_pos = np.where(better, j + 1, best_pos)
-        best_rev = np.where(better, rev, best_rev)
-    found = np.flatnonzero(best_pos >= 0)
-    if len(found) == 0:
-        return None
-    r = int(found[0])
-    return int(ii[r]), int(best_pos[r]), bool(best_rev[r])
+    for lo, hi in _chunks(start, m - seg + 1, near is not None):
+        ii = np.arange(lo, hi)
+        first, last = arr[ii], arr[ii + seg - 1]
+        p = arr[ii - 1]
+        has_q = ii + seg < m
+        q = arr[np.minimum(ii + seg, m - 1)]
+        removed = cost[p, first] + np.where(has_q, cost[last, q], 0.0)
+        bridged = np.where(has_q, cost[p, q], 0.0)
+        inner_f = np.zeros(len(ii))
+        inner_b = np.zeros(len(ii))
+        for t in range(seg - 1):
+            inner_f = inner_f + cost[arr[ii + t], arr[ii + t + 1]]
+            inner_b = inner_b + cost[arr[ii + t + 1], arr[ii + t]]
+        # the path without the segment: rest[jj] = arr[jj] before it, arr[jj + seg] after it
+        if near is None or pos is None:
+            jj = np.broadcast_to(np.arange(n_rest), (len(ii), n_rest))
+            inside = np.zeros(jj.shape, dtype=bool)
+        else:
+            at = pos[np.concatenate([near[first], near[last]], axis=1)]
+            inside = np.concatenate([(at >= ii[:, None]) & (at < (ii + seg)[:, None])] * 2, axis=1)
+            rest_at = np.where(at >= ii[:, None] + seg, at - seg, at)
+            ends = np.broadcast_to(np.array([0, n_rest - 1]), (len(ii), 2))
+            jj = np.concatenate([rest_at, rest_at - 1, ends], axis=1)
+            inside = np.concatenate([inside, np.zeros(ends.shape, dtype=bool)], axis=1)
+            jj = np.maximum(jj, 0)
+        after = jj >= ii[:, None]
+        x = np.where(after, arr[np.minimum(jj + seg, m - 1)], arr[jj])
+        yj = jj + 1
+        has_y = yj < n_rest
+        y = np.where(
+            yj >= ii[:, None], arr[np.minimum(yj + seg, m - 1)], arr[np.minimum(yj, m - 1)]
+        )
+        y_safe = np.where(has_y, y, 0)
+        # the (rows × insertion points) lookups as flat indices into the matrix (the same
+        # entries; 2-D fancy indexing with broadcast index arrays was half of this time)
+        xw = x * width
+        opened = np.where(has_y, flat[xw + y_safe], 0.0)
+        rows = np.arange(len(ii))
+        best_delta = np.full(len(ii), -1e-12)
+        best_pos = np.full(len(ii), -1)
+        best_rev = np.zeros(len(ii), dtype=bool)
+        for rev, a, b, inner in ((False, first, last, inner_f), (True, last, first, inner_b)):
+            added = flat[xw + a[:, None]] + np.where(has_y, flat[b[:, None] * width + y_safe], 0.0)
+            delta = (bridged - removed)[:, None] + (added - opened) + (inner - inner_f)[:, None]
+            # where the segment came from, and neighbours inside the segment itself
+            delta[(jj == (ii - 1)[:, None]) | inside] = np.inf
+            j = np.argmin(delta, axis=1)
+            dj = delta[rows, j]
+            better = dj < best_delta
+            best_delta = np.where(better, dj, best_delta)
+            best_pos = np.where(better, jj[rows, j] + 1, best_pos)
+            best_rev = np.where(better, rev, best_rev)
+        found = np.flatnonzero(best_pos >= 0)
+        if len(found):
+            r = int(found[0])
+            return int(ii[r]), int(best_pos[r]), bool(best_rev[r])
+    return None
 
 
-def _local_search(nodes: list[int], cost: NDArray[np.float64], max_rounds: int = 100) -> list[int]:
+def _local_search(
+    nodes: list[int],
+    cost: NDArray[np.float64],
+    max_rounds: int = 100,
+    near: NDArray[np.intp] | None = None,
+) -> list[int]:
     for _ in range(max_rounds):
-        nodes, a = _two_opt(nodes, cost)
-        nodes, b = _or_opt(nodes, cost)
+        nodes, a = _two_opt(nodes, cost, near)
+        nodes, b = _or_opt(nodes, cost, near)
         if not (a or b):
             break
     return nodes
 
 
-def improve(order: list[int], cost: NDArray[np.float64]) -> list[int]:
-    """2-opt and Or-opt until neither helps; stops as 0-based indices."""
-    return [x - 1 for x in _local_search([0, *[i + 1 for i in order]], cost)[1:]]
+def improve(
+    order: list[int], cost: NDArray[np.float64], near: NDArray[np.intp] | None = None
+) -> list[int]:
+    """2-opt and Or-opt until neither helps; stops as 0-based indices. ``near``: neighbour
+    lists (:func:`neighbour_lists`) to try only moves to neighbours; None tries every move."""
+    nodes = _local_search([0, *[i + 1 for i in order]], cost, near=near)
+    return [x - 1 for x in nodes[1:]]
 
 
 def _double_bridge(nodes: list[int], rng: np.random.Generator) -> list[int]:
@@ -251,19 +350,27 @@ def heuristic_order(
     kicks: int | None = None,
     seed: int = 0,
     progress: Progress | None = None,
+    neighbours: int | None = None,
 ) -> list[int]:
     """Nearest neighbour from the ``seeds`` stops nearest the start, 2-opt + Or-opt, then
     iterated local search (double-bridge kicks, keep if better). Deterministic for a seed;
-    ``progress`` is told each step done (it does not change the order)."""
+    ``progress`` is told each step done (it does not change the order).
+
+    ``neighbours``: how many of each stop's nearest stops the passes try moves to; 0 tries
+    every move; None (the default) is 0 up to :data:`FULL_SEARCH_MAX` stops and
+    :data:`NEIGHBOURS` beyond."""
     n = cost.shape[0] - 1
     if n == 0:
         return []
+    if neighbours is None:
+        neighbours = 0 if n <= FULL_SEARCH_MAX else NEIGHBOURS
+    near = neighbour_lists(cost, neighbours) if neighbours > 0 and n >= 2 else None
     firsts = list(np.argsort(cost[0, 1:])[: max(1, min(seeds, n))])
     kicks = (max(20, 2000 // n) if kicks is None else kicks) if n >= 8 else 0
     total = len(firsts) + kicks
     best, best_t = None, np.inf
     for done, f in enumerate(firsts, 1):
-        cand = improve(_nearest_neighbour(cost, int(f)), cost)
+        cand = improve(_nearest_neighbour(cost, int(f)), cost, near)
         t = path_time_s(cand, cost)
         if t < best_t:
             best, best_t = cand, t
@@ -275,7 +382,7 @@ def heuristic_order(
     rng = np.random.default_rng(seed)
     nodes = [0, *[i + 1 for i in best]]
     for k in range(kicks):
-        cand = _local_search(_double_bridge(nodes, rng), cost)
+        cand = _local_search(_double_bridge(nodes, rng), cost, near=near)
         t = path_time_s([x - 1 for x in cand[1:]], cost)
         if t < best_t - 1e-12:
             nodes, best_t = cand, t
