@@ -5,9 +5,12 @@ the move-time model of :mod:`rti_rig.core.arm_motion` as the distance. Exact Hel
 programming up to :data:`EXACT_MAX` stops (2^12 * 12 states, vectorised with numpy: a few ms);
 beyond that nearest-neighbour construction from several seeds, improved by 2-opt and Or-opt
 (segments of 1-3 stops moved, possibly reversed) until no move helps, then iterated local
-search (double-bridge kicks, kept when they shorten the path; deterministic seed). The
-benchmark (``python -m benchmarks.arm_order``) measures the heuristic against the exact
-optimum at N = 14 and 16: median 0 %, worst 1.97 % above.
+search (double-bridge kicks, kept when they shorten the path; deterministic seed). Above
+:data:`FULL_SEARCH_MAX` stops 2-opt and Or-opt try only the moves that join a stop to one of
+its :data:`NEIGHBOURS` nearest (neighbour lists), so a pass costs O(N * K) rather than
+O(N^2) per move found. The benchmark (``python -m benchmarks.arm_order``) measures the
+heuristic against the exact optimum at N = 14 and 16: median 0 %, worst 1.97 % above;
+``python -m benchmarks.arm_order scaling`` the neighbour lists against every move tried.
 
 The order does not change *what* is imaged, only when: the session still writes its ``.lp``
 from what ran, in the order it ran.
