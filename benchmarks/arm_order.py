@@ -1,6 +1,9 @@
 """Total move time of an arm schedule: optimised order vs plan order vs the exact optimum.
 
-Run: ``python -m benchmarks.arm_order`` (writes the "arm_order" section of docs/benchmarks.md).
+Run: ``python -m benchmarks.arm_order`` (prints; ``--write`` writes the "arm_order" section of
+docs/benchmarks.md). ``python -m benchmarks.arm_order scaling`` instead measures the order search
+at N = 30, 100, 300 and 1000 with every move tried and with neighbour lists, on the same light
+sets (``--write``: the "arm_order_scaling" section).
 
 Light sets: directions drawn uniformly on the reachable part of the hemisphere (elevation
 5..70 deg, azimuth within the joint limits) of the XL430 test arm used by the tests, in random
@@ -17,7 +20,7 @@ import time
 
 import numpy as np
 
-from benchmarks.report import machine_line, write_section
+from benchmarks.report import machine_line, positional_args, write_section
 from rti_rig.core.arm_motion import move_time_matrix
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
@@ -25,6 +28,8 @@ from rti_rig.drivers.dynamixel.arm import DynamixelArm
 from rti_rig.drivers.dynamixel.settings import ArmSettings
 from rti_rig.planner.arm_order import (
     EXACT_MAX,
+    FULL_SEARCH_MAX,
+    NEIGHBOURS,
     held_karp,
     heuristic_order,
     order_for_arm,
@@ -38,6 +43,9 @@ TRIALS = 7
 REF_KICKS = 300
 #: Sizes above EXACT_MAX where the exact DP is still cheap: checks the heuristic itself.
 HEURISTIC_CHECK_SIZES = (14, 16)
+#: The scaling run: sizes and light sets per size.
+SCALING_SIZES = (30, 100, 300, 1000)
+SCALING_TRIALS = 3
 
 
 def bench_settings() -> ArmSettings:
@@ -191,8 +199,57 @@ def main() -> int:
     return 0
 
 
+def scaling() -> int:
+    """Search time and total move time, every move tried (``neighbours=0``) against neighbour
+    lists (``neighbours=NEIGHBOURS``), on the same seeded light sets. Time is the process's CPU
+    time: the machine is shared, and wall time there measures the neighbours' load too."""
+    settings = bench_settings()
+    rng = np.random.default_rng(20261202)
+    med = statistics.median
+    rows = []
+    for n in SCALING_SIZES:
+        cpu: dict[int, list[float]] = {0: [], NEIGHBOURS: []}
+        move: dict[int, list[float]] = {0: [], NEIGHBOURS: []}
+        for _ in range(SCALING_TRIALS):
+            cost = move_time_matrix(light_set(n, rng), settings)
+            for k in (NEIGHBOURS, 0):
+                t0 = time.process_time()
+                order = heuristic_order(cost, neighbours=k)
+                cpu[k].append(time.process_time() - t0)
+                move[k].append(path_time_s(order, cost))
+        ratio = [f / e for f, e in zip(move[NEIGHBOURS], move[0], strict=True)]
+        default = "every move" if n <= FULL_SEARCH_MAX else f"{NEIGHBOURS} neighbours"
+        rows.append(
+            f"| {n} | {med(cpu[0]):.2f} | {med(cpu[NEIGHBOURS]):.2f} | {med(move[0]):.1f} | "
+            f"{med(move[NEIGHBOURS]):.1f} | {100 * (med(ratio) - 1):+.2f} % / "
+            f"{100 * (max(ratio) - 1):+.2f} % | {default} |"
+        )
+        print(rows[-1], flush=True)
+    md = "\n".join(
+        [
+            "## Arm order search as N grows (`python -m benchmarks.arm_order scaling`)",
+            "",
+            machine_line(),
+            f"Medians over {SCALING_TRIALS} random light sets per N (the XL430 arm of the table "
+            "above). The heuristic (nearest neighbour from 4 seeds, 2-opt + Or-opt, "
+            "max(20, 2000 // N) double-bridge kicks) with every reversal and insertion point "
+            f"tried, and with only the moves that join a stop to one of its {NEIGHBOURS} "
+            "nearest (neighbour lists, Bentley 1992; Johnson & McGeoch 1997). Search time is "
+            "the process's CPU time in seconds (the machine is shared).",
+            "",
+            "| N | search, every move (s) | search, neighbour lists (s) | move time, every move "
+            "(s) | move time, neighbour lists (s) | lists vs every move (median / worst) | "
+            "`order_for_arm` uses |",
+            "|---|---|---|---|---|---|---|",
+            *rows,
+        ]
+    )
+    write_section("arm_order_scaling", md)
+    return 0
+
+
 if __name__ == "__main__":
     from benchmarks.report import exit_on_help
 
     exit_on_help(__doc__)
-    sys.exit(main())
+    sys.exit(scaling() if positional_args() == ["scaling"] else main())

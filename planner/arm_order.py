@@ -32,8 +32,8 @@ EXACT_MAX = 12
 #: Largest stop count whose 2-opt and Or-opt try every reversal and insertion point. Beyond it
 #: they try only moves that make an edge to one of a stop's :data:`NEIGHBOURS` nearest stops
 #: (neighbour lists, built once). Why: the exhaustive passes cost O(N^2) per move found, and the
-#: whole search grew as N^2.4 (50 s at 1000 stops); below this size it is cheap (under 0.6 s)
-#: and the orders stay exactly the ones it gave.
+#: whole search grew as N^2.4 (50 s at 1000 stops); below this size it is cheap (well under a
+#: second) and the orders stay exactly the ones it gave.
 FULL_SEARCH_MAX = 200
 
 #: Neighbour-list length for the passes above :data:`FULL_SEARCH_MAX`. Bentley (1992, "Fast
@@ -49,8 +49,8 @@ NEIGHBOURS = 12
 _CHUNK = 32
 
 #: ``progress(done, total)``: the heuristic's steps (each seed's descent, then each kick) as
-#: they finish. Why: at 1000 stops the search takes a minute or more, and ``plan`` had shown
-#: nothing in that time.
+#: they finish. Why: at 1000 stops the search takes seconds (it took a minute before the
+#: neighbour lists), and ``plan`` had shown nothing in that time.
 Progress = Callable[[int, int], None]
 
 

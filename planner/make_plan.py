@@ -432,7 +432,7 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
             f"({method.name} needs none)"
         )
     report.seconds = time.perf_counter() - t0
-    # the arm's stop order is part of planning (a minute at 1000 stops): timed apart and said,
+    # the arm's stop order is part of planning (seconds at 1000 stops): timed apart and said,
     # where "planned in 0.01 s" had left it out
     t1 = time.perf_counter()
     stops = _arm_stops(geometry, candidates, chosen, req.arm_order)

@@ -89,8 +89,8 @@ class PlanLightsRequest:
     #: Plan lights that cannot determine a normal (one plane, bunched at the zenith) with a
     #: warning, in place of the refusal: a ring of low lights for a relightable PTM/HSH only.
     allow_no_normals: bool = False
-    #: ``(done, total)`` of an arm's stop-order search as it goes (a minute or more at 1000
-    #: stops, which ``plan`` had passed in silence); None: not told
+    #: ``(done, total)`` of an arm's stop-order search as it goes (seconds at 1000 stops, a
+    #: minute before its neighbour lists, which ``plan`` had passed in silence); None: not told
     order_progress: Callable[[int, int], None] | None = None
 
     @property
