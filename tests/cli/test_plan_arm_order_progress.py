@@ -15,7 +15,7 @@ from conftest import CONFIGS
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.planner.arm_order import EXACT_MAX, heuristic_order
+from rti_rig.planner.arm_order import EXACT_MAX, FULL_SEARCH_MAX, heuristic_order
 
 
 def _plan(tmp_path: Path, rig: str, lights: int) -> str:
@@ -36,11 +36,17 @@ def _plan(tmp_path: Path, rig: str, lights: int) -> str:
     return " ".join(r.output.split())
 
 
-def test_an_arm_order_search_shows_its_steps_to_the_end(tmp_path: Path) -> None:
-    said = _plan(tmp_path, "simulated_arm.toml", EXACT_MAX + 8)
+@pytest.mark.parametrize("lights", [EXACT_MAX + 8, FULL_SEARCH_MAX + 10])
+def test_an_arm_order_search_shows_its_steps_to_the_end(tmp_path: Path, lights: int) -> None:
+    """Beyond FULL_SEARCH_MAX the search runs on neighbour lists: through ``plan`` too, to
+    its last step, with every light written once."""
+    said = _plan(tmp_path, "simulated_arm.toml", lights)
     found = re.search(r"ordering the arm's stops for the least move time \S* (\d+)/(\d+)", said)
     assert found is not None, said
     assert found.group(1) == found.group(2) and int(found.group(2)) > 1
+    rows = (tmp_path / "p.lp").read_text().split("\n")
+    assert int(rows[0]) == lights
+    assert len({r.split()[0] for r in rows[1:] if r.strip()}) == lights
 
 
 def test_a_dome_plan_shows_no_order_bar(tmp_path: Path) -> None:
