@@ -6,7 +6,7 @@ import signal
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, NoReturn
+from typing import TYPE_CHECKING, Annotated, NoReturn, Protocol
 
 import typer
 from rich.markup import escape
@@ -18,6 +18,15 @@ from rti_rig.core.errors import RtiRigError
 if TYPE_CHECKING:
     from rti_rig.app.usecases.check import CheckStopped
     from rti_rig.app.usecases.probe import ProbeResult
+
+
+class _Report(Protocol):
+    """What a check's, reboot's and park's reports share: their words and whether it ended well."""
+
+    @property
+    def ok(self) -> bool: ...
+
+    def lines(self) -> list[str]: ...
 
 
 @contextmanager
@@ -156,10 +165,7 @@ def check(
         raise typer.Exit(code=stop_exit_code(exc.signum)) from None
     except RtiRigError as exc:
         raise fail(exc) from None
-    for line in report.lines():
-        out.print(line, highlight=False, markup=False)  # a message may quote [a.table]
-    if not report.ok:
-        raise typer.Exit(code=1)
+    _said_report(report)
 
 
 def _reboot_faulted(rig_config: Path) -> None:
@@ -175,10 +181,7 @@ def _reboot_faulted(rig_config: Path) -> None:
         report = reboot_faulted(rig_config, on_start=looking)
     except RtiRigError as exc:
         raise fail(exc) from None
-    for line in report.lines():
-        out.print(line, highlight=False, markup=False)
-    if not report.ok:
-        raise typer.Exit(code=1)
+    _said_report(report)
 
 
 def _park_only(rig_config: Path) -> None:
@@ -201,6 +204,12 @@ def _park_only(rig_config: Path) -> None:
         raise typer.Exit(code=stop_exit_code(exc.signum)) from None
     except RtiRigError as exc:
         raise fail(exc) from None
+    _said_report(report)
+
+
+def _said_report(report: _Report) -> None:
+    """Print a check's, reboot's or park's report line by line, as written (a message may quote
+    ``[a.table]``, which rich markup would eat), and exit 1 unless it ended well."""
     for line in report.lines():
         out.print(line, highlight=False, markup=False)
     if not report.ok:
