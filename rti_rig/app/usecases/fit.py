@@ -277,11 +277,12 @@ def _converted_rows(source: Any, colour: FileColour, name: str) -> tuple[RawRows
 
 
 def _check_tiff_type(path: Path, rows: TiffRows) -> None:
-    """16-bit TIFFs are linear data, 8-bit ones sRGB like JPEG and PNG (as `plan` reads
-    them); anything else is refused with what to give instead, and so is a CFA mosaic (a
-    session shot with ``decode.mode = "mosaic"``): one colour per photosite is no picture,
-    and a fit of it is a checkerboard at the wrong white level (the black-subtracted sensor
-    range, not 65535) that no viewer or check would question."""
+    """16-bit and 8-bit TIFFs are read as `plan` reads them (in the space they say,
+    :func:`_colour_to_convert`; else 16-bit as linear, 8-bit as sRGB); anything else is
+    refused with what to give instead, and so is a CFA mosaic (a session shot with
+    ``decode.mode = "mosaic"``): one colour per photosite is no picture, and a fit of it is a
+    checkerboard at the wrong white level (the black-subtracted sensor range, not 65535) that
+    no viewer or check would question."""
     if rows.dtype not in (np.uint16, np.uint8):
         raise FitInputError(
             f"{shown_path(path)}: a {rows.dtype} TIFF; give 16-bit linear or 8-bit sRGB TIFFs (or "
