@@ -431,6 +431,23 @@ def qa_of(session: Path, out: Path) -> tuple[str, dict]:  # type: ignore[type-ar
     return " ".join(r.output.split()), json.loads((out / "qa.json").read_text())
 
 
+def planned_preview(preview: Path, out: Path, *extra: str) -> str:
+    """What ``rti-rig plan PREVIEW --rig simulated_dome.toml --method uniform --out OUT``
+    (and ``extra``) said, on one line, having checked it ended well: the preview tests read
+    the plan's words on how it read the file (orientation, colour space)."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    argv = ["plan", str(preview), "--rig", str(CONFIGS / "simulated_dome.toml")]
+    r = CliRunner().invoke(
+        app, [*argv, "--method", "uniform", *extra, "--out", str(out)], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    return said
+
+
 def servo_fault(at_command: int, servo_id: int, kind: str = "overload") -> str:
     """An ``[[emulator.faults]]`` table of the emulated arm (to append to its config, e.g. as
     :func:`inprocess_arm_config`'s ``extra``): servo ``servo_id`` reports ``kind`` from the

@@ -22,10 +22,7 @@ import numpy as np
 import pytest
 import tifffile
 from colour_files import icc_profile
-from conftest import CONFIGS
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
+from conftest import planned_preview
 
 
 def _sphere() -> np.ndarray:
@@ -40,22 +37,7 @@ def _sphere() -> np.ndarray:
 
 def _plan(preview: Path) -> tuple[tuple[float, ...], str]:
     """The plan's estimated light (az, el) and RMS relief tilt, and all it said."""
-    r = CliRunner().invoke(
-        app,
-        [
-            "plan",
-            str(preview),
-            "--rig",
-            str(CONFIGS / "simulated_dome.toml"),
-            "--method",
-            "uniform",
-            "--out",
-            str(preview.with_suffix(".lp")),
-        ],
-        terminal_width=400,
-    )
-    said = " ".join(r.output.split())
-    assert r.exit_code == 0 and "Traceback" not in said, said
+    said = planned_preview(preview, preview.with_suffix(".lp"))
     light = re.search(r"preview light az ([\d.-]+)°, el ([\d.-]+)°", said)
     tilt = re.search(r"RMS tilt ([\d.]+)°", said)
     assert light and tilt, said

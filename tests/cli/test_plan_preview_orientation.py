@@ -14,10 +14,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from conftest import CONFIGS
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
+from conftest import planned_preview
 
 
 def _shading() -> np.ndarray:
@@ -49,24 +46,7 @@ def _tiff(orientation: int) -> bytes:
 def _plan(tmp_path: Path, name: str, data: bytes) -> str:
     preview = tmp_path / name
     preview.write_bytes(data)
-    r = CliRunner().invoke(
-        app,
-        [
-            "plan",
-            str(preview),
-            "--rig",
-            str(CONFIGS / "simulated_dome.toml"),
-            "--method",
-            "uniform",
-            "--preview-light",
-            "0,90",
-            "--out",
-            str(tmp_path / "p.lp"),
-        ],
-        terminal_width=400,
-    )
-    assert r.exit_code == 0, r.output
-    return " ".join(r.output.split())
+    return planned_preview(preview, tmp_path / "p.lp", "--preview-light", "0,90")
 
 
 @pytest.mark.parametrize(
