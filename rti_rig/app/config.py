@@ -1637,6 +1637,19 @@ def rig_geometry(rig: LoadedRig) -> DomeGeometry | ArmGeometry:
     )
 
 
+def _converted_by_replay(path: Path) -> bool:
+    """Whether a replay converts ``path`` to linear sRGB by the space it says (the replay's
+    rule: a colour file, :func:`needs_conversion`), read from its headers alone."""
+    from rti_rig.core.image_files import header_bit_depth, header_layout
+    from rti_rig.drivers.cameras.colour_convert import needs_conversion
+    from rti_rig.drivers.cameras.file_colour import file_colour
+
+    layout, bits = header_layout(path), header_bit_depth(path)
+    if layout is None or not layout[2] or bits not in (8, 16):
+        return False
+    return needs_conversion(file_colour(path), np.dtype(np.uint16 if bits == 16 else np.uint8))
+
+
 def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     """A recorded acquisition as a rig: a dome with exactly the `.lp`'s lights (backend
     ``replay``) whose camera returns the image recorded beside the `.lp` for the light fired.
@@ -1680,7 +1693,17 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     # their readers drop a PNG's alpha: said once, among the rig's notes (run, check)
     notes.extend(png_alpha_note([e.name for e in entries], found.paths))
     width, height = found.width, found.height
-    mixed = mixed_depth_note(lp_path, [e.name for e in entries], found.paths, "replayed")
+    names = [e.name for e in entries]
+    mixed = mixed_depth_note(lp_path, names, found.paths, "replayed")
+    if mixed:
+        # a file the replay converts by the space it says is read by neither of the note's
+        # two guesses (fit leaves it out of its note too): a 16-bit sRGB PNG among JPEGs had
+        # been said "taken as linear" where the replay undoes its curve. Headers are read
+        # again only where there is a mix
+        kept = [i for i, p in enumerate(found.paths) if not _converted_by_replay(p)]
+        mixed = mixed_depth_note(
+            lp_path, [names[i] for i in kept], [found.paths[i] for i in kept], "replayed"
+        )
     if mixed:
         notes.append(mixed)
     data: dict[str, Any] = {

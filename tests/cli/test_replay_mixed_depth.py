@@ -6,6 +6,8 @@ session then holds every image as a linear TIFF, the mix no longer visible."""
 from __future__ import annotations
 
 import shutil
+import struct
+import zlib
 from pathlib import Path
 
 import cv2
@@ -35,3 +37,21 @@ def test_a_replay_of_jpegs_and_a_16_bit_png_says_the_mix(tmp_path: Path) -> None
         assert r.exit_code == 0, text
         assert f"{MIXES} (image25.png)" in text
         assert "they are replayed wrongly; export every image of the acquisition alike" in text
+
+
+def test_a_16_bit_srgb_png_among_jpegs_is_not_said_taken_as_linear(tmp_path: Path) -> None:
+    """A 16-bit PNG that says sRGB (its sRGB chunk) is converted by the replay, its curve
+    undone: neither of the note's guesses, so no mix is said of it (as fit says none)."""
+    acq = tmp_path / "acq"
+    shutil.copytree(REPO / "tests" / "data" / "neuralrti_replay", acq)
+    lp = acq / "dirs.lp"
+    pixels = cv2.imread(str(acq / "image25.jpg"))
+    ok, encoded = cv2.imencode(".png", pixels.astype("uint16") * 257)
+    assert ok
+    data = encoded.tobytes()
+    chunk = b"sRGB\0"  # ISO/IEC 15948 11.3.3.5, after the signature (8) and IHDR (25)
+    srgb = struct.pack(">I", 1) + chunk + struct.pack(">I", zlib.crc32(chunk))
+    (acq / "image25.png").write_bytes(data[:33] + srgb + data[33:])
+    lp.write_text(lp.read_text().replace("image25.jpg", "image25.png"))
+    r = runner.invoke(app, ["check", str(lp)])
+    assert r.exit_code == 0 and "mixes" not in said(r), said(r)
