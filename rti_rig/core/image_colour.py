@@ -275,10 +275,11 @@ ASSUMED_LINEAR_WORDS = (
 
 def other_space_words(file_colour: Mapping[str, str]) -> tuple[str, str, str]:
     """(the JPEGs' words, the linear TIFFs' words, the TIFF's ImageDescription head) for
-    images whose file said another space than sRGB: its primaries kept, not converted, and
-    no sRGB tag anywhere. Nor are they said to be linear in that space: an 8-bit file's
-    values are undone by the sRGB curve and a 16-bit one's taken as stored, not by that
-    space's own curve (Adobe RGB's gamma 563/256, ProPhoto's 1.8)."""
+    images whose file said a space rti-rig does not know (another profile, Exif
+    "uncalibrated"; Adobe RGB, ProPhoto and Display P3 are converted, :func:`converted_words`):
+    its primaries kept, not converted, and no sRGB tag anywhere. Nor are they said to be
+    linear in that space: an 8-bit file's values are undone by the sRGB curve and a 16-bit
+    one's taken as stored, not by that space's own curve, which is not known."""
     name = file_colour.get("name", "another space")
     said = file_colour.get("said_by", "")
     source = f"the source file is {name}, said by {said}; not converted"
