@@ -28,8 +28,9 @@ from rti_rig.app.light_calibration import (
     step_direction,
 )
 from rti_rig.app.output_files import check_output_file, rig_inputs
+from rti_rig.app.usecases.run_options import run_words
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.out_folders import free_folder_beside, free_name
+from rti_rig.core.out_folders import file_beside, free_folder_beside, free_name
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.drivers.led_dome.settings import DIMMING_LINK, IMAGE_GAINS_REMEDY
@@ -133,6 +134,34 @@ def _shoot_and_calibrate(req: CalibrateRequest, tag: str) -> str:
         f"as {plan}, run rti-rig run {rig} --plan {plan} --out {new_card} and calibrate that "
         f"with rti-rig calibrate-lights {new_card} --rig {rig}"
     )
+
+
+def calibrate_words(
+    req: CalibrateRequest, out_file: Path | None = None, *, not_flat_ok: bool = False
+) -> str:
+    """``rti-rig calibrate-lights CARD --rig RIG`` with the request's own options (``out_file``
+    for its ``--out`` where given), each a shell word: the command a refusal advises, pasteable.
+
+    Why: the refusals said "give --out" and "give --not-flat-ok", and the user had to rebuild
+    the command, the --card-normal and --min-elevation-deg they had typed included."""
+    words = [
+        "rti-rig calibrate-lights",
+        shell_word(str(req.card_session)),
+        "--rig",
+        shell_word(str(req.rig_config)),
+    ]
+    out = out_file or req.out_file
+    if out is not None:
+        words += ["--out", shell_word(str(out))]
+    if tuple(req.card_normal) != (0.0, 0.0, 1.0):
+        words += ["--card-normal", ",".join(f"{c:.6g}" for c in req.card_normal)]
+    if req.min_elevation_deg != CalibrateRequest.min_elevation_deg:
+        words += ["--min-elevation-deg", f"{req.min_elevation_deg:g}"]
+    if req.force and out_file is None:
+        words.append("--force")
+    if req.not_flat_ok or not_flat_ok:
+        words.append("--not-flat-ok")
+    return " ".join(words)
 
 
 def _without_led(req: CalibrateRequest, loaded: LoadedRig, which: str, led: int | None) -> str:
@@ -274,6 +303,17 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     # from the manifest, before any image is read: a card of other LEDs had every image read
     # (and a card with images missing was refused for them) before the refusal that mattered
     same_leds = _refuse_other_leds(req, loaded)
+    # the output too, before any image is read: a session calibrated already had every image
+    # read (minutes for a real dome's 48 full-size TIFFs) before the refusal
+    target = req.target
+    if req.out_file is None and target.exists():
+        elsewhere = file_beside(req.card_session, "-light_calibration.toml")
+        raise RtiRigError(
+            f"{shown_path(target)} exists: this card session was calibrated already (its file is "
+            "never replaced, even with --force, which replaces only a file named by --out); to "
+            f"write the calibration elsewhere: {calibrate_words(req, out_file=elsewhere)}"
+        )
+    check_output_file(target, req.force, rig_inputs(req.rig_config, loaded))
     try:
         card = read_card_session(req.card_session, rig_name=loaded.config.name)
     except CardStoppedAtLedError as exc:
@@ -285,14 +325,6 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             else "that LED"
         )
         raise RtiRigError(f"{exc}. {_without_led(req, loaded, which, exc.led)}") from None
-    target = req.target
-    if req.out_file is None and target.exists():
-        raise RtiRigError(
-            f"{shown_path(target)} exists: this card session was calibrated already (its file is "
-            "never replaced, even with --force, which replaces only a file named by --out); give "
-            "--out to write the calibration elsewhere"
-        )
-    check_output_file(target, req.force, rig_inputs(req.rig_config, loaded))
     spread = 0.0 if req.not_flat_ok else card_spread_deg(card)
     if spread > MAX_CARD_SPREAD_DEG:
         # an object's session had been "calibrated" into a correction the user was told to
@@ -301,8 +333,9 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             f"{shown_path(req.card_session)}: these images are not of a flat card: their fitted "
             f"normals spread {spread:.0f}° (90th percentile from their mean; a level card gives "
             f"about 1°, the limit is {MAX_CARD_SPREAD_DEG:g}°), so what differs between them is "
-            "the object's relief, not the LEDs. Shoot a level matte white card under every LED; "
-            "if this is one (a card large for its dome), give --not-flat-ok"
+            "the object's relief, not the LEDs. Shoot a level matte white card under every LED "
+            f"({run_words(req.rig_config, free_folder_beside(req.card_session, 'card'))}); if this "
+            f"is one (a card large for its dome): {calibrate_words(req, not_flat_ok=True)}"
         )
     try:
         cal = calibrate_dome(
