@@ -21,6 +21,10 @@ if TYPE_CHECKING:
     from rti_rig.app.usecases.calibrate import CalibrateRequest
 
 
+#: The calibration file a card session gets without ``--out`` (``CalibrateRequest.target``).
+DEFAULT_CALIBRATION_NAME = "light_calibration.toml"
+
+
 def _parse_normal(text: str) -> tuple[float, float, float]:
     """``"X,Y,Z"`` → a unit vector pointing up out of the card; a clear error otherwise."""
 
@@ -121,35 +125,38 @@ def calibrate_lights(
     # the backslash above keeps typer's rich help from reading "[dome.serial]" as markup and
     # dropping it (tests/cli/test_help_markup.py)
 
-    from rti_rig.app.usecases.calibrate import CalibrateRequest
-
-    try:
-        request = CalibrateRequest(
-            card_session,
-            rig_config,
-            out_file,
-            _parse_normal(card_normal),
-            _check_min_elevation(min_elevation_deg),
-            force,
-            not_flat_ok,
-        )
-    except RtiRigError as exc:
-        raise fail(exc) from None
-    target = request.target
-    if out_file is not None and _setting_line(target, rig_config) is None:
-        # refused before anything is measured or written: the line to paste cannot be said
-        raise fail(
-            RtiRigError(
-                f"{_not_toml_text(target, rig_config)}: give --out a file whose path from the "
-                "config's folder is UTF-8 (nothing was measured or written)"
-            )
-        )
+    # the file to write, as CalibrateRequest.target names it, known before the use case is
+    # imported: that import takes seconds on a loaded machine, and a Ctrl-C in it had said only
+    # "rti-rig: stopped (Ctrl-C)" (a SIGTERM nothing), not whether a --force'd --out was kept
+    target = out_file or card_session / DEFAULT_CALIBRATION_NAME
     before = stamp(target)  # a file there already (--force) is not one this run wrote
     reported: list[bool] = []  # set once the file is written and its report begun
     try:
         # SIGTERM as Ctrl-C: without a handler it ended the command mid-write, leaving a
         # hidden .light_calibration.toml.tmp beside the file asked for, and said nothing
         with sigterm_stops():
+            from rti_rig.app.usecases.calibrate import CalibrateRequest
+
+            try:
+                request = CalibrateRequest(
+                    card_session,
+                    rig_config,
+                    out_file,
+                    _parse_normal(card_normal),
+                    _check_min_elevation(min_elevation_deg),
+                    force,
+                    not_flat_ok,
+                )
+            except RtiRigError as exc:
+                raise fail(exc) from None
+            if out_file is not None and _setting_line(target, rig_config) is None:
+                # refused before anything is measured or written: the line cannot be said
+                raise fail(
+                    RtiRigError(
+                        f"{_not_toml_text(target, rig_config)}: give --out a file whose path "
+                        "from the config's folder is UTF-8 (nothing was measured or written)"
+                    )
+                )
             _calibrate_and_report(request, reported)
     except (KeyboardInterrupt, Terminated) as exc:
         signum = stop_signal(exc)
