@@ -200,7 +200,9 @@ class ReplayCamera:
             metadata["originals"] = [{"path": source, "name": name, "copy": True}]
             if colour is not None:  # what the recorded file says of its colours, as said
                 metadata["file_colour"] = colour.as_dict()
-                said = file_colour_notice(colour, "the replayed files")
+                said = file_colour_notice(
+                    colour, "the replayed files", bits=8 * stored.dtype.itemsize
+                )
                 notices = []
                 if converted is not None:
                     metadata["file_colour"].update(converted.record)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import struct
 import zlib
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -105,3 +106,53 @@ def png(srgb: bool = False, icc: bytes | None = None) -> bytes:
     if icc is not None:
         extra += chunk(b"iCCP", b"profile\0\0" + zlib.compress(icc))
     return data[:33] + extra + data[33:]  # after the signature (8) and IHDR (25)
+
+
+def raw_converter_tiff(path: Path, pixels: np.ndarray, colorspace: int | None = 1) -> None:
+    """A 16-bit RGB TIFF as dcraw or LibRaw's dcraw_emu writes linear output (``-4 -T -o 0``:
+    raw colour, so no ICC profile; dcraw.c ``tiff_head``: Make, Model, 300 dpi, Software, an
+    Exif IFD of ExposureTime, FNumber, ISOSpeedRatings and FocalLength) after
+    ``exiftool -tagsFromFile`` copied the camera's Exif ColorSpace (``colorspace``; None: not
+    copied) into that IFD.
+
+    tifffile writes the file (it will not write tag 34665 itself: the pointer is written under
+    a neighbouring code and renamed), and the Exif IFD is appended (TIFF 6.0, 2: an IFD is a
+    count, 12-byte entries sorted by tag, and the next IFD's offset; a RATIONAL is two LONGs
+    held beyond the IFD)."""
+    import tifffile
+
+    entries = [(33434, 5, (1, 125)), (33437, 5, (8, 1)), (34855, 3, 100), (37386, 5, (50, 1))]
+    if colorspace is not None:
+        entries.append((0xA001, 3, colorspace))
+    tifffile.imwrite(
+        path,
+        pixels,
+        photometric="rgb",
+        software="dcraw v9.28",
+        metadata=None,
+        resolution=(300, 300),
+        extratags=[
+            (271, "s", 0, "Canon", True),
+            (272, "s", 0, "Canon EOS 5D Mark III", True),
+            (34664, "I", 1, 0, True),
+        ],
+    )
+    data = bytearray(path.read_bytes())
+    assert data[:2] == b"II"
+    at = len(data) + len(data) % 2
+    rationals_at = at + 2 + 12 * len(entries) + 4
+    ifd, rationals = struct.pack("<H", len(entries)), b""
+    for tag, kind, value in entries:
+        if kind == 5:
+            ifd += struct.pack("<HHII", tag, kind, 1, rationals_at + len(rationals))
+            rationals += struct.pack("<II", *value)
+        else:
+            ifd += struct.pack("<HHIHH", tag, kind, 1, value, 0)
+    ifd += b"\0\0\0\0"
+    (first,) = struct.unpack_from("<I", data, 4)
+    (count,) = struct.unpack_from("<H", data, first)
+    for k in range(count):
+        entry = first + 2 + 12 * k
+        if struct.unpack_from("<H", data, entry)[0] == 34664:
+            struct.pack_into("<HHII", data, entry, 34665, 4, 1, at)
+    path.write_bytes(bytes(data + b"\0" * (at - len(data)) + ifd + rationals))

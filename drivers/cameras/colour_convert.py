@@ -141,13 +141,18 @@ class Converted:
 
 def needs_conversion(colour: FileColour | None, dtype: np.dtype) -> bool:
     """Whether a file of ``colour`` and ``dtype`` is converted: a known space other than sRGB,
-    or a 16-bit sRGB file whose profile is not linear (its curve undone). An 8-bit sRGB file
+    or a 16-bit sRGB file whose ICC profile says a curve that is not linear (its curve undone;
+    one said sRGB by its Exif ColorSpace alone is taken as linear, as raw converters' linear
+    TIFFs carry that tag copied from the camera:
+    :func:`~rti_rig.drivers.cameras.file_colour.exif_only_16_bit_notice`). An 8-bit sRGB file
     keeps its readers' own sRGB tables (the same curve); an unknown or unsaid space is left.
     Only 8- and 16-bit values are: a float or 32-bit file goes on to its reader's refusal of
     its pixel type (its values had indexed the curve's table: a traceback ended the run)."""
     if colour is None or colour.space not in SPACES or dtype not in (np.uint8, np.uint16):
         return False
-    return colour.space != "srgb" or (dtype == np.uint16 and not colour.linear_curve)
+    return colour.space != "srgb" or (
+        dtype == np.uint16 and not colour.linear_curve and not colour.exif_only
+    )
 
 
 def to_linear_srgb(image: NDArray, colour: FileColour, *, encoded: bool = True) -> Converted:

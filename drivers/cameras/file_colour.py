@@ -45,16 +45,22 @@ class FileColour:
     """``space``: which one; ``name``: its name (an unknown profile's own description);
     ``said_by``: where the file says it ("" when it says nothing); ``linear_curve``: its ICC
     profile's tone curve is the identity (gamma 1.0: a linear file, as a session's own linear
-    TIFFs are, whose values no curve must be undone from)."""
+    TIFFs are, whose values no curve must be undone from); ``exif_only``: only an Exif
+    ColorSpace says it (no ICC profile), a tag that names the camera's colour setting and that
+    raw converters' linear output carries when copied from the camera (dcraw/LibRaw ``-4 -T``
+    writes an Exif IFD without it; ``exiftool -tagsFromFile`` adds it), so it says nothing
+    trustworthy of a 16-bit file's curve (:func:`exif_only_16_bit_notice`)."""
 
     space: Space
     name: str
     said_by: str
     linear_curve: bool = False
+    exif_only: bool = False
 
     def as_dict(self) -> dict[str, str]:
         said = asdict(self)
         del said["linear_curve"]  # said in the conversion's record (colour_convert)
+        del said["exif_only"]  # said by said_by ("its Exif ColorSpace ...")
         return said
 
 
@@ -91,7 +97,7 @@ def file_colour(path: Path) -> FileColour:
                 space, name, f"its ICC profile {description!r}", icc_curve_is_linear(icc)
             )
     if colorspace == EXIF_SRGB:
-        return FileColour("srgb", "sRGB", "its Exif ColorSpace 1 (sRGB)")
+        return FileColour("srgb", "sRGB", "its Exif ColorSpace 1 (sRGB)", exif_only=True)
     if colorspace == EXIF_UNCALIBRATED and interop == "R03":
         return FileColour(
             "adobe_rgb",
@@ -224,11 +230,14 @@ def _tiff_tags(path: Path) -> tuple[bytes | None, int | None, str | None]:
     return icc, int(colorspace) if colorspace is not None else None, index
 
 
-def file_colour_notice(colour: FileColour, whose: str = "the camera's files") -> str | None:
+def file_colour_notice(
+    colour: FileColour, whose: str = "the camera's files", bits: int = 8
+) -> str | None:
     """The session notice for a file that is not said to be sRGB (None for sRGB): what was
-    assumed, or that the colours are another space's, recorded as such and not converted."""
+    assumed, or that the colours are another space's, recorded as such and not converted; for
+    a ``bits`` 16 file said sRGB by its Exif alone, that it was taken as linear."""
     if colour.space == "srgb":
-        return None
+        return exif_only_16_bit_notice(whose) if colour.exif_only and bits == 16 else None
     if colour.space == "untagged":
         return (
             f"{whose} say no colour space (no ICC profile, no Exif ColorSpace): "
@@ -239,4 +248,22 @@ def file_colour_notice(colour: FileColour, whose: str = "the camera's files") ->
         "does not convert them, so the session's images keep that space's primaries, read "
         "through the sRGB curve (8-bit) or as linear (16-bit), and carry no sRGB tag; the "
         "manifest's image_colour says so. For sRGB images, export or shoot sRGB"
+    )
+
+
+def exif_only_16_bit_notice(whose: str = "the camera's files") -> str:
+    """The notice for 16-bit files said to be sRGB by their Exif ColorSpace 1 alone, taken as
+    linear (their curve not undone).
+
+    Why: Exif ColorSpace (Exif 2.3, 4.6.5) names the camera's colour setting and has no value
+    for a tone curve; raw converters' linear 16-bit TIFFs carry it where it was copied from
+    the camera, while an sRGB-encoded 16-bit export from an editor embeds an ICC profile.
+    Undoing the sRGB curve of linear data had darkened its mid-tones silently; taking it as
+    linear is said here with the way to the other reading: an embedded sRGB ICC profile (which
+    rti-rig obeys, as colour-managed software does)."""
+    return (
+        f"{whose} are 16-bit and say sRGB only by their Exif ColorSpace 1 (no ICC profile), a "
+        "tag copied from the camera onto raw converters' linear output (dcraw or LibRaw -4 -T): "
+        "taken as linear, no curve undone; if they are sRGB-encoded exports, export them with "
+        "the sRGB ICC profile embedded and rti-rig undoes its curve"
     )

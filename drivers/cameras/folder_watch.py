@@ -1817,7 +1817,7 @@ class FolderWatchCamera:
             metadata.update(exposure_stats(pixels, white, s.decode.underexposed_level))
             if colour is not None:
                 metadata["file_colour"] = colour.as_dict()
-                said = file_colour_notice(colour)
+                said = file_colour_notice(colour, bits=8 * image.dtype.itemsize)
                 if converted is not None:
                     metadata["file_colour"].update(converted.record)
                     said = converted_notice(colour) if colour.space != "srgb" else None

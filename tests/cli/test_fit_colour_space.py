@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import tifffile
-from colour_files import icc_profile, jpeg
+from colour_files import icc_profile, jpeg, raw_converter_tiff
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -130,3 +130,29 @@ def test_a_converted_jpeg_is_not_called_a_16_bit_file_taken_as_linear(tmp_path: 
     assert "some colours of 1 of those Adobe RGB (1998) image(s) lie outside sRGB's" in said
     # converted into 16-bit linear sRGB, it is no 16-bit file whose reading is a guess
     assert "mixes" not in said, said
+
+
+def test_a_raw_converter_s_linear_tiff_with_the_camera_s_exif_srgb_is_taken_as_linear(
+    tmp_path: Path,
+) -> None:
+    """dcraw/LibRaw ``-4 -T -o 0`` output with the camera's Exif ColorSpace 1 copied in (no
+    ICC profile): the tag names the camera's setting, not the file's curve, so the values are
+    fitted as stored (as the same TIFFs without the tag are), and the notes say so and how to
+    have the sRGB curve undone instead. Its curve had been undone: mid-tones darkened."""
+
+    def tagged(path: Path, level: float) -> None:
+        raw_converter_tiff(path, np.full((16, 16, 3), round(level * 65535), np.uint16))
+
+    def bare(path: Path, level: float) -> None:
+        raw_converter_tiff(
+            path, np.full((16, 16, 3), round(level * 65535), np.uint16), colorspace=None
+        )
+
+    albedo, record, said = _fit(_acquisition(tmp_path / "a", tagged, ".tif"), tmp_path / "fa")
+    want, _, _ = _fit(_acquisition(tmp_path / "b", bare, ".tif"), tmp_path / "fb")
+    assert np.allclose(albedo, want, rtol=1e-4), (albedo[8, 8], want[8, 8])
+    step = record["image_colour"]["image01"]
+    assert step["said_by"] == "its Exif ColorSpace 1 (sRGB)", step
+    assert step["read_as"].startswith("16-bit, taken as linear"), step
+    assert "8 of 8 image(s) of" in said and "say sRGB only by their Exif ColorSpace 1" in said
+    assert "with the sRGB ICC profile embedded" in said, said

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from colour_files import exif_colour, icc_profile, jpeg
+from colour_files import exif_colour, icc_profile, jpeg, raw_converter_tiff
 from conftest import folder_watch_config, tethered_run
 
 pytestmark = [
@@ -100,6 +100,29 @@ def test_a_prophoto_16_bit_tiff_is_made_linear_srgb(tmp_path, monkeypatch):
     pixels = tifffile.imread(out / step["linear_image"])
     want = (20000 / 65535) ** 1.8 * 65535
     assert np.allclose(pixels, want, atol=2), (pixels[0, 0], want)
+
+
+def test_a_raw_converter_s_linear_tiff_with_the_camera_s_exif_srgb_is_kept_linear(
+    tmp_path, monkeypatch
+):
+    """dcraw/LibRaw ``-4 -T -o 0`` output with the camera's Exif ColorSpace 1 copied in and
+    no ICC profile (colour_files.raw_converter_tiff): recorded as stored, and the run says it
+    took them as linear and how to have them read as sRGB-encoded; its grey 20000 had been
+    made 3004 by the sRGB curve, unsaid."""
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0, tiffs=True)
+    raw_converter_tiff(tmp_path / "dcraw.tif", np.full((32, 32, 3), 20000, np.uint16))
+    files = [(f"IMG_{k:04d}.tif", (tmp_path / "dcraw.tif").read_bytes()) for k in (1, 2)]
+    out = tmp_path / "s"
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, files, out)
+    assert r.exit_code == 0 and "Traceback" not in said and not lit_at_end, said
+    step = json.loads((out / "manifest.json").read_text())["steps"][0]
+    assert step["file_colour"]["said_by"] == "its Exif ColorSpace 1 (sRGB)", step
+    assert "curve_undone" not in step["file_colour"], step
+    assert (tifffile.imread(out / step["linear_image"]) == 20000).all()
+    assert "say sRGB only by their Exif ColorSpace 1 (no ICC profile)" in said, said
+    assert "taken as linear, no curve undone" in said, said
 
 
 def test_a_float_tiff_in_a_known_space_is_refused_by_its_pixel_type(tmp_path, monkeypatch):

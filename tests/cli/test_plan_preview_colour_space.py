@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from colour_files import icc_profile
+from colour_files import icc_profile, raw_converter_tiff
 from conftest import planned_preview
 
 
@@ -85,3 +85,18 @@ def test_a_preview_is_read_through_its_own_colour_space(tmp_path, make, words) -
     assert abs(as_untagged[1] - want[1]) > 3 or abs(as_untagged[2] - want[2]) > 3, as_untagged
     assert np.allclose(got, want, atol=0.3), (got, want)
     assert f"preview {tagged} {words}: its brightness is read in linear sRGB" in said, said
+
+
+def test_a_linear_preview_with_the_camera_s_exif_srgb_is_read_as_linear(tmp_path) -> None:
+    """A raw converter's linear TIFF carrying the camera's Exif ColorSpace 1 and no ICC
+    profile (colour_files.raw_converter_tiff) plans as the same pixels without the tag do, and
+    the plan says how it read it; its sRGB curve had been undone, the sphere's shading
+    darkened."""
+    codes = np.round(_sphere() * 65535).astype(np.uint16)
+    tagged, bare = tmp_path / "dcraw.tif", tmp_path / "bare.tif"
+    raw_converter_tiff(tagged, codes)
+    raw_converter_tiff(bare, codes, colorspace=None)
+    got, said = _plan(tagged)
+    want, _ = _plan(bare)
+    assert np.allclose(got, want, atol=0.05), (got, want)
+    assert f"preview {tagged} is 16-bit and says sRGB only by its Exif ColorSpace 1" in said

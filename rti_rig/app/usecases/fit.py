@@ -21,7 +21,7 @@ import os
 import threading
 import time
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Collection, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -74,7 +74,11 @@ from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.drivers.cameras.colour_convert import needs_conversion, to_linear_srgb
-from rti_rig.drivers.cameras.file_colour import FileColour, file_colour
+from rti_rig.drivers.cameras.file_colour import (
+    FileColour,
+    exif_only_16_bit_notice,
+    file_colour,
+)
 from rti_rig.reconstruct import exporters, signal_check
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.qa import ImageCheck, QAReport, assess
@@ -764,7 +768,8 @@ def load_acquisition(
         for i, (colour, record) in sorted(said.items()):
             colours[names[i]] = record or {**colour.as_dict(), "read_as": _read_as(frames[i])}
     if notes is not None:
-        notes.extend(colour_notes(lp, said, len(paths)))
+        sixteen = {i for i in said if not _stored_8_bit(frames[i])}
+        notes.extend(colour_notes(lp, said, len(paths), sixteen))
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
         raise FitInputError(f"images of {shown_path(lp)} differ in shape: {sorted(shapes)}")
@@ -793,16 +798,25 @@ def _read_as(frame: Any) -> str:
 
 
 def colour_notes(
-    lp: Path, said: dict[int, tuple[FileColour, dict[str, str] | None]], n: int
+    lp: Path,
+    said: dict[int, tuple[FileColour, dict[str, str] | None]],
+    n: int,
+    sixteen: Collection[int] = (),
 ) -> list[str]:
     """What the fit says of the files' colour spaces: the images converted to linear sRGB
-    (by space), those whose colours sRGB cannot show (clipped, counted), and those of a space
-    rti-rig does not know (fitted as they are); nothing of sRGB or untagged files, read as
-    the fit always read them. Why: an acquisition's 8-bit files were taken as sRGB and
+    (by space), those whose colours sRGB cannot show (clipped, counted), those of a space
+    rti-rig does not know (fitted as they are), and the 16-bit ones (indices ``sixteen``)
+    said sRGB by their Exif alone (taken as linear); nothing of other sRGB or untagged files,
+    read as the fit always read them. Why: an acquisition's 8-bit files were taken as sRGB and
     16-bit ones as linear whatever the file said, an Adobe RGB JPEG or a ProPhoto TIFF
     (Lightroom's default export) fitted with another space's curve and primaries, silently,
     where a session of the same files converts them and says so."""
     by_name: dict[str, tuple[FileColour, list[int], int]] = {}
+    exif_linear = [
+        i
+        for i, (c, r) in said.items()
+        if r is None and c.exif_only and c.space == "srgb" and i in sixteen
+    ]
     for i, (colour, record) in sorted(said.items()):
         if record is None and colour.space != "other":
             continue
@@ -831,6 +845,10 @@ def colour_notes(
                 "gamut and were clipped to it for the fit (fit.json's image_colour counts "
                 "the pixels of each)"
             )
+    if exif_linear:
+        notes.append(
+            exif_only_16_bit_notice(f"{len(exif_linear)} of {n} image(s) of {shown_path(lp)}")
+        )
     return notes
 
 

@@ -322,6 +322,12 @@ def preview_in_its_space(path: Path, image: np.ndarray) -> tuple[np.ndarray, str
             "rti-rig does not convert: its brightness is read as if sRGB (8-bit through the "
             "sRGB curve, 16-bit as linear); for a plan from its true shading, export it as sRGB"
         )
+    if colour.space == "srgb" and colour.exif_only and image.dtype == np.uint16:
+        return image, (  # (needs_conversion's rule: an Exif tag copied from the camera)
+            f"preview {shown_path(path)} is 16-bit and says sRGB only by its Exif ColorSpace 1 "
+            "(no ICC profile): its brightness is read as linear, no curve undone; if it is an "
+            "sRGB-encoded export, export it with the sRGB ICC profile embedded"
+        )
     if not needs_conversion(colour, image.dtype):
         return image, None
     converted = to_linear_srgb(image, colour)
