@@ -144,15 +144,20 @@ def needs_conversion(colour: FileColour | None, dtype: np.dtype) -> bool:
     or a 16-bit sRGB file whose ICC profile says a curve that is not linear (its curve undone;
     one said sRGB by its Exif ColorSpace alone is taken as linear, as raw converters' linear
     TIFFs carry that tag copied from the camera:
-    :func:`~rti_rig.drivers.cameras.file_colour.exif_only_16_bit_notice`). An 8-bit sRGB file
-    keeps its readers' own sRGB tables (the same curve); an unknown or unsaid space is left.
+    :func:`~rti_rig.drivers.cameras.file_colour.exif_only_16_bit_notice`), or an 8-bit sRGB
+    file whose ICC profile's curve is linear (taken as linear, as the profile says, whatever
+    ``eight_bit_response`` says: it had been read through the sRGB table). Any other 8-bit
+    sRGB file keeps its readers' own sRGB tables (the same curve); an unknown or unsaid space
+    is left.
     Only 8- and 16-bit values are: a float or 32-bit file goes on to its reader's refusal of
     its pixel type (its values had indexed the curve's table: a traceback ended the run)."""
     if colour is None or colour.space not in SPACES or dtype not in (np.uint8, np.uint16):
         return False
-    return colour.space != "srgb" or (
-        dtype == np.uint16 and not colour.linear_curve and not colour.exif_only
-    )
+    if colour.space != "srgb":
+        return True
+    if dtype == np.uint8:  # its ICC profile's linear curve wins over the sRGB table
+        return colour.linear_curve
+    return not colour.linear_curve and not colour.exif_only
 
 
 def to_linear_srgb(image: NDArray, colour: FileColour, *, encoded: bool = True) -> Converted:

@@ -1770,7 +1770,13 @@ class FolderWatchCamera:
             metadata: dict[str, Any] = dict(decoded.metadata)
         else:
             image = read_image_file(path, self.name)
-            if image.dtype == np.uint8 and s.eight_bit_response == "refuse":
+            # an 8-bit file whose ICC profile says a linear curve is linear data, as it says
+            # (it had been refused as gamma-encoded, or read through the sRGB table)
+            if (
+                image.dtype == np.uint8
+                and s.eight_bit_response == "refuse"
+                and not file_colour(path).linear_curve
+            ):
                 raw = [x for x in s.patterns if Path(x).suffix.lower() in RAW_SUFFIXES]
                 # patterns matching RAWs too: a camera saving RAW+JPEG whose JPEG came first
                 # and was whole before its RAW appeared (being told to "save RAW" it already

@@ -269,7 +269,8 @@ class FolderWatchSettings(_Strict):
         "refuse",
         description="8-bit files (JPEG, PNG) are gamma-encoded: refuse them, or "
         "linearise with the curve the file says (the sRGB curve, or Adobe RGB's or ProPhoto's "
-        "where its profile or Exif says that space), or take them as linear",
+        "where its profile or Exif says that space), or take them as linear. A file whose ICC "
+        "profile's curve is linear (gamma 1.0) is taken as linear whatever this says",
     )
     decode: RawDecodeSettings = RawDecodeSettings()
 

@@ -24,6 +24,7 @@ from colour_files import icc_profile, jpeg, raw_converter_tiff
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.core.image_colour import icc_profile as own_profile
 
 
 def _directions() -> list[tuple[float, float, float]]:
@@ -156,3 +157,22 @@ def test_a_raw_converter_s_linear_tiff_with_the_camera_s_exif_srgb_is_taken_as_l
     assert step["read_as"].startswith("16-bit, taken as linear"), step
     assert "8 of 8 image(s) of" in said and "say sRGB only by their Exif ColorSpace 1" in said
     assert "with the sRGB ICC profile embedded" in said, said
+
+
+def test_an_8_bit_tiff_whose_profile_says_linear_is_fitted_as_linear(tmp_path: Path) -> None:
+    """An 8-bit TIFF whose ICC profile's curve is gamma 1.0 (rti-rig's own linear-sRGB
+    profile) fits as the same values in 16-bit linear TIFFs do: the profile says linear, and
+    it had been read through the sRGB curve as any 8-bit file."""
+
+    def tagged(path: Path, level: float) -> None:
+        pixels = np.full((16, 16, 3), round(level * 255), np.uint8)
+        tifffile.imwrite(path, pixels, iccprofile=own_profile("linear"))
+
+    def sixteen(path: Path, level: float) -> None:
+        tifffile.imwrite(path, np.full((16, 16, 3), round(level * 255) * 257, np.uint16))
+
+    albedo, record, said = _fit(_acquisition(tmp_path / "a", tagged, ".tif"), tmp_path / "fa")
+    want, _, _ = _fit(_acquisition(tmp_path / "b", sixteen, ".tif"), tmp_path / "fb")
+    assert np.allclose(albedo, want, rtol=1e-4), (albedo[8, 8], want[8, 8])
+    assert "gamma 1.0" in record["image_colour"]["image01"]["curve_undone"], record
+    assert "took their values as linear, as its curve (gamma 1.0) says" in said, said

@@ -21,6 +21,8 @@ import tifffile
 from colour_files import exif_colour, icc_profile, jpeg, raw_converter_tiff
 from conftest import folder_watch_config, tethered_run
 
+from rti_rig.core.image_colour import icc_profile as own_profile
+
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
     pytest.mark.pty,
@@ -123,6 +125,27 @@ def test_a_raw_converter_s_linear_tiff_with_the_camera_s_exif_srgb_is_kept_linea
     assert (tifffile.imread(out / step["linear_image"]) == 20000).all()
     assert "say sRGB only by their Exif ColorSpace 1 (no ICC profile)" in said, said
     assert "taken as linear, no curve undone" in said, said
+
+
+def test_an_8_bit_tiff_whose_profile_says_linear_is_recorded_linear(tmp_path, monkeypatch):
+    """An 8-bit TIFF with a gamma-1.0 ICC profile, on the example's default
+    ``eight_bit_response = "refuse"``: its profile says linear data, so it is recorded as
+    such (grey 128 is 128 * 257); it had been refused as gamma-encoded (and with "srgb",
+    read through the sRGB curve)."""
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0, tiffs=True)
+    assert "eight_bit_response" not in cfg.read_text()
+    buffer = io.BytesIO()
+    pixels = np.full((32, 32, 3), 128, np.uint8)
+    tifffile.imwrite(buffer, pixels, iccprofile=own_profile("linear"))
+    files = [(f"IMG_{k:04d}.tif", buffer.getvalue()) for k in (1, 2)]
+    out = tmp_path / "s"
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, files, out)
+    assert r.exit_code == 0 and "Traceback" not in said and not lit_at_end, said
+    step = json.loads((out / "manifest.json").read_text())["steps"][0]
+    assert "gamma 1.0" in step["file_colour"]["curve_undone"], step
+    assert (tifffile.imread(out / step["linear_image"]) == 128 * 257).all()
 
 
 def test_a_float_tiff_in_a_known_space_is_refused_by_its_pixel_type(tmp_path, monkeypatch):

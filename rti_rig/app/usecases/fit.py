@@ -820,7 +820,9 @@ def colour_notes(
     for i, (colour, record) in sorted(said.items()):
         if record is None and colour.space != "other":
             continue
-        key = f"{colour.space} {colour.name} {colour.said_by} {record is None}"
+        key = (
+            f"{colour.space} {colour.name} {colour.said_by} {colour.linear_curve} {record is None}"
+        )
         c, images, clipped = by_name.get(key, (colour, [], 0))
         clipped_here = 0 if record is None else int(record["out_of_gamut_clipped"].split()[0])
         by_name[key] = (c, [*images, i], clipped + (clipped_here > 0))
@@ -834,10 +836,16 @@ def colour_notes(
                 "linear), their colours that space's; for a fit in sRGB, export them as sRGB"
             )
             continue
+        done = (
+            "the fit took their values as linear, as its curve (gamma 1.0) says, not through "
+            "the sRGB curve"
+            if colour.linear_curve
+            else "the fit undid its curve"
+        )
         notes.append(
-            f"{count} are {colour.name} (said by {colour.said_by}): the fit undid its curve "
-            "and converted its primaries to linear sRGB's before fitting (the files are "
-            "untouched); fit.json's image_colour says what was done to each"
+            f"{count} are {colour.name} (said by {colour.said_by}): {done} and converted its "
+            "primaries to linear sRGB's before fitting (the files are untouched); fit.json's "
+            "image_colour says what was done to each"
         )
         if clipped:
             notes.append(

@@ -331,10 +331,14 @@ def preview_in_its_space(path: Path, image: np.ndarray) -> tuple[np.ndarray, str
     if not needs_conversion(colour, image.dtype):
         return image, None
     converted = to_linear_srgb(image, colour)
+    curve = (
+        "taken as linear, as its profile's curve (gamma 1.0) says,"
+        if colour.linear_curve
+        else f"{converted.record['curve_undone']} undone"
+    )
     return converted.pixels, (
         f"preview {shown_path(path)} is {colour.name} (said by {colour.said_by}): its brightness "
-        f"is read in linear sRGB, {converted.record['curve_undone']} undone and its primaries "
-        "converted to sRGB's"
+        f"is read in linear sRGB, {curve} and its primaries converted to sRGB's"
     )
 
 
