@@ -100,3 +100,19 @@ def test_a_linear_preview_with_the_camera_s_exif_srgb_is_read_as_linear(tmp_path
     want, _ = _plan(bare)
     assert np.allclose(got, want, atol=0.05), (got, want)
     assert f"preview {tagged} is 16-bit and says sRGB only by its Exif ColorSpace 1" in said
+
+
+def test_a_preview_s_out_of_gamut_pixels_are_counted(tmp_path) -> None:
+    """An Adobe RGB preview with a square of its own pure green, which sRGB cannot show: the
+    plan says how many pixels were clipped (a session's frame's are counted: folder_watch,
+    fit); the plan had said nothing of them. A grey preview of the same space says none."""
+    codes = np.round(_sphere() ** (256 / 563) * 65535).astype(np.uint16)
+    grey = tmp_path / "grey.tif"
+    tifffile.imwrite(grey, codes, iccprofile=icc_profile("Adobe RGB (1998)"))
+    codes[:8, :8] = (0, 65535, 0)
+    green = tmp_path / "green.tif"
+    tifffile.imwrite(green, codes, iccprofile=icc_profile("Adobe RGB (1998)"))
+    _, said = _plan(green)
+    assert "its primaries converted to sRGB's; 64 of its 2304 pixels lie outside sRGB's" in said
+    _, said = _plan(grey)
+    assert "converted to sRGB's" in said and "outside sRGB's gamut" not in said, said

@@ -336,9 +336,17 @@ def preview_in_its_space(path: Path, image: np.ndarray) -> tuple[np.ndarray, str
         if colour.linear_curve
         else f"{converted.record['curve_undone']} undone"
     )
+    # its colours sRGB cannot show are clipped, and counted (as a session's frame's are,
+    # colour_convert.clipped_notice): the plan's brightness of those pixels is the clipped one
+    clipped = (
+        f"; {converted.clipped} of its {image.shape[0] * image.shape[1]} pixels lie outside "
+        "sRGB's gamut and were clipped to it"
+        if converted.clipped
+        else ""
+    )
     return converted.pixels, (
         f"preview {shown_path(path)} is {colour.name} (said by {colour.said_by}): its brightness "
-        f"is read in linear sRGB, {curve} and its primaries converted to sRGB's"
+        f"is read in linear sRGB, {curve} and its primaries converted to sRGB's{clipped}"
     )
 
 
