@@ -176,3 +176,33 @@ def test_an_8_bit_tiff_whose_profile_says_linear_is_fitted_as_linear(tmp_path: P
     assert np.allclose(albedo, want, rtol=1e-4), (albedo[8, 8], want[8, 8])
     assert "gamma 1.0" in record["image_colour"]["image01"]["curve_undone"], record
     assert "took their values as linear, as its curve (gamma 1.0) says" in said, said
+
+
+def test_each_file_s_colour_is_read_once_and_its_clipped_pixels_counted(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """Every image's colour space is read from its file once, converted or not (an image read
+    as before had been read twice), and the note counts the converted images with clipped
+    pixels from the conversion's own count (it had parsed fit.json's words back)."""
+    import rti_rig.app.usecases.fit as fit
+    from rti_rig.drivers.cameras.file_colour import FileColour, file_colour
+
+    reads: list[str] = []
+
+    def counted(path: Path) -> FileColour:
+        reads.append(Path(path).name)
+        return file_colour(path)
+
+    monkeypatch.setattr(fit, "file_colour", counted)
+    profile = icc_profile("Adobe RGB (1998)")
+
+    def mixed(path: Path, level: float) -> None:  # two Adobe RGB JPEGs with green, six plain
+        rgb = np.full((16, 16, 3), round(level * 200), np.uint8)
+        tagged = path.stem in ("image07", "image08")
+        if tagged:
+            rgb[:4, :4] = (0, 200, 0)  # Adobe RGB's green: outside sRGB's gamut
+        path.write_bytes(jpeg(rgb=rgb, icc=profile if tagged else None))
+
+    _, _, said = _fit(_acquisition(tmp_path / "a", mixed, ".jpg"), tmp_path / "fa")
+    assert sorted(reads) == [f"image{k:02d}.jpg" for k in range(1, 9)], reads
+    assert "some colours of 2 of those Adobe RGB (1998) image(s) lie outside sRGB's" in said

@@ -235,16 +235,37 @@ def read_image(path: Path) -> Any:
 _COLOUR_ROWS = 256
 
 
+@dataclass(frozen=True)
+class SaidColour:
+    """What a colour image's file said of its colours and what the fit did: ``record`` is
+    the conversion's (fit.json's ``image_colour``; None where the file was read as before)
+    and ``clipped`` its out-of-gamut pixels, the number itself (:func:`colour_notes` had
+    parsed it back out of the record's words)."""
+
+    colour: FileColour
+    record: dict[str, str] | None = None
+    clipped: int = 0
+
+
+def _colour_of(path: Path, shape: tuple[int, ...]) -> FileColour | None:
+    """What ``path`` says of its colours, read once; None for a grey file (no primaries)."""
+    return file_colour(path) if len(shape) == 3 else None
+
+
+def _converts(colour: FileColour | None, shape: tuple[int, ...], dtype: Any) -> bool:
+    """Whether pixels of ``colour`` are converted to linear sRGB (a known space other than
+    sRGB, or 16-bit sRGB-encoded: :func:`needs_conversion`, the rule of the watched folder
+    and the replay); not where they are read as before (8-bit sRGB or untagged through the
+    sRGB table, 16-bit linear as they are, an unknown space as it is, said by
+    :func:`colour_notes`)."""
+    return colour is not None and shape[2] == 3 and needs_conversion(colour, np.dtype(dtype))
+
+
 def _colour_to_convert(path: Path, shape: tuple[int, ...], dtype: Any) -> FileColour | None:
-    """What ``path`` says of its colours where its pixels are converted to linear sRGB (a
-    known space other than sRGB, or 16-bit sRGB-encoded: :func:`needs_conversion`, the rule
-    of the watched folder and the replay); None where they are read as before (8-bit sRGB
-    or untagged through the sRGB table, 16-bit linear as they are, an unknown space as it
-    is, said by :func:`colour_notes`). Grey files have no primaries to convert."""
-    if len(shape) != 3 or shape[2] != 3:
-        return None
-    colour = file_colour(path)
-    return colour if needs_conversion(colour, np.dtype(dtype)) else None
+    """What ``path`` says of its colours where its pixels are converted (:func:`_converts`),
+    else None."""
+    colour = _colour_of(path, shape)
+    return colour if _converts(colour, shape, dtype) else None
 
 
 def _convert_into(
@@ -271,13 +292,14 @@ def _convert_into(
     return record, clipped
 
 
-def _converted_rows(source: Any, colour: FileColour, name: str) -> tuple[RawRows, dict[str, str]]:
+def _converted_rows(source: Any, colour: FileColour, name: str) -> tuple[RawRows, SaidColour]:
     """``source`` converted to linear sRGB into a temporary file of its own, read back by
-    rows (:func:`_decoded_rows`'s way), and the conversion's record."""
+    rows (:func:`_decoded_rows`'s way), and what was done."""
     store = DecodedStore()
-    record, _ = _convert_into(source, colour, store.fileno(), 0)
+    record, clipped = _convert_into(source, colour, store.fileno(), 0)
     shape = (source.shape[0], source.shape[1], 3)
-    return RawRows(store, 0, shape, np.dtype(np.uint16), None, name=name), record
+    rows = RawRows(store, 0, shape, np.dtype(np.uint16), None, name=name)
+    return rows, SaidColour(colour, record, clipped)
 
 
 def _check_tiff_type(path: Path, rows: TiffRows) -> None:
@@ -346,7 +368,7 @@ _SRGB_TO_LINEAR16 = _srgb_to_linear16(np.arange(256, dtype=np.uint8))
 def _open_frames(
     paths: list[Path],
     label: str,
-    said: dict[int, tuple[FileColour, dict[str, str] | None]] | None = None,
+    said: dict[int, SaidColour] | None = None,
 ) -> list[Any]:
     """Row-readable frames (uint16 linear) of ``paths``, each decoded at most once.
 
@@ -357,8 +379,8 @@ def _open_frames(
     nothing holds the acquisition in memory. 8-bit images are kept 8-bit there and linearised
     on read. A colour image whose file says a space other than sRGB (or a 16-bit sRGB-encoded
     one) is converted to linear sRGB a band of rows at a time as it is stored
-    (:func:`_convert_into`); ``said`` gets each colour image's :class:`FileColour` and the
-    conversion's record (None where it was read as before), by index.
+    (:func:`_convert_into`); ``said`` gets each colour image's :class:`SaidColour`, by index
+    (its file's colour read once).
     """
     frames: list[Any] = [None] * len(paths)
     pending = []
@@ -371,14 +393,15 @@ def _open_frames(
         if path.suffix.lower() in (".tif", ".tiff"):
             rows = TiffRows(path)
             _check_tiff_type(path, rows)
-            colour = _colour_to_convert(path, rows.shape, rows.dtype)
-            if colour is not None:  # read a band at a time, converted, never whole
-                frames[i], record = _converted_rows(rows, colour, str(path))
+            colour = _colour_of(path, rows.shape)
+            if colour is not None and _converts(colour, rows.shape, rows.dtype):
+                # read a band at a time, converted, never whole
+                frames[i], done = _converted_rows(rows, colour, str(path))
                 if said is not None:
-                    said[i] = (colour, record)
+                    said[i] = done
                 continue
-            if said is not None and rows.ndim == 3:
-                said[i] = (file_colour(path), None)
+            if said is not None and colour is not None:
+                said[i] = SaidColour(colour)
             if rows.dtype == np.uint16 and rows.reads_in_place:
                 frames[i] = rows
                 continue
@@ -421,17 +444,17 @@ def _open_frames(
                 f"but {paths[i].name} is {_layout_words(img.shape)}; an acquisition has one "
                 "image size and kind (replace those images, or list only the others)"
             )
-        colour = _colour_to_convert(paths[i], img.shape, img.dtype)
-        if colour is not None:
+        colour = _colour_of(paths[i], img.shape)
+        if colour is not None and _converts(colour, img.shape, img.dtype):
             # converted a band at a time into the 16-bit store: linear sRGB, no table on read
             store, offset = place_bytes(np.dtype(np.uint16), img.shape[0] * img.shape[1] * 6)
-            record, _ = _convert_into(img, colour, store.fileno(), offset)
+            record, clipped = _convert_into(img, colour, store.fileno(), offset)
             frames[i] = RawRows(store, offset, img.shape, np.dtype(np.uint16), name=str(paths[i]))
             if said is not None:
-                said[i] = (colour, record)
+                said[i] = SaidColour(colour, record, clipped)
             return
-        if said is not None and img.ndim == 3:
-            said[i] = (file_colour(paths[i]), None)
+        if said is not None and colour is not None:
+            said[i] = SaidColour(colour)
         store, offset = place(img)
         os.pwrite(store.fileno(), memoryview(img.reshape(-1).view(np.uint8)), offset)
         lut = _SRGB_TO_LINEAR16 if img.dtype == np.uint8 else None
@@ -762,11 +785,14 @@ def load_acquisition(
     spaces, are appended to ``notes``; ``colours`` gets each colour image's record by name
     (fit.json's ``image_colour``)."""
     lp, lights, paths, names = acquisition_files(source, notes)
-    said: dict[int, tuple[FileColour, dict[str, str] | None]] = {}
+    said: dict[int, SaidColour] = {}
     frames = _open_frames(paths, str(lp), said)
     if colours is not None:
-        for i, (colour, record) in sorted(said.items()):
-            colours[names[i]] = record or {**colour.as_dict(), "read_as": _read_as(frames[i])}
+        for i, done in sorted(said.items()):
+            colours[names[i]] = done.record or {
+                **done.colour.as_dict(),
+                "read_as": _read_as(frames[i]),
+            }
     if notes is not None:
         sixteen = {i for i in said if not _stored_8_bit(frames[i])}
         notes.extend(colour_notes(lp, said, len(paths), sixteen))
@@ -776,7 +802,7 @@ def load_acquisition(
     if notes is not None and not any(p.parent.name == "linear" for p in paths):
         # (a session's linear/ with stand-ins is said by acquisition_files); a converted
         # file's reading is its own file's, said by colour_notes, neither of the two guesses
-        guessed = [i for i in range(len(paths)) if said.get(i, (None, None))[1] is None]
+        guessed = [i for i in range(len(paths)) if (i not in said or said[i].record is None)]
         notes.extend(
             _mixed_depth_note(lp, [frames[i] for i in guessed], [paths[i] for i in guessed])
         )
@@ -799,7 +825,7 @@ def _read_as(frame: Any) -> str:
 
 def colour_notes(
     lp: Path,
-    said: dict[int, tuple[FileColour, dict[str, str] | None]],
+    said: dict[int, SaidColour],
     n: int,
     sixteen: Collection[int] = (),
 ) -> list[str]:
@@ -814,18 +840,18 @@ def colour_notes(
     by_name: dict[str, tuple[FileColour, list[int], int]] = {}
     exif_linear = [
         i
-        for i, (c, r) in said.items()
-        if r is None and c.exif_only and c.space == "srgb" and i in sixteen
+        for i, d in said.items()
+        if d.record is None and d.colour.exif_only and d.colour.space == "srgb" and i in sixteen
     ]
-    for i, (colour, record) in sorted(said.items()):
+    for i, done in sorted(said.items()):
+        colour, record = done.colour, done.record
         if record is None and colour.space != "other":
             continue
         key = (
             f"{colour.space} {colour.name} {colour.said_by} {colour.linear_curve} {record is None}"
         )
         c, images, clipped = by_name.get(key, (colour, [], 0))
-        clipped_here = 0 if record is None else int(record["out_of_gamut_clipped"].split()[0])
-        by_name[key] = (c, [*images, i], clipped + (clipped_here > 0))
+        by_name[key] = (c, [*images, i], clipped + (done.clipped > 0))
     notes = []
     for key, (colour, images, clipped) in by_name.items():
         count = f"{len(images)} of {n} image(s) of {shown_path(lp)}"
