@@ -245,6 +245,13 @@ def mixed_depth_note(lp_path: Path, names: Sequence[str], paths: Sequence[Path],
     depths = [header_bit_depth(p) for p in paths]
     eight = [n for n, d in zip(names, depths, strict=True) if d == 8]
     sixteen = [n for n, d in zip(names, depths, strict=True) if d == 16]
+    return mixed_depth_words(lp_path, eight, sixteen, use)
+
+
+def mixed_depth_words(lp_path: Path, eight: Sequence[str], sixteen: Sequence[str], use: str) -> str:
+    """The words of :func:`mixed_depth_note` for the images named ``eight`` (8-bit) and
+    ``sixteen`` (16-bit); "" unless both are some. ``fit``, which knows each image's depth
+    from its frames, says it in these words too (one wording, one place)."""
     if not eight or not sixteen:
         return ""
     shown = ", ".join(sixteen[:3]) + (" ..." if len(sixteen) > 3 else "")

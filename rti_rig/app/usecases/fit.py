@@ -45,7 +45,7 @@ from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.app.usecases.fit_signal import no_signal_warning
 from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core import opencv_files
-from rti_rig.core.acquisition_images import check_image_files
+from rti_rig.core.acquisition_images import check_image_files, mixed_depth_words
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, PHOTOMETRIC_STEREO, AutoFit, auto_models
 from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation, png_alpha_note
@@ -890,17 +890,12 @@ def _mixed_depth_note(lp: Path, frames: list[Any], paths: list[Path]) -> list[st
     """A note when an acquisition mixes 8-bit images (decoded as sRGB) with 16-bit ones (taken
     as linear, as sessions write them): one 16-bit export that is gamma-encoded, not linear,
     beside JPEGs would be fitted several times too bright in its mid-tones, silently. Both
-    readings are the documented ones, so the files are fitted; the user is told to check."""
+    readings are the documented ones, so the files are fitted; the user is told to check, in
+    the words replay and check use (:func:`mixed_depth_words`)."""
     eight = [p.name for f, p in zip(frames, paths, strict=True) if _stored_8_bit(f)]
-    if not eight or len(eight) == len(paths):
-        return []
     sixteen = [p.name for f, p in zip(frames, paths, strict=True) if not _stored_8_bit(f)]
-    shown = ", ".join(sixteen[:3]) + (" ..." if len(sixteen) > 3 else "")
-    return [
-        f"{shown_path(lp)} mixes {len(eight)} 8-bit image(s), decoded as sRGB, with {len(sixteen)} "
-        f"16-bit one(s), taken as linear ({shown}): if the 16-bit files are gamma-encoded exports, "
-        "not linear data, they are fitted wrongly; export every image of the acquisition alike"
-    ]
+    note = mixed_depth_words(lp, eight, sixteen, "fitted")
+    return [note] if note else []
 
 
 def _stored_8_bit(frame: Any) -> bool:
