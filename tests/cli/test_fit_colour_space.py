@@ -19,6 +19,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+import pytest
 import tifffile
 from colour_files import icc_profile, jpeg, raw_converter_tiff
 from typer.testing import CliRunner
@@ -49,9 +50,11 @@ def _acquisition(folder: Path, write: Callable[[Path, float], None], suffix: str
     return folder / "dirs.lp"
 
 
-def _fit(lp: Path, out: Path) -> tuple[np.ndarray, dict, str]:
+def _fit(lp: Path, out: Path, *extra: str) -> tuple[np.ndarray, dict, str]:
     r = CliRunner().invoke(
-        app, ["fit", str(lp), "--out", str(out), "--no-qa", "--model", "ps"], terminal_width=400
+        app,
+        ["fit", str(lp), "--out", str(out), "--no-qa", "--model", "ps", *extra],
+        terminal_width=400,
     )
     said = " ".join(r.output.split())
     assert r.exit_code == 0 and "Traceback" not in said, said
@@ -206,3 +209,29 @@ def test_each_file_s_colour_is_read_once_and_its_clipped_pixels_counted(
     _, _, said = _fit(_acquisition(tmp_path / "a", mixed, ".jpg"), tmp_path / "fa")
     assert sorted(reads) == [f"image{k:02d}.jpg" for k in range(1, 9)], reads
     assert "some colours of 2 of those Adobe RGB (1998) image(s) lie outside sRGB's" in said
+
+
+@pytest.mark.parametrize("suffix", [".tif", ".jpg"])
+def test_the_dask_fit_converts_as_the_plain_fit_does(tmp_path: Path, suffix: str) -> None:
+    """``--scheduler threads`` reads its bands through the lazy stack's own reader
+    (fit.read_image, in Dask's local threads), not the plain fit's: a ProPhoto TIFF (read in
+    place by rows) and an Adobe RGB JPEG (decoded) with out-of-gamut green are converted there
+    too, to the same albedo bytes as the plain fit's."""
+    space = "ProPhoto RGB" if suffix == ".tif" else "Adobe RGB (1998)"
+
+    def tagged(path: Path, level: float) -> None:
+        if suffix == ".tif":
+            pixels = np.full((16, 16, 3), round(level * 65535), np.uint16)
+            pixels[:4, :4] = (0, 65535, 0)
+            tifffile.imwrite(path, pixels, iccprofile=icc_profile(space))
+        else:
+            rgb = np.full((16, 16, 3), round(level * 200), np.uint8)
+            rgb[:4, :4] = (0, 200, 0)
+            path.write_bytes(jpeg(rgb=rgb, icc=icc_profile(space)))
+
+    lp = _acquisition(tmp_path / "a", tagged, suffix)
+    plain, _, _ = _fit(lp, tmp_path / "plain")
+    threads, record, said = _fit(lp, tmp_path / "threads", "--scheduler", "threads")
+    assert plain.tobytes() == threads.tobytes(), (plain[8, 8], threads[8, 8])
+    assert record["image_colour"]["image01"]["space"] != "untagged", record["image_colour"]
+    assert "converted its primaries to linear sRGB" in said, said
