@@ -18,7 +18,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import tifffile
-from colour_files import icc_profile, jpeg
+from colour_files import icc_profile, jpeg, raw_converter_tiff
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -78,3 +78,32 @@ def test_a_replay_of_adobe_rgb_jpegs_is_converted_to_linear_srgb(tmp_path: Path)
         hashlib.sha256(kept.read_bytes()).digest()
         == hashlib.sha256((acq / "image01.jpg").read_bytes()).digest()
     ), kept
+
+
+def test_a_replay_of_raw_converter_tiffs_with_the_camera_s_exif_srgb_keeps_them_linear(
+    tmp_path: Path,
+) -> None:
+    """dcraw/LibRaw ``-4 -T -o 0`` TIFFs with the camera's Exif ColorSpace 1 copied in and no
+    ICC profile (colour_files.raw_converter_tiff) replay as stored, and the run says it took
+    them as linear; their sRGB curve had been undone (grey 20000 made 3004), unsaid."""
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lines = []
+    for k in range(8):
+        name = f"image{k + 1:02d}.tif"
+        raw_converter_tiff(acq / name, np.full((16, 16, 3), 20000 + 1000 * k, np.uint16))
+        a = 2 * math.pi * k / 8
+        r = math.sqrt(0.5)
+        lines.append(f"{name} {r * math.cos(a):.6f} {r * math.sin(a):.6f} {r:.6f}")
+    (acq / "dirs.lp").write_text(f"{len(lines)}\n" + "\n".join(lines) + "\n")
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--no-verdict"], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    step = json.loads((out / "manifest.json").read_text())["steps"][0]
+    assert step["file_colour"]["said_by"] == "its Exif ColorSpace 1 (sRGB)", step
+    linear = tifffile.imread(out / step["linear_image"])
+    assert (linear == linear[0, 0, 0]).all() and linear[0, 0, 0] in range(20000, 27001, 1000)
+    assert "the replayed files are 16-bit and say sRGB only by their Exif ColorSpace 1" in said
