@@ -110,7 +110,7 @@ def test_a_raw_converter_s_linear_tiff_with_the_camera_s_exif_srgb_is_kept_linea
     """dcraw/LibRaw ``-4 -T -o 0`` output with the camera's Exif ColorSpace 1 copied in and
     no ICC profile (colour_files.raw_converter_tiff): recorded as stored, and the run says it
     took them as linear and how to have them read as sRGB-encoded; its grey 20000 had been
-    made 3004 by the sRGB curve, unsaid."""
+    made 4970 by the sRGB curve, unsaid."""
     tether = tmp_path / "tether"
     tether.mkdir()
     cfg = folder_watch_config(tmp_path, tether, timeout_s=4.0, tiffs=True)

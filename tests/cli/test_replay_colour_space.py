@@ -85,7 +85,7 @@ def test_a_replay_of_raw_converter_tiffs_with_the_camera_s_exif_srgb_keeps_them_
 ) -> None:
     """dcraw/LibRaw ``-4 -T -o 0`` TIFFs with the camera's Exif ColorSpace 1 copied in and no
     ICC profile (colour_files.raw_converter_tiff) replay as stored, and the run says it took
-    them as linear; their sRGB curve had been undone (grey 20000 made 3004), unsaid."""
+    them as linear; their sRGB curve had been undone (grey 20000 made 4970), unsaid."""
     acq = tmp_path / "acq"
     acq.mkdir()
     lines = []
