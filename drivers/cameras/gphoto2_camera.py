@@ -297,6 +297,8 @@ class Gphoto2Camera:
         hint = GP_ERROR_HINTS.get(code, "see `gphoto2 --debug` output")
         if command == "capture":
             hint = self._capture_advice(code, hint)
+        elif code == -53:
+            hint = self._claimed_advice("so rti-rig could not open it")
         over = f" over {waited_s:g} s" if waited_s else ""
         if waited_s and spent_s is not None and spent_s > waited_s + 1.0:
             over = f" over {spent_s:.0f} s ({waited_s:g} s of them the waits between tries)"
@@ -317,6 +319,23 @@ class Gphoto2Camera:
         """The camera as a user finds it: its config name, model and USB port."""
         said = [w for w in (self.camera_model, self.camera_port) if w]
         return f"{self.name} ({' on '.join(said)})" if said else self.name
+
+    def _claimed_advice(self, consequence: str) -> str:
+        """What GP_ERROR_IO_USB_CLAIM (-53) means and what to do, naming the camera.
+
+        Why: libgphoto2 claims the camera's USB interface when the camera is opened
+        (``gp_camera_init``), so a desktop's gvfs that mounted the camera as it was plugged
+        in refuses ``rti-rig run`` there, before any shot (gphoto2 #181, libgphoto2 #617:
+        ``gio mount -s gphoto2``, then replug). That refusal had said only "stop that program
+        or unmount the camera", naming neither the camera nor the program nor a command; the
+        capture's own refusal already said them."""
+        return (
+            f"the USB device of {self._device()} is claimed by another program (on desktops "
+            "gvfs-gphoto2-volume-monitor or a file manager mounts a camera as it is plugged "
+            f"in), {consequence}. Unmount the camera in the file manager or stop that program "
+            "(`gio mount -s gphoto2`; `systemctl --user stop gvfs-gphoto2-volume-monitor` "
+            "until the next login), then check that `gphoto2 --auto-detect` lists it"
+        )
 
     def _capture_advice(self, code: int | None, hint: str) -> str:
         """What a capture that failed for good means, per libgphoto2 code: whether the camera
@@ -346,13 +365,8 @@ class Gphoto2Camera:
                 "(rti-rig never records it)"
             )
         if code == -53:
-            return (
-                f"the USB device of {device} is claimed by another program (on desktops "
-                "gvfs-gphoto2-volume-monitor or a file manager mounts a camera as it is "
-                "plugged in), so the capture never reached the camera: no picture was taken. "
-                "Unmount the camera in the file manager or stop that program (`gio mount -s "
-                "gphoto2`; `systemctl --user stop gvfs-gphoto2-volume-monitor` until the next "
-                "login), then check that `gphoto2 --auto-detect` lists it"
+            return self._claimed_advice(
+                "so the capture never reached the camera: no picture was taken"
             )
         if code == -110:
             return (
@@ -413,10 +427,11 @@ class Gphoto2Camera:
             abilities.load()
             cam.set_port_info(ports[ports.lookup_path(port)])
             cam.set_abilities(abilities[abilities.lookup_model(model)])
-        self._call("init", cam.init, DeviceError)
-        self._cam = cam
+        # named before init: its refusals (-53, the USB device claimed) say which camera
         self.camera_model = model
         self.camera_port = port
+        self._call("init", cam.init, DeviceError)
+        self._cam = cam
         try:
             self._configure()
         except BaseException:

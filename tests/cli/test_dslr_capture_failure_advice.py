@@ -88,3 +88,26 @@ def test_a_failed_capture_of_a_camera_left_at_its_own_target_names_no_place_as_k
     assert "a picture taken is on the camera's card" not in said, said
     assert "it cannot be recovered" not in said, said
     assert "where the camera's own capture target puts it" in said, said
+
+
+def test_a_camera_claimed_by_gvfs_when_it_is_opened_is_named_with_the_commands_that_free_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """GP_ERROR_IO_USB_CLAIM (-53) comes where libgphoto2 claims the USB interface, as the
+    camera is opened (``gp_camera_init``): a desktop's gvfs that mounted it refuses the run
+    there, before any shot (gphoto2 #181, libgphoto2 #617). That refusal had said only "the
+    USB device is claimed by another program …: stop that program or unmount the camera",
+    naming neither the camera nor a command that frees it."""
+    cfg = _config(tmp_path, "Memory card")
+    body = Body(render=_raw, failures={"init": [-53]})
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "2"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert body.shots == 0 and "Nothing was captured" in said, said
+    assert "gphoto2 error -53" in said, said
+    assert "the USB device of dslr (Canon EOS 600D on usb:001,005) is claimed" in said, said
+    assert "so rti-rig could not open it" in said and "no picture was taken" not in said, said
+    assert "`gio mount -s gphoto2`" in said, said
+    assert "`systemctl --user stop gvfs-gphoto2-volume-monitor`" in said, said
