@@ -231,6 +231,8 @@ class Gphoto2Camera:
         #: whether the shot ``_fire`` took last came after busy answers (a picture may have
         #: been taken behind one and never announced: ``collect`` then lists the card folder)
         self._fired_after_busy = False
+        #: the busy answers the last shot ``_fire`` took came after (said in its notices)
+        self._busy_tries_of_shot = 0
         #: card folder → the names listed there after the last shot in it (what was on the
         #: card before any busy spell that follows): listed once per folder, then again only
         #: after a busy spell, so a body that is never busy costs one listing a session
@@ -319,6 +321,25 @@ class Gphoto2Camera:
         """The camera as a user finds it: its config name, model and USB port."""
         said = [w for w in (self.camera_model, self.camera_port) if w]
         return f"{self.name} ({' on '.join(said)})" if said else self.name
+
+    def _busy_retried_notice(self) -> str:
+        """The notice of a shot taken only after the camera answered busy and was tried again.
+
+        Why: a body busy writing its previous file to a slow card (or whose autofocus hunts)
+        was retried and its shot taken, and the run said nothing of it: the waits lengthen
+        every step, and a user whose body is busy at most shots is never told why the session
+        runs slow, nor how close it came to ``busy_retries``. One wording for every shot, so
+        the session's notice counts the shots it concerns (the journal's step notices say
+        which)."""
+        s = self.settings
+        return (
+            f"{self._device()} answered busy (gphoto2 error -110, PTP Device Busy: still "
+            "writing a previous file, or its autofocus searching) and was tried again until it "
+            f"took the shot, at most busy_retries = {s.busy_retries} tries a shot spaced "
+            f"{s.retry_delay_s:g} s to {s.retry_max_delay_s:g} s apart: the waits lengthen the "
+            "session; a faster card, capture_target = 'Internal RAM' or manual focus shortens "
+            "them"
+        )
 
     def _claimed_advice(self, consequence: str) -> str:
         """What GP_ERROR_IO_USB_CLAIM (-53) means and what to do, naming the camera.
@@ -703,6 +724,7 @@ class Gphoto2Camera:
             try:
                 path = cam.capture(gp.GP_CAPTURE_IMAGE)
                 self._fired_after_busy = spell.tries > 0
+                self._busy_tries_of_shot = spell.tries
                 return path
             except gp.GPhoto2Error as exc:
                 # a body may answer busy only after a pause (a Canon whose autofocus fails:
@@ -941,6 +963,8 @@ class Gphoto2Camera:
                 "aside in strays/ (the step's 'strays' in the journal), never as an image of "
                 "the session"
             )
+        if self._busy_tries_of_shot:
+            notices.append(self._busy_retried_notice())
         if s.keep_jpeg and not jpeg:
             notices.append(
                 f"keep_jpeg is set but the camera announced no JPEG within event_timeout_s = "

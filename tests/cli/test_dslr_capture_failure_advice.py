@@ -10,6 +10,7 @@ camera's card, or its RAM, which keeps it only until the next capture).
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -111,3 +112,33 @@ def test_a_camera_claimed_by_gvfs_when_it_is_opened_is_named_with_the_commands_t
     assert "so rti-rig could not open it" in said and "no picture was taken" not in said, said
     assert "`gio mount -s gphoto2`" in said, said
     assert "`systemctl --user stop gvfs-gphoto2-volume-monitor`" in said, said
+
+
+def test_a_busy_camera_retried_until_it_shot_is_said_with_the_shots_it_concerns(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A body still writing its previous file answers the next two captures busy (-110, PTP
+    Device Busy) and takes the third: the shot is taken, and the run had said nothing of the
+    retries, whose waits lengthen every step of a session on a slow card."""
+    cfg = _config(tmp_path, "Memory card")
+    _busy_retries_spaced_short(cfg)
+    body = Body(render=_raw, busy_after_shot=2)
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch,
+        cfg,
+        body,
+        ["run", str(cfg), "--out", str(out), "--lights", "3", "--no-verdict"],
+    )
+    assert r.exit_code == 0 and "Traceback" not in said and lit_at_end is None, said
+    assert body.shots == 3 and body.calls.count("capture") == 7, body.calls
+    notice = (
+        "dslr (Canon EOS 600D on usb:001,005) answered busy (gphoto2 error -110, PTP Device "
+        "Busy: still writing a previous file, or its autofocus searching) and was tried again "
+        "until it took the shot, at most busy_retries = 6 tries a shot spaced 0.01 s to 0.02 s "
+        "apart"
+    )
+    assert notice in said and "[2 of 3 images]" in said.split(notice, 1)[1], said
+    steps = [json.loads(line) for line in (out / "journal.jsonl").read_text().splitlines()]
+    said_of = [any(n.startswith(notice) for n in st.get("notices", [])) for st in steps]
+    assert said_of == [False, True, True], steps
