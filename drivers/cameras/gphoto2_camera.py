@@ -1155,7 +1155,8 @@ class Gphoto2Camera:
         if self.output_dir is None:
             fate = "it was a test shot outside any session (metering)"
         elif self.shoot_again == SHOOT_AGAIN_BY_RESUME:
-            fate = "its step is not recorded, so the resume shoots it again"
+            # not "the resume": a first shot's run keeps nothing, and is run again
+            fate = "its step is not recorded, so it is shot again when the session goes on"
         else:
             fate = "nothing of it was recorded"  # the command again: said before
         return CameraGoneError(
@@ -1171,13 +1172,19 @@ class Gphoto2Camera:
         preview again); before any session is bound (metering, a check) the command is run
         again. Why: every gone camera had been told "continue with 'rti-rig run --resume
         SESSION'", also in a preview and at a metering shot, whose run said nothing was
-        captured or written."""
+        captured or written.
+
+        Why a session's words leave the command to the run: the camera does not know whether
+        the session holds an image (a camera gone as it was opened, or at the first shot, had
+        been told "Images already taken are kept … continue with 'rti-rig run --resume
+        SESSION'" under the run's "Nothing was captured"), nor its folder as a pasteable word;
+        the run's summary, printed above the error, says both."""
         if self.output_dir is None:
             return "Reconnect it, then run the command again"
         if self.shoot_again == SHOOT_AGAIN_BY_RESUME:
             return (
-                "Images already taken are kept: reconnect it, then continue with "
-                "'rti-rig run --resume SESSION'"
+                "Reconnect it, then go on as said above: whether the session kept images, "
+                "and the command that continues it"
             )
         return f"Reconnect it, then {self.shoot_again}"
 

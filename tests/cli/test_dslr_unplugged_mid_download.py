@@ -46,7 +46,8 @@ def test_a_camera_unplugged_at_a_download_says_where_the_shot_is_and_the_resume_
     assert body.shots == 3, body.shots
     assert f"stopped answering during '{'download' if op == 'file_get' else op}'" in said, said
     assert "This shot was taken but its file" in said and "IMG_0003.CR2" in said, said
-    assert "the resume shoots it again" in said and "rti-rig run --resume" in said, said
+    assert "it is shot again when the session goes on" in said, said
+    assert f"Continue with: rti-rig run --resume {out}" in said, said
     if target == "Internal RAM":
         assert "so it is lost: /IMG_0003.CR2 existed only there" in said, said
     else:
@@ -65,3 +66,29 @@ def test_a_camera_unplugged_at_a_download_says_where_the_shot_is_and_the_resume_
     assert (out / "lights.lp").read_text().split()[0] == "4"
     for k in range(1, 5):
         assert (out / f"raw/image_{k:03d}.cr2").read_bytes() == _raw(body)
+
+
+@pytest.mark.parametrize(
+    "gone",
+    [{"failures": {"get_config": [-7]}}, {"off_at_shot": 1}],
+    ids=["as it is opened", "at the first shot"],
+)
+def test_a_camera_gone_before_any_image_is_kept_claims_no_image_kept(tmp_path, monkeypatch, gone):
+    """Gone as it is opened (its settings read after init), or at the first shot: the run
+    keeps nothing and says so. The camera's error had gone on "Images already taken are kept:
+    reconnect it, then continue with 'rti-rig run --resume SESSION'" (a template, and a
+    resume of a session that holds no image)."""
+    cfg = _config(tmp_path, "Memory card")
+    body = Body(render=_raw, **gone)
+    monkeypatch.setitem(sys.modules, "gphoto2", make_module(body))
+    out = tmp_path / "s"
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "2"])
+        lit_at_end = firmware.lit
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert body.shots == 0 and "Nothing was captured" in said, said
+    assert "the camera stopped answering" in said, said
+    assert "Images already taken are kept" not in said, said
+    assert "SESSION" not in said and "--resume" not in said, said
+    assert "Reconnect it, then go on as said above" in said, said
