@@ -61,7 +61,9 @@ def test_camera_switched_off_mid_session_is_a_named_error(tmp_path):
     with camera(body, tmp_path) as cam:
         cam.capture(1 / 60)
         body.switch_off()
-        with pytest.raises(CameraGoneError, match=r"stopped answering.*Reconnect it, then go on") as info:
+        with pytest.raises(
+            CameraGoneError, match=r"stopped answering.*Reconnect it, then go on"
+        ) as info:
             cam.capture(1 / 60)
     assert isinstance(info.value, CaptureError)  # exit code 2 through the CLI, no traceback
 
