@@ -246,6 +246,8 @@ class Gphoto2Camera:
         #: the last ``collect`` began: said as that shot's notice
         self._undeleted: list[tuple[str, int | None]] = []
         self.retries_used = 0
+        #: names of the card files of a shot whose download would not decode: left there
+        self._kept_for_decode: set[str] = set()
         self.camera_model: str | None = None
         #: the USB port the camera was found on (``usb:001,005``), to name it in errors
         self.camera_port: str | None = None
@@ -933,22 +935,36 @@ class Gphoto2Camera:
                     "left_on_card": left_on_card,
                 }
             )
-        if left_on_card:
-            self._delete(files)
-            self._note_card(str(path.folder), files + late)
-            seen = self._card_seen.get(str(path.folder))
-            if seen is not None:  # on the card now: never found again as a new picture
-                seen |= {n for _, n in strays}
-        else:
-            self._delete(files + strays)
-            self._note_card(str(path.folder), files + strays + late)
+
+        def delete_downloaded() -> None:
+            if left_on_card:
+                self._delete(files)
+                self._note_card(str(path.folder), files + late)
+                seen = self._card_seen.get(str(path.folder))
+                if seen is not None:  # on the card now: never found again as a new picture
+                    seen |= {n for _, n in strays}
+            else:
+                self._delete(files + strays)
+                self._note_card(str(path.folder), files + strays + late)
+
+        # a card's copy is deleted only once the download decodes: a RAW that would not (a
+        # transfer damaged on the way, a format this LibRaw lacks) had been deleted from the
+        # card first, its one good copy, and the user told to "copy it again from the
+        # camera's card". A RAM capture is deleted first, as before (no copy to keep there)
+        on_card = not _in_ram(str(path.folder))
+        if not on_card:
+            delete_downloaded()
         raw_path = saved[raw_files[0][1]]
         try:
             decoded = decode_raw(raw_path, s.decode, timestamp_s=t_capture)
-        except RawFileMissingError as exc:
-            raise self._download_gone(raw_path, raw_files[0]) from exc
-        except CaptureError as exc:
-            raise self._undecoded(raw_path, raw_files[0][1], exc) from exc
+        except (RawFileMissingError, CaptureError) as exc:
+            if on_card and s.delete_from_camera:
+                self._kept_for_decode = {n for _, n in files + strays}
+            if isinstance(exc, RawFileMissingError):
+                raise self._download_gone(raw_path, raw_files[0]) from exc
+            raise self._undecoded(raw_path, raw_files[0], exc) from exc
+        if on_card:
+            delete_downloaded()
         jpeg = [str(p) for n, p in saved.items() if not is_camera_raw(Path(n))]
         iso = _number(s.iso) or decoded.gain
         metadata = dict(decoded.metadata)
@@ -1201,6 +1217,8 @@ class Gphoto2Camera:
         on_camera = f"{folder.rstrip('/')}/{name}"
         if any(n == name for n, _ in self._undeleted):
             copy = f"the camera's copy stays on its card at {on_camera} (its delete failed)"
+        elif name in self._kept_for_decode:
+            copy = f"the camera's copy stays on its card at {on_camera}, never deleted"
         elif self.settings.delete_from_camera:
             copy = "the camera's copy was deleted after the download, so this shot is lost"
         elif self.settings.capture_target == "Internal RAM":
@@ -1236,20 +1254,26 @@ class Gphoto2Camera:
             return 'not kept (a capture to its RAM, capture_target = "Internal RAM")'
         return "kept"
 
-    def _undecoded(self, raw_path: Path, camera_name: str, exc: CaptureError) -> CaptureError:
+    def _undecoded(
+        self, raw_path: Path, camera_file: tuple[str, str], exc: CaptureError
+    ) -> CaptureError:
         """The error for a downloaded RAW that would not decode: the camera's file and where
         its only copy is kept (it is gone from the camera once downloaded).
 
         Why: the error named ``raw/.incoming/cap0002_IMG_0002.RAF`` only, a folder a resume
         empties into ``recovered/``, and said nothing of the camera's copy, already deleted:
         an owner who looked for the shot on the card found nothing."""
+        folder, camera_name = camera_file
         where = str(raw_path)
         if self.output_dir is not None and self.output_dir.name == ".incoming":
             where += " (a resume moves it to the session's recovered/ folder, never deleting it)"
+        copy = self._copy_said(camera_name)
+        if camera_name in self._kept_for_decode:
+            copy = f"stays on its card at {folder.rstrip('/')}/{camera_name}, not deleted"
         return CaptureError(
             self.name,
             f"the camera's file {camera_name} would not decode; it is kept at {shown_path(where)}, "
-            f"the camera's copy {self._copy_said(camera_name)}. "
+            f"the camera's copy {copy}. "
             + (exc.problem if isinstance(exc, RawDecodeError) else exc.message)
             + (
                 ". `rti-rig check` finds a RAW this LibRaw cannot read with a test shot, "

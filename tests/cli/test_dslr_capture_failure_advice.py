@@ -142,3 +142,24 @@ def test_a_busy_camera_retried_until_it_shot_is_said_with_the_shots_it_concerns(
     steps = [json.loads(line) for line in (out / "journal.jsonl").read_text().splitlines()]
     said_of = [any(n.startswith(notice) for n in st.get("notices", [])) for st in steps]
     assert said_of == [False, True, True], steps
+
+
+def test_a_raw_that_would_not_decode_is_left_on_the_card_as_its_error_says(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Shot to the card, the second RAW downloads as bytes LibRaw cannot read (a transfer
+    damaged on the way, a format newer than this LibRaw). Its card copy had been deleted
+    before the decode, while the error went on "if no other program opens the file either,
+    it is damaged: copy it again from the camera's card": the one good copy was gone."""
+    cfg = _config(tmp_path, "Memory card")
+    body = Body(render=lambda b: _raw(b) if b.shots < 1 else b"II*\x00damaged" * 100)
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "2"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "the camera's file IMG_0002.CR2 would not decode" in said, said
+    on_card = "/store_00020001/DCIM/100CANON/IMG_0002.CR2"
+    assert f"the camera's copy stays on its card at {on_card}, not deleted" in said, said
+    assert "IMG_0002.CR2" in body.card and body.deleted == ["IMG_0001.CR2"], body.deleted
+    assert (out / "raw" / ".incoming" / "cap0002_IMG_0002.CR2").is_file()
