@@ -585,7 +585,9 @@ def _refuse_other_layout(
         f"not image {index + 1} of the session: {said(got, 'x')}, the session's are "
         f"{said(layout, 'x')}"
     )
-    tiff, *originals = folder.set_aside(index, frame, why)
+    # as paths that paste from anywhere: relative to the session they had named no file from
+    # the folder the user ran rti-rig in
+    tiff, *originals = (shown_path(folder.root / p) for p in folder.set_aside(index, frame, why))
     camera_files = f", the camera's own file(s) as {', '.join(originals)}" if originals else ""
     raise CaptureError(
         rig.camera.name,

@@ -14,7 +14,9 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+from dng_spec_writer import dng, mosaic_from_rgb
 from fake_gphoto2 import Body
 from test_dslr_download_disk_full import _config, _raw, _shot_with
 
@@ -163,3 +165,28 @@ def test_a_raw_that_would_not_decode_is_left_on_the_card_as_its_error_says(
     assert f"the camera's copy stays on its card at {on_card}, not deleted" in said, said
     assert "IMG_0002.CR2" in body.card and body.deleted == ["IMG_0001.CR2"], body.deleted
     assert (out / "raw" / ".incoming" / "cap0002_IMG_0002.CR2").is_file()
+
+
+def test_a_raw_of_another_size_is_named_where_it_is_kept_as_paths_that_paste(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The second RAW comes back another size (a setting changed on the camera): the run
+    stops and keeps it under recovered/, named relative to the session folder ("kept as
+    recovered/…/image_002.tif"), which names no file from where the user ran rti-rig."""
+    cfg = _config(tmp_path, "Memory card")
+
+    def render(b: Body) -> bytes:
+        size = (32, 48) if b.shots < 1 else (40, 60)
+        rgb = np.broadcast_to(np.array([0.2, 0.5, 0.8]), (*size, 3))
+        return dng(mosaic_from_rgb(np.array(rgb), "RGGB", (0,) * 4, 4095), "RGGB", (0,) * 4, 4095)
+
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, Body(render=render), ["run", str(cfg), "--out", str(out), "--lights", "2"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "image 2 came back 60×40 colour, but this session's images are 48×32" in said, said
+    kept = said.split("(kept as ", 1)[1].split("); set the camera back", 1)[0]
+    tiff, raw = kept.split(", the camera's own file(s) as ")
+    assert Path(tiff).is_absolute() and Path(tiff).is_file(), said
+    assert Path(raw).is_absolute() and Path(raw).read_bytes() == render(Body(render, shots=1))
