@@ -126,21 +126,22 @@ def check(
     from rti_rig.runtime.controller import EmergencyStop
 
     if park_only:
+        from rti_rig.app.usecases.park import refuse_park_only_with
+
         given = [
-            name
-            for name, on in (
-                ("--reboot-faulted", reboot_faulted),
-                ("--intensity", intensity is not None),
-                ("--auto-exposure", auto_exposure),
+            words
+            for words, on in (
+                (["--reboot-faulted"], reboot_faulted),
+                (["--intensity", str(intensity)], intensity is not None),
+                (["--auto-exposure"], auto_exposure),
             )
             if on
         ]
         if given:
-            raise fail(
-                RtiRigError(
-                    f"--park-only parks the arm and does nothing else: drop {' and '.join(given)}"
-                )
-            )
+            try:
+                refuse_park_only_with(rig_config, given)
+            except RtiRigError as exc:
+                raise fail(exc) from None
         _park_only(rig_config)
         return
     if reboot_faulted:

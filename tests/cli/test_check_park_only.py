@@ -167,8 +167,18 @@ def test_a_fault_during_the_park_is_not_called_parked(
             ["check", str(CONFIGS / "simulated_arm.toml"), "--park-only", "--reboot-faulted"],
             "--park-only parks the arm and does nothing else: drop --reboot-faulted",
         ),
+        (  # both problems in one refusal, the dome's check keeping the level asked for
+            ["check", str(CONFIGS / "simulated_dome.toml"), "--park-only", "--intensity", "0.5"],
+            "has no park pose. To check it (its check ends with every LED switched off): "
+            f"rti-rig check {CONFIGS / 'simulated_dome.toml'} --intensity 0.5",
+        ),
+        (
+            ["check", "{acq}", "--park-only", "--intensity", "0.5", "--reboot-faulted"],
+            "with nothing to move. To check it (--reboot-faulted and --intensity left out, "
+            "which a replay's check does not take): rti-rig check {acq}",
+        ),
     ],
-    ids=["dome", "replay", "with-reboot"],
+    ids=["dome", "replay", "with-reboot", "dome-with-intensity", "replay-with-options"],
 )
 def test_park_only_refused_where_there_is_nothing_to_park(
     argv: list[str], words: str, tmp_path: Path

@@ -11,9 +11,10 @@ torque on, as a session's park does, and is said as such.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NoReturn
 
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
@@ -70,26 +71,72 @@ class ParkReport:
         return out
 
 
-def refuse_unparkable(loaded: object, rig_config: Path) -> None:
+def refuse_unparkable(
+    loaded: object,
+    rig_config: Path,
+    others: Sequence[Sequence[str]] = (),
+) -> None:
     """Refuse ``--park-only`` for a rig that has no arm to park (a dome, a replay): a dome has
-    no park pose, and its all-off is what ``rti-rig check`` ends with."""
+    no park pose, and its all-off is what ``rti-rig check`` ends with.
+
+    ``others``: the check's other options given with ``--park-only``, each as its command-line
+    words (``["--intensity", "0.5"]``). Why: ``check DOME --park-only --intensity 0.5`` was
+    refused for the option, and then, the option dropped, for the dome: one problem at a time.
+    Both are said at once, and a dome's check command keeps the walk's options given
+    (``--intensity``, ``--auto-exposure``), which its check takes."""
     config = loaded.config  # type: ignore[attr-defined]
     if config.arm is not None and config.backend != "replay":
         return
+    replay = config.backend == "replay"
     # a replay's own words: it had been called a rig config, and told that its check ends
     # "with every LED switched off", of an .lp and its images that have no LED
     what, ends = (
         ("is a replayed acquisition (a .lp and its images), with nothing to move", "")
-        if config.backend == "replay"
+        if replay
         else (
             "rig config describes a dome, which has no park pose",
             " (its check ends with every LED switched off)",
         )
     )
-    raise RtiRigError(
-        f"{shown_path(rig_config)}: --park-only parks an arm; this {what}. To check it{ends}: "
-        f"rti-rig check {shell_word(str(rig_config))}"
+    # a dome's check lights at --intensity and meters for --auto-exposure; a replay's check
+    # refuses both, and --reboot-faulted is an arm's
+    kept = [] if replay else [o for o in others if o[0] in _DOME_CHECK_OPTIONS]
+    dropped = [o[0] for o in others if o not in kept]
+    left_out = (
+        f"{' and '.join(dropped)} left out, which {'a replay' if replay else 'a dome'}'s check "
+        "does not take"
+        if dropped
+        else ""
     )
+    if left_out:
+        ends = f" ({ends[2:-1]}; {left_out})" if ends else f" ({left_out})"
+    words = " ".join(shell_word(w) for o in kept for w in o)
+    command = f"rti-rig check {shell_word(str(rig_config))}" + (f" {words}" if words else "")
+    raise RtiRigError(
+        f"{shown_path(rig_config)}: --park-only parks an arm; this {what}. "
+        f"To check it{ends}: {command}"
+    )
+
+
+#: the options of ``rti-rig check`` that a dome's check takes, kept in the command a dome's
+#: ``--park-only`` refusal gives
+_DOME_CHECK_OPTIONS = ("--intensity", "--auto-exposure")
+
+
+def refuse_park_only_with(rig_config: Path, others: Sequence[Sequence[str]]) -> NoReturn:
+    """Refuse ``--park-only`` given with the check's other options (``others``, as in
+    :func:`refuse_unparkable`), saying in the one message every reason it is refused: the
+    options, and a rig with nothing to park or a config that does not load.
+
+    Why: each had been said alone, the next only once the first was put right."""
+    names = " and ".join(o[0] for o in others)
+    drop = f"--park-only parks the arm and does nothing else: drop {names}"
+    try:
+        loaded = load_rig_config(rig_config)
+    except RtiRigError as exc:
+        raise RtiRigError(f"{exc}\nAlso: {drop}.") from None
+    refuse_unparkable(loaded, rig_config, others)
+    raise RtiRigError(drop)
 
 
 def park_arm(rig_config: Path, on_start: Callable[[], None] | None = None) -> ParkReport:
