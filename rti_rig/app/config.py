@@ -394,7 +394,9 @@ class RigConfig(_Strict):
         raise ValueError(
             f"emulator.faults[{i}]: {kind} is rehearsed by an emulated dome's firmware on its "
             "serial link (backend = 'emulated' with a [dome.serial]), and this rig is not one; "
-            "remove the fault, or rehearse it on rig_configs/emulated_dome.toml"
+            "remove the fault, or rehearse it on the emulated dome rti-rig ships, "
+            f"{shell_word(shipped_config_path('emulated_dome.toml'))} (copy it and add the "
+            "fault to the copy)"
         )
 
     def _sync_faults_have_a_flash_dome(self) -> None:
@@ -1516,7 +1518,15 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
 
 def default_config_path() -> Path:
     """The embedded simulated dome config shipped with the package."""
-    return Path(str(resources.files("rti_rig.rig_configs").joinpath("simulated_dome.toml")))
+    return shipped_config_path("simulated_dome.toml")
+
+
+def shipped_config_path(name: str) -> Path:
+    """Where the rig config ``name`` shipped with the package is, installed or in a checkout.
+
+    Why: a hint that named ``rig_configs/emulated_dome.toml`` named a path only a checkout's
+    root has; an installed user pasting it was told there is no such file."""
+    return Path(str(resources.files("rti_rig.rig_configs").joinpath(name)))
 
 
 def _ring_directions(rings: list[Ring]) -> NDArray[np.float64]:

@@ -87,3 +87,26 @@ def test_a_fault_nothing_would_rehearse_is_refused(
     assert r.exit_code == 2 and "Traceback" not in said, said
     assert "PASS" not in said
     assert f"{config}: {words}" in said, said
+
+
+def test_the_dome_it_names_for_a_rehearsal_is_there_from_anywhere(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The refusal of a serial fault on a simulated dome names the emulated dome to rehearse it
+    on: it had named ``rig_configs/emulated_dome.toml``, a path only a checkout's root has (an
+    installed user, or one anywhere else, pasting it was told there is no such file). Run from
+    another folder, every rig config the words name is a file there, as shell words."""
+    import shlex
+
+    config = tmp_path / "rig.toml"
+    config.write_text((CONFIGS / "simulated_dome.toml").read_text() + RESET)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    r = runner.invoke(app, ["check", str(config)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "rehearse it on" in said, said
+    named = [w.rstrip(",.;") for w in shlex.split(said.split("rehearse it on", 1)[1])]
+    tomls = [w for w in named if w.endswith(".toml")]
+    assert tomls and all(Path(w).is_file() for w in tomls), said
+    assert any(Path(w).name == "emulated_dome.toml" for w in tomls), said
