@@ -95,8 +95,9 @@ def check(
             "--park-only",
             help="Instead of the walk: connect the arm, switch its lamp off, move it to the "
             "config's park pose and close it as its torque_policy says; nothing else moves. "
-            "Ctrl-C stops the park and holds the arm where it is. Refused for a dome or a "
-            "replay (no park pose).",
+            "Ctrl-C stops the park and holds the arm where it is (torque_policy = "
+            '"release_on_close": released all the same if it stopped at its park pose). '
+            "Refused for a dome or a replay (no park pose).",
         ),
     ] = False,
     auto_exposure: Annotated[

@@ -191,3 +191,37 @@ def test_park_only_refused_where_there_is_nothing_to_park(
     code, said = _invoke(*(a.replace("{acq}", str(acq)) for a in argv))
     words = words.replace("{acq}", str(acq))
     assert code == 2 and words in said and "Parking" not in said, said
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_stopped_park_at_the_park_pose_is_released_by_release_on_close(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """docs/protocols/dynamixel-arm.md's word on a stopped ``--park-only``: held where it
+    stands, torque on, *unless* ``torque_policy = "release_on_close"`` and the arm is at its
+    park pose, which the close then releases (the doc had said it holds, whatever the
+    policy). The arm parked and held first; a Ctrl-C as the second park begins; the servos' Torque
+    Enable read from the emulator, the truth."""
+    from rti_rig.drivers.dynamixel import control_table as ct
+    from rti_rig.drivers.dynamixel.arm import DynamixelArm
+
+    cfg = inprocess_arm_config(tmp_path)
+    assert _invoke("check", str(cfg), "--park-only")[0] == 0  # parked, held ("hold")
+    text = cfg.read_text()
+    assert 'torque_policy = "hold"' in text
+    cfg.write_text(text.replace('torque_policy = "hold"', 'torque_policy = "release_on_close"'))
+    rigs = built_rigs(monkeypatch)
+    real_park = DynamixelArm.park
+
+    def park(self: Any, *args: Any, **kwargs: Any) -> Any:
+        signal.raise_signal(signal.SIGINT)  # held by the teardown; the park's wait sees it
+        return real_park(self, *args, **kwargs)
+
+    monkeypatch.setattr(DynamixelArm, "park", park)
+    got, said = _invoke("check", str(cfg), "--park-only")
+    assert got == 130 and "Traceback" not in said, said
+    assert "close enough to the park pose for the close to release it" in said, said
+    assert "torque on" not in said, said
+    (rig,) = rigs
+    servos = [rig.emulator.servos[j.servo_id] for j in rig.lighting.carrier.settings.joints]
+    assert [s.get(ct.TORQUE_ENABLE) for s in servos] == [0, 0]  # released, not held

@@ -6,7 +6,9 @@ user asked for one. This connects the arm (as every command does: limits checked
 where it stands, torque on), switches the lamp off, stops, moves to the config's park pose
 and closes with the config's ``torque_policy`` (the teardown of a session, with no session):
 nothing else moves. A stop (Ctrl-C, SIGTERM) during the park holds the arm where it stands,
-torque on, as a session's park does, and is said as such.
+torque on, as a session's park does, and is said as such; with ``torque_policy =
+"release_on_close"`` an arm the stop left at its park pose (within the driver's
+``PARKED_TICKS``) is released by the close all the same, and said to be.
 """
 
 from __future__ import annotations
