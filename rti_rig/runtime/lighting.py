@@ -299,18 +299,15 @@ class DomeLighting:
         return False if known is None else bool(known.link_open)
 
 
-def park_check(config: str | None) -> str:
+def park_check(config: str) -> str:
     """The command that parks an arm and does nothing else: ``rti-rig check CONFIG
-    --park-only``, the config's path as shell words, so that it pastes and runs;
-    ``'rti-rig check RIG_CONFIG --park-only'`` only where no config is known (an arm built
-    without one, as in unit tests).
+    --park-only``, the config's path as shell words, so that it pastes and runs.
 
     Why: the run's end said "park it with 'rti-rig check'", a command that, pasted, is refused
     for its missing RIG_CONFIG, while the error above it named the config in full; and the
     plain check it then named walks every self-test pose before it parks, eight moves near the
-    object for a user who asked for one."""
-    if not config:
-        return "'rti-rig check RIG_CONFIG --park-only'"
+    object for a user who asked for one. Every arm is built from a rig config
+    (:class:`ArmLighting` requires it), so there is no ``RIG_CONFIG`` template to fall back to."""
     return f"rti-rig check {shell_word(config)} --park-only"
 
 
@@ -336,7 +333,8 @@ class ArmLighting:
         carrier: LightCarrier,
         park_after_session: bool = True,
         park_on_emergency: bool = False,
-        config: str | None = None,
+        *,
+        config: str,
         clock: Clock | None = None,
     ) -> None:
         self.carrier = carrier
@@ -351,7 +349,8 @@ class ArmLighting:
         self.park_finished = False
         self.name = carrier.name
         #: the rig config's path, named in the check that parks the arm after a failure
-        #: ("park it with 'rti-rig check'" had named no config: pasted, it was refused)
+        #: ("park it with 'rti-rig check'" had named no config: pasted, it was refused);
+        #: required, so that no hint falls back to a ``RIG_CONFIG`` template
         self.config = config
         self.park_after_session = park_after_session
         self.park_on_emergency = park_on_emergency

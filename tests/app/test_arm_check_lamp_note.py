@@ -33,7 +33,7 @@ def _rig(backend: str, lamp: str) -> SimpleNamespace:
     clock = VirtualClock()
     arm = DynamixelArm(settings, InProcessPort(emulator_for_arm(settings, clock)), clock)
     return SimpleNamespace(
-        lighting=ArmLighting(arm),
+        lighting=ArmLighting(arm, config="arm.toml"),
         loaded=SimpleNamespace(config=SimpleNamespace(backend=backend)),
     )
 

@@ -23,7 +23,7 @@ def said_after_a_session(backend: str, **overrides) -> str:  # type: ignore[no-u
     settings = arm_settings(**overrides)
     clock = VirtualClock()
     arm = DynamixelArm(settings, InProcessPort(emulator_for_arm(settings, clock)), clock)
-    lighting = ArmLighting(arm)
+    lighting = ArmLighting(arm, config="arm.toml")
     lighting.connect()
     lighting.safe()
     lighting.close()

@@ -45,7 +45,7 @@ class _Carrier:
 @pytest.mark.parametrize(("sig", "who"), [(signal.SIGINT, "Ctrl-C"), (signal.SIGTERM, "SIGTERM")])
 def test_a_stop_during_the_teardown_s_stop_begins_no_park(sig: int, who: str) -> None:
     carrier = _Carrier(sig)
-    lighting = ArmLighting(carrier)  # type: ignore[arg-type]
+    lighting = ArmLighting(carrier, config="arm.toml")  # type: ignore[arg-type]
     seen: list[int] = []
 
     def handler(signum: int, frame: Any) -> None:

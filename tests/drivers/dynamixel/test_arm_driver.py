@@ -724,7 +724,9 @@ def test_a_connect_that_fails_after_writing_is_not_said_to_have_commanded_nothin
     assert emu.servos[1].torque_on  # what the claim must not deny
     text = " ".join(report.lines())
     assert "nothing was commanded" not in text and "failed part-way" in text
-    rig = SimpleNamespace(lighting=ArmLighting(arm), loaded=SimpleNamespace(config=None))
+    rig = SimpleNamespace(
+        lighting=ArmLighting(arm, config="arm.toml"), loaded=SimpleNamespace(config=None)
+    )
     said = lights_state(rig)
     assert "nothing was commanded" not in said and "under torque" in said
     # a port that would not open: nothing was written, and that is said
@@ -732,7 +734,9 @@ def test_a_connect_that_fails_after_writing_is_not_said_to_have_commanded_nothin
     never._bus.port.openPort = lambda: False  # type: ignore[method-assign]
     report = arm_self_test(never, geometry, clock)
     assert "nothing was commanded: the arm could not be connected" in " ".join(report.lines())
-    rig = SimpleNamespace(lighting=ArmLighting(never), loaded=SimpleNamespace(config=None))
+    rig = SimpleNamespace(
+        lighting=ArmLighting(never, config="arm.toml"), loaded=SimpleNamespace(config=None)
+    )
     assert lights_state(rig) == "nothing was commanded: the arm could not be connected"
 
 
