@@ -860,6 +860,20 @@ def _with_min_lights(opened, minimum: int) -> str:  # type: ignore[no-untyped-de
     )
 
 
+def _without_lights(opened) -> str:  # type: ignore[no-untyped-def]
+    """The ``rti-rig run`` that starts this adaptive session again without its ``--lights``
+    (the rig's own maximum), its other options as it began (the manifest's record), into a
+    folder beside it that is free now."""
+    from rti_rig.app.usecases.replay_advice import session_options
+
+    manifest = dict(opened.folder.manifest)
+    manifest["adaptive"] = {**(manifest.get("adaptive") or {}), "design_lights": None}
+    more = free_folder_beside(Path(opened.out_dir), "more")
+    return f"rti-rig run {_arg(opened.rig.loaded.path)} --out {_arg(more)}" + session_options(
+        manifest
+    )
+
+
 def _cannot_resume(opened) -> str | None:  # type: ignore[no-untyped-def]
     """What is said instead of "continue with --resume" of a session this rig cannot resume
     (None: it can): a camera-triggered dome, whose own count went on, or an image-sequence
@@ -2054,7 +2068,11 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         )
     adaptive_result = opened.extra.get("adaptive_result")
     if adaptive_result is not None:
-        from rti_rig.app.usecases.adaptive import estimate_phrase, few_lights_note
+        from rti_rig.app.usecases.adaptive import (
+            estimate_phrase,
+            few_lights_note,
+            short_of_target_note,
+        )
 
         chosen_for = adaptive_result.get("objective", "normals")
         out.print(
@@ -2066,6 +2084,10 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         short = few_lights_note(adaptive_result, lambda m: _with_min_lights(opened, m))
         if short is not None:  # one line: the command it ends with pastes whole
             err.print(f"[yellow]note:[/] {escape(short)}", highlight=False, soft_wrap=True)
+        offered = int((opened.folder.manifest.get("adaptive") or {}).get("candidates") or 0)
+        unreached = short_of_target_note(adaptive_result, offered, lambda: _without_lights(opened))
+        if unreached is not None:  # one line, as the note above
+            err.print(f"[yellow]note:[/] {escape(unreached)}", highlight=False, soft_wrap=True)
     if result.finish_reason is FinishReason.CANCELLED:
         err.print(
             f"[yellow]Session cancelled; the images captured so far are kept.[/] "

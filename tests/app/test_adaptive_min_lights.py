@@ -11,6 +11,7 @@ before anything is opened.
 from __future__ import annotations
 
 import os
+import shlex
 import subprocess
 from pathlib import Path
 
@@ -105,6 +106,30 @@ def test_a_session_that_did_not_reach_its_target_gives_no_such_note(
     assert result["lights_used"] == 5 and result["target_claimed"] is False
     text = said(r)
     assert "the target is not claimed" in text and "reached the normal-error target" not in text
+    # and what to do next: the command that shoots on without the cap, which pastes whole
+    # (the run had ended "the target is not claimed" with no word of what to do)
+    offered = manifest(out)["adaptive"]["candidates"]
+    assert offered > 5
+    lines = [line.rstrip() for line in r.output.splitlines()]
+    (note,) = [line for line in lines if "was not reached in this session's maximum" in line]
+    assert "--until-error 1e-09° was not reached in this session's maximum of 5 lights" in note
+    assert f"with up to the {offered} lights this rig offers" in note, note
+    argv = shlex.split(note.rsplit(": ", 1)[1])
+    assert argv == [
+        "rti-rig", "run", str(cfg), "--out", str(tmp_path / "s-more"), "--until-error", "1e-09"
+    ], note  # fmt: skip
+
+
+def test_a_session_that_took_every_light_short_of_its_target_says_none_can_shoot_more(
+    never_reached: tuple[Path, Path],
+) -> None:
+    """Every LED of the rig shot, the target not reached: no command is offered that would
+    shoot the same lights again, and that is said."""
+    _, out = never_reached
+    text = (out.parent / "said.txt").read_text()
+    assert "was not reached in this session's maximum of" in text, text
+    assert "They are every light this rig offers here" in text, text
+    assert "start a new session" not in text, text
 
 
 def test_min_lights_holds_the_stop_until_m_lights_with_the_choices_of_no_target(

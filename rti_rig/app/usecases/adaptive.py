@@ -1227,6 +1227,43 @@ def few_lights_note(
     return text
 
 
+def short_of_target_note(
+    result: dict[str, Any], offered: int, start_more: Callable[[], str] | None = None
+) -> str | None:
+    """What a session that ran to its maximum without reaching its --until-error target is
+    to do next (None: no target, the target reached, or the session stopped otherwise).
+
+    ``offered``: the lights the session could choose from (the rig's, in its band);
+    ``start_more()``: the ``rti-rig run`` command that starts the session again without its
+    ``--lights`` (the rig's own maximum, a free --out). Why: the run ended "the target is not
+    claimed" and nothing more: a user who wanted the target had to find that a resume keeps
+    the session's maximum, and which command shoots on; where the rig has no more lights,
+    no command would, and that is said instead of leaving one to be tried."""
+    until = result.get("until_error_deg")
+    if until is None or result.get("target_claimed"):
+        return None
+    used, cap = int(result.get("lights_used") or 0), int(result.get("max_lights") or 0)
+    up = result.get("upper_error_deg")
+    if used < cap or up is None:  # stopped otherwise (nothing left to fit, no estimate)
+        return None
+    text = (
+        f"--until-error {until:g}° was not reached in this session's maximum of {cap} lights "
+        f"(upper estimate {up:.2f}°); its {used} images are kept as they are."
+    )
+    if cap < offered and start_more is not None:
+        text += (
+            " The session is complete (a resume adds no light); to shoot toward the target "
+            f"with up to the {offered} lights this rig offers, start a new session (it shoots "
+            f"its lights from the start; more lights are not known to reach it): {start_more()}"
+        )
+    elif cap >= offered:
+        text += (
+            f" They are every light this rig offers here ({offered}): no session on it can "
+            "shoot more toward the target."
+        )
+    return text
+
+
 def check_objective(
     objective: str,
     lights: int | None,
