@@ -249,16 +249,27 @@ def _probe_stopped(why: str, signum: signal.Signals, result: ProbeResult) -> NoR
 @app.command()
 def probe(
     port: Annotated[str, typer.Argument(help="Serial port of the dome, e.g. /dev/ttyACM0.")],
+    rig: Annotated[
+        Path | None,
+        typer.Option(
+            "--rig",
+            help="The rig config you will put the printed lines in: what to do next is then "
+            "said as a check command of it, to paste (nothing is read from it or written).",
+        ),
+    ] = None,
 ) -> None:
     """Identify which known dome firmware answers on PORT (least intrusive probes first; none
     lights an LED, and a dome that boots lit is switched off, or you are told it could not be
     and the probe exits 1) and print the rig-config lines to use. Ctrl-C stops the probe after
-    switching off a dome that booted lit, and says what is known of the lights."""
+    switching off a dome that booted lit, and says what is known of the lights. Exits 1 too
+    when the firmware found cannot be used as it is (a banner rti-rig refuses), as its check
+    would fail."""
     from rti_rig.app.usecases.probe import ProbeRequest, ProbeResult, ProbeStopped
     from rti_rig.app.usecases.probe import probe as run_probe
     from rti_rig.runtime.controller import EmergencyStop
 
-    result = ProbeResult(port)  # filled by the probe: what it established, whenever a stop lands
+    # filled by the probe: what it established, whenever a stop lands
+    result = ProbeResult(port, rig=None if rig is None else str(rig))
 
     def trying(what: str, tries: str) -> None:
         # on stderr as it goes: a port where nothing answers takes over 20 s, which the
@@ -285,7 +296,7 @@ def probe(
         err.print(f"[bold red]error:[/] {said}", highlight=False, soft_wrap=True)
     for line in result.conclusion_lines():
         out.print(line, highlight=False, markup=False)
-    if result.profile is None or result.error is not None:
+    if result.profile is None or result.error is not None or result.unusable is not None:
         # a port that failed after the firmware was found (a Nab board whose all-off could
         # not be sent, possibly fully lit) had exited 0, as a probe that succeeded
         raise typer.Exit(code=1)

@@ -8,6 +8,7 @@ the lines heard, and advised ``profile = "rti-dome-m"`` (a dome that never answe
 
 from __future__ import annotations
 
+import shlex
 import sys
 from pathlib import Path
 
@@ -60,7 +61,12 @@ def test_probe_names_the_framed_protocol_of_the_shipped_hardware_dome(
 
 
 def _probe_a_default_board(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, codec: DefaultProfile, checksum: bool
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    codec: DefaultProfile,
+    checksum: bool,
+    *extra: str,
+    code: int = 0,
 ) -> str:
     """What ``rti-rig probe`` says of the shipped emulated dome's board speaking ``codec``,
     checked for what every default board's probe must say (named, its checksum setting, and
@@ -70,9 +76,9 @@ def _probe_a_default_board(
     config = emulated_dome_as_hardware(tmp_path, "emulated_dome.toml", port)
     with shipped_dome_on_pty(monkeypatch, config) as firmware:
         firmware.codec = codec
-        r = runner.invoke(app, ["probe", port], terminal_width=400)
+        r = runner.invoke(app, ["probe", port, *extra], terminal_width=400)
         words = said(r)
-        assert r.exit_code == 0, words
+        assert r.exit_code == code, words
         assert "No known dome firmware" not in words and "Traceback" not in words
         assert 'profile = "default" baudrate = 115200' in words, words
         assert ("checksum = false" in words) is not checksum, words
@@ -105,9 +111,23 @@ def test_probe_names_a_default_board_whose_banner_has_an_extra_field_and_says_it
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, checksum: bool
 ) -> None:
     """A banner with a field after the LED count (a board revision) reads as damaged to the
-    codec: the probe had said "No known dome firmware answered" and named nothing."""
+    codec: the probe had said "No known dome firmware answered" and named nothing. Then it
+    said "Found: default" and exited 0, though every check of the board fails on that
+    banner: it exits 1, saying the board cannot be used as it is, and ends with the check of
+    the rig config named by --rig, a command that pastes ("then run rti-rig check" had named
+    no config)."""
+    rig = tmp_path / "my rigs" / "dome.toml"
     words = _probe_a_default_board(
-        tmp_path, monkeypatch, _WithRevision(checksum=checksum), checksum
+        tmp_path,
+        monkeypatch,
+        _WithRevision(checksum=checksum),
+        checksum,
+        "--rig",
+        str(rig),
+        code=1,
     )
     assert "carries 1 field(s) more than rti-rig's default protocol's" in words, words
     assert "('rev-B')" in words and "end the firmware's banner at the LED count" in words
+    found = "Found: default, but its boot banner has fields after the LED count, so rti-rig "
+    assert found + "cannot use it as it is" in words, words
+    assert f"then run rti-rig check {shlex.quote(str(rig))}" in words, words

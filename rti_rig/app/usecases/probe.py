@@ -33,6 +33,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum, auto
 
+from rti_rig.core.shell_words import shell_word
 from rti_rig.drivers.led_dome.codec_binary import BinaryCodec
 from rti_rig.drivers.led_dome.codec_default import DefaultCodec
 from rti_rig.drivers.led_dome.codec_framed import FramedCodec, FramedSpec
@@ -138,6 +139,9 @@ class _PortNotOpened(TransportError):
 @dataclass
 class ProbeResult:
     port: str
+    #: The rig config the user will put the config lines in (``probe --rig``; None: not
+    #: named): the check the notes advise names it, as shell words, so that it pastes.
+    rig: str | None = None
     profile: str | None = None
     #: The baud rate the firmware answered at (with ``profile``).
     baudrate: int | None = None
@@ -151,6 +155,10 @@ class ProbeResult:
     error: ProbeError | None = None
     #: What else the firmware showed that the user must act on before a check (or None).
     note: str | None = None
+    #: Why the firmware found cannot be used as it is (None: it can): a banner the profile's
+    #: codec refuses. The probe then exits 1, as the check would fail: it had said "Found:
+    #: default" and exited 0 for a board every check of which then failed on its banner.
+    unusable: str | None = None
     #: How many times a port opening was attempted (each resets a board like an Arduino).
     openings: int = 0
     #: The opening (its number in :attr:`openings`) on which the Nab sketch's all-off was last
@@ -181,6 +189,19 @@ class ProbeResult:
         rate = [f"baudrate = {self.baudrate}"] if self.baudrate is not None else []
         lines = ["[dome.serial]", f'port = "{self.port}"', f'profile = "{self.profile}"', *rate]
         return lines + self.extra_lines
+
+    def check_command(self) -> str:
+        """The check to run once the config lines are in place: with the rig config named
+        (``--rig``) as shell words, a command that pastes; without, what to add to it.
+
+        Why: the notes ended "then run rti-rig check", which pasted is refused for its
+        missing rig config."""
+        if self.rig:
+            return f"rti-rig check {shell_word(self.rig)}"
+        return (
+            "rti-rig check with the rig config you put these lines in (probe --rig CONFIG "
+            "names it here, as a command to paste)"
+        )
 
     def heard_lines(self) -> list[str]:
         """What each probe heard, one line each (the end of a long text)."""
@@ -247,6 +268,13 @@ class ProbeResult:
                 "(their bytes could be commands to a dome); for an arm, run rti-rig check on "
                 "its rig config."
             )
+        elif self.unusable is not None:
+            out.append(
+                f"Found: {self.profile}, but {self.unusable}, so rti-rig cannot use it as it "
+                "is (the note below says what to change). Rig-config lines to use once it is "
+                "changed:"
+            )
+            out += ["  " + line for line in self.config_lines()]
         else:
             out.append(f"Found: {self.profile}. Rig-config lines to use:")
             out += ["  " + line for line in self.config_lines()]
@@ -859,7 +887,7 @@ def _nichlock_found(result: ProbeResult, text: str, baud: int) -> bool:
         result.note = (
             "its boot waits in its touch-screen calibration (the screen is not calibrated): "
             "tap the two red circles on its display, or press 'c' in a serial terminal to skip "
-            "it this once ('s' to stop it for good), before rti-rig check"
+            f"it this once ('s' to stop it for good), before {result.check_command()}"
         )
     return True
 
@@ -876,17 +904,18 @@ _OWN_BANNERS = (
     ("binary", re.compile("\xffRDY")),
 )
 
-#: What the probe cannot hear of each own profile, said with its config lines.
+#: What the probe cannot hear of each own profile, said with its config lines (each ends
+#: "then run ", the check command following: :meth:`ProbeResult.check_command`).
 _OWN_UNHEARD = {
     "framed": (
         "a framed board's other options (index_base, line_ending, the command codes) are not "
         "in its banner: set [dome.serial.framed] as its firmware's documentation says (the "
-        "defaults are 0-based and no line ending), then run rti-rig check"
+        "defaults are 0-based and no line ending), then run "
     ),
     "binary": (
         "a binary board's start_byte and index_base are not in its banner: set "
         "[dome.serial.binary] as its firmware's documentation says if they are not 0xA5 and 0, "
-        "then run rti-rig check"
+        "then run "
     ),
 }
 
@@ -996,7 +1025,7 @@ def _own_protocol_found(result: ProbeResult, text: str, baud: int) -> bool:
                     f"it announced {who.firmware_id} {who.version} with {who.led_count} LEDs"
                 )
             if profile in _OWN_UNHEARD:
-                notes.append(_OWN_UNHEARD[profile])
+                notes.append(_OWN_UNHEARD[profile] + result.check_command())
             result.note = "; ".join(notes) or None
             return True
         if (extra := _banner_extra_fields(profile, match.group())) is not None:
@@ -1004,12 +1033,14 @@ def _own_protocol_found(result: ProbeResult, text: str, baud: int) -> bool:
             result.profile, result.baudrate = profile, baud
             if profile == "default" and not checksum:
                 result.extra_lines = ["[dome.serial.default]", "checksum = false"]
+            # no codec of the profile accepts it (tried above): the check would fail on it
+            result.unusable = "its boot banner has fields after the LED count"
             result.note = (
                 f"its banner {match.group().strip()!r} carries {len(fields)} field(s) more than "
                 f"rti-rig's {profile} protocol's id, version and LED count "
                 f"({', '.join(repr(f) for f in fields)}), which rti-rig reads as a damaged "
                 "banner: end the firmware's banner at the LED count, as "
-                "docs/protocols/led-dome.md writes it, then run rti-rig check"
+                f"docs/protocols/led-dome.md writes it, then run {result.check_command()}"
             )
             return True
     return False
