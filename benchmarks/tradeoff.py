@@ -97,6 +97,10 @@ class Row:
     #: (``benchmarks.tradeoff_from``; empty / NaN where not measured)
     file_model: str = ""
     file_psnr_db: float = float("nan")
+    #: the plan's lights, their candidate indices in the order chosen, space-separated: what
+    #: :func:`retime_arm` checks a plan made again against (a planner changed since the run
+    #: chooses other lights for the same row, whose scores are not the new plan's)
+    lights: str = ""
 
 
 @dataclass
@@ -402,12 +406,36 @@ def run_scene(
         if last_n is not None and n != last_n:
             progress(f"{data.name}: N={last_n} done")
         last_n = n
-        scores = score_plan(data, idx)
-        dome_s, arm_s = session_times(data.candidate_dirs[idx], dome_rig, arm_rig)
-        rows.append(Row(data.name, method, objective, n, floor, *scores, dome_s, arm_s, plan_s))
+        rows.append(measured_row(data, method, objective, n, floor, idx, plan_s, dome_rig, arm_rig))
     if last_n is not None:
         progress(f"{data.name}: N={last_n} done")
     return rows
+
+
+def lights_word(idx: Iterable[int]) -> str:
+    """A plan's lights as results.csv's ``lights`` cell (:attr:`Row.lights`)."""
+    return " ".join(str(int(i)) for i in idx)
+
+
+def measured_row(
+    data: SceneData,
+    method: str,
+    objective: str,
+    n: int,
+    floor: float,
+    idx: NDArray[np.intp],
+    plan_s: float,
+    dome_rig: LoadedRig,
+    arm_rig: LoadedRig,
+) -> Row:
+    """One plan scored and timed: the whole of a row (the run's, and a re-timed run's row
+    whose plan changed since it was measured)."""
+    scores = score_plan(data, idx)
+    dome_s, arm_s = session_times(data.candidate_dirs[idx], dome_rig, arm_rig)
+    return Row(
+        data.name, method, objective, n, floor, *scores, dome_s, arm_s, plan_s,
+        lights=lights_word(idx),
+    )  # fmt: skip
 
 
 def retime_arm(
@@ -418,27 +446,22 @@ def retime_arm(
     scores kept (they do not depend on the arm). Minutes, where the whole run takes longer:
     for a change to the arm's timing, not to a plan or a score.
 
-    A row whose plan is no longer made (a planner that changed) is refused by name rather
-    than kept with a time of another plan."""
+    A row whose plan is made again with other lights than the run measured (a planner that
+    changed) is measured again whole, scores and times, and said by name: its scores had
+    been kept beside the new plan's arm time, a row of two plans (14 rows of the optimal
+    planner in docs/research/tradeoff.md's history). A run from before the ``lights`` column
+    does not say its plans, so each is scored again and compared: the same scores are the
+    same plan (kept as written), other scores a changed one. A row whose plan is no longer
+    made at all is refused by name rather than kept with a time of another plan."""
     import dataclasses
 
     path = folder / "results.csv"
     with path.open(newline="", encoding="utf-8") as f:
         recorded = list(csv.DictReader(f))
     fields = {f.name: f.type for f in dataclasses.fields(Row)}
-    arm_rig = shipped_rig(ARM_CONFIG)
-    timed: dict[tuple[str, str, str, int, float], float] = {}
-    for scene in dict.fromkeys(r["scene"] for r in recorded):
-        data = render_scene_data(scene, s)
-        for method, objective, n, floor, idx, _ in plans(data, s):
-            key = (scene, method, objective, n, floor)
-            timed[key] = session_times(data.candidate_dirs[idx], arm_rig, arm_rig)[1]
-        progress(f"{scene}: arm times re-measured")
-    rows: list[Row] = []
-    for r in recorded:
-        key = (r["scene"], r["method"], r["objective"], int(r["n"]), float(r["floor_deg"]))
-        if key not in timed:
-            raise ValueError(f"{path}: no plan is made today for the row {key}")
+    dome_rig, arm_rig = shipped_rig(DOME_CONFIG), shipped_rig(ARM_CONFIG)
+
+    def as_row(r: dict[str, str]) -> Row:
         values: dict[str, Any] = {}
         for name, kind in fields.items():
             if name not in r:  # a column newer than the run (file_model): its default
@@ -450,9 +473,51 @@ def retime_arm(
                 values[name] = float(text) if text != "" else float("nan")
             else:
                 values[name] = text
-        values["arm_time_s"] = timed[key]
-        rows.append(Row(**values))
-    return rows
+        return Row(**values)
+
+    def key_of(r: dict[str, str]) -> tuple[str, str, str, int, float]:
+        return (r["scene"], r["method"], r["objective"], int(r["n"]), float(r["floor_deg"]))
+
+    done: dict[int, Row] = {}  # by the row's place in results.csv
+    for scene in dict.fromkeys(r["scene"] for r in recorded):
+        data = render_scene_data(scene, s)
+        made = {
+            (scene, method, objective, n, floor): (idx, plan_s)
+            for method, objective, n, floor, idx, plan_s in plans(data, s)
+        }
+        changed: list[str] = []
+        for i, r in enumerate(recorded):
+            if r["scene"] != scene:
+                continue
+            key = key_of(r)
+            if key not in made:
+                raise ValueError(f"{path}: no plan is made today for the row {key}")
+            idx, plan_s = made[key]
+            row = as_row(r)
+            said = r.get("lights", "")
+            if said == lights_word(idx):
+                row.arm_time_s = session_times(data.candidate_dirs[idx], arm_rig, arm_rig)[1]
+                done[i] = row
+                continue
+            again = measured_row(data, *key[1:], idx, plan_s, dome_rig, arm_rig)
+            same = not said and all(
+                np.isclose(getattr(again, k), getattr(row, k), rtol=1e-9, equal_nan=True)
+                for k in ("normal_mean_deg", "normal_median_deg", "relight_psnr_db")
+            )
+            if same:  # a run from before the lights column, the same plan: its scores kept
+                row.arm_time_s, row.lights = again.arm_time_s, again.lights
+                done[i] = row
+                continue
+            done[i] = again
+            changed.append(f"{key[1]}/{key[2]} N={key[3]} floor {key[4]:g}°")
+        progress(f"{scene}: arm times re-measured")
+        if changed:
+            progress(
+                f"{scene}: {len(changed)} row(s) whose plan is not the one the run measured "
+                "(other lights, or other scores where results.csv has no lights column) were "
+                "measured again whole, scores and times: " + ", ".join(changed)
+            )
+    return [done[i] for i in range(len(recorded))]
 
 
 def best_floor(rows: Iterable[Row], scene: str) -> float:
@@ -698,6 +763,8 @@ def main(argv: list[str] | None = None, settings: TradeoffSettings | None = None
     path = args.retime_arm / "results.csv"
     with path.open(newline="", encoding="utf-8") as f:
         columns = next(csv.reader(f))
+    if "lights" not in columns:  # a run from before it: written now, its plans checked
+        columns.append("lights")
     rows = retime_arm(args.retime_arm, settings or TradeoffSettings())
     write_csv(rows, path, columns)
     plot(rows, args.retime_arm)

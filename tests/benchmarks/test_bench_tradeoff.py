@@ -248,7 +248,7 @@ def test_retime_arm_keeps_the_scores_and_remeasures_the_arm_column(rows, tmp_pat
     old.mkdir()
     with (tmp_path / "results.csv").open(newline="") as f:
         recorded = list(csv.DictReader(f))
-    columns = [c for c in recorded[0] if c not in ("file_model", "file_psnr_db")]
+    columns = [c for c in recorded[0] if c not in ("file_model", "file_psnr_db", "lights")]
     with (old / "results.csv").open("w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
         w.writeheader()
@@ -257,8 +257,52 @@ def test_retime_arm_keeps_the_scores_and_remeasures_the_arm_column(rows, tmp_pat
     main(["--retime-arm", str(old)], TINY)
     with (old / "results.csv").open(newline="") as f:
         rewritten = list(csv.DictReader(f))
-    assert list(rewritten[0]) == columns
+    # the run's columns kept, with the plans' lights it had not said (each plan scored again:
+    # the same scores, the same plan)
+    assert list(rewritten[0]) == [*columns, "lights"]
+    assert [r["lights"] for r in rewritten] == [r.lights for r in rows]
     assert [float(r["arm_time_s"]) for r in rewritten] == pytest.approx(
         [r.arm_time_s for r in rows]
     )
     assert [r["normal_mean_deg"] for r in rewritten] == [r["normal_mean_deg"] for r in recorded]
+
+
+def test_retime_arm_measures_again_a_row_whose_plan_changed(  # type: ignore[no-untyped-def]
+    rows, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A row the run measured on other lights than today's plan for it (a planner changed
+    since) is measured again whole and said by name: --retime-arm had kept its scores beside
+    the new plan's arm time, a row of two plans (docs/research/tradeoff.md's 14 rows). The
+    same for a run from before the lights column whose scores are not today's plan's."""
+    import csv
+
+    from benchmarks.tradeoff import main
+
+    kmeans8 = next(i for i, r in enumerate(rows) if r.method == "kmeans" and r.n == 8)
+    for name, tamper in (
+        ("lights", {"lights": "0 1 2 3 4 5 6 7", "normal_mean_deg": "42.0"}),
+        ("before", {"normal_mean_deg": "42.0"}),
+    ):
+        folder = tmp_path / name
+        write_csv(rows, folder / "results.csv")
+        with (folder / "results.csv").open(newline="") as f:
+            recorded = list(csv.DictReader(f))
+        recorded[kmeans8].update(tamper)
+        columns = [c for c in recorded[0] if name == "lights" or c != "lights"]
+        with (folder / "results.csv").open("w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
+            w.writeheader()
+            w.writerows(recorded)
+        main(["--retime-arm", str(folder)], TINY)
+        said = " ".join(capsys.readouterr().out.split())
+        assert "1 row(s) whose plan is not the one the run measured" in said, said
+        assert "were measured again whole, scores and times: kmeans/normals N=8 floor 0°" in said
+        with (folder / "results.csv").open(newline="") as f:
+            rewritten = list(csv.DictReader(f))
+        assert float(rewritten[kmeans8]["normal_mean_deg"]) == pytest.approx(
+            rows[kmeans8].normal_mean_deg
+        )
+        assert rewritten[kmeans8]["lights"] == rows[kmeans8].lights
+        assert [float(r["arm_time_s"]) for r in rewritten] == pytest.approx(
+            [r.arm_time_s for r in rows]
+        )
