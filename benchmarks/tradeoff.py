@@ -328,9 +328,14 @@ def _clamp_to_band(d: NDArray[np.float64], arm: ArmGeometry) -> NDArray[np.float
     return direction_from_az_el(float(az), el)
 
 
-def run_tradeoff(s: TradeoffSettings, progress: Callable[[str], None] = print) -> list[Row]:
-    """Run the whole benchmark; returns one row per (scene, method, objective, floor, N)."""
-    rows: list[Row] = []
+def run_tradeoff(
+    s: TradeoffSettings, progress: Callable[[str], None] = print, done: list[Row] | None = None
+) -> list[Row]:
+    """Run the whole benchmark; returns one row per (scene, method, objective, floor, N).
+
+    ``done``: a list the rows are added to a whole scene at a time, so a caller stopped
+    midway (``bench tradeoff``'s Ctrl-C) keeps the scenes measured whole (minutes each)."""
+    rows: list[Row] = [] if done is None else done
     for scene in s.scenes:
         t0 = time.perf_counter()
         data = render_scene_data(scene, s)
@@ -654,11 +659,17 @@ def plot(rows: list[Row], out_dir: Path) -> list[Path]:
     return paths
 
 
-def summarise(rows: list[Row], s: TradeoffSettings, seconds: float, command: str) -> str:
-    """The markdown summary: tables per scene and plain statements of who wins where."""
+def summarise(
+    rows: list[Row], s: TradeoffSettings, seconds: float, command: str, stopped: str = ""
+) -> str:
+    """The markdown summary: tables per scene and plain statements of who wins where.
+
+    ``stopped``: what a run stopped midway measured and what it did not, said first (its
+    scenes are then those measured whole)."""
     lines = [
         "# Speed/accuracy trade-off",
         "",
+        *([f"**{stopped}**", ""] if stopped else []),
         f"Measured with `{command}` in {seconds:.0f} s. Scenes {', '.join(s.scenes)} at "
         f"{s.size_px}×{s.size_px} px; candidates: {s.candidates} homogeneous dome positions "
         f"(3°–87°); relighting reference: {s.held_out_lights} held-out lights of a "

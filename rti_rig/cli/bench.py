@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import signal
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out, print_notes, shown_path
+from rti_rig.cli.app import app, err, fail, out, print_notes, shown_path, stop_exit_code
+from rti_rig.cli.stopping import Terminated, sigterm_stops, stop_signal
+from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import (
     ensure_writable_folder,
@@ -17,6 +21,9 @@ from rti_rig.core.out_folders import (
     refuse_a_file_in_the_way,
 )
 from rti_rig.core.shell_words import shell_word
+
+if TYPE_CHECKING:
+    from benchmarks.tradeoff import Row, TradeoffSettings
 
 bench_app = typer.Typer(
     help="Benchmarks: the speed/accuracy trade, on the simulator or on your own acquisition."
@@ -209,6 +216,50 @@ def _nothing_written(options: str) -> str:
     )
 
 
+def _stopped_midway(
+    rows: list[Row],
+    settings: TradeoffSettings,
+    out_dir: Path | None,
+    command: str,
+    seconds: float,
+    signum: signal.Signals,
+) -> None:
+    """A stopped simulated trade-off: the scenes measured whole (``rows``) written and said as
+    a partial table, the scene cut short and those not begun named. Why whole scenes only: a
+    scene's verdicts compare its plans across every N, which a cut-short scene lacks."""
+    from benchmarks.tradeoff import plot, summarise, write_csv
+
+    why = stop_words(signum)
+    measured = tuple(dict.fromkeys(r.scene for r in rows))
+    missing = [s for s in settings.scenes if s not in measured]
+    if not measured:
+        where = "" if out_dir is None else f" to {shown_path(out_dir)}"
+        err.print(
+            f"Stopped ({why}) before a scene was measured whole: nothing written{where}",
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
+        return
+    said = (
+        f"Stopped ({why}): {len(measured)} of {len(settings.scenes)} scenes measured whole "
+        f"({', '.join(measured)}); not measured: {', '.join(missing)}"
+    )
+    text = summarise(rows, replace(settings, scenes=measured), seconds, command, said)
+    if out_dir is not None:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        write_csv(rows, out_dir / "results.csv")
+        plot(rows, out_dir)
+        (out_dir / "summary.md").write_text(text, encoding="utf-8")
+    _plain(text)
+    kept = (
+        "nothing written"
+        if out_dir is None
+        else f"the partial results are in {shown_path(out_dir)} (summary.md says it is partial)"
+    )
+    err.print(f"{said}; {kept}", markup=False, highlight=False, soft_wrap=True)
+
+
 def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bool) -> None:
     """The body of ``bench tradeoff``, once the command has found the benchmarks."""
     import time
@@ -253,12 +304,21 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
 
     settings = TradeoffSettings.quick() if quick else TradeoffSettings()
     t0 = time.perf_counter()
-    rows = run_tradeoff(settings, progress=_plain)
+    rows: list[Row] = []
     command = "rti-rig bench tradeoff" + (" --quick" if quick else "")
     if out_dir is not None:
         # one shell word, as the command is pasted from summary.md (a folder with a space had
         # been written bare, and pasted ran into two arguments)
         command += f" --out {shell_word(out_dir)}" + (" --force" if force else "")
+    try:
+        with sigterm_stops():
+            run_tradeoff(settings, progress=_plain, done=rows)
+    except (KeyboardInterrupt, Terminated) as exc:
+        # the scenes measured whole are kept and said (a Ctrl-C after minutes had said only
+        # "stopped (Ctrl-C)": every scene measured was lost, --out left empty)
+        signum = stop_signal(exc)
+        _stopped_midway(rows, settings, out_dir, command, time.perf_counter() - t0, signum)
+        raise typer.Exit(code=stop_exit_code(signum)) from None
     text = summarise(rows, settings, time.perf_counter() - t0, command)
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)

@@ -90,7 +90,9 @@ def test_bench_writes_nothing_unless_asked(  # type: ignore[no-untyped-def]
     from rti_rig.cli import app
 
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(tradeoff, "run_tradeoff", lambda settings, progress: rows)
+    monkeypatch.setattr(
+        tradeoff, "run_tradeoff", lambda settings, progress, done: done.extend(rows) or rows
+    )
     r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick"])
     assert r.exit_code == 0, r.output
     assert list(tmp_path.rglob("*")) == []
@@ -306,3 +308,43 @@ def test_retime_arm_measures_again_a_row_whose_plan_changed(  # type: ignore[no-
         assert [float(r["arm_time_s"]) for r in rewritten] == pytest.approx(
             [r.arm_time_s for r in rows]
         )
+
+
+def test_a_stopped_run_keeps_and_says_the_scenes_measured_whole(  # type: ignore[no-untyped-def]
+    rows, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C in the second scene of `bench tradeoff --quick --out` keeps the first scene's
+    table in --out, says it is partial (and which scenes it lacks), exit 130: it had said only
+    "stopped (Ctrl-C)", every scene measured lost and the --out folder left empty."""
+    from types import SimpleNamespace
+
+    from typer.testing import CliRunner
+
+    import benchmarks.tradeoff as tradeoff
+    from rti_rig.cli import app
+
+    def scene(data, settings, progress):  # type: ignore[no-untyped-def]
+        if data.name != "painting":
+            raise KeyboardInterrupt
+        return rows
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(tradeoff, "render_scene_data", lambda name, s: SimpleNamespace(name=name))
+    monkeypatch.setattr(tradeoff, "run_scene", scene)
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick", "--out", "part"])
+    assert r.exit_code == 130, r.output
+    said = " ".join(r.output.split())
+    stopped = "Stopped (Ctrl-C): 1 of 4 scenes measured whole (painting); not measured: coin, "
+    assert stopped + "tilted, industrial; the partial results are in part" in said, said
+    summary = (tmp_path / "part" / "summary.md").read_text(encoding="utf-8")
+    assert stopped in summary and "## painting" in summary and "## coin" not in summary
+    assert "Scenes painting at" in summary, summary
+    written = (tmp_path / "part" / "results.csv").read_text(encoding="utf-8")
+    assert written.count("\n") == len(rows) + 1
+    # stopped in the first scene: nothing measured whole, nothing written, said so
+    monkeypatch.setattr(
+        tradeoff, "run_scene", lambda *_a: scene(SimpleNamespace(name="x"), *_a[1:])
+    )
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick"])
+    assert r.exit_code == 130, r.output
+    assert "Stopped (Ctrl-C) before a scene was measured whole: nothing written" in r.output
