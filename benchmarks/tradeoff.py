@@ -659,6 +659,24 @@ def plot(rows: list[Row], out_dir: Path) -> list[Path]:
     return paths
 
 
+def _time_words() -> str:
+    """What the session time (results.csv's ``dome_time_s``, ``arm_time_s``; the ``*_time``
+    plots) counts, with the shipped configs' own figures. Why: the summary had said nothing
+    of it, and a reader took it for the whole session a user waits (it is the rig time
+    ``rti-rig run`` reports for the plan's lights, measured equal on both configs)."""
+    dome, arm = shipped_rig(DOME_CONFIG), shipped_rig(ARM_CONFIG)
+    return (
+        "Session time (results.csv's dome_time_s and arm_time_s, the *_time plots) is the rig "
+        'time `rti-rig run` reports ("Session time on the real rig") for the plan\'s lights: '
+        f"on rig_configs/{DOME_CONFIG} {per_light_s(dome):.2f} s a light (LED switch, settle, "
+        f"exposure, readout, transfer); on rig_configs/{ARM_CONFIG} "
+        f"{per_light_s(arm) + arm.config.timing.light_switch_s:.2f} s a light (its settle, the "
+        "lamp switched on and off) plus the arm's moves in run's order, its park and a "
+        "lamp-off at each end. It leaves out connecting, the preview, planning (results.csv's "
+        "plan_s), writing and fitting."
+    )
+
+
 def summarise(
     rows: list[Row], s: TradeoffSettings, seconds: float, command: str, stopped: str = ""
 ) -> str:
@@ -675,8 +693,12 @@ def summarise(
         f"(3°–87°); relighting reference: {s.held_out_lights} held-out lights of a "
         f"{s.ground_truth_lights}-light homogeneous acquisition; preview lit from az/el "
         f"{s.preview_light_az_el_deg[0]:g}°/{s.preview_light_az_el_deg[1]:g}°. Normal error is "
-        "the mean over all pixels of robust photometric stereo (unsolved pixels count); "
-        "relighting uses the model chosen from the acquired images by held-out error.",
+        "the mean angle to the scene's true normals over all pixels of robust photometric "
+        "stereo (unsolved pixels count); relighting PSNR is against noise-free renders under "
+        "the held-out lights, with the model chosen from the acquired images by held-out "
+        "error.",
+        "",
+        _time_words(),
         "",
     ]
     verdicts: list[str] = []

@@ -112,6 +112,17 @@ def test_bench_writes_nothing_unless_asked(  # type: ignore[no-untyped-def]
     # the command in the summary pastes back as run (the folder had been written bare)
     summary = (tmp_path / "my res" / "summary.md").read_text(encoding="utf-8")
     assert "`rti-rig bench tradeoff --quick --out 'my res'`" in summary, summary
+    # it says against what truth it scores and what its session time counts, the shipped
+    # dome's own figure (it had said neither: the time read as the whole session a user waits)
+    said = " ".join(summary.split())
+    assert "the mean angle to the scene's true normals" in said, said
+    assert "against noise-free renders under the held-out lights" in said, said
+    per_light = per_light_s(shipped_rig(DOME_CONFIG))
+    assert (
+        'is the rig time `rti-rig run` reports ("Session time on the real rig") for the '
+        f"plan's lights: on rig_configs/simulated_dome.toml {per_light:.2f} s a light" in said
+    ), said
+    assert "It leaves out connecting, the preview, planning" in said, said
 
 
 def test_fault_campaign_writes_its_report_only_when_asked(
