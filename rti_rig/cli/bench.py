@@ -246,7 +246,12 @@ def _stopped_midway(
         f"({', '.join(measured)}); not measured: {', '.join(missing)}"
     )
     text = summarise(rows, replace(settings, scenes=measured), seconds, command, said)
-    if out_dir is not None:
+    # a folder given with --force that holds a run's results keeps them: a whole run's table
+    # is not replaced by a part of one
+    held = out_dir is not None and any(
+        (out_dir / name).exists() for name in ("results.csv", "summary.md")
+    )
+    if out_dir is not None and not held:
         out_dir.mkdir(parents=True, exist_ok=True)
         write_csv(rows, out_dir / "results.csv")
         plot(rows, out_dir)
@@ -255,6 +260,9 @@ def _stopped_midway(
     kept = (
         "nothing written"
         if out_dir is None
+        else f"the results already in {shown_path(out_dir)} are left as they were (the partial "
+        "table is printed above)"
+        if held
         else f"the partial results are in {shown_path(out_dir)} (summary.md says it is partial)"
     )
     err.print(f"{said}; {kept}", markup=False, highlight=False, soft_wrap=True)

@@ -352,6 +352,12 @@ def test_a_stopped_run_keeps_and_says_the_scenes_measured_whole(  # type: ignore
     assert "Scenes painting at" in summary, summary
     written = (tmp_path / "part" / "results.csv").read_text(encoding="utf-8")
     assert written.count("\n") == len(rows) + 1
+    # a folder of earlier results, given with --force: kept as they were, not replaced by a part
+    (tmp_path / "part" / "summary.md").write_text("a whole run's\n", encoding="utf-8")
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick", "--out", "part", "--force"])
+    assert r.exit_code == 130, r.output
+    assert "the results already in part are left as they were" in " ".join(r.output.split())
+    assert (tmp_path / "part" / "summary.md").read_text(encoding="utf-8") == "a whole run's\n"
     # stopped in the first scene: nothing measured whole, nothing written, said so
     monkeypatch.setattr(
         tradeoff, "run_scene", lambda *_a: scene(SimpleNamespace(name="x"), *_a[1:])
