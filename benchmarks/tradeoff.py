@@ -23,7 +23,7 @@ from __future__ import annotations
 import csv
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -444,7 +444,10 @@ def measured_row(
 
 
 def retime_arm(
-    folder: Path, s: TradeoffSettings, progress: Callable[[str], None] = print
+    folder: Path,
+    s: TradeoffSettings,
+    progress: Callable[[str], None] = print,
+    remeasured: list[str] | None = None,
 ) -> list[Row]:
     """Re-measure the arm time column of a run's ``results.csv`` in ``folder`` alone, and its
     two ``*_vs_arm_time.png`` plots: every plan made again, timed on :data:`ARM_CONFIG`, its
@@ -457,7 +460,8 @@ def retime_arm(
     planner in docs/research/tradeoff.md's history). A run from before the ``lights`` column
     does not say its plans, so each is scored again and compared: the same scores are the
     same plan (kept as written), other scores a changed one. A row whose plan is no longer
-    made at all is refused by name rather than kept with a time of another plan."""
+    made at all is refused by name rather than kept with a time of another plan.
+    ``remeasured``: gets each row measured again whole, by name."""
     import dataclasses
 
     path = folder / "results.csv"
@@ -516,6 +520,8 @@ def retime_arm(
             done[i] = again
             changed.append(f"{key[1]}/{key[2]} N={key[3]} floor {key[4]:g}°")
         progress(f"{scene}: arm times re-measured")
+        if remeasured is not None:
+            remeasured += [f"{scene} {c}" for c in changed]
         if changed:
             progress(
                 f"{scene}: {len(changed)} row(s) whose plan is not the one the run measured "
@@ -780,9 +786,17 @@ def main(argv: list[str] | None = None, settings: TradeoffSettings | None = None
 
     The whole run is ``rti-rig bench tradeoff --out FOLDER``; this re-measures a full run's
     arm times (:func:`retime_arm`) in place after a change to the arm's timing, and rewrites
-    results.csv and the plots from it (the scores and the dome's plots are unchanged).
-    ``settings``: the run's (the full run's by default; a test's smaller one)."""
+    results.csv and the plots from it (the scores and the dome's plots are unchanged), and
+    summary.md when a row was measured again whole (its tables had kept the old plan's
+    scores). ``settings``: the run's (the full run's by default; a test's smaller one).
+
+    A folder that is not a full simulated run is refused by name, as is a missing
+    results.csv (a traceback had reached the user): a ``--quick`` run's plans are not the
+    full settings' (120 candidates, not 240) and a ``--from`` run has no arm column."""
     import argparse
+    import re
+
+    from rti_rig.core.shell_words import shell_word
 
     ap = argparse.ArgumentParser(description=main.__doc__.split("\n")[0] if main.__doc__ else "")
     ap.add_argument(
@@ -793,14 +807,36 @@ def main(argv: list[str] | None = None, settings: TradeoffSettings | None = None
         help="a full run's folder (results.csv): re-measure its arm time column and arm plots",
     )
     args = ap.parse_args(argv)
-    path = args.retime_arm / "results.csv"
-    with path.open(newline="", encoding="utf-8") as f:
-        columns = next(csv.reader(f))
+    folder: Path = args.retime_arm
+    path = folder / "results.csv"
+    summary = folder / "summary.md"
+    try:
+        with path.open(newline="", encoding="utf-8") as f:
+            columns = next(csv.reader(f))
+        said = summary.read_text(encoding="utf-8") if summary.is_file() else ""
+    except (OSError, StopIteration, UnicodeDecodeError) as exc:
+        ap.error(f"{shell_word(path)}: {getattr(exc, 'strerror', None) or 'empty or not text'}")
+    measured = re.search(r"Measured with `(.+?)` in (\d+) s", said)
+    if settings is None and said and (measured is None or "--quick" in measured[1]):
+        ap.error(
+            f"{shell_word(folder)} is not a full simulated run (its summary.md says "
+            + ("a --quick one" if measured else "another command")
+            + "): --retime-arm re-times the full run's plans; run the benchmark again instead"
+        )
     if "lights" not in columns:  # a run from before it: written now, its plans checked
         columns.append("lights")
-    rows = retime_arm(args.retime_arm, settings or TradeoffSettings())
+    remeasured: list[str] = []
+    try:
+        rows = retime_arm(folder, settings or TradeoffSettings(), remeasured=remeasured)
+    except (KeyError, ValueError) as exc:
+        ap.error(f"{shell_word(path)}: {exc}")
     write_csv(rows, path, columns)
-    plot(rows, args.retime_arm)
+    plot(rows, folder)
+    if remeasured and measured is not None:
+        scenes = tuple(dict.fromkeys(r.scene for r in rows))
+        s = replace(settings or TradeoffSettings(), scenes=scenes)
+        summary.write_text(summarise(rows, s, float(measured[2]), measured[1]), encoding="utf-8")
+        print(f"{shell_word(summary)} rewritten: {len(remeasured)} row(s) measured again whole")
 
 
 if __name__ == "__main__":

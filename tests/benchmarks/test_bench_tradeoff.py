@@ -306,8 +306,14 @@ def test_retime_arm_measures_again_a_row_whose_plan_changed(  # type: ignore[no-
             w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
             w.writeheader()
             w.writerows(recorded)
+        (folder / "summary.md").write_text("Measured with `rti-rig bench tradeoff` in 5 s.\n")
         main(["--retime-arm", str(folder)], TINY)
         said = " ".join(capsys.readouterr().out.split())
+        # its tables are written again from the rows as they now are (they had the old scores)
+        assert f"{folder / 'summary.md'} rewritten: 1 row(s) measured again whole" in said, said
+        summary = (folder / "summary.md").read_text()
+        assert "## painting" in summary and "42.00" not in summary, summary
+        assert "Measured with `rti-rig bench tradeoff` in 5 s" in summary, summary
         assert "1 row(s) whose plan is not the one the run measured" in said, said
         assert "were measured again whole, scores and times: kmeans/normals N=8 floor 0°" in said
         with (folder / "results.csv").open(newline="") as f:
@@ -365,3 +371,26 @@ def test_a_stopped_run_keeps_and_says_the_scenes_measured_whole(  # type: ignore
     r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick"])
     assert r.exit_code == 130, r.output
     assert "Stopped (Ctrl-C) before a scene was measured whole: nothing written" in r.output
+
+
+def test_retime_arm_refuses_by_name_what_is_not_a_full_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A --quick run's folder (its plans are made on 120 candidates, not the full run's 240:
+    every row would have been timed on another plan) and a folder without results.csv are
+    refused by name, exit 2, before anything is rendered (the second had been a traceback)."""
+    from benchmarks.tradeoff import main
+
+    (tmp_path / "results.csv").write_text("scene,method\n", encoding="utf-8")
+    (tmp_path / "summary.md").write_text(
+        "Measured with `rti-rig bench tradeoff --quick --out q` in 40 s.\n", encoding="utf-8"
+    )
+    for folder, words in (
+        (tmp_path, "is not a full simulated run (its summary.md says a --quick one)"),
+        (tmp_path / "none", "results.csv: No such file or directory"),
+    ):
+        with pytest.raises(SystemExit) as stop:
+            main(["--retime-arm", str(folder)])
+        assert stop.value.code == 2
+        said = " ".join(capsys.readouterr().err.split())
+        assert f"{folder}" in said and words in said, said
