@@ -300,7 +300,22 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
             raise fail(exc) from None
     if from_lp is not None:
         try:
-            text = bench_from(from_lp, out_dir, _plain, force=force)
+            with sigterm_stops():
+                text = bench_from(from_lp, out_dir, _plain, force=force)
+        except (KeyboardInterrupt, Terminated) as exc:
+            # said, with what is on disk (only "stopped (Ctrl-C)" had been, an --out folder
+            # left empty without a word): the trade on an acquisition is written at its end
+            signum = stop_signal(exc)
+            where = "" if out_dir is None else f" to {shown_path(out_dir)}"
+            err.print(
+                f"Stopped ({stop_words(signum)}) during the trade on {shown_path(from_lp)}: "
+                f"nothing written{where} (its results are written once every layout is "
+                "measured)",
+                markup=False,
+                highlight=False,
+                soft_wrap=True,
+            )
+            raise typer.Exit(code=stop_exit_code(signum)) from None
         except RtiRigError as exc:
             raise fail(exc) from None
         except ValueError as exc:

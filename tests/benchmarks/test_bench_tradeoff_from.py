@@ -13,6 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.core.shell_words import shown_path
 
 ACQ = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay" / "dirs.lp"
 
@@ -711,3 +712,27 @@ def test_the_fits_trust_notes_are_sentences_said_once(tmp_path: Path) -> None:
     assert any("fit ridge-regularised" in n for n in notes), r.output  # the premise
     assert not [n for n in notes if "Warning" in n], notes
     assert len(notes) == len(set(notes)), notes
+
+
+def test_a_stop_during_the_trade_on_an_acquisition_says_nothing_was_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C during `bench tradeoff --from --out` says the --out holds nothing of it (it is
+    written at the end), exit 130: only "stopped (Ctrl-C)" had been said, the folder left
+    empty. The trade-off is a stand-in stopped midway."""
+    import benchmarks.tradeoff_from as tradeoff_from
+
+    lp = _acquisition(tmp_path / "acq")
+
+    def bench_from(*_args: object, **_kwargs: object) -> str:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(tradeoff_from, "bench_from", bench_from)
+    out = tmp_path / "my out"
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out)])
+    assert r.exit_code == 130, r.output
+    said = " ".join(r.output.split())
+    assert (
+        f"Stopped (Ctrl-C) during the trade on {shown_path(lp)}: nothing written to "
+        f"{shown_path(out)} (its results are written once every layout is measured)" in said
+    ), said
