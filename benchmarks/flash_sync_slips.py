@@ -2,10 +2,12 @@
 
 The shipped ``rig_configs/emulated_cceh_rti.toml`` (the cceh/rti emulator fired by the simulated
 camera's PC-sync contact; 60 LEDs in the firmware's order), on several simulated scenes, with
-one fault injected at a chosen image: a lost flash pulse (``missed_pulse``) or a bounced one
-(``double_step``). Each session runs through the product's own path (the rig the composition
-root builds, the controller, the slip guard) into a temporary folder; then the emulator's record
-(which LED really lit each exposure) is compared with the session's ``lights.lp``.
+one fault injected at a chosen image: a lost flash pulse (``missed_pulse``), a bounced one
+(``double_step``) or the dome's power cut and back just before it (``power_cycle``: the
+firmware starts its order again from LED 0). Each session runs through the product's own
+path (the rig the composition root builds, the controller, the slip guard) into a temporary
+folder; then the emulator's record (which LED really lit each exposure) is compared with the
+session's ``lights.lp``.
 
 Printed per scene and fault: how many slips were caught **at the slipped image** (nothing
 mislabelled), **late with the session disowned** (the images between are in ``lights.lp`` with
@@ -107,7 +109,7 @@ def _option(argv: list[str], name: str, default: tuple[str, ...]) -> tuple[str, 
 def main(argv: list[str]) -> None:
     quick = "--quick" in argv
     scenes = _option(argv, "--scenes", SCENES)
-    kinds = _option(argv, "--kinds", ("missed_pulse", "double_step"))
+    kinds = _option(argv, "--kinds", ("missed_pulse", "double_step", "power_cycle"))
     positions = range(2, 60, 12) if quick else range(1, 60, 4)
     print(
         f"config {CONFIG.name}; scenes {list(scenes)}; fault positions (image, 1-based): "
