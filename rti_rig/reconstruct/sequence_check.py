@@ -22,7 +22,10 @@ Evidence, cheapest first, on the grey image reduced to at most :data:`SIDE` pixe
    accepted so far, then the prediction ``rho max(0, n . l)`` of this image under the expected
    LED and under the LEDs before and after it in the order, each with a free gain. A neighbour
    whose relative residual is below :data:`SLIP_RATIO` of the expected LED's is a slip: the
-   next LED means a double step, the previous one a missed step.
+   next LED means a double step, the previous one a missed step. The previous LED lit the last
+   image of the fit, which the model reproduces better than any light it extrapolates to, so
+   it is judged by the fit without that image, and the image must be that image again
+   (:meth:`SequenceChecker._previous_judged_fairly`).
 
 3. **a slip before the neighbour test could run** (images :data:`SHIFT_FROM` + 1 to
    :data:`SHIFT_UNTIL` + 1): a double step in the first images shifts every later image by
@@ -135,7 +138,7 @@ def reduce_image(pixels: ArrayLike, white_level: float) -> NDArray[np.float32]:
     return cv2.resize(g, size, interpolation=cv2.INTER_AREA) if f > 1 else g.copy()
 
 
-def _pixel_residual(
+def pixel_residual(
     img: NDArray[np.float32], ref: NDArray[np.float32], use: NDArray[np.bool_] | None = None
 ) -> float:
     """Relative residual of ``img`` against ``ref`` up to a gain, over unsaturated pixels
@@ -270,7 +273,7 @@ class SequenceChecker:
             if (
                 fair is not None
                 and fair[index - 1] <= SLIP_RATIO * fair[index]
-                and _pixel_residual(img, self._images[-1]) <= SLIP_RATIO * fair[index]
+                and pixel_residual(img, self._images[-1]) <= SLIP_RATIO * fair[index]
             ):
                 residuals, expected = fair, fair[index]  # its figures, not the biased ones
             else:
@@ -342,7 +345,7 @@ class SequenceChecker:
         use = (img < 1.0) & (first < 1.0) & (last < 1.0)
         if use.sum() < 10:
             return False
-        return _pixel_residual(img, first, use) < SLIP_RATIO * _pixel_residual(img, last, use)
+        return pixel_residual(img, first, use) < SLIP_RATIO * pixel_residual(img, last, use)
 
     def _whole_set_residual(self, stack: NDArray[np.float32], labels: list[int]) -> float:
         """Relative RMS residual of a least-squares photometric-stereo fit of ``stack``
