@@ -540,6 +540,57 @@ def _flat(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
     )
 
 
+#: The calibration sphere's radius, as a fraction of the image's shorter side.
+SPHERE_RADIUS = 0.3
+
+
+def sphere_circle(rows: int, cols: int) -> tuple[float, float, float]:
+    """The ``sphere`` scene's circle in image pixels: centre column, centre row, radius.
+
+    Pixel centres are at integer coordinates (column 0 is the first pixel's centre), as an
+    image viewer and OpenCV report them; what ``rti-rig lights-from-sphere --sphere`` takes."""
+    return ((cols - 1) / 2.0, (rows - 1) / 2.0, SPHERE_RADIUS * float(min(rows, cols)))
+
+
+def _sphere(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
+    """Black glossy calibration sphere on a matte grey ground: the highlight method's target.
+
+    Why analytic normals (not finite differences of the height, as the other scenes): the
+    scene is the truth a light-direction calibration is measured against, and differenced
+    normals are off by up to a degree where the sphere curves fastest."""
+    u, v, s = _frame_grid(rows, cols)
+    rad = np.hypot(u, v) / SPHERE_RADIUS  # 1 on the rim
+    on = rad < 1.0
+    nz = np.sqrt(np.clip(1.0 - rad * rad, 0.0, 1.0))
+    normals = np.zeros((rows, cols, 3))
+    normals[..., 0] = np.where(on, u / SPHERE_RADIUS, 0.0)
+    normals[..., 1] = np.where(on, v / SPHERE_RADIUS, 0.0)
+    normals[..., 2] = np.where(on, nz, 1.0)
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    height = np.where(on, SPHERE_RADIUS * s * nz, 0.0)
+    oc = on[..., None].astype(np.float64)
+    albedo = _fill((rows, cols), (0.35, 0.35, 0.35)) * (1 - oc) + 0.01 * oc
+    spec = _fill((rows, cols), (0.04, 0.04, 0.04)) * oc  # black glass: F0 of n = 1.5
+    rough = np.where(on, 0.12, 1.0)
+    cx, cy, r = sphere_circle(rows, cols)
+    return Scene(
+        name="sphere",
+        seed=seed,
+        height=height,
+        normals=normals,
+        albedo=albedo,
+        specular_albedo=spec,
+        roughness=rough,
+        passes=frozenset({"specular"}),
+        pixel_size_mm=pixel_mm,
+        material="black glass sphere (GGX, sharp lobe) on matte grey",
+        description="A black glossy sphere of radius 0.3 of the short side at the image "
+        "centre, for light calibration by its highlight (rti-rig lights-from-sphere): the "
+        "highlight sits where the sphere's normal is the half-vector of light and view.",
+        metadata={"sphere_circle_px": (cx, cy, r)},
+    )
+
+
 _BUILDERS: dict[str, Callable[[int, int, int, float], Scene]] = {
     "painting": _painting,
     "tablet": _tablet,
@@ -547,6 +598,7 @@ _BUILDERS: dict[str, Callable[[int, int, int, float], Scene]] = {
     "tilted": _tilted,
     "industrial": _industrial,
     "flat": _flat,
+    "sphere": _sphere,
 }
 
 #: Names accepted by :func:`make_scene`.
