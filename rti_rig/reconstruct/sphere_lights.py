@@ -1,0 +1,191 @@
+"""Light directions from a reflective sphere's highlight (the highlight method of RTI).
+
+Why: a dome's LED directions are what every fit and viewer reads from the ``.lp``; a new dome
+has none until they are measured. The standard measurement (Cultural Heritage Imaging's
+highlight method, RTIBuilder's and relight's sphere detection) puts a black glossy or chrome
+sphere in frame: in each image the mirror highlight sits where the sphere's normal n is the
+half-vector of the light l and the view v, so ``l = 2 (n·v) n − v``.
+
+Conventions (docs/conventions.md): the camera is taken as orthographic, v = (0, 0, 1); the
+frame has x to the image's right and y to its **top**, so image rows run against y. Circle and
+highlight positions are in image pixels with pixel centres at integer coordinates (column 0 is
+the first pixel's centre), as an image viewer and OpenCV report them.
+
+Pure: arrays in, directions or a reason out. Nothing here reads a file or guesses a direction:
+an image whose highlight cannot be measured is rejected with why, never given a direction.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+#: A highlight whose blob reaches beyond this fraction of the radius is "on the rim": there the
+#: normal changes fastest with position and the sphere's edge (and whatever lies behind it)
+#: blends in, so a direction from it would be a guess.
+RIM_FRACTION = 0.95
+#: The blob is the pixels at least this fraction of the peak's height above the disc's median
+#: (half maximum: the lobe's core, not its skirt).
+BLOB_LEVEL = 0.5
+#: A peak must stand this many times the disc's median above it (and above the noise floor
+#: below) to be a highlight; a disc with no clear peak has none (the LED did not light, or the
+#: sphere is not where the circle says).
+MIN_CONTRAST = 4.0
+#: A blob of more than this fraction of the disc's area is too large to place: a saturated
+#: smear (over-exposure, a diffuse or scratched sphere) whose centroid is not the peak.
+MAX_BLOB_FRACTION = 0.02
+
+
+class SphereCircleError(ValueError):
+    """The sphere's circle does not fit the images (outside the frame, or too small)."""
+
+
+@dataclass(frozen=True)
+class Circle:
+    """The sphere's outline in image pixels: centre column ``x``, centre row ``y``, radius."""
+
+    x: float
+    y: float
+    radius: float
+
+
+@dataclass(frozen=True)
+class Highlight:
+    """One image's highlight: its sub-pixel centre (column, row), its blob's area in pixels,
+    and the light direction it gives (unit, frame of docs/conventions.md)."""
+
+    column: float
+    row: float
+    area_px: int
+    direction: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Rejected:
+    """An image whose highlight gives no direction, and why, in words for the user."""
+
+    reason: str
+
+
+#: The smallest sphere radius measured: below it a pixel of highlight position is more than
+#: 7° of light direction.
+MIN_RADIUS_PX = 16.0
+
+
+def check_circle(circle: Circle, shape: tuple[int, int]) -> None:
+    """Refuse a circle that does not lie inside a ``(rows, cols)`` image or is too small."""
+    rows, cols = shape
+    if not all(math.isfinite(v) for v in (circle.x, circle.y, circle.radius)):
+        raise SphereCircleError("the circle's centre and radius must be numbers")
+    if circle.radius < MIN_RADIUS_PX:
+        raise SphereCircleError(
+            f"radius {circle.radius:g} px is too small to measure directions from (at least "
+            f"{MIN_RADIUS_PX:g} px: shoot the sphere larger in frame)"
+        )
+    if (
+        circle.x - circle.radius < -0.5
+        or circle.y - circle.radius < -0.5
+        or circle.x + circle.radius > cols - 0.5
+        or circle.y + circle.radius > rows - 0.5
+    ):
+        raise SphereCircleError(
+            f"the circle (centre {circle.x:g},{circle.y:g}, radius {circle.radius:g}) does not lie "
+            f"inside the {cols}×{rows} px images: the whole sphere must be in frame"
+        )
+
+
+def direction_at(circle: Circle, column: float, row: float) -> tuple[float, float, float]:
+    """The light direction whose mirror highlight is at (``column``, ``row``) on the sphere.
+
+    n = ((column − x)/R, −(row − y)/R, √(1 − ρ²)) (rows run against y), v = (0, 0, 1), and
+    l = 2 (n·v) n − v. Raises ValueError for a point outside the circle."""
+    nx = (column - circle.x) / circle.radius
+    ny = -(row - circle.y) / circle.radius
+    rho2 = nx * nx + ny * ny
+    if rho2 >= 1.0:
+        raise ValueError(f"({column:g}, {row:g}) is outside the sphere's circle")
+    nz = math.sqrt(1.0 - rho2)
+    lx, ly, lz = 2 * nz * nx, 2 * nz * ny, 2 * nz * nz - 1.0
+    norm = math.sqrt(lx * lx + ly * ly + lz * lz)
+    return (lx / norm, ly / norm, lz / norm)
+
+
+def find_highlight(
+    grey: NDArray[np.floating], circle: Circle, white_level: float
+) -> Highlight | Rejected:
+    """The highlight of one linear grey image on the sphere in ``circle``.
+
+    The blob is the 8-connected region around the disc's brightest pixel that stands at least
+    :data:`BLOB_LEVEL` of the peak's height above the disc's median; its centre is the centroid
+    of the blob weighted by that height above the level (sub-pixel, and a saturated plateau
+    gives its middle). ``white_level`` is the value of a clipped pixel, for the words only."""
+    rows, cols = grey.shape
+    check_circle(circle, (rows, cols))
+    r0, r1 = (
+        max(0, math.floor(circle.y - circle.radius)),
+        min(rows, math.ceil(circle.y + circle.radius) + 1),
+    )
+    c0, c1 = (
+        max(0, math.floor(circle.x - circle.radius)),
+        min(cols, math.ceil(circle.x + circle.radius) + 1),
+    )
+    patch = np.asarray(grey[r0:r1, c0:c1], dtype=np.float64)
+    yy, xx = np.mgrid[r0:r1, c0:c1].astype(np.float64)
+    dist = np.hypot(xx - circle.x, yy - circle.y) / circle.radius
+    disc = dist < 1.0
+    values = np.where(disc, patch, -np.inf)
+    peak = float(values.max())
+    floor = float(np.median(patch[disc]))
+    noise = float(np.median(np.abs(patch[disc] - floor))) * 1.4826
+    if not math.isfinite(peak) or peak - floor <= max((MIN_CONTRAST - 1.0) * floor, 6 * noise, 0.0):
+        return Rejected(
+            f"no highlight on the sphere (brightest {peak:.0f} against a median of {floor:.0f}): "
+            "did the LED light, and is the circle on the sphere?"
+        )
+    level = floor + BLOB_LEVEL * (peak - floor)
+    above = (values >= level).astype(np.uint8)
+    _, labels = cv2.connectedComponents(above, connectivity=8)
+    pr, pc = np.unravel_index(int(np.argmax(values)), values.shape)
+    blob = labels == labels[pr, pc]
+    area = int(blob.sum())
+    if area > MAX_BLOB_FRACTION * math.pi * circle.radius**2:
+        clipped = int((blob & (patch >= white_level)).sum())
+        return Rejected(
+            f"the highlight is a blob of {area} px ({clipped} of them clipped), more than "
+            f"{MAX_BLOB_FRACTION:.0%} of the sphere: shoot with a shorter exposure, or use a "
+            "glossier sphere"
+        )
+    if float(dist[blob].max()) > RIM_FRACTION:
+        return Rejected(
+            "the highlight is on the sphere's rim, where its position gives no reliable "
+            "direction (a light near or below the sphere's equator, or a reflection of the "
+            "ground): check the circle, or leave this LED to a later calibration"
+        )
+    weight = (patch - level)[blob]
+    column = float((xx[blob] * weight).sum() / weight.sum())
+    row = float((yy[blob] * weight).sum() / weight.sum())
+    direction = direction_at(circle, column, row)
+    if direction[2] <= 0.0:
+        return Rejected(
+            f"the highlight at column {column:.1f}, row {row:.1f} gives a light below the "
+            "object plane: check the circle (centre and radius)"
+        )
+    return Highlight(column, row, area, direction)
+
+
+def as_grey(image: NDArray[np.generic]) -> NDArray[np.float64]:
+    """An image's mean over its colour channels (a grey image is returned as floats)."""
+    arr = np.asarray(image)
+    if arr.ndim == 3:
+        return arr[..., :3].astype(np.float64).mean(axis=-1)
+    return arr.astype(np.float64)
+
+
+def angle_deg(a: tuple[float, float, float], b: tuple[float, float, float]) -> float:
+    """The angle between two unit directions, in degrees."""
+    dot = float(np.clip(np.dot(np.asarray(a), np.asarray(b)), -1.0, 1.0))
+    return math.degrees(math.acos(dot))
