@@ -325,3 +325,72 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
         out.print(
             "Then shoot the card again and calibrate that session: its spread is what is left."
         )
+
+
+def _parse_circle(text: str) -> tuple[float, float, float]:
+    """``"X,Y,R"`` → the sphere's centre column, centre row and radius in pixels."""
+    try:
+        x, y, r = (float(p) for p in text.replace(" ", "").split(","))
+    except ValueError:
+        raise RtiRigError(
+            f"--sphere {text!r}: give the sphere's circle as X,Y,R in image pixels (centre "
+            "column, centre row, radius; e.g. 2990,2010,850), as an image viewer shows them"
+        ) from None
+    return (x, y, r)
+
+
+@app.command("lights-from-sphere")
+def lights_from_sphere(
+    session: Annotated[
+        Path,
+        typer.Argument(
+            help="A session of a black glossy or chrome sphere shot under every LED "
+            "('rti-rig run').",
+            show_default=False,
+        ),
+    ],
+    sphere: Annotated[
+        str,
+        typer.Option(
+            "--sphere",
+            help="The sphere's circle in the images as X,Y,R: centre column, centre row and "
+            "radius, in pixels (row 0 at the top).",
+            show_default=False,
+        ),
+    ],
+    out_file: Annotated[
+        Path, typer.Option("--out", help="The dome's .lp to write.", show_default=False)
+    ],
+    force: Annotated[bool, typer.Option("--force", help="Replace an existing --out file.")] = False,
+) -> None:
+    """Measure each LED's direction from the sphere's highlight in a session (the highlight
+    method: l = 2(n·v)n − v, n the sphere's normal at the highlight) and write the dome's .lp,
+    line i = LED i, for layout = "lp" in its config. An image whose highlight cannot be
+    measured is named with why, and no .lp is written."""
+    from rti_rig.app.usecases.sphere_lights import SphereRequest
+    from rti_rig.app.usecases.sphere_lights import lights_from_sphere as measure
+    from rti_rig.reconstruct.sphere_lights import Circle
+
+    try:
+        request = SphereRequest(session, Circle(*_parse_circle(sphere)), out_file, force)
+        result = measure(request)
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    out.print(
+        f"Wrote {shown_path(result.out)}: {len(result.highlights)} LED directions measured "
+        f"from the sphere in {shown_path(session)} (line i = LED i).",
+        markup=False,
+        highlight=False,
+        soft_wrap=True,
+    )
+    try:
+        named = toml_basic_string(str(result.out.resolve()))
+    except NotTomlText:  # a name no TOML file can hold: the user copies the file to one
+        named = '"…" (copy the file to a UTF-8 name first)'
+    out.print(
+        f'To use it, set layout = "lp" and lp_file = {named} under [dome] in the dome\'s '
+        "config, in place of its count.",
+        markup=False,
+        highlight=False,
+        soft_wrap=True,
+    )

@@ -1,0 +1,155 @@
+"""`rti-rig lights-from-sphere`: a dome's LED directions from a session of a reflective sphere.
+
+Why: a new dome has no ``.lp`` yet. The user shoots one session under every LED with a black
+glossy or chrome sphere in frame (a dome config with ``layout = "fibonacci"`` and ``count`` =
+its LEDs stands in for the directions while shooting), and this measures each LED's direction
+from the sphere's highlight (:mod:`rti_rig.reconstruct.sphere_lights`) and writes the dome's
+``.lp``, line i = LED i, for ``layout = "lp"``. An LED whose highlight cannot be measured is
+named with why, and no ``.lp`` is written: a guessed line would be fitted as if measured.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rti_rig.app.usecases.run_options import run_words
+from rti_rig.core.errors import RtiRigError, SessionError
+from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.lp_format import LpEntry, write_lp
+from rti_rig.core.out_folders import free_folder_beside
+from rti_rig.core.shell_words import shown_path
+from rti_rig.reconstruct.sphere_lights import (
+    Circle,
+    Highlight,
+    Rejected,
+    SphereCircleError,
+    as_grey,
+    find_highlight,
+)
+from rti_rig.runtime.session import read_manifest
+
+
+@dataclass(frozen=True)
+class SphereRequest:
+    """What the command was asked: the session, the sphere's circle, the ``.lp`` to write."""
+
+    session: Path
+    circle: Circle
+    out: Path
+    force: bool = False
+
+
+@dataclass(frozen=True)
+class SphereLights:
+    """Each LED's image and highlight, in LED index order, and the ``.lp`` written."""
+
+    out: Path
+    images: tuple[str, ...]
+    highlights: tuple[Highlight, ...]
+
+
+def _steps_by_led(root: Path, manifest: dict[str, Any]) -> list[dict[str, Any]]:
+    """The session's captured steps in LED order, when it shot every LED of its dome once."""
+    rig = manifest.get("rig") or {}
+    if rig.get("kind") != "dome":
+        raise SessionError(
+            f"{shown_path(root)}: a session of the {rig.get('kind')!r} rig '{rig.get('name')}'; "
+            "light directions from a sphere are measured for a dome's LEDs"
+        )
+    count = len(((rig.get("identity") or {}).get("light_directions")) or [])
+    steps = manifest.get("steps") or []
+    by_led: dict[int, dict[str, Any]] = {}
+    for step in steps:
+        led = step.get("led")
+        if isinstance(led, int) and not isinstance(led, bool):
+            if led in by_led:
+                raise SessionError(
+                    f"{shown_path(root)}: LED {led} was shot twice ({by_led[led]['image']} and "
+                    f"{step.get('image')}): shoot the sphere once under every LED"
+                )
+            by_led[led] = step
+    missing = [k for k in range(count) if k not in by_led]
+    if not count or missing:
+        config = rig.get("config_path")
+        again = (
+            run_words(Path(config), free_folder_beside(root, "sphere"))
+            if isinstance(config, str) and config
+            else "rti-rig run with the dome's config"
+        )
+        said = ", ".join(str(k) for k in missing[:10]) + (" …" if len(missing) > 10 else "")
+        raise SessionError(
+            f"{shown_path(root)}: the session has images of {len(by_led)} of the dome's "
+            f"{count} LEDs (missing: {said or 'all'}); a dome's .lp needs every LED: shoot the "
+            f"sphere under all of them ({again}, without --lights or --plan)"
+        )
+    return [by_led[k] for k in range(count)]
+
+
+def _grey_image(root: Path, step: dict[str, Any]) -> tuple[np.ndarray, float, str]:
+    """A step's image as linear grey (its linear TIFF where the session kept one), the value
+    of a clipped pixel, and the image's name to say."""
+    import cv2
+
+    name = str(step.get("image"))
+    linear = step.get("linear_image")
+    path = root / str(linear) if linear and (root / str(linear)).is_file() else root / name
+    try:
+        if path.suffix.lower() in (".tif", ".tiff"):
+            pixels = read_linear_tiff(path)
+        else:
+            pixels = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    except Exception as exc:  # tifffile and OpenCV raise many kinds for a damaged file
+        raise SessionError(f"{shown_path(path)} cannot be read ({exc}): is it complete?") from None
+    if pixels is None:
+        raise SessionError(f"{shown_path(path)} cannot be read as an image: is it there?")
+    white = float(np.iinfo(pixels.dtype).max) if pixels.dtype.kind in "ui" else 1.0
+    return as_grey(pixels), white, name
+
+
+def lights_from_sphere(request: SphereRequest) -> SphereLights:
+    """Measure every LED's direction from the sphere session and write the dome's ``.lp``.
+
+    Raises :class:`SessionError` naming the session, the image or the file: a session that is
+    not a dome's, misses an LED, an image unreadable or without a usable highlight (all such
+    images listed, with why), or an ``--out`` that is there already without ``force``."""
+    root = Path(request.session)
+    out = Path(request.out)
+    lights_lp = root / "lights.lp"
+    if out.exists() and lights_lp.exists() and out.resolve() == lights_lp.resolve():
+        raise SessionError(
+            f"{shown_path(out)} is the session's own record of what ran: give --out another "
+            "file (e.g. my_dome.lp beside the dome's config)"
+        )
+    if out.exists() and not request.force:
+        raise SessionError(
+            f"{shown_path(out)} is there already: give --out another file, or add --force to "
+            "replace it (nothing was measured or written)"
+        )
+    steps = _steps_by_led(root, read_manifest(root))
+    found: list[Highlight] = []
+    names: list[str] = []
+    refused: list[str] = []
+    for led, step in enumerate(steps):
+        grey, white, name = _grey_image(root, step)
+        try:
+            result = find_highlight(grey, request.circle, white)
+        except SphereCircleError as exc:
+            raise RtiRigError(f"--sphere: {exc}") from None
+        if isinstance(result, Rejected):
+            refused.append(f"{name} (LED {led}): {result.reason}")
+        else:
+            found.append(result)
+            names.append(name)
+    if refused:
+        raise SessionError(
+            f"{shown_path(root)}: {len(refused)} of {len(steps)} images give no direction, so "
+            f"nothing was written to {shown_path(out)}:\n  " + "\n  ".join(refused)
+        )
+    width = max(2, len(str(len(found) - 1)))
+    entries = [LpEntry(f"led_{k:0{width}d}.jpg", h.direction) for k, h in enumerate(found)]
+    write_lp(out, entries)
+    return SphereLights(out, tuple(names), tuple(found))
