@@ -7,9 +7,9 @@ This is the one place in the core that imports ``simulator`` (and, as backends a
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from rti_rig.app.config import LoadedRig, rig_geometry
+from rti_rig.app.config import LoadedRig, emulated_led_directions, rig_geometry
 from rti_rig.core.clock import Clock, SystemClock, VirtualClock
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.runtime.duty_ledger import DutyLedger
@@ -83,17 +83,24 @@ def _simulated_camera(loaded: LoadedRig, state, clock: Clock):  # type: ignore[n
     )
 
 
+def _where_leds_are(loaded: LoadedRig, geometry: DomeGeometry) -> Any:
+    """Where the emulated dome's LEDs really are: ``[emulator] led_directions_file`` if set
+    (a dome shot on a stand-in layout), else where its config says."""
+    real = emulated_led_directions(loaded, geometry.count)
+    return geometry.directions if real is None else real
+
+
 class _FirmwareLight:
     """The light state the emulated dome firmware really produces, for the simulated camera."""
 
-    def __init__(self, firmware, geometry: DomeGeometry, max_level: int, power) -> None:  # type: ignore[no-untyped-def]
-        self._fw, self._geometry, self._max = firmware, geometry, max_level
+    def __init__(self, firmware, directions, max_level: int, power) -> None:  # type: ignore[no-untyped-def]
+        self._fw, self._directions, self._max = firmware, directions, max_level
         self._power = power  # each emulated LED's output relative to nominal
 
     @property
     def direction(self):  # type: ignore[no-untyped-def]
         lit = self._fw.lit
-        return None if lit is None else self._geometry.directions[lit[0]]
+        return None if lit is None else self._directions[lit[0]]
 
     @property
     def intensity(self) -> float:
@@ -143,7 +150,7 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
             loaded,
             _FirmwareLight(
                 firmware,
-                geometry,
+                _where_leds_are(loaded, geometry),
                 serial.max_level,
                 cfg.emulator.led_powers(geometry.count, cfg.scene.seed),
             ),
@@ -168,8 +175,11 @@ class _BoardLight:
     as these emulators model no current sensing (``reports_dead_leds`` concerns the project's
     own protocols)."""
 
-    def __init__(self, board, geometry: DomeGeometry, link, power, dead=frozenset()) -> None:  # type: ignore[no-untyped-def]
+    def __init__(
+        self, board, geometry: DomeGeometry, link, power, dead=frozenset(), directions=None
+    ) -> None:  # type: ignore[no-untyped-def]
         self._board, self._geometry, self._link = board, geometry, link
+        self._directions = geometry.directions if directions is None else directions
         self._power = power  # each emulated LED's output relative to nominal
         self._dead = frozenset(dead)  # LEDs that give no light when switched on
 
@@ -183,7 +193,7 @@ class _BoardLight:
     @property
     def direction(self):  # type: ignore[no-untyped-def]
         led = self._led()
-        return None if led is None else self._geometry.directions[led]
+        return None if led is None else self._directions[led]
 
     @property
     def intensity(self) -> float:
@@ -237,7 +247,9 @@ def _build_emulated_firmware_dome(
             ledger=DutyLedger.for_emulated(Path(loaded.path)),
         )
         power = cfg.emulator.led_powers(geometry.count, cfg.scene.seed)
-        light = _BoardLight(board, geometry, link, power, cfg.emulator.dead_leds)
+        light = _BoardLight(
+            board, geometry, link, power, cfg.emulator.dead_leds, _where_leds_are(loaded, geometry)
+        )
         camera = _simulated_camera(loaded, light, clock)
     except BaseException:
         stack.close_said(cfg.name)

@@ -25,7 +25,13 @@ from rti_rig.core.errors import ConfigError, LpFormatError
 from rti_rig.core.exposure_range import Bound, shared_range
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
 from rti_rig.core.image_files import looks_like_image
-from rti_rig.core.lp_format import acquisition_lp_files, lp_files_in, lp_name_from, read_lp
+from rti_rig.core.lp_format import (
+    acquisition_lp_files,
+    directions_of,
+    lp_files_in,
+    lp_name_from,
+    read_lp,
+)
 from rti_rig.core.rig_geometry import (
     COINCIDENT_LED_DEG,
     ArmGeometry,
@@ -281,6 +287,12 @@ class EmulatorConfig(_Strict):
     faults: list[EmulatorFault] = Field(default_factory=list)
     led_power: list[float] | None = None
     led_power_spread: float = Field(default=0.0, ge=0.0, le=1.0)
+    #: Where the emulated dome's LEDs really are: an ``.lp`` (line i = LED i, relative to the
+    #: config's folder). Why: a new dome is shot with a stand-in layout (``fibonacci`` with its
+    #: LED count) until ``rti-rig lights-from-sphere`` measures its directions; rehearsing that
+    #: needs LEDs that are not where the config says. The camera renders the light from here;
+    #: the rig, its schedule and its session's lights.lp keep the config's directions.
+    led_directions_file: str | None = None
     #: Flash pulses lost or bounced at chosen exposures (a camera-triggered dome).
     sync_faults: list[SyncFaultConfig] = Field(default_factory=list)
 
@@ -552,6 +564,13 @@ class RigConfig(_Strict):
             raise ValueError(
                 "emulator.led_power / led_power_spread make an emulated dome's LEDs uneven: "
                 f"they need kind = 'dome' and backend = 'emulated'{self._real_unevenness()}"
+            )
+        if emu.led_directions_file is not None and (
+            self.backend != "emulated" or self.kind != "dome"
+        ):
+            raise ValueError(
+                "emulator.led_directions_file puts an emulated dome's LEDs elsewhere than the "
+                "config says: it needs kind = 'dome' and backend = 'emulated'"
             )
         self._arm_faults_are_replies()
         self._sync_faults_have_a_flash_dome()
@@ -1100,6 +1119,8 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
                 "emulator.led_power",
                 f"{len(power)} values for {len(dirs)} LEDs: give one per LED, in LED order",
             )
+        if config.emulator.led_directions_file is not None:
+            emulated_led_directions(loaded, len(dirs))  # refused now, not at the first image
         # an LED index the dome has not had been ignored without a word: the rehearsal then
         # had no dead LED at all, and its check and fit "found" none
         outside = sorted({i for i in config.emulator.dead_leds if not 0 <= i < len(dirs)})
@@ -1535,6 +1556,29 @@ def _ring_directions(rings: list[Ring]) -> NDArray[np.float64]:
         az = ring.azimuth_offset_deg + 360.0 * np.arange(ring.count) / ring.count
         dirs.append(direction_from_az_el(az, np.full(ring.count, ring.elevation_deg)))
     return np.concatenate(dirs, axis=0)
+
+
+def emulated_led_directions(rig: LoadedRig, count: int) -> NDArray[np.float64] | None:
+    """The directions ``[emulator] led_directions_file`` gives the emulated dome's ``count``
+    LEDs (LED index order), None where it is not set; a file that cannot be read or lists
+    another number of lights is refused with the key."""
+    name = rig.config.emulator.led_directions_file
+    if name is None:
+        return None
+    key = "emulator.led_directions_file"
+    path = (rig.folder / name).resolve()
+    try:
+        entries = read_lp(path, upper_hemisphere=True)
+    except LpFormatError as exc:
+        raise ConfigError(rig.path, key, str(exc)) from None
+    if len(entries) != count:
+        raise ConfigError(
+            rig.path,
+            key,
+            f"{shown_path(path)} lists {len(entries)} lights for the dome's {count} LEDs: give "
+            "one line per LED, in LED order",
+        )
+    return directions_of(entries)
 
 
 def dome_led_directions(
