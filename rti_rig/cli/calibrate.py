@@ -383,13 +383,16 @@ def lights_from_sphere(
         highlight=False,
         soft_wrap=True,
     )
+    config = result.config
+    base = config.resolve().parent if config is not None else Path.cwd()
     try:
-        named = toml_basic_string(str(result.out.resolve()))
+        named = toml_basic_string(os.path.relpath(result.out.resolve(), base))
     except NotTomlText:  # a name no TOML file can hold: the user copies the file to one
         named = '"…" (copy the file to a UTF-8 name first)'
+    where = f"the dome's config {shown_path(config)}" if config else "the dome's config"
     out.print(
-        f'To use it, set layout = "lp" and lp_file = {named} under [dome] in the dome\'s '
-        "config, in place of its count.",
+        f'To use it, set layout = "lp" and lp_file = {named} under [dome] in {where}, in '
+        "place of its count.",
         markup=False,
         highlight=False,
         soft_wrap=True,

@@ -1,5 +1,8 @@
-"""`rti-rig lights-from-sphere`: the shipped simulated dome shoots the sphere scene at 160 px,
-and the command's `.lp` gives back the dome's LED directions (the highlight method)."""
+"""`rti-rig lights-from-sphere` on a new dome's path: the shipped emulated dome (real driver
+over a pty) with its directions not yet known (``layout = "fibonacci"``, its LED count) shoots
+the sphere scene at 160 px while its emulated LEDs really are where example_dome_48.lp says;
+the command's `.lp` must give those back (the session's own lights.lp says the stand-in).
+"""
 
 from __future__ import annotations
 
@@ -7,40 +10,64 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import dome_session
+from conftest import CONFIGS, shipped_variant
 from typer.testing import CliRunner
 
-from rti_rig.app.config import dome_led_directions, load_rig_config
+from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
-from rti_rig.core.lp_format import read_lp
+from rti_rig.core.errors import ConfigError
+from rti_rig.core.lp_format import directions_of, read_lp
 from rti_rig.simulator.scenes import sphere_circle
 
 SIDE = 160
+TRUTH = CONFIGS / "example_dome_48.lp"
+STAND_IN = (
+    ('layout = "lp"\nlp_file = "example_dome_48.lp"', 'layout = "fibonacci"\ncount = 48'),
+    ("width = 256", f"width = {SIDE}"),
+    ("height = 256", f"height = {SIDE}"),
+    ('name = "tablet"', 'name = "sphere"'),
+)
+
+
+def _new_dome(folder: Path, count_file: Path = TRUTH) -> Path:
+    return shipped_variant(
+        folder, "emulated_dome.toml", STAND_IN, f'led_directions_file = "{count_file}"\n'
+    )
 
 
 @pytest.fixture(scope="module")
 def sphere_session(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The shipped simulated dome's 48 LEDs on the sphere scene (read only)."""
-    return dome_session(tmp_path_factory.mktemp("sphere"), "sphere", SIDE, 48)
+    """The new dome's 48 LEDs on the sphere (read only)."""
+    root = tmp_path_factory.mktemp("sphere")
+    out = root / "s"
+    r = CliRunner().invoke(app, ["run", str(_new_dome(root)), "--out", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    return out
 
 
-def _circle() -> str:
+def _angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.degrees(np.arccos(np.clip((a * b).sum(1), -1, 1)))
+
+
+def _circle(dx: float = 0.0) -> str:
     x, y, r = sphere_circle(SIDE, SIDE)
-    return f"{x},{y},{r}"
+    return f"{x + dx},{y},{r}"
 
 
-def test_directions_match_the_domes_lights(sphere_session: Path, tmp_path: Path) -> None:
-    out = tmp_path / "dome.lp"
+def test_directions_are_the_domes_real_leds(sphere_session: Path, tmp_path: Path) -> None:
+    out = tmp_path / "my_dome.lp"
     r = CliRunner().invoke(
         app, ["lights-from-sphere", str(sphere_session), "--sphere", _circle(), "--out", str(out)]
     )
     assert r.exit_code == 0, r.output
     assert "48 LED directions" in r.output and 'layout = "lp"' in r.output
-    measured = np.array([e.direction for e in read_lp(out)])
-    truth, _ = dome_led_directions(load_rig_config(sphere_session.parent / f"sphere_{SIDE}.toml"))
-    errors = np.degrees(np.arccos(np.clip((measured * truth).sum(1), -1, 1)))
-    # measured 2026-12-02: median 0.36°, worst 0.40° (a pixel of highlight is 2.4° at R = 48 px)
+    truth = directions_of(read_lp(TRUTH))
+    errors = _angles(directions_of(read_lp(out)), truth)
+    # measured 2026-12-02: median 0.29°, worst 0.47° (a pixel of highlight is 2.4° at R = 48 px)
     assert np.median(errors) < 0.6 and errors.max() < 1.0, errors
+    # the stand-in the session recorded is nowhere near: the directions came from the images
+    stand_in = directions_of(read_lp(sphere_session / "lights.lp"))
+    assert np.median(_angles(stand_in, truth)) > 10
 
 
 def test_an_existing_out_is_kept_and_a_wrong_circle_names_the_images(
@@ -52,9 +79,15 @@ def test_an_existing_out_is_kept_and_a_wrong_circle_names_the_images(
     r = CliRunner().invoke(app, args)
     assert r.exit_code == 2 and "--force" in r.output and "Traceback" not in r.output
     assert out.read_text() == "mine\n"
-    x, y, rad = sphere_circle(SIDE, SIDE)
     wrong = tmp_path / "wrong.lp"
-    args = ["lights-from-sphere", str(sphere_session), "--sphere", f"{x - 20},{y},{rad}"]
+    args = ["lights-from-sphere", str(sphere_session), "--sphere", _circle(-20)]
     r = CliRunner().invoke(app, [*args, "--out", str(wrong)])
     assert r.exit_code == 2 and "image_001.jpg (LED 0)" in r.output, r.output
     assert not wrong.exists()
+
+
+def test_led_directions_file_must_list_every_led(tmp_path: Path) -> None:
+    short = tmp_path / "short.lp"
+    short.write_text("1\nled_00.jpg 0.0 0.0 1.0\n")
+    with pytest.raises(ConfigError, match=r"emulator\.led_directions_file"):
+        load_rig_config(_new_dome(tmp_path, short))

@@ -50,6 +50,8 @@ class SphereLights:
     out: Path
     images: tuple[str, ...]
     highlights: tuple[Highlight, ...]
+    #: the rig config the session was shot with (its manifest's), None if it names none
+    config: Path | None = None
 
 
 def _steps_by_led(root: Path, manifest: dict[str, Any]) -> list[dict[str, Any]]:
@@ -129,7 +131,9 @@ def lights_from_sphere(request: SphereRequest) -> SphereLights:
             f"{shown_path(out)} is there already: give --out another file, or add --force to "
             "replace it (nothing was measured or written)"
         )
-    steps = _steps_by_led(root, read_manifest(root))
+    manifest = read_manifest(root)
+    steps = _steps_by_led(root, manifest)
+    config = (manifest.get("rig") or {}).get("config_path")
     found: list[Highlight] = []
     names: list[str] = []
     refused: list[str] = []
@@ -152,4 +156,5 @@ def lights_from_sphere(request: SphereRequest) -> SphereLights:
     width = max(2, len(str(len(found) - 1)))
     entries = [LpEntry(f"led_{k:0{width}d}.jpg", h.direction) for k, h in enumerate(found)]
     write_lp(out, entries)
-    return SphereLights(out, tuple(names), tuple(found))
+    shot_with = Path(config) if isinstance(config, str) and config else None
+    return SphereLights(out, tuple(names), tuple(found), shot_with)
