@@ -571,7 +571,10 @@ def _sphere(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
     oc = on[..., None].astype(np.float64)
     albedo = _fill((rows, cols), (0.35, 0.35, 0.35)) * (1 - oc) + 0.01 * oc
     spec = _fill((rows, cols), (0.04, 0.04, 0.04)) * oc  # black glass: F0 of n = 1.5
-    rough = np.where(on, 0.12, 1.0)
+    # roughness 0.2: a highlight a couple of pixels wide at 160 px, as a real camera's optics
+    # spread one; at 0.12 the lobe fell between the renderer's point samples (0.36° median
+    # error at 160 px against 0.03° at 320 px)
+    rough = np.where(on, 0.2, 1.0)
     cx, cy, r = sphere_circle(rows, cols)
     return Scene(
         name="sphere",
