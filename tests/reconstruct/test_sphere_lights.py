@@ -1,0 +1,65 @@
+"""The highlight method's pure part: a highlight's position gives l = 2(n·v)n − v in the
+project's frame (y up, rows down), sub-pixel; what gives no direction is rejected with why."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rti_rig.reconstruct.sphere_lights import (
+    Circle,
+    Highlight,
+    Rejected,
+    SphereCircleError,
+    angle_deg,
+    direction_at,
+    find_highlight,
+)
+
+CIRCLE = Circle(60.0, 50.0, 40.0)
+SHAPE = (100, 120)
+
+
+def _image(column: float, row: float, sigma: float = 1.2, peak: float = 1000.0) -> np.ndarray:
+    rows, cols = np.mgrid[0 : SHAPE[0], 0 : SHAPE[1]].astype(float)
+    spot = peak * np.exp(-((cols - column) ** 2 + (rows - row) ** 2) / (2 * sigma**2))
+    return 10.0 + spot
+
+
+def test_centre_is_the_camera_and_up_the_image_is_plus_y() -> None:
+    assert np.allclose(direction_at(CIRCLE, 60.0, 50.0), (0.0, 0.0, 1.0))
+    # a highlight above the centre (a smaller row) is a light towards the image's top: +y
+    up = direction_at(CIRCLE, 60.0, 50.0 - 40.0 * math.sin(math.radians(20)))
+    assert up[1] > 0 and abs(up[0]) < 1e-12
+    assert math.isclose(math.degrees(math.asin(up[2])), 50.0, abs_tol=1e-9)  # 90 − 2·20
+    right = direction_at(CIRCLE, 60.0 + 10.0, 50.0)
+    assert right[0] > 0 and abs(right[1]) < 1e-12
+
+
+def test_a_sub_pixel_highlight_gives_its_direction() -> None:
+    column, row = 71.3, 38.6
+    found = find_highlight(_image(column, row), CIRCLE, 65535)
+    assert isinstance(found, Highlight)
+    assert abs(found.column - column) < 0.05 and abs(found.row - row) < 0.05
+    assert angle_deg(found.direction, direction_at(CIRCLE, column, row)) < 0.2
+
+
+@pytest.mark.parametrize(
+    ("image", "words"),
+    [
+        (np.full(SHAPE, 10.0), "no highlight"),
+        (_image(60.0, 50.0, sigma=8.0, peak=60000.0), "blob of"),
+        (_image(60.0 + 39.0, 50.0), "rim"),
+        (_image(60.0 + 34.0, 50.0), "below the object plane"),
+    ],
+)
+def test_what_gives_no_direction_is_rejected_with_why(image: np.ndarray, words: str) -> None:
+    found = find_highlight(image, CIRCLE, 65535)
+    assert isinstance(found, Rejected) and words in found.reason
+
+
+def test_a_circle_outside_the_frame_is_refused() -> None:
+    with pytest.raises(SphereCircleError, match="inside"):
+        find_highlight(np.zeros(SHAPE), Circle(100.0, 50.0, 40.0), 65535)
