@@ -17,7 +17,9 @@ runner = CliRunner()
 at_80 = CliRunner(env={"COLUMNS": "80"})
 
 
-@pytest.mark.parametrize("command", ["run", "preview", "plan", "export-lp", "calibrate-lights"])
+@pytest.mark.parametrize(
+    "command", ["run", "preview", "plan", "export-lp", "calibrate-lights", "lights-from-sphere"]
+)
 def test_flags_show_no_value_type_in_help(command: str) -> None:
     r = runner.invoke(app, [command, "--help"], terminal_width=100)
     assert r.exit_code == 0, r.output

@@ -92,3 +92,24 @@ def test_led_directions_file_must_list_every_led(tmp_path: Path) -> None:
     short.write_text("1\nled_00.jpg 0.0 0.0 1.0\n")
     with pytest.raises(ConfigError, match=r"emulator\.led_directions_file"):
         load_rig_config(_new_dome(tmp_path, short))
+
+
+def test_a_session_of_some_leds_or_a_stopped_one_says_what_to_run(
+    sphere_session: Path, tmp_path: Path
+) -> None:
+    import json
+    import shutil
+
+    part = tmp_path / "part"
+    shutil.copytree(sphere_session, part)
+    manifest = json.loads((part / "manifest.json").read_text())
+    manifest["steps"] = manifest["steps"][:12]
+    (part / "manifest.json").write_text(json.dumps(manifest))
+    args = ["lights-from-sphere", str(part), "--sphere", _circle(), "--out", str(tmp_path / "a.lp")]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 2 and "12 of the dome's 48 LEDs" in r.output, r.output
+    assert "rti-rig run " in r.output and "without --lights" in r.output
+    manifest["runner"]["finish_reason"] = "stopped"
+    (part / "manifest.json").write_text(json.dumps(manifest))
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 2 and "--resume" in r.output and not (tmp_path / "a.lp").exists()

@@ -21,7 +21,7 @@ from rti_rig.core.errors import RtiRigError, SessionError
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.core.out_folders import free_folder_beside
-from rti_rig.core.shell_words import shown_path
+from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.reconstruct.sphere_lights import (
     Circle,
     Highlight,
@@ -75,6 +75,14 @@ def _steps_by_led(root: Path, manifest: dict[str, Any]) -> list[dict[str, Any]]:
                 )
             by_led[led] = step
     missing = [k for k in range(count) if k not in by_led]
+    finish = (manifest.get("runner") or {}).get("finish_reason")
+    if missing and finish != "completed":
+        # a stopped session lists no steps until it finishes: "shoot it again" would throw
+        # away the images it has
+        raise SessionError(
+            f"{shown_path(root)}: the session did not finish ({finish or 'no finish recorded'}): "
+            f"continue it with rti-rig run --resume {shell_word(str(root))}, then measure it"
+        )
     if not count or missing:
         config = rig.get("config_path")
         again = (
