@@ -14,7 +14,7 @@ import re
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, interrupted, journal, manifest, said
+from conftest import CONFIGS, interrupted, journal, manifest, said, virtual_arm_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -248,22 +248,27 @@ def test_the_shipped_simulated_dome_stops_where_its_estimate_reaches_the_target(
 def test_an_arm_with_only_until_error_chooses_within_growing_designs_and_counts_moves(
     tmp_path: Path,
 ) -> None:
+    """The shipped virtual arm's geometry and timing with 96 px frames (the choice, its guesses
+    and its move times do not depend on the frame size; at 512 px the images, the decisions'
+    fits and the QA made this test ~4× as long) and a target of 0.4°, which it reaches in
+    ~17 lights (0.2° took 33 at 96 px: more decisions, none of another kind)."""
     out = tmp_path / "arm"
-    cfg = CONFIGS / "virtual_arm.toml"
-    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--until-error", "0.2"])
+    cfg = virtual_arm_variant(tmp_path, "relief", side=96)
+    target = 0.4
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--until-error", f"{target:g}"])
     assert r.exit_code == 0, r.output
     m = manifest(out)["adaptive"]
     steps = journal(out)
     assert m["design_lights"] is None and m["result"]["lights_used"] == len(steps)
-    assert len(steps) > 6  # decisions were taken (on this scene 0.2° needs several)
+    assert len(steps) > 6  # decisions were taken (on this scene 0.4° needs several)
     for k, s in enumerate(steps[4:], start=4):
         d = s["decision"]
         assert d["guessed_lights"] == guessed_lights(k, m["max_lights"])
-        assert d["upper_error_deg"] > 0.2
+        assert d["upper_error_deg"] > target
         assert all(c["move_s"] >= 0 for c in d["best_candidates"])
         assert any(c["move_s"] > 0 for c in d["best_candidates"])  # an arm's moves are counted
     stop = m["result"]["stop"]
-    assert len(steps) == m["max_lights"] or stop["upper_error_deg"] <= 0.2
+    assert len(steps) == m["max_lights"] or stop["upper_error_deg"] <= target
 
 
 def test_the_stops_reason_and_the_final_line_print_one_upper_estimate_alike() -> None:
