@@ -484,8 +484,9 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
     """``--adaptive`` without ``--lights`` is capped at the config's ``default_lights``, the
     default ``--lights`` documents (it had shot 100 lights, the cap meant for
     ``--until-error`` alone, on an arm whose config says 24); ``--until-error`` alone keeps
-    the larger cap, its N being unknown."""
-    text = (CONFIGS / "virtual_arm.toml").read_text()
+    the larger cap, its N being unknown. (With 96 px frames: the cap is the config's, not the
+    images'.)"""
+    text = virtual_arm_variant(tmp_path, "relief", side=96).read_text()
     assert "default_lights = 24" in text
     cfg = write_config(tmp_path, text.replace("default_lights = 24", "default_lights = 6"))
     out = tmp_path / "s"
@@ -909,10 +910,12 @@ def test_a_resume_cannot_change_the_band(tmp_path: Path) -> None:
 
 
 def test_an_adaptive_arm_session_keeps_to_the_band(tmp_path: Path) -> None:
+    """The shipped virtual arm with 96 px frames: the band is a matter of poses alone."""
     out = tmp_path / "s"
+    cfg = virtual_arm_variant(tmp_path, "relief", side=96)
     r = runner.invoke(
         app,
-        ["run", str(CONFIGS / "virtual_arm.toml"), "--out", str(out), "--adaptive",
+        ["run", str(cfg), "--out", str(out), "--adaptive",
          "--lights", "7", "--max-elevation-deg", "40"],
     )  # fmt: skip
     assert r.exit_code == 0, r.output
