@@ -1,14 +1,15 @@
 """`rti-rig run RIG --adaptive --lights N --objective relight` through the front door, on the
-shipped simulated dome and on a replayed real acquisition: the designs are scored by their
-simulated relighting PSNR, the objective is data (settings and every decision), a resume
-continues it and refuses another objective, and what it cannot mean is refused clearly."""
+shipped simulated dome (its LEDs and scene, with small frames) and on a replayed real
+acquisition: the designs are scored by their simulated relighting PSNR, the objective is data
+(settings and every decision), a resume continues it and refuses another objective, and what it
+cannot mean is refused clearly."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import pytest
-from conftest import interrupted, journal, manifest, said
+from conftest import interrupted, journal, manifest, said, shipped_variant
 from typer.testing import CliRunner
 
 from rti_rig.app.usecases.adaptive import FORMAT
@@ -28,11 +29,20 @@ def files(folder: Path) -> list[tuple[str, bytes]]:
 
 
 @pytest.fixture(scope="module")
-def relight_session(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def dome(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The shipped simulated dome (its 48 LEDs, scene and timing) with 96 px frames: the
+    objective, its designs and a resume's choices are the LEDs' and the scene's, and its
+    512 px frames made this module's sessions several times as long."""
+    side = (("width = 512", "width = 96"), ("height = 512", "height = 96"))
+    return shipped_variant(tmp_path_factory.mktemp("dome"), "simulated_dome.toml", side)
+
+
+@pytest.fixture(scope="module")
+def relight_session(tmp_path_factory: pytest.TempPathFactory, dome: Path) -> Path:
     out = tmp_path_factory.mktemp("relight") / "s"
     r = runner.invoke(
         app,
-        ["run", str(DOME), "--out", str(out), "--adaptive", "--lights", "8", *RELIGHT],
+        ["run", str(dome), "--out", str(out), "--adaptive", "--lights", "8", *RELIGHT],
     )
     assert r.exit_code == 0, r.output
     assert "Adaptive (designs for relight): 8 lights; stopped: reached" in said(r)
@@ -82,10 +92,10 @@ def test_the_starting_lights_are_above_the_start_floor(relight_session: Path) ->
     assert el[:START_LIGHTS].min() >= START_FLOOR_DEG - 1e-6
 
 
-def test_the_default_objective_is_normals_and_says_so(tmp_path: Path) -> None:
+def test_the_default_objective_is_normals_and_says_so(tmp_path: Path, dome: Path) -> None:
     out = tmp_path / "s"
     r = runner.invoke(
-        app, ["run", str(DOME), "--out", str(out), "--adaptive", "--lights", "6", "--no-verdict"]
+        app, ["run", str(dome), "--out", str(out), "--adaptive", "--lights", "6", "--no-verdict"]
     )
     assert r.exit_code == 0, r.output
     assert manifest(out)["adaptive"]["objective"] == "normals"
@@ -127,10 +137,10 @@ def test_what_the_objective_cannot_mean_is_refused_before_anything_moves(
 
 
 def test_a_relight_session_resumes_to_the_same_session_and_refuses_another_objective(
-    relight_session: Path, tmp_path: Path
+    relight_session: Path, tmp_path: Path, dome: Path
 ) -> None:
     out = tmp_path / "cut"
-    result = interrupted(DOME, out, after_step=5, objective="relight")
+    result = interrupted(dome, out, after_step=5, objective="relight")
     assert result.finish_reason is FinishReason.CANCELLED and len(journal(out)) == 6
     before = files(out)
     r = runner.invoke(app, ["run", "--resume", str(out), "--objective", "normals"])
@@ -151,16 +161,16 @@ def test_a_relight_session_resumes_to_the_same_session_and_refuses_another_objec
     assert choices(out) == choices(relight_session)
 
 
-def test_a_normals_session_refuses_a_resume_for_relighting(tmp_path: Path) -> None:
+def test_a_normals_session_refuses_a_resume_for_relighting(tmp_path: Path, dome: Path) -> None:
     out = tmp_path / "cut"
-    interrupted(DOME, out, after_step=4, objective="normals")
+    interrupted(dome, out, after_step=4, objective="normals")
     r = runner.invoke(app, ["run", "--resume", str(out), "--objective", "relight"])
     assert r.exit_code == 2 and "begun with --objective normals" in said(r)
 
 
-def test_a_fixed_session_refuses_an_objective_on_resume(tmp_path: Path) -> None:
+def test_a_fixed_session_refuses_an_objective_on_resume(tmp_path: Path, dome: Path) -> None:
     out = tmp_path / "fixed"
-    r = runner.invoke(app, ["run", str(DOME), "--out", str(out), "--lights", "5", "--no-verdict"])
+    r = runner.invoke(app, ["run", str(dome), "--out", str(out), "--lights", "5", "--no-verdict"])
     assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["run", "--resume", str(out), "--objective", "relight"])
     assert r.exit_code == 2 and "not" in said(r) and "drop --objective relight" in said(r)
