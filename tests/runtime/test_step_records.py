@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import shutil
 import signal
 from pathlib import Path
 
@@ -333,8 +334,12 @@ def test_a_record_file_with_no_journal_line_keeps_its_image_only_as_captured(
 ) -> None:
     """A kill between the record file and the journal line: the image is whole and its
     record says so, so the resume takes it back into the journal (not shot again); the same
-    kill with the image changed since is set aside and shot again, as any unproven image."""
+    kill with the image changed since is set aside and shot again, as any unproven image.
+    (The second case is a copy of the killed folder: a second killed run of the same
+    deterministic session, a subprocess and its imports, left the same files.)"""
     out = _killed(tmp_path, "after_record", 3)
+    changed = tmp_path / "b" / "s"
+    shutil.copytree(out, changed, symlinks=True)
     journal = out / "journal.jsonl"
     assert len(journal.read_bytes().splitlines()) == 3
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
@@ -343,8 +348,6 @@ def test_a_record_file_with_no_journal_line_keeps_its_image_only_as_captured(
     records = [json.loads(x) for x in journal.read_text().splitlines()]
     assert [r["index"] for r in records] == list(range(LIGHTS))
 
-    (tmp_path / "b").mkdir()
-    changed = _killed(tmp_path / "b", "after_record", 3)
     (changed / "image_004.jpg").write_bytes(b"edited")
     r = runner.invoke(app, ["run", "--resume", str(changed), "--no-verdict"])
     assert r.exit_code == 0, r.output
