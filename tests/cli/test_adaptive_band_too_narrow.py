@@ -15,7 +15,7 @@ import shlex
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, journal, said
+from conftest import CONFIGS, journal, said, virtual_arm_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -166,8 +166,9 @@ def test_more_lights_than_an_arm_offers_are_refused_with_a_command_that_runs(
     (or widen --min/--max-elevation-deg)" gave no value, and no value would do: an arm's
     candidates are a fixed number of directions spread over whatever band is asked, so a wider
     band holds no more. The refusal says so and gives the command with the count it offers,
-    which runs in the band."""
-    arm = CONFIGS / "virtual_arm.toml"
+    which runs in the band. The shipped virtual arm's relief at 96 px (virtual_arm_variant):
+    the count an arm offers, the advice and the band are its poses', not its frame size's."""
+    arm = virtual_arm_variant(tmp_path, "relief", 96)
     r = runner.invoke(
         app,
         ["run", str(arm), "--out", str(tmp_path / "s"), "--adaptive", "--lights", "130",
