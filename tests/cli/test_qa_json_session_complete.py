@@ -12,12 +12,14 @@ import json
 import shutil
 from pathlib import Path
 
-from conftest import CONFIGS, cut_new_session
+from conftest import cut_new_session, shipped_variant
 from typer.testing import CliRunner
 
 from rti_rig.app.usecases.session import NewSessionRequest
 from rti_rig.cli import app
 from rti_rig.runtime.controller import FinishReason
+
+SMALL = (("width = 512", "width = 96"), ("height = 512", "height = 96"))
 
 
 def _qa_json(session: Path, out: Path) -> dict:  # type: ignore[type-arg]
@@ -29,7 +31,8 @@ def _qa_json(session: Path, out: Path) -> dict:  # type: ignore[type-arg]
 
 
 def test_qa_json_says_whether_the_session_completed(tmp_path: Path) -> None:
-    cfg = CONFIGS / "simulated_dome.toml"
+    # the shipped dome at 96 px: whether a session completed is its record's, not its images'
+    cfg = shipped_variant(tmp_path, "simulated_dome.toml", SMALL)
     stopped = tmp_path / "stopped"
     request = NewSessionRequest(cfg, stopped, lights=12)
     # cancelled once image 8 is committed, as a Ctrl-C in `run` does
