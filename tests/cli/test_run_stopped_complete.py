@@ -17,12 +17,13 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, REPO
+from conftest import CONFIGS, REPO, shipped_variant
 from sigterm_support import signal_at_commit
 
 #: ``rti-rig run`` in a process of its own that sends itself SIGTERM as image ``AT`` (0-based)
 #: is committed: the commit holds the signal, which stops the run right after it
 SCRIPT = signal_at_commit("SIGTERM")
+SMALL = (("width = 512", "width = 96"), ("height = 512", "height = 96"))
 
 
 def _python(*argv: str) -> tuple[int, str]:
@@ -39,8 +40,12 @@ def _python(*argv: str) -> tuple[int, str]:
 
 
 def _run_sigterm_at(tmp_path: Path, at: int, *extra: str) -> tuple[int, str, Path]:
+    """``run --lights 6`` (and ``extra``) on the shipped simulated dome at 96 px, SIGTERM as
+    image ``at`` is committed: what is in, what is said and what the resume records are the
+    images' count and the session's record, not their size."""
     out = tmp_path / "s"
-    args = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), "--lights", "6"]
+    config = shipped_variant(tmp_path, "simulated_dome.toml", SMALL)
+    args = ["run", str(config), "--out", str(out), "--lights", "6"]
     return (*_python("-c", SCRIPT, str(at), *args, *extra, "--no-verdict"), out)
 
 
