@@ -309,7 +309,8 @@ class SequenceChecker:
     ) -> dict[int, float] | None:
         """The residuals of ``img`` under the previous LED and the expected one from a fit
         without the last accepted image (the one the previous LED lit); None when that fit
-        cannot be made (then no missed step is named: the end-of-run proof still checks).
+        cannot be made (then no missed step is named here: test 3 may see the shift later,
+        and only an order of all the firmware's LEDs has the end-of-run proof behind it).
         The caller also asks the last image itself: a lit missed step on this firmware is the
         LED of the image before lit again, so the image must be that image again (closer to
         it than :data:`SLIP_RATIO` of the expected LED's residual), not merely nearer the
