@@ -247,6 +247,9 @@ def test_the_shipped_simulated_dome_stops_where_its_estimate_reaches_the_target(
         assert used > 6  # decisions were taken (the test would not check them otherwise)
     stop = m["result"]["stop"]
     cap = m["max_lights"]
+    # which branch each case takes, said: at 512 px the capped case stopped on its estimate at
+    # 14 and the cap's branch went untested without a word
+    assert (used == cap) == (lights is not None and target < 1.0), (used, cap)
     if used < cap:
         assert stop["upper_error_deg"] <= target
         assert f"--until-error {target:g}°" in stop["reason"]
