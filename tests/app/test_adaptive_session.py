@@ -810,6 +810,8 @@ def _five_ring_dome(tmp_path: Path) -> Path:
     """The shipped simulated dome (rings at 10°, 25°, 40°, 55°, 70°) with a small camera: 22
     LEDs between 20° and 45° to choose among."""
     text = (CONFIGS / "simulated_dome.toml").read_text()
+    # a shipped config that changed its frame fails here, not as tests quietly at 512 px again
+    assert "width = 512" in text and "height = 512" in text
     return write_config(tmp_path, text.replace("width = 512", "width = 96").replace(
         "height = 512", "height = 96"))  # fmt: skip
 
