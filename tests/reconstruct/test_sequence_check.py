@@ -92,3 +92,21 @@ def test_a_slip_found_late_is_traced_back_to_the_image_it_began_at() -> None:
         chk2.check(i, frame(ORDER[i]), 65535)
     v = chk2.check(10, frame(ORDER[11]), 65535)
     assert v.kind == DOUBLE and v.since is None
+
+
+def test_a_missed_step_shot_again_with_its_own_noise_is_still_named() -> None:
+    """A real camera's second exposure of the previous LED has noise of its own (the
+    simulator's is keyed by the light, so there it is the image before bit for bit): the
+    "that image again" condition must hold at shot noise, not only at equality. Poisson noise
+    of a 20000 e- full well, drawn afresh for every shot."""
+    rng = np.random.default_rng(1)
+
+    def shot(direction) -> np.ndarray:  # type: ignore[no-untyped-def]
+        electrons = rng.poisson(np.clip(RENDER(direction, 1.0) * 0.75, 0, None) * 20000.0)
+        return np.round(np.clip(electrons / 20000.0, 0, 1) * 65535).astype(np.uint16)
+
+    chk = SequenceChecker(ORDER)
+    for i in range(10):
+        assert chk.check(i, shot(ORDER[i]), 65535).kind == OK
+    v = chk.check(10, shot(ORDER[9]), 65535)
+    assert v.kind == MISSED and v.best_position == 9 and "previous LED" in v.reason
