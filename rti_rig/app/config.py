@@ -407,8 +407,9 @@ class RigConfig(_Strict):
             f"emulator.faults[{i}]: {kind} is rehearsed by an emulated dome's firmware on its "
             "serial link (backend = 'emulated' with a [dome.serial]), and this rig is not one; "
             "remove the fault, or rehearse it on the emulated dome rti-rig ships, "
-            f"{shell_word(shipped_config_path('emulated_dome.toml'))} (copy it and add the "
-            "fault to the copy)"
+            f"{shell_word(shipped_config_path('emulated_dome.toml'))} (copy it, with the "
+            f"{shell_word(shipped_config_path('example_dome_48.lp'))} its lp_file names, into "
+            "one folder and add the fault to the copy)"
         )
 
     def _sync_faults_have_a_flash_dome(self) -> None:

@@ -110,3 +110,32 @@ def test_the_dome_it_names_for_a_rehearsal_is_there_from_anywhere(
     tomls = [w for w in named if w.endswith(".toml")]
     assert tomls and all(Path(w).is_file() for w in tomls), said
     assert any(Path(w).name == "emulated_dome.toml" for w in tomls), said
+
+
+def test_the_rehearsal_it_advises_loads_when_followed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Followed as written (every file the refusal names copied into one folder, the fault
+    added to the copied dome), the rehearsal config loads: the words had said to copy only
+    emulated_dome.toml, whose ``lp_file = "example_dome_48.lp"`` is relative to its folder, so
+    the copy was refused for a missing .lp."""
+    import shlex
+    import shutil
+
+    from rti_rig.app.config import load_rig_config
+
+    config = tmp_path / "rig.toml"
+    config.write_text((CONFIGS / "simulated_dome.toml").read_text() + RESET)
+    r = runner.invoke(app, ["check", str(config)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "rehearse it on" in said, said
+    named = [w.rstrip(",.;") for w in shlex.split(said.split("rehearse it on", 1)[1])]
+    files = [Path(w) for w in named if Path(w).is_file()]
+    copies = tmp_path / "rehearsal"
+    copies.mkdir()
+    for f in files:
+        shutil.copy(f, copies / f.name)
+    copy = copies / "emulated_dome.toml"
+    copy.write_text(copy.read_text() + RESET)
+    monkeypatch.chdir(tmp_path)
+    load_rig_config(copy)  # raises (a missing lp_file) where the .lp was not named
