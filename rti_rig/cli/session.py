@@ -2069,6 +2069,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
     adaptive_result = opened.extra.get("adaptive_result")
     if adaptive_result is not None:
         from rti_rig.app.usecases.adaptive import (
+            ARM_MAX_LIGHTS,
             estimate_phrase,
             few_lights_note,
             short_of_target_note,
@@ -2085,7 +2086,10 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         if short is not None:  # one line: the command it ends with pastes whole
             err.print(f"[yellow]note:[/] {escape(short)}", highlight=False, soft_wrap=True)
         offered = int((opened.folder.manifest.get("adaptive") or {}).get("candidates") or 0)
-        unreached = short_of_target_note(adaptive_result, offered, lambda: _without_lights(opened))
+        most = ARM_MAX_LIGHTS if opened.rig.loaded.config.arm is not None else None
+        unreached = short_of_target_note(
+            adaptive_result, offered, lambda: _without_lights(opened), most
+        )
         if unreached is not None:  # one line, as the note above
             err.print(f"[yellow]note:[/] {escape(unreached)}", highlight=False, soft_wrap=True)
     if result.finish_reason is FinishReason.CANCELLED:

@@ -113,7 +113,7 @@ def test_a_session_that_did_not_reach_its_target_gives_no_such_note(
     lines = [line.rstrip() for line in r.output.splitlines()]
     (note,) = [line for line in lines if "was not reached in this session's maximum" in line]
     assert "--until-error 1e-09° was not reached in this session's maximum of 5 lights" in note
-    assert f"with up to the {offered} lights this rig offers" in note, note
+    assert f"with up to the {offered} lights a session on this rig can take" in note, note
     argv = shlex.split(note.rsplit(": ", 1)[1])
     assert argv == [
         "rti-rig", "run", str(cfg), "--out", str(tmp_path / "s-more"), "--until-error", "1e-09"
@@ -270,3 +270,26 @@ def test_a_minimum_above_the_start_gives_no_such_note(
     r = _run(cfg, tmp_path / "s", "--until-error", LOOSE, "--min-lights", "5")
     assert r.exit_code == 0, r.output
     assert "holds nothing" not in said(r)
+
+
+def test_an_arm_session_at_the_most_a_session_takes_is_not_told_to_start_another() -> None:
+    """An arm's session stops at ARM_MAX_LIGHTS (100) whatever its rig offers (the virtual
+    arm: 120): one that ran to 100 short of its target had been told to start a new session
+    "with up to the 120 lights this rig offers", which stops at 100 again. It is told that
+    no session on the rig shoots more; a session under that most is still given the command."""
+    from rti_rig.app.usecases.adaptive import ARM_MAX_LIGHTS, short_of_target_note
+
+    result = {
+        "until_error_deg": 0.1,
+        "target_claimed": False,
+        "lights_used": ARM_MAX_LIGHTS,
+        "max_lights": ARM_MAX_LIGHTS,
+        "upper_error_deg": 0.5,
+    }
+    text = short_of_target_note(result, 120, lambda: "rti-rig run A --out B", ARM_MAX_LIGHTS)
+    assert text is not None and "rti-rig run" not in text, text
+    assert f"({ARM_MAX_LIGHTS} of the 120 it offers)" in text, text
+    fewer = {**result, "lights_used": 40, "max_lights": 40}
+    text = short_of_target_note(fewer, 120, lambda: "rti-rig run A --out B", ARM_MAX_LIGHTS)
+    assert text is not None and f"up to the {ARM_MAX_LIGHTS} lights" in text, text
+    assert text.endswith("rti-rig run A --out B"), text

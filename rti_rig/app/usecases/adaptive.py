@@ -1228,7 +1228,10 @@ def few_lights_note(
 
 
 def short_of_target_note(
-    result: dict[str, Any], offered: int, start_more: Callable[[], str] | None = None
+    result: dict[str, Any],
+    offered: int,
+    start_more: Callable[[], str] | None = None,
+    most: int | None = None,
 ) -> str | None:
     """What a session that ran to its maximum without reaching its --until-error target is
     to do next (None: no target, the target reached, or the session stopped otherwise).
@@ -1238,7 +1241,12 @@ def short_of_target_note(
     ``--lights`` (the rig's own maximum, a free --out). Why: the run ended "the target is not
     claimed" and nothing more: a user who wanted the target had to find that a resume keeps
     the session's maximum, and which command shoots on; where the rig has no more lights,
-    no command would, and that is said instead of leaving one to be tried."""
+    no command would, and that is said instead of leaving one to be tried.
+
+    ``most``: the largest maximum any session on the rig takes (an arm's
+    :data:`ARM_MAX_LIGHTS`; None: every light offered). Why: the virtual arm offers 120
+    lights, an arm's session stops at 100, and a 100-light session short of its target had been
+    told a new session would shoot "up to the 120 lights" (it stops at 100 again)."""
     until = result.get("until_error_deg")
     if until is None or result.get("target_claimed"):
         return None
@@ -1250,17 +1258,21 @@ def short_of_target_note(
         f"--until-error {until:g}° was not reached in this session's maximum of {cap} lights "
         f"(upper estimate {up:.2f}°); its {used} images are kept as they are."
     )
-    if cap < offered and start_more is not None:
+    reach = offered if most is None else min(offered, most)
+    if cap < reach and start_more is not None:
         text += (
             " The session is complete (a resume adds no light); to shoot toward the target "
-            f"with up to the {offered} lights this rig offers, start a new session (it shoots "
-            f"its lights from the start; more lights are not known to reach it): {start_more()}"
+            f"with up to the {reach} lights a session on this rig can take, start a new "
+            "session (it shoots its lights from the start; more lights are not known to reach "
+            f"it): {start_more()}"
         )
-    elif cap >= offered:
-        text += (
-            f" They are every light this rig offers here ({offered}): no session on it can "
-            "shoot more toward the target."
+    elif cap >= reach:
+        every = (
+            f"every light this rig offers here ({offered})"
+            if reach == offered
+            else f"the most a session on this rig takes ({reach} of the {offered} it offers)"
         )
+        text += f" They are {every}: no session on it can shoot more toward the target."
     return text
 
 
