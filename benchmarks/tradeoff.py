@@ -835,7 +835,11 @@ def main(argv: list[str] | None = None, settings: TradeoffSettings | None = None
     if remeasured and measured is not None:
         scenes = tuple(dict.fromkeys(r.scene for r in rows))
         s = replace(settings or TradeoffSettings(), scenes=scenes)
-        summary.write_text(summarise(rows, s, float(measured[2]), measured[1]), encoding="utf-8")
+        # a stopped run's partial table stays one: its first line, which says so, had been
+        # dropped, and the rewritten summary read as a whole run's
+        stopped = re.search(r"^\*\*(Stopped \(.+)\*\*$", said, re.MULTILINE)
+        text = summarise(rows, s, float(measured[2]), measured[1], stopped[1] if stopped else "")
+        summary.write_text(text, encoding="utf-8")
         print(f"{shell_word(summary)} rewritten: {len(remeasured)} row(s) measured again whole")
 
 
