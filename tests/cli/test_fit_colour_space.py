@@ -179,6 +179,8 @@ def test_an_8_bit_tiff_whose_profile_says_linear_is_fitted_as_linear(tmp_path: P
     assert np.allclose(albedo, want, rtol=1e-4), (albedo[8, 8], want[8, 8])
     assert "gamma 1.0" in record["image_colour"]["image01"]["curve_undone"], record
     assert "took their values as linear, as its curve (gamma 1.0) says" in said, said
+    # sRGB's primaries are kept: no conversion is claimed that was never made
+    assert "converted its primaries" not in said and "primaries kept" in said, said
 
 
 def test_each_file_s_colour_is_read_once_and_its_clipped_pixels_counted(

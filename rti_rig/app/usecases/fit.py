@@ -868,10 +868,17 @@ def colour_notes(
             if colour.linear_curve
             else "the fit undid its curve"
         )
+        # an sRGB file's primaries are sRGB's already: only its curve was read differently,
+        # and a note saying its primaries were converted claims a step never taken
+        primaries = (
+            ", its primaries kept (sRGB's already),"
+            if colour.space == "srgb"
+            else " and converted its primaries to linear sRGB's"
+        )
         notes.append(
-            f"{count} are {colour.name} (said by {colour.said_by}): {done} and converted its "
-            "primaries to linear sRGB's before fitting (the files are untouched); fit.json's "
-            "image_colour says what was done to each"
+            f"{count} are {colour.name} (said by {colour.said_by}): {done}{primaries} before "
+            "fitting (the files are untouched); fit.json's image_colour says what was done "
+            "to each"
         )
         if clipped:
             notes.append(
