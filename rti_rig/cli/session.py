@@ -2076,10 +2076,12 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         )
 
         chosen_for = adaptive_result.get("objective", "normals")
+        reason = adaptive_result["stop"]["reason"]
+        estimates = estimate_phrase(adaptive_result, reason)  # what the reason did not say
         out.print(
             ("Adaptive" if chosen_for == "normals" else f"Adaptive (designs for {chosen_for})")
-            + f": {adaptive_result['lights_used']} lights; stopped: "
-            f"{adaptive_result['stop']['reason']}; {estimate_phrase(adaptive_result)}",
+            + f": {adaptive_result['lights_used']} lights; stopped: {reason}"
+            + (f"; {estimates}" if estimates else ""),
             highlight=False,
         )
         short = few_lights_note(adaptive_result, lambda m: _with_min_lights(opened, m))

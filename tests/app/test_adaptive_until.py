@@ -40,6 +40,14 @@ def _printed_tol(value: float) -> float:
     return 0.5 * 10.0 ** (math.floor(math.log10(abs(value))) - 2) + 5e-5
 
 
+def _adaptive_line(text: str) -> str:
+    """The run's "Adaptive: …" summary line out of its unwrapped output (up to the note or
+    the QA verdict that follows it)."""
+    found = re.search(r"Adaptive: .*?(?= note: | QA verdict|$)", text)
+    assert found is not None, text
+    return found.group(0)
+
+
 def test_every_decision_the_stop_and_the_result_record_the_point_and_upper_estimates(
     never_reached: tuple[Path, Path],
 ) -> None:
@@ -61,11 +69,14 @@ def test_every_decision_the_stop_and_the_result_record_the_point_and_upper_estim
             UPPER_FACTOR * rec["estimated_error_deg"], abs=1e-3
         )
     text = (out.parent / "said.txt").read_text()
+    line = _adaptive_line(text)
+    # each figure once: the stop's reason gives the upper estimate, the line adds the point one
+    upper = f"upper estimate {result['upper_error_deg']:.2f}°"
+    assert line.count(upper) == 1, line
     assert (
-        f"estimated mean normal error {result['estimated_error_deg']:.2f}°, upper estimate "
-        f"{result['upper_error_deg']:.2f}° (×{UPPER_FACTOR:g}: what --until-error is compared "
-        "with)"
-    ) in text
+        f"estimated mean normal error {result['estimated_error_deg']:.2f}° (the upper estimate "
+        f"is ×{UPPER_FACTOR:g} of it: what --until-error is compared with)"
+    ) in line, line
 
 
 def test_a_point_estimate_under_the_target_does_not_claim_it(
@@ -257,7 +268,10 @@ def test_the_shipped_simulated_dome_stops_where_its_estimate_reaches_the_target(
         assert stop["reason"].startswith(f"reached its maximum of {cap} lights before")
         assert stop["upper_error_deg"] > target  # not claimed
     assert f"Adaptive: {used} lights" in said(r)
-    assert f"upper estimate {m['result']['upper_error_deg']:.2f}° (×{UPPER_FACTOR:g}" in said(r)
+    # the upper estimate is said once, in the stop's reason, the factor beside it
+    line = _adaptive_line(said(r))
+    assert line.count(f"upper estimate {m['result']['upper_error_deg']:.2f}°") == 1, line
+    assert f"× {UPPER_FACTOR:g})" in line or f"is ×{UPPER_FACTOR:g} of it" in line, line
 
 
 def test_an_arm_with_only_until_error_chooses_within_growing_designs_and_counts_moves(
@@ -304,6 +318,8 @@ def test_the_stops_reason_and_the_final_line_print_one_upper_estimate_alike() ->
     shown = re.search(r"upper estimate ([\d.]+)°", line)
     assert shown is not None and f"upper estimate {shown.group(1)}°" in reason
     assert f"estimate {fake.stop_terms(est)['estimated_error_deg']:.2f}°" in reason
+    # after a reason giving both figures, the final line gives neither again
+    assert estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0}, reason) == ""
 
 
 def test_a_relight_session_s_upper_estimate_is_not_tied_to_until_error() -> None:

@@ -1146,25 +1146,32 @@ def _decided_on_another_rig(folder, done: int) -> int:  # type: ignore[no-untype
     return min(max(changed, default=0), done)
 
 
-def estimate_phrase(result: dict[str, Any]) -> str:
+def estimate_phrase(result: dict[str, Any], reason: str = "") -> str:
     """The result's estimates in words, for the final message: the point estimate and the
     upper one, with the factor between them — said to be what --until-error was compared with
-    only when the session had a target."""
+    only when the session had a target. ``reason`` is the stop's reason printed before it:
+    a figure it already gives is not given again ("" when it gives both), as the summary line
+    had said the upper estimate twice, once in the reason and once after it."""
     est = result.get("estimated_error_deg")
     if est is None:
         return "estimated mean normal error n/a"
     up = result.get("upper_error_deg")
     text = f"estimated mean normal error {est:.2f}°"
-    if up is not None:
-        factor = result.get("upper_factor", up / est if est else 0)
-        if result.get("until_error_deg") is not None:
-            role = ": what --until-error is compared with"
-        elif result.get("objective", "normals") == "normals":
-            role = ": what --until-error would be compared with"
-        else:  # --until-error goes with normals only: a relight session is never compared
-            role = ""
-        text += f", upper estimate {up:.2f}° (×{factor:g}{role})"
-    return text
+    if up is None:
+        return text
+    factor = result.get("upper_factor", up / est if est else 0)
+    if result.get("until_error_deg") is not None:
+        role = ": what --until-error is compared with"
+    elif result.get("objective", "normals") == "normals":
+        role = ": what --until-error would be compared with"
+    else:  # --until-error goes with normals only: a relight session is never compared
+        role = ""
+    upper_said = f"upper estimate {up:.2f}°" in reason
+    if upper_said and f"(estimate {est:.2f}°" in reason:
+        return ""  # the reason gives both figures and the factor
+    if upper_said:
+        return f"{text} (the upper estimate is ×{factor:g} of it{role})"
+    return f"{text}, upper estimate {up:.2f}° (×{factor:g}{role})"
 
 
 #: The fewest lights `rti-rig fit` writes each relighting file from (the file, its model, the
