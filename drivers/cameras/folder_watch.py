@@ -115,6 +115,7 @@ from rti_rig.drivers.cameras.raw_decode import (
     libraw_printed,
     orientation_words,
 )
+from rti_rig.drivers.cameras.resume_words import resume_command
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
 from rti_rig.drivers.cameras.tiff_structure import (
     COMPLETE_TIFF_ADVICE,
@@ -511,6 +512,9 @@ class FolderWatchCamera:
         #: where a taken file is copied before it is decoded: the session's ``raw/.incoming``,
         #: set when the rig is bound to a session (None: decoded where it lies)
         self.output_dir: Path | None = None
+        #: the session folder (set by the composition root's session hook): a message that
+        #: sends the user to resume names the command for it
+        self.session_root: Path | None = None
 
     def connect(self) -> None:
         folder = self.settings.folder
@@ -802,7 +806,7 @@ class FolderWatchCamera:
                     ask = (
                         "; the folder is no longer there or cannot be reached (a network "
                         "share disconnected or unmounted, a disk unplugged?): reconnect it, "
-                        "then continue with 'rti-rig run --resume SESSION'"
+                        f"then continue with: {resume_command(self.session_root)}"
                     )
                 none = (
                     f"no other new file matching {list(s.patterns)} came to {shown_path(s.folder)}"

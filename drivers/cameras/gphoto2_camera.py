@@ -40,6 +40,7 @@ from rti_rig.drivers.cameras.raw_decode import (
     decode_raw,
     libraw_named,
 )
+from rti_rig.drivers.cameras.resume_words import resume_command
 from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 
 #: libgphoto2's name for an object of a capture kept in the camera's RAM when the body gives
@@ -151,10 +152,6 @@ def _not_offered(
     )
 
 
-#: How a session's lost step is shot again unless the use case says otherwise (``preview``).
-SHOOT_AGAIN_BY_RESUME = "'rti-rig run --resume SESSION' shoots it again"
-
-
 def load_gphoto2() -> Any:
     """Import python-gphoto2 lazily, with an error that says how to install it."""
     try:
@@ -212,7 +209,10 @@ class Gphoto2Camera:
         #: how the user shoots a lost step again, as a clause ("… then {again}"): a session's
         #: resume, or what the use case that opened the session sets (``rti-rig preview``
         #: says to run the preview again, the command its user typed)
-        self.shoot_again = SHOOT_AGAIN_BY_RESUME
+        self._shoot_again: str | None = None  # None: a session's resume
+        #: the session folder this camera captures for (set with ``output_dir`` by the
+        #: composition root's session hook): its messages name the command that resumes it
+        self.session_root: Path | None = None
         self._clock = clock or SystemClock()
         self._gp = gp_module
         self._cam: Any = None
@@ -1080,7 +1080,7 @@ class Gphoto2Camera:
                     f"session), came from the camera but could not be written into "
                     f"{target.parent} ({why}); {refusal}. {self._stray_where(folder, name)}. "
                     f"{self._shot_kept(folder, shot)}. The step is not recorded: {fix}, then "
-                    "'rti-rig run --resume SESSION' shoots this light again",
+                    f"shoot this light again with: {resume_command(self.session_root)}",
                     "download",
                 ) from exc
             where = self._where(folder, name)
@@ -1099,6 +1099,17 @@ class Gphoto2Camera:
                 f"{then}",
                 "download",
             ) from exc
+
+    @property
+    def shoot_again(self) -> str:
+        """How the user shoots a lost step again, as a clause ("… then {shoot_again}")."""
+        if self._shoot_again is not None:
+            return self._shoot_again
+        return f"shoot it again with: {resume_command(self.session_root)}"
+
+    @shoot_again.setter
+    def shoot_again(self, clause: str) -> None:
+        self._shoot_again = clause
 
     def _stray_where(self, folder: str, name: str) -> str:
         """Where a stray whose file did not reach the computer is now (see :meth:`_where`)."""
@@ -1151,8 +1162,8 @@ class Gphoto2Camera:
         return CaptureError(
             self.name,
             f"{exc.message}; downloading {on_camera} failed, {where}. Its step is not "
-            "recorded: 'rti-rig run --resume SESSION' shoots it again (check the USB cable "
-            "and that no other program holds the camera first)",
+            "recorded: check the USB cable and that no other program holds the camera, then "
+            f"{self.shoot_again}",
             "download",
         )
 
@@ -1170,7 +1181,7 @@ class Gphoto2Camera:
         # of a test shot whose run said "nothing was captured or written", and of a preview
         if self.output_dir is None:
             fate = "it was a test shot outside any session (metering)"
-        elif self.shoot_again == SHOOT_AGAIN_BY_RESUME:
+        elif self._shoot_again is None:
             # not "the resume": a first shot's run keeps nothing, and is run again
             fate = "its step is not recorded, so it is shot again when the session goes on"
         else:
@@ -1197,7 +1208,7 @@ class Gphoto2Camera:
         the run's summary, printed above the error, says both."""
         if self.output_dir is None:
             return "Reconnect it, then run the command again"
-        if self.shoot_again == SHOOT_AGAIN_BY_RESUME:
+        if self._shoot_again is None:
             return (
                 "Reconnect it, then go on as said above: whether the session kept images, "
                 "and the command that continues it"
@@ -1516,7 +1527,7 @@ class Gphoto2Camera:
             f"card ({left} file{'s' if left != 1 else ''} this session downloaded are still "
             "on it), which is what fills it: set delete_from_camera = true (each shot is "
             "deleted there only once it is in the session's raw/), or free the card, then "
-            "continue with 'rti-rig run --resume SESSION'"
+            f"continue with: {resume_command(self.session_root)}"
         )
 
     def _delete(self, files: list[tuple[str, str]]) -> None:

@@ -456,6 +456,8 @@ def _session_hook(camera):  # type: ignore[no-untyped-def]
     def hook(root: Path) -> None:
         if hasattr(camera, "output_dir"):
             camera.output_dir = root / RAW_INCOMING
+        if hasattr(camera, "session_root"):  # its messages name the command that resumes
+            camera.session_root = root
 
     return hook
 

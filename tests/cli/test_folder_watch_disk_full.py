@@ -167,3 +167,43 @@ def test_a_disk_full_at_the_first_image_says_the_disk_the_shot_and_what_the_resu
     assert (out / "raw" / "image_001.dng").read_bytes() == again[0][1]
     moved = list((out / "recovered").rglob("*.dng"))
     assert [p.read_bytes() for p in moved] == [files[0][1]], moved
+
+
+class _ShareDropsAtSecondShot(Tether):
+    """The tethering program's folder on a network share that disconnects at the second
+    shutter pulse: the first shot arrives, then the folder is gone."""
+
+    def save(self, name: str, data: bytes) -> None:
+        if name == "IMG_0002.DNG":
+            shutil.rmtree(self.folder)
+            return
+        super().save(name, data)
+
+
+def test_a_watched_folder_gone_mid_run_gives_the_resume_command_itself(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The stop said "reconnect it, then continue with 'rti-rig run --resume SESSION'": a
+    template to fill in, where the session's folder is known. It names the folder now, quoted
+    for the shell (a space in it)."""
+    from rti_rig.core.shell_words import shell_word
+
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=2.0)
+    out = tmp_path / "my session"
+    files = [(f"IMG_{k:04d}.DNG", flat_dng(0.1 * k)) for k in range(1, 3)]
+    run = tethered_run(
+        monkeypatch,
+        cfg,
+        tether,
+        files,
+        out,
+        lights=2,
+        camera=lambda fw: _ShareDropsAtSecondShot(fw, tether, files),
+    )
+    said = run.said
+    assert run.result.exit_code != 0 and "Traceback" not in said, said
+    assert "no longer there or cannot be reached" in said, said
+    assert f"then continue with: rti-rig run --resume {shell_word(str(out))}" in said, said
+    assert "SESSION" not in said, said
