@@ -19,6 +19,7 @@ from rti_rig.core.toml_strings import NotTomlText, toml_basic_string
 
 if TYPE_CHECKING:
     from rti_rig.app.usecases.calibrate import CalibrateRequest
+    from rti_rig.app.usecases.sphere_lights import SphereLights
 
 
 #: The calibration file a card session gets without ``--out`` (``CalibrateRequest.target``).
@@ -367,22 +368,60 @@ def lights_from_sphere(
     method: l = 2(n·v)n − v, n the sphere's normal at the highlight) and write the dome's .lp,
     line i = LED i, for layout = "lp" in its config. An image whose highlight cannot be
     measured is named with why, and no .lp is written."""
-    from rti_rig.app.usecases.sphere_lights import SphereRequest
-    from rti_rig.app.usecases.sphere_lights import lights_from_sphere as measure
-    from rti_rig.reconstruct.sphere_lights import Circle
-
+    # SIGTERM and a hang-up as Ctrl-C, from before the use case's import (seconds on a loaded
+    # machine): without a handler a SIGTERM ended the command without a word, and a Ctrl-C said
+    # only "rti-rig: stopped (Ctrl-C)", not whether --out (a file kept there with --force) was
+    # written. The .lp is written whole at the end (a rename), so a stop before it wrote nothing.
+    before = stamp(out_file)
+    done: list[SphereLights] = []  # the result, once measured and written
     try:
-        request = SphereRequest(session, Circle(*_parse_circle(sphere)), out_file, force)
-        result = measure(request)
-    except RtiRigError as exc:
-        raise fail(exc) from None
-    out.print(
-        f"Wrote {shown_path(result.out)}: {len(result.highlights)} LED directions measured "
-        f"from the sphere in {shown_path(session)} (line i = LED i).",
-        markup=False,
-        highlight=False,
-        soft_wrap=True,
-    )
+        with sigterm_stops():
+            from rti_rig.app.usecases.sphere_lights import SphereRequest
+            from rti_rig.app.usecases.sphere_lights import lights_from_sphere as measure
+            from rti_rig.reconstruct.sphere_lights import Circle
+
+            try:
+                request = SphereRequest(session, Circle(*_parse_circle(sphere)), out_file, force)
+                done.append(measure(request))
+            except RtiRigError as exc:
+                raise fail(exc) from None
+            result = done[0]
+            out.print(
+                f"Wrote {shown_path(result.out)}: {len(result.highlights)} LED directions "
+                f"measured from the sphere in {shown_path(session)} (line i = LED i).",
+                markup=False,
+                highlight=False,
+                soft_wrap=True,
+            )
+            out.print(
+                f"To use it, {_sphere_lp_line(result)}.",
+                markup=False,
+                highlight=False,
+                soft_wrap=True,
+            )
+    except (KeyboardInterrupt, Terminated) as exc:
+        signum = stop_signal(exc)
+        why = stop_words(signum)
+        if done:
+            said = (
+                f"Stopped ({why}): {shown_path(out_file)} is written; to use it, "
+                f"{_sphere_lp_line(done[0])}"
+            )
+        elif written_since(out_file, before):  # stopped as the use case returned
+            said = f"Stopped ({why}): {shown_path(out_file)} is written"
+        else:
+            kept = "" if before is None else " (the file already there is as it was)"
+            said = (
+                f"Stopped ({why}) before the .lp was written: nothing was written to "
+                f"{shown_path(out_file)}{kept}"
+            )
+        err.print(said, markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(code=stop_exit_code(signum)) from None
+
+
+def _sphere_lp_line(result: SphereLights) -> str:
+    """The setting that puts a measured ``.lp`` in the dome's config, its path relative to the
+    config the sphere was shot with (where the config is named; else to the working folder)."""
     config = result.config
     base = config.resolve().parent if config is not None else Path.cwd()
     try:
@@ -390,10 +429,4 @@ def lights_from_sphere(
     except NotTomlText:  # a name no TOML file can hold: the user copies the file to one
         named = '"…" (copy the file to a UTF-8 name first)'
     where = f"the dome's config {shown_path(config)}" if config else "the dome's config"
-    out.print(
-        f'To use it, set layout = "lp" and lp_file = {named} under [dome] in {where}, in '
-        "place of its count.",
-        markup=False,
-        highlight=False,
-        soft_wrap=True,
-    )
+    return f'set layout = "lp" and lp_file = {named} under [dome] in {where}, in place of its count'

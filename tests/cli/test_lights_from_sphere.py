@@ -6,11 +6,15 @@ the command's `.lp` must give those back (the session's own lights.lp says the s
 
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, shipped_variant
+from conftest import CONFIGS, said, shipped_variant
+from sigterm_support import Unhandled, sigterm_fails_the_test, terminated
 from typer.testing import CliRunner
 
 from rti_rig.app.config import load_rig_config
@@ -113,3 +117,66 @@ def test_a_session_of_some_leds_or_a_stopped_one_says_what_to_run(
     (part / "manifest.json").write_text(json.dumps(manifest))
     r = CliRunner().invoke(app, args)
     assert r.exit_code == 2 and "--resume" in r.output and not (tmp_path / "a.lp").exists()
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+@pytest.mark.parametrize(("how", "code"), [("Ctrl-C", 130), ("SIGTERM", 143)])
+def test_a_stop_while_measuring_says_nothing_was_written_to_out(
+    sphere_session: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, how: str, code: int
+) -> None:
+    """A Ctrl-C or SIGTERM at the third image: the .lp is written whole at the end, so the
+    user is told nothing was written to --out and the file kept there (--force) is as it was;
+    exit 130/143, no temporary file. The stop is raised from inside the command (no sleeps)."""
+    import rti_rig.app.usecases.sphere_lights as use_case
+
+    out = tmp_path / "my dome.lp"
+    out.write_text("last month's\n")
+    real, seen = use_case.find_highlight, []
+
+    def stopped(*args: Any, **kwargs: Any) -> Any:
+        seen.append(1)
+        if len(seen) == 3:
+            if how == "SIGTERM":
+                terminated()
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(use_case, "find_highlight", stopped)
+    argv = ["lights-from-sphere", str(sphere_session), "--sphere", _circle()]
+    with sigterm_fails_the_test("lights-from-sphere"):
+        r = CliRunner().invoke(app, [*argv, "--out", str(out), "--force"])
+    text = said(r)
+    assert not isinstance(r.exception, Unhandled), text
+    assert r.exit_code == code, (r.exception, text)
+    assert (
+        f"Stopped ({how}) before the .lp was written: nothing was written to {out} (the file "
+        "already there is as it was)"
+    ) in text, text
+    assert out.read_text() == "last month's\n" and sorted(tmp_path.iterdir()) == [out]
+    assert len(seen) == 3 and "Traceback" not in text
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_sigterm_once_written_says_the_lp_and_its_line(
+    sphere_session: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from rti_rig.cli import calibrate as calibrate_cli
+
+    out = tmp_path / "my_dome.lp"
+    printed = calibrate_cli.out.print
+
+    def interrupted(*args: Any, **kwargs: Any) -> None:
+        if args and str(args[0]).startswith("Wrote "):
+            terminated()  # as the first line of the report is printed
+        printed(*args, **kwargs)
+
+    monkeypatch.setattr(calibrate_cli.out, "print", interrupted)
+    argv = ["lights-from-sphere", str(sphere_session), "--sphere", _circle(), "--out", str(out)]
+    with sigterm_fails_the_test("lights-from-sphere"):
+        r = CliRunner().invoke(app, argv)
+    text = said(r)
+    assert r.exit_code == 143 and not isinstance(r.exception, Unhandled), text
+    rel = os.path.relpath(out, (sphere_session.parent / "rig.toml").resolve().parent)
+    assert f'Stopped (SIGTERM): {out} is written; to use it, set layout = "lp" and ' in text, text
+    assert f'lp_file = "{rel}" under [dome]' in text, text
+    assert len(read_lp(out)) == 48
