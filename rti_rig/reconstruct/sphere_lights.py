@@ -38,6 +38,12 @@ MIN_CONTRAST = 4.0
 #: A blob of more than this fraction of the disc's area is too large to place: a saturated
 #: smear (over-exposure, a diffuse or scratched sphere) whose centroid is not the peak.
 MAX_BLOB_FRACTION = 0.02
+#: A peak must also stand this fraction of the white level above the disc's median. Why: on a
+#: dark frame (an LED that did not light) of a black sphere, an 8-bit JPEG is 0 but for a few
+#: counts of noise: its median absolute deviation is 0, so the rules above took a pixel of 3
+#: for a highlight and gave its direction. A sphere's highlight at any usable exposure stands
+#: far above this (it is usually clipped).
+MIN_HEIGHT_FRACTION = 0.025
 
 
 class SphereCircleError(ValueError):
@@ -119,10 +125,15 @@ def find_highlight(
 ) -> Highlight | Rejected:
     """The highlight of one linear grey image on the sphere in ``circle``.
 
-    The blob is the 8-connected region around the disc's brightest pixel that stands at least
-    :data:`BLOB_LEVEL` of the peak's height above the disc's median; its centre is the centroid
-    of the blob weighted by that height above the level (sub-pixel, and a saturated plateau
-    gives its middle). ``white_level`` is the value of a clipped pixel, for the words only."""
+    The blob is an 8-connected region of the disc that stands at least :data:`BLOB_LEVEL` of
+    the peak's height above the disc's median; its centre is the centroid of the blob weighted
+    by that height above the level (sub-pixel, and a saturated plateau gives its middle).
+
+    Only one such region, of more than one pixel, is a highlight: a lone pixel is a hot pixel
+    or noise (a highlight seen through a lens spreads over several), and two regions are two
+    lights or a reflection besides the LED's, either of which would give a direction that is
+    not the LED's. ``white_level`` is the value of a clipped pixel: a peak must stand
+    :data:`MIN_HEIGHT_FRACTION` of it above the median."""
     rows, cols = grey.shape
     check_circle(circle, (rows, cols))
     r0, r1 = (
@@ -141,16 +152,31 @@ def find_highlight(
     peak = float(values.max())
     floor = float(np.median(patch[disc]))
     noise = float(np.median(np.abs(patch[disc] - floor))) * 1.4826
-    if not math.isfinite(peak) or peak - floor <= max((MIN_CONTRAST - 1.0) * floor, 6 * noise, 0.0):
+    least = max((MIN_CONTRAST - 1.0) * floor, 6 * noise, MIN_HEIGHT_FRACTION * white_level)
+    if not math.isfinite(peak) or peak - floor <= least:
         return Rejected(
             f"no highlight on the sphere (brightest {peak:.0f} against a median of {floor:.0f}): "
             "did the LED light, and is the circle on the sphere?"
         )
     level = floor + BLOB_LEVEL * (peak - floor)
     above = (values >= level).astype(np.uint8)
-    _, labels = cv2.connectedComponents(above, connectivity=8)
-    pr, pc = np.unravel_index(int(np.argmax(values)), values.shape)
-    blob = labels == labels[pr, pc]
+    count, labels, stats, centres = cv2.connectedComponentsWithStats(above, connectivity=8)
+    spots = [k for k in range(1, count) if stats[k, cv2.CC_STAT_AREA] > 1]
+    if not spots:
+        pr, pc = np.unravel_index(int(np.argmax(values)), values.shape)
+        return Rejected(
+            f"the brightest spot on the sphere is a single pixel (column {c0 + pc}, row "
+            f"{r0 + pr}): a hot pixel or noise, not a highlight; did the LED light?"
+        )
+    if len(spots) > 1:
+        at = " and ".join(
+            f"column {c0 + centres[k][0]:.0f}, row {r0 + centres[k][1]:.0f}" for k in spots[:3]
+        )
+        return Rejected(
+            f"{len(spots)} bright spots on the sphere ({at}): two LEDs lit, or a reflection "
+            "besides the LED's; which one is the LED's cannot be told, so none is taken"
+        )
+    blob = labels == spots[0]
     area = int(blob.sum())
     if area > MAX_BLOB_FRACTION * math.pi * circle.radius**2:
         clipped = int((blob & (patch >= white_level)).sum())

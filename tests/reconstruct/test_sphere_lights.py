@@ -22,7 +22,9 @@ CIRCLE = Circle(60.0, 50.0, 40.0)
 SHAPE = (100, 120)
 
 
-def _image(column: float, row: float, sigma: float = 1.2, peak: float = 1000.0) -> np.ndarray:
+def _image(column: float, row: float, sigma: float = 1.2, peak: float = 3000.0) -> np.ndarray:
+    """A highlight of ``peak`` above a sphere at 10, unclipped at the white level 65535 (a
+    highlight must stand 2.5 % of it above the sphere)."""
     rows, cols = np.mgrid[0 : SHAPE[0], 0 : SHAPE[1]].astype(float)
     spot = peak * np.exp(-((cols - column) ** 2 + (rows - row) ** 2) / (2 * sigma**2))
     return 10.0 + spot
@@ -58,6 +60,35 @@ def test_a_sub_pixel_highlight_gives_its_direction() -> None:
 def test_what_gives_no_direction_is_rejected_with_why(image: np.ndarray, words: str) -> None:
     found = find_highlight(image, CIRCLE, 65535)
     assert isinstance(found, Rejected) and words in found.reason
+
+
+def _dark_jpeg() -> np.ndarray:
+    """An LED that did not light, on a black sphere in 8 bits: 0 but for a few counts of noise
+    (the disc's median and its median absolute deviation are both 0)."""
+    rng = np.random.default_rng(3)
+    image = np.zeros(SHAPE)
+    image[rng.integers(35, 65, 40), rng.integers(45, 75, 40)] = rng.integers(1, 4, 40)
+    return image
+
+
+def _two_spots() -> np.ndarray:
+    return _image(50.0, 45.0) + _image(72.0, 58.0, peak=2500.0) - 10.0
+
+
+@pytest.mark.parametrize(
+    ("image", "white", "words"),
+    [
+        (_dark_jpeg(), 255, "no highlight"),
+        (_image(70.0, 40.0, sigma=0.01), 65535, "single pixel (column 70, row 40)"),
+        (_two_spots(), 65535, "2 bright spots on the sphere (column 50, row 45 and column 72"),
+    ],
+    ids=["dark-8-bit", "hot-pixel", "two-spots"],
+)
+def test_no_direction_is_invented_from_noise_a_hot_pixel_or_two_spots(
+    image: np.ndarray, white: float, words: str
+) -> None:
+    found = find_highlight(image, CIRCLE, white)
+    assert isinstance(found, Rejected) and words in found.reason, found
 
 
 def test_a_circle_outside_the_frame_is_refused() -> None:
