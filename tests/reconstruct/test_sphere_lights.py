@@ -62,6 +62,17 @@ def test_what_gives_no_direction_is_rejected_with_why(image: np.ndarray, words: 
     assert isinstance(found, Rejected) and words in found.reason
 
 
+def test_a_clipped_highlight_gives_its_centre() -> None:
+    """The usual case on a chrome sphere at a real exposure: the highlight's core is clipped
+    flat at the white level; the plateau's middle is the highlight, sub-pixel."""
+    column, row = 52.4, 61.7
+    image = np.minimum(_image(column, row, sigma=1.5, peak=1e6), 65535.0)
+    assert (image >= 65535).sum() > 20  # a clipped plateau, not a peak
+    found = find_highlight(image, CIRCLE, 65535)
+    assert isinstance(found, Highlight), found
+    assert abs(found.column - column) < 0.05 and abs(found.row - row) < 0.05
+
+
 def _dark_jpeg() -> np.ndarray:
     """An LED that did not light, on a black sphere in 8 bits: 0 but for a few counts of noise
     (the disc's median and its median absolute deviation are both 0)."""
