@@ -116,7 +116,11 @@ def test_a_session_of_some_leds_or_a_stopped_one_says_what_to_run(
     manifest["runner"]["finish_reason"] = "stopped"
     (part / "manifest.json").write_text(json.dumps(manifest))
     r = CliRunner().invoke(app, args)
-    assert r.exit_code == 2 and "--resume" in r.output and not (tmp_path / "a.lp").exists()
+    assert r.exit_code == 2 and not (tmp_path / "a.lp").exists(), r.output
+    assert (
+        "the session did not finish (stopped; 12 of the dome's 48 LEDs shot): once what stopped "
+        f"it, as its run said, is put right, continue it with rti-rig run --resume {part}"
+    ) in said(r), r.output
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")

@@ -77,11 +77,14 @@ def _steps_by_led(root: Path, manifest: dict[str, Any]) -> list[dict[str, Any]]:
     missing = [k for k in range(count) if k not in by_led]
     finish = (manifest.get("runner") or {}).get("finish_reason")
     if missing and finish != "completed":
-        # a stopped session lists no steps until it finishes: "shoot it again" would throw
-        # away the images it has
+        # a stopped session has the images it shot: "shoot it again" would throw them away.
+        # Its stop may be one a resume meets again (an LED the firmware refused), which its
+        # run said: the resume is for once that is put right, not at once
         raise SessionError(
-            f"{shown_path(root)}: the session did not finish ({finish or 'no finish recorded'}): "
-            f"continue it with rti-rig run --resume {shell_word(str(root))}, then measure it"
+            f"{shown_path(root)}: the session did not finish ({finish or 'no finish recorded'}; "
+            f"{len(by_led)} of the dome's {count} LEDs shot): once what stopped it, as its run "
+            f"said, is put right, continue it with rti-rig run --resume "
+            f"{shell_word(str(root))}, then measure it"
         )
     if not count or missing:
         config = rig.get("config_path")
