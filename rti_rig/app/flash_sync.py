@@ -503,6 +503,7 @@ def emulated_flash_sync_camera(loaded, geometry: DomeGeometry, clock: Clock):  #
     firmware fires it (accepted and ignored here, the one emulated dome left so, a dead LED
     could not be rehearsed on a camera-triggered dome)."""
     from rti_rig.app.compose import SIMULATED_SCENE_EXPOSURE_S, scene_renderer
+    from rti_rig.app.config import emulated_led_directions
     from rti_rig.simulator.domes.cceh_rti import CcehRtiFirmware
     from rti_rig.simulator.flash_sync_camera import FlashSyncCamera, SyncFault
 
@@ -510,10 +511,13 @@ def emulated_flash_sync_camera(loaded, geometry: DomeGeometry, clock: Clock):  #
     render = scene_renderer(loaded)
     powers = cfg.emulator.led_powers(geometry.count, cfg.scene.seed)
     dead = frozenset(cfg.emulator.dead_leds)
+    # where the LEDs really are: [emulator] led_directions_file, a new dome's rehearsal on a
+    # stand-in layout (it had been accepted here and ignored: the camera rendered the stand-in)
+    real = emulated_led_directions(loaded, geometry.count)
     return FlashSyncCamera(
         render,
         CcehRtiFirmware(start=clock.now()),
-        geometry.directions,
+        geometry.directions if real is None else real,
         clock,
         faults=tuple(SyncFault(f.at_image, f.kind) for f in cfg.emulator.sync_faults),
         power=lambda led: 0.0 if led in dead else float(powers[led]),

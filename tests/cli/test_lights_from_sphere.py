@@ -184,3 +184,30 @@ def test_a_sigterm_once_written_says_the_lp_and_its_line(
     assert f'Stopped (SIGTERM): {out} is written; to use it, set layout = "lp" and ' in text, text
     assert f'lp_file = "{rel}" under [dome]' in text, text
     assert len(read_lp(out)) == 48
+
+
+def test_a_camera_triggered_emulated_dome_puts_its_leds_where_the_file_says(
+    tmp_path: Path,
+) -> None:
+    """The cceh/rti emulator (the dome the camera's flash steps) renders the LEDs of
+    ``led_directions_file``, as the serial emulators do: it had accepted the key and rendered
+    the stand-in layout, so a rehearsal measured the stand-in back."""
+    from rti_rig.app.config import rig_geometry
+    from rti_rig.app.flash_sync import emulated_flash_sync_camera
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.core.lp_format import LpEntry, write_lp
+
+    rings = rig_geometry(load_rig_config(CONFIGS / "emulated_cceh_rti.toml")).directions
+    write_lp(
+        tmp_path / "rings.lp", [LpEntry(f"led_{i:02d}.jpg", tuple(d)) for i, d in enumerate(rings)]
+    )
+    text = (CONFIGS / "emulated_cceh_rti.toml").read_text(encoding="utf-8")
+    stand_in = text[: text.index('layout = "rings"')] + 'layout = "fibonacci"\ncount = 60\n\n'
+    stand_in += text[text.index("[dome.flash_sync]") :]
+    config = tmp_path / "rig.toml"
+    config.write_text(stand_in + '\n[emulator]\nled_directions_file = "rings.lp"\n')
+    loaded = load_rig_config(config)
+    geometry = rig_geometry(loaded)
+    camera = emulated_flash_sync_camera(loaded, geometry, VirtualClock())
+    np.testing.assert_allclose(camera._dirs, directions_of(read_lp(tmp_path / "rings.lp")))
+    assert np.median(_angles(geometry.directions, camera._dirs)) > 10  # not the stand-in
