@@ -121,6 +121,16 @@ def test_a_session_of_some_leds_or_a_stopped_one_says_what_to_run(
         "the session did not finish (stopped; 12 of the dome's 48 LEDs shot): once what stopped "
         f"it, as its run said, is put right, continue it with rti-rig run --resume {part}"
     ) in said(r), r.output
+    # a dome the camera's flash steps cannot resume (its own count went on): shoot it again
+    manifest["rig"]["config"]["dome"]["flash_sync"] = {"firmware": "cceh-rti"}
+    (part / "manifest.json").write_text(json.dumps(manifest))
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 2 and "--resume" not in r.output, r.output
+    assert (
+        "A camera-triggered dome cannot resume a session (its own count went on): long-press its "
+        f"start button to rewind it, then start a new session: rti-rig run "
+        f"{manifest['rig']['config_path']} --out {tmp_path / 'part-sphere'}"
+    ) in said(r), r.output
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")

@@ -30,6 +30,7 @@ from rti_rig.reconstruct.sphere_lights import (
     as_grey,
     find_highlight,
 )
+from rti_rig.runtime.flash_sync import CameraTriggeredLighting
 from rti_rig.runtime.session import read_manifest
 
 
@@ -76,6 +77,17 @@ def _steps_by_led(root: Path, manifest: dict[str, Any]) -> list[dict[str, Any]]:
             by_led[led] = step
     missing = [k for k in range(count) if k not in by_led]
     finish = (manifest.get("runner") or {}).get("finish_reason")
+    flash_synced = ((rig.get("config") or {}).get("dome") or {}).get("flash_sync") is not None
+    config = rig.get("config_path")
+    if missing and finish != "completed" and flash_synced and isinstance(config, str) and config:
+        # a dome the camera's flash steps cannot resume: its own count went on
+        raise SessionError(
+            f"{shown_path(root)}: the session did not finish ({finish or 'no finish recorded'}; "
+            f"{len(by_led)} of the dome's {count} LEDs shot). "
+            + CameraTriggeredLighting.resume_hint(
+                shell_word(config), shell_word(str(free_folder_beside(root, "sphere")))
+            )
+        )
     if missing and finish != "completed":
         # a stopped session has the images it shot: "shoot it again" would throw them away.
         # Its stop may be one a resume meets again (an LED the firmware refused), which its
@@ -87,7 +99,6 @@ def _steps_by_led(root: Path, manifest: dict[str, Any]) -> list[dict[str, Any]]:
             f"{shell_word(str(root))}, then measure it"
         )
     if not count or missing:
-        config = rig.get("config_path")
         again = (
             run_words(Path(config), free_folder_beside(root, "sphere"))
             if isinstance(config, str) and config
