@@ -888,14 +888,14 @@ class Gphoto2Camera:
         self._count += 1
         raw_files = [f for f in files if is_camera_raw(Path(f[1]))]
         if not raw_files:
-            self._delete(files)
+            kept = self._keep_unusable(files)
             self._format_note = None  # the format is known now: this error says it
             raws = raw_choices(self._format_choices)
             offered = f": it offers {raws}" if raws else ""
             raise CaptureError(
                 self.name,
                 f"camera delivered {[n for _, n in files]} but no RAW file: set image_format in "
-                f"[camera.device] to the camera's RAW (or RAW+JPEG) value{offered}",
+                f"[camera.device] to the camera's RAW (or RAW+JPEG) value{offered}{kept}",
                 "capture",
             )
         staging = self._staging_dir()
@@ -1135,6 +1135,46 @@ class Gphoto2Camera:
         if self.settings.capture_target != "Internal RAM":
             kept += f"; its copy stays on the camera's card in {folder.rstrip('/')}/"
         return kept
+
+    def _keep_unusable(self, files: list[tuple[str, str]]) -> str:
+        """Keep a session's shot that gave no RAW (a JPEG-only format, or the body's dial
+        turned mid-session): downloaded beside the session's other downloads, then deleted
+        from the camera as any downloaded shot is. Returns the clause that says where it is.
+
+        Why: these files were deleted from the camera undownloaded: a picture taken under a
+        session's light was lost without a word. A test shot outside any session (metering,
+        ``check``) is deleted as before: it is a test, and its private folder goes at close.
+        A file whose download or save fails stays where it was (card or RAM), and is named."""
+        if self.output_dir is None or self._cam is None:
+            self._delete(files)
+            return ""
+        gp, cam = self._gp, self._cam
+        kept: list[str] = []
+        left: list[str] = []
+        downloaded: list[tuple[str, str]] = []
+        for folder, name in files:
+            target = _unused(self._staging_dir(), f"cap{self._count:04d}_{name}")
+            try:
+                camera_file = self._call(
+                    "download",
+                    lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL),
+                )
+                self._save(camera_file, target, folder, name)
+            except (CaptureError, CameraGoneError):
+                left.append(self._where(folder, name))
+                continue
+            kept.append(shown_path(target))
+            downloaded.append((folder, name))
+        self._delete(downloaded)
+        said = ""
+        if kept:
+            said += (
+                f". The shot is kept at {', '.join(kept)} (a resume moves it to the session's "
+                "recovered/ folder, never deleting it)"
+            )
+        if left:
+            said += ". Not downloaded: " + "; ".join(left)
+        return said
 
     def _where(self, folder: str, name: str) -> str:
         """Where a shot whose file did not reach the session is now: lost with the camera's

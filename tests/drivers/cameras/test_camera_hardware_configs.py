@@ -1175,6 +1175,12 @@ def test_an_image_format_whose_name_cannot_be_judged_is_said_at_check(body, dome
     assert result.exit_code == 2, said
     assert "but no RAW file" in said and "RAW+JPEG) value: it offers ['RAW']" in said, said
     assert body.shots == 2
+    # the session's shot, taken under its first light, is downloaded and kept, not deleted
+    # from the camera undownloaded; the words say where (a resume moves it to recovered/)
+    kept = sorted((tmp_path / "s").rglob("cap*"))
+    assert len(kept) == 1 and kept[0].suffix.lower() in {".jpg", ".jpeg"}, kept
+    assert kept[0].stat().st_size > 0
+    assert "The shot is kept at" in said and kept[0].name in said, said
     body.format_gives = {unknown: (True, False)}
     result = CliRunner().invoke(app, ["check", str(cfg)])
     said = " ".join(result.output.split())
