@@ -100,6 +100,13 @@ def check_time_ms(side: int = 512) -> tuple[float, float]:
     return float(np.median(times)), float(np.max(times))
 
 
+def _positions_for(kind: str, positions: range) -> list[int]:
+    """The images a fault of ``kind`` is injected before. A power cut before image 1 is left
+    out: the firmware starts its order again from LED 0, where it already stood, so nothing
+    slips, and the run had counted it as a slip "never caught" (4 of 60, none mislabelled)."""
+    return [p for p in positions if not (kind == "power_cycle" and p == 1)]
+
+
 def _option(argv: list[str], name: str, default: tuple[str, ...]) -> tuple[str, ...]:
     if name in argv and argv.index(name) + 1 < len(argv):
         return tuple(v for v in argv[argv.index(name) + 1].split(",") if v)
@@ -127,7 +134,7 @@ def main(argv: list[str]) -> None:
             for kind in totals:
                 at_slip = late = disowned = never = proof = 0
                 mislabelled = 0
-                for pos in positions:
+                for pos in _positions_for(kind, positions):
                     runs += 1
                     r = run_once(scene, (pos, kind), Path(tmp) / f"r{runs}")
                     mislabelled += int(r["wrong_in_lp"])  # type: ignore[call-overload]
@@ -149,8 +156,8 @@ def main(argv: list[str]) -> None:
                     f"never ({mislabelled} lp entries mislabelled)"
                 )
             print("; ".join(line), flush=True)
-    n = len(scenes) * len(positions)
     for kind, (a, disowned, late, never, proof) in totals.items():
+        n = len(scenes) * len(_positions_for(kind, positions))
         print(
             f"{kind}: caught at the slipped image {a}/{n} ({a / n:.0%}), late with the session "
             f"disowned {disowned}, late {late}, by the end-of-run proof {proof}, never {never}"
@@ -163,5 +170,5 @@ def main(argv: list[str]) -> None:
 if __name__ == "__main__":
     from benchmarks.report import exit_on_help
 
-    exit_on_help(__doc__)
+    exit_on_help(__doc__, writes=False)
     main(sys.argv[1:])

@@ -144,5 +144,5 @@ def main(argv: list[str]) -> None:
 if __name__ == "__main__":
     from benchmarks.report import exit_on_help
 
-    exit_on_help(__doc__)
+    exit_on_help(__doc__, writes=False)
     main(sys.argv[1:])

@@ -81,5 +81,5 @@ def main() -> None:
 if __name__ == "__main__":
     from benchmarks.report import exit_on_help
 
-    exit_on_help(__doc__)
+    exit_on_help(__doc__, writes=False)
     main()

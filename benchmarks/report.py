@@ -37,14 +37,35 @@ def write_asked(argv: list[str] | None = None) -> bool:
     return "--write" in (sys.argv[1:] if argv is None else argv)
 
 
-def exit_on_help(doc: str | None, argv: list[str] | None = None) -> None:
+def exit_on_help(doc: str | None, argv: list[str] | None = None, *, writes: bool = True) -> None:
     """For a script without an argument parser: ``-h``/``--help`` prints its docstring and
-    exits, instead of running the whole benchmark (minutes) as an unknown argument would."""
+    exits, instead of running the whole benchmark (minutes) as an unknown argument would.
+
+    ``writes=False``: the script only prints (its figures in docs/ are recorded by hand). Its
+    help says so, and a ``--write`` is refused before the run. Why: every script's help had
+    offered ``--write``, and three that write nothing ran for minutes with it and left the
+    recorded table as it was, the user believing it refreshed."""
     args = sys.argv[1:] if argv is None else argv
     if "-h" in args or "--help" in args:
         print((doc or "").strip())
-        print("\nOptions: --write  update the figures in docs/ (otherwise they are only printed)")
+        if writes:
+            print(WRITES)
+        else:
+            print(PRINTS_ONLY)
         raise SystemExit(0)
+    if not writes and "--write" in args:
+        print(f"--write: {PRINTS_ONLY.strip()}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+#: What a script that writes its figures into docs/ says of ``--write``.
+WRITES = "\nOptions: --write  update the figures in docs/ (otherwise they are only printed)"
+
+#: What a script that writes nothing into docs/ says of ``--write``.
+PRINTS_ONLY = (
+    "\nThis benchmark only prints its figures: it has no --write. The figures recorded in "
+    "docs/ from it were copied there by hand, with the date and command they came from."
+)
 
 
 def positional_args(argv: list[str] | None = None) -> list[str]:
