@@ -186,7 +186,8 @@ class SlipGuard:
                     f"image {index + 1} was not lit by {self._led(index)} of the dome's order — "
                     f"{what}: {verdict.reason}. A slip in the first images is seen only some "
                     f"images later, so images {first}–{index} in lights.lp may be mislabelled: "
-                    f"do not use this session. {kept.said('Image ' + str(index + 1))}.",
+                    f"do not use this session. {kept.said('Image ' + str(index + 1))}."
+                    + self._maybe_power_cut(first),
                 )
                 + f" {rewind}"
             )
@@ -195,6 +196,22 @@ class SlipGuard:
             f"image {index + 1} was not lit by {self._led(index)} of the dome's order — {what}: "
             f"{verdict.reason}. {kept.said('The image')}; lights.lp lists "
             f"{before} only. {rewind}"
+        )
+
+    def _maybe_power_cut(self, first: int) -> str:
+        """The clause for a slip that began before the check had a fit (images 1 to
+        ``min_fit_images``): a power cut there looks like it.
+
+        Why: the firmware lights LED 0 again after a power cut, which the check names only
+        once it has a fit to compare LED 0 with. Before that, a cut before image 2 or 3 is
+        seen images later as a shift of the order, and was named a "double step" or "missed
+        step" alone: the user went after the flash cable when the dome's supply had dropped."""
+        if first > self.checker.min_fit_images:
+            return ""
+        return (
+            f" A power cut before image {self.checker.min_fit_images + 1} (the dome starting "
+            "its order again from LED 0) shows the same way, so check the dome's power supply "
+            "and its plug as well as the flash cable."
         )
 
     def _restarted(self, index: int, reason: str, kept: Kept) -> str:

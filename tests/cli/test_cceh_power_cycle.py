@@ -124,3 +124,20 @@ def test_a_power_cycle_before_any_fit_is_never_said_verified(tmp_path: Path) -> 
     f = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fitted")])
     assert f.exit_code == 2 and "LABELS_NOT_VERIFIED.txt" in " ".join(f.output.split())
     assert not (tmp_path / "fitted").exists()
+
+
+def test_a_power_cut_before_the_first_fit_seen_later_says_it_may_be_one(tmp_path: Path) -> None:
+    """A power cut before image 2 on the relief is caught images later as a shift of the
+    order, named a double step: the check cannot tell it from a power cut there, so the words
+    say to check the dome's power as well as the flash cable (they had named the step alone)."""
+    config = tmp_path / "rig.toml"
+    config.write_text(
+        _two_rings() + '\n[[emulator.sync_faults]]\nat_image = 2\nkind = "power_cycle"\n',
+        encoding="utf-8",
+    )
+    r = runner.invoke(app, ["run", str(config), "--out", str(tmp_path / "s")], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0 and "Traceback" not in said, said
+    assert "do not use this session" in said, said
+    assert "A power cut before image 4 (the dome starting its order again from LED 0)" in said, said
+    assert "check the dome's power supply and its plug" in said, said
