@@ -51,7 +51,23 @@ HELD_OUT_SHARE = 1 / 6
 MIN_HELD_OUT = 3
 #: the fewest lights a trade-off plans from (a PTM needs 6; the smallest N is 6, below them)
 MIN_CANDIDATES = 7
-PER_LIGHT_S = 0.02 + 0.1 + 0.05 + 0.3 + 0.7  # the default dome timing and exposure
+
+
+def replay_seconds_per_light() -> float:
+    """The time one light takes on the replayed dome (`rti-rig run ACQ/dirs.lp`): the
+    config's default timing and exposure, as the replay rig is built from them.
+
+    Why from the defaults: the sum had been written out by hand (0.02 + 0.1 + 0.05 + 0.3 +
+    0.7), and a changed default would have left the trade's time axis on the old one while
+    the replayed run's own "Session time on the real rig" moved."""
+    from rti_rig.app.config import CameraConfig, TimingConfig
+
+    t = TimingConfig()
+    exposure_s = float(CameraConfig.model_fields["exposure_s"].default)
+    return t.light_switch_s + t.settle_s + exposure_s + t.readout_s + t.transfer_s
+
+
+PER_LIGHT_S = replay_seconds_per_light()
 
 
 def load_acquisition(lp: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:

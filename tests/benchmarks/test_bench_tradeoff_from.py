@@ -736,3 +736,19 @@ def test_a_stop_during_the_trade_on_an_acquisition_says_nothing_was_written(
         f"Stopped (Ctrl-C) during the trade on {shown_path(lp)}: nothing written to "
         f"{shown_path(out)} (its results are written once every layout is measured)" in said
     ), said
+
+
+def test_the_trades_seconds_a_light_are_the_replayed_runs(tmp_path: Path) -> None:
+    """The trade's time axis (n x PER_LIGHT_S) is what `rti-rig run ACQ/dirs.lp` itself says
+    its session takes on the replayed dome: the two had been kept equal by hand."""
+    import re
+
+    from benchmarks.tradeoff_from import PER_LIGHT_S
+
+    r = CliRunner().invoke(
+        app, ["run", str(ACQ), "--out", str(tmp_path / "s"), "--lights", "6"], terminal_width=300
+    )
+    assert r.exit_code == 0, r.output
+    said = re.search(r"Session time on the real rig: ([0-9.]+) s", r.output)
+    assert said is not None, r.output
+    assert abs(float(said.group(1)) - 6 * PER_LIGHT_S) <= 0.051, (said.group(0), PER_LIGHT_S)
