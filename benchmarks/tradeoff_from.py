@@ -68,6 +68,39 @@ def replay_seconds_per_light() -> float:
 
 
 PER_LIGHT_S = replay_seconds_per_light()
+#: How the summary names where ``PER_LIGHT_S`` comes from.
+PER_LIGHT_SAID = "the replayed dome's default timing"
+
+
+def rig_seconds_per_light(rig_path: Path) -> tuple[float, str]:
+    """(seconds a light takes on the user's dome, the words that say where that comes from),
+    from its rig config's ``[timing]`` and ``[camera] exposure_s``, summed as a dry run on the
+    simulated dome counts a step.
+
+    Why: the trade is for deciding how many lights the user's own objects need, and its time
+    axis had always been the replayed dome's defaults (1.17 s a light), where a DSLR dome's
+    step takes seconds. An arm is refused: its time depends on its moves between the lights,
+    which an acquisition's directions do not give it. Raises ``RtiRigError`` naming the file."""
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.core.errors import RtiRigError
+    from rti_rig.core.shell_words import shown_path
+
+    cfg = load_rig_config(rig_path).config
+    if cfg.kind != "dome":
+        raise RtiRigError(
+            f"--rig {shown_path(rig_path)} is an arm's config: an arm's session time depends on "
+            "its moves between the lights, which the trade on an acquisition does not plan. "
+            "Give a dome's config, or leave --rig out (the replayed dome's default timing)"
+        )
+    t, exposure_s = cfg.timing, cfg.camera.exposure_s
+    seconds = t.light_switch_s + t.settle_s + exposure_s + t.readout_s + t.transfer_s
+    said = (
+        f"{shown_path(rig_path)}'s timing.light_switch_s {t.light_switch_s:g} + settle_s "
+        f"{t.settle_s:g} + camera.exposure_s {exposure_s:g} + readout_s {t.readout_s:g} + "
+        f"transfer_s {t.transfer_s:g}, as a dry run counts a step (the serial link's replies "
+        "and the camera's own delays are in it only as far as these keys hold them)"
+    )
+    return seconds, said
 
 
 def load_acquisition(lp: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -303,8 +336,16 @@ def run_tradeoff_from(
     return rows, [names[i] for i in held]
 
 
-def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str]) -> str:
-    """The markdown summary; ``held``: the names of the held-out lights."""
+def summarise_from(
+    rows: list[Row],
+    seconds: float,
+    command: str,
+    held: list[str],
+    per_light: tuple[float, str] = (PER_LIGHT_S, PER_LIGHT_SAID),
+) -> str:
+    """The markdown summary; ``held``: the names of the held-out lights; ``per_light``: the
+    seconds a light takes and where they come from."""
+    per_light_s, per_light_said = per_light
     floor = best_floor(rows, rows[0].scene)  # as the plots' line: on the N every floor serves
     by = {(r.method, r.objective, r.floor_deg, r.n): r for r in rows}
     counts = sorted({r.n for r in rows if r.method != "all"})
@@ -317,7 +358,7 @@ def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str
         f"{len(held)} held-out lights for every plan ({', '.join(held)}: one drawn in each of "
         f"{len(held)} elevation bands of equal count), which no plan may take; every plan "
         f"chooses among the other {every.n}. Session time: "
-        f"{PER_LIGHT_S:.2f} s a light (the replayed dome's default timing).",
+        f"{per_light_s:.2f} s a light ({per_light_said}).",
         "",
         "| N | session s | uniform 0° | uniform, best floor here "
         f"({floor:g}°, hindsight) | optimal | adaptive | adaptive, `--objective relight` |",
@@ -326,7 +367,7 @@ def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str
     for n in counts:
         cells = _columns(by, floor, n)
         lines.append(
-            f"| {n} | {n * PER_LIGHT_S:.0f} | "
+            f"| {n} | {n * per_light_s:.0f} | "
             + " | ".join(
                 f"{r.normal_mean_deg:.2f}° / {r.relight_psnr_db:.1f} dB ({r.relight_model})"
                 if r is not None
@@ -336,7 +377,7 @@ def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str
             + " |"
         )
     lines += [
-        f"| all {every.n} | {every.n * PER_LIGHT_S:.0f} | "
+        f"| all {every.n} | {every.n * per_light_s:.0f} | "
         f"{every.normal_mean_deg:.2f}° / {every.relight_psnr_db:.1f} dB "
         f"({every.relight_model}): every light not held out | | | | |",
         "",
@@ -399,25 +440,33 @@ def bench_from(
     out_dir: Path | None,
     progress: Callable[[str], None] = print,
     force: bool = False,
+    rig: Path | None = None,
 ) -> str:
     """Run, write results.csv, the plots and summary.md into ``out_dir`` (nothing written when
     it is None: the summary is only returned); return the summary (its command line says
-    ``--force`` when the folder's files were replaced with it)."""
+    ``--force`` when the folder's files were replaced with it). ``rig``: the user's dome
+    config, whose timing gives the session time (:func:`rig_seconds_per_light`); else the
+    replayed dome's defaults."""
+    per_light = (PER_LIGHT_S, PER_LIGHT_SAID) if rig is None else rig_seconds_per_light(rig)
     t0 = time.perf_counter()
     rows, held = run_tradeoff_from(lp, progress)
+    for row in rows:
+        row.dome_time_s = row.n * per_light[0]
     # quoted as a shell reads it: an archive's folder with a space (``Tablet 3/dirs.lp``) had
     # been written bare, a command that fails when copied from summary.md; shell_word, not
     # shlex.quote: a name whose bytes are not UTF-8 is said as $'...' of those bytes (quoted,
     # it was a '\udce9' no shell reads back, and summary.md's UTF-8 write failed on it)
     command = f"rti-rig bench tradeoff --from {shell_word(lp)}"
+    if rig is not None:
+        command += f" --rig {shell_word(rig)}"
     if out_dir is None:
-        return summarise_from(rows, time.perf_counter() - t0, command, held)
+        return summarise_from(rows, time.perf_counter() - t0, command, held, per_light)
     out_dir.mkdir(parents=True, exist_ok=True)
     write_csv(rows, out_dir / "results.csv")
     for path in plot(rows, out_dir):
         if "arm_time" in path.name:  # a replayed acquisition is a dome: no arm time to plot
             path.unlink()
     command += f" --out {shell_word(out_dir)}" + (" --force" if force else "")
-    text = summarise_from(rows, time.perf_counter() - t0, command, held)
+    text = summarise_from(rows, time.perf_counter() - t0, command, held, per_light)
     (out_dir / "summary.md").write_text(text + "\n", encoding="utf-8")
     return text

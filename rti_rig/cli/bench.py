@@ -94,6 +94,15 @@ def bench_tradeoff(
             "into a session's folder or the --from acquisition's own.",
         ),
     ] = False,
+    rig: Annotated[
+        Path | None,
+        typer.Option(
+            "--rig",
+            help="With --from: your dome's rig config, whose [timing] and [camera] "
+            "exposure_s give the session time (else the replayed dome's defaults, 1.17 s a "
+            "light).",
+        ),
+    ] = None,
 ) -> None:
     """Error against number of lights and session time, for every planner, on simulated scenes
     (or on your own acquisition with --from).
@@ -129,7 +138,7 @@ def bench_tradeoff(
 
     with warnings.catch_warnings():  # restored after: the CLI may run inside a test process
         warnings.showwarning = _as_note
-        _tradeoff(out_dir, quick, from_lp, force)
+        _tradeoff(out_dir, quick, from_lp, force, rig)
 
 
 def _acquisition_lp(given: Path) -> Path:
@@ -268,12 +277,27 @@ def _stopped_midway(
     err.print(f"{said}; {kept}", markup=False, highlight=False, soft_wrap=True)
 
 
-def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bool) -> None:
+def _tradeoff(
+    out_dir: Path | None, quick: bool, from_lp: Path | None, force: bool, rig: Path | None = None
+) -> None:
     """The body of ``bench tradeoff``, once the command has found the benchmarks."""
     import time
 
     from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
-    from benchmarks.tradeoff_from import bench_from, check_acquisition
+    from benchmarks.tradeoff_from import bench_from, check_acquisition, rig_seconds_per_light
+
+    if rig is not None:  # its config read before minutes of computing, not after
+        if from_lp is None:
+            raise fail(
+                RtiRigError(
+                    "--rig gives the session time of the trade on your acquisition: it goes "
+                    "with --from ACQ/dirs.lp (the simulated trade times the rigs it runs)"
+                )
+            )
+        try:
+            rig_seconds_per_light(rig)
+        except RtiRigError as exc:
+            raise fail(exc) from None
 
     if from_lp is not None and quick:  # accepted and ignored, it had changed nothing
         raise fail(
@@ -301,7 +325,7 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
     if from_lp is not None:
         try:
             with sigterm_stops():
-                text = bench_from(from_lp, out_dir, _plain, force=force)
+                text = bench_from(from_lp, out_dir, _plain, force=force, rig=rig)
         except (KeyboardInterrupt, Terminated) as exc:
             # said, with what is on disk (only "stopped (Ctrl-C)" had been, an --out folder
             # left empty without a word): the trade on an acquisition is written at its end
@@ -322,7 +346,10 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
             raise fail(RtiRigError(str(exc))) from None
         _plain(text)
         if out_dir is None:
-            _plain(_nothing_written(f" --from {shell_word(from_lp)}"))
+            again = f" --from {shell_word(from_lp)}"
+            if rig is not None:
+                again += f" --rig {shell_word(rig)}"
+            _plain(_nothing_written(again))
         return
 
     settings = TradeoffSettings.quick() if quick else TradeoffSettings()

@@ -752,3 +752,87 @@ def test_the_trades_seconds_a_light_are_the_replayed_runs(tmp_path: Path) -> Non
     said = re.search(r"Session time on the real rig: ([0-9.]+) s", r.output)
     assert said is not None, r.output
     assert abs(float(said.group(1)) - 6 * PER_LIGHT_S) <= 0.051, (said.group(0), PER_LIGHT_S)
+
+
+def _stand_in_rows() -> tuple[list[Any], list[str]]:
+    """Rows as run_tradeoff_from gives them (replayed-dome times), for the plumbing tests."""
+    from benchmarks.tradeoff import Row
+    from benchmarks.tradeoff_from import PER_LIGHT_S
+
+    nan = float("nan")
+
+    def row(method: str, n: int, objective: str = "normals") -> Row:
+        return Row("acq/dirs.lp", method, objective, n, 0.0, 3.0, 3.0, 1.0, "ptm", 20.0, 0.5,
+                   n * PER_LIGHT_S, nan, 0.0, "hsh1", 20.0)  # fmt: skip
+
+    rows = [row(m, n) for n in (6, 9) for m in ("uniform", "optimal", "adaptive")]
+    rows += [row("adaptive", n, "relight") for n in (6, 9)] + [row("all", 15)]
+    return rows, ["a.jpg", "b.jpg", "c.jpg"]
+
+
+def test_rig_gives_the_trades_session_time_from_the_users_dome(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`bench tradeoff --from ACQ --rig MY_DOME.toml`: the time axis is the user's dome's step
+    (its [timing] and exposure), in results.csv, the summary and its command line; it had
+    always been the replayed dome's defaults, 1.17 s a light, where a DSLR dome takes seconds."""
+    import re
+    import shlex
+
+    import benchmarks.tradeoff_from as tradeoff_from
+
+    monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", lambda lp, progress: _stand_in_rows())
+    shipped = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    text = shipped.read_text(encoding="utf-8")
+    rig = tmp_path / "my dome.toml"
+    mine = re.sub(r"(?m)^transfer_s = 0\.7 ", "transfer_s = 2.5 ", text, count=1)
+    assert mine != text
+    rig.write_text(mine, encoding="utf-8")
+    from rti_rig.app.config import load_rig_config
+
+    cfg = load_rig_config(rig).config
+    t = cfg.timing
+    step = t.light_switch_s + t.settle_s + cfg.camera.exposure_s + t.readout_s + t.transfer_s
+    assert t.transfer_s == 2.5 and step > 2.5
+    out = tmp_path / "o"
+    r = CliRunner().invoke(
+        app,
+        ["bench", "tradeoff", "--from", str(ACQ), "--rig", str(rig), "--out", str(out)],
+        terminal_width=400,
+    )
+    assert r.exit_code == 0, r.output
+    rows = list(csv.DictReader((out / "results.csv").open()))
+    for row in rows:
+        assert float(row["dome_time_s"]) == pytest.approx(int(row["n"]) * step), row
+    summary = (out / "summary.md").read_text(encoding="utf-8")
+    assert f"{step:.2f} s a light (" in summary and "transfer_s 2.5" in summary, summary
+    assert f"| 9 | {9 * step:.0f} |" in summary, summary
+    command = summary.split("Command: `")[1].split("`")[0]
+    words = shlex.split(command)
+    assert words[words.index("--rig") + 1] == str(rig), command
+
+
+def test_rig_is_refused_for_an_arm_and_without_from_before_any_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An arm's session time depends on its moves (not planned by the trade on an acquisition),
+    and --rig without --from has nothing to time: each refused by name, nothing run or made."""
+    import benchmarks.tradeoff_from as tradeoff_from
+
+    def ran(*_a: object, **_k: object) -> None:
+        raise AssertionError("the trade ran")
+
+    monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", ran)
+    arm = Path(__file__).resolve().parents[2] / "rig_configs" / "virtual_arm.toml"
+    out = tmp_path / "o"
+    r = CliRunner().invoke(
+        app,
+        ["bench", "tradeoff", "--from", str(ACQ), "--rig", str(arm), "--out", str(out)],
+        terminal_width=400,
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "is an arm's config" in said and "Traceback" not in said, said
+    assert not out.exists()
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--rig", str(arm)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "it goes with --from ACQ/dirs.lp" in said, said
