@@ -408,6 +408,22 @@ def run(
                 except Exception as exc:
                     _verdict_failed(exc, opened.out_dir)
         _refuse_unsafe_end(unsafe)
+        _say_next(opened.out_dir)
+
+
+def _say_next(session: Path) -> None:
+    """The last line of a finished run: the fit that makes its normal map, ``.ptm`` and
+    ``.rti``, as a command that pastes.
+
+    Why: a finished run ended on its QA verdict with no next step, while a resume of the
+    same complete session, and every stop of one, named the fit. A session whose labels are
+    not verified (a camera-triggered dome's run without its end-of-run proof) gets none: fit
+    refuses it, and the run's own words said why."""
+    from rti_rig.runtime.disowned import MARKER
+
+    if (session / MARKER).exists():
+        return
+    out.print(f"Next: {escape(fit_beside(session))}", soft_wrap=True, highlight=False)
 
 
 def _same_folder(a: Path, b: Path) -> bool:

@@ -120,6 +120,7 @@ def test_a_power_cycle_before_any_fit_is_never_said_verified(tmp_path: Path) -> 
     # today it goes through unseen ("not verified"); a check that sees it later disowns it
     assert "the run is not verified" in said or "do not use this session" in said, said
     assert "proof passed" not in said and "each matched to its LED" not in said, said
+    assert "Next: rti-rig fit" not in said, said  # fit refuses it: no fit is offered
     assert (out / "LABELS_NOT_VERIFIED.txt").exists()
     f = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fitted")])
     assert f.exit_code == 2 and "LABELS_NOT_VERIFIED.txt" in " ".join(f.output.split())

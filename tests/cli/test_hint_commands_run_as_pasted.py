@@ -261,3 +261,22 @@ def test_a_card_session_of_too_few_images_advises_the_card_shot_again_as_a_comma
     command = command_after(r.stderr, "(with no --lights): ", "\n")
     assert command == f"rti-rig run {shlex.quote(str(cfg))} --out card-again", command
     accepted_as_pasted(tmp_path, command, "card-again")
+
+
+def test_a_finished_run_ends_with_the_fit_that_pastes(tmp_path: Path) -> None:
+    """A finished run's last line is its next step, `rti-rig fit S --out S-fit`, which pasted
+    fits the session (a finished run had ended on its QA verdict with no next step, where a
+    resume of the same complete session named the fit)."""
+    rig = shipped_variant(
+        tmp_path,
+        "simulated_dome.toml",
+        (("width = 512", "width = 48"), ("height = 512", "height = 48")),
+    )
+    r = rti_rig(tmp_path, "run", rig, "--out", "my session", "--lights", "6", "--no-verdict")
+    assert r.returncode == 0, r.stderr
+    last = r.stdout.rstrip().splitlines()[-1]
+    assert last == "Next: rti-rig fit 'my session' --out 'my session-fit'", r.stdout
+    fitted = pasted_run(tmp_path, last.removeprefix("Next: "))
+    assert fitted.returncode == 0, fitted.stderr
+    fit = tmp_path / "my session-fit"
+    assert (fit / "normals.png").exists() and (fit / "fit.rti").exists(), sorted(fit.iterdir())
