@@ -98,7 +98,7 @@ def bench_tradeoff(
         Path | None,
         typer.Option(
             "--rig",
-            help="With --from: your dome's rig config, whose [timing] and [camera] "
+            help="With --from: your dome's rig config, whose \\[timing] and \\[camera] "
             "exposure_s give the session time (else the replayed dome's defaults, 1.17 s a "
             "light).",
         ),

@@ -201,7 +201,9 @@ def test_a_clean_dry_run_of_the_shipped_arm_is_judged_good(tmp_path: Path) -> No
     r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "12"])
     assert r.exit_code == 0, r.output
     text = " ".join(r.output.split())
-    verdict = text.split("QA verdict: ", 1)[1].strip()
+    # the verdict, up to the run's next step (the fit), which follows it
+    verdict = text.split("QA verdict: ", 1)[1].split(" Next: rti-rig fit ", 1)[0].strip()
+    assert " Next: rti-rig fit " in text, text
     assert verdict == (
         "good; light direction not checked on image_001 (further than 10% from any "
         "Lambertian rendering of the fit: grazing light, gloss or clipping); shift not judged "
