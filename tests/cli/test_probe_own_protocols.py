@@ -131,3 +131,26 @@ def test_probe_names_a_default_board_whose_banner_has_an_extra_field_and_says_it
     found = "Found: default, but its boot banner has fields after the LED count, so rti-rig "
     assert found + "cannot use it as it is" in words, words
     assert f"then run rti-rig check {shlex.quote(str(rig))}" in words, words
+
+
+def test_probe_writes_a_windows_device_path_as_a_line_toml_reads_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Windows port past COM9 is opened by its device path, ``\\\\.\\COM10``: the line the
+    probe says to paste must read back as that port (it was written unescaped, a line TOML
+    refuses for its ``\\.`` escape)."""
+    import tomllib
+
+    port = "\\\\.\\COM10"
+    (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
+    config = emulated_dome_as_hardware(tmp_path, "emulated_dome.toml", port)
+    with shipped_dome_on_pty(monkeypatch, config):
+        r = runner.invoke(app, ["probe", port], terminal_width=400)
+    assert r.exit_code == 0, r.output
+    block = r.output.split("Rig-config lines to use:", 1)[1].split("\n\n", 1)[0]
+    lines = [
+        line.strip()
+        for line in block.splitlines()
+        if line.strip().startswith(("[", "port", "profile", "baudrate"))
+    ]
+    assert tomllib.loads("\n".join(lines))["dome"]["serial"]["port"] == port, lines

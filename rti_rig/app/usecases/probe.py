@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from enum import Enum, auto
 
 from rti_rig.core.shell_words import shell_word
+from rti_rig.core.toml_strings import NotTomlText, toml_basic_string
 from rti_rig.drivers.led_dome.codec_binary import BinaryCodec
 from rti_rig.drivers.led_dome.codec_default import DefaultCodec
 from rti_rig.drivers.led_dome.codec_framed import FramedCodec, FramedSpec
@@ -187,7 +188,7 @@ class ProbeResult:
         # guide) keeps its "baudrate = 115200", which overrides the profile's own rate, and
         # a 9600-baud firmware then failed its check with no word of the rate that works
         rate = [f"baudrate = {self.baudrate}"] if self.baudrate is not None else []
-        lines = ["[dome.serial]", f'port = "{self.port}"', f'profile = "{self.profile}"', *rate]
+        lines = ["[dome.serial]", _port_line(self.port), f'profile = "{self.profile}"', *rate]
         return lines + self.extra_lines
 
     def check_command(self) -> str:
@@ -1314,3 +1315,19 @@ def _not_a_serial_port(port: str, error: TransportError) -> str | None:
 
 #: The system's numbers for a character device that refuses a terminal's settings.
 _NOT_A_TERMINAL = frozenset({errno.ENOTTY, errno.EINVAL})
+
+
+def _port_line(port: str) -> str:
+    """The ``port = ...`` line for ``port`` as TOML reads it back: a basic string, escaped.
+
+    Why: the line was written ``port = "{port}"`` as it was, so a Windows port by its device
+    path (``\\\\.\\COM10``, what COM10 and above need) made a line TOML refuses for its
+    escapes, pasted into the config the user was told to run. A name whose bytes are not
+    UTF-8 cannot be in a TOML file at all: the line says so and what to do instead."""
+    try:
+        return f"port = {toml_basic_string(port)}"
+    except NotTomlText:
+        return (
+            "# port: its name is not UTF-8, which a TOML file cannot hold: give it a UTF-8 "
+            'name (a symlink, or a udev rule\'s SYMLINK) and write that here as port = "..."'
+        )
