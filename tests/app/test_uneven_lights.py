@@ -10,6 +10,7 @@ shipped emulated nab-rti-v1 dome given uneven LEDs."""
 from __future__ import annotations
 
 import re
+import shlex
 from pathlib import Path
 from typing import Any
 
@@ -160,6 +161,33 @@ def test_the_shipped_card_dome_advises_calibrate_lights(tmp_path: Path) -> None:
         "brighter than the other images predict"
     ), verdict
     assert "rti-rig calibrate-lights" in verdict and "reshoot:" not in verdict
+
+
+@pytest.mark.slow
+@pytest.mark.pty
+@pytest.mark.e2e
+def test_the_calibrate_lights_the_verdict_gives_pastes(tmp_path: Path) -> None:
+    """Before: "even out the LEDs with rti-rig calibrate-lights (a card shot under every LED;
+    docs/guide.md, section 6)", a command that pasted is refused (no card session, no --rig).
+    The commands now name the recorded rig config and a card folder beside the session; on
+    the card dome's own session (a card, as the verdict allows), the one for this session
+    pasted back measures the LEDs."""
+    out = tmp_path / "my card"
+    config = CONFIGS / "emulated_dome_card.toml"
+    r = runner.invoke(app, ["run", str(config), "--out", str(out)], terminal_width=2000)
+    assert r.exit_code == 0, r.output
+    verdict = _verdict(r.output)
+    shoot = f"rti-rig run {config} --out {shlex.quote(str(tmp_path / 'my card-card'))}"
+    assert shoot in verdict, verdict
+    measure = re.search(
+        r"if this session is such a card: rti-rig (calibrate-lights .*?); ", verdict
+    )
+    assert measure, verdict
+    words = shlex.split(measure.group(1))
+    assert words == ["calibrate-lights", str(out), "--rig", str(config)], words
+    done = runner.invoke(app, [*words, "--out", str(tmp_path / "cal.toml")])
+    assert done.exit_code == 0, done.output
+    assert (tmp_path / "cal.toml").is_file()
 
 
 @pytest.mark.slow

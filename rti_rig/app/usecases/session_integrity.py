@@ -95,7 +95,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     if manifest is not None:
         qa = _with_relabelled(qa, lp, source, manifest)
     if manifest is not None:
-        qa = with_uneven_lights(qa, manifest)  # a bright image its uncalibrated LED explains
+        qa = with_uneven_lights(qa, manifest, source)  # a bright image its LED explains
         qa = _with_unfinished(_with_session_kind(qa, manifest), source, manifest)
     renamed = _only(renamed_since_capture(source), fitted)
     if renamed:  # there, under another name: said, and not called lost (nothing to reshoot)

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.app.config import MEASURED_KEY
+from rti_rig.core.shell_words import shell_word
 from rti_rig.drivers.led_dome.settings import (
     DomeSerialSettings,
     FramedOptions,
@@ -68,6 +69,36 @@ def recorded_dimming_refusal(manifest: dict[str, Any]) -> str | None:
         )
 
 
+def card_commands(manifest: dict[str, Any], session: Path | None) -> str:
+    """How to even the dome out, as commands that paste: a card session shot under every LED
+    on the rig config the session recorded, beside the session, then ``calibrate-lights`` on
+    it (docs/guide.md, section 6).
+
+    Why: the verdict named ``rti-rig calibrate-lights`` alone, which pasted is refused for its
+    missing card session and ``--rig``; the config and the folder are known here. A session
+    that recorded no config path (an older one) is told the shape of the commands instead."""
+    config = str((manifest.get("rig") or {}).get("config_path") or "")
+    guide = "docs/guide.md, section 6"
+    if not config:
+        return (
+            "a level matte white card shot under every LED with rti-rig run on this dome's rig "
+            f"config, then rti-rig calibrate-lights on that session with --rig and the config; "
+            f"{guide}"
+        )
+    card = shell_word(session.parent / f"{session.name}-card") if session else "sessions/card"
+    rig = shell_word(config)
+    this = (
+        f"; if this session is such a card: rti-rig calibrate-lights {shell_word(session)} "
+        f"--rig {rig}"
+        if session
+        else ""
+    )
+    return (
+        f"a level matte white card filling the frame, shot under every LED: rti-rig run {rig} "
+        f"--out {card}, then rti-rig calibrate-lights {card} --rig {rig}{this}; {guide}"
+    )
+
+
 def unmeasured_leds(manifest: dict[str, Any]) -> frozenset[int]:
     """The LEDs the session's light calibration did not measure (assumed to give the median
     light, so not evened out): a card shot under only some LEDs. Empty where the calibration
@@ -89,7 +120,9 @@ def _dome_serial(manifest: dict[str, Any]) -> dict[str, Any] | None:
     return serial if isinstance(serial, dict) and serial else None
 
 
-def with_uneven_lights(qa: QAReport, manifest: dict[str, Any]) -> QAReport:
+def with_uneven_lights(
+    qa: QAReport, manifest: dict[str, Any], session: Path | None = None
+) -> QAReport:
     """``qa`` with its bright images that the dome's uneven LEDs explain taken off the reshoot
     list, and the verdict pointing to what evens them out (unchanged where
     the session's rig or evidence does not allow it: see the module's docstring).
@@ -100,7 +133,10 @@ def with_uneven_lights(qa: QAReport, manifest: dict[str, Any]) -> QAReport:
 
     On a dome that cannot dim (an on/off firmware) the images stay off the reshoot list (a
     reshoot under the same LED repeats them), and the verdict says the firmware cannot even
-    them out and what can: a card's gains divided out of the images in Python."""
+    them out and what can: a card's gains divided out of the images in Python.
+
+    ``session`` (the session's folder) names the card session's folder beside it in the
+    commands the verdict gives (:func:`card_commands`)."""
     cannot_dim = recorded_dimming_refusal(manifest)
     if cannot_dim is not None:
         # with or without a recorded correction: an older session's correction on such a link
@@ -116,10 +152,8 @@ def with_uneven_lights(qa: QAReport, manifest: dict[str, Any]) -> QAReport:
     elif uncalibrated_serial_dome(manifest):
         bright = qa.bright_within_light_scatter()
         why = "and no light calibration applied"
-        fix = (
-            ": even out the LEDs with rti-rig calibrate-lights (a card shot under every LED; "
-            "docs/guide.md, section 6)"
-        )
+        card = card_commands(manifest, session)
+        fix = f": even out the LEDs with rti-rig calibrate-lights ({card})"
     else:
         unmeasured = unmeasured_leds(manifest)
         led_of = {
@@ -127,10 +161,8 @@ def with_uneven_lights(qa: QAReport, manifest: dict[str, Any]) -> QAReport:
         }
         bright = [c for c in qa.bright_within_light_scatter() if led_of.get(c.name) in unmeasured]
         why = "under LEDs the light calibration did not measure"
-        fix = (
-            ": calibrate them with rti-rig calibrate-lights (a card shot under every LED; "
-            "docs/guide.md, section 6)"
-        )
+        card = card_commands(manifest, session)
+        fix = f": calibrate them with rti-rig calibrate-lights ({card})"
     if not bright:
         return qa
     listed = ", ".join(f"{c.name} ({c.gain:.1f}×)" for c in bright)
