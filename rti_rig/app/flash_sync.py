@@ -184,10 +184,10 @@ class SlipGuard:
                 _disowned(
                     root,
                     f"image {index + 1} was not lit by {self._led(index)} of the dome's order — "
-                    f"{what}: {verdict.reason}. A slip in the first images is seen only some "
-                    f"images later, so images {first}–{index} in lights.lp may be mislabelled: "
-                    f"do not use this session. {kept.said('Image ' + str(index + 1))}."
-                    + self._maybe_power_cut(first),
+                    f"{self._early_slip(verdict.since, what, verdict.reason)}. A slip in the first "
+                    f"images is seen only some images later, so images {first}–{index} in "
+                    "lights.lp may be mislabelled: do not use this session. "
+                    f"{kept.said('Image ' + str(index + 1))}." + self._maybe_power_cut(first),
                 )
                 + f" {rewind}"
             )
@@ -196,6 +196,29 @@ class SlipGuard:
             f"image {index + 1} was not lit by {self._led(index)} of the dome's order — {what}: "
             f"{verdict.reason}. {kept.said('The image')}; lights.lp lists "
             f"{before} only. {rewind}"
+        )
+
+    def _early_slip(self, since: int | None, what: str, reason: str) -> str:
+        """The slip's name and the check's reason, for a slip in the first images: named as
+        the check's best reading where the images fit best with it beginning (``since``,
+        0-based) among those the check's fit was made from.
+
+        Why: the check judges an image against a fit of the images before it, and a fit of
+        images the slip had already mislabelled, all shifted alike, explains the later ones
+        about as well one LED either way (a shift of the labels within a ring is close to a
+        turn of the lights, which the fitted normals take up). A power cut before image 2 (the
+        dome one LED behind from then on, as after a missed step) was named a "double step"
+        the images "fit best" as beginning at image 1, and the user was pointed at the
+        flash cable's bounces. Where the images fit best with the slip beginning at the image
+        judged (no ``since``), the fit was made from images labelled right, and its step
+        stands."""
+        if since is None or since >= self.checker.min_fit_images:
+            return f"{what}: {reason}"
+        return (
+            "a slip of the order that may have begun before the check had a fit to judge by "
+            f"(from image {self.checker.min_fit_images + 1} on), so whether the dome missed a "
+            "step, stepped twice or started again after a power cut cannot be told; the "
+            f"check's best reading is a {what}: {reason}"
         )
 
     def _maybe_power_cut(self, first: int) -> str:
@@ -209,9 +232,8 @@ class SlipGuard:
         if first > self.checker.min_fit_images:
             return ""
         return (
-            f" A power cut before image {self.checker.min_fit_images + 1} (the dome starting "
-            "its order again from LED 0) shows the same way, so check the dome's power supply "
-            "and its plug as well as the flash cable."
+            " Check the dome's power supply and its plug as well as the flash cable (a power cut "
+            "starts its order again from LED 0)."
         )
 
     def _restarted(self, index: int, reason: str, kept: Kept) -> str:

@@ -129,8 +129,11 @@ def test_a_power_cycle_before_any_fit_is_never_said_verified(tmp_path: Path) -> 
 
 def test_a_power_cut_before_the_first_fit_seen_later_says_it_may_be_one(tmp_path: Path) -> None:
     """A power cut before image 2 on the relief is caught images later as a shift of the
-    order, named a double step: the check cannot tell it from a power cut there, so the words
-    say to check the dome's power as well as the flash cable (they had named the step alone)."""
+    order. The check's fit was made from images the cut had already mislabelled, so the words
+    name no step as fact: they had said "— double step" (the dome one LED *ahead*, where a cut
+    leaves it one behind), then said a power cut "shows the same way"; now the slip is one
+    that may have begun before the check had a fit, the step only its best reading, and the
+    dome's power is to be checked as well as the flash cable."""
     config = tmp_path / "rig.toml"
     config.write_text(
         _two_rings() + '\n[[emulator.sync_faults]]\nat_image = 2\nkind = "power_cycle"\n',
@@ -140,5 +143,11 @@ def test_a_power_cut_before_the_first_fit_seen_later_says_it_may_be_one(tmp_path
     said = " ".join(r.output.split())
     assert r.exit_code != 0 and "Traceback" not in said, said
     assert "do not use this session" in said, said
-    assert "A power cut before image 4 (the dome starting its order again from LED 0)" in said, said
-    assert "check the dome's power supply and its plug" in said, said
+    assert "of the dome's order — a slip of the order that may have begun before the check " in said
+    assert (
+        "so whether the dome missed a step, stepped twice or started again after a power cut "
+        in said
+    )
+    assert "cannot be told; the check's best reading is a " in said, said
+    assert "— double step" not in said and "— missed step" not in said, said
+    assert "Check the dome's power supply and its plug as well as the flash cable" in said, said
