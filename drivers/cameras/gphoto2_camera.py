@@ -1144,7 +1144,9 @@ class Gphoto2Camera:
         Why: these files were deleted from the camera undownloaded: a picture taken under a
         session's light was lost without a word. A test shot outside any session (metering,
         ``check``) is deleted as before: it is a test, and its private folder goes at close.
-        A file whose download or save fails stays where it was (card or RAM), and is named."""
+        A file whose download or save fails stays where it was (card or RAM), and is named
+        with why it failed (the words had said where the file stayed, not why: a full disk
+        and an unplugged cable call for different fixes)."""
         if self.output_dir is None or self._cam is None:
             self._delete(files)
             return ""
@@ -1160,8 +1162,8 @@ class Gphoto2Camera:
                     lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL),
                 )
                 self._save(camera_file, target, folder, name)
-            except (CaptureError, CameraGoneError):
-                left.append(self._where(folder, name))
+            except CaptureError as exc:  # CameraGoneError too: the camera left mid-download
+                left.append(f"{self._where(folder, name)} (the download failed: {exc.message})")
                 continue
             kept.append(shown_path(target))
             downloaded.append((folder, name))

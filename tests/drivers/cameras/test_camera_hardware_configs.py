@@ -1188,6 +1188,24 @@ def test_an_image_format_whose_name_cannot_be_judged_is_said_at_check(body, dome
     assert "its RAW" in said and "does not tell whether it gives a RAW" not in said, said
 
 
+def test_a_no_raw_shot_that_will_not_download_says_where_it_stays_and_why(body, dome, tmp_path):
+    """The session's first shot gives no RAW (a format whose name cannot be judged), and its
+    JPEG will not download (libgphoto2 -1): the words say where the shot stays and why its
+    download failed (they had said where only), and nothing is deleted from the camera."""
+    unknown = "Unknown value 0007"
+    body.choices["imageformat"] = ["Large Fine JPEG", unknown, "RAW"]
+    body.format_gives = {unknown: (False, True)}
+    cfg = dslr_config(tmp_path, ('image_format = "RAW"', f'image_format = "{unknown}"'))
+    body.failures["file_get"] = [-1]
+    result = run(str(cfg), "--out", str(tmp_path / "s"), "--lights", "4")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2 and "Traceback" not in said, said
+    assert "but no RAW file" in said, said
+    assert "Not downloaded: the shot" in said, said
+    assert "(the download failed: gphoto2 error -1" in said, said
+    assert not sorted((tmp_path / "s").rglob("cap*")), "a file was said not downloaded"
+
+
 def test_a_download_failed_from_the_camera_s_ram_says_the_shot_is_lost_and_resume_reshoots(
     body, tmp_path
 ):
