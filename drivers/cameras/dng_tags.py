@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO
 
+from rti_rig.core.shell_words import pip_upgrade
 from rti_rig.drivers.cameras.tiff_ifd import (
     MAX_TAGS,
     Layout,
@@ -260,7 +261,7 @@ def dng_refusal(path: Path) -> str | None:
     if tags.compression == JPEG_XL:
         return (
             "it is compressed as JPEG XL (DNG 1.7), which this LibRaw build does not "
-            "decode. Update rawpy (pip install -U rawpy) to one built with JPEG XL, or save "
+            f"decode. Update rawpy ({pip_upgrade('rawpy')}) to one built with JPEG XL, or save "
             "DNGs with lossless JPEG compression (the converter's or camera's compatibility "
             "setting)"
         )
@@ -269,7 +270,7 @@ def dng_refusal(path: Path) -> str | None:
         return (
             f"it asks for a reader of DNG {_version(needs)} (its DNGVersion "
             f"{_version(tags.version)}), newer than the DNG {_version(LIBRAW_DNG)} this LibRaw "
-            "was written for. Update rawpy (pip install -U rawpy), or save the DNGs for an "
+            f"was written for. Update rawpy ({pip_upgrade('rawpy')}), or save the DNGs for an "
             "older DNG version (the converter's compatibility setting)"
         )
     compression = (
@@ -281,7 +282,7 @@ def dng_refusal(path: Path) -> str | None:
         f"its main image's tags look whole (DNGVersion {_version(tags.version)}{compression}), "
         "so it is either newer than this LibRaw reads or damaged in a way its tags do not "
         "show. Open it in another program (Adobe DNG Converter, darktable): if it opens, "
-        "update rawpy (pip install -U rawpy); if it does not, copy the shot again from the "
+        f"update rawpy ({pip_upgrade('rawpy')}); if it does not, copy the shot again from the "
         "camera's card"
     )
 

@@ -31,7 +31,7 @@ from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError
 from rti_rig.core.image_files import is_camera_raw
-from rti_rig.core.shell_words import shown_path
+from rti_rig.core.shell_words import pip_install, pip_upgrade, shown_path
 from rti_rig.drivers.cameras.gphoto2_formats import gives_raw, raw_choices
 from rti_rig.drivers.cameras.raw_decode import (
     RawDecodeError,
@@ -159,7 +159,7 @@ def load_gphoto2() -> Any:
     except ImportError as exc:
         raise DeviceError(
             "gphoto2",
-            "python-gphoto2 is not installed: pip install gphoto2 (binary wheels bundle "
+            f"python-gphoto2 is not installed: {pip_install('gphoto2')} (binary wheels bundle "
             "libgphoto2 on Linux and macOS)",
             "import",
         ) from exc
@@ -412,7 +412,7 @@ class Gphoto2Camera:
                 "(libgphoto2 issues #808, #1126): switch it off and on, set its mode dial to M "
                 "and close its menus, then run `env LANG=C gphoto2 --debug --debug-logfile="
                 "gphoto2.log --capture-image` to see what the camera answered; a body newer "
-                "than the installed libgphoto2 may need it updated (pip install -U gphoto2)"
+                f"than the installed libgphoto2 may need it updated ({pip_upgrade('gphoto2')})"
             )
         return hint
 
@@ -833,7 +833,7 @@ class Gphoto2Camera:
             self.name,
             f"{self._device()} gives RAW files the installed {libraw_named()} cannot read "
             f"(a test shot's RAW: {exc.libraw_said or 'unsupported format'}): every shot of "
-            "a session would be refused at its decode. Update rawpy (pip install -U rawpy) "
+            f"a session would be refused at its decode. Update rawpy ({pip_upgrade('rawpy')}) "
             f"to one whose LibRaw reads the {model} (https://www.libraw.org/supported-cameras), "
             "then run the check again. Shooting JPEG is no way round it: every decode mode "
             "reads the RAW (the camera's JPEG is only kept beside it, keep_jpeg); a body that "

@@ -27,6 +27,7 @@ import numpy as np
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.core.shell_words import pip_install
 from rti_rig.drivers.cameras.image_io import to_linear_uint16
 from rti_rig.drivers.cameras.raw_decode import exposure_stats
 from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
@@ -520,7 +521,7 @@ class OpenCvCamera:
                 f"flat row of {image.size} {image.dtype} values, not as its {width}×{height} "
                 "pixels: OpenCV 4.11.0's V4L2 backend does so with every frame it does not "
                 "convert to colour (opencv/opencv#27166, fixed in 4.12.0). Install another "
-                "OpenCV (pip install 'opencv-contrib-python-headless>=4.12') and run again"
+                f"OpenCV ({pip_install('opencv-contrib-python-headless>=4.12')}) and run again"
             )
         else:
             message = (

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
-from rti_rig.core.shell_words import shown_path
+from rti_rig.core.shell_words import pip_upgrade, shown_path
 from rti_rig.drivers.cameras.dng_tags import dng_refusal, read_blind
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
@@ -655,7 +655,7 @@ def decode_raw(
             if dng is not None
             else f"{libraw} does not read this file's format ({said}){_reported(printed)}: "
             "a camera newer than this LibRaw, or a file that is no RAW or is damaged. "
-            "Update rawpy (pip install -U rawpy), or shoot a format it reads (DNG where the "
+            f"Update rawpy ({pip_upgrade('rawpy')}), or shoot a format it reads (DNG where the "
             "camera offers it, or convert the files with a DNG converter and watch a "
             "folder of DNGs); if no other program opens the file either, it is damaged: "
             "copy it again from the camera's card"
@@ -672,7 +672,7 @@ def decode_raw(
             read,
             f"rawpy cannot lay out its colour filter array ({exc}): its CFA tags are damaged, "
             "or it is a sensor layout this rawpy does not know. Copy the shot again from the "
-            "camera's card; if another program opens it, update rawpy (pip install -U rawpy)",
+            f"camera's card; if another program opens it, update rawpy ({pip_upgrade('rawpy')})",
         ) from exc
     except rawpy.LibRawError as exc:
         said = libraw_words(exc)

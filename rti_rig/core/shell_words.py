@@ -73,3 +73,21 @@ def _ansi_c_quoted(name: bytes) -> str:
         else:
             chars.append(f"\\x{byte:02x}")
     return "$'" + "".join(chars) + "'"
+
+
+def pip_install(*requirements: str, upgrade: bool = False) -> str:
+    """The command that installs ``requirements`` into the environment running rti-rig: its
+    own interpreter's pip (``/path/.venv/bin/python -m pip install ...``), as shell words.
+
+    Why: the hints said a bare ``pip install gphoto2``. The README installs rti-rig into
+    ``.venv`` and runs ``.venv/bin/rti-rig`` without activating it, so the ``pip`` a shell
+    finds is another environment's (or the system's, which Debian and Ubuntu refuse as
+    "externally managed"): the package went elsewhere and rti-rig still said it was missing."""
+    words = [shell_word(sys.executable), "-m", "pip", "install"]
+    words += ["-U"] if upgrade else []
+    return " ".join(words + [shlex.quote(r) for r in requirements])
+
+
+def pip_upgrade(requirement: str) -> str:
+    """:func:`pip_install` of ``requirement`` with ``-U``: the command that updates it."""
+    return pip_install(requirement, upgrade=True)
