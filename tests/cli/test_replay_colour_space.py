@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
@@ -24,20 +25,31 @@ from typer.testing import CliRunner
 from rti_rig.cli import app
 
 
-def test_a_replay_of_adobe_rgb_jpegs_is_converted_to_linear_srgb(tmp_path: Path) -> None:
-    acq = tmp_path / "acq"
+def _ring_acquisition(acq: Path, suffix: str, write: Callable[[Path, int], None]) -> Path:
+    """An acquisition of eight lights on a ring at 45 degrees' elevation: image ``k`` written
+    by ``write(path, k)``, listed in ``acq/dirs.lp`` (returned)."""
     acq.mkdir()
     lines = []
-    profile = icc_profile("Adobe RGB (1998)")
-    for k in range(8):  # eight lights on a ring at 45 degrees' elevation
-        name = f"image{k + 1:02d}.jpg"
-        rgb = np.full((16, 16, 3), 60 + 10 * k, np.uint8)
-        rgb[:8, :8] = (0, 200, 0)  # Adobe RGB's green: outside sRGB's gamut
-        (acq / name).write_bytes(jpeg(icc=profile, rgb=rgb))
+    for k in range(8):
+        name = f"image{k + 1:02d}{suffix}"
+        write(acq / name, k)
         a = 2 * math.pi * k / 8
         r = math.sqrt(0.5)
         lines.append(f"{name} {r * math.cos(a):.6f} {r * math.sin(a):.6f} {r:.6f}")
     (acq / "dirs.lp").write_text(f"{len(lines)}\n" + "\n".join(lines) + "\n")
+    return acq / "dirs.lp"
+
+
+def test_a_replay_of_adobe_rgb_jpegs_is_converted_to_linear_srgb(tmp_path: Path) -> None:
+    acq = tmp_path / "acq"
+    profile = icc_profile("Adobe RGB (1998)")
+
+    def adobe_jpeg(path: Path, k: int) -> None:
+        rgb = np.full((16, 16, 3), 60 + 10 * k, np.uint8)
+        rgb[:8, :8] = (0, 200, 0)  # Adobe RGB's green: outside sRGB's gamut
+        path.write_bytes(jpeg(icc=profile, rgb=rgb))
+
+    _ring_acquisition(acq, ".jpg", adobe_jpeg)
     out = tmp_path / "s"
     r = CliRunner().invoke(
         app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--no-verdict"], terminal_width=400
@@ -87,15 +99,11 @@ def test_a_replay_of_raw_converter_tiffs_with_the_camera_s_exif_srgb_keeps_them_
     ICC profile (colour_files.raw_converter_tiff) replay as stored, and the run says it took
     them as linear; their sRGB curve had been undone (grey 20000 made 4970), unsaid."""
     acq = tmp_path / "acq"
-    acq.mkdir()
-    lines = []
-    for k in range(8):
-        name = f"image{k + 1:02d}.tif"
-        raw_converter_tiff(acq / name, np.full((16, 16, 3), 20000 + 1000 * k, np.uint16))
-        a = 2 * math.pi * k / 8
-        r = math.sqrt(0.5)
-        lines.append(f"{name} {r * math.cos(a):.6f} {r * math.sin(a):.6f} {r:.6f}")
-    (acq / "dirs.lp").write_text(f"{len(lines)}\n" + "\n".join(lines) + "\n")
+    _ring_acquisition(
+        acq,
+        ".tif",
+        lambda path, k: raw_converter_tiff(path, np.full((16, 16, 3), 20000 + 1000 * k, np.uint16)),
+    )
     out = tmp_path / "s"
     r = CliRunner().invoke(
         app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--no-verdict"], terminal_width=400
