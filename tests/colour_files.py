@@ -108,12 +108,20 @@ def png(srgb: bool = False, icc: bytes | None = None) -> bytes:
     return data[:33] + extra + data[33:]  # after the signature (8) and IHDR (25)
 
 
-def raw_converter_tiff(path: Path, pixels: np.ndarray, colorspace: int | None = 1) -> None:
+def raw_converter_tiff(
+    path: Path,
+    pixels: np.ndarray,
+    colorspace: int | None = 1,
+    software: str = "dcraw v9.28",
+    interop: bytes | None = None,
+) -> None:
     """A 16-bit RGB TIFF as dcraw or LibRaw's dcraw_emu writes linear output (``-4 -T -o 0``:
     raw colour, so no ICC profile; dcraw.c ``tiff_head``: Make, Model, 300 dpi, Software, an
     Exif IFD of ExposureTime, FNumber, ISOSpeedRatings and FocalLength) after
     ``exiftool -tagsFromFile`` copied the camera's Exif ColorSpace (``colorspace``; None: not
-    copied) into that IFD.
+    copied) into that IFD. ``software``: its Software tag (another writer's name: a TIFF that
+    is no raw converter's); ``interop``: an Interoperability IFD holding that
+    InteroperabilityIndex ("R03": Adobe RGB), pointed to from the Exif IFD.
 
     tifffile writes the file (it will not write tag 34665 itself: the pointer is written under
     a neighbouring code and renamed), and the Exif IFD is appended (TIFF 6.0, 2: an IFD is a
@@ -128,7 +136,7 @@ def raw_converter_tiff(path: Path, pixels: np.ndarray, colorspace: int | None = 
         path,
         pixels,
         photometric="rgb",
-        software="dcraw v9.28",
+        software=software,
         metadata=None,
         resolution=(300, 300),
         extratags=[
@@ -140,15 +148,23 @@ def raw_converter_tiff(path: Path, pixels: np.ndarray, colorspace: int | None = 
     data = bytearray(path.read_bytes())
     assert data[:2] == b"II"
     at = len(data) + len(data) % 2
+    if interop is not None:
+        entries.append((0xA005, 4, 0))  # its offset: after the rationals, set below
     rationals_at = at + 2 + 12 * len(entries) + 4
     ifd, rationals = struct.pack("<H", len(entries)), b""
+    interop_at = rationals_at + 8 * sum(1 for _, kind, _ in entries if kind == 5)
     for tag, kind, value in entries:
         if kind == 5:
             ifd += struct.pack("<HHII", tag, kind, 1, rationals_at + len(rationals))
             rationals += struct.pack("<II", *value)
+        elif kind == 4:
+            ifd += struct.pack("<HHII", tag, kind, 1, interop_at)
         else:
             ifd += struct.pack("<HHIHH", tag, kind, 1, value, 0)
     ifd += b"\0\0\0\0"
+    if interop is not None:
+        rationals += struct.pack("<H", 1) + struct.pack("<HHI4s", 0x0001, 2, 4, interop)
+        rationals += b"\0\0\0\0"
     (first,) = struct.unpack_from("<I", data, 4)
     (count,) = struct.unpack_from("<H", data, first)
     for k in range(count):

@@ -141,9 +141,9 @@ class Converted:
 
 def needs_conversion(colour: FileColour | None, dtype: np.dtype) -> bool:
     """Whether a file of ``colour`` and ``dtype`` is converted: a known space other than sRGB,
-    or a 16-bit sRGB file whose ICC profile says a curve that is not linear (its curve undone;
-    one said sRGB by its Exif ColorSpace alone is taken as linear, as raw converters' linear
-    TIFFs carry that tag copied from the camera:
+    or a 16-bit sRGB file whose ICC profile or Exif ColorSpace says sRGB, its curve not
+    linear (its curve undone; one said sRGB by its Exif ColorSpace alone and written by dcraw
+    or LibRaw is taken as linear, their linear TIFFs carrying that tag copied from the camera:
     :func:`~rti_rig.drivers.cameras.file_colour.exif_only_16_bit_notice`), or an 8-bit sRGB
     file whose ICC profile's curve is linear (taken as linear, as the profile says, whatever
     ``eight_bit_response`` says: it had been read through the sRGB table). Any other 8-bit
@@ -157,7 +157,7 @@ def needs_conversion(colour: FileColour | None, dtype: np.dtype) -> bool:
         return True
     if dtype == np.uint8:  # its ICC profile's linear curve wins over the sRGB table
         return colour.linear_curve
-    return not colour.linear_curve and not colour.exif_only
+    return not colour.linear_curve and not colour.exif_linear
 
 
 def to_linear_srgb(image: NDArray, colour: FileColour, *, encoded: bool = True) -> Converted:

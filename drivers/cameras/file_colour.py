@@ -17,6 +17,7 @@ InterColorProfile (TIFF/EP, ISO 12234-2).
 
 from __future__ import annotations
 
+import re
 import struct
 import zlib
 from dataclasses import asdict, dataclass
@@ -49,22 +50,48 @@ class FileColour:
     ColorSpace says it (no ICC profile), a tag that names the camera's colour setting and that
     raw converters' linear output carries when copied from the camera (dcraw/LibRaw ``-4 -T``
     writes an Exif IFD without it; ``exiftool -tagsFromFile`` adds it), so it says nothing
-    trustworthy of a 16-bit file's curve (:func:`exif_only_16_bit_notice`)."""
+    trustworthy of a 16-bit file's curve (:func:`exif_only_16_bit_notice`); ``written_by``:
+    a TIFF's Software tag (305), "" where absent: what tells a linear raw converter's output
+    (:attr:`exif_linear`)."""
 
     space: Space
     name: str
     said_by: str
     linear_curve: bool = False
     exif_only: bool = False
+    written_by: str = ""
+
+    @property
+    def exif_linear(self) -> bool:
+        """A 16-bit file of this colour is taken as linear though only its Exif ColorSpace
+        says sRGB: its Software tag names a raw converter whose 16-bit output is linear
+        (dcraw, LibRaw's dcraw_emu: ``dcraw v9.28``).
+
+        Why not every Exif-only file: the tag declares sRGB, whose standard (IEC 61966-2-1)
+        includes its curve, and the 16-bit TIFFs that carry it with no ICC profile are mostly
+        gamma-encoded exports (an editor's "Save As" with its profile unticked, raw
+        processors that copy the camera's tag onto their rendered output). dcraw's own TIFF
+        has no ColorSpace tag and embeds a profile (gamma 1.0 for ``-4``) unless ``-o 0``
+        (dcraw.c ``tiff_head``), so the tag beside dcraw's name is one copied from the camera
+        (``exiftool -tagsFromFile``) onto linear data. Until 2026-12-03 every such file was
+        taken as linear, an sRGB-encoded export's mid-tones fitted about 2.3 times too
+        bright."""
+        return self.exif_only and _LINEAR_WRITER.search(self.written_by) is not None
 
     def as_dict(self) -> dict[str, str]:
         said = asdict(self)
         del said["linear_curve"]  # said in the conversion's record (colour_convert)
         del said["exif_only"]  # said by said_by ("its Exif ColorSpace ...")
+        if not said["written_by"]:
+            del said["written_by"]
         return said
 
 
 UNTAGGED = FileColour("untagged", "sRGB", "")
+
+#: A TIFF Software tag of a raw converter whose 16-bit output is linear (dcraw.c writes
+#: "dcraw v" and its version; LibRaw's dcraw_emu and unprocessed_raw the same or "LibRaw").
+_LINEAR_WRITER = re.compile(r"\b(dcraw|libraw)", re.IGNORECASE)
 
 
 def file_colour(path: Path) -> FileColour:
@@ -72,9 +99,10 @@ def file_colour(path: Path) -> FileColour:
     untagged) says of its colour space. An ICC profile is what colour-managed software obeys,
     so it wins over the Exif ColorSpace."""
     suffix = path.suffix.lower()
+    software = ""
     try:
         if suffix in (".tif", ".tiff"):
-            icc, colorspace, interop = _tiff_tags(path)
+            icc, colorspace, interop, software = _tiff_tags(path)
         elif suffix in (".jpg", ".jpeg", ".jpe"):
             with path.open("rb") as f:
                 icc = jpeg_icc_profile(f.read(HEAD_BYTES))
@@ -89,15 +117,20 @@ def file_colour(path: Path) -> FileColour:
     if colorspace == PNG_SRGB_CHUNK and not icc:
         return FileColour("srgb", "sRGB", "its PNG sRGB chunk")
     if icc:
-        description = icc_description(icc)
+        try:
+            description, linear = icc_description(icc), icc_curve_is_linear(icc)
+        except (struct.error, ValueError):
+            # a damaged profile (a tag table running past its end): no profile to obey, so
+            # what else the file says is read (it had ended the command with a traceback)
+            description, linear = None, False
         if description:
             space = space_of_description(description)
             name = SPACE_NAMES.get(space, description)
-            return FileColour(
-                space, name, f"its ICC profile {description!r}", icc_curve_is_linear(icc)
-            )
+            return FileColour(space, name, f"its ICC profile {description!r}", linear)
     if colorspace == EXIF_SRGB:
-        return FileColour("srgb", "sRGB", "its Exif ColorSpace 1 (sRGB)", exif_only=True)
+        return FileColour(
+            "srgb", "sRGB", "its Exif ColorSpace 1 (sRGB)", exif_only=True, written_by=software
+        )
     if colorspace == EXIF_UNCALIBRATED and interop == "R03":
         return FileColour(
             "adobe_rgb",
@@ -210,8 +243,13 @@ def _png_colour(head: bytes) -> tuple[bytes | None, int | None]:
     return icc, srgb
 
 
-def _tiff_tags(path: Path) -> tuple[bytes | None, int | None, str | None]:
-    """(InterColorProfile, Exif ColorSpace, InteroperabilityIndex) of a TIFF's first page."""
+def _tiff_tags(path: Path) -> tuple[bytes | None, int | None, str | None, str]:
+    """(InterColorProfile, Exif ColorSpace, InteroperabilityIndex, Software) of a TIFF's
+    first page.
+
+    tifffile gives the Exif IFD's InteroperabilityTag as the offset of its IFD, not its tags
+    (tifffile 2026.3): that IFD is read here, so a TIFF's "R03" (Adobe RGB) is seen as a
+    JPEG's is (it had never been, and such a TIFF was called an unnamed space)."""
     import tifffile
 
     try:
@@ -219,15 +257,40 @@ def _tiff_tags(path: Path) -> tuple[bytes | None, int | None, str | None]:
             tags = tif.pages[0].tags
             icc_tag = tags.get(34675)
             exif_tag = tags.get(34665)
+            soft_tag = tags.get(305)
             icc = bytes(icc_tag.value) if icc_tag is not None else None
             exif = exif_tag.value if exif_tag is not None else {}
+            exif = exif if isinstance(exif, dict) else {}
+            interop = exif.get("InteroperabilityTag")
+            if isinstance(interop, int):
+                interop = _interop_ifd(tif, interop)
+            software = soft_tag.value if soft_tag is not None else ""
     except tifffile.TiffFileError as exc:
         raise ValueError(str(exc)) from exc
-    exif = exif if isinstance(exif, dict) else {}
-    interop = exif.get("InteroperabilityTag")
     index = interop.get("InteroperabilityIndex") if isinstance(interop, dict) else None
     colorspace = exif.get("ColorSpace")
-    return icc, int(colorspace) if colorspace is not None else None, index
+    return (
+        icc,
+        int(colorspace) if colorspace is not None else None,
+        index if isinstance(index, str) else None,
+        software if isinstance(software, str) else "",
+    )
+
+
+def _interop_ifd(tif: object, offset: int) -> dict[str, object]:
+    """The Interoperability IFD at ``offset`` of an open TIFF, read with tifffile's own reader
+    of it; {} where it cannot be read (a damaged offset is no colour space)."""
+    from tifffile import tifffile as tf
+
+    try:
+        fh = tif.filehandle  # type: ignore[attr-defined]
+        if not 8 <= offset < fh.size:
+            return {}
+        fh.seek(offset)
+        read = tf.read_interoperability_ifd
+        return dict(read(fh, tif.byteorder, 13, 1, tif.tiff.offsetsize))  # type: ignore[attr-defined]
+    except Exception:  # any damage in an optional IFD leaves it unread
+        return {}
 
 
 def file_colour_notice(
@@ -237,7 +300,9 @@ def file_colour_notice(
     assumed, or that the colours are another space's, recorded as such and not converted; for
     a ``bits`` 16 file said sRGB by its Exif alone, that it was taken as linear."""
     if colour.space == "srgb":
-        return exif_only_16_bit_notice(whose) if colour.exif_only and bits == 16 else None
+        if not colour.exif_only or bits != 16:
+            return None
+        return exif_only_16_bit_notice(whose) if colour.exif_linear else exif_encoded_notice(whose)
     if colour.space == "untagged":
         return (
             f"{whose} say no colour space (no ICC profile, no Exif ColorSpace): "
@@ -252,18 +317,28 @@ def file_colour_notice(
 
 
 def exif_only_16_bit_notice(whose: str = "the camera's files") -> str:
-    """The notice for 16-bit files said to be sRGB by their Exif ColorSpace 1 alone, taken as
-    linear (their curve not undone).
+    """The notice for 16-bit files said to be sRGB by their Exif ColorSpace 1 alone and
+    written by a linear raw converter (:attr:`FileColour.exif_linear`), taken as linear.
 
-    Why: Exif ColorSpace (Exif 2.3, 4.6.5) names the camera's colour setting and has no value
-    for a tone curve; raw converters' linear 16-bit TIFFs carry it where it was copied from
-    the camera, while an sRGB-encoded 16-bit export from an editor embeds an ICC profile.
-    Undoing the sRGB curve of linear data had darkened its mid-tones silently; taking it as
-    linear is said here with the way to the other reading: an embedded sRGB ICC profile (which
-    rti-rig obeys, as colour-managed software does)."""
+    Why: their tag was copied from the camera onto linear data (dcraw's own TIFF has none);
+    the way to the other reading is said: an embedded sRGB ICC profile, which rti-rig obeys
+    as colour-managed software does."""
     return (
-        f"{whose} are 16-bit and say sRGB only by their Exif ColorSpace 1 (no ICC profile), a "
-        "tag copied from the camera onto raw converters' linear output (dcraw or LibRaw -4 -T): "
-        "taken as linear, no curve undone; if they are sRGB-encoded exports, export them with "
-        "the sRGB ICC profile embedded and rti-rig undoes its curve"
+        f"{whose} are 16-bit, say sRGB only by their Exif ColorSpace 1 (no ICC profile) and "
+        "were written by a raw converter whose 16-bit output is linear (their Software tag "
+        "names dcraw or LibRaw; the tag was copied from the camera): taken as linear, no curve "
+        "undone; if they are sRGB-encoded, export them with the sRGB ICC profile embedded and "
+        "rti-rig undoes its curve"
+    )
+
+
+def exif_encoded_notice(whose: str = "the camera's files") -> str:
+    """The notice for 16-bit files said to be sRGB by their Exif ColorSpace 1 alone and not
+    written by a linear raw converter: their sRGB curve undone, as the tag says, and how to
+    have them read as linear if they are (:attr:`FileColour.exif_linear`'s why)."""
+    return (
+        f"{whose} are 16-bit and say sRGB only by their Exif ColorSpace 1 (no ICC profile): "
+        "the sRGB curve undone, as the tag says; if they are linear (a raw converter's output "
+        "with the camera's tags copied in), remove the copied tag (exiftool "
+        "-ExifIFD:ColorSpace= FILES) or embed a gamma-1.0 profile, and they are read as linear"
     )

@@ -1830,7 +1830,8 @@ class FolderWatchCamera:
                 said = file_colour_notice(colour, bits=8 * image.dtype.itemsize)
                 if converted is not None:
                     metadata["file_colour"].update(converted.record)
-                    said = converted_notice(colour) if colour.space != "srgb" else None
+                    if colour.space != "srgb":  # an sRGB file's own words stand (Exif-only)
+                        said = converted_notice(colour)
                     if converted.clipped:
                         notices.append(clipped_notice(colour))
                 if said:

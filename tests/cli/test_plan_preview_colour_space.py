@@ -99,7 +99,7 @@ def test_a_linear_preview_with_the_camera_s_exif_srgb_is_read_as_linear(tmp_path
     got, said = _plan(tagged)
     want, _ = _plan(bare)
     assert np.allclose(got, want, atol=0.05), (got, want)
-    assert f"preview {tagged} is 16-bit and says sRGB only by its Exif ColorSpace 1" in said
+    assert f"preview {tagged} is 16-bit, says sRGB only by its Exif ColorSpace 1" in said
 
 
 def test_a_preview_s_out_of_gamut_pixels_are_counted(tmp_path) -> None:

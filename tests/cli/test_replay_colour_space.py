@@ -13,13 +13,14 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import struct
 from collections.abc import Callable
 from pathlib import Path
 
 import cv2
 import numpy as np
 import tifffile
-from colour_files import icc_profile, jpeg, raw_converter_tiff
+from colour_files import exif_colour, icc_profile, jpeg, raw_converter_tiff
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -114,4 +115,80 @@ def test_a_replay_of_raw_converter_tiffs_with_the_camera_s_exif_srgb_keeps_them_
     assert step["file_colour"]["said_by"] == "its Exif ColorSpace 1 (sRGB)", step
     linear = tifffile.imread(out / step["linear_image"])
     assert (linear == linear[0, 0, 0]).all() and linear[0, 0, 0] in range(20000, 27001, 1000)
-    assert "the replayed files are 16-bit and say sRGB only by their Exif ColorSpace 1" in said
+    assert "the replayed files are 16-bit, say sRGB only by their Exif ColorSpace 1" in said
+    assert "their Software tag names dcraw or LibRaw" in said, said
+
+
+def _replay(tmp_path: Path, write: Callable[[Path, int], None], suffix: str) -> tuple[str, dict]:
+    """``rti-rig run`` of a ring acquisition whose images ``write`` makes: its words and its
+    manifest's first step (the run must succeed, with no traceback)."""
+    lp = _ring_acquisition(tmp_path / "acq", suffix, write)
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app, ["run", str(lp), "--out", str(out), "--no-verdict"], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    return said, json.loads((out / "manifest.json").read_text())["steps"][0] | {"out": str(out)}
+
+
+def test_an_exif_srgb_tiff_no_raw_converter_wrote_has_its_curve_undone(tmp_path: Path) -> None:
+    """A 16-bit TIFF that says sRGB by its Exif ColorSpace 1 alone (no ICC profile) and whose
+    Software tag names no raw converter (an editor's export with its profile unticked): read
+    as the tag says, its sRGB curve undone (grey 20000 is 4970 linear), and said so with how
+    to have it read as linear. Every such file had been taken as linear, its mid-tones about
+    2.3 times too bright. The same file written by dcraw stays linear (the test above)."""
+    said, step = _replay(
+        tmp_path,
+        lambda path, k: raw_converter_tiff(
+            path, np.full((16, 16, 3), 20000, np.uint16), software="Adobe Photoshop 25.0"
+        ),
+        ".tif",
+    )
+    assert step["file_colour"]["said_by"] == "its Exif ColorSpace 1 (sRGB)", step
+    assert step["file_colour"]["written_by"] == "Adobe Photoshop 25.0", step
+    linear = tifffile.imread(Path(step["out"]) / step["linear_image"])
+    want = ((20000 / 65535 + 0.055) / 1.055) ** 2.4 * 65535  # IEC 61966-2-1's decoding
+    assert abs(int(linear[0, 0, 0]) - want) <= 2, (linear[0, 0, 0], want)
+    assert (
+        "say sRGB only by their Exif ColorSpace 1 (no ICC profile): the sRGB curve undone" in said
+    )
+    assert "exiftool -ExifIFD:ColorSpace= FILES" in said, said
+
+
+def test_a_tiff_that_says_adobe_rgb_by_its_interoperability_index_is_converted(
+    tmp_path: Path,
+) -> None:
+    """A 16-bit TIFF whose Exif says ColorSpace 0xFFFF and InteroperabilityIndex "R03" (DCF's
+    Adobe RGB, as a camera set to Adobe RGB writes it): converted from Adobe RGB as a JPEG
+    saying so is. tifffile gives the Interoperability IFD as an offset, and the index had never
+    been read from a TIFF: the file was called an unnamed space and left unconverted."""
+    said, step = _replay(
+        tmp_path,
+        lambda path, k: raw_converter_tiff(
+            path,
+            np.full((16, 16, 3), 30000, np.uint16),
+            colorspace=0xFFFF,
+            software="Camera firmware 1.0",
+            interop=b"R03\0",
+        ),
+        ".tif",
+    )
+    assert "InteroperabilityIndex R03" in step["file_colour"]["said_by"], step
+    assert "Adobe RGB (1998)" in said, said
+    assert "gamma 563/256" in step["file_colour"]["curve_undone"], step
+    linear = tifffile.imread(Path(step["out"]) / step["linear_image"])
+    assert abs(int(linear[0, 0, 1]) - (30000 / 65535) ** (563 / 256) * 65535) < 40, linear[0, 0]
+
+
+def test_a_jpeg_whose_icc_profile_is_damaged_is_read_by_what_else_it_says(tmp_path: Path) -> None:
+    """A JPEG whose ICC profile's tag table runs past its end (a count of 40, no table): the
+    profile is no profile to obey, and the file's Exif ColorSpace 1 says sRGB. Parsing it had
+    ended the run with a struct.error traceback."""
+    damaged = icc_profile("sRGB IEC61966-2.1")[:128] + struct.pack(">I", 40)
+    _, step = _replay(
+        tmp_path,
+        lambda path, k: path.write_bytes(jpeg(level=60 + 10 * k, icc=damaged, exif=exif_colour(1))),
+        ".jpg",
+    )
+    assert step["file_colour"]["said_by"] == "its Exif ColorSpace 1 (sRGB)", step

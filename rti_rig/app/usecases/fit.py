@@ -841,7 +841,7 @@ def colour_notes(
     exif_linear = [
         i
         for i, d in said.items()
-        if d.record is None and d.colour.exif_only and d.colour.space == "srgb" and i in sixteen
+        if d.record is None and d.colour.exif_linear and d.colour.space == "srgb" and i in sixteen
     ]
     for i, done in sorted(said.items()):
         colour, record = done.colour, done.record

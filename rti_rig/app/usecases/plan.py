@@ -322,11 +322,12 @@ def preview_in_its_space(path: Path, image: np.ndarray) -> tuple[np.ndarray, str
             "rti-rig does not convert: its brightness is read as if sRGB (8-bit through the "
             "sRGB curve, 16-bit as linear); for a plan from its true shading, export it as sRGB"
         )
-    if colour.space == "srgb" and colour.exif_only and image.dtype == np.uint16:
+    if colour.space == "srgb" and colour.exif_linear and image.dtype == np.uint16:
         return image, (  # (needs_conversion's rule: an Exif tag copied from the camera)
-            f"preview {shown_path(path)} is 16-bit and says sRGB only by its Exif ColorSpace 1 "
-            "(no ICC profile): its brightness is read as linear, no curve undone; if it is an "
-            "sRGB-encoded export, export it with the sRGB ICC profile embedded"
+            f"preview {shown_path(path)} is 16-bit, says sRGB only by its Exif ColorSpace 1 "
+            "(no ICC profile) and was written by dcraw or LibRaw (its Software tag), whose "
+            "16-bit output is linear: its brightness is read as linear, no curve undone; if "
+            "it is sRGB-encoded, export it with the sRGB ICC profile embedded"
         )
     if not needs_conversion(colour, image.dtype):
         return image, None
@@ -344,9 +345,11 @@ def preview_in_its_space(path: Path, image: np.ndarray) -> tuple[np.ndarray, str
         if converted.clipped
         else ""
     )
+    # an sRGB file's primaries are sRGB's already: only its curve was read differently
+    primaries = "its primaries kept as" if colour.space == "srgb" else "its primaries converted"
     return converted.pixels, (
         f"preview {shown_path(path)} is {colour.name} (said by {colour.said_by}): its brightness "
-        f"is read in linear sRGB, {curve} and its primaries converted to sRGB's{clipped}"
+        f"is read in linear sRGB, {curve} and {primaries} to sRGB's{clipped}"
     )
 
 
