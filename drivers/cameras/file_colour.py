@@ -300,6 +300,14 @@ def file_colour_notice(
     assumed, or that the colours are another space's, recorded as such and not converted; for
     a ``bits`` 16 file said sRGB by its Exif alone, that it was taken as linear."""
     if colour.space == "srgb":
+        if colour.linear_curve and bits == 8:
+            # taken as linear against the 8-bit reading a config or a reader would give: said,
+            # as fit and plan say it (a run and a replay had recorded it in the manifest only)
+            return (
+                f"{whose} are 8-bit with an ICC profile whose curve is linear (gamma 1.0, "
+                f"{colour.said_by}): taken as linear, as the profile says, not through the "
+                "sRGB curve an 8-bit file is otherwise read by"
+            )
         if not colour.exif_only or bits != 16:
             return None
         return exif_only_16_bit_notice(whose) if colour.exif_linear else exif_encoded_notice(whose)

@@ -146,6 +146,9 @@ def test_an_8_bit_tiff_whose_profile_says_linear_is_recorded_linear(tmp_path, mo
     step = json.loads((out / "manifest.json").read_text())["steps"][0]
     assert "gamma 1.0" in step["file_colour"]["curve_undone"], step
     assert (tifffile.imread(out / step["linear_image"]) == 128 * 257).all()
+    # said, as fit and plan say it (the run had recorded it in the manifest only)
+    assert "are 8-bit with an ICC profile whose curve is linear (gamma 1.0" in said, said
+    assert "taken as linear, as the profile says, not through the sRGB curve" in said, said
 
 
 def test_a_float_tiff_in_a_known_space_is_refused_by_its_pixel_type(tmp_path, monkeypatch):
