@@ -47,10 +47,10 @@ class FileColour:
     ``said_by``: where the file says it ("" when it says nothing); ``linear_curve``: its ICC
     profile's tone curve is the identity (gamma 1.0: a linear file, as a session's own linear
     TIFFs are, whose values no curve must be undone from); ``exif_only``: only an Exif
-    ColorSpace says it (no ICC profile), a tag that names the camera's colour setting and that
-    raw converters' linear output carries when copied from the camera (dcraw/LibRaw ``-4 -T``
-    writes an Exif IFD without it; ``exiftool -tagsFromFile`` adds it), so it says nothing
-    trustworthy of a 16-bit file's curve (:func:`exif_only_16_bit_notice`); ``written_by``:
+    ColorSpace says it (no ICC profile): sRGB, its curve included, except on a raw
+    converter's linear output that carries the tag copied from the camera (dcraw/LibRaw
+    ``-4 -T`` writes an Exif IFD without it; ``exiftool -tagsFromFile`` adds it), told by
+    ``written_by`` (:attr:`exif_linear`); ``written_by``:
     a TIFF's Software tag (305), "" where absent: what tells a linear raw converter's output
     (:attr:`exif_linear`)."""
 
