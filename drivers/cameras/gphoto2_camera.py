@@ -302,7 +302,13 @@ class Gphoto2Camera:
         if command == "capture":
             hint = self._capture_advice(code, hint)
         elif code == -53:
-            hint = self._claimed_advice("so rti-rig could not open it")
+            # opening is where a desktop's mount claims it first; past that, the command that
+            # failed is named (a download or a delete had been said "could not open it")
+            hint = self._claimed_advice(
+                "so rti-rig could not open it"
+                if command in ("autodetect", "init")
+                else f"so its {command} call did not reach the camera"
+            )
         over = f" over {waited_s:g} s" if waited_s else ""
         if waited_s and spent_s is not None and spent_s > waited_s + 1.0:
             over = f" over {spent_s:.0f} s ({waited_s:g} s of them the waits between tries)"

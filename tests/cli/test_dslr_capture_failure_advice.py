@@ -116,6 +116,25 @@ def test_a_camera_claimed_by_gvfs_when_it_is_opened_is_named_with_the_commands_t
     assert "`systemctl --user stop gvfs-gphoto2-volume-monitor`" in said, said
 
 
+def test_a_camera_claimed_at_a_download_names_the_download_not_the_opening(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The camera's USB device claimed by another program as the first shot downloads (a file
+    manager mounting the card once the shot appears): the words name the download that did
+    not reach the camera; they had said "so rti-rig could not open it" of a camera it had
+    opened and shot with."""
+    cfg = _config(tmp_path, "Memory card")
+    body = Body(render=_raw, failures={"file_get": [-53]})
+    out = tmp_path / "s"
+    r, said, _ = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "2"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said, said
+    assert "gphoto2 error -53" in said and "is claimed by another program" in said, said
+    assert "so its download call did not reach the camera" in said, said
+    assert "could not open it" not in said, said
+
+
 def test_a_busy_camera_retried_until_it_shot_is_said_with_the_shots_it_concerns(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
