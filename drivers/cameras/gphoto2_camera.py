@@ -340,9 +340,17 @@ class Gphoto2Camera:
         the session's notice counts the shots it concerns (the journal's step notices say
         which)."""
         s = self.settings
+        # the codes retried are the config's: one beside -110 is named as what it is, a code
+        # the user chose to retry (the notice had called every retried reply -110)
+        answered = (
+            "busy (gphoto2 error -110, PTP Device Busy: still writing a previous file, or its "
+            "autofocus searching)"
+            if tuple(s.retry_codes) == (-110,)
+            else f"a gphoto2 error of retry_codes = {list(s.retry_codes)} (-110 is PTP Device "
+            "Busy: still writing a previous file, or its autofocus searching)"
+        )
         return (
-            f"{self._device()} answered busy (gphoto2 error -110, PTP Device Busy: still "
-            "writing a previous file, or its autofocus searching) and was tried again until it "
+            f"{self._device()} answered {answered} and was tried again until it "
             f"took the shot, at most busy_retries = {s.busy_retries} tries a shot spaced "
             f"{s.retry_delay_s:g} s to {s.retry_max_delay_s:g} s apart: the waits lengthen the "
             "session; a faster card, capture_target = 'Internal RAM' or manual focus shortens "

@@ -165,6 +165,33 @@ def test_a_busy_camera_retried_until_it_shot_is_said_with_the_shots_it_concerns(
     assert said_of == [False, True, True], steps
 
 
+def test_a_retried_code_other_than_busy_is_said_as_the_config_s_retry_codes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """retry_codes = [-110, -1] in the config, and the body answers the first shot's capture
+    with -1 once: the shot is taken, and the notice names the config's retry codes. It had
+    said every retried reply was -110, PTP Device Busy, of a -1 (libgphoto2's generic
+    failure)."""
+    cfg = _config(tmp_path, "Memory card")
+    _busy_retries_spaced_short(cfg)
+    cfg.write_text(
+        cfg.read_text().replace(
+            "busy_retries = 6\n", "busy_retries = 6\nretry_codes = [-110, -1]\n"
+        )
+    )
+    body = Body(render=_raw, failures={"capture": [-1]})
+    out = tmp_path / "s"
+    r, said, _ = _shot_with(
+        monkeypatch,
+        cfg,
+        body,
+        ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"],
+    )
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    assert "answered a gphoto2 error of retry_codes = [-110, -1] (-110 is PTP Device Busy" in said
+    assert "answered busy (gphoto2 error -110" not in said, said
+
+
 def test_a_raw_that_would_not_decode_is_left_on_the_card_as_its_error_says(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
