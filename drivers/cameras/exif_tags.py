@@ -17,6 +17,7 @@ from __future__ import annotations
 import io
 import struct
 from pathlib import Path
+from typing import BinaryIO
 
 from rti_rig.drivers.cameras.tiff_ifd import (
     Entry,
@@ -169,7 +170,7 @@ def _datetime_original(tiff: bytes) -> str | None:
     return raw.decode("ascii", "replace").rstrip("\x00") or None
 
 
-def _entry(f: io.BytesIO, layout: Layout, offset: int, tag: int) -> Entry | None:
+def _entry(f: BinaryIO, layout: Layout, offset: int, tag: int) -> Entry | None:
     count = read_count(f, layout, offset)
     if not count or count > 4096:
         return None
@@ -205,7 +206,24 @@ def jpeg_exif_colour(path: Path) -> tuple[int | None, str | None]:
     where = None if interop is None else read_values(f, layout, interop, len(exif), 1)
     if not where:
         return colorspace, None
-    index = _entry(f, layout, where[0], INTEROPERABILITY_INDEX_TAG)
+    return colorspace, _interop_index(f, layout, where[0])
+
+
+def tiff_interoperability_index(path: Path, offset: int) -> str | None:
+    """The InteroperabilityIndex of a TIFF whose Exif IFD points its Interoperability IFD at
+    ``offset``; None where that IFD or the tag is not there (or is damaged).
+
+    Why: tifffile reads a TIFF's Exif IFD but gives its InteroperabilityTag as that offset,
+    not the IFD's tags (tifffile 2026.3), so a TIFF's "R03" (Adobe RGB) had never been read;
+    the IFD is read here as a JPEG's is (:func:`jpeg_exif_colour`)."""
+    with path.open("rb") as f:
+        found = read_header(f)
+        return None if found is None else _interop_index(f, found[0], offset)
+
+
+def _interop_index(f: BinaryIO, layout: Layout, offset: int) -> str | None:
+    """The InteroperabilityIndex ("R98", "R03") of the Interoperability IFD at ``offset``."""
+    index = _entry(f, layout, offset, INTEROPERABILITY_INDEX_TAG)
     if index is None or index.type != 2 or not 0 < index.count <= 4:
-        return colorspace, None
-    return colorspace, index.field[: index.count].decode("ascii", "replace").rstrip("\0") or None
+        return None
+    return index.field[: index.count].decode("ascii", "replace").rstrip("\0") or None

@@ -24,7 +24,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Literal
 
-from rti_rig.drivers.cameras.exif_tags import HEAD_BYTES, jpeg_exif_colour
+from rti_rig.drivers.cameras.exif_tags import (
+    HEAD_BYTES,
+    jpeg_exif_colour,
+    tiff_interoperability_index,
+)
 
 Space = Literal["srgb", "adobe_rgb", "prophoto", "display_p3", "other", "untagged"]
 
@@ -248,8 +252,9 @@ def _tiff_tags(path: Path) -> tuple[bytes | None, int | None, str | None, str]:
     first page.
 
     tifffile gives the Exif IFD's InteroperabilityTag as the offset of its IFD, not its tags
-    (tifffile 2026.3): that IFD is read here, so a TIFF's "R03" (Adobe RGB) is seen as a
-    JPEG's is (it had never been, and such a TIFF was called an unnamed space)."""
+    (tifffile 2026.3): that IFD is read by :func:`tiff_interoperability_index`, so a TIFF's
+    "R03" (Adobe RGB) is seen as a JPEG's is (it had never been, and such a TIFF was called
+    an unnamed space)."""
     import tifffile
 
     try:
@@ -262,12 +267,16 @@ def _tiff_tags(path: Path) -> tuple[bytes | None, int | None, str | None, str]:
             exif = exif_tag.value if exif_tag is not None else {}
             exif = exif if isinstance(exif, dict) else {}
             interop = exif.get("InteroperabilityTag")
-            if isinstance(interop, int):
-                interop = _interop_ifd(tif, interop)
             software = soft_tag.value if soft_tag is not None else ""
     except tifffile.TiffFileError as exc:
         raise ValueError(str(exc)) from exc
-    index = interop.get("InteroperabilityIndex") if isinstance(interop, dict) else None
+    index = (
+        tiff_interoperability_index(path, interop)
+        if isinstance(interop, int)
+        else interop.get("InteroperabilityIndex")
+        if isinstance(interop, dict)
+        else None
+    )
     colorspace = exif.get("ColorSpace")
     return (
         icc,
@@ -275,22 +284,6 @@ def _tiff_tags(path: Path) -> tuple[bytes | None, int | None, str | None, str]:
         index if isinstance(index, str) else None,
         software if isinstance(software, str) else "",
     )
-
-
-def _interop_ifd(tif: object, offset: int) -> dict[str, object]:
-    """The Interoperability IFD at ``offset`` of an open TIFF, read with tifffile's own reader
-    of it; {} where it cannot be read (a damaged offset is no colour space)."""
-    from tifffile import tifffile as tf
-
-    try:
-        fh = tif.filehandle  # type: ignore[attr-defined]
-        if not 8 <= offset < fh.size:
-            return {}
-        fh.seek(offset)
-        read = tf.read_interoperability_ifd
-        return dict(read(fh, tif.byteorder, 13, 1, tif.tiff.offsetsize))  # type: ignore[attr-defined]
-    except Exception:  # any damage in an optional IFD leaves it unread
-        return {}
 
 
 def file_colour_notice(
