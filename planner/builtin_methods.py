@@ -12,11 +12,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.planner import tilt_guard as tilt_guard_module
 from rti_rig.planner.kmeans_method import plan_kmeans
 from rti_rig.planner.methods import MethodContext, SurfaceNeed, register_method
 from rti_rig.planner.objectives import NormalsObjective, RelightObjective
 from rti_rig.planner.optimal import exchange_search
 from rti_rig.planner.pixel_bins import binned_objective
+from rti_rig.planner.tilt_guard import TiltGuard, tilt_guard
 
 #: Below this many lights the exchange search is not run: 3 lights are exactly the unknowns of
 #: the Lambertian fit, with no redundancy left for a shadow or a highlight.
@@ -140,8 +142,9 @@ class OptimalMethod:
             )
             return chosen
         search = binned_objective(objective)
-        res = exchange_search(objective, ctx.starts, search=search)
+        res = exchange_search(objective, ctx.starts, search=search, guard=_guard(ctx))
         report.start_layout, report.swaps = res.start_label, res.swaps
+        report.guarded_tilt_deg = res.guarded_tilt_deg
         if search is not objective:
             assert isinstance(search, NormalsObjective) and isinstance(objective, NormalsObjective)
             report.search_pixels = (len(objective.n), len(search.n))
@@ -150,6 +153,19 @@ class OptimalMethod:
         if n >= MANY_LIGHTS and ctx.objective == "normals" and res.swaps > 0:
             report.notes.append(_even_layout_note(ctx))
         return res.chosen
+
+
+def _guard(ctx: MethodContext) -> TiltGuard | None:
+    """The tilt guard of the exchange (:mod:`rti_rig.planner.tilt_guard`) around the plane the
+    surface estimate sees (the mean of its normals: level for a flat or unreadable preview)."""
+    if not tilt_guard_module.ENABLED:
+        return None
+    up = np.array([0.0, 0.0, 1.0])
+    if ctx.surface is not None:
+        mean = ctx.surface.normals.reshape(-1, 3).mean(axis=0)
+        if np.linalg.norm(mean) > 1e-6:
+            up = mean
+    return tilt_guard(ctx.candidates.directions, up, [s for _, s in ctx.starts])
 
 
 def _even_layout_note(ctx: MethodContext) -> str:

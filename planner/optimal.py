@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.planner.objectives import NormalsObjective, RelightObjective
+from rti_rig.planner.tilt_guard import TiltGuard
 
 #: At most this many sweeps over the chosen lights (a bound on run time; rarely reached).
 MAX_PASSES = 4
@@ -45,6 +46,8 @@ class ExchangeResult:
     start_label: str
     swaps: int
     start_costs: dict[str, float] = field(default_factory=dict)
+    #: the tilt (degrees) the result was kept solvable under (:mod:`rti_rig.planner.tilt_guard`)
+    guarded_tilt_deg: float | None = None
 
 
 def exchange_search(
@@ -53,6 +56,7 @@ def exchange_search(
     max_passes: int | None = None,
     min_gain: float = SWEEP_GAIN,
     search: NormalsObjective | RelightObjective | None = None,
+    guard: TiltGuard | None = None,
 ) -> ExchangeResult:
     """Exchange search from the cheapest of ``starts`` (label, candidate indices).
 
@@ -65,20 +69,28 @@ def exchange_search(
     sample, :mod:`rti_rig.planner.pixel_bins`) that the sweeps score instead. The starts and
     the result are costed on ``objective``; a result that is not cheaper than its start there
     is dropped for the start, so the plan is never worse than its start on ``objective``.
+
+    ``guard``: a :class:`~rti_rig.planner.tilt_guard.TiltGuard` every accepted swap must keep;
+    the search then starts from the cheapest start that meets it (and is unguarded, from the
+    cheapest of all, if none does).
     """
     if not starts:
         raise ValueError("exchange search needs at least one starting layout")
     costs = {label: objective.cost(np.asarray(s, dtype=np.intp)) for label, s in starts}
-    label, first = min(starts, key=lambda ls: costs[ls[0]])
+    meeting = starts if guard is None else [ls for ls in starts if guard.holds(ls[1])]
+    if not meeting:
+        meeting, guard = starts, None
+    label, first = min(meeting, key=lambda ls: costs[ls[0]])
     chosen = np.asarray(first, dtype=np.intp).copy()
+    tilt = None if guard is None else guard.tolerance_deg
     if search is None or search is objective:
-        chosen, cost, swaps = _sweeps(objective, chosen, costs[label], max_passes, min_gain)
-        return ExchangeResult(chosen, cost, costs[label], label, swaps, costs)
-    chosen, _, swaps = _sweeps(search, chosen, search.cost(chosen), max_passes, min_gain)
+        chosen, cost, swaps = _sweeps(objective, chosen, costs[label], max_passes, min_gain, guard)
+        return ExchangeResult(chosen, cost, costs[label], label, swaps, costs, tilt)
+    chosen, _, swaps = _sweeps(search, chosen, search.cost(chosen), max_passes, min_gain, guard)
     cost = objective.cost(chosen)
     if not cost < costs[label]:
         chosen, cost, swaps = np.asarray(first, dtype=np.intp).copy(), costs[label], 0
-    return ExchangeResult(chosen, cost, costs[label], label, swaps, costs)
+    return ExchangeResult(chosen, cost, costs[label], label, swaps, costs, tilt)
 
 
 def _sweeps(
@@ -87,9 +99,10 @@ def _sweeps(
     cost: float,
     max_passes: int | None,
     min_gain: float,
+    guard: TiltGuard | None = None,
 ) -> tuple[NDArray[np.intp], float, int]:
     """The sweeps of :func:`exchange_search` from ``chosen`` (of cost ``cost``): the layout,
-    its cost and the swaps accepted."""
+    its cost and the swaps accepted; with a ``guard``, only swaps that keep it."""
     n = len(chosen)
     limit = max_passes if max_passes is not None else MAX_PASSES
     swaps = 0
@@ -124,6 +137,8 @@ def _sweeps(
                 bound_kw = {"below": target} if bounded else {}
                 trial = objective.swap_costs(chosen, pos, **level, **scan_kw, **bound_kw)
                 trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
+                if guard is not None:
+                    trial[~guard.allowed(chosen, pos)] = np.inf
                 k = int(np.argmin(trial))
                 if not float(trial[k]) < target:
                     break  # no improving swap at this position

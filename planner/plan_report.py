@@ -50,6 +50,9 @@ class PlanReport:
     #: pixel rows the objective scores and the rows the exchange search swept, when it swept a
     #: binned stand-in (:mod:`rti_rig.planner.pixel_bins`)
     search_pixels: tuple[int, int] | None = None
+    #: the global tilt (degrees) the exchange kept the plan solvable under, as its start was
+    #: (:mod:`rti_rig.planner.tilt_guard`); None when no guard applied
+    guarded_tilt_deg: float | None = None
     kmeans_distinct_normals: int | None = None
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
@@ -108,6 +111,13 @@ class PlanReport:
                 f"searched on {binned} binned pixel rows of {every} (nearly equal normals, same "
                 f"shadows from lights above {GRAZING_DEG:g}°); the expected errors above are on "
                 f"all {every}"
+            )
+        if self.guarded_tilt_deg is not None:
+            out.append(
+                f"kept solvable (3 lights facing every point) if the object is tilted up to "
+                f"{self.guarded_tilt_deg:g}° in any direction, as the most tilt-robust of the "
+                "even layouts compared was: one image cannot show a global tilt, so layouts "
+                "that would lose a point to it were not taken for a lower expected error"
             )
         out.extend(self.notes)
         if self.order_seconds is None:

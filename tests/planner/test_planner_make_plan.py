@@ -283,14 +283,17 @@ def _mean_elevation(schedule) -> float:
 @pytest.mark.parametrize("preview", [None, PREVIEW])
 def test_signal_noise_takes_more_oblique_lights(preview: np.ndarray | None) -> None:
     """Noise that grows with n·l makes head-on light worth less: on the real dome's 72 LEDs the
-    plan's lights sit lower with --signal-noise 0.05, and the report says what was modelled."""
+    plan's lights sit lower with --signal-noise 0.05, and the report says what was modelled.
+
+    The margin is 1.5°: the tilt guard (planner/tilt_guard.py) holds a light or two up in both
+    plans, and at 9 lights without a preview it left 1.9° between them (2.7° unguarded)."""
     light = (30.0, 50.0) if preview is not None else None
     for n in (9, 12, 18):
         plain, plain_report = plan_with_report(preview, REAL_DOME, n, "optimal", "normals", light)
         noisy, report = plan_with_report(
             preview, REAL_DOME, n, "optimal", "normals", light, signal_noise=0.05
         )
-        assert _mean_elevation(noisy) < _mean_elevation(plain) - 2.0
+        assert _mean_elevation(noisy) < _mean_elevation(plain) - 1.5
         assert plain_report.signal_noise == 0 and report.signal_noise == 0.05
         assert any("5 % of the signal" in line for line in report.lines())
         assert noisy.provenance["report"]["signal_noise"] == 0.05

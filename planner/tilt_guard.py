@@ -1,0 +1,118 @@
+"""A guard for the ``optimal`` exchange: a swap may not leave a tilted object unsolvable.
+
+The planner cannot see a global tilt (a tilted plane shades like a level one of another albedo),
+so :func:`rti_rig.planner.surface_estimate.hedge_global_tilt` adds copies of the surface tilted
+by 25°. That hedge is a cost, and a cost trades: on the simulated 50°-tilted plane it let the
+exchange pick 4 lights at 24–34° elevation, two of them behind the plane, leaving every pixel
+with two lit lights and nothing solved (49.8° mean error in 2 of 6 draws, against 0.25° for an
+even layout). Heavier or wider hedges fixed that scene only by making glossy ones worse
+(docs/research/tradeoff.md). The cliff is not a matter of degree, so it is guarded as a
+constraint, not weighed as a cost: the exchange may not accept a swap that makes the layout
+lose the robustness to tilt its homogeneous start had.
+
+Robustness here is :func:`tilt_tolerance`: the largest tilt of the object's plane (every
+azimuth) under which at least :data:`NEED_LIT` lights still face it past grazing — the three a
+Lambertian fit needs. The guard asks the plan for the largest tolerance among the even layouts
+the exchange may start from, capped at :data:`MAX_GUARD_DEG`, and starts it from the cheapest
+layout that has it; it never asks more than a start had, so the exchange keeps a layout to
+return.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.planner.objectives import GRAZING_COS
+
+#: Whether ``optimal``'s exchange is guarded; only ``benchmarks.planner_tilt_guard`` turns it
+#: off, to measure what the guard costs and saves.
+ENABLED = True
+
+#: Lights a Lambertian fit needs to face a pixel (its three unknowns).
+NEED_LIT = 3
+
+#: The tilts checked (degrees from the plane's estimated normal), and their azimuths. The cap
+#: was chosen on the simulator's five trade-off scenes (``benchmarks.planner_tilt_guard``, which
+#: also measures 60°): at 40° no cell was left unsolved (worst: the 50°-tilted plane at 4
+#: lights, 2.2° against 17.4° unguarded) and the glossy coin kept most of its gain at 4–5
+#: lights; at 60° the ratios to the even layout were better but the coin at 4 lights fell from
+#: 8.1° to 21.5°, no better than an even layout.
+TILT_STEP_DEG = 5.0
+MAX_GUARD_DEG = 40.0
+GUARD_AZIMUTHS = 24
+
+
+def tilted_planes(up: NDArray[np.float64], max_deg: float) -> NDArray[np.float64]:
+    """Unit normals of the plane ``up`` tilted by every step up to ``max_deg`` towards every
+    azimuth (:data:`TILT_STEP_DEG`, :data:`GUARD_AZIMUTHS`), ``up`` itself first."""
+    up = np.asarray(up, dtype=np.float64)
+    up = up / np.linalg.norm(up)
+    # an orthonormal frame around up
+    seed = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = np.cross(up, seed)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(up, e1)
+    steps = np.arange(TILT_STEP_DEG, max_deg + 1e-9, TILT_STEP_DEG)
+    phi = 2.0 * np.pi * np.arange(GUARD_AZIMUTHS) / GUARD_AZIMUTHS
+    t = np.radians(steps)[:, None, None]
+    around = np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2  # (azimuths, 3)
+    planes = np.cos(t) * up + np.sin(t) * around[None]
+    return np.concatenate([up[None], planes.reshape(-1, 3)])
+
+
+def tilt_tolerance(
+    lights: NDArray[np.float64], up: NDArray[np.float64], max_deg: float | None = None
+) -> float:
+    """The largest checked tilt (degrees, a multiple of :data:`TILT_STEP_DEG` up to
+    ``max_deg``) under which, at every azimuth and every smaller tilt, at least
+    :data:`NEED_LIT` of ``lights`` face the plane past grazing; -1 if the level plane itself
+    is not lit by that many. ``max_deg`` None: :data:`MAX_GUARD_DEG`."""
+    planes = tilted_planes(up, MAX_GUARD_DEG if max_deg is None else max_deg)
+    enough = ((planes @ np.asarray(lights).T) > GRAZING_COS).sum(axis=1) >= NEED_LIT
+    if not enough[0]:
+        return -1.0
+    per_step = enough[1:].reshape(-1, GUARD_AZIMUTHS).all(axis=1)
+    failed = np.flatnonzero(~per_step)
+    steps = len(per_step) if len(failed) == 0 else int(failed[0])
+    return steps * TILT_STEP_DEG
+
+
+@dataclass(frozen=True)
+class TiltGuard:
+    """Which swaps keep every plane of ``lit`` (rows: planes, columns: candidates) faced by at
+    least :data:`NEED_LIT` of the chosen lights."""
+
+    lit: NDArray[np.bool_]
+    tolerance_deg: float
+
+    def holds(self, chosen: NDArray[np.intp]) -> bool:
+        """Whether ``chosen`` meets the guard."""
+        return bool((self.lit[:, chosen].sum(axis=1) >= NEED_LIT).all())
+
+    def allowed(self, chosen: NDArray[np.intp], pos: int) -> NDArray[np.bool_]:
+        """Per candidate: whether putting it at position ``pos`` of ``chosen`` meets the guard."""
+        others = np.delete(np.asarray(chosen, dtype=np.intp), pos)
+        count = self.lit[:, others].sum(axis=1)
+        if (count < NEED_LIT - 1).any():
+            return np.zeros(self.lit.shape[1], dtype=bool)
+        short = count < NEED_LIT  # planes the newcomer must face
+        return self.lit[short].all(axis=0)
+
+
+def tilt_guard(
+    candidates: NDArray[np.float64],
+    up: NDArray[np.float64],
+    starts: Sequence[NDArray[np.intp]],
+) -> TiltGuard | None:
+    """The guard that keeps the largest tilt tolerance among ``starts`` (capped at
+    :data:`MAX_GUARD_DEG`); None when no start has any to keep."""
+    candidates = np.asarray(candidates, dtype=np.float64)
+    tolerance = max(tilt_tolerance(candidates[np.asarray(s, dtype=np.intp)], up) for s in starts)
+    if tolerance <= 0.0:
+        return None
+    lit = (tilted_planes(up, tolerance) @ candidates.T) > GRAZING_COS
+    return TiltGuard(lit, tolerance)
