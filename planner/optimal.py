@@ -46,7 +46,7 @@ class ExchangeResult:
     start_label: str
     swaps: int
     start_costs: dict[str, float] = field(default_factory=dict)
-    #: the tilt (degrees) the result was kept solvable under (:mod:`rti_rig.planner.tilt_guard`)
+    #: the tilt (degrees) under which the result keeps its guard (:mod:`rti_rig.planner.tilt_guard`)
     guarded_tilt_deg: float | None = None
 
 
@@ -129,6 +129,7 @@ def _sweeps(
                 break
             idle += 1
             scan_kw = {} if unused is None else {"among": np.flatnonzero(unused)}
+            barred = None if guard is None else ~guard.allowed(chosen, pos)
             for level in levels:
                 # the fast scan may be approximate (rank-one updates, single precision): a swap
                 # is accepted on its exact cost, and a proposal that cost does not confirm
@@ -137,8 +138,8 @@ def _sweeps(
                 bound_kw = {"below": target} if bounded else {}
                 trial = objective.swap_costs(chosen, pos, **level, **scan_kw, **bound_kw)
                 trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
-                if guard is not None:
-                    trial[~guard.allowed(chosen, pos)] = np.inf
+                if barred is not None:
+                    trial[barred] = np.inf  # the swaps that would break the tilt guard
                 k = int(np.argmin(trial))
                 if not float(trial[k]) < target:
                     break  # no improving swap at this position

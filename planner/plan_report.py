@@ -50,7 +50,8 @@ class PlanReport:
     #: pixel rows the objective scores and the rows the exchange search swept, when it swept a
     #: binned stand-in (:mod:`rti_rig.planner.pixel_bins`)
     search_pixels: tuple[int, int] | None = None
-    #: the global tilt (degrees) the exchange kept the plan solvable under, as its start was
+    #: the global tilt (degrees) under which the exchange kept 3 lights facing the object's
+    #: plane, as the most tilt-robust even layout compared did, up to a cap
     #: (:mod:`rti_rig.planner.tilt_guard`); None when no guard applied
     guarded_tilt_deg: float | None = None
     kmeans_distinct_normals: int | None = None
@@ -114,10 +115,11 @@ class PlanReport:
             )
         if self.guarded_tilt_deg is not None:
             out.append(
-                f"kept solvable (3 lights facing every point) if the object is tilted up to "
-                f"{self.guarded_tilt_deg:g}° in any direction, as the most tilt-robust of the "
-                "even layouts compared was: one image cannot show a global tilt, so layouts "
-                "that would lose a point to it were not taken for a lower expected error"
+                "kept 3 lights facing the object's plane (what a normal needs) if the object is "
+                f"tilted up to {self.guarded_tilt_deg:g}° in any direction, as the most "
+                "tilt-robust of the even layouts compared did: one image cannot show a global "
+                "tilt, so layouts that would lose the plane to it were not taken for a lower "
+                "expected error"
             )
         out.extend(self.notes)
         if self.order_seconds is None:

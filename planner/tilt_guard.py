@@ -6,9 +6,9 @@ by 25°. That hedge is a cost, and a cost trades: on the simulated 50°-tilted p
 exchange pick 4 lights at 24–34° elevation, two of them behind the plane, leaving every pixel
 with two lit lights and nothing solved (49.8° mean error in 2 of 6 draws, against 0.25° for an
 even layout). Heavier or wider hedges fixed that scene only by making glossy ones worse
-(docs/research/tradeoff.md). The cliff is not a matter of degree, so it is guarded as a
-constraint, not weighed as a cost: the exchange may not accept a swap that makes the layout
-lose the robustness to tilt its homogeneous start had.
+(docs/research/planner.md, "The tilt guard"). The cliff is not a matter of degree, so it is
+guarded as a constraint, not weighed as a cost: the exchange may not accept a swap that leaves
+the layout less robust to a tilt than the even layouts it is compared with (up to a cap).
 
 Robustness here is :func:`tilt_tolerance`: the largest tilt of the object's plane (every
 azimuth) under which at least :data:`NEED_LIT` lights still face it past grazing — the three a
