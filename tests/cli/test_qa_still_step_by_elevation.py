@@ -10,6 +10,12 @@ high ones, whose shadow edges differ by up to 5 px. Now a step the lights' eleva
 as well (the edges of the higher side's images move with their elevation too) is said, in
 those words, and not claimed; the glossy coin's real part-way moves stay named
 (tests/cli/test_qa_move_start_glossy.py).
+
+Seed 8 then failed again on the same code after its dependencies were installed afresh (CI of
+2026-12-04; it had passed at stop 79): the step refused, image_009 alone (the first of the
+higher lights, its edges 2.9 px off the others', the bar 2.6 px) was "object or camera moved".
+One image's edges are now claimed moved only beyond the still images' bar plus how far the
+edges lean with the elevation (the refused step's size), and the verdict says that bar.
 """
 
 from __future__ import annotations
@@ -47,5 +53,12 @@ def test_a_still_part_is_not_called_moved_part_way(tmp_path: Path, seed: int, un
     assert "QA verdict" in said, said
     assert "moved" not in qa["verdict"], qa["verdict"]
     assert not any("moved" in p for c in qa["images"] for p in c["problems"]), qa["verdict"]
-    # the step is said, not passed over
+    # the step is said, not passed over; the bar a shift must pass, where there is one (else
+    # too few images hold their edges still: none is claimed), counts the edges' lean
     assert "could not be told from the light's elevation" in said, said
+    assert (
+        "is how far they lean with the light's elevation" in said
+        or "too few images hold their edges still to tell: none is claimed" in said
+    ), said
+    if seed == 8:  # image_009's edges (2.9 px) within the bar with the lean, beyond it without
+        assert "is how far they lean with the light's elevation" in said, said
