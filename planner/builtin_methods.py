@@ -18,7 +18,7 @@ from rti_rig.planner.methods import MethodContext, SurfaceNeed, register_method
 from rti_rig.planner.objectives import NormalsObjective, RelightObjective
 from rti_rig.planner.optimal import exchange_search
 from rti_rig.planner.pixel_bins import binned_objective
-from rti_rig.planner.tilt_guard import TiltGuard, tilt_guard
+from rti_rig.planner.tilt_guard import TiltGuard, object_plane, tilt_guard
 
 #: Below this many lights the exchange search is not run: 3 lights are exactly the unknowns of
 #: the Lambertian fit, with no redundancy left for a shadow or a highlight.
@@ -160,11 +160,7 @@ def _guard(ctx: MethodContext) -> TiltGuard | None:
     surface estimate sees (the mean of its normals: level for a flat or unreadable preview)."""
     if not tilt_guard_module.ENABLED:
         return None
-    up = np.array([0.0, 0.0, 1.0])
-    if ctx.surface is not None:
-        mean = ctx.surface.normals.reshape(-1, 3).mean(axis=0)
-        if np.linalg.norm(mean) > 1e-6:
-            up = mean
+    up = object_plane(None if ctx.surface is None else ctx.surface.normals)
     return tilt_guard(ctx.candidates.directions, up, [s for _, s in ctx.starts])
 
 

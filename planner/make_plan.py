@@ -58,6 +58,7 @@ from rti_rig.planner.surface_estimate import (
     sample_surface,
     tilt_stats,
 )
+from rti_rig.planner.tilt_guard import REPORT_MAX_DEG, object_plane, tilt_tolerance
 from rti_rig.planner.topography import DepthModelSpec
 from rti_rig.planner.uniform import (
     arm_band_note,
@@ -426,6 +427,11 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
         )
         chosen = method.decide(ctx, obj, chosen)
         report.notes.append(_expected_caveat(report.shading_explained_r2))
+    up = object_plane(None if surface is None else surface.normals)
+    report.tilt_tolerance_deg = tilt_tolerance(candidates.directions[chosen], up, REPORT_MAX_DEG)
+    report.even_tilt_tolerance_deg = tilt_tolerance(
+        candidates.directions[starts[0][1]], up, REPORT_MAX_DEG
+    )
     if surface is None and req.material != "auto":
         report.notes.append(
             f"--material {req.material} is not used: no surface was modelled "

@@ -8,6 +8,7 @@ from typing import Any
 
 from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.pixel_bins import GRAZING_DEG
+from rti_rig.planner.tilt_guard import REPORT_MAX_DEG
 
 
 @dataclass
@@ -54,12 +55,44 @@ class PlanReport:
     #: plane, as the most tilt-robust even layout compared did, up to a cap
     #: (:mod:`rti_rig.planner.tilt_guard`); None when no guard applied
     guarded_tilt_deg: float | None = None
+    #: the largest global tilt of the object's plane (degrees, every direction, checked up to
+    #: :data:`~rti_rig.planner.tilt_guard.REPORT_MAX_DEG`) under which 3 of the written lights
+    #: still face it past grazing (-1: not even level); and the same of the even layout of
+    #: as many lights from the user's floor (``--method uniform``'s): every plan says it, since
+    #: one image cannot show a global tilt and a layout that loses the plane solves nothing
+    tilt_tolerance_deg: float | None = None
+    even_tilt_tolerance_deg: float | None = None
     kmeans_distinct_normals: int | None = None
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
     #: the arm's stop-order search (after the lights are chosen), None on a dome: ``seconds``
     #: is the choosing alone
     order_seconds: float | None = None
+
+    def _tilt_line(self, tolerance: float, even: float | None) -> str:
+        """What the written lights keep of a global tilt, and what the even layout would."""
+        if tolerance < 0.0:
+            said = (
+                "fewer than 3 of these lights face the object's plane past grazing even with "
+                "the object level: a normal cannot be fitted from them"
+            )
+        elif tolerance >= REPORT_MAX_DEG:
+            said = (
+                "3 lights face the object's plane (what a normal needs) even if the object "
+                f"is tilted {REPORT_MAX_DEG:g}° in any direction"
+            )
+        else:
+            said = (
+                "3 lights face the object's plane (what a normal needs) if the object is "
+                f"tilted up to {tolerance:g}° in any direction, not beyond"
+            )
+        if even is not None and even > tolerance and self.method != "uniform":
+            kept = f"{REPORT_MAX_DEG:g}° and more" if even >= REPORT_MAX_DEG else f"up to {even:g}°"
+            said += (
+                f"; the even layout of {self.n} lights (--method uniform) keeps them "
+                f"{kept}: one image cannot show a global tilt"
+            )
+        return said
 
     def light_said(self) -> str | None:
         """The preview light's origin as the reader is told it."""
@@ -121,6 +154,8 @@ class PlanReport:
                 "tilt, so layouts that would lose the plane to it were not taken for a lower "
                 "expected error"
             )
+        elif self.tilt_tolerance_deg is not None:
+            out.append(self._tilt_line(self.tilt_tolerance_deg, self.even_tilt_tolerance_deg))
         out.extend(self.notes)
         if self.order_seconds is None:
             out.append(f"planned in {self.seconds:.2f} s")

@@ -44,6 +44,19 @@ NEED_LIT = 3
 TILT_STEP_DEG = 5.0
 MAX_GUARD_DEG = 40.0
 GUARD_AZIMUTHS = 24
+#: How far every plan's written layout is checked (:func:`tilt_tolerance`) for the plan to say
+#: the tilt its lights survive: past the guard's cap, so a plan that keeps more says so.
+REPORT_MAX_DEG = 60.0
+
+
+def object_plane(normals: NDArray[np.float64] | None) -> NDArray[np.float64]:
+    """The object's plane as the preview's surface estimate sees it: the mean of its normals;
+    level (z up) with no estimate or a mean too short to have a direction."""
+    if normals is not None:
+        mean = np.asarray(normals, dtype=np.float64).reshape(-1, 3).mean(axis=0)
+        if np.linalg.norm(mean) > 1e-6:
+            return mean / np.linalg.norm(mean)
+    return np.array([0.0, 0.0, 1.0])
 
 
 def tilted_planes(up: NDArray[np.float64], max_deg: float) -> NDArray[np.float64]:
