@@ -3,12 +3,18 @@ expects, for the CLI to print and the session to keep beside the schedule."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from rti_rig.planner.light_origin import LightOrigin
+from rti_rig.planner.objectives import GRAZING_COS
 from rti_rig.planner.pixel_bins import GRAZING_DEG
-from rti_rig.planner.tilt_guard import REPORT_MAX_DEG
+from rti_rig.planner.tilt_guard import MAX_GUARD_DEG, REPORT_MAX_DEG, TILT_STEP_DEG
+
+#: The elevation above the object's plane below which a light counts as grazing (the
+#: objectives' ``GRAZING_COS``), as a plan says it.
+GRAZING_COS_DEG = math.degrees(math.asin(GRAZING_COS))
 
 
 @dataclass
@@ -71,28 +77,34 @@ class PlanReport:
 
     def _tilt_line(self, tolerance: float, even: float | None) -> str:
         """What the written lights keep of a global tilt, and what the even layout would."""
-        if tolerance < 0.0:
-            said = (
-                "fewer than 3 of these lights face the object's plane past grazing even with "
-                "the object level: a normal cannot be fitted from them"
-            )
-        elif tolerance >= REPORT_MAX_DEG:
-            said = (
-                "3 lights face the object's plane (what a normal needs) even if the object "
-                f"is tilted {REPORT_MAX_DEG:g}° in any direction"
-            )
-        else:
-            said = (
-                "3 lights face the object's plane (what a normal needs) if the object is "
-                f"tilted up to {tolerance:g}° in any direction, not beyond"
-            )
+        said = _kept_by_lights(tolerance)
         if even is not None and even > tolerance and self.method != "uniform":
-            kept = f"{REPORT_MAX_DEG:g}° and more" if even >= REPORT_MAX_DEG else f"up to {even:g}°"
             said += (
-                f"; the even layout of {self.n} lights (--method uniform) keeps them "
-                f"{kept}: one image cannot show a global tilt"
+                f"; the even layout of {self.n} lights (--method uniform) keeps 3 facing it "
+                f"{_kept_phrase(even)}: one image cannot show a global tilt"
             )
         return said
+
+    def _guarded_line(self, guarded: float) -> str:
+        """What ``optimal``'s tilt guard kept, and the written lights' own tolerance where it
+        is more (the guard asks at most :data:`~rti_rig.planner.tilt_guard.MAX_GUARD_DEG`)."""
+        why = (
+            "the most the guard asks (an even layout compared may keep more)"
+            if guarded >= MAX_GUARD_DEG
+            else "as the most tilt-robust of the even layouts compared did"
+        )
+        own = self.tilt_tolerance_deg
+        mine = (
+            f"; the written lights keep them {_kept_phrase(own)}"
+            if own is not None and own > guarded
+            else ""
+        )
+        return (
+            "kept 3 lights facing the object's plane (what a normal needs) if the object is "
+            f"tilted up to {guarded:g}° in any direction, {why}{mine}: one image cannot show a "
+            "global tilt, so layouts that would lose the plane to it were not taken for a lower "
+            "expected error"
+        )
 
     def light_said(self) -> str | None:
         """The preview light's origin as the reader is told it."""
@@ -147,13 +159,7 @@ class PlanReport:
                 f"all {every}"
             )
         if self.guarded_tilt_deg is not None:
-            out.append(
-                "kept 3 lights facing the object's plane (what a normal needs) if the object is "
-                f"tilted up to {self.guarded_tilt_deg:g}° in any direction, as the most "
-                "tilt-robust of the even layouts compared did: one image cannot show a global "
-                "tilt, so layouts that would lose the plane to it were not taken for a lower "
-                "expected error"
-            )
+            out.append(self._guarded_line(self.guarded_tilt_deg))
         elif self.tilt_tolerance_deg is not None:
             out.append(self._tilt_line(self.tilt_tolerance_deg, self.even_tilt_tolerance_deg))
         out.extend(self.notes)
@@ -165,3 +171,37 @@ class PlanReport:
                 f"choosing the lights, {self.order_seconds:.2f} s ordering the arm's stops)"
             )
         return out
+
+
+def _kept_phrase(tolerance: float) -> str:
+    """How far a tilt keeps 3 lights facing the plane, after "keeps 3 facing it"."""
+    if tolerance < 0.0:
+        return "not even level"
+    if tolerance == 0.0:
+        return "only while it is level"
+    if tolerance >= REPORT_MAX_DEG:
+        return f"at {REPORT_MAX_DEG:g}° of tilt in any direction (as far as checked)"
+    return f"up to {tolerance:g}° of tilt in any direction"
+
+
+def _kept_by_lights(tolerance: float) -> str:
+    """The written lights' tolerance as a sentence's start."""
+    if tolerance < 0.0:
+        return (
+            f"fewer than 3 of these lights stand {GRAZING_COS_DEG:.0f}° or more above the "
+            "object's plane even with the object level: its normals rest on grazing light"
+        )
+    if tolerance == 0.0:
+        return (
+            "3 lights (what a normal needs) face the object's plane only while the object is "
+            f"level: a {TILT_STEP_DEG:g}° tilt in some direction leaves fewer"
+        )
+    if tolerance >= REPORT_MAX_DEG:
+        return (
+            "3 lights (what a normal needs) face the object's plane even if the object is tilted "
+            f"{REPORT_MAX_DEG:g}° in any direction (as far as checked)"
+        )
+    return (
+        "3 lights (what a normal needs) face the object's plane if the object is tilted up to "
+        f"{tolerance:g}° in any direction, not beyond"
+    )

@@ -1794,7 +1794,9 @@ def assess(
     drift_note = ""
     if not edges_trusted and poor_fit > MISFIT_LIMIT:
         noise = still_spread_px(edge_dev)
-        lean = _elevation_lean_px(refused_steps)
+        # (a step claimed was undone before these edges were read: a refused one's size, taken
+        # from the crop as captured, may hold part of that move, and is not said then either)
+        lean = _elevation_lean_px(refused_steps) if step is None else 0.0
         unclaimed = np.array(
             [
                 bool(ev.moved[i])
@@ -1828,7 +1830,7 @@ def assess(
                 f" (beyond {shown:.1f} px"
                 + (
                     f", of which {lean:.1f} px is how far they lean with the light's elevation"
-                    if lean > 0.0
+                    if lean >= 0.05
                     else ""
                 )
                 + f", and up to about {MAX_SHIFT_PX - 1} px); a smaller "
