@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import asyncio
 import gc
+import os
+import signal
 import sys
 import warnings
 from collections.abc import Iterator
@@ -160,3 +162,55 @@ def test_a_stop_while_the_loop_is_made_leaves_no_coroutine_unawaited(
             _run_quietly(main)
         gc.collect()
     assert [str(w.message) for w in said if "never awaited" in str(w.message)] == []
+
+
+@pytest.fixture
+def python_ctrl_c() -> Iterator[None]:
+    """SIGINT as a shell gives ``rti-rig fit``: Python's own handler (this pytest process
+    may have had it ignored by an earlier in-process ``run``)."""
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+def test_a_ctrl_c_that_lands_in_a_finalizer_still_stops_the_probe(
+    python_ctrl_c: None, unraisable: list[Any]
+) -> None:
+    """CI, under load: the Ctrl-C came while the garbage collector ran a half-made
+    connection's ``StreamWriter.__del__``; Python raised its KeyboardInterrupt there, printed
+    it as "Exception ignored in …" and dropped it, and the stopped fit waited out the silent
+    port's 20 s. Here the Ctrl-C is sent from inside a finalizer on purpose: without the
+    loop's own handler this probe runs its 30 s out and returns."""
+
+    class Dropped:
+        def __del__(self) -> None:
+            os.kill(os.getpid(), signal.SIGINT)
+            sum(range(10_000))  # Python's handler would raise here, inside __del__
+
+    async def main() -> str:
+        Dropped()  # dropped at once: its __del__ runs now, in this frame
+        await asyncio.sleep(30)
+        return "waited it out"
+
+    with pytest.raises(KeyboardInterrupt):
+        _run_quietly(main)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # given back
+    _no_coroutine_closed_on_a_closed_loop(unraisable)
+
+
+def test_a_ctrl_c_that_is_ignored_stays_ignored_during_the_probe() -> None:
+    """A caller that ignores SIGINT (``run`` once its session is over) keeps it ignored."""
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+
+        async def main() -> int:
+            os.kill(os.getpid(), signal.SIGINT)
+            await asyncio.sleep(0.05)
+            return 7
+
+        assert _run_quietly(main) == 7
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, before)

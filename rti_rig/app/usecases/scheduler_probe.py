@@ -14,6 +14,7 @@ from __future__ import annotations
 import asyncio
 import copy
 import gc
+import signal
 import socket
 import threading
 from collections.abc import Callable, Coroutine, Sequence
@@ -366,16 +367,29 @@ def _run_quietly(make: Callable[[], Coroutine[Any, Any, Any]]) -> Any:
     loop: asyncio.AbstractEventLoop | None = None
     main: Coroutine[Any, Any, Any] | None = None
     cut = False
+    ctrl_c: list[bool] = []  # a Ctrl-C the loop took (_ctrl_c_stops)
+    held = False
     try:
         loop = asyncio.new_event_loop()
+        held = _ctrl_c_stops(loop, ctrl_c)
         main = make()
-        return loop.run_until_complete(main)
+        try:
+            result = loop.run_until_complete(main)
+        except RuntimeError:  # "Event loop stopped before Future completed": the Ctrl-C's stop
+            if not ctrl_c:
+                raise
+        if ctrl_c:  # raised here, in this frame, whatever the loop was running when it came
+            raise KeyboardInterrupt
+        return result
     except BaseException as exc:  # a stop, or an error the caller words: its frames let go
         exc.__traceback__ = None  # what is said never shows them; they hold the cut coroutines
         cut = True
         raise
     finally:
         if loop is not None:
+            if held:  # Python's own Ctrl-C again for the clean-up (a second one cuts it short)
+                with suppress(Exception):
+                    loop.remove_signal_handler(signal.SIGINT)
             loop.set_exception_handler(lambda _loop, _context: None)
             try:
                 _end_what_is_left(loop, cut)
@@ -384,6 +398,31 @@ def _run_quietly(make: Callable[[], Coroutine[Any, Any, Any]]) -> Any:
                     with suppress(BaseException):
                         main.close()
                 loop.close()
+
+
+def _ctrl_c_stops(loop: asyncio.AbstractEventLoop, took: list[bool]) -> bool:
+    """Whether a Ctrl-C now stops ``loop`` (noted in ``took``) instead of raising
+    KeyboardInterrupt wherever Python happens to be: only where Python's own handler is in
+    place (a caller that ignores SIGINT keeps ignoring it) and this is the main thread.
+
+    Why: Python raises a Ctrl-C's KeyboardInterrupt in whatever frame runs when it comes, and
+    one that came while the garbage collector ran a finalizer (a half-made connection's
+    ``StreamWriter.__del__``) was printed as "Exception ignored in …" and lost: the stopped
+    ``fit`` waited out the 20 s for the silent port and said it could not reach the scheduler
+    (CI under load, once). The loop's own handler runs between its callbacks, never inside a
+    finalizer; the stop is raised by :func:`_run_quietly` once the loop has returned."""
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        return False
+
+    def stop() -> None:
+        took.append(True)
+        loop.stop()
+
+    try:
+        loop.add_signal_handler(signal.SIGINT, stop)
+    except (ValueError, RuntimeError, NotImplementedError):  # not the main thread; no Unix
+        return False
+    return True
 
 
 def _end_what_is_left(loop: asyncio.AbstractEventLoop, cut: bool) -> None:
