@@ -10,11 +10,25 @@ from typing import Any
 from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.objectives import GRAZING_COS
 from rti_rig.planner.pixel_bins import GRAZING_DEG
-from rti_rig.planner.tilt_guard import MAX_GUARD_DEG, REPORT_MAX_DEG, TILT_STEP_DEG
+from rti_rig.planner.tilt_guard import (
+    MAX_GUARD_DEG,
+    NEED_LIT,
+    REPORT_MAX_DEG,
+    SOLVABLE_COND,
+    TILT_STEP_DEG,
+)
 
 #: The elevation above the object's plane below which a light counts as grazing (the
 #: objectives' ``GRAZING_COS``), as a plan says it.
 GRAZING_COS_DEG = math.degrees(math.asin(GRAZING_COS))
+#: What the tilt lines mean by lights that "determine a normal" (:func:`~rti_rig.planner.
+#: tilt_guard.solvable`): a count of facing lights alone was said before, and three facing
+#: lights on one great circle solve nothing.
+DETERMINE_RULE = (
+    f"{NEED_LIT} or more lights {GRAZING_COS_DEG:.0f}° or more above the object's plane and not "
+    f"nearly on one great circle, their condition number at most {SOLVABLE_COND:g} as the fit "
+    "asks of a pixel's lights"
+)
 
 
 @dataclass
@@ -57,15 +71,16 @@ class PlanReport:
     #: pixel rows the objective scores and the rows the exchange search swept, when it swept a
     #: binned stand-in (:mod:`rti_rig.planner.pixel_bins`)
     search_pixels: tuple[int, int] | None = None
-    #: the global tilt (degrees) under which the exchange kept 3 lights facing the object's
-    #: plane, as the most tilt-robust even layout compared did, up to a cap
+    #: the global tilt (degrees) under which the exchange kept lights that determine a normal
+    #: (:data:`DETERMINE_RULE`), as the most tilt-robust even layout compared did, up to a cap
     #: (:mod:`rti_rig.planner.tilt_guard`); None when no guard applied
     guarded_tilt_deg: float | None = None
     #: the largest global tilt of the object's plane (degrees, every direction, checked up to
-    #: :data:`~rti_rig.planner.tilt_guard.REPORT_MAX_DEG`) under which 3 of the written lights
-    #: still face it past grazing (-1: not even level); and the same of the even layout of
-    #: as many lights from the user's floor (``--method uniform``'s): every plan says it, since
-    #: one image cannot show a global tilt and a layout that loses the plane solves nothing
+    #: :data:`~rti_rig.planner.tilt_guard.REPORT_MAX_DEG`) under which the written lights
+    #: still determine a normal (:data:`DETERMINE_RULE`; -1: not even level); and the same of
+    #: the even layout of as many lights from the user's floor (``--method uniform``'s): every
+    #: plan says it, since one image cannot show a global tilt and a layout that loses the
+    #: plane solves nothing
     tilt_tolerance_deg: float | None = None
     even_tilt_tolerance_deg: float | None = None
     kmeans_distinct_normals: int | None = None
@@ -80,7 +95,7 @@ class PlanReport:
         said = _kept_by_lights(tolerance)
         if even is not None and even > tolerance and self.method != "uniform":
             said += (
-                f"; the even layout of {self.n} lights (--method uniform) keeps 3 facing it "
+                f"; the even layout of {self.n} lights (--method uniform) does so "
                 f"{_kept_phrase(even)}: one image cannot show a global tilt"
             )
         return said
@@ -95,12 +110,12 @@ class PlanReport:
         )
         own = self.tilt_tolerance_deg
         mine = (
-            f"; the written lights keep them {_kept_phrase(own)}"
+            f"; the written lights do so {_kept_phrase(own)}"
             if own is not None and own > guarded
             else ""
         )
         return (
-            "kept 3 lights facing the object's plane (what a normal needs) if the object is "
+            f"kept lights that determine a normal ({DETERMINE_RULE}) if the object is "
             f"tilted up to {guarded:g}° in any direction, {why}{mine}: one image cannot show a "
             "global tilt, so layouts that would lose the plane to it were not taken for a lower "
             "expected error"
@@ -174,7 +189,7 @@ class PlanReport:
 
 
 def _kept_phrase(tolerance: float) -> str:
-    """How far a tilt keeps 3 lights facing the plane, after "keeps 3 facing it"."""
+    """How far a tilt leaves lights that determine a normal, after "does so"."""
     if tolerance < 0.0:
         return "not even level"
     if tolerance == 0.0:
@@ -188,20 +203,21 @@ def _kept_by_lights(tolerance: float) -> str:
     """The written lights' tolerance as a sentence's start."""
     if tolerance < 0.0:
         return (
-            f"fewer than 3 of these lights stand {GRAZING_COS_DEG:.0f}° or more above the "
-            "object's plane even with the object level: its normals rest on grazing light"
+            f"these lights do not determine a normal ({DETERMINE_RULE}) even with the object "
+            f"level: fewer than {NEED_LIT} stand that high, or those that do lie nearly on one "
+            "great circle, and its normals rest on grazing light or on too few directions"
         )
     if tolerance == 0.0:
         return (
-            "3 lights (what a normal needs) face the object's plane only while the object is "
-            f"level: a {TILT_STEP_DEG:g}° tilt in some direction leaves fewer"
+            f"these lights determine a normal ({DETERMINE_RULE}) only while the object is "
+            f"level: a {TILT_STEP_DEG:g}° tilt in some direction leaves too few"
         )
     if tolerance >= REPORT_MAX_DEG:
         return (
-            "3 lights (what a normal needs) face the object's plane even if the object is tilted "
+            f"these lights determine a normal ({DETERMINE_RULE}) even if the object is tilted "
             f"{REPORT_MAX_DEG:g}° in any direction (as far as checked)"
         )
     return (
-        "3 lights (what a normal needs) face the object's plane if the object is tilted up to "
+        f"these lights determine a normal ({DETERMINE_RULE}) if the object is tilted up to "
         f"{tolerance:g}° in any direction, not beyond"
     )

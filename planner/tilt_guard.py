@@ -101,9 +101,15 @@ def solvable(grams: NDArray[np.float64], counts: NDArray[np.intp]) -> NDArray[np
     counts = np.asarray(counts).reshape(-1)
     ok = counts >= NEED_LIT
     if ok.any():
-        eig = np.linalg.eigvalsh(grams[ok])
-        ok[ok] = (eig[:, 0] > 0.0) & (eig[:, -1] <= SOLVABLE_COND**2 * eig[:, 0])
+        ok[ok] = _conditioned(np.linalg.eigvalsh(grams[ok]))
     return ok
+
+
+def _conditioned(eig: NDArray[np.float64], slack: float = 0.0) -> NDArray[np.bool_]:
+    """Per row of ascending eigenvalues of LᵀL: λmin > 0 and λmax + ``slack`` ≤
+    SOLVABLE_COND² λmin — the one test :func:`solvable` and :meth:`TiltGuard.allowed` share
+    (``slack`` 1: still true after any unit light is added)."""
+    return (eig[:, 0] > 0.0) & (eig[:, -1] + slack <= SOLVABLE_COND**2 * eig[:, 0])
 
 
 def _planes_solved(lights: NDArray[np.float64], planes: NDArray[np.float64]) -> NDArray[np.bool_]:
@@ -159,11 +165,10 @@ class TiltGuard:
             return np.zeros(n_cand, dtype=bool)
         gram = facing @ self.outer[others]  # (planes, 9)
         eig = np.linalg.eigvalsh(gram.reshape(-1, 3, 3))
-        limit = SOLVABLE_COND**2
-        solved = (count >= NEED_LIT) & (eig[:, 0] > 0.0) & (eig[:, -1] <= limit * eig[:, 0])
+        enough = count >= NEED_LIT
         # a plane the others leave unsolved stays so unless the newcomer faces it
-        allowed = self.lit[~solved].all(axis=0)
-        roomy = (count >= NEED_LIT) & (eig[:, -1] + 1.0 <= limit * eig[:, 0])
+        allowed = self.lit[~(enough & _conditioned(eig))].all(axis=0)
+        roomy = enough & _conditioned(eig, slack=1.0)
         check = np.flatnonzero(~roomy)
         todo = np.flatnonzero(allowed)
         if check.size == 0 or todo.size == 0:

@@ -188,21 +188,24 @@ def _report(method: str, tolerance: float, even: float) -> PlanReport:
 def test_every_plan_says_the_tilt_its_lights_survive_and_the_even_layouts() -> None:
     said = " ".join(_report("kmeans", 15.0, 45.0).lines())
     assert "if the object is tilted up to 15° in any direction, not beyond" in said, said
-    assert "the even layout of 6 lights (--method uniform) keeps 3 facing it up to 45°" in said
+    assert "the even layout of 6 lights (--method uniform) does so up to 45°" in said
     said = " ".join(_report("kmeans", 60.0, 45.0).lines())
     assert "even if the object is tilted 60° in any direction (as far as checked)" in said, said
     assert "--method uniform" not in said, said  # no worse than it: nothing to offer
     said = " ".join(_report("kmeans", 20.0, REPORT_MAX_DEG).lines())
-    assert "keeps 3 facing it at 60° of tilt in any direction (as far as checked)" in said, said
+    assert "does so at 60° of tilt in any direction (as far as checked)" in said, said
     said = " ".join(_report("uniform", 25.0, 25.0).lines())
     assert "up to 25° in any direction, not beyond" in said and "--method uniform" not in said
     # three lights at one elevation survive no tilt: said so, not "up to 0°"
     said = " ".join(_report("uniform", 0.0, 0.0).lines())
-    assert "only while the object is level: a 5° tilt in some direction leaves fewer" in said
+    assert "only while the object is level: a 5° tilt in some direction leaves too few" in said
     assert "up to 0°" not in said, said
     said = " ".join(_report("kmeans", -1.0, 45.0).lines())
-    assert "fewer than 3 of these lights stand 9° or more above the object's plane" in said
-    assert "keeps 3 facing it up to 45°" in said, said
+    # not "fewer than 3 stand above the plane": lights on one great circle also give -1
+    assert "these lights do not determine a normal (3 or more lights 9° or more above" in said
+    assert "fewer than 3 stand that high, or those that do lie nearly on one great circle" in said
+    assert "does so up to 45°" in said, said
+    assert "condition number at most 100" in said, said
 
 
 def test_the_guarded_line_says_the_cap_and_the_written_lights_own_tolerance() -> None:
@@ -210,13 +213,13 @@ def test_the_guarded_line_says_the_cap_and_the_written_lights_own_tolerance() ->
     capped.guarded_tilt_deg = MAX_GUARD_DEG
     said = " ".join(capped.lines())
     assert f"tilted up to {MAX_GUARD_DEG:g}° in any direction, the most the guard asks" in said
-    assert "the written lights keep them at 60° of tilt in any direction" in said, said
+    assert "the written lights do so at 60° of tilt in any direction" in said, said
     assert "not beyond" not in said, said  # one line: the guard's
     below = _report("optimal", 30.0, 30.0)
     below.guarded_tilt_deg = 30.0
     said = " ".join(below.lines())
     assert "up to 30° in any direction, as the most tilt-robust of the even layouts" in said
-    assert "the written lights keep" not in said, said
+    assert "the written lights do so" not in said, said
 
 
 def _plan(tmp_path: Path, method: str, lights: int, *preview: str) -> tuple[str, np.ndarray]:
@@ -284,6 +287,7 @@ def test_a_plan_of_lights_that_cannot_solve_a_50_degree_tilt_says_less(tmp_path:
     r = CliRunner().invoke(app, [*argv, "--out", str(out)], terminal_width=400)
     assert r.exit_code == 0, r.output
     said = " ".join(r.output.split())
-    assert "face the object's plane if the object is tilted up to 35° in any direction" in said
+    assert "determine a normal (3 or more lights 9° or more above the object's plane" in said
+    assert "if the object is tilted up to 35° in any direction" in said
     assert "60°" not in said
     assert len(np.loadtxt(out, skiprows=1, usecols=(1, 2, 3))) == 6
