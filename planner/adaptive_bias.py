@@ -38,7 +38,7 @@ injects it.
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -46,6 +46,8 @@ from numpy.typing import NDArray
 
 #: Exponents of the specular lobe tried (Blinn–Phong; 2/e ≈ GGX α²).
 LOBE_EXPONENTS = (4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0)
+#: A lobe value at or below this is 0 (:func:`lobes`).
+LOBE_FLOOR = 1e-9
 #: A captured light's shadow extends to candidate lights within this azimuth difference.
 SHADOW_AZ_DEG = 30.0
 #: Pixels simulated per design (a fixed subset of the chooser's sample: every k-th).
@@ -163,9 +165,31 @@ def _half_cos(n: NDArray, lights: NDArray) -> NDArray:
 
 
 def _lobe(c: NDArray, e: float) -> NDArray:
-    """``c**e`` with what falls below 1e-9 set to 0 (denormals make powers 20× slower)."""
-    c = np.clip(c, 0.0, 1.0)
-    return np.where(c > 1e-9 ** (1.0 / e), c, 0.0) ** e
+    """``c**e`` with what falls below :data:`LOBE_FLOOR` set to 0 (:func:`lobes`)."""
+    return next(lobes(c, (e,)))
+
+
+def lobes(c: NDArray, exponents: Sequence[float]) -> Iterator[NDArray]:
+    """``c**e`` (``c`` clipped to [0, 1]) for each of ``exponents`` in turn, what falls to
+    :data:`LOBE_FLOOR` or below set to 0 (denormals make powers 20× slower).
+
+    An exponent a power of two times the one before (the lobe fit's grid, 4 … 512) is reached
+    by squaring the previous power, which is ~4× cheaper than a power over the grid's 100 000
+    observations (a power costs ~20 ns a value: a quarter of the object model's fit); a value
+    at the floor is zeroed before it is squared again, as its power would be. The results
+    differ from ``**`` by rounding only (relative 3e-14 at 512)."""
+    base = np.clip(c, 0.0, 1.0)
+    x, power = base, 1.0
+    for e in exponents:
+        ratio = e / power
+        if ratio >= 2.0 and ratio.is_integer() and int(ratio) & (int(ratio) - 1) == 0:
+            for _ in range(int(ratio).bit_length() - 1):
+                x = x * x
+                x[x <= LOBE_FLOOR] = 0.0
+            power = float(e)
+            yield x
+        else:
+            yield np.where(base > LOBE_FLOOR ** (1.0 / e), base, 0.0) ** e
 
 
 def _az_el(d: NDArray) -> tuple[NDArray, NDArray]:
@@ -366,8 +390,7 @@ def fit_object_model(
     r = resid[use]
     c = hc[use]
     best = (np.inf, 0.0, LOBE_EXPONENTS[0])
-    for e in LOBE_EXPONENTS:
-        x = _lobe(c, e)
+    for e, x in zip(LOBE_EXPONENTS, lobes(c, LOBE_EXPONENTS), strict=True):
         # element-wise sums, not BLAS dot products: on a busy machine a vector dot waits for
         # BLAS's threads (measured 5–30 ms against 0.1 ms for these 30 000 terms)
         xx = float((x * x).sum())
