@@ -58,7 +58,12 @@ from rti_rig.planner.surface_estimate import (
     sample_surface,
     tilt_stats,
 )
-from rti_rig.planner.tilt_guard import REPORT_MAX_DEG, object_plane, tilt_tolerance
+from rti_rig.planner.tilt_guard import (
+    REPORT_MAX_DEG,
+    facing_count,
+    object_plane,
+    tilt_tolerance,
+)
 from rti_rig.planner.topography import DepthModelSpec
 from rti_rig.planner.uniform import (
     arm_band_note,
@@ -429,6 +434,7 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
         report.notes.append(_expected_caveat(report.shading_explained_r2))
     up = object_plane(None if surface is None else surface.normals)
     report.tilt_tolerance_deg = tilt_tolerance(candidates.directions[chosen], up, REPORT_MAX_DEG)
+    report.level_facing_lights = facing_count(candidates.directions[chosen], up)
     report.even_tilt_tolerance_deg = tilt_tolerance(
         candidates.directions[starts[0][1]], up, REPORT_MAX_DEG
     )

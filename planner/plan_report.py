@@ -83,6 +83,10 @@ class PlanReport:
     #: plane solves nothing
     tilt_tolerance_deg: float | None = None
     even_tilt_tolerance_deg: float | None = None
+    #: how many of the written lights face the object's plane, level, past grazing: where they
+    #: determine no normal even level, it says whether too few face it or those that do lie on
+    #: one great circle (None: not counted, and the line names both)
+    level_facing_lights: int | None = None
     kmeans_distinct_normals: int | None = None
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
@@ -92,7 +96,7 @@ class PlanReport:
 
     def _tilt_line(self, tolerance: float, even: float | None) -> str:
         """What the written lights keep of a global tilt, and what the even layout would."""
-        said = _kept_by_lights(tolerance)
+        said = _kept_by_lights(tolerance, self.level_facing_lights)
         if even is not None and even > tolerance and self.method != "uniform":
             said += (
                 f"; the even layout of {self.n} lights (--method uniform) does so "
@@ -199,8 +203,23 @@ def _kept_phrase(tolerance: float) -> str:
     return f"up to {tolerance:g}° of tilt in any direction"
 
 
-def _kept_by_lights(tolerance: float) -> str:
-    """The written lights' tolerance as a sentence's start."""
+def _kept_by_lights(tolerance: float, facing: int | None = None) -> str:
+    """The written lights' tolerance as a sentence's start (``facing``: how many face the
+    level object's plane past grazing, to say why a tolerance of -1)."""
+    high = f"{GRAZING_COS_DEG:.0f}° or more above the object's plane"
+    if tolerance < 0.0 and facing is not None and facing < NEED_LIT:
+        few = "none of these lights stands" if facing == 0 else f"only {facing} of these lights"
+        few += "" if facing == 0 else (" stands" if facing == 1 else " stand")
+        return (
+            f"{few} {high} even with the object level, and a normal needs {NEED_LIT}: its "
+            "normals rest on grazing light"
+        )
+    if tolerance < 0.0 and facing is not None:
+        return (
+            f"the {facing} of these lights that stand {high} lie nearly on one great circle "
+            f"(their condition number above {SOLVABLE_COND:g}, more than the fit allows a "
+            "pixel's lights): they determine no normal even with the object level"
+        )
     if tolerance < 0.0:
         return (
             f"these lights do not determine a normal ({DETERMINE_RULE}) even with the object "

@@ -112,6 +112,13 @@ def _conditioned(eig: NDArray[np.float64], slack: float = 0.0) -> NDArray[np.boo
     return (eig[:, 0] > 0.0) & (eig[:, -1] + slack <= SOLVABLE_COND**2 * eig[:, 0])
 
 
+def facing_count(lights: NDArray[np.float64], up: NDArray[np.float64]) -> int:
+    """How many of ``lights`` face the plane of normal ``up`` past grazing: with
+    :func:`tilt_tolerance` -1, it tells too few facing lights from facing lights that lie on
+    one great circle."""
+    return int(((np.asarray(lights, dtype=np.float64) @ np.asarray(up)) > GRAZING_COS).sum())
+
+
 def _planes_solved(lights: NDArray[np.float64], planes: NDArray[np.float64]) -> NDArray[np.bool_]:
     facing = (planes @ np.asarray(lights, dtype=np.float64).T) > GRAZING_COS
     return solvable(facing @ outer_products(lights), facing.sum(axis=1))

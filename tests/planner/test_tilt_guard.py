@@ -200,8 +200,25 @@ def test_every_plan_says_the_tilt_its_lights_survive_and_the_even_layouts() -> N
     said = " ".join(_report("uniform", 0.0, 0.0).lines())
     assert "only while the object is level: a 5° tilt in some direction leaves too few" in said
     assert "up to 0°" not in said, said
+    # -1 said by its cause, where the report counted the lights facing the level plane
+    for facing, words in [
+        (0, "none of these lights stands 9° or more above the object's plane even with"),
+        (1, "only 1 of these lights stands 9° or more above the object's plane even with"),
+        (2, "only 2 of these lights stand 9° or more above the object's plane even with"),
+        (
+            6,
+            "the 6 of these lights that stand 9° or more above the object's plane lie nearly "
+            "on one great circle (their condition number above 100",
+        ),
+    ]:
+        r = _report("kmeans", -1.0, 45.0)
+        r.level_facing_lights = facing
+        said = " ".join(r.lines())
+        assert words in said, said
+        assert "does so up to 45°" in said, said
     said = " ".join(_report("kmeans", -1.0, 45.0).lines())
-    # not "fewer than 3 stand above the plane": lights on one great circle also give -1
+    # uncounted: both causes named, not "fewer than 3 stand above the plane", which lights on
+    # one great circle are not
     assert "these lights do not determine a normal (3 or more lights 9° or more above" in said
     assert "fewer than 3 stand that high, or those that do lie nearly on one great circle" in said
     assert "does so up to 45°" in said, said
@@ -269,25 +286,47 @@ def test_a_kmeans_plan_from_a_preview_says_the_tilt_its_lights_survive(tmp_path:
 COLLAPSED_6 = [(-127, 20), (116, 22), (-2, 24), (-177, 34), (-71, 35), (54, 39)]
 
 
-@pytest.mark.e2e
-def test_a_plan_of_lights_that_cannot_solve_a_50_degree_tilt_says_less(tmp_path: Path) -> None:
-    """Through the front door: a recorded acquisition of exactly those 6 lights is the rig,
-    `plan --method uniform --lights 6` writes all six, and its tilt line says 35° (counting
-    the facing lights, it had said they faced the plane at 60°, as far as checked)."""
+def _plan_all_of(tmp_path: Path, az_el: list[tuple[float, float]], *extra: str) -> str:
+    """`plan --method uniform` of every light of a recorded acquisition (an .lp of exactly
+    ``az_el`` with its images beside it) as the rig: the plan's words, whitespace joined."""
     acq = tmp_path / "acq"
     acq.mkdir()
-    lines = ["6"]
-    for i, (az, el) in enumerate(COLLAPSED_6, start=1):
+    lines = [str(len(az_el))]
+    for i, (az, el) in enumerate(az_el, start=1):
         x, y, z = direction_from_az_el(az, el)
         lines.append(f"img{i:02d}.jpg {x:.6f} {y:.6f} {z:.6f}")
         cv2.imwrite(str(acq / f"img{i:02d}.jpg"), np.full((32, 32, 3), 128, np.uint8))
     (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
     out = tmp_path / "plan.lp"
-    argv = ["plan", "--rig", str(acq / "dirs.lp"), "--method", "uniform", "--lights", "6"]
-    r = CliRunner().invoke(app, [*argv, "--out", str(out)], terminal_width=400)
+    argv = ["plan", "--rig", str(acq / "dirs.lp"), "--method", "uniform"]
+    argv += ["--lights", str(len(az_el)), "--out", str(out), *extra]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
     assert r.exit_code == 0, r.output
-    said = " ".join(r.output.split())
+    assert len(np.loadtxt(out, skiprows=1, usecols=(1, 2, 3))) == len(az_el)
+    return " ".join(r.output.split())
+
+
+@pytest.mark.e2e
+def test_a_plan_of_lights_that_cannot_solve_a_50_degree_tilt_says_less(tmp_path: Path) -> None:
+    """Through the front door: a recorded acquisition of exactly those 6 lights is the rig,
+    `plan --method uniform --lights 6` writes all six, and its tilt line says 35° (counting
+    the facing lights, it had said they faced the plane at 60°, as far as checked)."""
+    said = _plan_all_of(tmp_path, COLLAPSED_6)
     assert "determine a normal (3 or more lights 9° or more above the object's plane" in said
     assert "if the object is tilted up to 35° in any direction" in said
     assert "60°" not in said
-    assert len(np.loadtxt(out, skiprows=1, usecols=(1, 2, 3))) == 6
+
+
+@pytest.mark.e2e
+def test_a_plan_of_lights_on_one_great_circle_says_they_determine_no_normal(
+    tmp_path: Path,
+) -> None:
+    """Six lights high above the object, all in one vertical plane: every one faces the level
+    object, yet they determine no normal. The plan says so, and not that fewer than 3 stand
+    above the object's plane (which it had said of any layout with no tolerance). Such lights
+    are planned only when the user asks for relighting without normals."""
+    circle = [(0, 20), (0, 45), (0, 70), (180, 30), (180, 55), (180, 80)]
+    said = _plan_all_of(tmp_path, circle, "--allow-no-normals")
+    assert "the 6 of these lights that stand 9° or more above the object's plane lie" in said
+    assert "nearly on one great circle" in said and "even with the object level" in said, said
+    assert "fewer than 3 of these lights stand" not in said, said
