@@ -208,8 +208,9 @@ def _kept_by_lights(tolerance: float, facing: int | None = None) -> str:
     level object's plane past grazing, to say why a tolerance of -1)."""
     high = f"{GRAZING_COS_DEG:.0f}° or more above the object's plane"
     if tolerance < 0.0 and facing is not None and facing < NEED_LIT:
-        few = "none of these lights stands" if facing == 0 else f"only {facing} of these lights"
-        few += "" if facing == 0 else (" stands" if facing == 1 else " stand")
+        few = {0: "none of these lights stands", 1: "only 1 of these lights stands"}.get(
+            facing, f"only {facing} of these lights stand"
+        )
         return (
             f"{few} {high} even with the object level, and a normal needs {NEED_LIT}: its "
             "normals rest on grazing light"
