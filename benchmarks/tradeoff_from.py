@@ -441,13 +441,17 @@ def bench_from(
     progress: Callable[[str], None] = print,
     force: bool = False,
     rig: Path | None = None,
+    per_light: tuple[float, str] | None = None,
 ) -> str:
     """Run, write results.csv, the plots and summary.md into ``out_dir`` (nothing written when
     it is None: the summary is only returned); return the summary (its command line says
     ``--force`` when the folder's files were replaced with it). ``rig``: the user's dome
     config, whose timing gives the session time (:func:`rig_seconds_per_light`); else the
-    replayed dome's defaults."""
-    per_light = (PER_LIGHT_S, PER_LIGHT_SAID) if rig is None else rig_seconds_per_light(rig)
+    replayed dome's defaults. ``per_light``: that time, when the caller has already read it
+    from ``rig`` (the CLI reads the config before minutes of computing; read again here, a
+    config edited in between would time the trade by another config than the one checked)."""
+    if per_light is None:
+        per_light = (PER_LIGHT_S, PER_LIGHT_SAID) if rig is None else rig_seconds_per_light(rig)
     t0 = time.perf_counter()
     rows, held = run_tradeoff_from(lp, progress)
     for row in rows:

@@ -286,6 +286,7 @@ def _tradeoff(
     from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
     from benchmarks.tradeoff_from import bench_from, check_acquisition, rig_seconds_per_light
 
+    per_light: tuple[float, str] | None = None  # the rig's time per light, read once
     if rig is not None:  # its config read before minutes of computing, not after
         if from_lp is None:
             raise fail(
@@ -295,7 +296,7 @@ def _tradeoff(
                 )
             )
         try:
-            rig_seconds_per_light(rig)
+            per_light = rig_seconds_per_light(rig)
         except RtiRigError as exc:
             raise fail(exc) from None
 
@@ -325,7 +326,9 @@ def _tradeoff(
     if from_lp is not None:
         try:
             with sigterm_stops():
-                text = bench_from(from_lp, out_dir, _plain, force=force, rig=rig)
+                text = bench_from(
+                    from_lp, out_dir, _plain, force=force, rig=rig, per_light=per_light
+                )
         except (KeyboardInterrupt, Terminated) as exc:
             # said, with what is on disk (only "stopped (Ctrl-C)" had been, an --out folder
             # left empty without a word): the trade on an acquisition is written at its end

@@ -812,6 +812,48 @@ def test_rig_gives_the_trades_session_time_from_the_users_dome(
     assert words[words.index("--rig") + 1] == str(rig), command
 
 
+def test_rig_config_is_read_once_the_time_is_that_of_the_config_checked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The CLI reads --rig before minutes of computing; the trade's time axis is that reading.
+    A config edited after that check (or turned invalid) had been read again once the
+    acquisition was checked, and timed the trade by another config than the one checked."""
+    import re
+
+    import benchmarks.tradeoff_from as tradeoff_from
+
+    shipped = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    text = shipped.read_text(encoding="utf-8")
+    rig = tmp_path / "dome.toml"
+    rig.write_text(re.sub(r"(?m)^transfer_s = 0\.7 ", "transfer_s = 2.5 ", text, count=1))
+    from rti_rig.app.config import load_rig_config
+
+    cfg = load_rig_config(rig).config
+    t = cfg.timing
+    step = t.light_switch_s + t.settle_s + cfg.camera.exposure_s + t.readout_s + t.transfer_s
+
+    checked = tradeoff_from.check_acquisition
+
+    def check_and_edit(lp: Path, notes: list[str]) -> list[Path]:
+        found = checked(lp, notes)
+        rig.write_text("this is not a rig config\n", encoding="utf-8")  # after --rig's check
+        return found
+
+    monkeypatch.setattr(tradeoff_from, "check_acquisition", check_and_edit)
+    monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", lambda lp, progress: _stand_in_rows())
+    out = tmp_path / "o"
+    r = CliRunner().invoke(
+        app,
+        ["bench", "tradeoff", "--from", str(ACQ), "--rig", str(rig), "--out", str(out)],
+        terminal_width=400,
+    )
+    assert r.exit_code == 0, r.output
+    rows = list(csv.DictReader((out / "results.csv").open()))
+    assert rows
+    for row in rows:
+        assert float(row["dome_time_s"]) == pytest.approx(int(row["n"]) * step), row
+
+
 def test_rig_is_refused_for_an_arm_and_without_from_before_any_work(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
