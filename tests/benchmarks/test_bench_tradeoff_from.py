@@ -770,30 +770,37 @@ def _stand_in_rows() -> tuple[list[Any], list[str]]:
     return rows, ["a.jpg", "b.jpg", "c.jpg"]
 
 
+def _slow_transfer_dome(rig: Path) -> tuple[Path, float]:
+    """The shipped simulated dome's config with a 2.5 s transfer, written to ``rig``, and the
+    time one light takes on it (its [timing] and exposure summed as a dry run sums them)."""
+    import re
+
+    from rti_rig.app.config import load_rig_config
+
+    shipped = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    text = shipped.read_text(encoding="utf-8")
+    mine = re.sub(r"(?m)^transfer_s = 0\.7 ", "transfer_s = 2.5 ", text, count=1)
+    assert mine != text
+    rig.write_text(mine, encoding="utf-8")
+    cfg = load_rig_config(rig).config
+    t = cfg.timing
+    step = t.light_switch_s + t.settle_s + cfg.camera.exposure_s + t.readout_s + t.transfer_s
+    assert t.transfer_s == 2.5 and step > 2.5
+    return rig, step
+
+
 def test_rig_gives_the_trades_session_time_from_the_users_dome(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """`bench tradeoff --from ACQ --rig MY_DOME.toml`: the time axis is the user's dome's step
     (its [timing] and exposure), in results.csv, the summary and its command line; it had
     always been the replayed dome's defaults, 1.17 s a light, where a DSLR dome takes seconds."""
-    import re
     import shlex
 
     import benchmarks.tradeoff_from as tradeoff_from
 
     monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", lambda lp, progress: _stand_in_rows())
-    shipped = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
-    text = shipped.read_text(encoding="utf-8")
-    rig = tmp_path / "my dome.toml"
-    mine = re.sub(r"(?m)^transfer_s = 0\.7 ", "transfer_s = 2.5 ", text, count=1)
-    assert mine != text
-    rig.write_text(mine, encoding="utf-8")
-    from rti_rig.app.config import load_rig_config
-
-    cfg = load_rig_config(rig).config
-    t = cfg.timing
-    step = t.light_switch_s + t.settle_s + cfg.camera.exposure_s + t.readout_s + t.transfer_s
-    assert t.transfer_s == 2.5 and step > 2.5
+    rig, step = _slow_transfer_dome(tmp_path / "my dome.toml")
     out = tmp_path / "o"
     r = CliRunner().invoke(
         app,
@@ -818,19 +825,10 @@ def test_rig_config_is_read_once_the_time_is_that_of_the_config_checked(
     """The CLI reads --rig before minutes of computing; the trade's time axis is that reading.
     A config edited after that check (or turned invalid) had been read again once the
     acquisition was checked, and timed the trade by another config than the one checked."""
-    import re
 
     import benchmarks.tradeoff_from as tradeoff_from
 
-    shipped = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
-    text = shipped.read_text(encoding="utf-8")
-    rig = tmp_path / "dome.toml"
-    rig.write_text(re.sub(r"(?m)^transfer_s = 0\.7 ", "transfer_s = 2.5 ", text, count=1))
-    from rti_rig.app.config import load_rig_config
-
-    cfg = load_rig_config(rig).config
-    t = cfg.timing
-    step = t.light_switch_s + t.settle_s + cfg.camera.exposure_s + t.readout_s + t.transfer_s
+    rig, step = _slow_transfer_dome(tmp_path / "dome.toml")
 
     checked = tradeoff_from.check_acquisition
 
