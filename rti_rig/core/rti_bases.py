@@ -11,10 +11,10 @@ Lights are unit vectors (N, 3) in the frame of docs/conventions.md (x right, y u
   the hemisphere by ``cos(theta~) = 2 cos(theta) - 1`` and normalised over 2 pi steradians, in
   the index order of the ``.rti`` files (RTIViewer, relight). With ``c = cos(theta) = l_z``,
   ``phi = atan2(l_y, l_x)`` and ``s = sqrt(c - c^2)``, the order-3 terms 9 and 15 use
-  ``(c - c^2)^(3/2)`` — exponent **1.5**, the true HSH. (C/C++/Java ports of RTIViewer write
-  ``pow(x, 3/2)``, which integer division makes exponent 1; files fitted by those tools use that
-  basis and will not relight identically here.) The basis is orthonormal over the hemisphere,
-  which a test checks by quadrature.
+  ``(c - c^2)^(3/2)`` — exponent **1.5**, the true HSH, as the desktop RTIViewer evaluates
+  them. (Some tools write ``pow(x, 3/2)``, which integer division makes exponent 1; files fitted
+  by those use that basis and will not relight identically here: docs/reconstruction.md.) The
+  basis is orthonormal over the hemisphere, which a test checks by quadrature.
 """
 
 from __future__ import annotations
