@@ -789,6 +789,18 @@ def _slow_transfer_dome(rig: Path) -> tuple[Path, float]:
     return rig, step
 
 
+def _trade_with_rig(rig: Path, out: Path) -> list[dict[str, str]]:
+    """`rti-rig bench tradeoff --from ACQ --rig RIG --out OUT`, which must succeed; the rows of
+    its results.csv."""
+    r = CliRunner().invoke(
+        app,
+        ["bench", "tradeoff", "--from", str(ACQ), "--rig", str(rig), "--out", str(out)],
+        terminal_width=400,
+    )
+    assert r.exit_code == 0, r.output
+    return list(csv.DictReader((out / "results.csv").open()))
+
+
 def test_rig_gives_the_trades_session_time_from_the_users_dome(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -802,13 +814,7 @@ def test_rig_gives_the_trades_session_time_from_the_users_dome(
     monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", lambda lp, progress: _stand_in_rows())
     rig, step = _slow_transfer_dome(tmp_path / "my dome.toml")
     out = tmp_path / "o"
-    r = CliRunner().invoke(
-        app,
-        ["bench", "tradeoff", "--from", str(ACQ), "--rig", str(rig), "--out", str(out)],
-        terminal_width=400,
-    )
-    assert r.exit_code == 0, r.output
-    rows = list(csv.DictReader((out / "results.csv").open()))
+    rows = _trade_with_rig(rig, out)
     for row in rows:
         assert float(row["dome_time_s"]) == pytest.approx(int(row["n"]) * step), row
     summary = (out / "summary.md").read_text(encoding="utf-8")
@@ -825,7 +831,6 @@ def test_rig_config_is_read_once_the_time_is_that_of_the_config_checked(
     """The CLI reads --rig before minutes of computing; the trade's time axis is that reading.
     A config edited after that check (or turned invalid) had been read again once the
     acquisition was checked, and timed the trade by another config than the one checked."""
-
     import benchmarks.tradeoff_from as tradeoff_from
 
     rig, step = _slow_transfer_dome(tmp_path / "dome.toml")
@@ -840,13 +845,7 @@ def test_rig_config_is_read_once_the_time_is_that_of_the_config_checked(
     monkeypatch.setattr(tradeoff_from, "check_acquisition", check_and_edit)
     monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", lambda lp, progress: _stand_in_rows())
     out = tmp_path / "o"
-    r = CliRunner().invoke(
-        app,
-        ["bench", "tradeoff", "--from", str(ACQ), "--rig", str(rig), "--out", str(out)],
-        terminal_width=400,
-    )
-    assert r.exit_code == 0, r.output
-    rows = list(csv.DictReader((out / "results.csv").open()))
+    rows = _trade_with_rig(rig, out)
     assert rows
     for row in rows:
         assert float(row["dome_time_s"]) == pytest.approx(int(row["n"]) * step), row

@@ -13,6 +13,7 @@ import math
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from rti_rig.reconstruct import qa
 
@@ -21,7 +22,7 @@ NOISE_PX = 2.6 / qa.EDGE_NOISE_FACTOR
 
 
 def test_an_image_off_by_more_than_the_bar_is_claimed_without_a_lean() -> None:
-    assert qa._claim_bar_px(NOISE_PX, 0.0) == 2.6
+    assert qa._claim_bar_px(NOISE_PX, 0.0) == pytest.approx(2.6)
     assert qa._edges_agree((2.9, 0.0), np.array([2.9, 0.0]), NOISE_PX, 0.0)
 
 
@@ -29,7 +30,7 @@ def test_the_lean_of_a_refused_step_raises_the_bar_past_that_image() -> None:
     refused = [SimpleNamespace(shift=(-1.0, 0.9))]
     lean = qa._elevation_lean_px(refused)  # type: ignore[arg-type]
     assert lean == math.hypot(-1.0, 0.9)
-    assert qa._claim_bar_px(NOISE_PX, lean) == 2.6 + lean
+    assert qa._claim_bar_px(NOISE_PX, lean) == pytest.approx(2.6 + lean)
     assert not qa._edges_agree((2.9, 0.0), np.array([2.9, 0.0]), NOISE_PX, lean)
     # a real move beyond the raised bar is still claimed
     assert qa._edges_agree((4.5, 0.0), np.array([4.5, 0.0]), NOISE_PX, lean)
