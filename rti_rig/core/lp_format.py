@@ -836,17 +836,25 @@ def parse_lp(
 ) -> list[LpEntry]:
     """Parse `.lp` text; ``source`` names the file in errors and notes.
 
-    ``upper_hemisphere`` refuses lights below the object plane (z < 0), naming the line: for a
-    rig's own lights or a plan to run, where such a light cannot be meant (a reader of other
-    tools' files leaves it off and lets the fit decide). A light less than
-    :data:`HORIZON_TOLERANCE` below is clamped to the horizon instead. What was tolerated is
-    appended to ``notes`` (``"FILE, line N: what and what was done"``) for the caller to show.
+    ``upper_hemisphere`` refuses lights below the object plane (z < 0), naming the line: every
+    command that lights, plans or fits from a file asks for it (``plan``, ``run``, ``check``,
+    ``fit``, a rig's ``dome.lp_file``), since no such light can have lit the object; without it
+    (a session's own ``lights.lp`` read back, the benchmarks) a direction is read as written. A
+    light less than :data:`HORIZON_TOLERANCE` below is clamped to the horizon instead. What was
+    tolerated is appended to ``notes`` (``"FILE, line N: what and what was done"``) for the
+    caller to show.
+
+    Refused as well, though each line alone reads: a lone light vector far from unit length in
+    a file of unit vectors (:func:`_refuse_lone_off_unit`), and a line starting with '#' that
+    the count line counts as a light (:func:`_refuse_counted_comment`).
     """
     notes = notes if notes is not None else []
     lines = _without_dos_eof(text).splitlines()  # handles LF, CRLF and CR
     numbered = [(i + 1, ln.strip()) for i, ln in enumerate(lines)]
     content = [(n, ln) for n, ln in numbered if ln]
     comments = [n for n, ln in content if ln.startswith("#")]
+    # '#05.jpg 0 0 1' may be an image named '#05.jpg'; '# 05.jpg 0 0 1' is a light commented out
+    light_like = [(n, ln) for n, ln in content if ln.startswith("#") and _reads_as_light(ln)]
     if comments:
         # cceh/rti's image-filer.py wrote a '# run of <date>' line above the count, and a
         # hand-annotated file is no wrong file: skipped, and said (a '# LP file from RTIBuilder,
@@ -857,6 +865,13 @@ def parse_lp(
             f"{shown_path(source)}, line{'s' if len(comments) > 1 else ''} "
             f"{', '.join(map(str, comments[:5]))}{' ...' if len(comments) > 5 else ''}: "
             "comment line(s) starting with '#' skipped"
+            + (
+                f"; line {light_like[0][0]} ({light_like[0][1]!r}) reads as a light: if "
+                f"{light_like[0][1].split()[0]!r} is an image, rename it and its line (an .lp "
+                "cannot name an image starting with '#')"
+                if light_like
+                else ""
+            )
         )
     if not content:
         raise LpFormatError(source, None, "the file is empty; expected a count line and lights")
@@ -889,6 +904,7 @@ def parse_lp(
     entries: list[LpEntry] = []
     seen: dict[str, int] = {}
     off_unit: list[tuple[int, float]] = []
+    below: list[tuple[int, str, float]] = []
     for lineno, line in content:
         tokens = line.split()
         if len(tokens) == 3 and all(_is_number(t) for t in tokens):
@@ -944,13 +960,7 @@ def parse_lp(
             )
             x, y, z, norm = x / flat, y / flat, 0.0, 1.0
         if upper_hemisphere and z / norm < -1e-9:
-            raise LpFormatError(
-                source,
-                lineno,
-                f"direction ({x}, {y}, {z}) points below the object plane (z < 0): a light "
-                "there cannot light the object; check the sign convention "
-                "(docs/conventions.md: z up, towards the camera)",
-            )
+            below.append((lineno, name, z / norm))
         _check_name(name, source, lineno)
         if name in seen:
             raise LpFormatError(
@@ -963,6 +973,10 @@ def parse_lp(
 
     if not entries:
         raise LpFormatError(source, None, "no light lines after the count line")
+    if below:
+        _refuse_below_plane(below, len(entries), source)
+    _refuse_lone_off_unit(off_unit, content, len(entries), source, text)
+    _refuse_counted_comment(light_like, declared, len(entries), first_no, source)
     if off_unit:
         # rounding noise is no news; vectors of length 3 may be lamp positions read as
         # directions, which is worth a line (they are normalised either way)
@@ -983,6 +997,128 @@ def parse_lp(
             f"file lists {len(entries)}; the {len(entries)} listed lights are used"
         )
     return entries
+
+
+def _reads_as_light(line: str) -> bool:
+    """Whether a line is an image name and three numbers (a comment line: one whose name
+    starts with '#', the '#' touching it)."""
+    tokens = line.split()
+    return (
+        len(tokens) >= 4
+        and tokens[0].lower().endswith(_IMAGE_ENDINGS)
+        and all(_is_number(t) for t in tokens[-3:])
+    )
+
+
+def _refuse_below_plane(below: list[tuple[int, str, float]], lights: int, source: str) -> None:
+    """Refuse lights below the object plane, saying which way out fits the file.
+
+    Why two messages: most of a file's lights below the plane is a z axis pointing the other
+    way (another tool's convention), one of 72 is not, yet it had been told "check the sign
+    convention" too, with no word of how far below it was or what to do with that one line."""
+    lineno, name, z = below[0]
+    more = len(below) - 1
+    others = (
+        f" ({more} more line{'s' if more > 1 else ''} below the plane: "
+        f"{', '.join(str(n) for n, _, _ in below[1:6])}{' ...' if more > 5 else ''})"
+        if more
+        else ""
+    )
+    if 2 * len(below) > lights:
+        raise LpFormatError(
+            source,
+            lineno,
+            f"{len(below)} of the file's {lights} lights point below the object plane (z < 0), "
+            f"{name!r} first: the file's z axis points the other way? rti-rig's z points up, "
+            "towards the camera (docs/conventions.md); negate the z column",
+        )
+    elevation = math.degrees(math.asin(max(-1.0, z)))
+    raise LpFormatError(
+        source,
+        lineno,
+        f"the light of {name!r} is {-elevation:.1f}° below the object plane (z = {z:.4f}; "
+        f"up to {HORIZON_TOLERANCE} below is read as the horizon): no light there can have lit "
+        "the object. If it is a light at the horizon whose calibration is off, set its z to 0; "
+        f"otherwise remove the line and leave its image out{others}",
+    )
+
+
+#: A light vector this far from unit length, in a file of unit vectors, is a mistyped number.
+FAR_FROM_UNIT = 0.2
+
+
+def _refuse_lone_off_unit(
+    off_unit: list[tuple[int, float]],
+    content: list[tuple[int, str]],
+    lights: int,
+    source: str,
+    text: str,
+) -> None:
+    """Refuse a light vector far from unit length where nearly all others are unit vectors.
+
+    Why: a z of 0.0949 typed for 0.949 (length 0.33) had been normalised with a note and used
+    about 55° from where the light was, ``check`` saying PASS; so had a last line cut off at
+    ``0.`` (a zenith light made a horizon light). A file of lamp positions (every length
+    alike, or all spread about 1) is still read as directions with a note; the rule fires
+    only when at least three lines, and three quarters of them, are unit vectors."""
+    far = [(n, length) for n, length in off_unit if abs(length - 1.0) > FAR_FROM_UNIT]
+    unit = lights - len(off_unit)
+    if not far or unit < 3 or 4 * unit < 3 * lights:
+        return
+    lineno, length = far[0]
+    line = dict(content)[lineno]
+    z = float(line.split()[-1])
+    elevation = math.degrees(math.asin(max(-1.0, min(1.0, z / length))))
+    last = lineno == content[-1][0] and not text.endswith(("\n", "\r"))
+    more = len(far) - 1
+    raise LpFormatError(
+        source,
+        lineno,
+        f"light vector {' '.join(line.split()[-3:])} has length {length:.3g}, where {unit} of "
+        f"the file's {lights} lights are unit vectors (length 1 ± {UNIT_TOLERANCE}): a "
+        f"mistyped number? Read as a direction (normalised) it lights from {elevation:.0f}° "
+        "elevation"
+        + (
+            "; the file ends on this line without a line break: cut off while written or "
+            "copied? Copy it again from its source"
+            if last
+            else "; correct the numbers on that line"
+        )
+        + (
+            f" ({more} more such line{'s' if more > 1 else ''}: "
+            f"{', '.join(str(n) for n, _ in far[1:6])}{' ...' if more > 5 else ''})"
+            if more
+            else ""
+        ),
+    )
+
+
+def _refuse_counted_comment(
+    light_like: list[tuple[int, str]],
+    declared: int | None,
+    lights: int,
+    first_no: int,
+    source: str,
+) -> None:
+    """Refuse comment lines that read as lights when the count line counts them.
+
+    Why: an image named ``#05.jpg`` had its line skipped as a comment, the count mismatch
+    was only a note, and ``check`` passed with one light fewer. A commented-out light and an
+    image whose name starts with '#' look the same; the count line tells them apart."""
+    if declared is None or declared == lights or declared != lights + len(light_like):
+        return
+    lineno, line = light_like[0]
+    name = line.split()[0]
+    raise LpFormatError(
+        source,
+        lineno,
+        f"{line!r} starts with '#' and is read as a comment, but the count line (line "
+        f"{first_no}) says {declared} lights and the file lists {lights} without "
+        f"{'it' if len(light_like) == 1 else f'its {len(light_like)} such lines'}: is "
+        f"{name!r} an image? An .lp cannot name an image starting with '#': rename the image "
+        f"and its line (e.g. {name.lstrip('#') or 'image.jpg'!r}); if the line was commented "
+        f"out on purpose, write the count {lights}",
+    )
 
 
 #: What a reader wants where it is given no ``.lp``, unless its command says it in its own words.

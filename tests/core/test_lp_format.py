@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
@@ -518,3 +519,39 @@ def test_an_absolute_names_folders_never_lead_out_of_the_lp_folder(tmp_path: Pat
     assert image_path(lp_dir, "/mnt/c/captures/sub/a.jpg") == lp_dir / "sub" / "a.jpg"
     assert image_path(lp_dir, "C:\\x\\..\\..\\secret.jpg") == lp_dir / "secret.jpg"
     assert image_path(lp_dir, "C:\\x\\..\\sub\\a.jpg") == lp_dir / "sub" / "a.jpg"
+
+
+def _ring(n: int, scale: float = 1.0) -> list[str]:
+    """``n`` lights at 45° elevation round the object, each vector ``scale`` long."""
+    c = scale * math.sqrt(0.5)
+    return [
+        f"image_{i + 1}.jpg {c * math.cos(i):.6f} {c * math.sin(i):.6f} {c:.6f}" for i in range(n)
+    ]
+
+
+def test_a_lone_vector_far_from_unit_length_is_refused_only_among_unit_vectors() -> None:
+    """The rule fires where the other lines show the file is of unit vectors, and no sooner:
+    lamp positions (every length alike, or spread about 1) are still read with a note."""
+    lone = "image_x.jpg 0.2 0.1 0.09"  # length 0.24
+    with pytest.raises(
+        LpFormatError,
+        match=r"d\.lp, line 4: light vector 0\.2 0\.1 0\.09 has "
+        r"length 0\.241, where 3 of the file's 4 lights are unit vectors",
+    ):
+        parse_lp("\n".join([*_ring(3), lone]) + "\n", "d.lp")
+    # two unit lines say too little of the file: noted, read
+    notes: list[str] = []
+    assert len(parse_lp("\n".join([*_ring(2), lone]) + "\n", "d.lp", notes=notes)) == 3
+    assert "light vector length 0.241, not 1" in notes[0]
+    # a quarter of the lines off unit length: not a lone typo, noted and read
+    notes.clear()
+    mixed = [*_ring(3), _ring(1, 3.0)[0].replace("image_1", "image_z")]
+    assert len(parse_lp("\n".join([*mixed, lone.replace("x", "y")]) + "\n", notes=notes)) == 5
+    # within 0.2 of unit length (0.849): lamp positions of a dome of about 1 m, read
+    notes.clear()
+    assert len(parse_lp("\n".join([*_ring(6), "a.jpg 0.6 0 0.6"]) + "\n", notes=notes)) == 7
+    assert "light vector length 0.849, not 1" in notes[0]
+    # all alike far from 1 (a file scaled by 3): noted, read
+    notes.clear()
+    assert len(parse_lp("\n".join(_ring(5, 3.0)) + "\n", notes=notes)) == 5
+    assert "light vector length 3, not 1" in notes[0]
