@@ -113,7 +113,8 @@ def check_image_files(
     missing = [n for n in names if not paths[n].is_file()]
     if missing:
         more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
-        shown = ", ".join(missing[:5]) + more
+        # a name with an invisible character in it is shown escaped ('ima\u200bge05.jpg')
+        shown = ", ".join(n if n.isprintable() else repr(n) for n in missing[:5]) + more
         lp_dir = Path(lp_path).parent
         # an RTIBuilder project's others are in its jpeg-exports/: said, and copied, there
         exports = exports_folder(lp_dir, [paths[n] for n in names if n not in missing])

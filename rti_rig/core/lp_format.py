@@ -31,6 +31,7 @@ import contextlib
 import math
 import os
 import re
+import unicodedata
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath, PureWindowsPath
@@ -280,16 +281,25 @@ def image_paths(lp_path: Path, entries: Sequence[LpEntry]) -> list[Path]:
         if why is not None:
             raise LpFormatError(lp_path, None, why)
     paths = [image_path(lp_dir, e.name) for e in entries]
-    first: dict[Path, str] = {}
-    for e, p in zip(entries, paths, strict=True):
+    first: dict[Path, tuple[int, str]] = {}
+    for number, (e, p) in enumerate(zip(entries, paths, strict=True), start=1):
         if p in first:
+            earlier, name = first[p]
+            # './image02.jpg' beside 'image02.jpg' had been told its names "differ only in
+            # folders the .lp's machine had", with no word of which lights they were
+            why = (
+                "their names differ only in folders the .lp's machine had"
+                if is_absolute_name(name) or is_absolute_name(e.name)
+                else "the two names are one path written two ways"
+            )
             raise LpFormatError(
                 lp_path,
                 None,
-                f"{first[p]!r} and {e.name!r} are both read from {shown_path(p)}: two lights "
-                "cannot share an image (their names differ only in folders the .lp's machine had)",
+                f"lights {earlier} and {number} of the file, {name!r} and {e.name!r}, are both "
+                f"read from {shown_path(p)} ({why}): two lights cannot share an image; remove "
+                "the line that is not this image's light, or correct its name",
             )
-        first[p] = e.name
+        first[p] = (number, e.name)
     return paths
 
 
@@ -309,7 +319,39 @@ def case_hint(missing: Sequence[Path]) -> str:
     beside the very files; a file of another kind is never read as the one named (a RAW and
     its JPEG are not the same data), only named."""
     twins, kin = _name_twins(missing)
-    return _twins_said(twins, len(missing)) + _kin_said(kin, len(missing))
+    hidden = _invisible_names(missing)
+    return _twins_said(twins, len(missing)) + _kin_said(kin, len(missing)) + _invisible_said(hidden)
+
+
+def _invisible_names(missing: Sequence[Path]) -> list[str]:
+    """The missing images' names that hold a character no one sees (a zero-width space, a
+    byte-order mark, a soft hyphen pasted with the name), each said with the characters'
+    code points and names, and whether the name without them is there."""
+    said: list[str] = []
+    for path in missing:
+        name = path.name
+        if name.isprintable():
+            continue
+        hidden = sorted({c for c in name if not c.isprintable()})
+        chars = ", ".join(f"U+{ord(c):04X} {unicodedata.name(c, 'unnamed')}" for c in hidden)
+        visible = "".join(c for c in name if c.isprintable())
+        there = f", and {visible} is there" if (path.parent / visible).is_file() else ""
+        said.append(f"{name!r} holds {chars}{there}")
+    return said
+
+
+def _invisible_said(hidden: list[str]) -> str:
+    """:func:`case_hint`'s clause for names holding invisible characters.
+
+    Why: a zero-width space pasted into a name had been told "image05.jpg missing" beside
+    the image05.jpg the user sees, the name printed with its invisible character in it."""
+    if not hidden:
+        return ""
+    more = f" and {len(hidden) - 3} more" if len(hidden) > 3 else ""
+    return (
+        f"; {'; '.join(hidden[:3])}{more}: an invisible character in the .lp's name (pasted "
+        "text?); delete it from the .lp"
+    )
 
 
 def _name_twins(missing: Sequence[Path]) -> tuple[list[str], list[str]]:
@@ -460,8 +502,9 @@ def missing_images_advice(
         tail = others if len(names) < total else ""
         quoted += f"; for the other {rest} not found, {copy}{tail}"
     twins, kin = _name_twins(paths)  # listed once (case_hint's own, which had listed again)
-    named = _twins_said(twins, len(paths)) + _kin_said(kin, len(paths))
-    if named and (rest := len(names) - len(twins) - len(kin)):
+    hidden = _invisible_names(paths)
+    named = _twins_said(twins, len(paths)) + _kin_said(kin, len(paths)) + _invisible_said(hidden)
+    if named and (rest := len(names) - len(twins) - len(kin) - len(hidden)):
         # the images with no such file are missing all the same: their way out is said too
         tail = others if len(names) < total else ""
         named += f"; for the other {rest} not found, {copy}{tail}"
@@ -828,6 +871,46 @@ def _count_line_words(
     )
 
 
+def _whole_count(token: str, first: str, source: str, lineno: int, notes: list[str]) -> int:
+    """The count of a count line; a whole number written with a decimal point (``72.0``, as a
+    spreadsheet or a script's float writes it) read as that number and said in ``notes``
+    (relight's ``QString::toInt`` reads only digits there). Raises ValueError for anything
+    else (``72.5``, a word).
+
+    Why: ``72.0`` had been refused as "not a whole number" with nothing to do."""
+    try:
+        return int(token)
+    except ValueError:
+        value = float(token)  # ValueError for a word: the caller's refusal
+        if not value.is_integer():
+            raise
+        notes.append(
+            f"{shown_path(source)}, line {lineno}: count line {first!r} read as the count "
+            f"{int(value)}; relight reads only a whole number there (write '{int(value)}')"
+        )
+        return int(value)
+
+
+def _refuse_name_last(tokens: list[str], line: str, source: str, lineno: int) -> None:
+    """Refuse a line in the order ``x y z name`` (three numbers, then an image name).
+
+    Why: such a file (a script's columns in another order) had been refused as "z component
+    'image01.jpg' is not a number", as if one number were wrong, with no word of the order."""
+    if (
+        len(tokens) == 4
+        and all(_is_number(t) for t in tokens[:3])
+        and tokens[3].lower().endswith(_IMAGE_ENDINGS)
+    ):
+        raise LpFormatError(
+            source,
+            lineno,
+            f"the line {line!r} gives the light before the image name ('x y z name'): an .lp's "
+            "lines are 'name x y z', the order relight and RTIBuilder read; move each name to "
+            "the front of its line (e.g. awk 'NR == 1 && NF == 1 {print; next} {print $4, $1, "
+            "$2, $3}' in.lp > out.lp)",
+        )
+
+
 def parse_lp(
     text: str,
     source: str = "<lp>",
@@ -884,7 +967,7 @@ def parse_lp(
         first_tokens = _count_line_words(first, first_tokens, source, first_no, notes)
     if len(first_tokens) == 1:
         try:
-            declared = int(first_tokens[0])
+            declared = _whole_count(first_tokens[0], first, source, first_no, notes)
         except ValueError:
             raise LpFormatError(
                 source,
@@ -936,6 +1019,7 @@ def parse_lp(
         # Older relight (its QRegExp-split parseLP) refused any line of other than 4 fields,
         # so a name with spaces reads in only some relight versions.
         name = " ".join(tokens[:-3])
+        _refuse_name_last(tokens, line, source, lineno)
         _refuse_extra_columns(tokens, line, source, lineno)
         x, y, z = (
             _parse_float(t, source, lineno, axis, line)

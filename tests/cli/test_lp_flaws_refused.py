@@ -16,6 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
 
 ACQ = Path(__file__).resolve().parents[2] / "tests" / "data" / "neuralrti_replay"
 runner = CliRunner()
@@ -142,3 +143,64 @@ def test_a_light_commented_out_with_the_count_corrected_is_skipped(
     assert f"{lp}, line 4: comment line(s) starting with '#' skipped" in text
     # only a name touching its '#' may be an image's
     assert ("reads as a light" in text) == (hashed == "#image09.jpg")
+
+
+def test_one_image_named_twice_says_which_lights_and_why(tmp_path: Path) -> None:
+    """'./image05.jpg' and 'image05.jpg': one path written two ways, the two lights named."""
+
+    def twice(lines: list[str]) -> list[str]:
+        return _set_field(lines, 5, 0, "./" + lines[2].split()[0])
+
+    lp = _acquisition(tmp_path, twice)
+    r = runner.invoke(app, ["run", str(lp), "--out", str(tmp_path / "s"), "--lights", "6"])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, r.output
+    assert "lights 2 and 5 of the file, 'image05.jpg' and './image05.jpg'" in text
+    assert "one path written two ways" in text and "folders the .lp's machine had" not in text
+    assert not (tmp_path / "s").exists()
+
+
+def test_a_count_written_as_a_decimal_is_read_and_said(tmp_path: Path) -> None:
+    lp = _acquisition(tmp_path, lambda lines: ["18.0", *lines[1:]])
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--lights", "6"])
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert f"{lp}, line 1: count line '18.0' read as the count 18" in text
+    assert len(read_lp(out / "lights.lp")) == 6
+    # a count that is no whole number is still refused
+    (lp).write_text(lp.read_text().replace("18.0", "18.5", 1))
+    r = runner.invoke(app, ["run", str(lp), "--out", str(tmp_path / "s2"), "--lights", "6"])
+    assert r.exit_code == 2 and "count line '18.5' is not a whole number" in r.output
+
+
+def test_lines_with_the_name_last_are_told_the_order(tmp_path: Path) -> None:
+    def name_last(lines: list[str]) -> list[str]:
+        return [lines[0], *(" ".join([*ln.split()[1:], ln.split()[0]]) for ln in lines[1:])]
+
+    lp = _acquisition(tmp_path, name_last)
+    _refused_everywhere(
+        lp,
+        tmp_path,
+        f"{lp}, line 2:",
+        "gives the light before the image name ('x y z name')",
+        "move each name to the front of its line",
+    )
+
+
+def test_an_invisible_character_in_a_name_is_shown_and_named(tmp_path: Path) -> None:
+    def zero_width(lines: list[str]) -> list[str]:
+        return [*lines[:2], lines[2].replace("image", "ima\u200bge", 1), *lines[3:]]
+
+    lp = _acquisition(tmp_path, zero_width)
+    for args in (
+        ["run", str(lp), "--out", str(tmp_path / "s"), "--lights", "6"],
+        ["fit", str(lp), "--out", str(tmp_path / "f")],
+    ):
+        r = runner.invoke(app, args)
+        assert r.exit_code == 2, r.output
+        text = " ".join(r.output.split())
+        assert "('ima\\u200bge05.jpg')" in text, text
+        assert "holds U+200B ZERO WIDTH SPACE, and image05.jpg is there" in text
+        assert "delete it from the .lp" in text
+        assert "copy them where their names point" not in text
