@@ -12,7 +12,9 @@ docs/research/planner.md the estimate is 17–59° off). So when the user does n
   record captured it (a session cut off lists in its manifest only the steps of its last
   finished run), else its manifest's;
 * an image that the bare ``.lp`` given as ``--rig`` lists (a dome's acquisition ``.lp``): its
-  line there, the user having named that file.
+  line there, the user having named that file; else its one line naming it but for upper/lower
+  case (``image08.jpg`` listed, ``image08.JPG`` given: one file on Windows and macOS), said
+  with both names; two such lines are refused, naming both.
 
 Any other ``.lp`` lying beside the image is *not* read: it may be a plan (whose names look like
 a session's) or belong to another acquisition. Two records that disagree are an error.
@@ -66,6 +68,10 @@ class PreviewSource:
     image: Path
     light_az_el_deg: tuple[float, float] | None = None
     light_source: str | None = None
+    #: Which record gave the light, without what :attr:`light_source` adds of how it was read
+    #: (a name matched but for upper/lower case: why, and what to do): what a note beside
+    #: another light names it by.
+    recorded_by: str | None = None
     #: Why no record of the light was found (None where it was, or where it was given):
     #: what the plan says beside the light it then estimates.
     unrecorded: str | None = None
@@ -212,8 +218,9 @@ def _lit_from_above(direction: Any, record: str, image: Path) -> tuple[float, fl
     return az, el
 
 
-def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any]]:
-    """``(where, short name, direction)`` of every record of ``image``'s light (module notes)."""
+def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any, str | None]]:
+    """``(where, short name, direction, how it was read)`` of every record of ``image``'s light
+    (module notes); how it was read is None unless said (:func:`_lp_record`)."""
     target = image.resolve()
     found = []
     root = _session_root(image)
@@ -222,15 +229,100 @@ def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any]]:
         for step in steps:
             if any((root / n).resolve() == target for n in _files_of(step)):
                 light = _step_light(root, step, journaled, image)
-                found.append((f"the session {root}", f"the session {root.name}", light))
+                found.append((f"the session {root}", f"the session {root.name}", light, None))
                 break
     if rig_lp is not None:
-        lp, entries = rig_lp
-        for e in entries:
-            if image_path(lp.parent, e.name).resolve() == target:
-                found.append((str(lp), lp.name, e.direction))
-                break
+        found.extend(_lp_record(image, rig_lp))
     return found
+
+
+@dataclass(frozen=True)
+class _LpNames:
+    """Which lines of the ``--rig`` ``.lp`` name a preview (indexes into its entries): by its
+    very path; by a name differing from it only in upper/lower case that is it (no file of
+    that name here, or this file on a system that ignores case); by such a name whose file
+    here is another (this system tells the two names apart, and both files exist)."""
+
+    exact: list[int]
+    twins: list[int]
+    other_files: list[int]
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` are one file on this system (False where either is not there)."""
+    try:
+        return a.samefile(b)
+    except OSError:
+        return False
+
+
+def _lp_names(image: Path, rig_lp: RigLp) -> _LpNames:
+    """The lines of ``rig_lp`` that name ``image`` (:class:`_LpNames`).
+
+    Why the case twins: Windows and macOS ignore the case of file names, so an acquisition
+    listed there as ``image08.jpg`` may be on disk as ``image08.JPG`` (a camera's own name, a
+    card mounted with ``shortname=lower``); a preview of that name matched no line, and its
+    light was estimated from its shading, more than 100° from the one recorded. Compared as
+    :func:`rti_rig.core.lp_format.case_hint` compares names for ``run``, ``fit`` and ``bench``
+    (``str.casefold``), so the commands agree on what a case twin is. A listed name whose own
+    file here is another file (both spellings on disk, told apart by this system) names that
+    file, not the preview."""
+    lp, entries = rig_lp
+    target = image.resolve()
+    exact: list[int] = []
+    twins: list[int] = []
+    other_files: list[int] = []
+    for i, e in enumerate(entries):
+        listed = image_path(lp.parent, e.name).resolve()
+        if listed == target:
+            exact.append(i)
+        elif str(listed).casefold() == str(target).casefold():
+            if not listed.exists() or _same_file(listed, target):
+                twins.append(i)
+            else:
+                other_files.append(i)
+    return _LpNames(exact, twins, other_files)
+
+
+def _lights_said(entries: Sequence[LpEntry], indexes: Sequence[int]) -> str:
+    """``lights 3 (image09.jpg) and 7 (IMAGE09.jpg)``: as a bare ``.lp`` rig's repeated lights
+    are named (their number in the file, their image name)."""
+    said = [f"{i + 1} ({entries[i].name})" for i in indexes]
+    return f"lights {', '.join(said[:-1])} and {said[-1]}"
+
+
+def _lp_record(image: Path, rig_lp: RigLp) -> list[tuple[str, str, Any, str | None]]:
+    """The ``--rig`` ``.lp``'s record of ``image``'s light, as :func:`_records` lists one: its
+    line naming the image, else its one line naming it but for upper/lower case (said, with
+    both spellings, in the words the plan prints beside the light); two or more such lines
+    and none exact are refused, naming them: which of them lit the preview is not ours to
+    guess."""
+    lp, entries = rig_lp
+    names = _lp_names(image, rig_lp)
+    if names.exact:
+        return [(str(lp), lp.name, entries[names.exact[0]].direction, None)]
+    if not names.twins:
+        return []
+    if len(names.twins) > 1:
+        raise ScheduleError(
+            f"{shown_path(lp)}: {_lights_said(entries, names.twins)} each name the preview "
+            f"{image.name} but for upper/lower case (one file on Windows and macOS, which ignore "
+            "the case of file names), so which light lit it is not known: correct the names in "
+            "the .lp, or give the light with --preview-light AZ,EL"
+        )
+    (i,) = names.twins
+    listed = entries[i].name
+    if image_path(lp.parent, listed).exists():  # this system ignores case: one file
+        why = "one file here, this system ignoring the case of file names as Windows and macOS do"
+    else:
+        why = (
+            "read as one file, as Windows and macOS read it; this system tells the two "
+            "apart, so rename the file or correct the name in the .lp"
+        )
+    said = (
+        f"{lp.name} for {listed}, light {i + 1}, the preview {image.name} but for upper/lower case"
+    )
+    return [(f"{lp} (as {listed})", said, entries[i].direction, why)]
 
 
 def _refuse_a_rig_as_preview(path: Path) -> None:
@@ -262,10 +354,28 @@ def _unrecorded(image: Path, rig_lp: RigLp | None) -> str:
     if root is not None:
         where.append(f"the session {root.name} records no step with {image.name}")
     if rig_lp is not None:
-        where.append(f"{rig_lp[0].name} (--rig) does not list it")
+        where.append(f"{rig_lp[0].name} (--rig) does not list it{_other_file_said(image, rig_lp)}")
     if not where:
         return "no rti-rig session or --rig .lp records its light"
     return " and ".join(where)
+
+
+def _other_file_said(image: Path, rig_lp: RigLp) -> str:
+    """What to add to "does not list it" when the ``.lp`` lists the preview's name but for
+    upper/lower case and that name's file here is another (:func:`_lp_names`): "" otherwise.
+
+    Why: a user who sees the name in the .lp had been told only that it "does not list it"."""
+    entries = rig_lp[1]
+    if not image.is_file():
+        return ""
+    others = _lp_names(image, rig_lp).other_files
+    if not others:
+        return ""
+    i = others[0]
+    return (
+        f" (its light {i + 1}, {entries[i].name}, differs only in upper/lower case from "
+        f"{image.name} and is another file on this system, which tells the two names apart)"
+    )
 
 
 def resolve_preview(
@@ -301,15 +411,17 @@ def resolve_preview(
     found = _records(path, rig_lp) if path.is_file() and not light_given else []
     if not found:
         return PreviewSource(path, unrecorded=None if light_given else _unrecorded(path, rig_lp))
-    (first_where, short, first), *others = found
-    for where, _, d in others:
+    (first_where, short, first, how), *others = found
+    for where, _, d, _ in others:
         off = float(angle_between_deg(np.asarray(first), np.asarray(d)))
         if off > AGREE_DEG:
             raise ScheduleError(
                 f"{first_where} and {where} give the light of {path} {off:.1f}° apart: give "
                 "it with --preview-light AZ,EL"
             )
-    return PreviewSource(path, _lit_from_above(first, first_where, path), f"recorded by {short}")
+    light = _lit_from_above(first, first_where, path)
+    said = f"recorded by {short}" + (f": {how}" if how else "")
+    return PreviewSource(path, light, said, recorded_by=f"recorded by {short}")
 
 
 def given_light_differs(
@@ -339,6 +451,7 @@ def given_light_differs(
     az, el = source.light_az_el_deg
     return (
         f"--preview-light {given_az_el[0]:g},{given_az_el[1]:g} is {off:.1f}° from the light "
-        f"{source.light_source} (az {az:.1f}°, el {el:.1f}°): the plan used the light given; "
+        f"{source.recorded_by or source.light_source} (az {az:.1f}°, el {el:.1f}°): the plan "
+        "used the light given; "
         "leave --preview-light out to plan with the recorded one"
     )
