@@ -1417,6 +1417,10 @@ class ResumeState:
     #: capture, set aside to be shot again, said as the verdict says them
     #: (:func:`lost_since_capture_said`'s words: ``image_005: raw/image_005.dng changed``)
     lost_since_capture: list[str] = field(default_factory=list)
+    #: where a ``lights.lp`` that was not rti-rig's own listing of the journal's lights (edited
+    #: by hand) was kept before the resume wrote it again (``recovered/STAMP/lights.lp``, also
+    #: in ``recovered``), said by :func:`edited_lp_note`; None when there was none
+    edited_lp: str | None = None
 
 
 @dataclass
@@ -2142,6 +2146,21 @@ def _prepare_resume(
             raise SessionWriteError(root / LINEAR_DIR, exc) from None
         if repair and (root / "recovered" / stamp / "journal-rejected.txt").is_file():
             recovered.append(f"recovered/{stamp}/journal-rejected.txt")
+        # a lights.lp edited by hand is kept before it is written again from the journal; the
+        # last step recorded (a journal line or record file, lights.lp then still to write) and
+        # a journal rebuilt (its last commit unknown) may be left out of the run's own listing
+        last = scan.records[max(0, len(scan.records) - len(scan.mended) - 1) :]
+        edited_lp = _keep_edited_lp(
+            root,
+            stamp,
+            [*scan.records, *(rebuilt or {}).values(), *restored.values()],
+            done,
+            None
+            if rebuilt is not None or scan.missing
+            else {int(rec["index"]) for rec in last} | set(restored),
+        )
+        if edited_lp is not None:
+            recovered.append(edited_lp)
         moved_lp = _relist_verified(root, done, stamp)
         if moved_lp is not None:
             recovered.append(moved_lp)
@@ -2152,6 +2171,7 @@ def _prepare_resume(
         journal_repair=repair,
         journal_rebuild=rebuild,
         lost_since_capture=lost_now,
+        edited_lp=edited_lp,
     )
 
 
@@ -2389,7 +2409,11 @@ def rebuild_finished_journal(root: Path) -> list[str]:
                     root, manifest, taken, names, stamp, scan.records, lost
                 )
                 # lights.lp lists what is on disk as captured: a lost image is not listed
-                # (relight pairs its lines with the JPEGs in order)
+                # (relight pairs its lines with the JPEGs in order); one edited by hand is kept
+                records = [*scan.records, *taken.values(), *lost.values()]
+                edited_lp = _keep_edited_lp(root, stamp, records, (), None)
+                if edited_lp is not None:
+                    notes.append(edited_lp_note(root, edited_lp, run=False))
                 _relist_verified(
                     root, verified_steps(root, [*taken.values(), *lost.values()], "image"), stamp
                 )
@@ -2881,6 +2905,94 @@ def _relist_verified(root: Path, done: dict[int, StepRecord], stamp: str) -> str
     if not path.is_file():
         return None
     return _set_aside(root, path, stamp)
+
+
+def _keep_edited_lp(
+    root: Path,
+    stamp: str,
+    records: list[dict[str, Any]],
+    done: Collection[int],
+    may_lack: Collection[int] | None,
+) -> str | None:
+    """Move session ``root``'s ``lights.lp`` to ``recovered/STAMP/`` (a name never taken
+    before) if it is not a listing rti-rig wrote of the journal's lights, before the resume
+    writes it again; returns where it went (relative to ``root``), or None when it is the run's
+    own (or missing, or empty: nothing of the user's to keep).
+
+    Why: the resume writes ``lights.lp`` again from the journal, the record of the lights that
+    fired, and a ``lights.lp`` edited by hand in the stopped session (a name or a light
+    corrected, a comment added, a line deleted) was overwritten, unsaid, with no copy.
+
+    The run's own listing is what :func:`write_lp_atomic` writes for some of the lights
+    ``records`` hold (any record of a step: an image shot again has two), byte for byte, in
+    step order, listing every step of ``done`` (the steps this resume verified) but those of
+    ``may_lack``: the run writes ``lights.lp`` after a step's journal line (and its record file
+    before that), so a run stopped in between left the last step recorded out of it, which is
+    no edit. It may list steps ``done`` leaves out (images lost or set aside since it was
+    written). ``may_lack`` None: any step may be left out (a journal rebuilt from the manifest
+    or record files, whose last commit before the loss is not known)."""
+    path = root / LP_NAME
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        return None
+    except OSError:
+        data = None  # unreadable as it is: kept all the same, never overwritten unread
+    if data is not None and (not data.strip() or _run_wrote_lp(data, records, done, may_lack)):
+        return None
+    dest = free_name(root / "recovered" / stamp / LP_NAME)
+    try:
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        os.replace(path, dest)
+    except OSError as exc:
+        raise SessionWriteError(dest, exc) from None
+    return dest.relative_to(root).as_posix()
+
+
+def _run_wrote_lp(
+    data: bytes,
+    records: list[dict[str, Any]],
+    done: Collection[int],
+    may_lack: Collection[int] | None,
+) -> bool:
+    """Whether ``data`` is a ``lights.lp`` rti-rig wrote of ``records``' lights (see
+    :func:`_keep_edited_lp`)."""
+    lines: dict[str, set[str]] = {}  # image → the lines format_lp writes for its lights
+    index: dict[str, int] = {}
+    for entry in records:
+        try:
+            rec = _to_record(entry)
+            text = format_lp([LpEntry(rec.image, rec.actual_direction)])
+        except (KeyError, TypeError, ValueError):
+            continue
+        lines.setdefault(rec.image, set()).add(text.split("\n")[1])
+        index[rec.image] = rec.index
+    try:
+        head, *body = data.decode("ascii").split("\n")
+    except UnicodeDecodeError:
+        return False
+    if not body or body.pop() != "" or head != str(len(body)):
+        return False  # format_lp: the count, one line a light, each ending in a newline
+    listed = [line.split(" ", 1)[0] for line in body]
+    if any(line not in lines.get(name, ()) for name, line in zip(listed, body, strict=True)):
+        return False
+    steps = [index[name] for name in listed]
+    if steps != sorted(set(steps)):
+        return False  # reordered, or a light given twice
+    return may_lack is None or set(done) - set(steps) <= set(may_lack)
+
+
+def edited_lp_note(root: Path, kept: str, run: bool = True) -> str:
+    """What a resume says of a ``lights.lp`` it set aside (:func:`_keep_edited_lp`) as kept
+    at ``kept`` (relative to session ``root``): both paths, why, and what to do to keep the
+    edit (once the run has ended, if ``run``: it writes ``lights.lp`` at every image)."""
+    lp = shown_path(root / LP_NAME)
+    return (
+        f"{lp} differs from what rti-rig wrote from {JOURNAL} (edited by hand?): kept as "
+        f"{shown_path(root / kept)}; {LP_NAME} is written again from the journal, which is the "
+        f"record of the lights that fired; to keep your edit, make it again in {lp}"
+        + (" once this run has ended" if run else "")
+    )
 
 
 def _set_aside(root: Path, path: Path, stamp: str) -> str:

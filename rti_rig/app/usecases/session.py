@@ -19,7 +19,7 @@ from rti_rig.app.usecases.replay_advice import new_session_command
 from rti_rig.app.usecases.run_options import run_words
 from rti_rig.core.errors import ConfigError, RtiRigError, ScheduleError
 from rti_rig.core.out_folders import free_folder_beside, free_name
-from rti_rig.core.rig_geometry import led_fields
+from rti_rig.core.rig_geometry import DomeGeometry, led_fields
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.controller import (
@@ -1535,7 +1535,8 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     if diffs:
         # recorded in the manifest when the session goes on: a resume refused after this (a
         # remaining step the changed rig cannot run, an adaptive step it would decide
-        # otherwise) records nothing, and the note had said "recorded" all the same
+        # otherwise) records nothing. A resume says it only once those are checked
+        # (open_resumed_session): it had said "rig change accepted" and then refused
         on_note(
             Note(
                 "rig change accepted (recorded in the manifest once the session goes on): "
@@ -1835,7 +1836,10 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         from rti_rig.app.usecases.resume_request import check_same_start
 
         check_same_start(req.start, manifest, loaded, Path(req.session_dir))
-    for note in rig_notes:
+    # a change accepted is said once the steps still to shoot are found to run on the rig as
+    # changed (_opened_resume): "rig change accepted" had been followed by a refusal of them
+    accepted = rig_notes if diffs else []
+    for note in [] if diffs else rig_notes:
         on_note(note)
     check_done = None
     if "adaptive" in manifest:
@@ -1847,7 +1851,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         req.session_dir, check_done, req.reshoot_lost, req.rebuild_journal
     )
     try:
-        return _opened_resume(req, loaded, folder, identity, diffs, on_note)
+        return _opened_resume(req, loaded, folder, identity, diffs, on_note, accepted)
     except BaseException:
         # the folder's lock (taken by the reopen) goes with the run that did not start: a
         # process that stays (a test, a program calling this) had kept every other one out
@@ -1871,7 +1875,9 @@ def _refuse_image_sequence_resume(loaded: Any, root: Path) -> None:
     )
 
 
-def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: ignore[no-untyped-def]
+def _opened_resume(  # type: ignore[no-untyped-def]
+    req, loaded, folder, identity, diffs, on_note, accepted=()
+):
     folder.rig_identity = identity
     folder.rig_change = diffs or None
     folder.input_notes = list(loaded.notes)  # recorded in this run's entry of the manifest
@@ -1905,6 +1911,10 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         on_note(Note(f"{note.text}{aside}", "warning"))
     for line in resume.journal_rebuild if resume else []:
         on_note(Note(line, "warning"))
+    if resume is not None and resume.edited_lp is not None:
+        from rti_rig.runtime.session import edited_lp_note
+
+        on_note(Note(edited_lp_note(folder.root, resume.edited_lp), "warning"))
     lost = resume.lost_since_capture if resume else []
     if lost:
         # in the verdict's words, with what this resume does about them: it had said only "N
@@ -1928,6 +1938,10 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     # refused a light the resume would not take)
     adaptive = "adaptive" in folder.manifest
     shot = frozenset(folder.done)
+    leds_now = _leds_numbered_alike(loaded, folder, identity) if diffs else None
+    if leds_now is not None and not adaptive:
+        # a fixed plan's LEDs still to shoot, from where they are now (re-measured)
+        schedule = _start_as_placed(schedule, _lit_from(leds_now, schedule), shot, folder)
     try:
         rig = checked_rig(loaded, schedule, frozenset(range(len(schedule))) if adaptive else shot)
     except ScheduleError as exc:
@@ -1948,11 +1962,46 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         except BaseException:
             rig.close_said()  # its failures said, never in place of the error raised
             raise
+    for note in accepted:  # the steps still to shoot run on the rig as changed
+        on_note(note)
     if diffs and shot:
-        _say_shot_beyond(rig, schedule, folder, shot, on_note)
+        _say_shot_beyond(rig, schedule, folder, shot, on_note, leds_now)
     return OpenedSession(
         rig, schedule, folder, Path(req.session_dir), resumed=True, source=source, request=req
     )
+
+
+def _leds_numbered_alike(  # type: ignore[no-untyped-def]
+    loaded, folder, identity: dict[str, Any]
+) -> DomeGeometry | None:
+    """The LEDs of a dome resumed on a change accepted, when they are numbered as the session
+    began (as many of them: ``lights`` of its recorded identity), so that an LED's index is
+    the same light, moved perhaps (re-measured); None for an arm, or for a dome with another
+    number of LEDs.
+
+    Why the number: an LED taken out of a ring numbers every later one otherwise, and a step
+    moved to whatever light now has its index would fire another LED than the one planned or
+    shot. Such a dome's steps are checked as recorded instead: an LED gone is refused by its
+    number, one now elsewhere as "planned direction is … from LED N's calibrated direction"."""
+    from rti_rig.app.config import rig_geometry
+
+    geometry = rig_geometry(loaded)
+    recorded = (folder.manifest.get("rig") or {}).get("identity") or {}
+    if not isinstance(geometry, DomeGeometry) or recorded.get("lights") != identity.get("lights"):
+        return None
+    return geometry
+
+
+def _lit_from(leds: DomeGeometry, schedule: LightSchedule) -> LightSchedule:
+    """``schedule`` with each step lighting its LED from where ``leds`` has it now (a step
+    whose LED is not one of them kept, for the check to refuse by its number)."""
+    steps = tuple(
+        replace(step, direction=tuple(float(x) for x in leds.directions[step.led]))
+        if step.led is not None and step.led < leds.count
+        else step
+        for step in schedule.steps
+    )
+    return LightSchedule(steps, method=schedule.method, provenance=schedule.provenance)
 
 
 def _start_as_placed(  # type: ignore[no-untyped-def]
@@ -1961,7 +2010,9 @@ def _start_as_placed(  # type: ignore[no-untyped-def]
     """An adaptive session's starting layout as this resume shoots it: its steps shot as
     recorded, the rest as the rig as it is now places them (``placed``). Where that differs
     from the layout recorded (an accepted rig change), the manifest's ``schedule`` is made this
-    one and the one recorded is kept in the run (``schedule_before_rig_change``).
+    one and the one recorded is kept in the run (``schedule_before_rig_change``). A fixed
+    dome plan resumed on re-measured LEDs is placed so too, each step on its own LED
+    (:func:`_lit_from`).
 
     Why: after a change of reach the manifest still gave a start light at 53.3° that never
     fired, while lights.lp and the journal said 36.2°; a tool reading the manifest's schedule
@@ -1998,18 +2049,30 @@ def _refused_on_changed_rig(  # type: ignore[no-untyped-def]
 
 
 def _say_shot_beyond(  # type: ignore[no-untyped-def]
-    rig, schedule: LightSchedule, folder, shot: frozenset[int], on_note: NoteSink
+    rig,
+    schedule: LightSchedule,
+    folder,
+    shot: frozenset[int],
+    on_note: NoteSink,
+    leds_now: DomeGeometry | None = None,
 ) -> None:
     """Say, and record in this run's manifest entry, the images already shot that the rig as
     changed could not take (an arm's reach narrowed, an LED taken out): kept, as shot on the
-    rig as it was; ``lights.lp`` lists the lights that fired for them.
+    rig as it was; ``lights.lp`` lists the lights that fired for them. ``leds_now``: a dome's
+    LEDs numbered as the session began (:func:`_leds_numbered_alike`), each still there,
+    re-measured or not: its LEDs can all be lit again.
 
     Why: the resume had refused such a session whole; going on, the images kept beside ones
     the rig could no longer take must be told as what they are, not left to look like the
-    changed rig's work."""
+    changed rig's work. Why ``leds_now``: an image shot under an LED since re-measured had
+    been said (and recorded) as one the rig could not take, "the plan was made for another
+    dome layout"."""
     from rti_rig.runtime.controller import schedule_problems
 
-    beyond = schedule_problems(rig, _as_shot(schedule, folder), sorted(shot))
+    as_shot = _as_shot(schedule, folder)
+    if leds_now is not None:
+        as_shot = _lit_from(leds_now, as_shot)
+    beyond = schedule_problems(rig, as_shot, sorted(shot))
     if not beyond:
         return
     folder.shot_beyond_change = beyond
