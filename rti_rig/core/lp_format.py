@@ -195,14 +195,33 @@ def image_path(lp_dir: Path, name: str) -> Path:
     that climbs out with ``..`` is refused; a ``..`` in the name ends the components tried).
     The first that exists is returned; none existing, the file beside the `.lp` (for the
     caller's "missing" message). Why the folders: an acquisition copied with its subfolders
-    (``sub/IMG.JPG``) had been looked for only as ``IMG.JPG`` and said to be missing."""
+    (``sub/IMG.JPG``) had been looked for only as ``IMG.JPG`` and said to be missing. A bare
+    relative name not beside an `.lp` in ``assembly-files/`` is looked for in the project's
+    ``jpeg-exports/`` too (:func:`_in_project_exports`)."""
     lp_dir = Path(lp_dir)
     if not is_absolute_name(name):
         literal = lp_dir / name
         portable = lp_dir / PureWindowsPath(name).as_posix() if "\\" in name else literal
-        return literal if literal.exists() and not portable.exists() else portable
+        beside = literal if literal.exists() and not portable.exists() else portable
+        return beside if beside.exists() else _in_project_exports(lp_dir, name) or beside
     candidates = _absolute_name_candidates(lp_dir, name)
     return next((c for c in candidates if c.is_file()), lp_dir / image_file_name(name))
+
+
+def _in_project_exports(lp_dir: Path, name: str) -> Path | None:
+    """Where a bare file name listed by an `.lp` in an RTIBuilder project's
+    ``assembly-files/`` is, when not beside the `.lp`: the project's ``jpeg-exports/``, if
+    the file is there; None otherwise (a name with folders in it is the user's path, read as
+    written).
+
+    Why: the guide's own recipe for RTIBuilder (a session's ``lights.lp``, whose names are
+    bare, copied into ``assembly-files/``, its JPEGs into ``jpeg-exports/``) made a project
+    that ``fit``, ``run``, ``check`` and ``bench`` refused as "12 of 12 image(s) missing",
+    though an absolute name of that project was found there."""
+    if lp_dir.name.casefold() != ASSEMBLY_FILES or len(_pure_name(name).parts) != 1:
+        return None
+    exported = lp_dir.parent / "jpeg-exports" / name
+    return exported if exported.is_file() else None
 
 
 def _trailing_parts(name: str) -> list[str]:
