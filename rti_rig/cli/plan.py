@@ -57,7 +57,8 @@ def plan(
         typer.Option(
             "--rig",
             help="Rig config TOML, or a bare .lp meaning 'a dome with exactly these lights' "
-            "(default: the simulated 48-LED dome shipped with rti-rig).",
+            "(default: the rig config the preview's rti-rig session records, with a note; "
+            "else the simulated 48-LED dome shipped with rti-rig, with a note).",
         ),
     ] = None,
     lights: Annotated[
@@ -190,6 +191,8 @@ def plan(
     try:
         request = PlanLightsRequest(
             rig=rig or default_config_path(),
+            # without --rig, a preview's rti-rig session says which rig it was shot on
+            rig_given=rig is not None,
             out_file=out_file,
             lights=lights,
             # the default had been refused as if asked for ("asked for 12 lights but the dome

@@ -63,6 +63,10 @@ class PlanLightsRequest:
 
     rig: Path
     out_file: Path = Path("plan.lp")
+    #: False where ``rig`` is the command's default (no ``--rig``): a preview from an rti-rig
+    #: session is then planned for the rig config its manifest records, and any other plan is
+    #: told which rig it was planned for (:func:`_rig_of_preview`).
+    rig_given: bool = True
     lights: int = PLAN_DEFAULT_LIGHTS
     #: False where ``lights`` is the command's default, not the user's: a rig with fewer
     #: lights is then told what the default is (it was told it had "asked for 12 lights").
@@ -116,6 +120,105 @@ class PlannedLights:
     notes: tuple[str, ...] = ()
 
 
+@dataclass(frozen=True)
+class _PreviewRig:
+    """The rig a plan without ``--rig`` is for, and the note that says so; ``manifest`` and
+    ``recorded`` (the identity it records) where it is the rig the preview's session names."""
+
+    config: Path
+    note: str
+    manifest: Path | None = None
+    recorded: dict[str, object] | None = None
+
+
+#: The identity keys that say where a rig's lights can be (:mod:`rti_rig.app.rig_identity`):
+#: what a plan is made of. The camera, exposure, scene or a dome's controller board may have
+#: changed since the preview without changing which directions a plan can hold.
+_LIGHT_KEYS = ("kind", "lights", "light_positions", "light_directions", "arm_reach")
+
+
+def _rig_of_preview(req: PlanLightsRequest) -> _PreviewRig:
+    """The rig to plan for when no ``--rig`` was given: the rig config the preview's rti-rig
+    session records (a session folder, or an image in one), else ``req.rig`` (the default),
+    each with a note naming it. A recorded config that is not there any more is refused.
+
+    Why: ``rti-rig plan S`` of a preview shot on another rig planned for the shipped simulated
+    dome in silence, its advice naming that dome; the plan was refused only by ``run`` ("no
+    LED of this dome within 1° … replan"), though the session's manifest names its rig."""
+    from rti_rig.app.preview_source import _session_root
+    from rti_rig.runtime.session import MANIFEST, read_manifest
+
+    preview = req.preview
+    default = f"rti-rig's simulated dome, {shown_path(req.rig)}"
+    give = "give --rig RIG.toml to plan for your rig"
+    if preview is None:
+        return _PreviewRig(
+            req.rig, f"no --rig given and no preview: planning for {default}; {give}"
+        )
+    root = preview if (preview / MANIFEST).is_file() else None
+    if root is None and preview.is_file():
+        root = _session_root(preview)
+    if root is None:
+        return _PreviewRig(
+            req.rig,
+            f"the preview {shown_path(preview)} is not from an rti-rig session (no {MANIFEST} "
+            f"beside it), so nothing says which rig it was shot on: planning for {default}; "
+            f"{give}",
+        )
+    manifest = root / MANIFEST
+    rig = read_manifest(root).get("rig") or {}
+    config = rig.get("config_path") if isinstance(rig, dict) else None
+    if not isinstance(config, str) or not config:
+        return _PreviewRig(
+            req.rig,
+            f"{shown_path(manifest)} does not say which rig config the preview was shot on: "
+            f"planning for {default}; {give}",
+        )
+    path = Path(config)
+    if not path.is_file():
+        raise RtiRigError(
+            f"{shown_path(manifest)}: the preview was shot on the rig {shown_path(path)}, "
+            "which is not there any more (moved or renamed?): give --rig with its path now "
+            "(or another rig's) to plan for it"
+        )
+    recorded = rig.get("identity")
+    return _PreviewRig(
+        path,
+        f"planning for the rig the preview was shot on: {shown_path(path)} (from "
+        f"{shown_path(manifest)}); give --rig to plan for another",
+        manifest,
+        recorded if isinstance(recorded, dict) else None,
+    )
+
+
+def _check_preview_rig(preview_rig: _PreviewRig, loaded: LoadedRig) -> None:
+    """Refuse the preview session's rig config where its lights are no longer where the
+    session recorded them (edited, or another file under its name since the preview).
+
+    Why: the plan is made of the rig's light directions, and a plan for the config as it is
+    now, from a preview shot with lights elsewhere, is what ``--rig`` asks for knowingly;
+    compared as a resume compares a rig (:func:`~rti_rig.app.rig_identity.
+    identity_differences`), on where the lights can be only (:data:`_LIGHT_KEYS`)."""
+    if preview_rig.recorded is None or preview_rig.manifest is None:
+        return  # a session from before identities were recorded: the file is all there is
+    from rti_rig.app.rig_identity import identity_differences, rig_identity
+
+    now = rig_identity(loaded)
+    diffs = identity_differences(
+        {k: v for k, v in preview_rig.recorded.items() if k in _LIGHT_KEYS},
+        {k: v for k, v in now.items() if k in _LIGHT_KEYS},
+    )
+    if diffs:
+        config = shell_word(str(preview_rig.config))
+        raise RtiRigError(
+            f"{shown_path(preview_rig.manifest)}: the rig the preview was shot on, "
+            f"{shown_path(preview_rig.config)}, is no longer the rig it recorded ("
+            + "; ".join(diffs)
+            + f"): give --rig to say which rig to plan for (--rig {config} to plan for it as "
+            "it is now)"
+        )
+
+
 def _bare_lp_dome(rig: Path, notes: list[str]) -> tuple[DomeGeometry, list[LpEntry]]:
     """A bare ``.lp`` as a rig: a dome with exactly these lights, each listed once."""
     entries = read_lp(rig, upper_hemisphere=True, notes=notes)
@@ -167,7 +270,22 @@ def _check_outputs(req: PlanLightsRequest, loaded: LoadedRig | None) -> None:
 
 
 def plan_lights(req: PlanLightsRequest) -> PlannedLights:
-    """Check, plan and write ``req.out_file``; nothing is read before the options are checked."""
+    """Check, plan and write ``req.out_file``; nothing is read before the options are checked
+    but the preview session's manifest, which says which rig the plan is for (its messages
+    name that rig)."""
+    preview_rig = None
+    if not req.rig_given:
+        preview_rig = _rig_of_preview(req)
+        req = replace(req, rig=preview_rig.config, rig_given=True)
+    planned = _plan_lights(req, preview_rig)
+    if preview_rig is None:
+        return planned
+    return replace(planned, notes=(preview_rig.note, *planned.notes))
+
+
+def _plan_lights(req: PlanLightsRequest, preview_rig: _PreviewRig | None) -> PlannedLights:
+    """:func:`plan_lights` for ``req.rig``: ``preview_rig``, where ``req.rig`` was found in
+    the preview's session, is checked against what the session recorded once it is loaded."""
     project_lp = rtibuilder_project_lp(req.rig)
     if project_lp is not None:  # an RTIBuilder project folder: planned on its .lp, as given
         said = project_lp_note(req.rig, project_lp, "planning on")
@@ -198,6 +316,8 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     )
     bare_lp = req.rig.suffix.lower() == ".lp"
     loaded = None if bare_lp else load_rig_config(req.rig)
+    if preview_rig is not None and loaded is not None:
+        _check_preview_rig(preview_rig, loaded)
     if loaded is not None:
         from rti_rig.app.flash_sync import refuse_options
 
