@@ -1434,7 +1434,9 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
 ) -> tuple[dict[str, Any], list[str]]:
     """The rig's identity, checked against the session's; the differences the user accepted.
 
-    Refuses (:class:`RigChangedError`, listing what differs) unless ``accept_change``.
+    Refuses (:class:`RigChangedError`, listing what differs) unless ``accept_change``; what
+    no flag accepts (another kind of rig, another picture) is refused even then. Every
+    difference is named in the one refusal (:func:`_rig_refusal`), not the first found.
     """
     from rti_rig.app.rig_identity import (
         IMAGE_KEYS,
@@ -1499,38 +1501,15 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         raise RigChangedError(
             _replay_read_otherwise(config_path, image_diffs, manifest, session_dir)
         )
-    if recorded.get("kind") == identity.get("kind") and image_diffs:
-        # accepted, a new exposure had gone into the fit as a brighter light: normals 5.5° off
-        # on average, with a "good" verdict; nothing downstream corrects for it
+    other_kind = recorded.get("kind") != identity.get("kind")
+    # never accepted: another kind of rig, or another picture (accepted, a new exposure had
+    # gone into the fit as a brighter light: normals 5.5° off on average, with a "good"
+    # verdict; nothing downstream corrects for it). The rest is refused unless accepted.
+    if other_kind or image_diffs or (diffs and not accept_change):
         raise RigChangedError(
-            f"{shown_path(config_path)} changes what this session's images are ("
-            + "; ".join(image_diffs)
-            + "): images shot now would not match the ones already taken (another exposure "
-            "or gain reads as a brighter or darker light, another size or decoding as another "
-            "picture), and fit, relight and RTIBuilder take a session's images as one set. "
-            "That cannot be accepted into this session, even with --accept-rig-change: set it "
-            f"back to continue (rti-rig run --resume {shell_word(str(session_dir))} with the "
-            "session's own "
-            "config), or start a new session with the new settings"
-        )
-    if recorded.get("kind") != identity.get("kind"):
-        raise RigChangedError(
-            f"{shown_path(config_path)} is a rig of kind '{identity.get('kind')}', and this "
-            f"session was begun on a '{recorded.get('kind')}': a session cannot change kind of "
-            f"rig, even with --accept-rig-change. Resume with its own config (rti-rig run --resume "
-            f"{session_dir}) or start a new session"
-        )
-    if diffs and not accept_change:
-        raise RigChangedError(
-            f"{shown_path(config_path)} does not describe the rig this session began on ("
-            + "; ".join(diffs)
-            + "): its images would not match the ones already taken. "
-            + (
-                _read_file_changed(loaded, manifest)
-                or _back_to_own_config(config_path, manifest, session_dir)
+            _rig_refusal(
+                config_path, loaded, manifest, session_dir, recorded, identity, diffs, image_diffs
             )
-            + ", or, if the change is deliberate (a repaired LED, recalibrated light "
-            "positions, a new controller board), add --accept-rig-change to record it"
         )
     if diffs:
         # recorded in the manifest when the session goes on: a resume refused after this (a
@@ -1555,6 +1534,112 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     if not diffs:  # the same rig: its positions as the session recorded them (rounding aside)
         identity = same_rig(recorded, identity)
     return identity, diffs
+
+
+#: How many differences make a config given in place of the session's own another rig, not
+#: a change to this one (with its kind or backend, which always do). One or two is the shape
+#: of a deliberate change copied into a new file (a re-measured ``.lp``, a new controller
+#: board); three or more (rig_configs/emulated_dome.toml against a session of
+#: simulated_dome.toml: backend, all 48 LEDs, firmware profile, camera size, scene) is another
+#: rig, which no setting set back and no --accept-rig-change makes this session's.
+ANOTHER_RIG_DIFFERENCES = 3
+
+
+def _rig_refusal(  # type: ignore[no-untyped-def]
+    config_path: Path,
+    loaded,
+    manifest: dict[str, Any],
+    session_dir: Path | str,
+    recorded: dict[str, Any],
+    identity: dict[str, Any],
+    diffs: list[str],
+    image_diffs: list[str],
+) -> str:
+    """Why a resume on ``config_path`` is refused: every difference from the rig the session
+    began on, in one message, which of them no ``--accept-rig-change`` takes, and the way out
+    (another rig: its own config, or a new session; else set back, or accept the rest).
+
+    Why: what the images are (:data:`~rti_rig.app.rig_identity.IMAGE_KEYS`) and the kind of
+    rig were checked, and refused, one before the other and before the rest, since no flag
+    accepts them. The refusal named only those: a session of simulated_dome.toml resumed on
+    emulated_dome.toml was told "camera size: 512×512 → 256×256 … set it back to continue",
+    and, with the size matched, the backend, all 48 LEDs moved, the firmware profile and the
+    scene. The user fixed one thing, ran again and was told the next, and "set it back" was
+    the wrong advice for a whole other rig. The checks and what they refuse are unchanged;
+    only the telling is collected."""
+    other_kind = recorded.get("kind") != identity.get("kind")
+    last = (manifest.get("rig") or {}).get("config_path")
+    own_file = bool(last) and _same_file(Path(config_path), Path(last))
+    other_rig = (
+        other_kind
+        or recorded.get("backend") != identity.get("backend")
+        or (not own_file and len(diffs) >= ANOTHER_RIG_DIFFERENCES)
+    )
+    resume = f"rti-rig run --resume {shell_word(str(session_dir))}"
+    listed = "; ".join(diffs)
+    if other_rig:
+        text = (
+            f"{shown_path(config_path)} describes another rig than the one this session began "
+            f"on ({len(diffs)} difference{'s' if len(diffs) != 1 else ''}: {listed})"
+        )
+    else:
+        text = f"{shown_path(config_path)} does not describe the rig this session began on"
+        text += f" ({listed})"
+    text += ": its images would not match the ones already taken. "
+    refused = []
+    if other_kind:
+        refused.append(
+            f"it is a rig of kind '{identity.get('kind')}', and this session was begun on a "
+            f"'{recorded.get('kind')}': a session cannot change kind of rig"
+        )
+    if image_diffs:
+        labels = ", ".join(d.split(":", 1)[0] for d in image_diffs)
+        refused.append(
+            f"{labels} change{'' if len(image_diffs) > 1 else 's'} what "
+            "this session's images are (another exposure or gain reads as a brighter or darker "
+            "light, another size or decoding as another picture), and fit, relight and "
+            "RTIBuilder take a session's images as one set"
+        )
+    if refused:
+        said = "; ".join(refused)
+        text += (
+            said[0].upper()
+            + said[1:]
+            + ": that cannot be accepted into this session, even with --accept-rig-change. "
+        )
+    new = new_session_command(config_path, manifest, session_dir)
+    if other_rig:
+        back = (
+            _back_to_own_config(config_path, manifest, session_dir)
+            if own_file or not last
+            else (
+                f"Resume with the session's own config, {last} (recorded in "
+                f"{Path(session_dir) / 'manifest.json'} under rig.config_path): {resume}"
+            )
+        )
+        return text + (
+            f"{back}; or shoot a new session on this rig: {new}. (--accept-rig-change is for "
+            "a deliberate change to this session's rig, a repaired LED, re-measured light "
+            "positions, a new controller board; not for another rig)"
+        )
+    back = _read_file_changed(loaded, manifest) or _back_to_own_config(
+        config_path, manifest, session_dir
+    )
+    if refused:
+        rest = len(diffs) - len(image_diffs)
+        return text + (
+            f"{back}, or start a new session with the new settings ({new})"
+            + (
+                f". The other difference{'s' if rest > 1 else ''}, if deliberate, "
+                "--accept-rig-change records once the images' settings are as the session began"
+                if rest > 0
+                else ""
+            )
+        )
+    return text + (
+        f"{back}, or, if the change is deliberate (a repaired LED, recalibrated light "
+        "positions, a new controller board), add --accept-rig-change to record it"
+    )
 
 
 def _replay_images_changed(
