@@ -2263,10 +2263,12 @@ def preview(
         )
         metered = _metered_apart(opened) if auto_exposure else None
         if metered is not None:
+            # the limit the preview metered with, or the run meters at the default 0.1 %
+            limit = f" --max-saturated {max_saturated:g}" if max_saturated is not None else ""
             out.print(
                 f"Then: rti-rig run {_arg(rig_config)} --plan {_arg(plan_lp)} --out "
                 f"{_arg(free_name(out_dir.parent / 'planned', folder=True))} "
-                f"--auto-exposure (this preview was metered at {metered[0]:.4g} s; without "
+                f"--auto-exposure{limit} (this preview was metered at {metered[0]:.4g} s; without "
                 f"--auto-exposure the run uses the config's exposure_s = {metered[1]:g} s)",
                 highlight=False,
                 markup=False,

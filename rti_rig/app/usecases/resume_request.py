@@ -120,9 +120,14 @@ def _new_session_command(asked: StartOptions, loaded: Any, root: Path) -> str:
         words += ["--lights", str(asked.lights)] if asked.lights is not None else []
         words += ["--min-lights", str(asked.min_lights)] if asked.min_lights is not None else []
         words += ["--objective", shlex.quote(asked.objective)] if asked.objective else []
-    words += _exposure_words(asked.auto_exposure, asked.max_saturated)
+    # only options a new session accepts together (run's own refusals): --max-saturated only
+    # with --auto-exposure (a limit given asks for the metering that reads it), neither with
+    # an adaptive session, nor --allow-no-normals. The command had repeated a lone
+    # --max-saturated, and pasted it was refused.
+    metered = not asked.is_adaptive and (asked.auto_exposure or asked.max_saturated is not None)
+    words += _exposure_words(metered, asked.max_saturated if metered else None)
     words.append(band_options((asked.min_elevation_deg, asked.max_elevation_deg)).strip())
-    if asked.allow_no_normals:
+    if asked.allow_no_normals and not asked.is_adaptive:
         words.append("--allow-no-normals")
     words += ["--out", shell_word(str(free_name(root, folder=True)))]
     return " ".join(w for w in words if w)  # no band: no word
