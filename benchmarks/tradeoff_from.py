@@ -24,7 +24,9 @@ every plan chosen among the lights not held out:
   run per N, since with N known the design is chosen for N), with the normals objective and
   with `--objective relight`.
 
-Session time: N lights at the replayed dome's ~1.12 s a light (the default dome timing). The
+Session time: N lights at the replayed dome's 1.17 s a light (the default dome timing), or at
+the step of the dome ``--rig`` gives (:func:`rig_seconds_per_light`, its firmware's own hold
+window included where it times its LEDs itself). The
 images are read as the replay rig reads them (JPEG decoded and linearised, 16-bit as they are),
 averaged to grey, and shrunk to at most ``MAX_PX`` wide for speed.
 """
@@ -99,6 +101,43 @@ def rig_seconds_per_light(rig_path: Path) -> tuple[float, str]:
         f"{t.settle_s:g} + camera.exposure_s {exposure_s:g} + readout_s {t.readout_s:g} + "
         f"transfer_s {t.transfer_s:g}, as a dry run counts a step (the serial link's replies "
         "and the camera's own delays are in it only as far as these keys hold them)"
+    )
+    held = timed_firmware_seconds(cfg)
+    if held is not None and held[0] > seconds:
+        return held[0], f"{shown_path(rig_path)}: {held[1]}"
+    return seconds, said
+
+
+def timed_firmware_seconds(cfg: Any) -> tuple[float, str] | None:
+    """(seconds a light takes, the words) on a dome whose firmware times its LEDs itself
+    (RTIPy: ``T,x,y,secs`` lights an LED for whole seconds and blocks), None for any other.
+
+    Why: the bench summed ``[timing]`` and the exposure (1.17 s a light on
+    ``emulated_rtipy.toml``) where a dry run of that config takes about 3.1 s a light: the
+    scripted driver writes the light command, the firmware reads it only after its framing
+    silence (``frame_silence_s``, 1 s), holds the LED for its window (``window_s``, 2 s) and
+    the host waits the window out plus ``TIMED_MARGIN_S`` before the next light
+    (``ScriptedDomeDriver.light`` and ``_wait_window``). The figures are the driver's own: the
+    profile's description (``protocol_for``, as the dry run's driver is built from it), its
+    wire time (10 bits a character at the profile's baud rate) and its margin."""
+    from rti_rig.drivers.led_dome.factory import protocol_for
+    from rti_rig.drivers.led_dome.scripted import TIMED_MARGIN_S
+
+    serial = cfg.dome.serial if cfg.dome is not None else None
+    if serial is None or not serial.is_described:
+        return None
+    spec = protocol_for(serial)
+    if spec.window_s is None or spec.stepping:
+        return None
+    count = min(spec.led_count, int(cfg.dome.count))
+    longest = max(len(spec.render(spec.light.send, i, frozenset({i}))) for i in range(count))
+    wire_s = longest * 10.0 / spec.baudrate
+    seconds = wire_s + spec.frame_silence_s + spec.window_s + TIMED_MARGIN_S
+    said = (
+        f"the {spec.name} firmware times each LED itself: its light command on the wire "
+        f"{wire_s:.3f} s + its framing silence {spec.frame_silence_s:g} s + the {spec.window_s} s "
+        f"it holds the LED lit (light_on_s) + {TIMED_MARGIN_S:g} s margin, as a dry run's "
+        "driver waits them; longer than its [timing] and exposure, which fit inside the window"
     )
     return seconds, said
 

@@ -99,8 +99,8 @@ def bench_tradeoff(
         typer.Option(
             "--rig",
             help="With --from: your dome's rig config, whose \\[timing] and \\[camera] "
-            "exposure_s give the session time (else the replayed dome's defaults, 1.17 s a "
-            "light).",
+            "exposure_s give the session time, or its firmware's own hold window where that "
+            "is longer (RTIPy's); else the replayed dome's defaults, 1.17 s a light.",
         ),
     ] = None,
 ) -> None:
@@ -141,9 +141,16 @@ def bench_tradeoff(
         _tradeoff(out_dir, quick, from_lp, force, rig)
 
 
-def _acquisition_lp(given: Path) -> Path:
-    """The ``.lp`` of ``--from``: the file, or a folder's only ``.lp`` (a session's lights.lp),
-    as ``rti-rig fit`` takes a folder ("Is a directory" had been the answer).
+def _acquisition_lp(given: Path, notes: list[str] | None = None) -> Path:
+    """The ``.lp`` of ``--from``: the file, a session's ``lights.lp``, or a folder's only
+    ``.lp``, as ``rti-rig fit`` takes a folder ("Is a directory" had been the answer).
+
+    A session folder (rti-rig's manifest beside its ``lights.lp``) is read from its
+    ``lights.lp`` whatever other ``.lp`` lies beside it, as ``fit`` reads it: one written into
+    it by ``export-lp --linear`` (``demo_linear.lp``) had the session refused as "a folder with
+    2 .lp files", though its own lights are never in doubt. The others are named in a note
+    (``notes``). Any other folder with several ``.lp`` stays refused: which lists the
+    acquisition cannot be told.
 
     A file not named ``.lp`` is refused by name, as ``fit`` and ``run`` refuse it: read as an
     ``.lp``, an image had been told its "line 1 holds NUL bytes" (save it again as UTF-8 text)
@@ -157,8 +164,20 @@ def _acquisition_lp(given: Path) -> Path:
             )
         return given
     from rti_rig.core.lp_format import acquisition_lp_files, lp_name_from
+    from rti_rig.runtime.session import LP_NAME, MANIFEST
 
     found = acquisition_lp_files(given)  # an RTIBuilder project's in its assembly-files/
+    own = given / LP_NAME
+    if (given / MANIFEST).is_file() and own.is_file():
+        others = [p for p in found if p.resolve() != own.resolve()]
+        if others and notes is not None:
+            names = ", ".join(lp_name_from(given, p) for p in others[:5])
+            notes.append(
+                f"--from {shown_path(given)} is an rti-rig session: its {LP_NAME} is read, not "
+                f"the other .lp beside it ({names}" + (", …)" if len(others) > 5 else ")") + "; "
+                "give one of those instead of the folder to trade on it"
+            )
+        return own
     if len(found) == 1:
         return found[0]
     names = ", ".join(lp_name_from(given, p) for p in found[:5])
@@ -312,8 +331,8 @@ def _tradeoff(
         # its images before the --out folder is made: a refused acquisition had left an
         # empty --out folder behind
         try:
-            from_lp = _acquisition_lp(from_lp)
             notes: list[str] = []
+            from_lp = _acquisition_lp(from_lp, notes)
             acquisition = [from_lp, *check_acquisition(from_lp, notes)]
         except RtiRigError as exc:
             raise fail(exc) from None
