@@ -2940,13 +2940,7 @@ def _keep_edited_lp(
         data = None  # unreadable as it is: kept all the same, never overwritten unread
     if data is not None and (not data.strip() or _run_wrote_lp(data, records, done, may_lack)):
         return None
-    dest = free_name(root / "recovered" / stamp / LP_NAME)
-    try:
-        dest.parent.mkdir(parents=True, exist_ok=True)
-        os.replace(path, dest)
-    except OSError as exc:
-        raise SessionWriteError(dest, exc) from None
-    return dest.relative_to(root).as_posix()
+    return _set_aside(root, path, stamp, fresh=True)
 
 
 def _run_wrote_lp(
@@ -2995,10 +2989,13 @@ def edited_lp_note(root: Path, kept: str, run: bool = True) -> str:
     )
 
 
-def _set_aside(root: Path, path: Path, stamp: str) -> str:
+def _set_aside(root: Path, path: Path, stamp: str, fresh: bool = False) -> str:
     """Move ``path`` (inside session ``root``) to ``recovered/STAMP/`` under the same relative
-    path, never deleting anything; returns where it went, relative to ``root``."""
+    path, never deleting anything; returns where it went, relative to ``root``. ``fresh``: a
+    name no earlier move there took (``free_name``), for a file set aside more than once in
+    one run's folder (an edited ``lights.lp``)."""
     dest = root / "recovered" / stamp / path.relative_to(root)
+    dest = free_name(dest) if fresh else dest
     try:
         dest.parent.mkdir(parents=True, exist_ok=True)
         os.replace(path, dest)
