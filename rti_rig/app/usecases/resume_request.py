@@ -237,6 +237,12 @@ def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded:
     from rti_rig.core.schedule import LightSchedule
 
     recorded = LightSchedule.from_dict(manifest["schedule"])
+    if not _chooses_lights(asked):
+        # only options that choose no light (--allow-no-normals, the metering's): the session's
+        # own lights go on, as a plain --resume's do. Planned again as a new session would
+        # plan them, the rig's default layout had been compared with the session's plan, and
+        # `--resume S --allow-no-normals` of a raking-light plan refused as another request
+        return _allow_difference(recorded, asked)
     request = NewSessionRequest(
         Path(loaded.path),
         Path("."),
@@ -274,6 +280,21 @@ def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded:
             return band or [said]
     if band:
         return band
+    return _allow_difference(recorded, asked)
+
+
+def _chooses_lights(asked: StartOptions) -> bool:
+    """Whether ``asked`` gives an option that chooses the lights (a count, a plan, a band)."""
+    return (
+        asked.lights is not None
+        or asked.plan is not None
+        or asked.min_elevation_deg != 0.0
+        or asked.max_elevation_deg != 90.0
+    )
+
+
+def _allow_difference(recorded: Any, asked: StartOptions) -> list[str]:
+    """``--allow-no-normals`` asked against what the session recorded of it."""
     allowed = bool((recorded.provenance or {}).get("allow_no_normals", False))
     if allowed != asked.allow_no_normals:
         return [
