@@ -925,7 +925,7 @@ class SessionFolder:
                 run["config_path"] = new_path
                 self.manifest.setdefault("rig", {})["config_path"] = new_path
             runs.append(run)
-            self.manifest["runner"] = {"state": "running", "finish_reason": None}
+            self.manifest["runner"] = self._running()
         else:
             self._make_folder()
             rig = dict(header.get("rig") or {})
@@ -938,12 +938,28 @@ class SessionFolder:
                 **header,
                 "rig": rig,
                 **({"input_notes": list(self.input_notes)} if self.input_notes else {}),
-                "runner": {"state": "running", "finish_reason": None},
+                "runner": self._running(),
                 "runs": [run],
                 "steps": [],
             }
         _write_json_atomic(self.root / MANIFEST, self.manifest)
         self.begun = True
+
+    def _running(self) -> dict[str, Any]:
+        """The manifest's ``runner`` while a run is under way: its steps counted from the
+        start.
+
+        Why: ``steps_done`` and ``steps_planned`` had been written only at a run's end, so a
+        script reading the manifest during a run, or after a run killed outright, found
+        neither. The manifest is not rewritten per image (``lights.lp`` and the journal are):
+        ``steps_done`` here is the images committed when the run began, a lower bound, brought
+        up to date where the run's end is recorded."""
+        return {
+            "state": "running",
+            "finish_reason": None,
+            "steps_planned": self.total_steps,
+            "steps_done": len(self.committed),
+        }
 
     def record_cut_end(self, reason: str, teardown_failures: list[str] | None = None) -> bool:
         """Record in the manifest that this run was stopped (``reason``: a finish reason such
@@ -971,6 +987,9 @@ class SessionFolder:
             "state": "stopped",
             "finish_reason": reason,
             "end_cut": True,
+            # the images committed by the time the stop came (one whose commit the stop cut
+            # is read back by the resume, as after a kill)
+            "steps_done": len(self.committed),
             "teardown_failures": list(teardown_failures or []),
         }
         try:

@@ -52,7 +52,12 @@ def test_a_run_the_full_disk_kept_from_recording_its_end_is_said_so(
         assert r.exit_code == 2, said(r)
         assert "not enough free disk space" in said(r) and "--resume" in said(r), said(r)
         manifest = json.loads((out / "manifest.json").read_text())
-        assert manifest["runner"] == {"state": "running", "finish_reason": None}
+        assert manifest["runner"] == {
+            "state": "running",
+            "finish_reason": None,
+            "steps_planned": 6,
+            "steps_done": 0,  # the count when the run began: the end was never recorded
+        }
 
         # the disk still full: the verdict names it, and calls the session not finished
         r = CliRunner().invoke(

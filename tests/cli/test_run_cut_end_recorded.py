@@ -106,7 +106,9 @@ def test_a_run_whose_end_a_stop_cut_is_resumed_as_stopped_not_killed(
     assert run["finish_reason"] == "emergency-stop" and run["end_cut"] is True, run
     assert "rig_time_s" not in run  # not known where the stop cut the end: not made up
     assert manifest["runner"]["finish_reason"] == "emergency-stop", manifest["runner"]
-    assert manifest["runner"].get("steps_done") is None  # the steps stay for the resume
+    # the images committed when the stop came; the steps themselves stay for the resume
+    assert manifest["runner"]["steps_done"] == 6 and manifest.get("steps") == [], manifest
+    assert manifest["runner"]["steps_planned"] == 6, manifest["runner"]
 
     # the verdict (a QA of the session's images, seconds under load) is not what this shows:
     # the resume's opening words are
