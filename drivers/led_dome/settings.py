@@ -19,7 +19,7 @@ from pydantic import (
     model_validator,
 )
 
-from rti_rig.core.validation_text import error_text, key_of
+from rti_rig.core.validation_text import error_text, key_of, table_keys
 from rti_rig.drivers.led_dome.dome_profiles import (
     all_profiles,
     bootloader_touch_baud,
@@ -323,7 +323,8 @@ class DomeSerialSettings(_Strict):
             return ProtocolSpec.model_validate(merged)
         except ValidationError as exc:
             first = exc.errors()[0]
-            raise ProtocolKeyError(tuple(first["loc"]), error_text(first)) from None
+            known = table_keys(ProtocolSpec, tuple(first["loc"]))
+            raise ProtocolKeyError(tuple(first["loc"]), error_text(first, known)) from None
 
     def led_count_source(self) -> str:
         """Where a firmware profile's LED count comes from, as a check or error should say it.

@@ -42,6 +42,7 @@ from rti_rig.core.rig_geometry import (
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.core.validation_text import error_text as _error_text
 from rti_rig.core.validation_text import key_of as _key_of
+from rti_rig.core.validation_text import table_keys
 from rti_rig.drivers.dynamixel.settings import ArmSettings
 from rti_rig.drivers.led_dome.settings import (
     DIMMING_LINK,
@@ -694,7 +695,7 @@ def _problem(err: Any) -> tuple[str | None, str]:
     cause = err.get("ctx", {}).get("error")
     if isinstance(cause, ProtocolKeyError):
         return _key_of((*err["loc"], "protocol", *cause.loc)), cause.text
-    return _key_of(err["loc"]) or None, _error_text(err)
+    return _key_of(err["loc"]) or None, _error_text(err, table_keys(RigConfig, err["loc"]))
 
 
 def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
@@ -1524,6 +1525,7 @@ def timed_exposure_limit(rig: LoadedRig) -> TimedExposureLimit | None:
 
 def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
     """The validated driver settings of the rig's real camera (``[camera.device]``)."""
+    from rti_rig.drivers.cameras.kinds import camera_kind
     from rti_rig.drivers.cameras.settings import parse_camera_settings
 
     raw = rig.config.camera.device or {}
@@ -1531,8 +1533,10 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
         settings = parse_camera_settings(raw)
     except ValidationError as exc:
         err = exc.errors()[0]  # said as every other table's (parse_rig_config)
+        kind = camera_kind(raw.get("kind"))
+        known = table_keys(kind.settings, err["loc"]) if kind is not None else []
         raise ConfigError(
-            rig.path, _key_of(("camera", "device", *err["loc"])), _error_text(err)
+            rig.path, _key_of(("camera", "device", *err["loc"])), _error_text(err, known)
         ) from None
     refuse_quoted_value(rig.path, raw, settings, ("camera", "device"))
     return settings

@@ -8,7 +8,9 @@ needs no pydantic import.
 
 from __future__ import annotations
 
-from typing import Any
+import difflib
+from collections.abc import Iterable
+from typing import Any, get_args
 
 #: what every table says of a key it does not know
 UNKNOWN_KEY = "unknown key (check its spelling and the table it is in)"
@@ -25,12 +27,44 @@ def key_of(loc: tuple[Any, ...]) -> str:
     return out
 
 
-def error_text(err: Any) -> str:
+def _models_in(annotation: Any) -> list[Any]:
+    """The pydantic models an annotation holds (``Dome | None``, ``list[Ring]``), told by
+    their ``model_fields`` (the core imports no pydantic)."""
+    if isinstance(annotation, type) and hasattr(annotation, "model_fields"):
+        return [annotation]
+    return [m for arg in get_args(annotation) for m in _models_in(arg)]
+
+
+def table_keys(model: Any, loc: tuple[Any, ...]) -> list[str]:
+    """The keys of the table holding the key at pydantic location ``loc`` below ``model``:
+    what an unknown key there is compared with. Empty where that table is no model's (a free
+    dict such as ``[camera.device]``, checked by its driver's own model)."""
+    models = [model]
+    for part in loc[:-1]:
+        if isinstance(part, int):
+            continue  # an element of a list of tables: the list's annotation is its model's
+        fields = [m.model_fields[part] for m in models if part in m.model_fields]
+        models = [m for f in fields for m in _models_in(f.annotation)]
+    return sorted({f.alias or name for m in models for name, f in m.model_fields.items()})
+
+
+def unknown_key_text(key: str, known: Iterable[str] = ()) -> str:
+    """What an unknown ``key`` is told, with the known key of its table it is closest to.
+
+    Why: "check its spelling" left the user to find the slip (``exposur_s``) and the key it
+    stands for by reading the docs; the closest key is named where one is close."""
+    close = difflib.get_close_matches(key, list(known), n=1, cutoff=0.6)
+    return UNKNOWN_KEY + (f"; did you mean '{close[0]}'?" if close else "")
+
+
+def error_text(err: Any, known: Iterable[str] = ()) -> str:
     """One pydantic error in a user's words: what is wrong, the value given, and for a number
-    where the driver wants the camera's own text (``iso = 100``), how to write it."""
+    where the driver wants the camera's own text (``iso = 100``), how to write it. ``known``:
+    the keys of the table an unknown key was found in, the closest of them suggested."""
     msg = str(err["msg"]).removeprefix("Value error, ")
     if err["type"] == "extra_forbidden":
-        return UNKNOWN_KEY
+        last = err["loc"][-1] if err.get("loc") else ""
+        return unknown_key_text(str(last), known)
     if err["type"] in ("value_error", "missing") or "input" not in err:
         return msg
     got = err["input"]
