@@ -2,7 +2,8 @@
 
 A preview shot on a rig is an image *and* the light that made it; the planner reads the light's
 direction far better than it can estimate it from the image (on the real icon of
-docs/research/planner.md the estimate is 17–59° off). So when the user does not give
+docs/research/planner.md the estimate is 17–59° off, and 106° on a real dome image lit at
+16°). So when the user does not give
 ``--preview-light``, the light is taken from what records it, and only from that:
 
 * an rti-rig session folder holding one image (``rti-rig preview`` writes one): its linear
@@ -77,7 +78,7 @@ class PreviewSource:
     unrecorded: str | None = None
 
 
-def _session_root(image: Path) -> Path | None:
+def session_of_image(image: Path) -> Path | None:
     """The rti-rig session folder ``image`` belongs to (its own folder, or the one above a
     session's ``linear/`` or ``raw/`` folder: a DSLR user hands over the camera's RAW), if
     any."""
@@ -223,7 +224,7 @@ def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any, str
     (module notes); how it was read is None unless said (:func:`_lp_record`)."""
     target = image.resolve()
     found = []
-    root = _session_root(image)
+    root = session_of_image(image)
     if root is not None:
         steps, journaled = _recorded_steps(root)
         for step in steps:
@@ -349,7 +350,7 @@ def _unrecorded(image: Path, rig_lp: RigLp | None) -> str:
 
     Why: an image of a session that records no step with it (a copy, an image whose journal
     line was never written) had its light estimated with no word of the session at all."""
-    root = _session_root(image)
+    root = session_of_image(image)
     where = []
     if root is not None:
         where.append(f"the session {root.name} records no step with {image.name}")
@@ -389,6 +390,12 @@ def resolve_preview(
     image it holds), so an unreadable or unfinished one cannot stand in the way of the light
     the user gave.
     """
+    if not path.exists():  # "preview image not found" had read as a damaged session
+        raise ScheduleError(
+            f"{shown_path(path)}: no such file or folder: give a preview image, or the session "
+            "folder 'rti-rig preview RIG --out DIR' wrote; or plan with no preview: rti-rig "
+            "plan --rig RIG --lights N --method optimal --out PLAN.lp"
+        )
     if path.is_dir():
         if not (path / MANIFEST).is_file():
             raise ScheduleError(

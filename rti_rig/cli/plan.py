@@ -93,7 +93,8 @@ def plan(
             help="Azimuth,elevation of the preview's light in degrees (frame of the .lp files). "
             "When omitted: the light the preview's rti-rig session recorded, or the line of "
             "the bare .lp given as --rig that lists the image, else estimated from the image's "
-            "shading (its error not known: 17–59° on a real icon's previews). Given, it is "
+            "shading (its error not known: 17–59° on a real icon's previews, 106° on another "
+            "real image). Given, it is "
             "used, with a note when it is more than 1° from the light recorded.",
         ),
     ] = None,

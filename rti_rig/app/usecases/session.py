@@ -1063,6 +1063,11 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         _refuse_rig_config_as_plan(
             Path(req.plan), Path(req.rig_config), Path(req.out_dir), geometry
         )
+        if not Path(req.plan).exists():  # "nosuch.lp: cannot read" had not said which option
+            raise RtiRigError(
+                f"--plan {shown_path(req.plan)}: no such file: give the .lp that "
+                "'rti-rig plan … --out PLAN.lp' wrote (or drop --plan for the rig's own layout)"
+            )
         plan_notes: list[str] = []
         entries = read_lp(req.plan, upper_hemisphere=True, notes=plan_notes, wanted=PLAN_WANTED)
         for note in plan_notes:
