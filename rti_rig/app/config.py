@@ -862,6 +862,7 @@ def _with_correction_file(
         calibration, raw = read_calibration_file(file)
         values = correction_factors(calibration, file, str(data.get("name")))
     except ValueError as exc:
+        _refuse_undimmable_first(path, data, serial)
         raise ConfigError(path, key, str(exc)) from None
     recorded = {**serial, "intensity_correction": values}
     measured = measured_leds(calibration, len(values))
@@ -875,6 +876,21 @@ def _with_correction_file(
         {**data, "dome": {**dome, "serial": settings}},  # type: ignore[dict-item]
         raw,
     )
+
+
+def _refuse_undimmable_first(path: Path, data: dict[str, Any], serial: dict[str, Any]) -> None:
+    """Refuse a correction file on a link that cannot dim, before what is wrong with the file.
+
+    Why: a nab-rti-v1 config given another dome's calibration had been told to "calibrate this
+    dome (rti-rig calibrate-lights)", which refuses a dome that cannot dim: the refusal that
+    holds whatever the file says (remove the key) comes first. A ``[dome.serial]`` that does not
+    validate is left to the config's own refusal of it."""
+    given = {k: v for k, v in serial.items() if k != "intensity_correction_file"}
+    try:
+        settings = DomeSerialSettings.model_validate(given)
+    except ValueError:  # pydantic's ValidationError among them
+        return
+    _check_dome_can_dim(path, data, settings)
 
 
 def _with_led_map_path(data: dict[str, Any], folder: Path) -> dict[str, Any]:

@@ -182,13 +182,29 @@ def _card_again(root: Path, rig: dict[str, Any]) -> str:
     return run_words(Path(config), again)
 
 
-def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | None) -> CardSession:
-    rig = manifest["rig"]
+def refuse_card_of_another_rig(root: Path | str, rig_name: str) -> None:
+    """Refuse, from the manifest alone, a card session shot on another rig than ``rig_name``.
+
+    Why on its own: ``calibrate-lights`` asks it before it refuses a calibration file already
+    beside the card. A card calibrated already, given another rig's config, had been sent to
+    write its file elsewhere (``--out``), and only then told that the card is another rig's."""
+    root = Path(root)
+    rig = read_manifest(root).get("rig")
+    if isinstance(rig, dict):  # a manifest that says no rig is refused where the card is read
+        _refuse_other_rig(root, rig, rig_name)
+
+
+def _refuse_other_rig(root: Path, rig: dict[str, Any], rig_name: str | None) -> None:
     if rig_name is not None and rig.get("name") != rig_name:
         raise SessionError(
             f"{shown_path(root)} was shot on rig '{rig.get('name')}', not '{rig_name}': calibrate "
             "a dome from its own card session"
         )
+
+
+def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | None) -> CardSession:
+    rig = manifest["rig"]
+    _refuse_other_rig(root, rig, rig_name)
     steps = manifest.get("steps") or []
     if rig.get("kind") != "dome":
         raise SessionError(

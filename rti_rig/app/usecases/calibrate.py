@@ -25,6 +25,7 @@ from rti_rig.app.light_calibration import (
     calibration_toml,
     card_spread_deg,
     read_card_session,
+    refuse_card_of_another_rig,
     step_direction,
 )
 from rti_rig.app.output_files import check_output_file, rig_inputs
@@ -300,6 +301,9 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     loaded = load_rig_config(req.rig_config)
     _check_dome_can_dim(req, loaded)
     geometry = rig_geometry(loaded)
+    # another rig's card before a calibration already beside it: told to write it elsewhere
+    # first, the user had learnt only then that no file of this card fits this rig
+    refuse_card_of_another_rig(req.card_session, loaded.config.name)
     # from the manifest, before any image is read: a card of other LEDs had every image read
     # (and a card with images missing was refused for them) before the refusal that mattered
     same_leds = _refuse_other_leds(req, loaded)
