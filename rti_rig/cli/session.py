@@ -714,14 +714,23 @@ class HandOver:
 def _verdict_terminable() -> Iterator[None]:
     """A SIGTERM while the QA verdict is computed raises :class:`~rti_rig.cli.stopping.
     Terminated`, which the verdict says as it says a Ctrl-C (the session is complete) before
-    exiting 143; it had ended the process with no word. (It had its own class, fit's
+    exiting 143; it had ended the process with no word. A SIGINT inherited ignored is
+    answered as a Ctrl-C, as the capture answers it. (It had its own class, fit's
     ``VerdictTerminated``, a copy of Terminated: the same base, fields and signal kept as
     received; which stop it is follows from the handler installed, not the class.)"""
 
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
         raise Terminated(as_received(signum))  # a hang-up's: SIGHUP
 
-    with signal_handlers({signal.SIGTERM: terminated}):
+    handlers: dict[int, Any] = {signal.SIGTERM: terminated}
+    if handlers_settable() and signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        # a run started with SIGINT ignored (a script's `run … &`) is stopped by one while it
+        # captures, as every run is; the verdict had ignored it, so a `kill -INT` that stopped
+        # a capture went unanswered in the seconds of QA that follow. Now it ends the verdict
+        # as a Ctrl-C does (exit 130, the command that gives the verdict said); a handler of
+        # a caller's own (run called from Python) is left to answer as it chooses
+        handlers[signal.SIGINT] = signal.default_int_handler
+    with signal_handlers(handlers):
         yield
 
 
