@@ -431,7 +431,7 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
             else f"expected relighting MSE per unit albedo ({report.model})"
         )
         chosen = method.decide(ctx, obj, chosen)
-        report.notes.append(_expected_caveat(report.shading_explained_r2))
+        report.notes.append(_expected_caveat(report.shading_explained_r2, req.material))
     up = object_plane(None if surface is None else surface.normals)
     report.tilt_tolerance_deg = tilt_tolerance(candidates.directions[chosen], up, REPORT_MAX_DEG)
     report.level_facing_lights = facing_count(candidates.directions[chosen], up)
@@ -460,14 +460,23 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
 POOR_SHADING_R2 = 0.3
 
 
-def _expected_caveat(r2: float | None) -> str:
+def _expected_caveat(r2: float | None, material: str = "auto") -> str:
     """What the expected errors are: the camera noise propagated on the modelled surface. A
     session measures more (gloss, shadows, interreflection, relief the preview did not show):
-    on the replayed 18-light dome a 9-light plan "expected" 1.2° and measured 4.7° mean."""
+    on the replayed 18-light dome a 9-light plan "expected" 1.2° and measured 4.7° mean.
+
+    A declared glossy surface's gloss is modelled (the declared lobe): "not gloss" had been
+    said beside "declared glossy: highlights modelled as a 30° lobe", which read as a
+    contradiction; what is not counted there is the object's own gloss beyond that lobe."""
+    unseen = (
+        "not the object's own gloss beyond the declared lobe, nor shadows or relief"
+        if material == "glossy"
+        else "not gloss, shadows or relief"
+    )
     text = (
-        "the expected errors count the camera noise on the modelled surface only, not gloss, "
-        "shadows or relief the preview cannot show: read them to compare layouts, as a lower "
-        "bound of what a session measures"
+        f"the expected errors count the camera noise on the modelled surface only, {unseen} "
+        "the preview cannot show: read them to compare layouts, as a lower bound of what a "
+        "session measures"
     )
     if r2 is not None and r2 < POOR_SHADING_R2:
         text += (
