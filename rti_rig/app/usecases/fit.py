@@ -924,16 +924,22 @@ def prepare_out_dir(out: Path) -> None:
         )
     try:
         if out.exists() and any(out.iterdir()):
+            # a folder not there yet, named, as run's refusal names one: "choose another
+            # --out" had left the user to find a free name
+            fresh = (
+                f"--out {shell_word(str(free_name(out, folder=True)))}, which does not exist yet"
+            )
             unfinished = _unfinished_fit(out)
             if unfinished:
                 raise FitInputError(
                     f"{shown_path(out)} holds the outputs of a fit that did not finish "
                     f"({unfinished}; its fit.json, written last, is missing): the fit was killed, "
                     "or the machine stopped (out of memory?); delete that folder, or those files, "
-                    "and run this again, or choose another --out"
+                    f"and run this again, or choose another --out (such as {fresh})"
                 )
             raise FitInputError(
-                f"{shown_path(out)} is not empty: fit writes into a new or empty folder"
+                f"{shown_path(out)} is not empty: fit writes into a new or empty folder; "
+                f"choose another --out (such as {fresh})"
             )
     except OSError as exc:
         raise FitInputError(
