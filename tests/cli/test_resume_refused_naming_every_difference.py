@@ -63,7 +63,10 @@ def test_another_rig_is_refused_once_naming_every_difference_and_the_way_out(
             "simulated scene: changed",
         ):
             assert difference in text, text
-        assert "Camera size changes what this session's images are" in text, text
+        # what no flag accepts: the backend (since 2026-12-04: a backend change had gone
+        # through with --accept-rig-change) and what the images are
+        assert "Its backend is 'emulated', and this session was begun on 'simulated'" in text
+        assert "camera size changes what this session's images are" in text, text
         assert "cannot be accepted into this session, even with --accept-rig-change" in text
         # the way out: the session's own config, as its manifest records it, or a new session
         assert f"Resume with the session's own config, {SIMULATED}" in text, text

@@ -1507,10 +1507,13 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             _replay_read_otherwise(config_path, image_diffs, manifest, session_dir)
         )
     other_kind = recorded.get("kind") != identity.get("kind")
-    # never accepted: another kind of rig, or another picture (accepted, a new exposure had
-    # gone into the fit as a brighter light: normals 5.5° off on average, with a "good"
-    # verdict; nothing downstream corrects for it). The rest is refused unless accepted.
-    if other_kind or image_diffs or (diffs and not accept_change):
+    # never accepted: another kind of rig, another backend (accepted, a dry run's rendered
+    # images went on with the real dome's photographs, or a replay's, in one session), or
+    # another picture (accepted, a new exposure had gone into the fit as a brighter light:
+    # normals 5.5° off on average, with a "good" verdict; nothing downstream corrects for it).
+    # The rest is refused unless accepted.
+    other_backend = recorded.get("backend") != identity.get("backend")
+    if other_kind or other_backend or image_diffs or (diffs and not accept_change):
         raise RigChangedError(
             _rig_refusal(
                 config_path, loaded, manifest, session_dir, recorded, identity, diffs, image_diffs
@@ -1596,6 +1599,12 @@ def _rig_refusal(  # type: ignore[no-untyped-def]
         refused.append(
             f"it is a rig of kind '{identity.get('kind')}', and this session was begun on a "
             f"'{recorded.get('kind')}': a session cannot change kind of rig"
+        )
+    elif recorded.get("backend") != identity.get("backend"):
+        refused.append(
+            f"its backend is '{identity.get('backend')}', and this session was begun on "
+            f"'{recorded.get('backend')}': one session's images come from one backend (a dry "
+            "run's rendered images, a real camera's, a replayed acquisition's are not one set)"
         )
     if image_diffs:
         labels = ", ".join(d.split(":", 1)[0] for d in image_diffs)
