@@ -2949,7 +2949,9 @@ def _keep_edited_lp(
     before that), so a run stopped in between left the last step recorded out of it, which is
     no edit. It may list steps ``done`` leaves out (images lost or set aside since it was
     written). ``may_lack`` None: any step may be left out (a journal rebuilt from the manifest
-    or record files, whose last commit before the loss is not known)."""
+    or record files, whose last commit before the loss is not known). A run whose end the
+    manifest records wrote ``lights.lp`` listing every step of its ``steps`` before that
+    record: none of those may be lacking (its last line deleted by hand had gone unnoticed)."""
     path = root / LP_NAME
     try:
         data = path.read_bytes()
@@ -2957,6 +2959,15 @@ def _keep_edited_lp(
         return None
     except OSError:
         data = None  # unreadable as it is: kept all the same, never overwritten unread
+    with contextlib.suppress(
+        SessionError, OSError, AttributeError, LookupError, TypeError, ValueError
+    ):
+        ended = read_manifest(root)
+        runner = ended.get("runner") or {}
+        # "running": killed, or a resume begun since; end_cut: a stop that wrote no lights.lp
+        if may_lack and ended.get("lp_file") == LP_NAME and runner.get("state") != "running":
+            listed = set() if runner.get("end_cut") else ended.get("steps") or ()
+            may_lack = set(may_lack) - {int(s["index"]) for s in listed}
     if data is not None and (not data.strip() or _run_wrote_lp(data, records, done, may_lack)):
         return None
     return _set_aside(root, path, stamp, fresh=True)

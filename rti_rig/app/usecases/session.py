@@ -2044,7 +2044,7 @@ def _opened_resume(  # type: ignore[no-untyped-def]
     try:
         rig = checked_rig(loaded, schedule, frozenset(range(len(schedule))) if adaptive else shot)
     except ScheduleError as exc:
-        raise _refused_on_changed_rig(exc, diffs, loaded, req) from None
+        raise _refused_on_changed_rig(exc, diffs, loaded, req, folder, identity) from None
     source = None
     if adaptive:
         from rti_rig.app.usecases.adaptive import resume_adaptive_source
@@ -2057,7 +2057,7 @@ def _opened_resume(  # type: ignore[no-untyped-def]
             validate_schedule(rig, schedule, shot)
         except ScheduleError as exc:
             rig.close_said()
-            raise _refused_on_changed_rig(exc, diffs, loaded, req) from None
+            raise _refused_on_changed_rig(exc, diffs, loaded, req, folder, identity) from None
         except BaseException:
             rig.close_said()  # its failures said, never in place of the error raised
             raise
@@ -2127,20 +2127,37 @@ def _start_as_placed(  # type: ignore[no-untyped-def]
 
 
 def _refused_on_changed_rig(  # type: ignore[no-untyped-def]
-    exc: ScheduleError, diffs: list[str], loaded, req: ResumeRequest
+    exc: ScheduleError, diffs: list[str], loaded, req: ResumeRequest, folder=None, identity=None
 ) -> ScheduleError:
     """The refusal of a resume whose steps still to shoot cannot run: with an accepted change
     (an arm's reach narrowed) that leaves the session's own lights out of reach, what to do
     too (the list alone had said what, not what to do). Said as steps that cannot run, not
     "out of its reach": the refusal may be a narrower camera's exposure range or a timed
-    firmware's window, a change as accepted."""
+    firmware's window, a change as accepted.
+
+    ``folder``, ``identity``: the session and the rig as it is now; a dome whose number of
+    LEDs changed since the session began has its steps' LEDs said as renumbered. Why: each
+    was said "the plan was made for another dome layout", of a session whose plan was made
+    for this very dome as it began, and no plan was given; the LED added or taken out had
+    shifted the number of every LED after it."""
     if not diffs:
         return exc
     session = Path(req.session_dir)
     again = free_folder_beside(session, "again")
+    problems, renumbered = str(exc), ""
+    recorded = ((folder.manifest.get("rig") or {}).get("identity") or {}) if folder else {}
+    before, now = recorded.get("lights"), (identity or {}).get("lights")
+    layout = "the plan was made for another dome layout"
+    if before and now and before != now and layout in problems:
+        problems = problems.replace(layout, "renumbered or moved since this session began")
+        renumbered = (
+            f"This dome has {now} and had {before} when the session began: an LED added or "
+            "taken out changes the number of every LED after it, and the session's steps name "
+            "their LEDs by number: the LED each of these names stands elsewhere than planned. "
+        )
     return ScheduleError(
-        f"{exc}\nThe rig change accepted ({'; '.join(diffs)}) leaves these steps of "
-        f"{shown_path(session)} unable to run on it: to finish the session, set "
+        f"{problems}\n{renumbered}The rig change accepted ({'; '.join(diffs)}) leaves these "
+        f"steps of {shown_path(session)} unable to run on it: to finish the session, set "
         f"{shown_path(loaded.path)} back as it began (its copy is in "
         f"{shown_path(session / 'manifest.json')}, under rig.config) and resume; or shoot "
         f"a new session on the rig as it is: {run_words(loaded.path, again)}"
