@@ -39,6 +39,11 @@ LED_MATCH_TOLERANCE_DEG = 0.5
 NO_LIT_LIMIT = "no limit on how long a light stays lit"
 
 
+#: Why a dome step's LED is not where its direction says (a resume on a dome renumbered since
+#: rewords it: ``rti_rig.app.usecases.session._refused_on_changed_rig``)
+ANOTHER_LAYOUT = "the plan was made for another dome layout"
+
+
 @dataclass(frozen=True)
 class ActualLight:
     """The light that really lit an image."""
@@ -199,7 +204,7 @@ class DomeLighting:
         if off > LED_MATCH_TOLERANCE_DEG:
             return (
                 f"planned direction is {off:.2f}° from LED {step.led}'s calibrated direction: "
-                "the plan was made for another dome layout"
+                f"{ANOTHER_LAYOUT}"
             )
         return None
 

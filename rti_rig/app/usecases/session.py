@@ -31,6 +31,7 @@ from rti_rig.runtime.controller import (
     run_session,
     validate_schedule,
 )
+from rti_rig.runtime.lighting import ANOTHER_LAYOUT
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
     NoSpaceError,
@@ -2127,7 +2128,12 @@ def _start_as_placed(  # type: ignore[no-untyped-def]
 
 
 def _refused_on_changed_rig(  # type: ignore[no-untyped-def]
-    exc: ScheduleError, diffs: list[str], loaded, req: ResumeRequest, folder=None, identity=None
+    exc: ScheduleError,
+    diffs: list[str],
+    loaded,
+    req: ResumeRequest,
+    folder: Any = None,
+    identity: dict[str, Any] | None = None,
 ) -> ScheduleError:
     """The refusal of a resume whose steps still to shoot cannot run: with an accepted change
     (an arm's reach narrowed) that leaves the session's own lights out of reach, what to do
@@ -2147,9 +2153,8 @@ def _refused_on_changed_rig(  # type: ignore[no-untyped-def]
     problems, renumbered = str(exc), ""
     recorded = ((folder.manifest.get("rig") or {}).get("identity") or {}) if folder else {}
     before, now = recorded.get("lights"), (identity or {}).get("lights")
-    layout = "the plan was made for another dome layout"
-    if before and now and before != now and layout in problems:
-        problems = problems.replace(layout, "renumbered or moved since this session began")
+    if before and now and before != now and ANOTHER_LAYOUT in problems:
+        problems = problems.replace(ANOTHER_LAYOUT, "renumbered or moved since this session began")
         renumbered = (
             f"This dome has {now} and had {before} when the session began: an LED added or "
             "taken out changes the number of every LED after it, and the session's steps name "
