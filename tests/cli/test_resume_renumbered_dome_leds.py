@@ -44,6 +44,18 @@ def test_an_led_added_to_the_dome_is_said_to_renumber_the_steps_still_to_shoot(
     assert proc.returncode == 130, proc.stdout + proc.stderr
     config.write_text(shipped.replace(ring, "elevation_deg = 25.0, count = 13,"))
 
+    # without the flag: refused, and told what the flag can and cannot do here (it had been
+    # advised alone, and the resume with it then refused every step)
+    r = CliRunner().invoke(app, ["run", "--resume", str(out)])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "add --accept-rig-change to record it (the dome had 48 LEDs and has 49 LEDs: an LED" in (
+        text
+    ), text
+    assert "it goes on only if each step still to shoot names an LED that stands where it did" in (
+        text
+    )
+
     r = CliRunner().invoke(app, ["run", "--resume", str(out), "--accept-rig-change"])
 
     text = said(r)

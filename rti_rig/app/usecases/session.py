@@ -1654,6 +1654,24 @@ def _rig_refusal(  # type: ignore[no-untyped-def]
     return text + (
         f"{back}, or, if the change is deliberate (a repaired LED, recalibrated light "
         "positions, a new controller board), add --accept-rig-change to record it"
+        + _renumbered_caveat(recorded, identity)
+    )
+
+
+def _renumbered_caveat(recorded: dict[str, Any], identity: dict[str, Any]) -> str:
+    """What ``--accept-rig-change`` can do for a dome whose number of LEDs changed: go on only
+    where the steps still to shoot name LEDs that stand where they did.
+
+    Why: the refusal advised the flag alone, and with it the resume was then refused for
+    every step whose LED an LED added or taken out before it had renumbered."""
+    before, now = recorded.get("lights"), identity.get("lights")
+    if recorded.get("kind") != "dome" or not before or not now or before == now:
+        return ""
+    return (
+        f" (the dome had {before} and has {now}: an LED added or taken out changes the number "
+        "of every LED after it, and the session's steps name their LEDs by number, so with "
+        "--accept-rig-change it goes on only if each step still to shoot names an LED that "
+        "stands where it did; each that does not is named)"
     )
 
 
