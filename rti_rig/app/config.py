@@ -695,7 +695,8 @@ def _problem(err: Any) -> tuple[str | None, str]:
     cause = err.get("ctx", {}).get("error")
     if isinstance(cause, ProtocolKeyError):
         return _key_of((*err["loc"], "protocol", *cause.loc)), cause.text
-    return _key_of(err["loc"]) or None, _error_text(err, table_keys(RigConfig, err["loc"]))
+    known = table_keys(RigConfig, err["loc"]) if err["type"] == "extra_forbidden" else ()
+    return _key_of(err["loc"]) or None, _error_text(err, known)
 
 
 def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:

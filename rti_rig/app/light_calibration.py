@@ -182,19 +182,14 @@ def _card_again(root: Path, rig: dict[str, Any]) -> str:
     return run_words(Path(config), again)
 
 
-def refuse_card_of_another_rig(root: Path | str, rig_name: str) -> None:
-    """Refuse, from the manifest alone, a card session shot on another rig than ``rig_name``.
+def refuse_other_rig(root: Path, rig: dict[str, Any], rig_name: str | None) -> None:
+    """Refuse card session ``root`` (its manifest's ``rig``) if shot on another rig than
+    ``rig_name``.
 
-    Why on its own: ``calibrate-lights`` asks it before it refuses a calibration file already
-    beside the card. A card calibrated already, given another rig's config, had been sent to
-    write its file elsewhere (``--out``), and only then told that the card is another rig's."""
-    root = Path(root)
-    rig = read_manifest(root).get("rig")
-    if isinstance(rig, dict):  # a manifest that says no rig is refused where the card is read
-        _refuse_other_rig(root, rig, rig_name)
-
-
-def _refuse_other_rig(root: Path, rig: dict[str, Any], rig_name: str | None) -> None:
+    Why public: ``calibrate-lights`` asks it from the manifest it reads before anything else,
+    ahead of its refusal of a calibration file already beside the card. A card calibrated
+    already, given another rig's config, had been sent to write its file elsewhere
+    (``--out``), and only then told that the card is another rig's."""
     if rig_name is not None and rig.get("name") != rig_name:
         raise SessionError(
             f"{shown_path(root)} was shot on rig '{rig.get('name')}', not '{rig_name}': calibrate "
@@ -204,7 +199,7 @@ def _refuse_other_rig(root: Path, rig: dict[str, Any], rig_name: str | None) -> 
 
 def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | None) -> CardSession:
     rig = manifest["rig"]
-    _refuse_other_rig(root, rig, rig_name)
+    refuse_other_rig(root, rig, rig_name)
     steps = manifest.get("steps") or []
     if rig.get("kind") != "dome":
         raise SessionError(

@@ -2176,7 +2176,7 @@ def _prepare_resume(
             done,
             None
             if rebuilt is not None or scan.missing
-            else {int(rec["index"]) for rec in last} | set(restored),
+            else _may_lack(manifest, {int(rec["index"]) for rec in last} | set(restored)),
         )
         if edited_lp is not None:
             recovered.append(edited_lp)
@@ -2926,6 +2926,24 @@ def _relist_verified(root: Path, done: dict[int, StepRecord], stamp: str) -> str
     return _set_aside(root, path, stamp)
 
 
+def _may_lack(manifest: dict[str, Any], last: set[int]) -> set[int]:
+    """The steps of ``last`` (the last recorded) that the stopped session's ``lights.lp`` may
+    leave out without an edit: none the manifest lists as steps of a run whose end it records,
+    which wrote ``lights.lp`` listing every one of them before that record (its last line
+    deleted by hand had gone unnoticed). A run still "running" (killed, or a resume begun
+    since) or one whose end a stop cut (``end_cut``: no ``lights.lp`` written) may lack them.
+    Read from the manifest the resume already holds."""
+    runner = manifest.get("runner") or {}
+    if (
+        manifest.get("lp_file") != LP_NAME
+        or runner.get("state") == "running"
+        or runner.get("end_cut")
+    ):
+        return last
+    listed = {s.get("index") for s in manifest.get("steps") or () if isinstance(s, dict)}
+    return last - listed
+
+
 def _keep_edited_lp(
     root: Path,
     stamp: str,
@@ -2949,9 +2967,7 @@ def _keep_edited_lp(
     before that), so a run stopped in between left the last step recorded out of it, which is
     no edit. It may list steps ``done`` leaves out (images lost or set aside since it was
     written). ``may_lack`` None: any step may be left out (a journal rebuilt from the manifest
-    or record files, whose last commit before the loss is not known). A run whose end the
-    manifest records wrote ``lights.lp`` listing every step of its ``steps`` before that
-    record: none of those may be lacking (its last line deleted by hand had gone unnoticed)."""
+    or record files, whose last commit before the loss is not known)."""
     path = root / LP_NAME
     try:
         data = path.read_bytes()
@@ -2959,15 +2975,6 @@ def _keep_edited_lp(
         return None
     except OSError:
         data = None  # unreadable as it is: kept all the same, never overwritten unread
-    with contextlib.suppress(
-        SessionError, OSError, AttributeError, LookupError, TypeError, ValueError
-    ):
-        ended = read_manifest(root)
-        runner = ended.get("runner") or {}
-        # "running": killed, or a resume begun since; end_cut: a stop that wrote no lights.lp
-        if may_lack and ended.get("lp_file") == LP_NAME and runner.get("state") != "running":
-            listed = set() if runner.get("end_cut") else ended.get("steps") or ()
-            may_lack = set(may_lack) - {int(s["index"]) for s in listed}
     if data is not None and (not data.strip() or _run_wrote_lp(data, records, done, may_lack)):
         return None
     return _set_aside(root, path, stamp, fresh=True)

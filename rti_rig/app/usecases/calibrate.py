@@ -25,7 +25,7 @@ from rti_rig.app.light_calibration import (
     calibration_toml,
     card_spread_deg,
     read_card_session,
-    refuse_card_of_another_rig,
+    refuse_other_rig,
     step_direction,
 )
 from rti_rig.app.output_files import check_output_file, rig_inputs
@@ -186,7 +186,8 @@ LED_KEYS = ("lights", "light_positions", "light_directions", "dome_firmware")
 
 
 def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> str | None:
-    """Refuse a card session shot while the rig's LEDs were others than ``--rig`` gives now;
+    """Refuse a card session shot on another rig, or while the rig's LEDs were others than
+    ``--rig`` gives now;
     the note to say where they are the same LEDs re-measured, else None.
 
     Why: the correction is written per LED number and only the rig's name was compared. A
@@ -204,8 +205,11 @@ def _refuse_other_leds(req: CalibrateRequest, loaded: LoadedRig) -> str | None:
 
     manifest = read_manifest(req.card_session)
     rig = manifest.get("rig") or {}
-    if not isinstance(rig, dict) or rig.get("name") != loaded.config.name:
-        return None  # another rig's card: refused by name where the card session is read
+    if not isinstance(rig, dict):
+        return None  # a manifest that says no rig: refused where the card session is read
+    # another rig's card, refused before a calibration already beside it (told to write that
+    # elsewhere first, the user had learnt only then that no file of this card fits this rig)
+    refuse_other_rig(Path(req.card_session), rig, loaded.config.name)
     recorded = rig.get("identity")
     if not isinstance(recorded, dict):
         return None
@@ -301,9 +305,6 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     loaded = load_rig_config(req.rig_config)
     _check_dome_can_dim(req, loaded)
     geometry = rig_geometry(loaded)
-    # another rig's card before a calibration already beside it: told to write it elsewhere
-    # first, the user had learnt only then that no file of this card fits this rig
-    refuse_card_of_another_rig(req.card_session, loaded.config.name)
     # from the manifest, before any image is read: a card of other LEDs had every image read
     # (and a card with images missing was refused for them) before the refusal that mattered
     same_leds = _refuse_other_leds(req, loaded)
