@@ -1,10 +1,11 @@
 """Homogeneous light layouts: the baseline every smarter plan must beat.
 
 For a dome, "homogeneous" means choosing ``n`` of its LEDs that cover the hemisphere (above an
-optional elevation floor) as evenly as possible, without repeats: ideal equal-area directions are
-matched one-to-one to LEDs by minimum total angle (an optimal assignment, not greedy snapping,
-which can pick the same LED twice or leave gaps). For an arm, the ideal directions are used
-directly within its reachable band.
+optional elevation floor) as evenly as possible, without repeats: ideal equal-area directions
+(for three lights the orthogonal triad, :func:`~rti_rig.core.geometry.even_layout`) are matched
+one-to-one to LEDs by minimum total angle (an optimal assignment, not greedy snapping, which can
+pick the same LED twice or leave gaps). For an arm, the ideal directions are used directly
+within its reachable band.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import ScheduleError
-from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
+from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, even_layout
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule
 
@@ -69,14 +70,19 @@ def select_uniform_leds(
             fewer = f"{fewer} or {widen}" if fewer else widen
         if not fewer:  # no fewer lights will do and there is no band to widen
             fewer = f"a plan needs at least {fewest} lights: use a rig with more"
-        raise ScheduleError(
-            f"asked for {n} lights but the dome has only {len(candidates)} LEDs{band}; {fewer}"
+        # none in the band: where its LEDs do stand is what a user widens the band to ("only 0
+        # LEDs at or above 80°" had been said of a dome whose highest LED is at 70°)
+        has = (
+            f"only {len(candidates)} LED{'s' if len(candidates) != 1 else ''}{band}"
+            if len(candidates)
+            else f"no LED{band} (its LEDs stand between {el.min():.3g}° and {el.max():.3g}°)"
         )
+        raise ScheduleError(f"asked for {n} lights but the dome has {has}; {fewer}")
     if n == len(candidates):
         return np.sort(candidates)
     lo = max(min_elevation_deg, float(el[candidates].min()))
     hi = float(el[candidates].max())
-    ideal = fibonacci_cap(n, lo, hi) if hi > lo else fibonacci_cap(n, 0.0, 90.0)
+    ideal = even_layout(n, lo, hi) if hi > lo else even_layout(n, 0.0, 90.0)
     if azimuth_offset_deg:
         t = np.radians(azimuth_offset_deg)
         c, s = np.cos(t), np.sin(t)

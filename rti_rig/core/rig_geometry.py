@@ -17,7 +17,7 @@ from rti_rig.core.geometry import (
     angle_between_deg,
     az_el_from_direction,
     direction_from_az_el,
-    fibonacci_cap,
+    even_layout,
 )
 
 #: Two LEDs closer than this (degrees) are one LED listed twice: a real LED is several tenths of a
@@ -241,7 +241,7 @@ class ArmGeometry:
         if n <= 0:
             raise ScheduleError(f"--lights must be at least 1, got {n}")
         lo, hi = self.elevation_band(min_elevation_deg)
-        az, el = az_el_from_direction(fibonacci_cap(n, lo, hi))
+        az, el = az_el_from_direction(even_layout(n, lo, hi))
         a = np.where(az > 180.0, az - 360.0, az)
         span = self.max_azimuth_deg - self.min_azimuth_deg
         if span < 360.0:

@@ -90,3 +90,32 @@ def test_fibonacci_cap_band(n: int) -> None:
     assert d.shape == (n, 3)
     assert np.all(el >= 15.0) and np.all(el <= 80.0)
     np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0)
+
+
+def test_three_lights_are_the_orthogonal_triad() -> None:
+    """Three mutually orthogonal lights minimise photometric stereo's noise for a normal not
+    known in advance: ``LᵀL`` is the identity, and the three stand 120° apart at 35.26°."""
+    from rti_rig.core.geometry import ORTHOGONAL_TRIAD_ELEVATION_DEG, even_layout
+
+    lights = even_layout(3)
+    np.testing.assert_allclose(lights.T @ lights, np.eye(3), atol=1e-12)
+    az, el = az_el_from_direction(lights)
+    np.testing.assert_allclose(el, ORTHOGONAL_TRIAD_ELEVATION_DEG, atol=1e-9)
+    np.testing.assert_allclose(np.sort(az), [0.0, 120.0, 240.0], atol=1e-9)
+
+
+@pytest.mark.parametrize(("band", "expected"), [((0, 90), 35.26), ((50, 80), 50), ((0, 30), 30)])
+def test_three_lights_keep_to_the_band(band: tuple[float, float], expected: float) -> None:
+    """A band that leaves out 35.26° gets the triad at its nearest edge, still 120° apart."""
+    from rti_rig.core.geometry import even_layout
+
+    az, el = az_el_from_direction(even_layout(3, *band))
+    np.testing.assert_allclose(el, expected, atol=0.01)
+    np.testing.assert_allclose(np.sort(az), [0.0, 120.0, 240.0], atol=1e-9)
+
+
+@pytest.mark.parametrize("n", [1, 2, 4, 6, 12, 48])
+def test_other_counts_are_the_equal_area_spiral(n: int) -> None:
+    from rti_rig.core.geometry import even_layout
+
+    np.testing.assert_array_equal(even_layout(n, 10.0, 80.0), fibonacci_cap(n, 10.0, 80.0))

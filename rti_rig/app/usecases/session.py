@@ -1121,9 +1121,15 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
             if band:
                 fewer.append("widen --min-elevation-deg / --max-elevation-deg")
             asked = f"--lights {n}" if req.lights is not None else f"{n} lights (every image)"
+            has = (
+                f"only {inside} image{'s' if inside != 1 else ''}{band}"
+                if inside
+                else f"no image{band} (its images' lights stand between {el.min():.3g}° and "
+                f"{el.max():.3g}°)"
+            )
             raise RtiRigError(
-                f"{asked}: the acquisition {shown_path(loaded.path)} has only {inside} "
-                f"images{band}; " + " or ".join(fewer)
+                f"{asked}: the acquisition {shown_path(loaded.path)} has {has}; "
+                + " or ".join(fewer)
             )
     schedule = plan_uniform(
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
