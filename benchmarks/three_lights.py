@@ -19,7 +19,7 @@ what a user gets.
   photometric stereo on all 72 lights.
 * Each layout's tilt tolerance on the shipped dome and arm, as ``rti-rig plan`` says it.
 
-Run: ``python -m benchmarks.three_lights`` (about a minute; ``--write`` puts the figures in
+Run: ``python -m benchmarks.three_lights`` (seconds; ``--write`` puts the figures in
 docs/planning.md).
 """
 

@@ -96,13 +96,8 @@ def even_layout(
     tablet it fell by a third to three quarters in every draw, and the coin and a plane tilted
     50° (beyond any three lights) were ties."""
     if n == 3 and 0.0 <= min_elevation_deg <= max_elevation_deg <= 90.0:
-        el = np.radians(
-            min(max(ORTHOGONAL_TRIAD_ELEVATION_DEG, min_elevation_deg), max_elevation_deg)
-        )
-        az = np.radians([0.0, 120.0, 240.0])
-        return np.stack(
-            [np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.full(3, np.sin(el))], axis=-1
-        )
+        el = min(max(ORTHOGONAL_TRIAD_ELEVATION_DEG, min_elevation_deg), max_elevation_deg)
+        return direction_from_az_el([0.0, 120.0, 240.0], el)
     return fibonacci_cap(n, min_elevation_deg, max_elevation_deg)
 
 
