@@ -29,6 +29,23 @@ def band_text(min_elevation_deg: float, max_elevation_deg: float) -> str:
     return f" at or above {min_elevation_deg:g}° elevation" if min_elevation_deg > 0 else ""
 
 
+def count_in_band_text(
+    count: int,
+    band: str,
+    elevations: NDArray[np.float64],
+    one: str = "LED",
+    where: str = "its LEDs",
+) -> str:
+    """What a rig has in an elevation band, for a refusal of too many lights: "only 6 LEDs at or
+    above 65° elevation", or, with none there, where its lights do stand ("no LED at or above
+    80° elevation (its LEDs stand between 10° and 70°)"): the elevations to widen the band to.
+    Why: "only 0 LEDs at or above 80°" had been said of a dome whose highest LED is at 70°."""
+    if count:
+        return f"only {count} {one}{'s' if count != 1 else ''}{band}"
+    lo, hi = float(elevations.min()), float(elevations.max())
+    return f"no {one}{band} ({where} stand between {lo:.3g}° and {hi:.3g}°)"
+
+
 def band_run_options(lights: int, min_elevation_deg: float, max_elevation_deg: float) -> str:
     """``--lights N`` and the ``--min/--max-elevation-deg`` (those not at their defaults) of a
     planned run that keeps to a band: the advice of a refusal that sends the user to one."""
@@ -70,13 +87,7 @@ def select_uniform_leds(
             fewer = f"{fewer} or {widen}" if fewer else widen
         if not fewer:  # no fewer lights will do and there is no band to widen
             fewer = f"a plan needs at least {fewest} lights: use a rig with more"
-        # none in the band: where its LEDs do stand is what a user widens the band to ("only 0
-        # LEDs at or above 80°" had been said of a dome whose highest LED is at 70°)
-        has = (
-            f"only {len(candidates)} LED{'s' if len(candidates) != 1 else ''}{band}"
-            if len(candidates)
-            else f"no LED{band} (its LEDs stand between {el.min():.3g}° and {el.max():.3g}°)"
-        )
+        has = count_in_band_text(len(candidates), band, el)
         raise ScheduleError(f"asked for {n} lights but the dome has {has}; {fewer}")
     if n == len(candidates):
         return np.sort(candidates)

@@ -1110,7 +1110,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         # (with --min/--max-elevation-deg the planner's refusal had said "the dome has only
         # 8 LEDs at or above 50° elevation" of an acquisition's images)
         from rti_rig.core.geometry import az_el_from_direction
-        from rti_rig.planner.uniform import band_text
+        from rti_rig.planner.uniform import band_text, count_in_band_text
 
         lo, hi = req.min_elevation_deg, req.max_elevation_deg
         _, el = az_el_from_direction(geometry.directions)
@@ -1121,12 +1121,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
             if band:
                 fewer.append("widen --min-elevation-deg / --max-elevation-deg")
             asked = f"--lights {n}" if req.lights is not None else f"{n} lights (every image)"
-            has = (
-                f"only {inside} image{'s' if inside != 1 else ''}{band}"
-                if inside
-                else f"no image{band} (its images' lights stand between {el.min():.3g}° and "
-                f"{el.max():.3g}°)"
-            )
+            has = count_in_band_text(inside, band, el, "image", "its images' lights")
             raise RtiRigError(
                 f"{asked}: the acquisition {shown_path(loaded.path)} has {has}; "
                 + " or ".join(fewer)
