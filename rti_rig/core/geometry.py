@@ -101,6 +101,50 @@ def even_layout(
     return fibonacci_cap(n, min_elevation_deg, max_elevation_deg)
 
 
+#: The largest condition number of three lights' directions under which a fit solves a pixel
+#: lit by all three: ``rti_rig.reconstruct.solve.COND_LIMIT``, restated here (the core imports
+#: nothing else of rti_rig; a test keeps the two equal).
+TRIAD_RING_COND_LIMIT = 100.0
+
+
+def triad_within_azimuths(
+    min_azimuth_deg: float,
+    max_azimuth_deg: float,
+    min_elevation_deg: float,
+    max_elevation_deg: float,
+) -> NDArray[np.float64]:
+    """Three light directions for an arm whose base turns only from ``min_azimuth_deg`` to
+    ``max_azimuth_deg`` (degrees, in -180..180), within an elevation band: the triad of
+    :func:`even_layout` (on its ring, at the elevation in the band nearest 35.26°), turned to
+    the middle of the range where the range holds its 120° steps (240° of range or more), else
+    on the same ring at the range's two limits and its middle.
+
+    Why: the triad had been mapped linearly into the range, as the spiral of other counts is,
+    which on an arm turning ±90° put its lights at -60°, 0° and 60°: 120° of the 180° the arm
+    has, a noise bound ``tr (LᵀL)⁻¹`` of 19 against 4.5 at -90°/0°/90° (3 for the triad),
+    and on the simulator's scenes a larger normal error on four of five (``python -m
+    benchmarks.three_lights``, its arm table; docs/planning.md). Spreading the lights further
+    by raising some of them (the least noise bound with none below 35.26°: 3.97 at ±90°) was
+    measured too and lost on the glossy coin and brushed steel, whose highlights the higher
+    lights catch: the bound counts camera noise, not gloss, so the ring is kept. Under 34° of
+    range (±17°) three lights on one ring determine no normal (condition number over
+    :data:`TRIAD_RING_COND_LIMIT`, which the fit refuses), so there the middle light goes to the
+    band's top (±15°: condition number 5.4 against 128)."""
+    if max_azimuth_deg - min_azimuth_deg >= 360.0:
+        return even_layout(3, min_elevation_deg, max_elevation_deg)
+    el = min(max(ORTHOGONAL_TRIAD_ELEVATION_DEG, min_elevation_deg), max_elevation_deg)
+    middle = 0.5 * (min_azimuth_deg + max_azimuth_deg)
+    if max_azimuth_deg - min_azimuth_deg >= 240.0:
+        return direction_from_az_el(middle + np.array([-120.0, 0.0, 120.0]), el)
+    ring = direction_from_az_el([min_azimuth_deg, middle, max_azimuth_deg], el)
+    if np.linalg.cond(ring) <= TRIAD_RING_COND_LIMIT:
+        return ring
+    # under 34° of range the ring determines no normal: its middle light to the band's top
+    return direction_from_az_el(
+        [min_azimuth_deg, middle, max_azimuth_deg], [el, max_elevation_deg, el]
+    )
+
+
 def fibonacci_cap(
     n: int, min_elevation_deg: float = 0.0, max_elevation_deg: float = 90.0
 ) -> NDArray[np.float64]:

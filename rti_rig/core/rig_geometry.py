@@ -18,6 +18,7 @@ from rti_rig.core.geometry import (
     az_el_from_direction,
     direction_from_az_el,
     even_layout,
+    triad_within_azimuths,
 )
 
 #: Two LEDs closer than this (degrees) are one LED listed twice: a real LED is several tenths of a
@@ -237,10 +238,13 @@ class ArmGeometry:
         The even layout's azimuths (-180°..180°) are mapped linearly onto the arm's azimuth
         range, so that the spread stays even within it. Why: they had been moved onto the
         nearest limit instead, so an arm turning ±170° lit every light of the 20° it cannot
-        reach at exactly ±170° (two or three lights of 24 at one place, a gap beside them)."""
+        reach at exactly ±170° (two or three lights of 24 at one place, a gap beside them).
+        Three lights are the triad, placed within the range (:func:`triad_within_azimuths`)."""
         if n <= 0:
             raise ScheduleError(f"--lights must be at least 1, got {n}")
         lo, hi = self.elevation_band(min_elevation_deg)
+        if n == 3:  # mapped linearly, the triad's three lights would close up on one ring
+            return triad_within_azimuths(self.min_azimuth_deg, self.max_azimuth_deg, lo, hi)
         az, el = az_el_from_direction(even_layout(n, lo, hi))
         a = np.where(az > 180.0, az - 360.0, az)
         span = self.max_azimuth_deg - self.min_azimuth_deg

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from benchmarks.three_lights import spiral_leds, tolerances, triad_leds
 from benchmarks.tradeoff import shipped_rig
@@ -31,3 +32,34 @@ def test_the_tilt_figures_are_the_plans() -> None:
     assert "triad at 40°, 40°, 40°, tilt tolerated 30°" in lines
     assert "`virtual_arm.toml`: spiral at 14°, 32°, 57°, tilt tolerated 5°" in lines
     assert "triad at 35°, 35°, 35°, tilt tolerated 25°" in lines
+
+
+def test_the_arm_layouts_are_the_ones_named() -> None:
+    """On an arm turning ±90°: the spiral and the triad mapped as they were planned before,
+    the least bound with none below the triad's elevation, and the arm's plan as it ships."""
+    from benchmarks.three_lights import arm_layouts, turned
+    from rti_rig.core.rig_geometry import ArmGeometry
+
+    arm = ArmGeometry(0.0, 90.0, 15.0, 0.0, 10.0, -90.0, 90.0)
+    layouts = arm_layouts(arm)
+    assert list(layouts) == ["spiral", "mapped triad", "least bound", "ships"]
+    for lights in layouts.values():
+        assert arm.reachable(lights).all()
+
+    def bound(lights: np.ndarray) -> float:
+        return float(np.trace(np.linalg.inv(lights.T @ lights)))
+
+    az, _ = az_el_from_direction(layouts["mapped triad"])
+    np.testing.assert_allclose(np.sort(np.where(az > 180, az - 360, az)), [-60, 0, 60], atol=1e-9)
+    assert bound(layouts["mapped triad"]) == pytest.approx(19.0)
+    assert bound(layouts["least bound"]) < bound(layouts["ships"]) == pytest.approx(4.5)
+    assert az_el_from_direction(layouts["least bound"])[1].min() >= 35.26 - 1e-6
+    np.testing.assert_array_equal(layouts["ships"], arm.homogeneous(3))
+    # a turn about the camera axis keeps each light's elevation and the layout's shape
+    t = turned(layouts["ships"], 37.0)
+    np.testing.assert_allclose(
+        az_el_from_direction(t)[1], az_el_from_direction(layouts["ships"])[1]
+    )
+    ships = layouts["ships"]
+    np.testing.assert_allclose(np.linalg.eigvalsh(t.T @ t), np.linalg.eigvalsh(ships.T @ ships))
+    assert not np.allclose(t, ships)

@@ -52,3 +52,87 @@ def test_homogeneous_does_not_bunch_lights_at_a_limit() -> None:
     az, _ = az_el_from_direction(arm.homogeneous(24))
     at_limit = np.isclose(np.abs(_signed(az)), 170.0, atol=1e-6)
     assert at_limit.sum() <= 1, _signed(az)
+
+
+def _noise_bound(lights: np.ndarray) -> float:
+    """Photometric stereo's noise bound for a normal not known in advance, tr (LᵀL)⁻¹ (3 for
+    three orthogonal lights, the least three can give)."""
+    return float(np.trace(np.linalg.inv(lights.T @ lights)))
+
+
+def _linearly_mapped_triad(arm: ArmGeometry) -> np.ndarray:
+    """The triad as it had been placed before: 0°/120°/240° mapped linearly into the range."""
+    from rti_rig.core.geometry import direction_from_az_el, even_layout
+
+    lo, hi = arm.elevation_band()
+    az, el = az_el_from_direction(even_layout(3, lo, hi))
+    span = arm.max_azimuth_deg - arm.min_azimuth_deg
+    return direction_from_az_el(arm.min_azimuth_deg + (_signed(az) + 180.0) * span / 360.0, el)
+
+
+@pytest.mark.parametrize("half_span", [180.0, 170.0, 120.0])
+def test_three_lights_are_the_exact_triad_where_the_range_holds_it(half_span: float) -> None:
+    """From 240° of range the triad fits whole: turned to the range's middle, not squeezed."""
+    arm = ArmGeometry(0.0, 90.0, 15.0, 0.0, 10.0, -half_span, half_span)
+    lights = arm.homogeneous(3)
+    np.testing.assert_allclose(lights.T @ lights, np.eye(3), atol=1e-12)
+    assert arm.reachable(lights).all()
+
+
+@pytest.mark.parametrize(
+    ("low", "high"), [(-90.0, 90.0), (0.0, 180.0), (-60.0, 60.0), (-45.0, 45.0)]
+)
+def test_three_lights_on_a_narrow_arm_reach_its_limits(low: float, high: float) -> None:
+    """Under 240° of range the triad cannot stand 120° apart: its ring is kept and its lights
+    go to the range's two limits and its middle. Mapped linearly, they had stood at 1/6, 1/2
+    and 5/6 of the range (-60°/0°/60° on an arm turning ±90°: noise bound 19 against 4.5)."""
+    from rti_rig.core.geometry import ORTHOGONAL_TRIAD_ELEVATION_DEG
+
+    arm = ArmGeometry(0.0, 90.0, 15.0, 0.0, 10.0, low, high)
+    lights = arm.homogeneous(3)
+    assert arm.reachable(lights).all()
+    az, el = az_el_from_direction(lights)
+    np.testing.assert_allclose(el, ORTHOGONAL_TRIAD_ELEVATION_DEG, atol=1e-9)
+    np.testing.assert_allclose(np.sort(_signed(az)), [low, 0.5 * (low + high), high], atol=1e-9)
+    assert _noise_bound(lights) < _noise_bound(_linearly_mapped_triad(arm)) / 3.0
+    if (low, high) == (-90.0, 90.0):
+        assert _noise_bound(lights) == pytest.approx(4.5)
+
+
+def test_three_lights_on_a_narrow_arm_under_a_ceiling_stand_at_it() -> None:
+    """A ceiling below 35.26° holds every light at the ceiling, spread over the range."""
+    arm = ArmGeometry(0.0, 30.0, 15.0, 0.0, 10.0, -90.0, 90.0)
+    az, el = az_el_from_direction(arm.homogeneous(3))
+    np.testing.assert_allclose(el, 30.0, atol=1e-9)
+    np.testing.assert_allclose(np.sort(_signed(az)), [-90.0, 0.0, 90.0], atol=0.01)
+
+
+def test_the_ring_limit_is_the_fits() -> None:
+    """The core restates the fit's condition limit (it imports nothing else of rti_rig)."""
+    from rti_rig.core.geometry import TRIAD_RING_COND_LIMIT
+    from rti_rig.reconstruct.solve import COND_LIMIT
+
+    assert TRIAD_RING_COND_LIMIT == COND_LIMIT
+
+
+@pytest.mark.parametrize("half", [16.0, 10.0, 2.0])
+def test_three_lights_on_a_very_narrow_arm_raise_the_middle_one(half: float) -> None:
+    """Under 34° of range three lights on one ring are too nearly on one great circle for the
+    fit (condition number 112 at ±16°): the middle light goes to the top of the band, and the
+    three determine a normal again."""
+    from rti_rig.core.geometry import TRIAD_RING_COND_LIMIT
+
+    arm = ArmGeometry(0.0, 90.0, 15.0, 0.0, 10.0, -half, half)
+    lights = arm.homogeneous(3)
+    assert arm.reachable(lights).all()
+    az, el = az_el_from_direction(lights)
+    np.testing.assert_allclose(np.sort(_signed(az)), [-half, 0.0, half], atol=1e-9)
+    np.testing.assert_allclose(np.sort(el), [35.26, 35.26, 75.0], atol=0.01)
+    assert np.linalg.cond(lights) < TRIAD_RING_COND_LIMIT
+
+
+def test_the_ring_is_kept_while_it_determines_a_normal() -> None:
+    """At ±17° the ring still passes the fit's limit (condition number 99), so it is kept."""
+    arm = ArmGeometry(0.0, 90.0, 15.0, 0.0, 10.0, -17.0, 17.0)
+    _, el = az_el_from_direction(arm.homogeneous(3))
+    np.testing.assert_allclose(el, 35.26, atol=0.01)
