@@ -63,3 +63,18 @@ def test_the_arm_layouts_are_the_ones_named() -> None:
     ships = layouts["ships"]
     np.testing.assert_allclose(np.linalg.eigvalsh(t.T @ t), np.linalg.eigvalsh(ships.T @ ships))
     assert not np.allclose(t, ships)
+
+
+def test_the_sparse_domes_alternative_is_the_most_tilt_tolerant_turn() -> None:
+    """On the 12-LED elexol dome the triad at its fixed orientation takes a 17° LED (5° of
+    tilt); the alternative measured against it keeps a normal to 25°."""
+    from benchmarks.three_lights import tolerant_triad_leds
+    from rti_rig.planner.tilt_guard import tilt_tolerance
+
+    dome = rig_geometry(shipped_rig("emulated_elexol.toml"))
+    up = np.array([0.0, 0.0, 1.0])
+    ships = dome.directions[triad_leds(dome, 0.0)]
+    tolerant = dome.directions[tolerant_triad_leds(dome, 0.0)]
+    assert tilt_tolerance(ships, up) == 5.0
+    assert tilt_tolerance(tolerant, up) == 25.0
+    assert az_el_from_direction(ships)[1].min() == pytest.approx(17.0, abs=0.5)
