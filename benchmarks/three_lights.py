@@ -196,13 +196,33 @@ def turned(lights: NDArray[np.float64], turn_deg: float) -> NDArray[np.float64]:
     return lights @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T
 
 
+def errors_under_turns(
+    layouts: dict[str, NDArray[np.float64]], scene: str, settings: TradeoffSettings
+) -> dict[str, NDArray[np.float64]]:
+    """Each layout's mean normal error on ``scene`` in :data:`DRAWS` draws, each the object at
+    a random turn under the lights with fresh camera noise (the same for every layout), the
+    images rendered at the layout's exact directions."""
+    from benchmarks.tradeoff import scene_camera
+
+    model, shoot = scene_camera(scene, settings)
+    truth = np.asarray(model.normals, dtype=np.float64)
+    errs: dict[str, list[float]] = {k: [] for k in layouts}
+    for draw in range(DRAWS):
+        turn = float(np.random.default_rng([SEED, draw]).uniform(0.0, 360.0))
+        for label, lights in layouts.items():
+            lit = turned(lights, turn)
+            noise = np.random.default_rng([SEED, draw, 1])  # alike for every layout
+            images = np.stack([shoot(d, noise) for d in lit])
+            errs[label].append(normal_error(truth, images, lit)[0])
+    return {k: np.array(v) for k, v in errs.items()}
+
+
 def arms() -> tuple[list[str], list[str]]:
     """The table's rows and a line per arm range (each layout's noise bound and tilt
     tolerance). One row per arm range and scene: each layout's mean normal error over :data:`DRAWS`
     draws, each the object at a random turn under the arm with fresh camera noise (the same
     for every layout), the images rendered at the layout's exact directions; the paired
     verdicts of what ships against the others."""
-    from benchmarks.tradeoff import scene_camera
     from rti_rig.planner.tilt_guard import tilt_tolerance
 
     settings = replace(TradeoffSettings(), seed=0)
@@ -219,20 +239,11 @@ def arms() -> tuple[list[str], list[str]]:
         lines.append(f"- Arm turning ±{half:g}°: {said}.")
         print(lines[-1], flush=True)
         for scene in settings.scenes:
-            model, shoot = scene_camera(scene, settings)
-            truth = np.asarray(model.normals, dtype=np.float64)
-            errs: dict[str, list[float]] = {k: [] for k in layouts}
-            for draw in range(DRAWS):
-                turn = float(np.random.default_rng([SEED, draw]).uniform(0.0, 360.0))
-                for label, lights in layouts.items():
-                    lit = turned(lights, turn)
-                    noise = np.random.default_rng([SEED, draw, 1])  # alike for every layout
-                    images = np.stack([shoot(d, noise) for d in lit])
-                    errs[label].append(normal_error(truth, images, lit)[0])
-            ships = np.array(errs["ships"])
+            errs = errors_under_turns(layouts, scene, settings)
+            ships = errs["ships"]
             verdicts = []
             for other in ("mapped triad", "spiral", "least bound"):
-                c = compare(ships, np.array(errs[other]), SEED)
+                c = compare(ships, errs[other], SEED)
                 verdicts.append(f"{c.wins}/{c.draws} {c.verdict()}")
             means = " | ".join(f"{np.mean(errs[k]):.2f}" for k in layouts)
             rows.append(f"| ±{half:g}° | {scene} | {means} | {' | '.join(verdicts)} |")
@@ -266,7 +277,7 @@ def sparse_domes() -> tuple[list[str], list[str]]:
     """The table's rows and a line per dome (where each layout's lights stand). One row per
     sparse dome and scene: the triad at its fixed orientation (ships) against the most
     tilt-tolerant turn of it, over :data:`DRAWS` random turns of the object."""
-    from benchmarks.tradeoff import scene_camera, shipped_rig
+    from benchmarks.tradeoff import shipped_rig
     from rti_rig.app.config import rig_geometry
     from rti_rig.planner.tilt_guard import tilt_tolerance
 
@@ -287,17 +298,8 @@ def sparse_domes() -> tuple[list[str], list[str]]:
         )
         lines.append(f"- `{name}`, {len(dome.names)} LEDs: {said}.")
         for scene in settings.scenes:
-            model, shoot = scene_camera(scene, settings)
-            truth = np.asarray(model.normals, dtype=np.float64)
-            errs: dict[str, list[float]] = {k: [] for k in layouts}
-            for draw in range(DRAWS):
-                turn = float(np.random.default_rng([SEED, draw]).uniform(0.0, 360.0))
-                for label, lights in layouts.items():
-                    lit = turned(lights, turn)
-                    noise = np.random.default_rng([SEED, draw, 1])
-                    images = np.stack([shoot(d, noise) for d in lit])
-                    errs[label].append(normal_error(truth, images, lit)[0])
-            c = compare(np.array(errs["ships"]), np.array(errs["most tolerant"]), SEED)
+            errs = errors_under_turns(layouts, scene, settings)
+            c = compare(errs["ships"], errs["most tolerant"], SEED)
             rows.append(
                 f"| `{name}` | {scene} | "
                 f"{np.mean(errs['ships']):.2f} | {np.mean(errs['most tolerant']):.2f} | "

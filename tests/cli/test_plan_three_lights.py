@@ -82,48 +82,42 @@ def test_a_three_light_session_is_shot_on_the_ring_and_fitted(tmp_path: Path) ->
     assert np.isfinite(normals).all() and normals[..., 2].mean() > 0.5
 
 
-def test_an_arm_turning_half_way_round_spreads_the_three_lights(tmp_path: Path) -> None:
-    """The shipped servo arm with its base limited to ±90° (a cable, a wall): the triad mapped
-    linearly into that range had stood at -60°, 0° and 60° (noise bound tr (LᵀL)⁻¹ = 19,
-    against 3 for the triad). Now the triad's ring at the range's limits and middle: -90°, 0°
-    and 90° (bound 4.5), still at 35.26°, so a 25° tilt still faces all three."""
+def _plan_on_arm_turning(tmp_path: Path, half: float) -> tuple[np.ndarray, str]:
+    """``plan --lights 3`` on the shipped servo arm with its base limited to ±``half``°."""
     text = (CONFIGS / "simulated_arm.toml").read_text(encoding="utf-8")
     assert text.count("min_deg = -170.0") == 1 and text.count("max_deg = 170.0") == 1
-    config = tmp_path / "half_turn_arm.toml"
+    config = tmp_path / "limited_arm.toml"
     config.write_text(
-        text.replace("min_deg = -170.0", "min_deg = -90.0").replace(
-            "max_deg = 170.0", "max_deg = 90.0"
+        text.replace("min_deg = -170.0", f"min_deg = {-half}").replace(
+            "max_deg = 170.0", f"max_deg = {half}"
         ),
         encoding="utf-8",
     )
     out = tmp_path / "plan.lp"
     r = CliRunner().invoke(app, ["plan", "--rig", str(config), "--lights", "3", "--out", str(out)])
     assert r.exit_code == 0, r.output
-    lights = np.array([e.direction for e in read_lp(out)])
+    return np.array([e.direction for e in read_lp(out)]), " ".join(r.output.split())
+
+
+def test_an_arm_turning_half_way_round_spreads_the_three_lights(tmp_path: Path) -> None:
+    """The shipped servo arm with its base limited to ±90° (a cable, a wall): the triad mapped
+    linearly into that range had stood at -60°, 0° and 60° (noise bound tr (LᵀL)⁻¹ = 19,
+    against 3 for the triad). Now the triad's ring at the range's limits and middle: -90°, 0°
+    and 90° (bound 4.5), still at 35.26°, so a 25° tilt still faces all three."""
+    lights, said = _plan_on_arm_turning(tmp_path, 90.0)
     az, el = az_el_from_direction(lights)
     np.testing.assert_allclose(
         np.sort(np.where(az > 180.0, az - 360.0, az)), [-90, 0, 90], atol=0.01
     )
     np.testing.assert_allclose(el, 35.26, atol=0.01)
     assert np.trace(np.linalg.inv(lights.T @ lights)) == pytest.approx(4.5, abs=1e-3)
-    assert "tilted up to 25° in any direction" in " ".join(r.output.split())
+    assert "tilted up to 25° in any direction" in said
 
 
 def test_an_arm_turning_only_thirty_degrees_still_plans_a_normal_map(tmp_path: Path) -> None:
     """A base joint limited to ±15°: three lights on one ring were refused ("cannot determine
     a surface normal ... leave no other choice", though the arm reaches other elevations);
     now the middle one stands at the band's top and the plan is written."""
-    text = (CONFIGS / "simulated_arm.toml").read_text(encoding="utf-8")
-    config = tmp_path / "narrow_arm.toml"
-    config.write_text(
-        text.replace("min_deg = -170.0", "min_deg = -15.0").replace(
-            "max_deg = 170.0", "max_deg = 15.0"
-        ),
-        encoding="utf-8",
-    )
-    out = tmp_path / "plan.lp"
-    r = CliRunner().invoke(app, ["plan", "--rig", str(config), "--lights", "3", "--out", str(out)])
-    assert r.exit_code == 0, r.output
-    lights = np.array([e.direction for e in read_lp(out)])
+    lights, said = _plan_on_arm_turning(tmp_path, 15.0)
     assert np.linalg.cond(lights) < 10.0
-    assert "tilted up to 25° in any direction" in " ".join(r.output.split())
+    assert "tilted up to 25° in any direction" in said
