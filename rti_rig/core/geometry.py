@@ -122,7 +122,8 @@ def triad_within_azimuths(
     Why: the triad had been mapped linearly into the range, as the spiral of other counts is,
     which on an arm turning ±90° put its lights at -60°, 0° and 60°: 120° of the 180° the arm
     has, a noise bound ``tr (LᵀL)⁻¹`` of 19 against 4.5 at -90°/0°/90° (3 for the triad),
-    and on the simulator's scenes a larger normal error on four of five (``python -m
+    and on the simulator's scenes, at ±90° and at ±60°, a larger normal error on four of five
+    and a tie on the fifth, a plane tilted 50° that no three lights keep (``python -m
     benchmarks.three_lights``, its arm table; docs/planning.md). Spreading the lights further
     by raising some of them (the least noise bound with none below 35.26°: 3.97 at ±90°) was
     measured too and lost on the glossy coin and brushed steel, whose highlights the higher
@@ -140,6 +141,7 @@ def triad_within_azimuths(
     if np.linalg.cond(ring) <= TRIAD_RING_COND_LIMIT:
         return ring
     # under 34° of range the ring determines no normal: its middle light to the band's top
+    # (a band whose top is the ring's own leaves it as it is, and the plan says so)
     return direction_from_az_el(
         [min_azimuth_deg, middle, max_azimuth_deg], [el, max_elevation_deg, el]
     )
