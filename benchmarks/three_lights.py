@@ -219,10 +219,8 @@ def errors_under_turns(
 
 def arms() -> tuple[list[str], list[str]]:
     """The table's rows and a line per arm range (each layout's noise bound and tilt
-    tolerance). One row per arm range and scene: each layout's mean normal error over :data:`DRAWS`
-    draws, each the object at a random turn under the arm with fresh camera noise (the same
-    for every layout), the images rendered at the layout's exact directions; the paired
-    verdicts of what ships against the others."""
+    tolerance). One row per arm range and scene: each layout's mean normal error
+    (:func:`errors_under_turns`) and the paired verdicts of what ships against the others."""
     from rti_rig.planner.tilt_guard import tilt_tolerance
 
     settings = replace(TradeoffSettings(), seed=0)
