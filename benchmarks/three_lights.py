@@ -67,9 +67,7 @@ def spiral_leds(dome: DomeGeometry, turn_deg: float) -> NDArray[np.intp]:
 
     _, el = az_el_from_direction(dome.directions)
     ideal = fibonacci_cap(3, max(0.0, float(el.min())), float(el.max()))
-    t = np.radians(turn_deg)
-    c, s = np.cos(t), np.sin(t)
-    ideal = ideal @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T
+    ideal = turned(ideal, turn_deg)
     cost = angle_between_deg(ideal[:, None, :], dome.directions[None, :, :])
     _, cols = linear_sum_assignment(cost)
     return np.sort(cols)
@@ -139,15 +137,6 @@ def real_dome() -> list[str]:
 ARM_HALF_RANGES_DEG = (90.0, 60.0)
 
 
-def mapped_linearly(ideal: NDArray[np.float64], arm: ArmGeometry) -> NDArray[np.float64]:
-    """``ideal``'s azimuths (-180..180) mapped linearly onto the arm's range, as an arm's plan
-    of three placed them until 2026-12-05 (and still places every other count)."""
-    az, el = az_el_from_direction(ideal)
-    a = np.where(az > 180.0, az - 360.0, az)
-    span = arm.max_azimuth_deg - arm.min_azimuth_deg
-    return direction_from_az_el(arm.min_azimuth_deg + (a + 180.0) * span / 360.0, el)
-
-
 def least_bound_above_triad(arm: ArmGeometry) -> NDArray[np.float64]:
     """The alternative measured and not shipped: the three reachable directions of least
     noise bound ``tr (LᵀL)⁻¹`` with none below the triad's elevation (L-BFGS-B from four
@@ -181,16 +170,17 @@ def arm_layouts(arm: ArmGeometry) -> dict[str, NDArray[np.float64]]:
     the triad's elevation (measured, not shipped) and what ships (:meth:`homogeneous`)."""
     lo, hi = arm.elevation_band(0.0)
     return {
-        "spiral": mapped_linearly(fibonacci_cap(3, lo, hi), arm),
-        "mapped triad": mapped_linearly(even_layout(3, lo, hi), arm),
+        "spiral": arm.mapped_onto_range(fibonacci_cap(3, lo, hi)),
+        "mapped triad": arm.mapped_onto_range(even_layout(3, lo, hi)),
         "least bound": least_bound_above_triad(arm),
         "ships": arm.homogeneous(3),
     }
 
 
 def turned(lights: NDArray[np.float64], turn_deg: float) -> NDArray[np.float64]:
-    """``lights`` turned about the camera axis: the object turned the other way under the arm
-    (the error over a whole image does not depend on which of the two turns)."""
+    """``lights`` turned about the camera axis: a layout's arbitrary orientation, or the object
+    turned the other way under the lights (the error over a whole image does not depend on
+    which of the two turns)."""
     t = np.radians(turn_deg)
     c, s = np.cos(t), np.sin(t)
     return lights @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T

@@ -245,7 +245,12 @@ class ArmGeometry:
         lo, hi = self.elevation_band(min_elevation_deg)
         if n == 3:  # mapped linearly, the triad's three lights would close up on one ring
             return triad_within_azimuths(self.min_azimuth_deg, self.max_azimuth_deg, lo, hi)
-        az, el = az_el_from_direction(even_layout(n, lo, hi))
+        return self.mapped_onto_range(even_layout(n, lo, hi))
+
+    def mapped_onto_range(self, directions: ArrayLike) -> NDArray[np.float64]:
+        """``directions`` with their azimuths (-180°..180°) mapped linearly onto the arm's
+        azimuth range, each keeping its elevation (as they are on an arm turning all round)."""
+        az, el = az_el_from_direction(np.asarray(directions, dtype=np.float64))
         a = np.where(az > 180.0, az - 360.0, az)
         span = self.max_azimuth_deg - self.min_azimuth_deg
         if span < 360.0:
