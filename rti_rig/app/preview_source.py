@@ -36,7 +36,7 @@ from rti_rig.core.geometry import (
     az_el_from_direction,
     direction_from_az_el,
 )
-from rti_rig.core.lp_format import LpEntry, image_path
+from rti_rig.core.lp_format import LpEntry, image_path, lights_said
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.session import (
     JOURNAL,
@@ -285,11 +285,11 @@ def _lp_names(image: Path, rig_lp: RigLp) -> _LpNames:
     return _LpNames(exact, twins, other_files)
 
 
-def _lights_said(entries: Sequence[LpEntry], indexes: Sequence[int]) -> str:
-    """``lights 3 (image09.jpg) and 7 (IMAGE09.jpg)``: as a bare ``.lp`` rig's repeated lights
-    are named (their number in the file, their image name)."""
-    said = [f"{i + 1} ({entries[i].name})" for i in indexes]
-    return f"lights {', '.join(said[:-1])} and {said[-1]}"
+def _on_line(entry: LpEntry) -> str:
+    """`` (line 4)``: where the ``.lp`` holds ``entry``, for a user who opens it to correct
+    it (the light's number is not its line: a count line and comments come before); "" for
+    an entry not read from a file."""
+    return "" if entry.line is None else f" (line {entry.line})"
 
 
 def _lp_record(image: Path, rig_lp: RigLp) -> list[tuple[str, str, Any, str | None]]:
@@ -306,7 +306,7 @@ def _lp_record(image: Path, rig_lp: RigLp) -> list[tuple[str, str, Any, str | No
         return []
     if len(names.twins) > 1:
         raise ScheduleError(
-            f"{shown_path(lp)}: {_lights_said(entries, names.twins)} each name the preview "
+            f"{shown_path(lp)}: {lights_said(entries, names.twins)} each name the preview "
             f"{image.name} but for upper/lower case (one file on Windows and macOS, which ignore "
             "the case of file names), so which light lit it is not known: correct the names in "
             "the .lp, or give the light with --preview-light AZ,EL"
@@ -321,7 +321,8 @@ def _lp_record(image: Path, rig_lp: RigLp) -> list[tuple[str, str, Any, str | No
             "apart, so rename the file or correct the name in the .lp"
         )
     said = (
-        f"{lp.name} for {listed}, light {i + 1}, the preview {image.name} but for upper/lower case"
+        f"{lp.name} for {listed}, light {i + 1}{_on_line(entries[i])}, the preview {image.name} "
+        "but for upper/lower case"
     )
     return [(f"{lp} (as {listed})", said, entries[i].direction, why)]
 
@@ -374,7 +375,8 @@ def _other_file_said(image: Path, rig_lp: RigLp) -> str:
         return ""
     i = others[0]
     return (
-        f" (its light {i + 1}, {entries[i].name}, differs only in upper/lower case from "
+        f" (its light {i + 1}{_on_line(entries[i])}, {entries[i].name}, differs only in "
+        "upper/lower case from "
         f"{image.name} and is another file on this system, which tells the two names apart)"
     )
 

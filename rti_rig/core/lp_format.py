@@ -33,7 +33,7 @@ import os
 import re
 import unicodedata
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath, PureWindowsPath
 
 import numpy as np
@@ -56,10 +56,29 @@ _NAME_OK = re.compile(r"^[^\s]+$")
 
 @dataclass(frozen=True)
 class LpEntry:
-    """One line of an `.lp` file: an image name and the unit direction to its light."""
+    """One line of an `.lp` file: an image name and the unit direction to its light.
+
+    ``line`` is the line of the file it was read from (1-based; None for an entry made in
+    code), so that a refusal about a light can name the line a user opens the file at. It
+    takes no part in equality: the same light read from another file, or written by us, is
+    the same entry."""
 
     name: str
     direction: tuple[float, float, float]
+    line: int | None = field(default=None, compare=False)
+
+
+def lights_said(entries: Sequence[LpEntry], indexes: Sequence[int]) -> str:
+    """``lights 3 (line 4: image09.jpg) and 7 (line 8: IMAGE09.jpg)``: lights of one ``.lp``
+    named as a refusal names them — their number in the file (a dome's user thinks in
+    lights), the line to correct (past a count line and comments it is not the number) and
+    the image name."""
+    said = [
+        f"{i + 1} ({'' if entries[i].line is None else f'line {entries[i].line}: '}"
+        f"{entries[i].name})"
+        for i in indexes
+    ]
+    return f"lights {', '.join(said[:-1])} and {said[-1]}"
 
 
 def format_component(value: float) -> str:
@@ -1072,7 +1091,7 @@ def parse_lp(
         seen[name] = lineno
         if abs(norm - 1.0) > UNIT_TOLERANCE:
             off_unit.append((lineno, norm))
-        entries.append(LpEntry(name, (x / norm, y / norm, z / norm)))
+        entries.append(LpEntry(name, (x / norm, y / norm, z / norm), lineno))
 
     if not entries:
         raise LpFormatError(source, None, "no light lines after the count line")

@@ -204,3 +204,29 @@ def test_an_invisible_character_in_a_name_is_shown_and_named(tmp_path: Path) -> 
         assert "holds U+200B ZERO WIDTH SPACE, and image05.jpg is there" in text
         assert "delete it from the .lp" in text
         assert "copy them where their names point" not in text
+
+
+def test_two_lights_of_one_direction_as_a_plans_rig_are_named_by_their_lines(
+    tmp_path: Path,
+) -> None:
+    """As ``plan --rig``, an .lp is a dome of exactly its lights: a repeated direction is
+    refused with both lights' numbers, image names and lines (past a header comment, the
+    lines are not the numbers plus one)."""
+
+    def repeat(lines: list[str]) -> list[str]:
+        fields = lines[2].split()  # image05.jpg's light, given to image17.jpg (line 6)
+        lines = _set_field(lines, 5, 1, fields[1])
+        lines = _set_field(lines, 5, 2, fields[2])
+        return ["# dome C, calibrated 2026-12", *_set_field(lines, 5, 3, fields[3])]
+
+    lp = _acquisition(tmp_path, repeat)
+    r = runner.invoke(app, _commands(lp, tmp_path)[0])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert (
+        f"{lp}: lights 2 (line 4: image05.jpg) and 5 (line 7: image17.jpg) give the same "
+        "direction; as --rig, an .lp means a dome with exactly these lights, each listed once "
+        "(remove the repeats)" in text
+    ), text
+    assert "Traceback" not in r.output
+    assert not (tmp_path / "p.lp").exists()

@@ -71,8 +71,8 @@ def test_a_preview_named_but_for_case_plans_from_the_light_recorded_for_it(
     text = said(r)
     assert r.exit_code == 0, text
     assert (
-        f"preview light {recorded} (recorded by dirs.lp for image09.jpg, light 3, the preview "
-        "image09.JPG but for upper/lower case: " in text
+        f"preview light {recorded} (recorded by dirs.lp for image09.jpg, light 3 (line 4), the "
+        "preview image09.JPG but for upper/lower case: " in text
     ), text
     if _ignores_case(acq):
         why = "one file here, this system ignoring the case of file names as Windows and macOS do)"
@@ -95,8 +95,8 @@ def test_a_light_given_is_compared_with_the_light_recorded_for_the_case_twin(
     text = said(r)
     assert r.exit_code == 0, text
     assert (
-        "from the light recorded by dirs.lp for image09.jpg, light 3, the preview image09.JPG "
-        f"but for upper/lower case ({recorded}): the plan used the light given; leave "
+        "from the light recorded by dirs.lp for image09.jpg, light 3 (line 4), the preview "
+        f"image09.JPG but for upper/lower case ({recorded}): the plan used the light given; leave "
         "--preview-light out to plan with the recorded one" in text
     ), text
 
@@ -117,11 +117,15 @@ def test_two_lines_naming_the_preview_but_for_case_are_refused_naming_both(
 ) -> None:
     acq = _acquisition(tmp_path)
     _rename_line(acq, "image13.jpg", "IMAGE09.jpg")
+    # a header comment: the lines to correct are no longer the lights' numbers plus one
+    lp = acq / "dirs.lp"
+    lp.write_text("# dome A, 2026\n" + lp.read_text())
     r = _plan(acq, "image09.JPG")
     text = said(r)
     assert r.exit_code == 2, text
     assert (
-        f"{acq / 'dirs.lp'}: lights 3 (image09.jpg) and 4 (IMAGE09.jpg) each name the preview "
+        f"{acq / 'dirs.lp'}: lights 3 (line 5: image09.jpg) and 4 (line 6: IMAGE09.jpg) each "
+        "name the preview "
         "image09.JPG but for upper/lower case (one file on Windows and macOS, which ignore the "
         "case of file names), so which light lit it is not known: correct the names in the "
         ".lp, or give the light with --preview-light AZ,EL" in text
@@ -144,7 +148,7 @@ def test_a_case_twin_that_is_another_file_here_is_not_read_but_named(tmp_path: P
     text = said(r)
     assert r.exit_code == 0, text
     assert (
-        "as dirs.lp (--rig) does not list it (its light 3, image09.jpg, differs only in "
+        "as dirs.lp (--rig) does not list it (its light 3 (line 4), image09.jpg, differs only in "
         "upper/lower case from image09.JPG and is another file on this system, which tells the "
         "two names apart)" in text
     ), text

@@ -88,6 +88,17 @@ def test_tolerant_reading() -> None:
     assert [e.name for e in spaced] == ["IMG 001.jpg", "shot 2 b.tif", "my photo.jpg x.jpg"]
 
 
+def test_each_light_keeps_its_line_and_equality_ignores_it() -> None:
+    """The line a light was read from (for refusals a user corrects the file by), past a header
+    comment, a count line and blank lines; equality is the light's, not where it was read."""
+    text = "# dome A\n\n2\r\na_1.jpg 0.6 0.0 0.8\n\n\na_2.jpg 0 0 1\n"
+    entries = parse_lp(text)
+    assert [e.line for e in entries] == [4, 7]
+    assert entries[1] == LpEntry("a_2.jpg", (0.0, 0.0, 1.0))
+    assert len({entries[1], LpEntry("a_2.jpg", (0.0, 0.0, 1.0))}) == 1
+    assert LpEntry("a_2.jpg", (0.0, 0.0, 1.0)).line is None
+
+
 @pytest.mark.parametrize(
     ("text", "line", "fragment"),
     [

@@ -40,7 +40,7 @@ from rti_rig.core.errors import RtiRigError
 from rti_rig.core.fit_minimums import PLAN_DEFAULT_LIGHTS
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.image_files import png_alpha_note
-from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
+from rti_rig.core.lp_format import LpEntry, image_file_name, lights_said, read_lp, write_lp
 from rti_rig.core.out_folders import free_name
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 from rti_rig.core.schedule import LightSchedule
@@ -226,9 +226,8 @@ def _bare_lp_dome(rig: Path, notes: list[str]) -> tuple[DomeGeometry, list[LpEnt
     if pair is not None:
         i, j = pair
         raise RtiRigError(
-            f"{rig}: lights {i + 1} ({entries[i].name}) and {j + 1} "
-            f"({entries[j].name}) give the same direction; as --rig, an .lp means a "
-            "dome with exactly these lights, each listed once (remove the repeats)"
+            f"{rig}: {lights_said(entries, (i, j))} give the same direction; as --rig, an .lp "
+            "means a dome with exactly these lights, each listed once (remove the repeats)"
         )
     return DomeGeometry([e.direction for e in entries], tuple(e.name for e in entries)), entries
 
