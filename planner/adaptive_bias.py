@@ -225,10 +225,12 @@ def solve_unsolved(
     whose simulated relighting ranked the floors wrongly (docs/adaptive.md, "Why the model
     rendered a matte tilted plane wrongly"). Three lit lights do determine the normal (with the
     noise amplified by their conditioning): a noisy tilted plane is the better model. Counted
-    valid, the pixels solved so are also evidence for the lobe and shadows, and, where they have
-    residual degrees of freedom, for the noise (:func:`fit_object_model`): left out, the
-    specular lobe of that tilted plane was fitted to the 2 pixels the robust fit solved (ks 272,
-    e 128 on a matte surface)."""
+    valid, the pixels solved so are evidence for shadows, and, where they have residual
+    degrees of freedom (more than three lit lights), for the lobe and the noise
+    (:func:`fit_object_model`). Solved from exactly three, they are not evidence for the lobe:
+    where the robust fit solved a few pixels, the lobe of that tilted plane is still fitted to
+    those alone (ks 272, e 128 on a matte surface, 4 draws of 8; fixing it moved no decision's
+    error: docs/adaptive.md, "Probes of 2026-12-05")."""
     valid = np.asarray(valid, dtype=bool)
     lit_count = np.zeros(valid.shape, dtype=np.intp)
     todo = np.flatnonzero(~valid)
