@@ -286,10 +286,10 @@ def _lp_names(image: Path, rig_lp: RigLp) -> _LpNames:
 
 
 def _on_line(entry: LpEntry) -> str:
-    """`` (line 4)``: where the ``.lp`` holds ``entry``, for a user who opens it to correct
+    """`` on line 4``: where the ``.lp`` holds ``entry``, for a user who opens it to correct
     it (the light's number is not its line: a count line and comments come before); "" for
     an entry not read from a file."""
-    return "" if entry.line is None else f" (line {entry.line})"
+    return "" if entry.line is None else f" on line {entry.line}"
 
 
 def _lp_record(image: Path, rig_lp: RigLp) -> list[tuple[str, str, Any, str | None]]:

@@ -71,7 +71,7 @@ def test_a_preview_named_but_for_case_plans_from_the_light_recorded_for_it(
     text = said(r)
     assert r.exit_code == 0, text
     assert (
-        f"preview light {recorded} (recorded by dirs.lp for image09.jpg, light 3 (line 4), the "
+        f"preview light {recorded} (recorded by dirs.lp for image09.jpg, light 3 on line 4, the "
         "preview image09.JPG but for upper/lower case: " in text
     ), text
     if _ignores_case(acq):
@@ -95,7 +95,7 @@ def test_a_light_given_is_compared_with_the_light_recorded_for_the_case_twin(
     text = said(r)
     assert r.exit_code == 0, text
     assert (
-        "from the light recorded by dirs.lp for image09.jpg, light 3 (line 4), the preview "
+        "from the light recorded by dirs.lp for image09.jpg, light 3 on line 4, the preview "
         f"image09.JPG but for upper/lower case ({recorded}): the plan used the light given; leave "
         "--preview-light out to plan with the recorded one" in text
     ), text
@@ -148,7 +148,7 @@ def test_a_case_twin_that_is_another_file_here_is_not_read_but_named(tmp_path: P
     text = said(r)
     assert r.exit_code == 0, text
     assert (
-        "as dirs.lp (--rig) does not list it (its light 3 (line 4), image09.jpg, differs only in "
+        "as dirs.lp (--rig) does not list it (its light 3 on line 4, image09.jpg, differs only in "
         "upper/lower case from image09.JPG and is another file on this system, which tells the "
         "two names apart)" in text
     ), text
