@@ -90,7 +90,7 @@ def test_plan_on_a_bare_lp_with_a_repeated_light_is_refused(tmp_path: Path) -> N
     out = tmp_path / "plan.lp"
     r = CliRunner().invoke(app, ["plan", "--rig", str(rig), "--lights", "6", "--out", str(out)])
     assert r.exit_code != 0
-    assert "lights 5 (img_5.jpg) and 13 (img_5_again.jpg)" in r.output
+    assert "lights 5 (line 6: img_5.jpg) and 13 (line 14: img_5_again.jpg)" in r.output
     assert "acq.lp" in r.output
     assert not out.exists()
     # without the repeat the same rig plans
