@@ -27,6 +27,27 @@ from hypothesis import HealthCheck, settings
 settings.register_profile("rti-rig", deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile("rti-rig")
 
+
+def _hangup_outlived(signum: int, frame: Any) -> None:
+    """The suite's own answer to a hang-up where it was started to outlive one (``nohup``)."""
+
+
+# The hang-up tests need SIGHUP as a terminal leaves it, not ignored. Under `nohup` (or a CI
+# wrapper that ignores SIGHUP) the ignored disposition is inherited by every child, across exec:
+# rti-rig then rightly installs nothing (a nohup'd session is meant to outlive its terminal), the
+# tests' hang-ups never arrived, and two of them waited forever for a child that waited for a
+# reader (a rehearsal of CI started with `nohup` hung for 45 minutes, 2026-12-05). A handler
+# that does nothing keeps what nohup asked (the suite outlives its terminal) and is not
+# "ignored": rti-rig answers hang-ups in-process as on a terminal, and a handler, unlike an
+# ignored signal, is reset to the default in every program a test executes. The xdist workers
+# (executed, so at the default) are told by the environment to do the same.
+_OUTLIVE_HANGUP = "RTI_RIG_TESTS_OUTLIVE_HANGUP"
+if hasattr(signal, "SIGHUP") and (
+    signal.getsignal(signal.SIGHUP) == signal.SIG_IGN or os.environ.get(_OUTLIVE_HANGUP)
+):
+    signal.signal(signal.SIGHUP, _hangup_outlived)
+    os.environ[_OUTLIVE_HANGUP] = "1"
+
 REPO = Path(__file__).resolve().parent.parent
 CONFIGS = REPO / "rig_configs"
 

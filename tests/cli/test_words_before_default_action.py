@@ -15,6 +15,7 @@ while the signal is raised: not a test that can pass wrongly, one that could mis
 from __future__ import annotations
 
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -65,6 +66,25 @@ print("the signal did not end the process", file=sys.stderr)
 """.replace("LINES", str(LINES))
 
 
+def _wait_ready(ready_r: int, process: subprocess.Popen[bytes]) -> None:
+    """Wait (at most 600 s, as the child's own wait) for the child's word that it is at the
+    default action, or its end (EOF); closes ``ready_r``. A child that neither says it nor ends
+    is ended and the test fails with what it said: it waits for a reader this test has not
+    yet become, so an unbounded read here hung the whole suite (a signal that never came: the
+    suite run under ``nohup``, SIGHUP inherited ignored, before conftest undid that)."""
+    try:
+        if not select.select([ready_r], [], [], 600.0)[0]:
+            process.kill()
+            said, _ = process.communicate(timeout=60)
+            pytest.fail(
+                "the child neither reached the default action nor ended in 600 s; it said "
+                f"{said.decode(errors='replace')[-300:]!r}"
+            )
+        os.read(ready_r, 1)
+    finally:
+        os.close(ready_r)
+
+
 @pytest.mark.parametrize("path", ["hangup", "summary", "as_before"])
 def test_queued_words_are_written_before_a_signals_default_action(path: str) -> None:
     ready_r, ready_w = os.pipe()
@@ -78,10 +98,7 @@ def test_queued_words_are_written_before_a_signals_default_action(path: str) -> 
     finally:
         os.close(ready_w)
     with ended_on_exit(process):
-        try:
-            os.read(ready_r, 1)  # the child is at the default action (or ended: EOF)
-        finally:
-            os.close(ready_r)
+        _wait_ready(ready_r, process)  # the child is at the default action (or ended: EOF)
         said, _ = process.communicate(timeout=600)
     text = said.decode()
     missing = [i for i in range(LINES) if f"word {i:05d} " not in text]
@@ -140,10 +157,7 @@ def test_a_hang_up_as_a_command_ends_waits_for_its_words_then_ends_by_sighup() -
     finally:
         os.close(ready_w)
     with ended_on_exit(process):
-        try:
-            os.read(ready_r, 1)  # the child is at the default action's wait (or ended: EOF)
-        finally:
-            os.close(ready_r)
+        _wait_ready(ready_r, process)  # the child is at the default action's wait (or ended)
         said, _ = process.communicate(timeout=600)
     text = said.decode(errors="replace").lstrip("f")
     assert "Benchmarks: the speed/accuracy trade" in text, text[-500:]
