@@ -692,6 +692,10 @@ def configure_planner(args: argparse.Namespace) -> None:
         import rti_rig.planner.adaptive_bias as bias
 
         bias.FIT_RELIEF_GAIN = True
+    if args.clipped_censored:
+        import rti_rig.planner.adaptive_bias as bias
+
+        bias.CLIPPED_CENSORED = True
     if args.heldout_score:
         from benchmarks.adaptive_heldout import install
 
@@ -770,6 +774,12 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="fit the relief's depth to the captured shadows (planner.adaptive_relief; off in "
         "what ships)",
+    )
+    ap.add_argument(
+        "--clipped-censored",
+        action="store_true",
+        help="the object model reads observations at white as lower bounds, not values "
+        "(planner.adaptive_bias.CLIPPED_CENSORED; off in what ships)",
     )
     ap.add_argument(
         "--heldout-score",
@@ -984,6 +994,7 @@ def main(argv: list[str] | None = None) -> str:
                 else ""
             )
             + (" --relief-gain" if args.relief_gain else "")
+            + (" --clipped-censored" if args.clipped_censored else "")
             + (f" --heldout-score {args.heldout_score}" if args.heldout_score else "")
             + (" --no-fitted-design" if args.no_fitted_design else "")
             + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")

@@ -106,6 +106,18 @@ SOLVE_UNSOLVED = True
 #: conditioning left the solved normals further off than the level fallback (measured by a
 #: second reader: 23° against 18° on a synthetic plane at σ = 0.003).
 UNSOLVED_COND_LIMIT = 300.0
+#: Whether observations at white (at or above :data:`CLIP_LEVEL`, the images in units of white)
+#: are read as what a clipped pixel says, "at least this", rather than as measured values: left
+#: out of :func:`solve_unsolved`'s least squares and of the noise, and kept in the lobe's fit as
+#: lower bounds (:func:`fit_censored_lobe`). Why asked: on the polished coin's starting images at
+#: 9 and 12 lights, clipped over much of the coin, the least squares took white for a measured
+#: value and the lobe was fitted to 456 unclipped observations (ks 4e-5: a matte coin;
+#: docs/adaptive.md, "Probes of 2026-12-05", fault 3). A variant measured by ``benchmarks.adaptive
+#: --clipped-censored``, not what ships.
+CLIPPED_CENSORED = False
+#: An observation at or above this (in units of white) is clipped: the camera's top code, less
+#: the rounding of an area average of 16-bit codes.
+CLIP_LEVEL = 0.999
 
 #: ``fit(obs (L, P), lights (L, 3)) -> (normals (P, 3), valid (P,))``: the robust fit, or None
 #: when it refuses the light set (ill-conditioned). Any other error is a bug and propagates:
@@ -237,7 +249,7 @@ def solve_unsolved(
     if todo.size == 0:
         return normals, albedo, valid, lit_count
     o = np.asarray(obs, dtype=np.float64)[:, todo].T  # (U, K)
-    w = (o > dark).astype(np.float64)
+    w = ((o > dark) & ~_clipped(o)).astype(np.float64)
     count = w.sum(axis=1)
     lt = np.asarray(lights, dtype=np.float64)
     gram = np.einsum("uk,ki,kj->uij", w, lt, lt)  # (U, 3, 3) over each pixel's lit lights
@@ -265,6 +277,43 @@ def solve_unsolved(
     valid[which] = True
     lit_count[which] = count[ok][good].astype(np.intp)
     return normals, albedo, valid, lit_count
+
+
+def _clipped(obs: NDArray) -> NDArray[np.bool_]:
+    """Where an observation is at white (only with :data:`CLIPPED_CENSORED`; else nowhere)."""
+    if not CLIPPED_CENSORED:
+        return np.zeros(np.shape(obs), dtype=bool)
+    return np.asarray(obs) >= CLIP_LEVEL
+
+
+def fit_censored_lobe(
+    r: NDArray, x: NDArray, r_low: NDArray, x_low: NDArray
+) -> tuple[float, float]:
+    """(ks ≥ 0, its cost) minimizing ``Σ (r − ks x)² + Σ max(0, r_low − ks x_low)²``: a lobe
+    fitted to measured residuals ``r`` and to residuals ``r_low`` that are lower bounds (a
+    clipped observation: the true value is at least white, so the lobe must reach at least
+    it; above it costs nothing).
+
+    How: the cost is convex and piecewise quadratic in ks; Newton's step on the bounds active at
+    the current ks (those the lobe does not yet reach) is exact on each piece, so the iteration
+    stops when the active set repeats (a few steps; capped at 50)."""
+    # element-wise sums, not BLAS dot products: on a busy machine a vector dot waits for
+    # BLAS's threads (measured 5–30 ms against 0.1 ms for these 30 000 terms)
+    sxx = float((x * x).sum())
+    sxr = float((x * r).sum())
+    ks = max(0.0, sxr / sxx) if sxx > 0 else 0.0
+    active = None
+    for _ in range(50):
+        act = r_low > ks * x_low
+        if active is not None and np.array_equal(act, active):
+            break
+        active = act
+        den = sxx + float((x_low[act] ** 2).sum())
+        ks = max(0.0, (sxr + float((x_low[act] * r_low[act]).sum())) / den) if den > 0 else 0.0
+    cost = float(((r - ks * x) ** 2).sum()) + float(
+        (np.maximum(0.0, r_low - ks * x_low) ** 2).sum()
+    )
+    return ks, cost
 
 
 def fit_noise_model(signal: NDArray, resid2: NDArray, floor: float) -> tuple[float, float] | None:
@@ -376,7 +425,8 @@ def fit_object_model(
     lam = albedo[None, :] * np.maximum(cos, 0.0)
     resid = obs - lam
     facing = (cos > FACING_COS) & valid[None, :]
-    lit = facing & (obs > dark)
+    clipped = _clipped(obs)
+    lit = facing & (obs > dark) & ~clipped
     # noise: robust scale of the residuals of lit observations near the fit
     r_lit = np.abs(resid[lit & evidence[None, :]])
     noise = float(1.4826 * np.median(r_lit)) if r_lit.size else 0.0
@@ -385,7 +435,9 @@ def fit_object_model(
         noise *= float(np.sqrt(k / (k - 3)))
     noise = max(noise, noise_floor)
     # cast shadows: facing, but dark, or far below the fit
-    shadowed = facing & ((obs <= dark) | (resid < -np.maximum(4.0 * noise, 0.25 * lam)))
+    # (a clipped observation is bright, whatever the fit says: never a shadow)
+    below = (obs <= dark) | (resid < -np.maximum(4.0 * noise, 0.25 * lam))
+    shadowed = facing & ~clipped & below
     shadowed = shadowed.T  # (P, K)
     # specular lobe: least squares of the positive-side residuals on ks * (n.h)^e
     hc = _half_cos(normals, lights).T  # (K, P)
@@ -393,12 +445,13 @@ def fit_object_model(
     r = resid[use]
     c = hc[use]
     best = (np.inf, 0.0, LOBE_EXPONENTS[0])
-    for e, x in zip(LOBE_EXPONENTS, lobes(c, LOBE_EXPONENTS), strict=True):
-        # element-wise sums, not BLAS dot products: on a busy machine a vector dot waits for
-        # BLAS's threads (measured 5–30 ms against 0.1 ms for these 30 000 terms)
-        xx = float((x * x).sum())
-        ks = max(0.0, float((x * r).sum()) / xx) if xx > 0 else 0.0
-        sse = float(((r - ks * x) ** 2).sum())
+    # clipped observations (only with CLIPPED_CENSORED): lower bounds on the lobe, not values
+    low = facing & clipped & evidence[None, :]
+    r_low, c_low = resid[low], hc[low]
+    for e, x, x_low in zip(
+        LOBE_EXPONENTS, lobes(c, LOBE_EXPONENTS), lobes(c_low, LOBE_EXPONENTS), strict=True
+    ):
+        ks, sse = fit_censored_lobe(r, x, r_low, x_low)
         if sse < best[0] - 1e-12:
             best = (sse, ks, e)
     _, ks, e = best

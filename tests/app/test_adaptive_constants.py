@@ -66,6 +66,26 @@ def test_a_session_recorded_before_the_relight_floor_was_split_off_resumes_when_
     assert lines == [f"{key} 10.0 → 30.0"]
 
 
+def test_a_session_recorded_before_a_constant_was_added_resumes_while_it_is_neutral(
+    monkeypatch,  # type: ignore[no-untyped-def]
+) -> None:
+    """Sessions recorded before the clipped-as-bound variant existed lack its constants: this
+    build decides as theirs did while the variant is off, and names it once it is on."""
+    from rti_rig.app.usecases.adaptive_constants import ADDED_NEUTRAL
+    from rti_rig.planner import adaptive_bias
+
+    now = decision_constants()
+    assert set(ADDED_NEUTRAL) <= set(now)  # each names a constant that exists
+    assert {k: now[k] for k in ADDED_NEUTRAL} == ADDED_NEUTRAL  # what ships is neutral
+    older = {k: v for k, v in now.items() if k not in ADDED_NEUTRAL}
+    assert constant_differences(older, now) == []
+    monkeypatch.setattr(adaptive_bias, "CLIPPED_CENSORED", True)
+    key = "planner.adaptive_bias.CLIPPED_CENSORED"
+    assert constant_differences(older, decision_constants()) == [f"{key} 'absent' → True"]
+    # a session recorded with the constant is compared as any other
+    assert constant_differences(now, decision_constants()) == [f"{key} False → True"]
+
+
 def test_the_advice_only_constants_steer_nothing_and_live_in_the_usecase() -> None:
     """A name exempt from the resume check must not be a decision's constant anywhere: only
     the usecase defines RTI_FILE_LIGHTS, and its value never reaches a chooser."""

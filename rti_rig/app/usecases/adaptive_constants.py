@@ -104,17 +104,30 @@ def decision_constants() -> dict[str, Any]:
 SPLIT_FROM = {"planner.adaptive.RELIGHT_DEFAULT_FLOOR": "planner.adaptive.DESIGN_DEFAULT_FLOOR"}
 
 
+#: Constants added after sessions were recorded, with the value that makes this build decide as
+#: the builds before it did: a session recorded without one resumes while the build holds that
+#: value (a new constant had refused every earlier session, including those it changes nothing
+#: for), and is refused, naming it, once the value differs. The clipped-as-bound object model
+#: (2026-12-05) is a benchmark variant, off in what ships; its level matters only when on.
+ADDED_NEUTRAL: dict[str, Any] = {
+    "planner.adaptive_bias.CLIPPED_CENSORED": False,
+    "planner.adaptive_bias.CLIP_LEVEL": 0.999,
+}
+
+
 def constant_differences(recorded: dict[str, Any], current: dict[str, Any]) -> list[str]:
     """What differs between a session's recorded constants and this build's, one line each
     (``NAME recorded → now``; a constant one side lacks shows as ``absent``, unless it was
-    split off a recorded one, :data:`SPLIT_FROM`), apart from :data:`RESTORED_ON_RESUME` and
-    :data:`ADVICE_ONLY`."""
+    split off a recorded one, :data:`SPLIT_FROM`, or added since at its neutral value,
+    :data:`ADDED_NEUTRAL`), apart from :data:`RESTORED_ON_RESUME` and :data:`ADVICE_ONLY`."""
     lines = []
     for key in sorted(set(recorded) | set(current)):
         if key.rsplit(".", 1)[-1] in RESTORED_ON_RESUME | ADVICE_ONLY:
             continue
         was = recorded.get(key, recorded.get(SPLIT_FROM.get(key, ""), "absent"))
         now = current.get(key, "absent")
+        if key not in recorded and key in ADDED_NEUTRAL and now == ADDED_NEUTRAL[key]:
+            continue  # added since the session was recorded, at the value it decided under
         if was != now:
             lines.append(f"{key} {was!r} → {now!r}")
     return lines
