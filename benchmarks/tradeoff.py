@@ -99,7 +99,9 @@ class Row:
     file_psnr_db: float = float("nan")
     #: the plan's lights, their candidate indices in the order chosen, space-separated: what
     #: :func:`retime_arm` checks a plan made again against (a planner changed since the run
-    #: chooses other lights for the same row, whose scores are not the new plan's)
+    #: chooses other lights for the same row, whose scores are not the new plan's); in
+    #: ``benchmarks.tradeoff_from``'s rows, the acquisition's lights by their number in its
+    #: ``.lp`` (from 1, as a refusal numbers them), in the order chosen
     lights: str = ""
 
 

@@ -205,6 +205,9 @@ def check_acquisition(lp: Path, notes: list[str] | None = None) -> list[Path]:
     from rti_rig.core.lp_format import read_lp
 
     entries = read_lp(lp, upper_hemisphere=True, notes=notes)
+    twins = _twin_lights(lp, entries)
+    if twins is not None:
+        raise RtiRigError(twins)
     files = _image_files(lp, entries)
     if notes is not None:  # what run and fit of it say of its images, said alike here
         names = [e.name for e in entries]
@@ -219,6 +222,28 @@ def check_acquisition(lp: Path, notes: list[str] | None = None) -> list[Path]:
     if no_normals is not None:
         raise RtiRigError(no_normals)
     return files
+
+
+def _twin_lights(lp: Path, entries: list[Any]) -> str | None:
+    """What is said of an acquisition two of whose lines give one direction (a light re-shot
+    and kept, ``IMG_0013`` and ``IMG_0013b``), or None.
+
+    Why: ``run`` and ``check`` of it refuse it, but the trade measured it in silence, and the
+    lights held out to score relighting are drawn one by one: a held-out light whose twin
+    stayed among the lights planned from was "relit" by a copy of itself, its plan's PSNR
+    raised, and the columns no longer compared like with like."""
+    from rti_rig.core.lp_format import lights_said
+    from rti_rig.core.rig_geometry import COINCIDENT_LED_DEG, coincident_leds
+
+    pair = coincident_leds([e.direction for e in entries])
+    if pair is None:
+        return None
+    return (
+        f"{lp}: {lights_said(entries, pair)} share one direction (within "
+        f"{COINCIDENT_LED_DEG}°): a trade-off holds lights out to score relighting, and a held-out "
+        "light's twin among the lights planned from would relight it by its copy; remove one "
+        "of the two lines (its image is then left out) to measure the others"
+    )
 
 
 def _no_reference_normals(lp: Path, dirs: np.ndarray) -> str | None:
@@ -353,6 +378,8 @@ def run_tradeoff_from(
                 plan_s,
                 file_model,
                 file_psnr,
+                # which images the layout took, for a user to look at or replay (run --plan)
+                " ".join(str(int(i) + 1) for i in chosen),
             )
         )
 

@@ -28,6 +28,7 @@ from rti_rig.core.image_files import looks_like_image
 from rti_rig.core.lp_format import (
     acquisition_lp_files,
     directions_of,
+    lights_said,
     lp_files_in,
     lp_name_from,
     read_lp,
@@ -1638,8 +1639,8 @@ def dome_led_directions(
             raise ConfigError(
                 rig.path,
                 "dome.lp_file",
-                f"{shown_path(lp_path)}: lights {i + 1} ({entries[i].name}) and {j + 1} "
-                f"({entries[j].name}) give the same direction; a dome's calibration lists each LED "
+                f"{shown_path(lp_path)}: {lights_said(entries, (i, j))} give the same "
+                "direction; a dome's calibration lists each LED "
                 "once (an acquisition's .lp may repeat a light: remove the repeats)",
             )
         return dirs, [e.name for e in entries]  # read_lp refused lights below the plane
@@ -1754,7 +1755,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
         raise ConfigError(
             lp_path,
             None,
-            f"lights {i + 1} ({entries[i].name}) and {j + 1} ({entries[j].name}) share one "
+            f"{lights_said(entries, (i, j))} share one "
             f"direction (within {COINCIDENT_LED_DEG}°): a replay fires the acquisition's "
             "lights by direction, each once; remove one of the two lines (its image is then "
             "left out) to replay the others",

@@ -358,7 +358,41 @@ def case_hint(missing: Sequence[Path]) -> str:
     its JPEG are not the same data), only named."""
     twins, kin = _name_twins(missing)
     hidden = _invisible_names(missing)
-    return _twins_said(twins, len(missing)) + _kin_said(kin, len(missing)) + _invisible_said(hidden)
+    return (
+        _not_files_said(_not_files(missing))
+        + _twins_said(twins, len(missing))
+        + _kin_said(kin, len(missing))
+        + _invisible_said(hidden)
+    )
+
+
+def _not_files(missing: Sequence[Path]) -> list[str]:
+    """The listed names that are there but are no file to read (a folder, a link whose target
+    does not exist, a device or pipe), each said with what it is.
+
+    Why: such an entry had been named "the same name in other upper/lower case" of itself,
+    with the advice to rename it; "missing" alone is no help either when the user sees the
+    name in the folder."""
+    said: list[str] = []
+    for path in missing:
+        if not os.path.lexists(path) or path.is_file():
+            continue
+        if path.is_dir():
+            what = "a folder"
+        elif path.is_symlink() and not path.exists():
+            what = f"a link to {os.readlink(path)}, which does not exist"
+        else:
+            what = "not a regular file"
+        said.append(f"{path.name} is {what}")
+    return said
+
+
+def _not_files_said(said: list[str]) -> str:
+    """:func:`case_hint`'s clause for :func:`_not_files`."""
+    if not said:
+        return ""
+    more = f" and {len(said) - 3} more" if len(said) > 3 else ""
+    return f"; {', '.join(said[:3])}{more}: put the image file itself there"
 
 
 def _invisible_names(missing: Sequence[Path]) -> list[str]:
@@ -410,7 +444,9 @@ def _name_twins(missing: Sequence[Path]) -> tuple[list[str], list[str]]:
                         by_stem.setdefault(child.stem.casefold(), []).append(child.name)
             listings[folder] = (by_case, by_stem)
         by_case, by_stem = listings[folder]
-        found = by_case.get(path.name.casefold(), [])
+        # the entry of the very same name is no twin: a folder or a dead link there
+        # (:func:`_not_files_said`) had been called "the same name in other case" of itself
+        found = [n for n in by_case.get(path.name.casefold(), []) if n != path.name]
         if found:
             twins.append(f"{path.name} -> {found[0]}")
             continue
@@ -541,8 +577,14 @@ def missing_images_advice(
         quoted += f"; for the other {rest} not found, {copy}{tail}"
     twins, kin = _name_twins(paths)  # listed once (case_hint's own, which had listed again)
     hidden = _invisible_names(paths)
-    named = _twins_said(twins, len(paths)) + _kin_said(kin, len(paths)) + _invisible_said(hidden)
-    if named and (rest := len(names) - len(twins) - len(kin) - len(hidden)):
+    not_files = _not_files(paths)
+    named = (
+        _not_files_said(not_files)
+        + _twins_said(twins, len(paths))
+        + _kin_said(kin, len(paths))
+        + _invisible_said(hidden)
+    )
+    if named and (rest := len(names) - len(not_files) - len(twins) - len(kin) - len(hidden)):
         # the images with no such file are missing all the same: their way out is said too
         tail = others if len(names) < total else ""
         named += f"; for the other {rest} not found, {copy}{tail}"
@@ -653,9 +695,25 @@ def _heading_hint(line: str) -> str:
     )
 
 
+#: A number as C's ``strtod`` and Qt's ``toDouble`` read one (relight, RTIBuilder): ASCII
+#: digits, an optional sign, point and exponent, or a word for infinity or NaN (refused as not
+#: finite, by name). Python's ``float`` also takes ``1_0`` (as 10) and other scripts' digits
+#: (full-width ``０.5``), which those readers refuse: such a file had passed ``check``.
+_C_NUMBER = re.compile(
+    r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.ASCII | re.IGNORECASE
+)
+
+
+def _c_float(token: str) -> float:
+    """``float(token)`` for a number C's and Qt's readers take; ValueError for the rest."""
+    if not _C_NUMBER.fullmatch(token):
+        raise ValueError(token)
+    return float(token)
+
+
 def _parse_float(token: str, source: str, lineno: int, axis: str, line: str = "") -> float:
     try:
-        value = float(token)
+        value = _c_float(token)
     except ValueError:
         hint = _csv_hint(line) if token.endswith((",", ";")) or ";" in token else ""
         if not hint and "," in token:
@@ -681,7 +739,7 @@ UNIT_TOLERANCE = 0.05
 
 def _is_number(token: str) -> bool:
     try:
-        float(token)
+        _c_float(token)
     except ValueError:
         return False
     return True
@@ -916,17 +974,16 @@ def _whole_count(token: str, first: str, source: str, lineno: int, notes: list[s
     else (``72.5``, a word).
 
     Why: ``72.0`` had been refused as "not a whole number" with nothing to do."""
-    try:
+    if re.fullmatch(r"[+-]?\d+", token, re.ASCII):  # not int()'s '7_2' or other scripts' digits
         return int(token)
-    except ValueError:
-        value = float(token)  # ValueError for a word: the caller's refusal
-        if not value.is_integer():
-            raise
-        notes.append(
-            f"{shown_path(source)}, line {lineno}: count line {first!r} read as the count "
-            f"{int(value)}; relight reads only a whole number there (write '{int(value)}')"
-        )
-        return int(value)
+    value = _c_float(token)  # ValueError for a word: the caller's refusal
+    if not value.is_integer():
+        raise ValueError(token)
+    notes.append(
+        f"{shown_path(source)}, line {lineno}: count line {first!r} read as the count "
+        f"{int(value)}; relight reads only a whole number there (write '{int(value)}')"
+    )
+    return int(value)
 
 
 def _refuse_name_last(tokens: list[str], line: str, source: str, lineno: int) -> None:
@@ -1074,12 +1131,23 @@ def parse_lp(
                 "(a light the writing tool did not find? relight saves a missing direction as "
                 "'0 0 0'); find that light again, or remove the line and leave its image out",
             )
+        # the length as written: a clamped light is still checked as a unit vector (a clamp
+        # had hidden a mistyped line that the same line a hair above the plane is refused for)
+        length = norm
         if upper_hemisphere and -HORIZON_TOLERANCE < z / norm < -1e-9:
             flat = math.hypot(x, y)
+            # the file's z, and the direction's where the vector is not of unit length
+            unit_z = f" ({z / norm:.4f} as a direction)" if f"{z:.4f}" != f"{z / norm:.4f}" else ""
             notes.append(
-                f"{shown_path(source)}, line {lineno}: light z = {z / norm:.4f} is a hair below "
+                f"{shown_path(source)}, line {lineno}: light z = {z:.4f}{unit_z} is a hair below "
                 "the object plane (calibration noise at the horizon?); clamped to z = 0"
             )
+            x, y, z, norm = x / flat, y / flat, 0.0, 1.0
+        elif upper_hemisphere and z < 0.0 and z / norm >= -1e-9:
+            # float noise (-1e-16, -1e-10) is the horizon, set there without a word: left
+            # negative, the light had passed here and then fallen out of every elevation
+            # band (a 72-image replay refused "has only 71 images")
+            flat = math.hypot(x, y)
             x, y, z, norm = x / flat, y / flat, 0.0, 1.0
         if upper_hemisphere and z / norm < -1e-9:
             below.append((lineno, name, z / norm))
@@ -1089,8 +1157,8 @@ def parse_lp(
                 source, lineno, f"image name {name!r} already used on line {seen[name]}"
             )
         seen[name] = lineno
-        if abs(norm - 1.0) > UNIT_TOLERANCE:
-            off_unit.append((lineno, norm))
+        if abs(length - 1.0) > UNIT_TOLERANCE:
+            off_unit.append((lineno, length))
         entries.append(LpEntry(name, (x / norm, y / norm, z / norm), lineno))
 
     if not entries:
@@ -1159,7 +1227,7 @@ def _refuse_below_plane(below: list[tuple[int, str, float]], lights: int, source
         source,
         lineno,
         f"the light of {name!r} is {-elevation:.1f}° below the object plane (z = {z:.4f}; "
-        f"up to {HORIZON_TOLERANCE} below is read as the horizon): no light there can have lit "
+        f"less than {HORIZON_TOLERANCE} below is read as the horizon): no light there can have lit "
         "the object. If it is a light at the horizon whose calibration is off, set its z to 0; "
         f"otherwise remove the line and leave its image out{others}",
     )
@@ -1198,7 +1266,7 @@ def _refuse_lone_off_unit(
         lineno,
         f"light vector {' '.join(line.split()[-3:])} has length {length:.3g}, where {unit} of "
         f"the file's {lights} lights are unit vectors (length 1 ± {UNIT_TOLERANCE}): a "
-        f"mistyped number? Read as a direction (normalised) it lights from {elevation:.0f}° "
+        f"mistyped number? Read as a direction (normalised) it lights from {round(elevation)}° "
         "elevation"
         + (
             "; the file ends on this line without a line break: cut off while written or "

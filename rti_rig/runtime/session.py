@@ -2078,6 +2078,10 @@ def _prepare_resume(
         done = {i: _to_record(rec) for i, rec in latest.items() if i not in lost}
     else:
         if reshoot_lost:
+            if check_done is not None:
+                # what the plain resume would refuse is said first: an adaptive session with
+                # a step lost before later ones had been sent from here to that very resume
+                check_done(verified_steps(root, scan.records))
             # the command named: after a --reshoot-lost stopped part-way, the user's next try
             # is the same command again, and "drop --reshoot-lost" left the rest to guess
             raise SessionError(

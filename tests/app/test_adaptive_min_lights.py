@@ -293,3 +293,22 @@ def test_an_arm_session_at_the_most_a_session_takes_is_not_told_to_start_another
     text = short_of_target_note(fewer, 120, lambda: "rti-rig run A --out B", ARM_MAX_LIGHTS)
     assert text is not None and f"up to the {ARM_MAX_LIGHTS} lights" in text, text
     assert text.endswith("rti-rig run A --out B"), text
+
+
+@pytest.mark.parametrize("minimum", ["120", "130"])
+def test_an_arm_refuses_a_minimum_above_the_most_a_session_takes(
+    tmp_path: Path, minimum: str
+) -> None:
+    """The virtual arm offers 120 lights but a session without --lights takes at most 100
+    (ARM_MAX_LIGHTS): --min-lights 120 had been accepted, 100 shot and the target claimed
+    below the minimum, and 130 had been refused with advice to give that 120. Both are
+    refused before anything moves, with a command that runs."""
+    from rti_rig.app.usecases.adaptive import ARM_MAX_LIGHTS
+
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "virtual_arm.toml"
+    out = tmp_path / "s"
+    r = _run(cfg, out, "--until-error", "1", "--min-lights", minimum)
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert f"--min-lights {minimum}: this adaptive session shoots at most {ARM_MAX_LIGHTS}" in text
+    assert f"--until-error 1 --min-lights {ARM_MAX_LIGHTS}" in text and not out.exists()

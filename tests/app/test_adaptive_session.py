@@ -224,13 +224,16 @@ def test_a_resume_with_an_earlier_image_gone_is_refused_before_the_folder_change
         data[len(data) // 2] ^= 0xFF
         jpeg.write_bytes(bytes(data))
     before = folder_bytes(out)
-    r = runner.invoke(app, ["run", "--resume", str(out)])
-    assert r.exit_code == 2, r.output
-    text = said(r)
-    assert "step 3 (image_003) is missing or differs from its journaled checksum" in text
-    assert "nothing in the folder was changed" in text and "another --out" in text
-    assert folder_bytes(out) == before
-    assert not (out / "recovered").exists()
+    # with --reshoot-lost the same: it had said "continue it with rti-rig run --resume", the
+    # very command refused here
+    for extra in ([], ["--reshoot-lost"]):
+        r = runner.invoke(app, ["run", "--resume", str(out), *extra])
+        assert r.exit_code == 2, r.output
+        text = said(r)
+        assert "step 3 (image_003) is missing or differs from its journaled checksum" in text
+        assert "nothing in the folder was changed" in text and "another --out" in text
+        assert folder_bytes(out) == before
+        assert not (out / "recovered").exists()
 
 
 def test_until_error_stops_when_the_estimate_is_reached(
@@ -300,6 +303,12 @@ def test_until_error_stops_when_the_estimate_is_reached(
         # named by the options given: --adaptive had been named when only --until-error was
         (["--until-error", "2", "--lights", "4"], "--until-error 2 --lights 4: an adaptive"),
         (["--adaptive", "--lights", "4"], "--adaptive --lights 4: an adaptive"),
+        # the range at once: "give at least 1 light" had been said of 0, and 1 then refused
+        (["--adaptive", "--lights", "0"], "--lights 0: an adaptive session on this dome takes 5"),
+        (["--adaptive", "--lights=-1"], "--lights -1: an adaptive session on this dome takes 5"),
+        # "give a positive angle" had been said of inf, which is one
+        (["--until-error", "inf"], "--until-error inf: give the target as a finite positive"),
+        (["--until-error", "nan"], "--until-error nan: give the target as a finite positive"),
         # the reason and a way to meter it (it had said "chooses its own lights")
         (
             ["--adaptive", "--lights", "6", "--auto-exposure"],
@@ -496,6 +505,19 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
     assert len(journal(out)) == 6
     assert manifest(out)["adaptive"]["max_lights"] == 6
     assert "reached its maximum of 6 lights" in said(r)
+    # designed for those 6, as --lights 6 is: it had grown a guess as if N were unknown
+    assert manifest(out)["adaptive"]["design_lights"] == 6
+    given = tmp_path / "given"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(given), "--adaptive", "--lights", "6"])
+    assert r.exit_code == 0, r.output
+    assert (given / "lights.lp").read_bytes() == (out / "lights.lp").read_bytes()
+    # the count known, --objective relight needs no --lights (it had been told to give one)
+    r = runner.invoke(
+        app,
+        ["run", str(cfg), "--out", str(tmp_path / "r"), "--adaptive", "--objective", "relight"],
+    )
+    assert r.exit_code == 0, r.output
+    assert manifest(tmp_path / "r")["adaptive"]["design_lights"] == 6
     from rti_rig.app.config import load_rig_config
     from rti_rig.app.usecases.adaptive import ARM_MAX_LIGHTS, default_max_lights
 
@@ -533,6 +555,36 @@ def test_a_resume_on_a_faster_arm_names_the_times_that_changed(tmp_path: Path) -
     assert "Put those settings back as the session began to continue it" in text
     assert folder_bytes(out) == before
     r = runner.invoke(app, ["run", str(cfg), "--resume", str(out)])  # put back: it goes on
+    assert r.exit_code == 0, r.output
+    assert len(journal(out)) == 9
+
+
+def test_a_resume_on_a_slower_arm_is_refused_though_its_steps_taken_replay(
+    tmp_path: Path,
+) -> None:
+    """Stopped within its starting lights (which no time decides), a session resumed on an arm
+    at half speed replayed its steps as they were and went on without a word, choosing the
+    rest for the new move times: another session than the one begun. Refused, naming the
+    times, before anything moves; the speed put back, it goes on."""
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    assert "speed_deg_s = 60.0" in text
+    cfg = write_config(
+        tmp_path, text.replace("width = 512", "width = 96").replace("height = 512", "height = 96")
+    )
+    out = tmp_path / "s"
+    interrupted(cfg, out, after_step=2, lights=9)
+    before = folder_bytes(out)
+    slow = write_config(
+        tmp_path, cfg.read_text().replace("speed_deg_s = 60.0", "speed_deg_s = 30.0"), "slow.toml"
+    )
+    r = runner.invoke(app, ["run", str(slow), "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "the rig config now gives other times than this session's lights were chosen" in text
+    assert "arm moves, the longest from the last light" in text
+    assert "Put those settings back as the session began to continue it" in text
+    assert folder_bytes(out) == before
+    r = runner.invoke(app, ["run", str(cfg), "--resume", str(out)])
     assert r.exit_code == 0, r.output
     assert len(journal(out)) == 9
 

@@ -333,3 +333,15 @@ def test_a_relight_session_s_upper_estimate_is_not_tied_to_until_error() -> None
     assert normals.endswith("what --until-error would be compared with)")
     until = estimate_phrase({**terms, "until_error_deg": 4.0})
     assert until.endswith("what --until-error is compared with)")
+
+
+def test_the_stop_prints_its_upper_estimate_on_the_side_of_the_target_it_is() -> None:
+    """An upper estimate of 0.3175° reached --until-error 0.318 and was printed "0.32° ≤
+    --until-error 0.318°"; 0.317 then said "0.32°: not claimed", and the reader could not
+    tell why one passed and the other not. Printed with the places that keep the side."""
+    from rti_rig.app.usecases.adaptive import places_against
+
+    for value, target in [(0.3175, 0.318), (0.3175, 0.317), (2.004, 2.0), (1.9951, 2.0)]:
+        places = places_against(value, target)
+        assert (float(f"{value:.{places}f}") <= target) == (value <= target)
+    assert places_against(1.234, 2.0) == 2  # two places where two say it

@@ -47,6 +47,9 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
         assert 5.0 < float(row["relight_psnr_db"]) < 80.0
         assert float(row["dome_time_s"]) > 1.0 * int(row["n"])
         assert row["arm_time_s"] == ""  # a replayed dome has no arm: an empty cell, not "nan"
+        # which of the .lp's lights the layout took, numbered from 1 (the column was empty)
+        took = [int(t) for t in row["lights"].split()]
+        assert len(took) == len(set(took)) == int(row["n"]) and 1 <= min(took) <= max(took) <= 18
     for name in ("normal_vs_n.png", "relight_vs_dome_time.png", "summary.md"):
         assert (out / name).stat().st_size > 0
     assert not list(out.glob("*arm_time*"))

@@ -9,6 +9,7 @@ as a traceback.
 from __future__ import annotations
 
 import json
+import math
 import shlex
 import shutil
 from pathlib import Path
@@ -139,7 +140,8 @@ def test_fit_reports_what_the_tolerant_lp_reader_assumed(tmp_path: Path) -> None
     shutil.copytree(ACQ, acq)
     lines = (acq / "dirs.lp").read_text().splitlines()
     name, x, y, _ = lines[5].split()
-    lines[5] = f"{name} {x} {y} -0.001"
+    flat = math.hypot(float(x), float(y))  # a unit vector a hair below: the calibration's noise
+    lines[5] = f"{name} {float(x) / flat:.6f} {float(y) / flat:.6f} -0.001"
     lines[0] = str(int(lines[0]) - 1)
     (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
     out = tmp_path / "fit"
@@ -678,3 +680,25 @@ def test_check_of_an_rtibuilder_project_says_where_its_images_were_found(
     assert r.exit_code == 0, said
     assert "images: 18 listed in proj.lp, each present in ../jpeg-exports (from the .lp's" in said
     assert "beside it" not in said and said.endswith("RESULT: PASS")
+
+
+def test_a_listed_image_that_is_a_folder_or_a_dead_link_is_said_as_such(tmp_path: Path) -> None:
+    """A folder named like the image (an unpacked archive) or a link whose target is gone had
+    been called "the same name in other upper/lower case" of itself, with the advice to rename
+    it: `check` and `run` now say what the entry is."""
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lines = (ACQ / "dirs.lp").read_text().splitlines()[1:7]
+    for line in lines[2:]:
+        shutil.copy(ACQ / line.split()[0], acq / line.split()[0])
+    (acq / lines[0].split()[0]).mkdir()
+    (acq / lines[1].split()[0]).symlink_to(tmp_path / "gone.jpg")
+    (acq / "dirs.lp").write_text("\n".join(["6", *lines]) + "\n")
+    session = str(tmp_path / "s")
+    for args in (["check", str(acq / "dirs.lp")], ["run", str(acq / "dirs.lp"), "--out", session]):
+        r = runner.invoke(app, args)
+        said = " ".join(r.output.split())
+        assert r.exit_code != 0 and "2 of 6 image(s) missing" in said, said
+        assert "image01.jpg is a folder" in said, said
+        assert f"image05.jpg is a link to {tmp_path / 'gone.jpg'}, which does not exist" in said
+        assert "upper/lower case" not in said and "Traceback" not in said

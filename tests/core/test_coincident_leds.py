@@ -74,7 +74,7 @@ def test_lp_dome_with_a_repeated_light_is_refused(tmp_path: Path) -> None:
         load_rig_config(write_config(tmp_path, text))
     assert info.value.key == "dome.lp_file"
     msg = str(info.value)
-    assert "rep.lp" in msg and "lights 1 (led_1.jpg) and 3 (led_3.jpg)" in msg
+    assert "rep.lp" in msg and "lights 1 (line 2: led_1.jpg) and 3 (line 4: led_3.jpg)" in msg
 
 
 def test_plan_on_a_bare_lp_with_a_repeated_light_is_refused(tmp_path: Path) -> None:

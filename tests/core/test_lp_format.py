@@ -566,3 +566,59 @@ def test_a_lone_vector_far_from_unit_length_is_refused_only_among_unit_vectors()
     notes.clear()
     assert len(parse_lp("\n".join(_ring(5, 3.0)) + "\n", notes=notes)) == 5
     assert "light vector length 3, not 1" in notes[0]
+
+
+def test_a_clamped_light_is_still_checked_for_its_length() -> None:
+    """A mistyped vector a hair below the plane (length 0.618 among unit vectors) had been
+    clamped and accepted, where the same line a hair above the plane is refused: the clamp
+    judged the clamped vector's length, not the file's."""
+    units = [
+        f"image{i:02}.jpg {math.cos(a):.6f} {math.sin(a):.6f} 0.000000"
+        for i, a in enumerate(np.linspace(0.1, 6.0, 8))
+    ]
+    for z in ("-0.005", "0.005"):
+        text = "\n".join([str(len(units) + 1), *units, f"bad.jpg 0.611811 -0.088872 {z}"]) + "\n"
+        with pytest.raises(LpFormatError, match=r"line 10: light vector .* has length 0\.618"):
+            parse_lp(text, "m.lp", upper_hemisphere=True, notes=[])
+
+
+def test_the_clamp_note_gives_the_files_z_and_the_directions() -> None:
+    """A vector of length 2 a hair below the plane: the note quotes the z the file holds (a
+    user searches the file for it), and the direction's where the two differ."""
+    notes: list[str] = []
+    parse_lp("1\na.jpg 2 0 -0.01\n", "l.lp", upper_hemisphere=True, notes=notes)
+    assert notes[0].startswith("l.lp, line 2: light z = -0.0100 (-0.0050 as a direction) is a hair")
+    assert "light vector length 2" in notes[1]
+
+
+@pytest.mark.parametrize("token", ["1_0", "０.5", "0.9_5", "٠.5"])
+def test_numbers_only_c_and_qt_readers_take_are_read(token: str) -> None:
+    """Python's float() reads '1_0' as 10 and full-width or Arabic-Indic digits as digits;
+    relight's and RTIBuilder's readers do not, so such a file had passed `check` and been
+    replayed. Refused with the line and the token, as '0x1p-1' is."""
+    with pytest.raises(LpFormatError, match=rf"n\.lp, line 2: x component '{token}' is not a"):
+        parse_lp(f"1\na.jpg {token} 0 1\n", "n.lp", notes=[])
+
+
+@pytest.mark.parametrize("count", ["7_2", "７２"])
+def test_a_count_line_only_c_and_qt_readers_take(count: str) -> None:
+    with pytest.raises(LpFormatError, match=r"line 1: count line .* is not a whole number"):
+        parse_lp(f"{count}\na.jpg 0 0 1\n", "n.lp", notes=[])
+
+
+def test_the_numbers_real_tools_write_still_read() -> None:
+    """relight's six significant digits with exponents, signs, a leading point, '72.0'."""
+    notes: list[str] = []
+    text = "3.0\na.jpg 1e-05 -0 1\nb.jpg +.6 0 .8\nc.jpg -0.707107 3.09086E-08 0.707107\n"
+    assert len(parse_lp(text, "ok.lp", notes=notes)) == 3
+    with pytest.raises(LpFormatError, match="is not finite"):
+        parse_lp("1\na.jpg inf 0 1\n", "i.lp", notes=[])
+
+
+@pytest.mark.parametrize("z", ["-1e-10", "-1.2e-16", "-9e-10"])
+def test_float_noise_below_the_horizon_is_the_horizon(z: str) -> None:
+    """z = -1e-10 was neither clamped (the clamp began at -1e-9) nor refused, kept negative,
+    and then left out of every elevation band: a 72-image replay said it had 71 images."""
+    notes: list[str] = []
+    (entry,) = parse_lp(f"1\na.jpg 1.0 0.0 {z}\n", "h.lp", upper_hemisphere=True, notes=notes)
+    assert entry.direction == (1.0, 0.0, 0.0) and notes == []

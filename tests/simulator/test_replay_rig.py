@@ -8,6 +8,7 @@ session encodes it, equals the decoded source JPEG).
 from __future__ import annotations
 
 import json
+import math
 import re
 import shlex
 import shutil
@@ -87,7 +88,12 @@ def _flawed_acquisition(tmp_path: Path, count_line: str, z_of_line_4: str) -> Pa
     lines = (acq / "dirs.lp").read_text().splitlines()
     lines[0] = count_line
     fields = lines[3].split()
-    fields[3] = z_of_line_4
+    # a unit vector a hair below the plane, as calibration noise leaves one (with x and y as
+    # they were, the line would be a mistyped vector of length 0.51, refused)
+    flat = math.hypot(float(fields[1]), float(fields[2]))
+    z = float(z_of_line_4)
+    scale = math.sqrt(1.0 - z * z) / flat
+    fields[1:] = [f"{float(fields[1]) * scale:.6f}", f"{float(fields[2]) * scale:.6f}", z_of_line_4]
     lines[3] = " ".join(fields)
     (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
     return acq / "dirs.lp"
@@ -454,9 +460,21 @@ def test_an_acquisition_repeating_a_light_is_refused_in_a_replays_words(tmp_path
     r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")])
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
-    assert "lights 1 (image01.jpg) and 19 (image01b.jpg) share one direction" in said, said
+    # the lines to edit named (light 1 is on line 2, past the count line)
+    assert (
+        "lights 1 (line 2: image01.jpg) and 19 (line 20: image01b.jpg) share one direction" in said
+    ), said
     assert "remove one of the two lines" in said and "dome.lp_file" not in said
     assert not (tmp_path / "s").exists()
+    # the trade-off, which holds lights out by direction, refuses it too (it had measured it,
+    # a held-out light's twin among the lights planned from)
+    r = runner.invoke(
+        app, ["bench", "tradeoff", "--from", str(acq / "dirs.lp"), "--out", str(tmp_path / "b")]
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "lights 1 (line 2: image01.jpg) and 19 (line 20: image01b.jpg) share one" in said
+    assert "a trade-off holds lights out" in said and not (tmp_path / "b").exists()
 
 
 def test_a_resume_on_an_acquisition_whose_images_changed_is_refused(tmp_path: Path) -> None:
@@ -479,6 +497,8 @@ def test_a_resume_on_an_acquisition_whose_images_changed_is_refused(tmp_path: Pa
     assert r.exit_code == 2, r.output
     said = " ".join(r.output.split())
     assert "are not the ones this session began with" in said and "Put the original" in said
+    # which one, by name: the manifest holds each file's checksum
+    assert f"({last} differs from the one recorded)" in said, said
     assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before
     # the new session it offers runs as printed, with this one's 8 lights (it had no command)
     command = re.search(r"as it is now \(rti-rig run ([^()]+)\)$", said)

@@ -443,10 +443,11 @@ class AdaptiveChooser:
             if self._reaches(est):  # the last light reached the target as well
                 reason = self._reached_reason(est)
             else:
+                upper = self.stop_terms(est)["upper_error_deg"]
+                places = places_against(upper, self.until_error_deg)
                 reason += (
                     f" before --until-error {self.until_error_deg:g}° was reached (upper "
-                    f"estimate {self.stop_terms(est)['upper_error_deg']:.2f}°: the target is "
-                    "not claimed)"
+                    f"estimate {upper:.{places}f}°: the target is not claimed)"
                 )
         return {"kind": "stop", "reason": reason, **self.stop_terms(est)}
 
@@ -463,9 +464,11 @@ class AdaptiveChooser:
         # the figures as recorded (rounded to 4 places), so that the reason and the result's
         # line cannot print one upper estimate as 3.99° and 3.98° (3.98500… and 3.985)
         terms = self.stop_terms(est)
+        assert self.until_error_deg is not None
+        places = places_against(terms["upper_error_deg"], self.until_error_deg)
         reason = (
-            f"upper estimate {terms['upper_error_deg']:.2f}° (estimate "
-            f"{terms['estimated_error_deg']:.2f}° × {self.upper_factor:g}) ≤ --until-error "
+            f"upper estimate {terms['upper_error_deg']:.{places}f}° (estimate "
+            f"{terms['estimated_error_deg']:.{places}f}° × {self.upper_factor:g}) ≤ --until-error "
             f"{self.until_error_deg:g}°"
         )
         if self.min_lights is not None and index == self.min_lights:
@@ -880,7 +883,11 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
         cap = min(cap, default_max)
     max_lights = min(lights if lights is not None else cap, len(dirs))
     k0 = min(start_lights, max_lights)
-    n_design = max_lights if (lights is not None and design is not False) else None
+    # a count known in advance — --lights, or without it the config's default_lights (no
+    # --until-error) — is designed for as a whole: --adaptive alone on an arm (24 lights) had
+    # grown its guess 6, 9, 12, … as if N were unknown, 20 % worse than --lights 24
+    known = lights is not None or default_max is not None
+    n_design = max_lights if (known and design is not False) else None
     if isinstance(geometry, DomeGeometry):
         start = dome_start(
             sub, k0, n_design, objective, band=(float(lo), float(hi)), ring_span_deg=ring_span_deg
@@ -1042,6 +1049,21 @@ class AdaptiveSteps:
             self.chooser.observe(candidate, np.asarray(rec.actual_direction), small_grey(pixels))
         if other_rig:
             self._keep_start_unused(folder, len(done))
+        elif timing := self._timing_differences(folder):
+            # the steps taken replayed as they were, but the rest would be chosen for the new
+            # times: a resume on a slowed arm had gone on without a word, and finished another
+            # session than the one begun (whether it was refused hung on whether a step taken
+            # happened to be decided otherwise)
+            raise RtiRigError(
+                f"{shown_path(folder.root)}: the rig config now gives other times than this "
+                "session's lights were chosen with ("
+                + "; ".join(timing)
+                + "). An adaptive session weighs each light by the time it costs (the capture "
+                "and, on an arm, the move to it), so its remaining lights would be chosen "
+                "otherwise and it would not be the session it began as. Nothing was recorded or "
+                "captured. Put those settings back as the session began to continue it, or start "
+                "a new session"
+            )
 
     def _same_light(self, candidate: int, rec) -> bool:  # type: ignore[no-untyped-def]
         """Whether ``candidate`` is the light step ``rec`` recorded: the same LED (a dome) at
@@ -1132,6 +1154,17 @@ class AdaptiveSteps:
         if self._outcome is None:
             self._outcome = self.chooser.conclude()
         return self._outcome
+
+
+def places_against(value: float, target: float) -> int:
+    """Decimal places (2 to 4, the recorded figure's) at which ``value`` printed stands on the
+    same side of ``target`` as it does: an upper estimate of 0.3175° had been printed "0.32°
+    ≤ --until-error 0.318°", a comparison the reader sees is false."""
+    for places in (2, 3):
+        shown = float(f"{value:.{places}f}")
+        if (shown <= target) == (value <= target):
+            return places
+    return 4
 
 
 def _decided_on_another_rig(folder, done: int) -> int:  # type: ignore[no-untyped-def]
@@ -1733,7 +1766,10 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     from rti_rig.runtime.session import SessionFolder
 
     if until_error_deg is not None and not (np.isfinite(until_error_deg) and until_error_deg > 0):
-        raise RtiRigError(f"--until-error {until_error_deg:g}: give a positive angle in degrees")
+        raise RtiRigError(
+            f"--until-error {until_error_deg:g}: give the target as a finite positive angle in "
+            "degrees: the mean normal error to stop at, such as 2"
+        )
     from rti_rig.app.config import rig_geometry
 
     geometry = rig_geometry(loaded)
@@ -1746,8 +1782,11 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         if isinstance(geometry, DomeGeometry)
         else None
     )
+    # the config's default_lights is the count --adaptive alone designs for (adaptive_plan):
+    # --objective relight had been told to "give the count with --lights" where it is known
+    counted = lights if lights is not None else default_max_lights(loaded, until_error_deg)
     check_objective(
-        objective, lights, until_error_deg, run, hint_count(geometry, band), band, in_band
+        objective, counted, until_error_deg, run, hint_count(geometry, band), band, in_band
     )
     check_min_lights(min_lights, lights, until_error_deg, run, band)
     offered: int | None = None
@@ -1789,6 +1828,22 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
             band=band,
             default_max=None if lights is not None else default_max_lights(loaded, until_error_deg),
         )
+        if (
+            min_lights is not None
+            and min_lights > plan.max_lights
+            and plan.max_lights < len(plan.candidates)
+        ):
+            # a minimum the session's own maximum cannot reach though the rig offers more (an
+            # arm's 100 lights with --until-error alone, of 120 in reach): it had been
+            # accepted, 100 shot and the target claimed below the minimum asked, with no
+            # word (a minimum above the lights offered is refused below, with a band to widen)
+            most = plan.max_lights
+            without = "" if lights is not None else " without --lights"
+            raise RtiRigError(
+                f"--min-lights {min_lights}: this adaptive session shoots at most {most} lights "
+                f"(the most it takes on this rig{without}); give at most {most}: {run} "
+                f"{adaptive_options(until_error_deg, lights, most, objective)}{band_options(band)}"
+            )
         if not isinstance(geometry, DomeGeometry):  # an arm's reachable lights need the rig's
             in_reach = len(plan.candidates)  # own rules
 

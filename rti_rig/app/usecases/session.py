@@ -1256,6 +1256,7 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     """A new adaptive session: the starting layout, the step source and the folder."""
     from rti_rig.app.rig_identity import rig_identity
     from rti_rig.app.usecases.adaptive import open_adaptive_session
+    from rti_rig.planner.adaptive import START_LIGHTS
     from rti_rig.planner.make_plan import check_elevation_band
 
     if req.plan is not None:
@@ -1276,7 +1277,9 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
             "set camera.exposure_s = T in the rig config, then run this command again without "
             "--auto-exposure"
         )
-    if req.lights is not None:
+    if req.lights is not None and req.lights > START_LIGHTS:
+        # fewer are refused with the adaptive range (open_adaptive_session): "give at least 1
+        # light" had been said of --lights 0, and then 1 refused for the range
         check_light_count(req.lights)
     identity = rig_identity(loaded)
 
@@ -1431,6 +1434,31 @@ def _recorded_images_other(recorded: dict[str, Any], identity: dict[str, Any]) -
     return recorded.get("recorded_images") not in (None, identity.get("recorded_images"))
 
 
+def _changed_recorded_files(recorded: dict[str, Any], identity: dict[str, Any]) -> str:
+    """`` (image70.jpg differs from the one recorded)``: the files of a replayed acquisition
+    whose checksum differs from the session's record, or that are gone or new; "" where the
+    session recorded no per-file checksums (begun before they were).
+
+    Why: a resume refused "one was edited, replaced or re-exported since" without naming it,
+    though the manifest holds each file's SHA-256: among hundreds of images the user could
+    not tell which one to put back."""
+    before, now = recorded.get("recorded_files"), identity.get("recorded_files")
+    if not isinstance(before, dict) or not isinstance(now, dict):
+        return ""
+
+    def sha(stamp: Any) -> Any:
+        return stamp[3] if isinstance(stamp, list) and len(stamp) > 3 else None
+
+    changed = [n for n in before if sha(before[n]) != sha(now.get(n))]
+    changed += [n for n in now if n not in before]
+    if not changed:
+        return ""
+    more = f" and {len(changed) - 5} more" if len(changed) > 5 else ""
+    which = ", ".join(changed[:5]) + more
+    differs = "differs" if len(changed) == 1 else "differ"
+    return f" ({which} {differs} from the one{'s' if len(changed) > 1 else ''} recorded)"
+
+
 def check_resume_rig(  # type: ignore[no-untyped-def]
     manifest: dict[str, Any],
     loaded,
@@ -1486,7 +1514,9 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         # a replayed acquisition is a rig whose camera returns its files: they are its images
         raise RigChangedError(
             f"the images of {shown_path(config_path)} are not the ones this session began with "
-            "(one was edited, replaced or re-exported since): the session's first images and the "
+            "(one was edited, replaced or re-exported since)"
+            + _changed_recorded_files(recorded, identity)
+            + ": the session's first images and the "
             "ones a resume would take would come from two different acquisitions. Put the original "
             f"files back to continue (rti-rig run --resume {shell_word(str(session_dir))}), "
             "or start a new session from the acquisition as it is now ("
