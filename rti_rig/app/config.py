@@ -1736,7 +1736,11 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     default dome's (about 1 s a light), so a replayed session reports what a real dome would
     take.
     """
-    from rti_rig.core.acquisition_images import check_acquisition_images, mixed_depth_note
+    from rti_rig.core.acquisition_images import (
+        AcquisitionImagesError,
+        check_acquisition_images,
+        mixed_depth_note,
+    )
     from rti_rig.core.image_files import png_alpha_note
 
     lp_path = Path(lp_path).resolve()
@@ -1752,7 +1756,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
         # said "key 'dome.lp_file'" (a key of a config the user never wrote) and "a dome's
         # calibration lists each LED once"
         i, j = pair
-        raise ConfigError(
+        refused = ConfigError(
             lp_path,
             None,
             f"{lights_said(entries, (i, j))} share one "
@@ -1760,13 +1764,19 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             "lights by direction, each once; remove one of the two lines (its image is then "
             "left out) to replay the others",
         )
+        refused.reader_notes = tuple(notes)  # type: ignore[attr-defined]
+        raise refused
     # every image found, whole, readable, of one size and kind, before anything runs (shared
     # with bench tradeoff --from, which reads the same acquisitions)
-    found = check_acquisition_images(
-        lp_path,
-        entries,
-        lead="as a rig, an .lp is a recorded acquisition, replayed from the images it lists: ",
-    )
+    try:
+        found = check_acquisition_images(
+            lp_path,
+            entries,
+            lead="as a rig, an .lp is a recorded acquisition, replayed from the images it lists: ",
+        )
+    except AcquisitionImagesError as exc:
+        exc.reader_notes = tuple(notes)  # said with the refusal (run) or the failed check
+        raise
     # their readers drop a PNG's alpha: said once, among the rig's notes (run, check)
     notes.extend(png_alpha_note([e.name for e in entries], found.paths))
     width, height = found.width, found.height

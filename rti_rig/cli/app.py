@@ -180,6 +180,10 @@ def reflow_command_help(typer_app: typer.Typer) -> None:
 
 
 def fail(exc: RtiRigError) -> typer.Exit:
+    # what a tolerant reader had noted of the file refused (a count line that disagrees, a
+    # light clamped to the horizon): said first, or the user mends what the error names and
+    # learns of the rest only on the next try
+    print_notes(getattr(exc, "reader_notes", ()))
     # the message is plain text: "[camera]" or "[dome.serial]" in it must not be read as markup
     err.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
     return typer.Exit(code=2)

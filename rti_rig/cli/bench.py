@@ -335,6 +335,7 @@ def _tradeoff(
             from_lp = _acquisition_lp(from_lp, notes)
             acquisition = [from_lp, *check_acquisition(from_lp, notes)]
         except RtiRigError as exc:
+            print_notes(notes)  # what the reader noted, said with the refusal as on a pass
             raise fail(exc) from None
         print_notes(notes)
     if out_dir is not None:  # before minutes of computing, not after

@@ -54,6 +54,9 @@ class AcquisitionImagesError(ConfigError):
     def __init__(self, lp_path: Path | str, problems: Sequence[str]) -> None:
         super().__init__(lp_path, None, problems[0])
         self.problems = tuple(problems)
+        #: what the `.lp`'s tolerant reader noted of the file (set by the loader that read
+        #: it), said with the refusal: the user mending the images learns of the rest too
+        self.reader_notes: tuple[str, ...] = ()
 
 
 def check_acquisition_images(

@@ -755,6 +755,17 @@ def _refuse_extra_columns(tokens: list[str], line: str, source: str, lineno: int
     only where exactly one run of three is a unit vector (the light's direction)."""
     if len(tokens) < 5:
         return
+    # a comment after the light ('image02.jpg 0.1 0.2 0.97 # LED 2 weak') had been told "7
+    # fields after the name", with nothing of the '#': a '#' line is a comment, its tail not
+    mark = next((i for i, t in enumerate(tokens) if i >= 4 and t.startswith("#")), None)
+    if mark is not None and all(_is_number(t) for t in tokens[mark - 3 : mark]):
+        raise LpFormatError(
+            source,
+            lineno,
+            f"a comment after the light: {' '.join(tokens[mark:])!r}; an .lp has no "
+            "end-of-line comments (relight and RTIBuilder read every field of a light line): "
+            "move it to a line of its own starting with '#'",
+        )
     named_image = tokens[0].lower().endswith(_IMAGE_ENDINGS)
     if (named_image and any(_is_number(t) for t in tokens[1:-3])) or _columns_after_light(tokens):
         raise LpFormatError(

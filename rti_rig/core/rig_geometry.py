@@ -228,7 +228,8 @@ class ArmGeometry:
         if lo >= hi:
             raise ScheduleError(
                 f"elevation floor {min_elevation_deg:g}° leaves no reachable band "
-                f"(the arm reaches {self.min_elevation_deg:g}°..{hi:g}°)"
+                f"(the arm reaches {self.min_elevation_deg:g}°..{hi:g}°): lower it below "
+                f"{hi:g}° (--min-elevation-deg)"
             )
         return lo, hi
 

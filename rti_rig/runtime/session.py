@@ -3181,7 +3181,8 @@ def _lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None) -> 
     if adaptive:
         return (
             "put the originals back from a copy (an adaptive session cannot reshoot one image: "
-            "the lights after it were chosen from it), or start a new session with another --out"
+            "the lights after it were chosen from it, and the session's estimate and stop from "
+            "every image), or start a new session with another --out"
         )
     try:
         finished = (read_manifest(root).get("runner") or {}).get("finish_reason")

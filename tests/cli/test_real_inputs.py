@@ -702,3 +702,25 @@ def test_a_listed_image_that_is_a_folder_or_a_dead_link_is_said_as_such(tmp_path
         assert "image01.jpg is a folder" in said, said
         assert f"image05.jpg is a link to {tmp_path / 'gone.jpg'}, which does not exist" in said
         assert "upper/lower case" not in said and "Traceback" not in said
+
+
+def test_the_readers_notes_are_said_with_a_refusal_of_the_images(tmp_path: Path) -> None:
+    """A count line off by one and an image missing: `check`, `run` and `bench tradeoff
+    --from` named the image, but the count line's note, said on a passing acquisition, was
+    dropped, so the user mending the .lp learnt of it only on the next try."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    lines = (acq / "dirs.lp").read_text().splitlines()
+    lines[0] = str(int(lines[0]) + 1)
+    (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
+    (acq / lines[3].split()[0]).unlink()
+    counted = "line 1: count line says 19 lights but the file lists 18"
+    for args, code in (
+        (["check", str(acq / "dirs.lp")], 1),
+        (["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")], 2),
+        (["bench", "tradeoff", "--from", str(acq / "dirs.lp"), "--out", str(tmp_path / "b")], 2),
+    ):
+        r = runner.invoke(app, args)
+        said = " ".join(r.output.split())
+        assert r.exit_code == code, said
+        assert "1 of 18 image(s) missing" in said and counted in said, (args[0], said)

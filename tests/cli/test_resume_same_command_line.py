@@ -258,6 +258,17 @@ def test_an_adaptive_session_continues_with_its_own_line(tmp_path: Path) -> None
     r = runner.invoke(app, [*line, "--adaptive", "--lights", "7"])
     assert r.exit_code == 0, r.output
     assert "this session is complete" in said(r) and "Next: rti-rig fit" in said(r)
+    # another request of the finished session: it is not "continued as it began" (that
+    # resume answers "complete, nothing to resume"), it is said complete, with the new session
+    # and the fit
+    before = tree(out)
+    r = runner.invoke(app, [*line, "--adaptive", "--lights", "9"])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "It began with --adaptive --lights 7 and is complete" in text, text
+    assert "to continue it as it began" not in text and "rti-rig fit" in text
+    assert "start a new session: rti-rig run" in text and "--adaptive --lights 9" in text
+    assert tree(out) == before
 
 
 def test_a_metered_session_continues_with_its_own_metering_options(tmp_path: Path) -> None:

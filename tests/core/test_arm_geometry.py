@@ -136,3 +136,11 @@ def test_the_ring_is_kept_while_it_determines_a_normal() -> None:
     arm = ArmGeometry(0.0, 90.0, 15.0, 0.0, 10.0, -17.0, 17.0)
     _, el = az_el_from_direction(arm.homogeneous(3))
     np.testing.assert_allclose(el, 35.26, atol=0.01)
+
+
+def test_a_floor_above_the_arms_reach_says_how_low_it_must_be() -> None:
+    """It named the reach but not the way out, where a ceiling below it says "raise it"."""
+    from rti_rig.core.errors import ScheduleError
+
+    with pytest.raises(ScheduleError, match=r"5°\.\.80°\): lower it below 80° \(--min-elevation"):
+        ARMS[0].elevation_band(85.0)

@@ -622,3 +622,9 @@ def test_float_noise_below_the_horizon_is_the_horizon(z: str) -> None:
     notes: list[str] = []
     (entry,) = parse_lp(f"1\na.jpg 1.0 0.0 {z}\n", "h.lp", upper_hemisphere=True, notes=notes)
     assert entry.direction == (1.0, 0.0, 0.0) and notes == []
+
+
+def test_a_comment_after_a_light_is_named_with_where_to_put_it() -> None:
+    """It had been refused as "7 fields after the name", the '#' not named."""
+    with pytest.raises(LpFormatError, match=r"line 3: a comment after the light: '# LED 2 weak'"):
+        parse_lp("2\na.jpg 0 0 1\nb.jpg 0 0.6 0.8 # LED 2 weak\n", "c.lp", notes=[])

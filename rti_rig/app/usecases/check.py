@@ -110,7 +110,7 @@ def check_rig(
         # what this check is for: the images of a recorded acquisition, each problem said
         if on_start is not None:
             on_start()
-        return FailedReplayCheck(Path(exc.path).name, exc.problems)
+        return FailedReplayCheck(Path(exc.path).name, exc.problems, exc.reader_notes)
     if req.intensity is not None:
         _refuse_undimmable(loaded, req.intensity)
     if req.auto_exposure:
@@ -539,6 +539,9 @@ class FailedReplayCheck:
 
     lp_name: str
     problems: tuple[str, ...]
+    #: what the tolerant reader noted of the `.lp` (a passing check says them too): the user
+    #: mending the images had learnt of a count line that disagrees only on the next check
+    notes: tuple[str, ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -548,5 +551,6 @@ class FailedReplayCheck:
         return [
             "replay rig: a recorded acquisition, no device to light, move or open",
             *(f"images of {self.lp_name}: FAILED: {p}" for p in self.problems),
+            *config_note_lines(self),
             "RESULT: FAIL",
         ]

@@ -82,6 +82,19 @@ def check_same_start(
         said, rest = by_default
         began = f"{said} and {rest}" if rest else said
         give = "give those options without --lights, or none" if rest else "drop those options"
+    if (manifest.get("runner") or {}).get("finish_reason") == "completed":
+        # a finished session has nothing to continue: "to continue it as it began" had sent
+        # the user to a resume that answers "complete, nothing to resume"
+        from rti_rig.core.out_folders import fit_beside
+
+        raise RtiRigError(
+            f"{shown_path(root)}: this resume asks for another session than the one in it ("
+            + "; ".join(diffs)
+            + f"). It began with {began or 'the defaults'} and is complete: a finished session "
+            "is not extended (nothing in the folder was changed). To shoot this request, start "
+            f"a new session: {_new_session_command(asked, loaded, root)}; to use the session as "
+            f"it is: {fit_beside(root)}"
+        )
     raise RtiRigError(
         f"{shown_path(root)}: this resume asks for another session than the one in it ("
         + "; ".join(diffs)
