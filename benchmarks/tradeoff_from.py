@@ -203,7 +203,11 @@ def check_acquisition(lp: Path, notes: list[str] | None = None) -> list[Path]:
     from rti_rig.core.errors import RtiRigError
     from rti_rig.core.image_files import png_alpha_note
     from rti_rig.core.lp_format import read_lp
+    from rti_rig.runtime.session import refuse_if_in_use
 
+    # a session still being captured: its lights.lp and images are not yet the acquisition
+    # (a trade of its first 11 lights had been measured in silence)
+    refuse_if_in_use(lp.parent, "measure the trade on it")
     entries = read_lp(lp, upper_hemisphere=True, notes=notes)
     twins = _twin_lights(lp, entries)
     if twins is not None:

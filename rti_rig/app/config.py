@@ -1078,6 +1078,19 @@ def load_rig_config(path: Path | str, project_doing: str = "replaying") -> Loade
     data, settings, correction_bytes = _with_correction_file(data, path)
     settings = _with_led_map_path(settings, path.parent)
     config = parse_rig_config(settings, str(path))
+    if config.backend == "replay":
+        # the form a session's manifest records a replay rig in, not one to write by hand:
+        # such a file had been read with its images looked for beside the TOML, none checked
+        # before the run, and the first capture blamed "its drive unplugged"
+        lp_file = config.dome.lp_file if config.dome is not None else None
+        acq = shell_word(str((path.parent / lp_file).resolve())) if lp_file else "ACQ/dirs.lp"
+        raise ConfigError(
+            path,
+            "backend",
+            "'replay' is the rig rti-rig makes of a recorded acquisition's .lp, not one a "
+            f"config describes: give the .lp itself as the rig (rti-rig run {acq} --out "
+            f"SESSION, rti-rig check {acq})",
+        )
     serial_cfg = config.dome.serial if config.dome is not None else None
     if serial_cfg is not None and serial_cfg.led_map_file is not None:  # refuse a bad map now
         from rti_rig.drivers.led_dome.factory import protocol_for
@@ -1742,8 +1755,13 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
         mixed_depth_note,
     )
     from rti_rig.core.image_files import png_alpha_note
+    from rti_rig.runtime.session import refuse_if_in_use
 
     lp_path = Path(lp_path).resolve()
+    # a session's lights.lp while its run still captures (it grows, its next image may be
+    # half written): refused as check, fit and export-lp refuse it; run, plan --rig and
+    # bench had read the images so far as a whole acquisition, in silence
+    refuse_if_in_use(lp_path.parent, "use it as a recorded acquisition")
     try:
         raw_bytes = lp_path.read_bytes()
     except OSError as exc:

@@ -65,6 +65,18 @@ def test_a_session_being_captured_is_not_fitted_or_exported(tmp_path: Path) -> N
         assert r.exit_code == 2 and "being captured" in said(r), r.output
         assert "check its images once that run has ended" in said(r), r.output
         assert "RESULT" not in said(r), r.output
+        # as a replay rig, a plan's rig and a trade's acquisition: they had read the images
+        # so far as a whole acquisition, in silence
+        lp = str(s / "lights.lp")
+        for args in (
+            ["run", lp, "--out", str(tmp_path / "replay"), "--lights", "6"],
+            ["plan", "--rig", lp, "--lights", "6", "--out", str(tmp_path / "p.lp")],
+            ["bench", "tradeoff", "--from", lp, "--out", str(tmp_path / "bench")],
+        ):
+            r = runner.invoke(app, args)
+            assert r.exit_code == 2 and "being captured" in said(r), (args[0], r.output)
+            assert "once that run has ended" in said(r), r.output
+        assert not (tmp_path / "replay").exists() and not (tmp_path / "bench").exists()
     finally:
         assert holder.stdin is not None
         holder.stdin.close()

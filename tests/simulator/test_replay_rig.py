@@ -587,3 +587,23 @@ def test_a_plan_of_an_acquisition_with_spaced_accented_names_replays_on_it(
         decoded = read_jpeg_rgb(acq / src.name)
         mine = linear_to_srgb8(read_linear_tiff(out / step["linear_image"]), 65535)
         assert np.array_equal(mine, decoded), src.name
+
+
+def test_a_config_of_backend_replay_is_refused_with_the_lp_to_give(tmp_path: Path) -> None:
+    """The manifest's form of a replay rig, written by hand: its images had been looked for
+    beside the TOML, none checked before the run, and the first capture blamed an unplugged
+    drive; `check` called it "not an .lp". Refused by `run` and `check`, naming the .lp."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    cfg = tmp_path / "replay.toml"
+    cfg.write_text(
+        'name = "my replay"\nkind = "dome"\nbackend = "replay"\n[dome]\nlayout = "lp"\n'
+        'lp_file = "acq/dirs.lp"\n[camera]\nwidth = 402\nheight = 395\n'
+    )
+    for args in (["run", str(cfg), "--out", str(tmp_path / "s")], ["check", str(cfg)]):
+        r = runner.invoke(app, args)
+        said = " ".join(r.output.split())
+        assert r.exit_code == 2, said
+        assert "key 'backend': 'replay' is the rig rti-rig makes of a recorded acquisition" in said
+        assert f"rti-rig run {acq / 'dirs.lp'} --out" in said and "Traceback" not in said
+    assert not (tmp_path / "s").exists()

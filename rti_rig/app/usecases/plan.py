@@ -221,6 +221,11 @@ def _check_preview_rig(preview_rig: _PreviewRig, loaded: LoadedRig) -> None:
 
 def _bare_lp_dome(rig: Path, notes: list[str]) -> tuple[DomeGeometry, list[LpEntry]]:
     """A bare ``.lp`` as a rig: a dome with exactly these lights, each listed once."""
+    from rti_rig.runtime.session import refuse_if_in_use
+
+    # a session's lights.lp while its run still captures lists the lights fired so far: a
+    # plan had been made for "a dome of 11 LEDs" of what would be 72
+    refuse_if_in_use(rig.parent, "plan on its lights")
     entries = read_lp(rig, upper_hemisphere=True, notes=notes)
     pair = coincident_leds([e.direction for e in entries])
     if pair is not None:
