@@ -719,6 +719,11 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
 
     if not p.is_file():  # said here, before OpenCV prints its own warning line about it
         raise SessionError(f"cannot read image {shown_path(p)}: there is no such file")
+    if p.stat().st_size == 0:  # it had been "missing, or not an image OpenCV decodes"
+        raise SessionError(
+            f"cannot read image {shown_path(p)}: the file is empty (0 bytes: cut off while "
+            "copied, or a full card?)"
+        )
     refuse_truncated_jpeg(p)  # before OpenCV, which decodes it with a grey part
     img = opencv_files.imread(p)
     if img is None:

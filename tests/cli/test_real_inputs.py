@@ -724,3 +724,13 @@ def test_the_readers_notes_are_said_with_a_refusal_of_the_images(tmp_path: Path)
         said = " ".join(r.output.split())
         assert r.exit_code == code, said
         assert "1 of 18 image(s) missing" in said and counted in said, (args[0], said)
+
+
+def test_an_empty_image_is_said_empty_not_missing(tmp_path: Path) -> None:
+    """A 0-byte image (a copy cut off) had been "missing, or not an image OpenCV decodes"."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    (acq / "image01.jpg").write_bytes(b"")
+    r = runner.invoke(app, ["check", str(acq / "dirs.lp")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "image01.jpg: the file is empty (0 bytes" in said, said
