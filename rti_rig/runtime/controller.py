@@ -882,17 +882,25 @@ def run_session(
             if cancel.paused:
                 emit(Paused(i, total))
                 cancel.wait_while_paused()
-            if cancel.cancelled:
+            if cancel.cancelled and source is None:
                 reason = FinishReason.CANCELLED
                 break
             decision: dict[str, Any] | None = None
             if source is None:
                 step = schedule.steps[i]
             else:
+                # asked even after a stop was asked for: a source whose session is done (an
+                # --until-error target met by the image just taken) completes it. Whether a
+                # Ctrl-C on that image ended it "cancelled" (exit 130, resume advised) or
+                # complete (exit 0) had hung on whether it landed before or during this
+                # decision; and one landing during it had let the next light fire
                 decided = source.next_step(i)
                 if decided is None:  # the source says the session is done
                     concluded = source.conclude()
                     reason = FinishReason.COMPLETED
+                    break
+                if cancel.cancelled:  # not a light more once a stop was asked for
+                    reason = FinishReason.CANCELLED
                     break
                 step, decision = decided
                 validate_schedule(rig, LightSchedule((step,)))  # before this light moves

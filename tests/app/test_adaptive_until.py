@@ -345,3 +345,15 @@ def test_the_stop_prints_its_upper_estimate_on_the_side_of_the_target_it_is() ->
         places = places_against(value, target)
         assert (float(f"{value:.{places}f}") <= target) == (value <= target)
     assert places_against(1.234, 2.0) == 2  # two places where two say it
+    # and the summary line does not print it again at two places (0.318° in the reason,
+    # then "upper estimate 0.32°")
+    from rti_rig.app.usecases.adaptive import estimate_phrase
+
+    result = {
+        "until_error_deg": 0.318,
+        "estimated_error_deg": 0.1628,
+        "upper_error_deg": 0.3175,
+        "upper_factor": 1.95,
+    }
+    reason = "upper estimate 0.318° (estimate 0.163° × 1.95) ≤ --until-error 0.318°"
+    assert estimate_phrase(result, reason) == ""

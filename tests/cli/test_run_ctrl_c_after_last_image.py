@@ -175,3 +175,28 @@ def test_a_reshoot_stopped_before_it_wrote_anything_is_told_the_flags_it_was_giv
     assert code == 130 and "Traceback" not in said, said
     given = f"rti-rig run {cfg} --resume {out} --accept-rig-change --reshoot-lost"
     assert f"Continue with: {given}" in said, said
+
+
+def test_a_ctrl_c_on_the_image_that_meets_the_target_completes_the_session(
+    tmp_path: Path,
+) -> None:
+    """An --until-error session stopped by one Ctrl-C as the image that meets its target is
+    committed: whether it ended "cancelled" (exit 130, resume advised) or complete (exit 0)
+    had hung on whether the Ctrl-C landed before or during the next decision. The decision
+    is made either way, and a session it says is done is complete."""
+    whole = tmp_path / "whole"
+    whole.mkdir()
+    code, said, out = _run(whole, 99, 0, "--until-error", "30", "--lights", "20")
+    assert code == 0, said
+    kept = json.loads((out / "manifest.json").read_text())["runner"]["steps_done"]
+    assert 4 <= kept < 20, kept  # it stopped itself (judged from its 4th image on) short of 20
+    code, said, out = _run(tmp_path, kept - 1, 1, "--until-error", "30", "--lights", "20")
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert code == 0, said
+    assert manifest["runner"]["finish_reason"] == "completed", manifest["runner"]
+    assert manifest["runner"]["steps_done"] == kept and "--resume" not in said, said
+    # a Ctrl-C one image earlier still stops it there, cancelled, the resume said
+    code, said, out = _run(tmp_path / "x", kept - 2, 1, "--until-error", "30", "--lights", "20")
+    assert code == 130 and f"{kept - 1} image(s) in the session" in said and "--resume" in said, (
+        said
+    )

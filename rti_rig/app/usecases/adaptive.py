@@ -1199,8 +1199,11 @@ def estimate_phrase(result: dict[str, Any], reason: str = "") -> str:
         role = ": what --until-error would be compared with"
     else:  # --until-error goes with normals only: a relight session is never compared
         role = ""
-    upper_said = f"upper estimate {up:.2f}°" in reason
-    if upper_said and f"(estimate {est:.2f}°" in reason:
+    # the reason prints them at the places that keep the target's side (places_against)
+    target = result.get("until_error_deg")
+    places = 2 if target is None else places_against(up, float(target))
+    upper_said = f"upper estimate {up:.{places}f}°" in reason
+    if upper_said and f"(estimate {est:.{places}f}°" in reason:
         return ""  # the reason gives both figures and the factor
     if upper_said:
         return f"{text} (the upper estimate is ×{factor:g} of it{role})"
