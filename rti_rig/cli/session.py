@@ -423,7 +423,35 @@ def _say_next(session: Path) -> None:
 
     if (session / MARKER).exists():
         return
-    out.print(f"Next: {escape(fit_beside(session))}", soft_wrap=True, highlight=False)
+    out.print(
+        f"Next: {escape(fit_beside(session) + _fit_model_for(session))}",
+        soft_wrap=True,
+        highlight=False,
+    )
+
+
+def _fit_model_for(session: Path) -> str:
+    """`` --model ps`` where the fit's default ``--model auto`` fits nothing of the session's
+    lights but photometric stereo makes their normal map ("" otherwise).
+
+    Why: an ``--until-error`` session in a band of 3 LEDs was told, in its note, that the
+    default fit writes nothing and ``--model ps`` the normal map, and then "Next: rti-rig fit
+    S --out S-fit", which fit refused."""
+    import numpy as np
+
+    from rti_rig.app.normals_determined import undetermined_normals
+    from rti_rig.core.fit_minimums import FIT_MINIMUMS, AutoFit
+    from rti_rig.core.lp_format import read_lp
+
+    try:
+        entries = read_lp(session / "lights.lp")
+    except Exception:  # no lights.lp to read: the fit's own refusal says why
+        return ""
+    lights = np.array([e.direction for e in entries], dtype=np.float64)
+    determined = len(entries) >= FIT_MINIMUMS.normal and undetermined_normals(lights) is None
+    if determined and not AutoFit(len(entries), True).fits:
+        return " --model ps"
+    return ""
 
 
 def _same_folder(a: Path, b: Path) -> bool:

@@ -72,6 +72,10 @@ def test_a_three_light_session_is_shot_on_the_ring_and_fitted(tmp_path: Path) ->
         app, ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(session), "--lights", "3"]
     )
     assert r.exit_code == 0, r.output
+    # the next step named is the fit that takes 3 lights (the default --model auto refuses
+    # them, and "Next: rti-rig fit S --out S-fit" had been said all the same)
+    said = " ".join(r.output.split())
+    assert f"Next: rti-rig fit {session} --out {session}-fit --model ps" in said, said
     _, el = az_el_from_direction(np.array([e.direction for e in read_lp(session / "lights.lp")]))
     np.testing.assert_allclose(el, 40.0, atol=0.5)
     r = CliRunner().invoke(
