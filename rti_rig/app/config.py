@@ -1089,7 +1089,8 @@ def load_rig_config(path: Path | str, project_doing: str = "replaying") -> Loade
             "backend",
             "'replay' is the rig rti-rig makes of a recorded acquisition's .lp, not one a "
             f"config describes: give the .lp itself as the rig (rti-rig run {acq} --out "
-            f"SESSION, rti-rig check {acq})",
+            f"SESSION, rti-rig check {acq}); a session begun from this file continues with "
+            f"rti-rig run {acq} --resume SESSION",
         )
     serial_cfg = config.dome.serial if config.dome is not None else None
     if serial_cfg is not None and serial_cfg.led_map_file is not None:  # refuse a bad map now

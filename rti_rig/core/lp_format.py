@@ -584,7 +584,12 @@ def missing_images_advice(
         + _kin_said(kin, len(paths))
         + _invisible_said(hidden)
     )
-    if named and (rest := len(names) - len(not_files) - len(twins) - len(kin) - len(hidden)):
+    # each missing image counted once, whatever clauses name it (a folder image05.jpg beside
+    # image05.png is both "a folder" and "another extension": "the other -1" had been said)
+    covered = {p.name for p in paths if os.path.lexists(p) and not p.is_file()}
+    covered |= {t.split(" -> ")[0] for t in [*twins, *kin]}
+    covered |= {p.name for p in paths if not p.name.isprintable()}
+    if named and (rest := max(0, len(names) - len(covered))):
         # the images with no such file are missing all the same: their way out is said too
         tail = others if len(names) < total else ""
         named += f"; for the other {rest} not found, {copy}{tail}"

@@ -918,6 +918,11 @@ class SessionFolder:
                 run["schedule_before_rig_change"] = self.schedule_before_change
             if self.rig_identity is not None:
                 self.manifest.setdefault("rig", {})["identity"] = self.rig_identity
+            used = (header.get("rig") or {}).get("config")
+            if used is not None:
+                # the config as this run read it: the rig record keeps the first run's, and an
+                # adaptive resume compares the times its decisions weigh with the last run's
+                run["config"] = used
             new_path = (header.get("rig") or {}).get("config_path")
             if new_path:
                 # the config this run used is the session's own from now on (a change of rig was

@@ -518,6 +518,16 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
     )
     assert r.exit_code == 0, r.output
     assert manifest(tmp_path / "r")["adaptive"]["design_lights"] == 6
+    # interrupted, it continues with the line that began it (no --lights): the design for
+    # default_lights had been read as a --lights 6 given, and that line refused
+    cut = tmp_path / "cut"
+    interrupted(cfg, cut, after_step=2, lights=None)
+    line = ["run", str(cfg), "--out", str(cut), "--adaptive", "--resume", str(cut)]
+    r = runner.invoke(app, line)
+    assert r.exit_code == 0, r.output
+    assert (cut / "lights.lp").read_bytes() == (out / "lights.lp").read_bytes()
+    r = runner.invoke(app, [*line[:-2], "--lights", "6", "--resume", str(cut)])
+    assert r.exit_code == 2 and "--lights 6, the session not given" in said(r), said(r)
     from rti_rig.app.config import load_rig_config
     from rti_rig.app.usecases.adaptive import ARM_MAX_LIGHTS, default_max_lights
 
@@ -526,65 +536,56 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
     assert ARM_MAX_LIGHTS > 6
 
 
-def test_a_resume_on_a_faster_arm_names_the_times_that_changed(tmp_path: Path) -> None:
-    """An arm's decisions weigh each light's move time; a resume whose config speeds the arm
-    up (which the rig identity rightly ignores: the images do not change) decides a step
-    otherwise and is refused. It said "another rig config, software version or image on
-    disk ... start a new session"; it now names the times and that putting them back
-    continues the session (which it does)."""
+@pytest.mark.parametrize(
+    ("after_step", "changed", "said_first"),
+    [
+        # faster, stopped after a decided step: that step is decided otherwise. It said
+        # "another rig config, software version or image on disk ... start a new session"
+        (
+            5,
+            {
+                "speed_deg_s = 60.0": "speed_deg_s = 6000.0",
+                "acceleration_deg_s2 = 120.0": "acceleration_deg_s2 = 12000.0",
+            },
+            "an adaptive session weighs each light by the time it costs",
+        ),
+        # slower, stopped within the starting lights (which no time decides): the steps taken
+        # replayed as they were and it went on without a word, the rest chosen for the new
+        # move times, another session than the one begun
+        (
+            2,
+            {"speed_deg_s = 60.0": "speed_deg_s = 30.0"},
+            "the rig config now gives other times than this session's lights were chosen",
+        ),
+    ],
+    ids=["faster", "slower"],
+)
+def test_a_resume_on_an_arm_of_other_speed_names_the_times_that_changed(
+    tmp_path: Path, after_step: int, changed: dict[str, str], said_first: str
+) -> None:
+    """An arm's decisions weigh each light's move time, which the rig identity rightly
+    ignores (the images do not change): a resume whose config changes the arm's speed is
+    refused before anything moves, naming the times, and putting them back continues it."""
     text = (CONFIGS / "virtual_arm.toml").read_text()
-    assert "speed_deg_s = 60.0" in text and "acceleration_deg_s2 = 120.0" in text
+    assert all(old in text for old in changed)
     cfg = write_config(
         tmp_path, text.replace("width = 512", "width = 96").replace("height = 512", "height = 96")
     )
     out = tmp_path / "s"
-    interrupted(cfg, out, after_step=5, lights=9)
+    interrupted(cfg, out, after_step=after_step, lights=9)
     before = folder_bytes(out)
-    fast = write_config(
-        tmp_path,
-        cfg.read_text()
-        .replace("speed_deg_s = 60.0", "speed_deg_s = 6000.0")
-        .replace("acceleration_deg_s2 = 120.0", "acceleration_deg_s2 = 12000.0"),
-        "fast.toml",
+    other = cfg.read_text()
+    for old, new in changed.items():
+        other = other.replace(old, new)
+    r = runner.invoke(
+        app, ["run", str(write_config(tmp_path, other, "other.toml")), "--resume", str(out)]
     )
-    r = runner.invoke(app, ["run", str(fast), "--resume", str(out)])
     assert r.exit_code == 2, r.output
     text = said(r)
-    assert "an adaptive session weighs each light by the time it costs" in text
-    assert "arm moves, the longest from the last light" in text
+    assert said_first in text and "arm moves, the longest from the last light" in text
     assert "Put those settings back as the session began to continue it" in text
     assert folder_bytes(out) == before
     r = runner.invoke(app, ["run", str(cfg), "--resume", str(out)])  # put back: it goes on
-    assert r.exit_code == 0, r.output
-    assert len(journal(out)) == 9
-
-
-def test_a_resume_on_a_slower_arm_is_refused_though_its_steps_taken_replay(
-    tmp_path: Path,
-) -> None:
-    """Stopped within its starting lights (which no time decides), a session resumed on an arm
-    at half speed replayed its steps as they were and went on without a word, choosing the
-    rest for the new move times: another session than the one begun. Refused, naming the
-    times, before anything moves; the speed put back, it goes on."""
-    text = (CONFIGS / "virtual_arm.toml").read_text()
-    assert "speed_deg_s = 60.0" in text
-    cfg = write_config(
-        tmp_path, text.replace("width = 512", "width = 96").replace("height = 512", "height = 96")
-    )
-    out = tmp_path / "s"
-    interrupted(cfg, out, after_step=2, lights=9)
-    before = folder_bytes(out)
-    slow = write_config(
-        tmp_path, cfg.read_text().replace("speed_deg_s = 60.0", "speed_deg_s = 30.0"), "slow.toml"
-    )
-    r = runner.invoke(app, ["run", str(slow), "--resume", str(out)])
-    assert r.exit_code == 2, r.output
-    text = said(r)
-    assert "the rig config now gives other times than this session's lights were chosen" in text
-    assert "arm moves, the longest from the last light" in text
-    assert "Put those settings back as the session began to continue it" in text
-    assert folder_bytes(out) == before
-    r = runner.invoke(app, ["run", str(cfg), "--resume", str(out)])
     assert r.exit_code == 0, r.output
     assert len(journal(out)) == 9
 
@@ -1042,3 +1043,31 @@ def test_an_arm_s_start_is_unchanged_where_its_floor_leaves_a_band(tmp_path: Pat
         plan = adaptive_plan(rig, None)
     _, el = az_el_from_direction(plan.candidates[plan.start])
     assert min(el) >= START_FLOOR_DEG - 1.0, el  # the start's floor, as before the band
+
+
+def test_the_times_are_compared_with_the_last_run_s_config(tmp_path: Path) -> None:
+    """A session an earlier resume ran on a slowed arm (before resumes recorded their config)
+    stands on that run's times: compared with the first run's it was refused at every resume,
+    and putting the first times back no longer replays the steps: a dead end. With the last
+    run's config unknown the check is not made; with it recorded, it is made against it."""
+    from rti_rig.app.usecases.adaptive import _last_run_config
+
+    first = {"timing": {"settle_s": 0.1}}
+    runs = [{"config_sha256": "a"}, {"config_sha256": "a", "resumed_with_steps_done": 3}]
+    recorded = {"rig": {"config": first}, "runs": runs}
+    assert _last_run_config(recorded) == first  # resumed on the same config: the first's
+    runs[1]["config_sha256"] = "b"
+    assert _last_run_config(recorded) is None  # another config, unrecorded: unknown
+    later = {"timing": {"settle_s": 0.2}}
+    runs.append({"config_sha256": "b", "config": later})
+    assert _last_run_config(recorded) == later
+    # and a resume records the config it read
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    cfg = write_config(
+        tmp_path, text.replace("width = 512", "width = 96").replace("height = 512", "height = 96")
+    )
+    out = tmp_path / "s"
+    interrupted(cfg, out, after_step=2, lights=9)
+    r = runner.invoke(app, ["run", str(cfg), "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert manifest(out)["runs"][-1]["config"] == manifest(out)["rig"]["config"]

@@ -734,3 +734,22 @@ def test_an_empty_image_is_said_empty_not_missing(tmp_path: Path) -> None:
     r = runner.invoke(app, ["check", str(acq / "dirs.lp")])
     said = " ".join(r.output.split())
     assert r.exit_code == 1 and "image01.jpg: the file is empty (0 bytes" in said, said
+
+
+def test_an_image_named_by_two_clauses_is_counted_once(tmp_path: Path) -> None:
+    """image05.jpg a folder, image05.png beside it: both clauses name it, and the advice for
+    "the other -1 not found" had followed."""
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lines = (ACQ / "dirs.lp").read_text().splitlines()[1:7]
+    for line in lines:
+        shutil.copy(ACQ / line.split()[0], acq / line.split()[0])
+    name = lines[1].split()[0]
+    (acq / name).unlink()
+    (acq / name).mkdir()
+    shutil.copy(ACQ / name, acq / name.replace(".jpg", ".png"))
+    (acq / "dirs.lp").write_text("\n".join(["6", *lines]) + "\n")
+    r = runner.invoke(app, ["check", str(acq / "dirs.lp")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and f"{name} is a folder" in said, said
+    assert "for the other" not in said, said

@@ -606,4 +606,5 @@ def test_a_config_of_backend_replay_is_refused_with_the_lp_to_give(tmp_path: Pat
         assert r.exit_code == 2, said
         assert "key 'backend': 'replay' is the rig rti-rig makes of a recorded acquisition" in said
         assert f"rti-rig run {acq / 'dirs.lp'} --out" in said and "Traceback" not in said
+        assert f"rti-rig run {acq / 'dirs.lp'} --resume SESSION" in said, said
     assert not (tmp_path / "s").exists()

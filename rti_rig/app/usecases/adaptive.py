@@ -954,6 +954,10 @@ class AdaptiveSteps:
         self._pending: dict[int, int] = {}
         self._outcome: dict[str, Any] | None = None
         self._move = move  # for a refused resume's words (:meth:`_timing_differences`)
+        #: whether --lights was given: a design for the config's default_lights (``--adaptive``
+        #: alone) is recorded as design_lights too, and its resume with the line that began
+        #: it (no --lights) is the same request (recorded: ``header()['lights_given']``)
+        self.lights_given = plan.design_lights is not None
 
     @property
     def total(self) -> int:
@@ -976,6 +980,7 @@ class AdaptiveSteps:
             "min_lights": self.min_lights,
             "start_lights": len(self.plan.start),
             "design_lights": self.plan.design_lights,
+            "lights_given": self.lights_given,
             "objective": self.objective,
             "candidates": len(self.plan.candidates),
             "min_elevation_deg": self.plan.band[0],
@@ -1049,7 +1054,9 @@ class AdaptiveSteps:
             self.chooser.observe(candidate, np.asarray(rec.actual_direction), small_grey(pixels))
         if other_rig:
             self._keep_start_unused(folder, len(done))
-        elif timing := self._timing_differences(folder):
+        elif not getattr(folder, "rig_change", None) and (
+            timing := self._timing_differences(folder, _last_run_config(folder.manifest))
+        ):
             # the steps taken replayed as they were, but the rest would be chosen for the new
             # times: a resume on a slowed arm had gone on without a word, and finished another
             # session than the one begun (whether it was refused hung on whether a step taken
@@ -1109,7 +1116,7 @@ class AdaptiveSteps:
                 f"(rti-rig run --resume {folder.root}), or start a new session on the changed rig"
             )
 
-    def _timing_differences(self, folder) -> list[str]:  # type: ignore[no-untyped-def]
+    def _timing_differences(self, folder, recorded: Any = "first") -> list[str]:  # type: ignore[no-untyped-def]
         """On an arm, the times a decision weighs (capture, moves) that differ between the rig
         config the session last ran with (its manifest) and this one, in words; empty if they
         agree, on a dome, or if they cannot be told. The rig identity leaves timing and motion
@@ -1118,7 +1125,8 @@ class AdaptiveSteps:
         session" as the remedy, where putting the speed back continues it."""
         from rti_rig.app.config import parse_rig_config
 
-        recorded = (folder.manifest.get("rig") or {}).get("config")
+        if recorded == "first":  # the config the session began with
+            recorded = (folder.manifest.get("rig") or {}).get("config")
         if self._move is None or not isinstance(recorded, dict):
             # a dome's lights all cost one capture time: a time per second ranks them alike,
             # so another time cannot be why a dome's step is decided otherwise
@@ -1154,6 +1162,24 @@ class AdaptiveSteps:
         if self._outcome is None:
             self._outcome = self.chooser.conclude()
         return self._outcome
+
+
+def _last_run_config(manifest: dict[str, Any]) -> dict[str, Any] | None:
+    """The rig config the session's last run read: recorded with each resume since
+    2026-12-05; the first run's (the rig record) where the last run's config digest is the
+    first's; None where an earlier resume ran on another config whose text was not recorded
+    (its steps may stand on other times: the check cannot be made, and a resume that had gone
+    on must still go on)."""
+    first = (manifest.get("rig") or {}).get("config")
+    runs = manifest.get("runs") or []
+    if not runs:
+        return first if isinstance(first, dict) else None
+    last = runs[-1]
+    if isinstance(last.get("config"), dict):
+        return last["config"]
+    if last.get("config_sha256") == runs[0].get("config_sha256") and isinstance(first, dict):
+        return first
+    return None
 
 
 def places_against(value: float, target: float) -> int:
@@ -1870,6 +1896,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
             if min_lights is not None:
                 _check_min_within(min_lights, in_reach, band, widen(lambda n: options(lights, n)))
         source = AdaptiveSteps(rig, plan, until_error_deg, objective, min_lights=min_lights)
+        source.lights_given = lights is not None
         schedule = source.start_schedule()
         validate_schedule(rig, schedule)  # the starting layout, before anything moves
         folder = SessionFolder.create(out_dir, source.total)
@@ -2030,5 +2057,19 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
         header.get("upper_factor"),
         min_lights=header.get("min_lights"),  # absent in sessions begun before it existed
     )
+    source.lights_given = lights_given(header)
     source.replay(folder)
     return source
+
+
+def lights_given(header: dict[str, Any]) -> bool:
+    """Whether the session recorded by ``header`` was begun with ``--lights`` (absent in
+    sessions begun before ``--adaptive`` alone was designed for ``default_lights``: then a
+    design meant ``--lights``)."""
+    return bool(header.get("lights_given", header.get("design_lights") is not None))
+
+
+def lights_asked(header: dict[str, Any]) -> int | None:
+    """The ``--lights`` the session recorded by ``header`` began with (None: not given)."""
+    design = header.get("design_lights")
+    return int(design) if design is not None and lights_given(header) else None

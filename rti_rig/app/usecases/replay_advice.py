@@ -76,7 +76,9 @@ def session_options(manifest: dict[str, Any]) -> str:
     band: dict[str, Any] = {}  # the record that holds the elevation band, if any
     if isinstance(adaptive, dict):
         until = adaptive.get("until_error_deg")
-        lights, floor = adaptive.get("design_lights"), adaptive.get("min_lights")
+        from rti_rig.app.usecases.adaptive import lights_asked
+
+        lights, floor = lights_asked(adaptive), adaptive.get("min_lights")
         words.append(
             adaptive_options(
                 float(until) if until is not None else None,

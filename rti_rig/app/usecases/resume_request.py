@@ -214,12 +214,12 @@ def _differences(asked: StartOptions, manifest: dict[str, Any], loaded: Any) -> 
 
 
 def _adaptive_differences(asked: StartOptions, header: dict[str, Any]) -> list[str]:
+    from rti_rig.app.usecases.adaptive import lights_asked
+
     diffs = []
-    if asked.lights != header.get("design_lights"):
-        diffs.append(
-            f"--lights {_or_none(asked.lights)}, the session "
-            f"{_or_none(header.get('design_lights'))}"
-        )
+    began = lights_asked(header)  # not the default_lights an --adaptive alone designs for
+    if asked.lights != began:
+        diffs.append(f"--lights {_or_none(asked.lights)}, the session {_or_none(began)}")
     if not _same_number(asked.until_error_deg, header.get("until_error_deg")):
         diffs.append(
             f"--until-error {_or_none(asked.until_error_deg)}, the session "
