@@ -48,6 +48,15 @@ if hasattr(signal, "SIGHUP") and (
     signal.signal(signal.SIGHUP, _hangup_outlived)
     os.environ[_OUTLIVE_HANGUP] = "1"
 
+# Likewise Ctrl-C: a shell without job control starts a background job (`cmd &` in a script)
+# with SIGINT ignored, and every child inherits that across exec, so Python installs no
+# KeyboardInterrupt and the Ctrl-C tests' SIGINT never arrived: a rehearsal of CI started that
+# way had them fail or wait 600 s each for a child that never stopped (2026-12-05). Python's
+# own handler is what a terminal leaves, and a handler, unlike an ignored signal, is reset to
+# the default in every program a test executes.
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+
 REPO = Path(__file__).resolve().parent.parent
 CONFIGS = REPO / "rig_configs"
 
