@@ -424,3 +424,106 @@ def test_a_session_begun_without_lights_is_said_to_have_every_light(
         assert "It began with every light of the dome (48) (nothing" in said(r), said(r)
         assert "--lights 48" not in said(r) and "drop those options" in said(r)
     assert tree(out) == before
+
+
+@pytest.fixture(scope="module")
+def adaptive_stopped(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``--adaptive --lights 7`` on the shipped simulated dome, stopped after 5 images."""
+    out = tmp_path_factory.mktemp("adaptive") / "s"
+    assert interrupted(DOME, out, after_step=4, lights=7).finish_reason is FinishReason.CANCELLED
+    return out
+
+
+@pytest.mark.parametrize(
+    ("options", "named", "unasked", "advised"),
+    [
+        # an option the session did not have: the session's own options, with it put in
+        (
+            ["--max-elevation-deg", "45"],
+            "--max-elevation-deg 45, the session 90",
+            "--adaptive not given, the session is adaptive; --lights not given, the session 7",
+            ["--adaptive", "--lights", "7", "--max-elevation-deg", "45"],
+        ),
+        (["--lights", "9"], "--lights 9, the session 7", "--adaptive not given", None),
+        # the session's own count without --adaptive: only what was left out differs, and the
+        # request is taken as typed (a planned run of 7)
+        (["--lights", "7"], None, "--adaptive not given, the session is adaptive", ["--lights"]),
+    ],
+)
+def test_a_resume_asking_another_request_advises_the_session_with_it_put_in(
+    adaptive_stopped: Path,
+    tmp_path: Path,
+    options: list[str],
+    named: str | None,
+    unasked: str,
+    advised: list[str] | None,
+) -> None:
+    """Before: the options left out were listed as the user's mistakes, first, and the new
+    session repeated only the options given: ``--max-elevation-deg 45`` advised a planned run
+    of every LED of the dome, not the adaptive session of 7 it had asked to band."""
+    out = copy_of(adaptive_stopped, tmp_path)
+    before = tree(out)
+    r = runner.invoke(app, ["run", "--resume", str(out), *options])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    differences = text.split("another session than the one in it (", 1)[1].split("). It", 1)[0]
+    if named is not None:
+        assert differences.startswith(
+            named + "; options given with --resume are the whole request, so these differ too: "
+        ), differences
+    else:
+        assert differences.startswith(
+            "options given with --resume are the whole request, so these differ: "
+        ), differences
+    assert unasked in differences
+    new = text.split("to shoot this request, start a new session: ", 1)[1]
+    words = shlex.split(new)
+    assert words[:3] == ["rti-rig", "run", str(DOME)] and words[-2:] == ["--out", f"{out}-2"]
+    expected = advised or ["--adaptive", *options]
+    assert " ".join(expected) in " ".join(words), new
+    assert tree(out) == before
+    if options == ["--max-elevation-deg", "45"]:  # pasted, it runs as asked
+        r = runner.invoke(app, [*words[1:], "--no-verdict"])
+        assert r.exit_code == 0, r.output
+        header = manifest(Path(f"{out}-2"))["adaptive"]
+        assert header["max_elevation_deg"] == 45 and header["design_lights"] == 7
+
+
+def test_a_resume_asking_a_request_no_session_takes_says_so_rather_than_advise_it(
+    adaptive_stopped: Path, tmp_path: Path
+) -> None:
+    """``--min-lights 6`` on an ``--adaptive --lights 7`` session: put in, the request is one
+    run refuses (a minimum goes with --until-error). The refusal had advised ``rti-rig run RIG
+    --min-lights 6 --out S-2``, which pasted was refused in turn; it now says why no new
+    session takes it, in run's own words."""
+    out = copy_of(adaptive_stopped, tmp_path)
+    before = tree(out)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--min-lights", "6"])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "start a new session" not in text, text
+    assert (
+        "no new session takes this request either (--adaptive --lights 7 --min-lights 6): "
+        "--min-lights 6 goes with --until-error" in text
+    ), text
+    assert (
+        f"to continue it as it began, give those options or none (rti-rig run --resume {out})"
+        in text
+    )
+    assert tree(out) == before
+    # the same words as run gives the request itself
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(DOME),
+            "--out",
+            str(tmp_path / "n"),
+            "--adaptive",
+            "--lights",
+            "7",
+            "--min-lights",
+            "6",
+        ],
+    )
+    assert r.exit_code == 2 and "--min-lights 6 goes with --until-error" in said(r), r.output

@@ -29,7 +29,7 @@ def new_session_dir(session_dir: Path | str) -> Path:
     return free_folder_beside(Path(session_dir), "new")
 
 
-def _allowed_no_normals(manifest: dict[str, Any], provenance: dict[str, Any]) -> bool:
+def allowed_no_normals(manifest: dict[str, Any], provenance: dict[str, Any]) -> bool:
     """Whether the session was run with ``--allow-no-normals``: as its provenance records it,
     or, in a manifest from before that record, as the note the flag's lights were captured
     with says (kept in its ``input_notes``).
@@ -52,7 +52,7 @@ def new_session_command(
     """``rti-rig run CONFIG --out NEW`` with the session's layout options: its ``--plan``, its
     adaptive options (:func:`~rti_rig.app.usecases.run_options.adaptive_options`, ``--lights``
     only where it was given) or its homogeneous ``--lights N``, an elevation band other than
-    0–90°, and ``--allow-no-normals`` (see :func:`_allowed_no_normals`), each as the manifest
+    0–90°, and ``--allow-no-normals`` (see :func:`allowed_no_normals`), each as the manifest
     recorded it. The plan is recorded as an absolute path, so the command runs from any folder
     (a manifest from before that record holds the path as it was typed, repeated as it is:
     where it was relative to is unknown)."""
@@ -94,7 +94,7 @@ def session_options(manifest: dict[str, Any]) -> str:
     elif provenance.get("n") is not None:
         words.append(f"--lights {int(provenance['n'])}")
         band = provenance
-    if _allowed_no_normals(manifest, provenance) and not isinstance(adaptive, dict):
+    if allowed_no_normals(manifest, provenance) and not isinstance(adaptive, dict):
         words.append("--allow-no-normals")
     low, high = band.get("min_elevation_deg"), band.get("max_elevation_deg")
     return " ".join(words) + band_options(

@@ -12,8 +12,9 @@ anything on disk is touched, naming what differs and what to do.
 from __future__ import annotations
 
 import math
+import re
 import shlex
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -82,6 +83,8 @@ def check_same_start(
         said, rest = by_default
         began = f"{said} and {rest}" if rest else said
         give = "give those options without --lights, or none" if rest else "drop those options"
+    said = _differences_said(diffs, asked)
+    shoot = _new_session_advice(asked, manifest, loaded, root, by_default is not None)
     if (manifest.get("runner") or {}).get("finish_reason") == "completed":
         # a finished session has nothing to continue: "to continue it as it began" had sent
         # the user to a resume that answers "complete, nothing to resume"
@@ -89,20 +92,195 @@ def check_same_start(
 
         raise RtiRigError(
             f"{shown_path(root)}: this resume asks for another session than the one in it ("
-            + "; ".join(diffs)
+            + said
             + f"). It began with {began or 'the defaults'} and is complete: a finished session "
-            "is not extended (nothing in the folder was changed). To shoot this request, start "
-            f"a new session: {_new_session_command(asked, loaded, root)}; to use the session as "
-            f"it is: {fit_beside(root)}"
+            f"is not extended (nothing in the folder was changed). {shoot[0].upper()}"
+            f"{shoot[1:]}. To use the session as it is: {fit_beside(root)}"
         )
     raise RtiRigError(
         f"{shown_path(root)}: this resume asks for another session than the one in it ("
-        + "; ".join(diffs)
+        + said
         + f"). It began with {began or 'the defaults'} (nothing in the folder was changed): "
         f"to continue it as it began, {give} (rti-rig run --resume "
-        f"{folder}); to shoot this request, start a new session: "
-        f"{_new_session_command(asked, loaded, root)}"
+        f"{folder}); {shoot}"
     )
+
+
+def _differences_said(diffs: list[str], asked: StartOptions) -> str:
+    """``diffs`` with those of options the user gave first, then those of options not given.
+
+    Why: "--adaptive not given; --lights not given, the session 12; --min-lights 6, the
+    session not given" read as three mistakes where the user had typed one option; the options
+    not given differ too (a resume's options are the whole request), and are said as such."""
+    flags = _given_flags(asked)
+
+    def unasked(diff: str) -> bool:
+        flag = re.match(r"--[a-z-]+", diff)
+        return flag is not None and flag.group(0) not in flags
+
+    named = [d for d in diffs if not unasked(d)]
+    rest = [d for d in diffs if unasked(d)]
+    if not rest:
+        return "; ".join(named)
+    whole = "options given with --resume are the whole request, so these differ" + (
+        " too: " if named else ": "
+    )
+    return "; ".join([*named, whole + "; ".join(rest)])
+
+
+def _given_flags(asked: StartOptions) -> set[str]:
+    """The options ``asked`` was given with (``--objective`` is held apart by the CLI)."""
+    return set(asked.given) | ({"--objective"} if asked.objective is not None else set())
+
+
+#: the option that sets each field of :class:`StartOptions`
+_FIELD_OF = {
+    "--plan": "plan",
+    "--lights": "lights",
+    "--adaptive": "adaptive",
+    "--until-error": "until_error_deg",
+    "--min-lights": "min_lights",
+    "--objective": "objective",
+    "--auto-exposure": "auto_exposure",
+    "--max-saturated": "max_saturated",
+    "--min-elevation-deg": "min_elevation_deg",
+    "--max-elevation-deg": "max_elevation_deg",
+    "--allow-no-normals": "allow_no_normals",
+}
+_ADAPTIVE_FLAGS = frozenset({"--adaptive", "--until-error", "--min-lights", "--objective"})
+
+
+def _new_session_advice(
+    asked: StartOptions,
+    manifest: dict[str, Any],
+    loaded: Any,
+    root: Path,
+    default_count: bool,
+) -> str:
+    """The advice "to shoot this request, start a new session: CMD", the request being the
+    session's own options with those given put in their place; or, where run would refuse
+    that request, why.
+
+    Why: the command had repeated only the options given, so ``--resume S --max-elevation-deg
+    45`` of an adaptive session advised a planned run of every light, and ``--resume S
+    --min-lights 6`` a command run refused. Where the options given are all the session's own
+    (only some left out), the request is taken as typed, as before: what else differs is what
+    was left out."""
+    from rti_rig.app.usecases.session import NewSessionRequest, check_option_pairs
+
+    began = _began_options(manifest, default_count)
+    request = _merged(asked, began)
+    if replace(request, given=()) == replace(began, given=()):
+        request = asked
+    command = _new_session_command(request, loaded, root)
+    options = _request_options(request) or "the defaults"
+    if request.is_adaptive:  # the metering _request_options leaves out of an adaptive run's
+        options = " ".join(
+            [options, *_exposure_words(request.auto_exposure, request.max_saturated)]
+        )
+    try:
+        check_option_pairs(
+            NewSessionRequest(
+                Path(loaded.path),
+                free_name(root, folder=True),
+                lights=request.lights,
+                plan=request.plan,
+                min_elevation_deg=request.min_elevation_deg,
+                max_elevation_deg=request.max_elevation_deg,
+                auto_exposure=request.auto_exposure,
+                adaptive=request.adaptive,
+                until_error_deg=request.until_error_deg,
+                objective=request.objective,
+                min_lights=request.min_lights,
+                allow_no_normals=request.allow_no_normals,
+                **_limit(request.max_saturated),
+            )
+        )
+    except RtiRigError as exc:
+        return f"no new session takes this request either ({options}): {exc}"
+    if request.is_adaptive and (request.auto_exposure or request.max_saturated is not None):
+        return (
+            f"no new session takes this request either ({options}): an "
+            "adaptive session is not metered (its lights are chosen as the images arrive); "
+            "meter once with a planned run, set camera.exposure_s in the rig config, and leave "
+            "--auto-exposure out"
+        )
+    return f"to shoot this request, start a new session: {command}"
+
+
+def _limit(max_saturated: float | None) -> dict[str, float]:
+    return {} if max_saturated is None else {"max_saturated": max_saturated}
+
+
+def _began_options(manifest: dict[str, Any], default_count: bool) -> StartOptions:
+    """The options session ``manifest`` began with, as :class:`StartOptions` (a count the rig
+    chose by itself, ``default_count``, as no ``--lights``)."""
+    from rti_rig.app.usecases.replay_advice import allowed_no_normals
+
+    schedule = manifest.get("schedule") or {}
+    provenance = schedule.get("provenance") or {}
+    header = manifest.get("adaptive")
+    if isinstance(header, dict):
+        from rti_rig.app.usecases.adaptive import lights_asked
+
+        until, floor = header.get("until_error_deg"), header.get("min_lights")
+        objective = header.get("objective")
+        return StartOptions(
+            lights=lights_asked(header),
+            adaptive=until is None,
+            until_error_deg=float(until) if until is not None else None,
+            min_lights=int(floor) if floor is not None else None,
+            objective=str(objective) if objective not in (None, "normals") else None,
+            min_elevation_deg=float(header.get("min_elevation_deg", 0.0)),
+            max_elevation_deg=float(header.get("max_elevation_deg", 90.0)),
+        )
+    from rti_rig.app.usecases.session import NewSessionRequest
+
+    plan = provenance.get("plan_file")
+    n = provenance.get("n")
+    limit = _recorded_max_saturated(manifest) if _metered(manifest) else None
+    if limit is not None and _same_number(limit, NewSessionRequest.max_saturated):
+        limit = None  # the default: said by no option
+    return StartOptions(
+        lights=None if plan or default_count or n is None else int(n),
+        plan=Path(plan) if plan else None,
+        auto_exposure=_metered(manifest),
+        max_saturated=limit,
+        min_elevation_deg=float(provenance.get("min_elevation_deg", 0.0)),
+        max_elevation_deg=float(provenance.get("max_elevation_deg", 90.0)),
+        allow_no_normals=allowed_no_normals(manifest, provenance),
+    )
+
+
+def _merged(asked: StartOptions, began: StartOptions) -> StartOptions:
+    """``began`` with the options ``asked`` gave put in their place: a plan given replaces
+    the count and the adaptive options, a count or an adaptive option given replaces the plan,
+    and a request made adaptive drops the session's metering and ``--allow-no-normals``
+    (which an adaptive session refuses) unless they too were given."""
+    flags = _given_flags(asked)
+    request = began
+    if "--plan" in flags:
+        request = replace(
+            request,
+            lights=None,
+            adaptive=False,
+            until_error_deg=None,
+            min_lights=None,
+            objective=None,
+        )
+    elif flags & (_ADAPTIVE_FLAGS | {"--lights"}):
+        request = replace(request, plan=None)
+    request = replace(
+        request, **{_FIELD_OF[f]: getattr(asked, _FIELD_OF[f]) for f in flags & set(_FIELD_OF)}
+    )
+    if request.is_adaptive and not began.is_adaptive:
+        request = replace(
+            request,
+            auto_exposure=request.auto_exposure and "--auto-exposure" in flags,
+            max_saturated=request.max_saturated if "--max-saturated" in flags else None,
+            allow_no_normals=request.allow_no_normals and "--allow-no-normals" in flags,
+        )
+    return replace(request, given=asked.given)
 
 
 def _exposure_words(auto_exposure: bool, max_saturated: float | None) -> list[str]:
@@ -119,7 +297,24 @@ def _new_session_command(asked: StartOptions, loaded: Any, root: Path) -> str:
 
     Why: "start a new session in a new --out" had left the command to be put together, the
     config and a folder to be found."""
-    words = ["rti-rig", "run", shell_word(str(loaded.path))]
+    options = _request_options(asked)
+    return " ".join(
+        w
+        for w in [
+            "rti-rig",
+            "run",
+            shell_word(str(loaded.path)),
+            options,
+            "--out",
+            shell_word(str(free_name(root, folder=True))),
+        ]
+        if w
+    )
+
+
+def _request_options(asked: StartOptions) -> str:
+    """``asked``'s options as a new session's ``run`` is given them ('' for none)."""
+    words = []
     if asked.plan is not None:
         words += ["--plan", shell_word(str(asked.plan))]
     if asked.is_adaptive:  # as every advised adaptive run says them (run_options)
@@ -128,8 +323,8 @@ def _new_session_command(asked: StartOptions, loaded: Any, root: Path) -> str:
             adaptive_options(asked.until_error_deg, asked.lights, asked.min_lights, objective)
         )
     else:
-        # a planned request's --min-lights or --objective kept as asked: pasted, run says why
-        # it refuses them, rather than shooting a request the user did not make
+        # a planned request's --min-lights or --objective kept as asked: the advice says why
+        # run refuses them (check_option_pairs) rather than shoot a request not made
         words += ["--lights", str(asked.lights)] if asked.lights is not None else []
         words += ["--min-lights", str(asked.min_lights)] if asked.min_lights is not None else []
         words += ["--objective", shlex.quote(asked.objective)] if asked.objective else []
@@ -142,7 +337,6 @@ def _new_session_command(asked: StartOptions, loaded: Any, root: Path) -> str:
     words.append(band_options((asked.min_elevation_deg, asked.max_elevation_deg)).strip())
     if asked.allow_no_normals and not asked.is_adaptive:
         words.append("--allow-no-normals")
-    words += ["--out", shell_word(str(free_name(root, folder=True)))]
     return " ".join(w for w in words if w)  # no band: no word
 
 
@@ -202,7 +396,7 @@ def _differences(asked: StartOptions, manifest: dict[str, Any], loaded: Any) -> 
         # what differs, option by option (an --until-error not given is said by its own)
         plain = not asked.is_adaptive and header.get("until_error_deg") is None
         return [
-            *(["--adaptive not given; the session is adaptive"] if plain else []),
+            *(["--adaptive not given, the session is adaptive"] if plain else []),
             *_adaptive_differences(asked, header),
         ]
     if asked.is_adaptive:

@@ -1259,8 +1259,7 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     from rti_rig.planner.adaptive import START_LIGHTS
     from rti_rig.planner.make_plan import check_elevation_band
 
-    if req.plan is not None:
-        raise RtiRigError(f"{req.adaptive_option} chooses its own lights: drop --plan")
+    # --plan with it is refused by check_option_pairs, before the config is read
     # every light of the session is chosen in the band (it had been refused: the adaptive
     # loop chose among every light the rig can run)
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
@@ -1314,9 +1313,14 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     return OpenedSession(rig, schedule, folder, Path(req.out_dir), source=source)
 
 
-def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> OpenedSession:
-    """Check a new session's request, open and check the rig, and prepare its folder."""
-    from rti_rig.app.config import load_rig_config
+def check_option_pairs(req: NewSessionRequest) -> None:
+    """Refuse ``req``'s options on their own, before any file is read: each value, and the
+    options that do not go together.
+
+    Why here, in one place: a resume refused as another request advises the new session that
+    would shoot it, and that command is asked the same questions first, so that what it
+    advises is never refused in turn (it had advised ``--adaptive --lights 12 --min-lights 6``,
+    which run refuses: --min-lights goes with --until-error)."""
     from rti_rig.app.usecases.adaptive import check_min_lights
 
     check_max_saturated(req.max_saturated)
@@ -1327,12 +1331,10 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
         run_words(req.rig_config, req.out_dir),
         (req.min_elevation_deg, req.max_elevation_deg),
     )
-    loaded = load_rig_config(req.rig_config)
-    for note in loaded.notes:
-        on_note(Note(note, "warning"))
-    from rti_rig.app.flash_sync import check_new_session
-
-    check_new_session(req, loaded)  # a camera-triggered dome runs its own sequence only
+    if req.plan is not None and req.is_adaptive:
+        raise RtiRigError(f"{req.adaptive_option} chooses its own lights: drop --plan")
+    if req.plan is not None and req.lights is not None:
+        raise RtiRigError("give either --plan or --lights, not both")
     if req.objective is not None and not req.is_adaptive:
         raise RtiRigError(
             f"--objective {req.objective} goes with --adaptive (it says what the adaptive "
@@ -1344,6 +1346,19 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
             "--allow-no-normals goes with --plan or --lights: an adaptive session chooses its "
             "lights itself; drop --allow-no-normals"
         )
+
+
+def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> OpenedSession:
+    """Check a new session's request, open and check the rig, and prepare its folder."""
+    from rti_rig.app.config import load_rig_config
+
+    check_option_pairs(req)
+    loaded = load_rig_config(req.rig_config)
+    for note in loaded.notes:
+        on_note(Note(note, "warning"))
+    from rti_rig.app.flash_sync import check_new_session
+
+    check_new_session(req, loaded)  # a camera-triggered dome runs its own sequence only
     if req.is_adaptive:
         opened = _open_adaptive(req, loaded)
         opened.folder.input_notes = list(loaded.notes)
