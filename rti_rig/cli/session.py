@@ -17,6 +17,7 @@ import typer
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+from rti_rig.app.usecases.next_fit import fit_model_for, next_fit
 from rti_rig.cli.app import (
     app,
     err,
@@ -424,34 +425,10 @@ def _say_next(session: Path) -> None:
     if (session / MARKER).exists():
         return
     out.print(
-        f"Next: {escape(fit_beside(session) + _fit_model_for(session))}",
+        f"Next: {escape(next_fit(session))}",
         soft_wrap=True,
         highlight=False,
     )
-
-
-def _fit_model_for(session: Path) -> str:
-    """`` --model ps`` where the fit's default ``--model auto`` fits nothing of the session's
-    lights but photometric stereo makes their normal map ("" otherwise).
-
-    Why: an ``--until-error`` session in a band of 3 LEDs was told, in its note, that the
-    default fit writes nothing and ``--model ps`` the normal map, and then "Next: rti-rig fit
-    S --out S-fit", which fit refused."""
-    import numpy as np
-
-    from rti_rig.app.normals_determined import undetermined_normals
-    from rti_rig.core.fit_minimums import FIT_MINIMUMS, AutoFit
-    from rti_rig.core.lp_format import read_lp
-
-    try:
-        entries = read_lp(session / "lights.lp")
-    except Exception:  # no lights.lp to read: the fit's own refusal says why
-        return ""
-    lights = np.array([e.direction for e in entries], dtype=np.float64)
-    determined = len(entries) >= FIT_MINIMUMS.normal and undetermined_normals(lights) is None
-    if determined and not AutoFit(len(entries), True).fits:
-        return " --model ps"
-    return ""
 
 
 def _same_folder(a: Path, b: Path) -> bool:
@@ -525,7 +502,7 @@ def _rebuilt_finished(req: Any) -> bool:
         return True
     out.print(
         f"{shown_path(req.session_dir)}: {JOURNAL} rebuilt; the session is complete and whole "
-        f"again (no rig was opened, nothing was shot). Next: {fit_beside(req.session_dir)} "
+        f"again (no rig was opened, nothing was shot). Next: {next_fit(req.session_dir)} "
         "fits it and gives its QA verdict",
         highlight=False,
         markup=False,
@@ -650,7 +627,8 @@ def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
     except SessionComplete as exc:
         # a resume of a complete, intact session (a script's same line after a run that did
         # finish): no error, and the next step said (it had been exit 2, with none)
-        out.print(f"{exc}. Next: {exc.next_step}", markup=False)
+        model = fit_model_for(exc.root) if exc.root is not None else ""
+        out.print(f"{exc}. Next: {exc.next_step}{model}", markup=False)
         raise typer.Exit(code=0) from None
     except RtiRigError as exc:
         _print_metering_failures(exc)
@@ -1212,7 +1190,7 @@ def _said_stopping_rule(s: _Stop) -> str:
     return (
         f"{s.kept}, listed in {s.lp}: the session is complete (its stopping rule ended it at {n} "
         f"of at most {s.ending.total_steps} lights), nothing is left to resume. Next: "
-        f"{fit_beside(s.out_dir)}"
+        f"{next_fit(s.out_dir)}"
     )
 
 
@@ -1221,7 +1199,7 @@ def _said_complete(s: _Stop) -> str:
     # been said of a complete session, which the resume refused as "already completed"
     return (
         f"{s.kept}, listed in {s.lp}: the session is complete, nothing is left to resume. "
-        f"Next: {fit_beside(s.out_dir)}"
+        f"Next: {next_fit(s.out_dir)}"
     )
 
 

@@ -381,9 +381,11 @@ class SessionComplete(SessionError):
     not have finished; a complete session had been refused as an error (exit 2) with no word
     of the next step, though nothing was wrong with it. ``next_step`` is that step."""
 
-    def __init__(self, message: str, next_step: str) -> None:
+    def __init__(self, message: str, next_step: str, root: Path | None = None) -> None:
         super().__init__(message)
         self.next_step = next_step
+        #: the session's folder (the CLI adds the fit's ``--model`` from its lights.lp)
+        self.root = root
 
 
 class CompleteJournalNotWhole(SessionError):
@@ -2242,7 +2244,7 @@ def _refuse_complete(
         said += f"; only its {LP_NAME} is missing"
         own = shell_word(str(root / LP_NAME))
         fit = f"rti-rig export-lp {folder} --out {own} writes it from the journal, then {fit}"
-    raise SessionComplete(said, fit)
+    raise SessionComplete(said, fit, root)
 
 
 #: How a run that did not finish ended, by the manifest's finish_reason (for a refusal).

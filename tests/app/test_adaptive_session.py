@@ -547,7 +547,7 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
                 "speed_deg_s = 60.0": "speed_deg_s = 6000.0",
                 "acceleration_deg_s2 = 120.0": "acceleration_deg_s2 = 12000.0",
             },
-            "an adaptive session weighs each light by the time it costs",
+            "azimuth joint speed 60 → 6000 °/s; azimuth joint acceleration 120 → 12000 °/s²",
         ),
         # slower, stopped within the starting lights (which no time decides): the steps taken
         # replayed as they were and it went on without a word, the rest chosen for the new
@@ -555,7 +555,7 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
         (
             2,
             {"speed_deg_s = 60.0": "speed_deg_s = 30.0"},
-            "the rig config now gives other times than this session's lights were chosen",
+            "azimuth joint speed 60 → 30 °/s; elevation joint speed 60 → 30 °/s",
         ),
     ],
     ids=["faster", "slower"],
@@ -565,7 +565,9 @@ def test_a_resume_on_an_arm_of_other_speed_names_the_times_that_changed(
 ) -> None:
     """An arm's decisions weigh each light's move time, which the rig identity rightly
     ignores (the images do not change): a resume whose config changes the arm's speed is
-    refused before anything moves, naming the times, and putting them back continues it."""
+    refused before anything moves, naming the times, and putting them back continues it.
+    The refusal comes before any other word: it had followed "differs … in nothing the images
+    depend on" and "Resuming …: N of 9 images verified", two lines saying all was well."""
     text = (CONFIGS / "virtual_arm.toml").read_text()
     assert all(old in text for old in changed)
     cfg = write_config(
@@ -582,8 +584,10 @@ def test_a_resume_on_an_arm_of_other_speed_names_the_times_that_changed(
     )
     assert r.exit_code == 2, r.output
     text = said(r)
-    assert said_first in text and "arm moves, the longest from the last light" in text
+    assert "the rig config gives other times than this session's last run" in text, text
+    assert said_first in text and "weighs each light by the time it costs" in text
     assert "Put those settings back as the session began to continue it" in text
+    assert "Resuming" not in text and "in nothing the images depend on" not in text
     assert folder_bytes(out) == before
     r = runner.invoke(app, ["run", str(cfg), "--resume", str(out)])  # put back: it goes on
     assert r.exit_code == 0, r.output

@@ -75,7 +75,18 @@ def test_a_three_light_session_is_shot_on_the_ring_and_fitted(tmp_path: Path) ->
     # the next step named is the fit that takes 3 lights (the default --model auto refuses
     # them, and "Next: rti-rig fit S --out S-fit" had been said all the same)
     said = " ".join(r.output.split())
-    assert f"Next: rti-rig fit {session} --out {session}-fit --model ps" in said, said
+    fit_ps = f"rti-rig fit {session} --out {session}-fit --model ps"
+    assert f"Next: {fit_ps}" in said, said
+    # so is every other message that names a complete session's next step: a resume of it,
+    # and a resume asking another request of it (both had named the plain fit)
+    dome = str(CONFIGS / "simulated_dome.toml")
+    for options, words in (
+        ([], f"nothing to resume, nothing was changed. Next: {fit_ps}"),
+        (["--lights", "4"], f"To use the session as it is: {fit_ps}"),
+    ):
+        r = CliRunner().invoke(app, ["run", dome, "--resume", str(session), *options])
+        assert r.exit_code == (2 if options else 0), r.output
+        assert words in " ".join(r.output.split()), r.output
     _, el = az_el_from_direction(np.array([e.direction for e in read_lp(session / "lights.lp")]))
     np.testing.assert_allclose(el, 40.0, atol=0.5)
     r = CliRunner().invoke(

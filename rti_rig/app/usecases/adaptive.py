@@ -1164,6 +1164,63 @@ class AdaptiveSteps:
         return self._outcome
 
 
+def refuse_other_times(manifest: dict[str, Any], loaded: Any, root: Path) -> None:
+    """Refuse, before the session folder is opened, a resume of an adaptive session on an arm
+    whose config gives other times than its last run's: the time per capture, or what the
+    move-time model reads (each joint's speed, acceleration and limits, the park, the settle
+    time). Nothing is said where that config is unknown (:func:`_last_run_config`).
+
+    Why before: the same check made once the steps taken had been replayed (which it still
+    is, on the move times themselves) came after "differs … in nothing the images depend on"
+    and "Resuming S: 7 of 16 images verified", two lines saying the resume was fine, and after
+    the reopen had set aside any file it could not verify."""
+    from rti_rig.app.config import parse_rig_config
+
+    recorded = _last_run_config(manifest)
+    if loaded.config.arm is None or not isinstance(recorded, dict):
+        return  # a dome's lights all cost one capture time: no time ranks them otherwise
+    try:
+        then = parse_rig_config(recorded, "manifest.json")
+    except Exception:  # a manifest of another build: the replay's own check still holds
+        return
+    if then.arm is None:
+        return
+    now_said, then_said = _time_settings(loaded.config), _time_settings(then)
+    changed = [
+        f"{name} {then_said[(name, unit)]:g} → {value:g} {unit}"
+        for (name, unit), value in now_said.items()
+        if not np.isclose(then_said[(name, unit)], value, rtol=1e-9, atol=1e-12)
+    ]
+    if changed:
+        raise RtiRigError(
+            f"{shown_path(root)}: the rig config gives other times than this session's last run "
+            "(" + "; ".join(changed) + "). An adaptive session weighs each light by the time it "
+            "costs (the capture and, on an arm, the move to it), so its remaining lights would "
+            "be chosen otherwise and it would not be the session it began as. Nothing was read, "
+            "recorded or captured. Put those settings back as the session began to continue it, "
+            "or start a new session"
+        )
+
+
+def _time_settings(config: Any) -> dict[tuple[str, str], float]:
+    """What an arm's decisions weigh as time, by name and unit: the capture, and the settings
+    the move-time model reads (:func:`_arm_motion_settings`)."""
+    t = config.timing
+    capture = t.light_switch_s + t.settle_s + config.camera.exposure_s + t.readout_s + t.transfer_s
+    out = {("time per capture [timing]", "s"): float(capture)}
+    motion = _arm_motion_settings(SimpleNamespace(config=config))
+    for joint in ("azimuth", "elevation"):
+        j = getattr(motion, joint)
+        out[(f"{joint} joint speed", "°/s")] = float(j.joint_velocity_deg_s)
+        out[(f"{joint} joint acceleration", "°/s²")] = float(j.joint_acceleration_deg_s2)
+        out[(f"{joint} joint lower limit", "°")] = float(j.min_deg)
+        out[(f"{joint} joint upper limit", "°")] = float(j.max_deg)
+    out[("park azimuth", "°")] = float(motion.park_azimuth_deg)
+    out[("park elevation", "°")] = float(motion.park_elevation_deg)
+    out[("settle time", "s")] = float(motion.settle_time_s)
+    return out
+
+
 def _last_run_config(manifest: dict[str, Any]) -> dict[str, Any] | None:
     """The rig config the session's last run read: recorded with each resume since
     2026-12-05; the first run's (the rig record) where the last run's config digest is the

@@ -88,14 +88,14 @@ def check_same_start(
     if (manifest.get("runner") or {}).get("finish_reason") == "completed":
         # a finished session has nothing to continue: "to continue it as it began" had sent
         # the user to a resume that answers "complete, nothing to resume"
-        from rti_rig.core.out_folders import fit_beside
+        from rti_rig.app.usecases.next_fit import next_fit
 
         raise RtiRigError(
             f"{shown_path(root)}: this resume asks for another session than the one in it ("
             + said
             + f"). It began with {began or 'the defaults'} and is complete: a finished session "
             f"is not extended (nothing in the folder was changed). {shoot[0].upper()}"
-            f"{shoot[1:]}. To use the session as it is: {fit_beside(root)}"
+            f"{shoot[1:]}. To use the session as it is: {next_fit(root)}"
         )
     raise RtiRigError(
         f"{shown_path(root)}: this resume asks for another session than the one in it ("

@@ -2000,6 +2000,10 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         from rti_rig.app.usecases.resume_request import check_same_start
 
         check_same_start(req.start, manifest, loaded, Path(req.session_dir))
+    if "adaptive" in manifest and not diffs:  # on an arm whose times changed: before a word
+        from rti_rig.app.usecases.adaptive import refuse_other_times
+
+        refuse_other_times(manifest, loaded, Path(req.session_dir))
     # a change accepted is said once the steps still to shoot are found to run on the rig as
     # changed (_opened_resume): "rig change accepted" had been followed by a refusal of them
     accepted = rig_notes if diffs else []
