@@ -654,12 +654,33 @@ def _check_name(name: str, source: str, lineno: int) -> None:
         return
     for pure in (PurePosixPath(name), PureWindowsPath(name)):
         if ".." in pure.parts:
-            raise LpFormatError(
-                source,
-                lineno,
-                f"image name {name!r} climbs out of the .lp file's folder with '..'; "
-                "move the .lp next to the images and use bare file names",
-            )
+            raise LpFormatError(source, lineno, _dot_dot_refusal(name, pure))
+
+
+def _dot_dot_refusal(name: str, pure: PurePosixPath | PureWindowsPath) -> str:
+    """Why a relative name holding ``..`` is refused, and what to write instead.
+
+    Why two cases: ``imgs/../image01.jpg`` was told it "climbs out of the .lp file's folder",
+    though written out it stays inside; it is still refused (``imgs`` may be a link, and
+    ``..`` from a link's target is elsewhere), but said so, with the name to write."""
+    depth, kept = 0, []
+    for part in pure.parts:
+        if part == "..":
+            depth -= 1
+            if depth < 0:
+                return (
+                    f"image name {name!r} climbs out of the .lp file's folder with '..'; "
+                    "move the .lp next to the images and use bare file names"
+                )
+            kept.pop()
+        elif part not in ("", "."):
+            depth += 1
+            kept.append(part)
+    return (
+        f"image name {name!r} steps back with '..' (an .lp's image names are read without "
+        f"following '..', which from a linked folder would lead elsewhere); write it as "
+        f"{'/'.join(kept)!r}"
+    )
 
 
 #: A spreadsheet's CSV export of a light list: fields split by ',' or ';' (with or without
@@ -1358,7 +1379,33 @@ def read_lp(
         raise LpFormatError(path, None, f"this is an image, not an .lp file: {wanted}")
     if path.suffix.lower() == ".toml":
         raise LpFormatError(path, None, f"this is a TOML file, not an .lp: {wanted}")
+    if _is_binary(raw):
+        raise LpFormatError(path, None, f"this is a binary file (not text), not an .lp: {wanted}")
     return parse_lp(_decode(raw), str(path), upper_hemisphere, notes)
+
+
+def _is_binary(raw: bytes) -> bool:
+    """Whether ``raw`` is no text in any form an `.lp` is met in: not text up to a run of
+    zeros (a file cut off while being written, which FAT cards fill with zeros), not UTF-16
+    without a byte-order mark (every other byte zero), which the reader names as such.
+
+    Why: random bytes named ``.lp`` were told "line 6: the line holds NUL bytes … (UTF-16
+    without a byte-order mark?) or cut off while being written", guesses that fit a text file
+    and a line number that means nothing; a rig config of the same bytes was called binary."""
+    head = raw[:4096]
+
+    def controls(data: bytes) -> int:
+        return sum(1 for b in data if b < 0x20 and b not in b"\t\n\r\f\x1a")
+
+    if b"\x00" not in head and controls(head) <= len(head) // 20:
+        return False
+    text = head.rstrip(b"\x00")
+    if b"\x00" not in text and controls(text) <= len(text) // 20:
+        return False  # text, then zeros: cut off
+    for zeros, chars in ((head[1::2], head[0::2]), (head[0::2], head[1::2])):
+        if zeros.count(0) >= 0.9 * len(zeros) and controls(chars) <= len(chars) // 20:
+            return False  # UTF-16 without its mark
+    return True
 
 
 def _decode(raw: bytes) -> str:

@@ -49,7 +49,7 @@ def test_a_thumbnail_first_acquisition_is_checked_replayed_and_fitted_full_size(
         assert tif.pages[0].shape == (12, 16, 3)
     r = runner.invoke(app, ["check", str(acq / "dirs.lp")])
     said = " ".join(r.output.split())
-    assert r.exit_code == 0 and "all 64x48 of one kind" in said, said
+    assert r.exit_code == 0 and "all 64x48, all colour or all grey" in said, said
 
     out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--lights", "6"])

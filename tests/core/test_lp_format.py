@@ -108,6 +108,9 @@ def test_each_light_keeps_its_line_and_equality_ignores_it() -> None:
         ("1\n../a_1.jpg 0 0 1\n", 2, "climbs out"),
         ("1\nsub/../../a_1.jpg 0 0 1\n", 2, "climbs out"),
         ("1\nsub\\..\\..\\a_1.jpg 0 0 1\n", 2, "climbs out"),
+        # a '..' that stays inside is refused too, but not as climbing out: with the name to write
+        ("1\nimgs/../a_1.jpg 0 0 1\n", 2, "steps back with '..' (an .lp's image names"),
+        ("1\nimgs\\..\\x\\a_1.jpg 0 0 1\n", 2, "write it as 'x/a_1.jpg'"),
         ("2\na_1.jpg 0 0 1\na_1.jpg 0 1 0\n", 3, "already used on line 2"),
         ("1\na_1.jpg 0 0 nan\n", 2, "not finite"),
         ("1\na_1.jpg 0 1\n", 2, "expected 'name x y z'"),
@@ -628,3 +631,26 @@ def test_a_comment_after_a_light_is_named_with_where_to_put_it() -> None:
     """It had been refused as "7 fields after the name", the '#' not named."""
     with pytest.raises(LpFormatError, match=r"line 3: a comment after the light: '# LED 2 weak'"):
         parse_lp("2\na.jpg 0 0 1\nb.jpg 0 0.6 0.8 # LED 2 weak\n", "c.lp", notes=[])
+
+
+@pytest.mark.parametrize(
+    ("raw", "said"),
+    [
+        # bytes of no text at all: said to be binary (a line number of random bytes meant
+        # nothing, and the guesses below fit a text file)
+        (bytes(range(256)) * 8, "this is a binary file (not text), not an .lp"),
+        (np.random.default_rng(3).integers(0, 256, 3000, dtype=np.uint8).tobytes(), "binary"),
+        # text in forms an .lp is met in: named as before
+        ("2\na.jpg 0 0 1\nb.jpg 0 1 0\n".encode("utf-16-le"), "line 1: the line holds NUL"),
+        (b"2\na.jpg 0 0 1\nb.jp" + b"\0" * 512, "line 3: the line holds NUL bytes"),
+    ],
+    ids=["all-bytes", "random", "utf16-no-mark", "cut-off"],
+)
+def test_a_binary_file_is_told_apart_from_text_with_nul_bytes(
+    tmp_path: Path, raw: bytes, said: str
+) -> None:
+    lp = tmp_path / "dirs.lp"
+    lp.write_bytes(raw)
+    with pytest.raises(LpFormatError) as info:
+        read_lp(lp)
+    assert said in str(info.value), str(info.value)

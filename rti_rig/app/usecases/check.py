@@ -522,7 +522,9 @@ class ReplayCheck:
         return [
             "replay rig: a recorded acquisition, no device to light, move or open",
             f"images: {self.count} listed in {self.lp_name}, each present {self.where}, "
-            f"undamaged and readable, all {self.width}x{self.height} of one kind",
+            # "of one kind" had been read as one bit depth, a line before a note that the
+            # images mix 8-bit and 16-bit ones: it meant colour against grey, said so
+            f"undamaged and readable, all {self.width}x{self.height}, all colour or all grey",
             *config_note_lines(self),
             "RESULT: PASS",
         ]
