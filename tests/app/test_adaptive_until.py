@@ -13,6 +13,7 @@ import math
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import (
     interrupted,
@@ -357,3 +358,21 @@ def test_the_stop_prints_its_upper_estimate_on_the_side_of_the_target_it_is() ->
     }
     reason = "upper estimate 0.318° (estimate 0.163° × 1.95) ≤ --until-error 0.318°"
     assert estimate_phrase(result, reason) == ""
+
+
+def test_the_recorded_upper_estimate_keeps_its_side_of_a_target_of_four_places() -> None:
+    """Rounded to 4 places before its places were chosen, an upper estimate of 0.32004° (above
+    --until-error 0.32, the target not claimed) was recorded as 0.32, level with the target,
+    and printed "upper estimate 0.3200°: the target is not claimed"."""
+    from rti_rig.app.usecases.adaptive import AdaptiveChooser, places_against
+
+    chooser = AdaptiveChooser(
+        np.eye(3), [0, 1, 2], 8, until_error_deg=0.32, bias_aware=False, upper_factor=2.0
+    )
+    for estimate in (0.16002, 0.159998, 0.123456):
+        upper = chooser.upper(estimate)
+        recorded = chooser.stop_terms(estimate)["upper_error_deg"]
+        assert (recorded <= 0.32) == (upper <= 0.32), (upper, recorded)
+        places = places_against(recorded, 0.32)
+        assert (float(f"{recorded:.{places}f}") <= 0.32) == (upper <= 0.32)
+    assert chooser.stop_terms(0.123456)["upper_error_deg"] == 0.2469  # 4 places where they do

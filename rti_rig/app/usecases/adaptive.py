@@ -421,11 +421,16 @@ class AdaptiveChooser:
     def stop_terms(self, estimate_deg: float | None) -> dict[str, Any]:
         """What the stop compares, for the record: the point estimate, the upper one and the
         factor between them (None estimates before anything can be fitted)."""
+        upper = None if estimate_deg is None else self.upper(estimate_deg)
+        # to 4 places, or as many more as keep it on its side of the target: rounded to 4 first,
+        # an upper estimate within 5e-5 of a target of 4 places could be recorded (and printed)
+        # level with the target on the wrong side
+        places = 4
+        if upper is not None and self.until_error_deg is not None:
+            places = max(4, places_against(upper, self.until_error_deg))
         return {
             "estimated_error_deg": None if estimate_deg is None else round(estimate_deg, 4),
-            "upper_error_deg": (
-                None if estimate_deg is None else round(self.upper(estimate_deg), 4)
-            ),
+            "upper_error_deg": None if upper is None else round(upper, places),
             "upper_factor": self.upper_factor,
         }
 
@@ -1240,14 +1245,15 @@ def _last_run_config(manifest: dict[str, Any]) -> dict[str, Any] | None:
 
 
 def places_against(value: float, target: float) -> int:
-    """Decimal places (2 to 4, the recorded figure's) at which ``value`` printed stands on the
-    same side of ``target`` as it does: an upper estimate of 0.3175° had been printed "0.32°
-    ≤ --until-error 0.318°", a comparison the reader sees is false."""
-    for places in (2, 3):
+    """Decimal places (2 to 12) at which ``value`` printed stands on the same side of
+    ``target`` as it does: an upper estimate of 0.3175° had been printed "0.32° ≤ --until-error
+    0.318°", a comparison the reader sees is false. The stop records its figure at these
+    places where they are more than 4 (:meth:`stop_terms`)."""
+    for places in range(2, 12):
         shown = float(f"{value:.{places}f}")
         if (shown <= target) == (value <= target):
             return places
-    return 4
+    return 12
 
 
 def _decided_on_another_rig(folder, done: int) -> int:  # type: ignore[no-untyped-def]
