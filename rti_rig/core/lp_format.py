@@ -366,14 +366,14 @@ def case_hint(missing: Sequence[Path]) -> str:
     )
 
 
-def _not_files(missing: Sequence[Path]) -> list[str]:
+def _not_files(missing: Sequence[Path]) -> dict[str, str]:
     """The listed names that are there but are no file to read (a folder, a link whose target
-    does not exist, a device or pipe), each said with what it is.
+    does not exist, a device or pipe), each with the words that say what it is.
 
     Why: such an entry had been named "the same name in other upper/lower case" of itself,
     with the advice to rename it; "missing" alone is no help either when the user sees the
     name in the folder."""
-    said: list[str] = []
+    said: dict[str, str] = {}
     for path in missing:
         if not os.path.lexists(path) or path.is_file():
             continue
@@ -383,12 +383,13 @@ def _not_files(missing: Sequence[Path]) -> list[str]:
             what = f"a link to {os.readlink(path)}, which does not exist"
         else:
             what = "not a regular file"
-        said.append(f"{path.name} is {what}")
+        said[path.name] = f"{path.name} is {what}"
     return said
 
 
-def _not_files_said(said: list[str]) -> str:
+def _not_files_said(not_files: dict[str, str]) -> str:
     """:func:`case_hint`'s clause for :func:`_not_files`."""
+    said = list(not_files.values())
     if not said:
         return ""
     more = f" and {len(said) - 3} more" if len(said) > 3 else ""
@@ -586,7 +587,7 @@ def missing_images_advice(
     )
     # each missing image counted once, whatever clauses name it (a folder image05.jpg beside
     # image05.png is both "a folder" and "another extension": "the other -1" had been said)
-    covered = {p.name for p in paths if os.path.lexists(p) and not p.is_file()}
+    covered = set(not_files)
     covered |= {t.split(" -> ")[0] for t in [*twins, *kin]}
     covered |= {p.name for p in paths if not p.name.isprintable()}
     if named and (rest := max(0, len(names) - len(covered))):

@@ -1040,7 +1040,8 @@ class AdaptiveSteps:
             if i < other_rig:
                 candidate = self._recorded_candidate(folder, i, rec)
             elif candidate is None or not self._same_light(candidate, rec):
-                timing = self._timing_differences(folder)
+                # against the config the session began with, whose times decided this step
+                timing = self._timing_differences((folder.manifest.get("rig") or {}).get("config"))
                 if timing:  # the config's times changed: restoring them continues the session
                     raise RtiRigError(
                         f"{shown_path(folder.root)}: step {i + 1} is not decided as it was: an "
@@ -1060,7 +1061,7 @@ class AdaptiveSteps:
         if other_rig:
             self._keep_start_unused(folder, len(done))
         elif not getattr(folder, "rig_change", None) and (
-            timing := self._timing_differences(folder, _last_run_config(folder.manifest))
+            timing := self._timing_differences(_last_run_config(folder.manifest))
         ):
             # the steps taken replayed as they were, but the rest would be chosen for the new
             # times: a resume on a slowed arm had gone on without a word, and finished another
@@ -1121,17 +1122,16 @@ class AdaptiveSteps:
                 f"(rti-rig run --resume {folder.root}), or start a new session on the changed rig"
             )
 
-    def _timing_differences(self, folder, recorded: Any = "first") -> list[str]:  # type: ignore[no-untyped-def]
+    def _timing_differences(self, recorded: Any) -> list[str]:
         """On an arm, the times a decision weighs (capture, moves) that differ between the rig
-        config the session last ran with (its manifest) and this one, in words; empty if they
-        agree, on a dome, or if they cannot be told. The rig identity leaves timing and motion
-        out (they do not change the images), so a resume on a slowed arm got as far as
-        re-deciding its steps and was refused as "another rig config", with "start a new
-        session" as the remedy, where putting the speed back continues it."""
+        config ``recorded`` in the session's manifest (its first run's or its last run's) and
+        this one, in words; empty if they agree, on a dome, or if they cannot be told. The rig
+        identity leaves timing and motion out (they do not change the images), so a resume on
+        a slowed arm got as far as re-deciding its steps and was refused as "another rig
+        config", with "start a new session" as the remedy, where putting the speed back
+        continues it."""
         from rti_rig.app.config import parse_rig_config
 
-        if recorded == "first":  # the config the session began with
-            recorded = (folder.manifest.get("rig") or {}).get("config")
         if self._move is None or not isinstance(recorded, dict):
             # a dome's lights all cost one capture time: a time per second ranks them alike,
             # so another time cannot be why a dome's step is decided otherwise
