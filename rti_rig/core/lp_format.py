@@ -435,6 +435,13 @@ def _name_twins(missing: Sequence[Path]) -> tuple[list[str], list[str]]:
     kin: list[str] = []
     for path in missing:
         folder = path.parent
+        # a folder named in other case (JPEGS\image01.jpg, the images in jpegs/): its files
+        # are the twins, as Windows and macOS would find them ("missing" had been said of
+        # every image, with the advice to copy them where they already were)
+        other_case = _folder_in_other_case(folder)
+        listed = path.name
+        if other_case is not None:
+            folder, listed = other_case, f"{folder.name}/{path.name}"
         if folder not in listings:
             by_case: dict[str, list[str]] = {}
             by_stem: dict[str, list[str]] = {}
@@ -447,14 +454,41 @@ def _name_twins(missing: Sequence[Path]) -> tuple[list[str], list[str]]:
         by_case, by_stem = listings[folder]
         # the entry of the very same name is no twin: a folder or a dead link there
         # (:func:`_not_files_said`) had been called "the same name in other case" of itself
-        found = [n for n in by_case.get(path.name.casefold(), []) if n != path.name]
+        found = [n for n in by_case.get(path.name.casefold(), []) if n != listed]
+        there = f"{folder.name}/" if other_case is not None else ""
         if found:
-            twins.append(f"{path.name} -> {found[0]}")
+            twins.append(f"{listed} -> {there}{found[0]}")
             continue
-        other = [n for n in by_stem.get(path.stem.casefold(), []) if n != path.name]
+        other = [n for n in by_stem.get(path.stem.casefold(), []) if n != listed]
         if other:
-            kin.append(f"{path.name} -> {other[0]}")
+            kin.append(f"{listed} -> {there}{other[0]}")
     return twins, kin
+
+
+def _folder_in_other_case(folder: Path) -> Path | None:
+    """The folder that ``folder``, which is not there, names in other upper/lower case (each
+    missing component matched case-blind, from the nearest folder that is there), or None."""
+    if folder.is_dir():
+        return None
+    base, parts = folder, []
+    while not base.is_dir():
+        if base.parent == base:
+            return None
+        parts.insert(0, base.name)
+        base = base.parent
+    for part in parts:
+        try:
+            match = [
+                c
+                for c in sorted(base.iterdir())
+                if c.is_dir() and c.name.casefold() == part.casefold()
+            ]
+        except OSError:
+            return None
+        if not match:
+            return None
+        base = match[0]
+    return base
 
 
 def _twins_said(twins: list[str], missing: int) -> str:

@@ -654,3 +654,21 @@ def test_a_binary_file_is_told_apart_from_text_with_nul_bytes(
     with pytest.raises(LpFormatError) as info:
         read_lp(lp)
     assert said in str(info.value), str(info.value)
+
+
+def test_a_folder_named_in_other_case_is_said_with_its_files(tmp_path: Path) -> None:
+    """``JPEGS\\img00.jpg`` listed, the images in ``jpegs/``: Windows and macOS find them, so
+    the .lp reads where it was written. Every image had been called missing, with the advice
+    to copy them where they already were; the folder's case is now named, as a file's is."""
+    from rti_rig.core.lp_format import case_hint, image_path
+
+    (tmp_path / "jpegs").mkdir()
+    for i in range(2):
+        (tmp_path / "jpegs" / f"img0{i}.jpg").write_bytes(b"\xff\xd8\xff")
+    missing = [image_path(tmp_path, f"JPEGS\\img0{i}.jpg") for i in range(2)]
+    assert not any(p.exists() for p in missing)
+    hint = case_hint(missing)
+    assert "2 of them differ only in upper/lower case from a file there" in hint, hint
+    assert "JPEGS/img00.jpg -> jpegs/img00.jpg" in hint, hint
+    # a folder that is not there in any case: nothing to name
+    assert case_hint([image_path(tmp_path, "other\\img00.jpg")]) == ""
