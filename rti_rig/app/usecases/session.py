@@ -1043,6 +1043,47 @@ def _replan_command(req: NewSessionRequest, geometry: object, lights: int) -> st
     )
 
 
+def _refuse_plan_outside_band(req: NewSessionRequest, entries: Any, schedule: Any) -> None:
+    """Refuse a ``--plan`` whose lights leave the band ``--min/--max-elevation-deg`` given
+    with it, naming them by their lines.
+
+    Why: the band was ignored with a plan, so ``--plan P --max-elevation-deg 30`` fired P's
+    lights at 40° (a gilded object's highlights in the lens, the very thing a ceiling is for),
+    exit 0, and recorded no band. The plan's own lights are what fires; the band checks them."""
+    from rti_rig.core.geometry import az_el_from_direction
+
+    low, high = req.min_elevation_deg, req.max_elevation_deg
+    if low == 0.0 and high == 90.0:
+        return
+    outside = []
+    for entry, step in zip(entries, schedule.steps, strict=True):
+        el = float(az_el_from_direction(step.direction)[1])
+        if el < low - 1e-6 or el > high + 1e-6:
+            line = f"line {entry.line}" if entry.line is not None else entry.name
+            outside.append(f"{line} ({entry.name}) at {el:.1f}°")
+    if not outside:
+        return
+    band = " ".join(
+        [f"--min-elevation-deg {low:g}"] * (low != 0.0)
+        + [f"--max-elevation-deg {high:g}"] * (high != 90.0)
+    )
+    more = f" and {len(outside) - 5} more" if len(outside) > 5 else ""
+    raise RtiRigError(
+        f"--plan {shown_path(req.plan)}: {len(outside)} of its {len(entries)} lights lie outside "
+        f"{band} ({', '.join(outside[:5])}{more}); nothing was lit. Plan within the band "
+        f"(rti-rig plan … {band} --out PLAN.lp, then run --plan PLAN.lp), or run this plan "
+        "without the band"
+    )
+
+
+def _in_band(geometry: DomeGeometry, low: float, high: float) -> int:
+    """How many of a dome's LEDs lie from ``low`` to ``high`` degrees of elevation."""
+    from rti_rig.core.geometry import az_el_from_direction
+
+    _, el = az_el_from_direction(geometry.directions)
+    return int(((el >= low - 1e-9) & (el <= high + 1e-9)).sum())
+
+
 def new_session_schedule(  # type: ignore[no-untyped-def]
     req: NewSessionRequest, loaded, on_note: NoteSink = _ignore
 ) -> LightSchedule:
@@ -1081,6 +1122,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         schedule = schedule_from_lp(
             entries, geometry, str(req.plan), replan=_replan_command(req, geometry, len(entries))
         )
+        _refuse_plan_outside_band(req, entries, schedule)
         _check_determined(
             req,
             schedule,
@@ -1092,6 +1134,11 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         return _asked_for(schedule, req)
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     n = req.lights if req.lights is not None else default_lights(loaded, geometry)
+    if req.lights is None and isinstance(geometry, DomeGeometry):
+        # a band without --lights: every LED in it (or the config's default_lights, if fewer).
+        # "asked for 48 lights but the dome has only 24 LEDs between 0° and 30°" had refused
+        # a ceiling alone, the planning guide's advice for gilding, of a count never given
+        n = min(n, _in_band(geometry, req.min_elevation_deg, req.max_elevation_deg)) or n
     if req.lights is not None:
         check_light_count(n)
     else:
