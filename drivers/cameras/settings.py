@@ -7,6 +7,7 @@ automatic mode. Every model therefore forbids extra keys and is frozen once vali
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -48,6 +49,20 @@ class RawDecodeSettings(_Strict):
 
     mode: Literal["mosaic", "half", "demosaic"] = "demosaic"
     white_balance: Literal["unity", "camera"] | tuple[float, float, float, float] = "camera"
+
+    @field_validator("white_balance")
+    @classmethod
+    def _positive_multipliers(cls, v: object) -> object:
+        """Four multipliers, each a finite number above 0. Why: ``[-1, 1, 1, 1]`` had been
+        taken, and the red channel recorded as a constant, in silence, as a good image;
+        ``[0, 0, 0, 0]`` made every image black, with numpy's warnings."""
+        if isinstance(v, tuple) and not all(math.isfinite(m) and m > 0 for m in v):
+            raise ValueError(
+                f"white_balance {list(v)}: give four multipliers (R, G, B, G2) each above 0, "
+                'such as [2.0, 1.0, 1.5, 1.0], or "camera" (as shot) or "unity"'
+            )
+        return v
+
     output_color: Literal["raw", "srgb"] = "srgb"
     saturation_level: float = Field(
         1.0,

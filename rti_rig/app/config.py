@@ -906,6 +906,24 @@ def _with_led_map_path(data: dict[str, Any], folder: Path) -> dict[str, Any]:
     return {**data, "dome": {**dome, "serial": resolved}}  # type: ignore[dict-item]
 
 
+def _with_watched_folder_path(data: dict[str, Any], folder: Path) -> dict[str, Any]:
+    """A watched-folder camera's relative ``folder`` read relative to the config's folder,
+    as ``lp_file`` and ``led_map_file`` are (``~`` is the user's home, as before).
+
+    Why: it had been read relative to the folder the command was typed in, so ``check``
+    passed from the config's folder and failed from another, and a resume typed elsewhere
+    would have watched another folder than the session's."""
+    camera = data.get("camera")
+    device = camera.get("device") if isinstance(camera, dict) else None
+    if not isinstance(device, dict) or device.get("kind") != "folder_watch":
+        return data
+    name = device.get("folder")
+    if not isinstance(name, str) or Path(name).is_absolute() or name.startswith("~"):
+        return data
+    resolved = {**device, "folder": str((folder / name).resolve())}
+    return {**data, "camera": {**camera, "device": resolved}}  # type: ignore[dict-item]
+
+
 #: A rig config, as ``run``, ``check`` and ``plan --rig`` read one (or an acquisition's .lp).
 _RIG_FILE = _TextFileKind(
     "a rig config or an .lp",
@@ -1077,6 +1095,7 @@ def load_rig_config(path: Path | str, project_doing: str = "replaying") -> Loade
         raise ConfigError(path, None, f"not valid TOML: {exc}{_not_toml_hint(raw_bytes)}") from None
     data, settings, correction_bytes = _with_correction_file(data, path)
     settings = _with_led_map_path(settings, path.parent)
+    settings = _with_watched_folder_path(settings, path.parent)
     config = parse_rig_config(settings, str(path))
     if config.backend == "replay":
         # the form a session's manifest records a replay rig in, not one to write by hand:

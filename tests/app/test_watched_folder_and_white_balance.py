@@ -1,0 +1,58 @@
+"""A watched-folder camera's relative ``folder`` is read relative to its config, and raw white
+balance multipliers must each be above 0.
+
+Before: ``folder = "t_rel"`` was read relative to where the command was typed (``check``
+passed from the config's folder and failed from another; a resume typed elsewhere would have
+watched another folder); ``white_balance = [-1, 1, 1, 1]`` was taken, the red channel then
+recorded as a constant in silence, and ``[0, 0, 0, 0]`` made every image black.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rti_rig.app.config import camera_device_settings, load_rig_config
+from rti_rig.core.errors import ConfigError
+
+CONFIGS = Path(__file__).resolve().parents[2] / "rig_configs"
+SHIPPED = CONFIGS / "example_dome_48_folder_watch.toml"
+DECODE = '[camera.device.decode]\nmode = "demosaic"'
+
+
+def _config(tmp_path: Path, old: str, new: str) -> Path:
+    text = SHIPPED.read_text(encoding="utf-8")
+    assert old in text
+    (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
+    path = tmp_path / "rig.toml"
+    path.write_text(text.replace(old, new), encoding="utf-8")
+    return path
+
+
+def _folder(config: Path) -> Path:
+    return camera_device_settings(load_rig_config(config)).folder
+
+
+def test_a_relative_watched_folder_is_the_configs_wherever_the_command_is_typed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    config = _config(tmp_path, 'folder = "~/Pictures/rti-tether"', 'folder = "t_rel"')
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    for cwd in (tmp_path, elsewhere):
+        monkeypatch.chdir(cwd)
+        assert _folder(config) == (tmp_path / "t_rel").resolve()
+    # a home folder stays the user's, as the shipped config writes it
+    assert _folder(SHIPPED) == Path("~/Pictures/rti-tether").expanduser()
+
+
+@pytest.mark.parametrize("multipliers", ["[-1, 1, 1, 1]", "[0, 0, 0, 0]", "[2, 1, nan, 1]"])
+def test_white_balance_multipliers_at_or_below_zero_are_refused_by_key(
+    tmp_path: Path, multipliers: str
+) -> None:
+    config = _config(tmp_path, DECODE, f"{DECODE}\nwhite_balance = {multipliers}")
+    with pytest.raises(ConfigError) as info:
+        camera_device_settings(load_rig_config(config))
+    said = str(info.value)
+    assert "white_balance" in said and "each above 0" in said, said
