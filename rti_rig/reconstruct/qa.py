@@ -450,6 +450,11 @@ class QAReport:
     #: Images whose files could not be checked against their capture checksums, and why (set
     #: by the application for a session folder); empty when every image was checkable.
     integrity_note: str = ""
+    #: Where the session's lights.lp disagrees with its journal (a light edited, a line left
+    #: out, the lines reordered), set by the application; empty where it agrees. A defect of
+    #: what was fitted, not a check left unmade, so not :attr:`good`: an edited light had been
+    #: fitted 61° off and ``qa.json`` said ``"good": true``, a caveat after it.
+    lp_defect: str = ""
     #: What the session's kind allows of the advice (a replay or an adaptive session cannot
     #: reshoot one image), set by the application; empty for a session that can.
     session_note: str = ""
@@ -598,6 +603,7 @@ class QAReport:
             and not self.lost_unfitted
             and not self.lights_likely_wrong
             and not self.lights_mirrored
+            and not self.lp_defect
         )
 
     @property
@@ -647,6 +653,11 @@ class QAReport:
                 head += f"; {self.verdict_word} whatever the lights: " + ", ".join(whatever + lost)
             light = f"; {self.light_note}" if self.light_note else ""
             return head + light + tail
+        if self.lp_defect:  # what was fitted is not what was shot: said first, with the fix
+            light = f"; {self.light_note}" if self.light_note else ""
+            named = [c.name for c in self.reshoot] + list(self.lost_unfitted)
+            also = f"; {self.verdict_word} as well: {', '.join(named)}" if named else ""
+            return f"lights.lp wrong: {self.lp_defect}{also}{light}{tail}"
         if self.lights_mirrored and not self.reshoot and not self.lost_unfitted:
             # every image agrees with the fit: the mirror is the one finding, said first
             light = f"; {self.light_note}" if self.light_note else ""

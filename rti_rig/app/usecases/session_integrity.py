@@ -306,7 +306,7 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
             "fit paired each with its own line, but relight pairs the lines with the folder's "
             f"JPEGs in name order, so it would give them the wrong lights; {again}"
         )
-    return _integrity_noted(qa, note)
+    return replace(qa, lp_defect=f"{qa.lp_defect}; {note}" if qa.lp_defect else note)
 
 
 def _integrity_noted(qa: QAReport, note: str) -> QAReport:
