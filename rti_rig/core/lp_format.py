@@ -433,12 +433,15 @@ def _name_twins(missing: Sequence[Path]) -> tuple[list[str], list[str]]:
     listings: dict[Path, tuple[dict[str, list[str]], dict[str, list[str]]]] = {}
     twins: list[str] = []
     kin: list[str] = []
+    other_cases: dict[Path, Path | None] = {}
     for path in missing:
         folder = path.parent
         # a folder named in other case (JPEGS\image01.jpg, the images in jpegs/): its files
         # are the twins, as Windows and macOS would find them ("missing" had been said of
         # every image, with the advice to copy them where they already were)
-        other_case = _folder_in_other_case(folder)
+        if folder not in other_cases:  # one look per folder (600 images: 1 s, not 5)
+            other_cases[folder] = _folder_in_other_case(folder)
+        other_case = other_cases[folder]
         listed = path.name
         if other_case is not None:
             folder, listed = other_case, f"{folder.name}/{path.name}"
@@ -495,9 +498,11 @@ def _twins_said(twins: list[str], missing: int) -> str:
     """:func:`case_hint`'s clause for names that differ only in upper/lower case."""
     if not twins:
         return ""
+    folders = any("/" in t.split(" -> ")[0] for t in twins)  # a folder named in other case
     why = (
         ": Windows and macOS ignore the case of file names, this system does not; rename the "
-        "files or correct the names in the .lp"
+        + ("folder" if folders else "files")
+        + " or correct the names in the .lp"
     )
     if missing == 1:
         return (
@@ -687,9 +692,10 @@ def _check_name(name: str, source: str, lineno: int) -> None:
     absolute name is a tool's path on its own machine: see :func:`image_path`)."""
     if is_absolute_name(name):
         return
-    for pure in (PurePosixPath(name), PureWindowsPath(name)):
-        if ".." in pure.parts:
-            raise LpFormatError(source, lineno, _dot_dot_refusal(name, pure))
+    # read as the .lp's readers read it: "\\" a folder separator wherever it appears
+    pure = PureWindowsPath(name) if "\\" in name else PurePosixPath(name)
+    if ".." in pure.parts:
+        raise LpFormatError(source, lineno, _dot_dot_refusal(name, pure))
 
 
 def _dot_dot_refusal(name: str, pure: PurePosixPath | PureWindowsPath) -> str:
@@ -711,6 +717,8 @@ def _dot_dot_refusal(name: str, pure: PurePosixPath | PureWindowsPath) -> str:
         elif part not in ("", "."):
             depth += 1
             kept.append(part)
+    if not kept:
+        return f"image name {name!r} names the .lp file's folder itself, not an image file"
     return (
         f"image name {name!r} steps back with '..' (an .lp's image names are read without "
         f"following '..', which from a linked folder would lead elsewhere); write it as "
@@ -1420,27 +1428,35 @@ def read_lp(
 
 
 def _is_binary(raw: bytes) -> bool:
-    """Whether ``raw`` is no text in any form an `.lp` is met in: not text up to a run of
-    zeros (a file cut off while being written, which FAT cards fill with zeros), not UTF-16
-    without a byte-order mark (every other byte zero), which the reader names as such.
+    """Whether ``raw`` is no text in any form an `.lp` is met in: not a file with a byte-order
+    mark, not text up to a run of zeros (a file cut off while being written, which FAT cards
+    fill with zeros), not UTF-16 without a mark (in any script), each of which the reader
+    reads or names as such.
 
     Why: random bytes named ``.lp`` were told "line 6: the line holds NUL bytes … (UTF-16
     without a byte-order mark?) or cut off while being written", guesses that fit a text file
     and a line number that means nothing; a rig config of the same bytes was called binary."""
-    head = raw[:4096]
-
-    def controls(data: bytes) -> int:
-        return sum(1 for b in data if b < 0x20 and b not in b"\t\n\r\f\x1a")
-
-    if b"\x00" not in head and controls(head) <= len(head) // 20:
+    if raw.startswith((codecs.BOM_UTF8, codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
         return False
-    text = head.rstrip(b"\x00")
-    if b"\x00" not in text and controls(text) <= len(text) // 20:
-        return False  # text, then zeros: cut off
-    for zeros, chars in ((head[1::2], head[0::2]), (head[0::2], head[1::2])):
-        if zeros.count(0) >= 0.9 * len(zeros) and controls(chars) <= len(chars) // 20:
+    head = raw[:4096]
+    if _text_like(head) or _text_like(head.rstrip(b"\x00")):
+        return False  # text, or text then zeros (cut off)
+    for encoding in ("utf-16-le", "utf-16-be"):
+        try:
+            text = head[: len(head) // 2 * 2].decode(encoding)
+        except UnicodeDecodeError:
+            continue
+        unprintable = sum(1 for c in text if not c.isprintable() and c not in "\t\n\r\f\x1a")
+        if unprintable <= len(text) // 20:
             return False  # UTF-16 without its mark
     return True
+
+
+def _text_like(data: bytes) -> bool:
+    """No NUL byte, and control characters (but tab, line ends, form feed, DOS's end of file)
+    in at most 1 byte of 20."""
+    controls = sum(1 for b in data if b < 0x20 and b not in b"\t\n\r\f\x1a")
+    return b"\x00" not in data and controls <= len(data) // 20
 
 
 def _decode(raw: bytes) -> str:

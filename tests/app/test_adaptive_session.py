@@ -547,7 +547,7 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
                 "speed_deg_s = 60.0": "speed_deg_s = 6000.0",
                 "acceleration_deg_s2 = 120.0": "acceleration_deg_s2 = 12000.0",
             },
-            "azimuth joint speed 60 → 6000 °/s; azimuth joint acceleration 120 → 12000 °/s²",
+            "[arm] speed_deg_s 60 → 6000; [arm] acceleration_deg_s2 120 → 12000",
         ),
         # slower, stopped within the starting lights (which no time decides): the steps taken
         # replayed as they were and it went on without a word, the rest chosen for the new
@@ -555,7 +555,7 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
         (
             2,
             {"speed_deg_s = 60.0": "speed_deg_s = 30.0"},
-            "azimuth joint speed 60 → 30 °/s; elevation joint speed 60 → 30 °/s",
+            "([arm] speed_deg_s 60 → 30).",
         ),
     ],
     ids=["faster", "slower"],
@@ -592,6 +592,27 @@ def test_a_resume_on_an_arm_of_other_speed_names_the_times_that_changed(
     r = runner.invoke(app, ["run", str(cfg), "--resume", str(out)])  # put back: it goes on
     assert r.exit_code == 0, r.output
     assert len(journal(out)) == 9
+
+
+def test_a_complete_adaptive_session_on_an_arm_of_other_speed_is_said_complete(
+    tmp_path: Path,
+) -> None:
+    """A complete session has no light left to choose: a resume through a config whose arm
+    is slower says it is complete (exit 0, the fit next), as before the times were compared
+    up front (a review found that check refusing it, "its remaining lights")."""
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    cfg = write_config(
+        tmp_path, text.replace("width = 512", "width = 96").replace("height = 512", "height = 96")
+    )
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--adaptive", "--lights", "6"])
+    assert r.exit_code == 0, r.output
+    slow = write_config(
+        tmp_path, cfg.read_text().replace("speed_deg_s = 60.0", "speed_deg_s = 30.0"), "slow.toml"
+    )
+    r = runner.invoke(app, ["run", str(slow), "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "complete" in said(r) and "other times" not in said(r), said(r)
 
 
 def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:

@@ -100,7 +100,7 @@ def test_another_request_is_refused_naming_what_differs(
     assert tree(out) == before
     # the request as a new session, a command that runs pasted: the rig, the options asked and
     # a free folder beside the session ("start a new session in a new --out" had been said)
-    new = said(r).split("to shoot this request, start a new session: ", 1)[1]
+    new = said(r).split("with your options in place of its own, start a new session: ", 1)[1]
     assert new.startswith(f"rti-rig run {DOME} ") and new.endswith(f"--out {tmp_path / 's-2'}")
     words = shlex.split(new)
     assert [w for w in options if w not in words] == [], new
@@ -444,10 +444,20 @@ def adaptive_stopped(tmp_path_factory: pytest.TempPathFactory) -> Path:
             "--adaptive not given, the session is adaptive; --lights not given, the session 7",
             ["--adaptive", "--lights", "7", "--max-elevation-deg", "45"],
         ),
-        (["--lights", "9"], "--lights 9, the session 7", "--adaptive not given", None),
+        (
+            ["--lights", "9"],
+            "--lights 9, the session 7",
+            "--adaptive not given",
+            ["--adaptive", "--lights", "9"],
+        ),
         # the session's own count without --adaptive: only what was left out differs, and the
         # request is taken as typed (a planned run of 7)
-        (["--lights", "7"], None, "--adaptive not given, the session is adaptive", ["--lights"]),
+        (
+            ["--lights", "7"],
+            None,
+            "--adaptive not given, the session is adaptive",
+            ["--lights", "7"],
+        ),
     ],
 )
 def test_a_resume_asking_another_request_advises_the_session_with_it_put_in(
@@ -476,11 +486,12 @@ def test_a_resume_asking_another_request_advises_the_session_with_it_put_in(
             "options given with --resume are the whole request, so these differ: "
         ), differences
     assert unasked in differences
-    new = text.split("to shoot this request, start a new session: ", 1)[1]
+    how = "with your options in place of its own" if named else "with the options you gave alone"
+    new = text.split(f"to shoot it {how}, start a new session: ", 1)[1]
     words = shlex.split(new)
     assert words[:3] == ["rti-rig", "run", str(DOME)] and words[-2:] == ["--out", f"{out}-2"]
     expected = advised or ["--adaptive", *options]
-    assert " ".join(expected) in " ".join(words), new
+    assert words[3:-2] == expected, new
     assert tree(out) == before
     if options == ["--max-elevation-deg", "45"]:  # pasted, it runs as asked
         r = runner.invoke(app, [*words[1:], "--no-verdict"])
@@ -503,7 +514,8 @@ def test_a_resume_asking_a_request_no_session_takes_says_so_rather_than_advise_i
     text = said(r)
     assert "start a new session" not in text, text
     assert (
-        "no new session takes this request either (--adaptive --lights 7 --min-lights 6): "
+        "no new session takes it with your options in place of its own (--adaptive --lights 7 "
+        "--min-lights 6): "
         "--min-lights 6 goes with --until-error" in text
     ), text
     assert (

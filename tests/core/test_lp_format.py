@@ -111,6 +111,8 @@ def test_each_light_keeps_its_line_and_equality_ignores_it() -> None:
         # a '..' that stays inside is refused too, but not as climbing out: with the name to write
         ("1\nimgs/../a_1.jpg 0 0 1\n", 2, "steps back with '..' (an .lp's image names"),
         ("1\nimgs\\..\\x\\a_1.jpg 0 0 1\n", 2, "write it as 'x/a_1.jpg'"),
+        ("1\nimgs\\x/../a_1.jpg 0 0 1\n", 2, "write it as 'imgs/a_1.jpg'"),
+        ("1\nimgs/.. 0 0 1\n", 2, "names the .lp file's folder itself, not an image file"),
         ("2\na_1.jpg 0 0 1\na_1.jpg 0 1 0\n", 3, "already used on line 2"),
         ("1\na_1.jpg 0 0 nan\n", 2, "not finite"),
         ("1\na_1.jpg 0 1\n", 2, "expected 'name x y z'"),
@@ -643,8 +645,11 @@ def test_a_comment_after_a_light_is_named_with_where_to_put_it() -> None:
         # text in forms an .lp is met in: named as before
         ("2\na.jpg 0 0 1\nb.jpg 0 1 0\n".encode("utf-16-le"), "line 1: the line holds NUL"),
         (b"2\na.jpg 0 0 1\nb.jp" + b"\0" * 512, "line 3: the line holds NUL bytes"),
+        # UTF-16 without a mark in a script whose characters have no zero byte
+        ("2\nснимок1.jpg 0 0 1\nснимок2.jpg 0 1 0\n".encode("utf-16-le"), "line 1: the line"),
+        ("2\nصورة١.jpg 0 0 1\nصورة٢.jpg 0 1 0\n".encode("utf-16-be"), "line 1: the line"),
     ],
-    ids=["all-bytes", "random", "utf16-no-mark", "cut-off"],
+    ids=["all-bytes", "random", "utf16-no-mark", "cut-off", "cyrillic-le", "arabic-be"],
 )
 def test_a_binary_file_is_told_apart_from_text_with_nul_bytes(
     tmp_path: Path, raw: bytes, said: str
@@ -670,5 +675,14 @@ def test_a_folder_named_in_other_case_is_said_with_its_files(tmp_path: Path) -> 
     hint = case_hint(missing)
     assert "2 of them differ only in upper/lower case from a file there" in hint, hint
     assert "JPEGS/img00.jpg -> jpegs/img00.jpg" in hint, hint
+    assert "rename the folder or correct the names in the .lp" in hint, hint
     # a folder that is not there in any case: nothing to name
     assert case_hint([image_path(tmp_path, "other\\img00.jpg")]) == ""
+
+
+def test_utf16_with_its_mark_is_read_in_any_script(tmp_path: Path) -> None:
+    """A review found UTF-16 (with its byte-order mark, which relight reads) of Cyrillic names
+    called "a binary file" by the first form of the binary test."""
+    lp = tmp_path / "dirs.lp"
+    lp.write_bytes("\ufeff2\nснимок1.jpg 0 0 1\nснимок2.jpg 0 1 0\n".encode("utf-16-le"))
+    assert [e.name for e in read_lp(lp)] == ["снимок1.jpg", "снимок2.jpg"]

@@ -1170,17 +1170,21 @@ class AdaptiveSteps:
 
 
 def refuse_other_times(manifest: dict[str, Any], loaded: Any, root: Path) -> None:
-    """Refuse, before the session folder is opened, a resume of an adaptive session on an arm
-    whose config gives other times than its last run's: the time per capture, or what the
-    move-time model reads (each joint's speed, acceleration and limits, the park, the settle
-    time). Nothing is said where that config is unknown (:func:`_last_run_config`).
+    """Refuse, before the session folder is opened, a resume of an unfinished adaptive session
+    on an arm whose config gives other times than its last run's: the time per capture, each
+    joint's speed and acceleration, the settle time. Nothing is said of a complete session
+    (nothing is left to choose), nor where that config is unknown (:func:`_last_run_config`);
+    what else moves the move times (the joints' limits, the park) is left to the check of the
+    move times themselves once the steps taken are replayed (``AdaptiveSteps.replay``), which
+    refuses only what changes them.
 
-    Why before: the same check made once the steps taken had been replayed (which it still
-    is, on the move times themselves) came after "differs … in nothing the images depend on"
-    and "Resuming S: 7 of 16 images verified", two lines saying the resume was fine, and after
-    the reopen had set aside any file it could not verify."""
+    Why before: that check alone came after "differs … in nothing the images depend on" and
+    "Resuming S: 7 of 16 images verified", two lines saying the resume was fine, and after the
+    reopen had set aside any file it could not verify."""
     from rti_rig.app.config import parse_rig_config
 
+    if (manifest.get("runner") or {}).get("finish_reason") == "completed":
+        return
     recorded = _last_run_config(manifest)
     if loaded.config.arm is None or not isinstance(recorded, dict):
         return  # a dome's lights all cost one capture time: no time ranks them otherwise
@@ -1192,9 +1196,10 @@ def refuse_other_times(manifest: dict[str, Any], loaded: Any, root: Path) -> Non
         return
     now_said, then_said = _time_settings(loaded.config), _time_settings(then)
     changed = [
-        f"{name} {then_said[(name, unit)]:g} → {value:g} {unit}"
+        f"{name} {then_said[(name, unit)]:g} → {value:g}{unit}"
         for (name, unit), value in now_said.items()
-        if not np.isclose(then_said[(name, unit)], value, rtol=1e-9, atol=1e-12)
+        if (name, unit) in then_said
+        and not np.isclose(then_said[(name, unit)], value, rtol=1e-9, atol=1e-12)
     ]
     if changed:
         raise RtiRigError(
@@ -1208,21 +1213,27 @@ def refuse_other_times(manifest: dict[str, Any], loaded: Any, root: Path) -> Non
 
 
 def _time_settings(config: Any) -> dict[tuple[str, str], float]:
-    """What an arm's decisions weigh as time, by name and unit: the capture, and the settings
-    the move-time model reads (:func:`_arm_motion_settings`)."""
+    """What an arm's decisions weigh as time, by the config's words and a unit: the capture
+    ([timing] and [camera] exposure_s summed), and the motion: ``[arm] speed_deg_s`` and
+    ``acceleration_deg_s2``, or each servo joint's speed and acceleration as its
+    ``[arm.dynamixel]`` settings give them, and their settle time."""
     t = config.timing
     capture = t.light_switch_s + t.settle_s + config.camera.exposure_s + t.readout_s + t.transfer_s
-    out = {("time per capture [timing]", "s"): float(capture)}
-    motion = _arm_motion_settings(SimpleNamespace(config=config))
+    out = {("time per capture ([timing], [camera] exposure_s)", " s"): float(capture)}
+    arm = config.arm
+    if arm.dynamixel is None:
+        out[("[arm] speed_deg_s", "")] = float(arm.speed_deg_s)
+        out[("[arm] acceleration_deg_s2", "")] = float(arm.acceleration_deg_s2)
+        return out
+    servos = arm.dynamixel
     for joint in ("azimuth", "elevation"):
-        j = getattr(motion, joint)
-        out[(f"{joint} joint speed", "°/s")] = float(j.joint_velocity_deg_s)
-        out[(f"{joint} joint acceleration", "°/s²")] = float(j.joint_acceleration_deg_s2)
-        out[(f"{joint} joint lower limit", "°")] = float(j.min_deg)
-        out[(f"{joint} joint upper limit", "°")] = float(j.max_deg)
-    out[("park azimuth", "°")] = float(motion.park_azimuth_deg)
-    out[("park elevation", "°")] = float(motion.park_elevation_deg)
-    out[("settle time", "s")] = float(motion.settle_time_s)
+        j = getattr(servos, joint)
+        said = f"[arm.dynamixel.{joint}]"
+        out[(f"{said} speed (profile_velocity_rpm)", " °/s")] = float(j.joint_velocity_deg_s)
+        out[(f"{said} acceleration (profile_acceleration_rev_min2)", " °/s²")] = float(
+            j.joint_acceleration_deg_s2
+        )
+    out[("[arm.dynamixel] settle_time_s", " s")] = float(servos.settle_time_s)
     return out
 
 
@@ -1465,6 +1476,15 @@ def hint_count(geometry: object, band: tuple[float, float]) -> int:
     from rti_rig.core.rig_geometry import hint_light_count
 
     return max(START_LIGHTS + 1, hint_light_count(geometry, *band))
+
+
+def check_until_error(until_error_deg: float | None) -> None:
+    """Refuse an ``--until-error`` that is no finite positive angle (before anything opens)."""
+    if until_error_deg is not None and not (np.isfinite(until_error_deg) and until_error_deg > 0):
+        raise RtiRigError(
+            f"--until-error {until_error_deg:g}: give the target as a finite positive angle in "
+            "degrees: the mean normal error to stop at, such as 2"
+        )
 
 
 def check_min_lights(
@@ -1857,11 +1877,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     from rti_rig.runtime.controller import validate_schedule
     from rti_rig.runtime.session import SessionFolder
 
-    if until_error_deg is not None and not (np.isfinite(until_error_deg) and until_error_deg > 0):
-        raise RtiRigError(
-            f"--until-error {until_error_deg:g}: give the target as a finite positive angle in "
-            "degrees: the mean normal error to stop at, such as 2"
-        )
+    check_until_error(until_error_deg)
     from rti_rig.app.config import rig_geometry
 
     geometry = rig_geometry(loaded)

@@ -157,9 +157,9 @@ def _new_session_advice(
     root: Path,
     default_count: bool,
 ) -> str:
-    """The advice "to shoot this request, start a new session: CMD", the request being the
-    session's own options with those given put in their place; or, where run would refuse
-    that request, why.
+    """The advice "to shoot it with your options in place of its own, start a new session:
+    CMD": the session's own options with those given put in their place; or, where run would
+    refuse that, why.
 
     Why: the command had repeated only the options given, so ``--resume S --max-elevation-deg
     45`` of an adaptive session advised a planned run of every light, and ``--resume S
@@ -170,8 +170,9 @@ def _new_session_advice(
 
     began = _began_options(manifest, default_count)
     request = _merged(asked, began)
-    if replace(request, given=()) == replace(began, given=()):
-        request = asked
+    how = "with your options in place of its own"
+    if _same_request(request, began):
+        request, how = asked, "with the options you gave alone"
     command = _new_session_command(request, loaded, root)
     options = _request_options(request) or "the defaults"
     if request.is_adaptive:  # the metering _request_options leaves out of an adaptive run's
@@ -197,15 +198,15 @@ def _new_session_advice(
             )
         )
     except RtiRigError as exc:
-        return f"no new session takes this request either ({options}): {exc}"
+        return f"no new session takes it {how} ({options}): {exc}"
     if request.is_adaptive and (request.auto_exposure or request.max_saturated is not None):
         return (
-            f"no new session takes this request either ({options}): an "
+            f"no new session takes it {how} ({options}): an "
             "adaptive session is not metered (its lights are chosen as the images arrive); "
             "meter once with a planned run, set camera.exposure_s in the rig config, and leave "
             "--auto-exposure out"
         )
-    return f"to shoot this request, start a new session: {command}"
+    return f"to shoot it {how}, start a new session: {command}"
 
 
 def _limit(max_saturated: float | None) -> dict[str, float]:
@@ -252,6 +253,16 @@ def _began_options(manifest: dict[str, Any], default_count: bool) -> StartOption
     )
 
 
+def _same_request(a: StartOptions, b: StartOptions) -> bool:
+    """Whether ``a`` and ``b`` ask one session (``--adaptive`` says nothing beside
+    ``--until-error``, which is adaptive by itself)."""
+
+    def plain(o: StartOptions) -> StartOptions:
+        return replace(o, given=(), adaptive=o.is_adaptive and o.until_error_deg is None)
+
+    return plain(a) == plain(b)
+
+
 def _merged(asked: StartOptions, began: StartOptions) -> StartOptions:
     """``began`` with the options ``asked`` gave put in their place: a plan given replaces
     the count and the adaptive options, a count or an adaptive option given replaces the plan,
@@ -273,6 +284,14 @@ def _merged(asked: StartOptions, began: StartOptions) -> StartOptions:
     request = replace(
         request, **{_FIELD_OF[f]: getattr(asked, _FIELD_OF[f]) for f in flags & set(_FIELD_OF)}
     )
+    if "--until-error" in flags:
+        # the stop decides the count (a planned session's --lights had become a cap its
+        # --min-lights could not exceed), and --until-error goes with the normals objective
+        request = replace(
+            request,
+            lights=asked.lights if "--lights" in flags else None,
+            objective=asked.objective if "--objective" in flags else None,
+        )
     if request.is_adaptive and not began.is_adaptive:
         request = replace(
             request,

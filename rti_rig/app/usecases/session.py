@@ -1368,9 +1368,12 @@ def check_option_pairs(req: NewSessionRequest) -> None:
     would shoot it, and that command is asked the same questions first, so that what it
     advises is never refused in turn (it had advised ``--adaptive --lights 12 --min-lights 6``,
     which run refuses: --min-lights goes with --until-error)."""
-    from rti_rig.app.usecases.adaptive import check_min_lights
+    from rti_rig.app.usecases.adaptive import check_min_lights, check_until_error
+    from rti_rig.planner.make_plan import check_elevation_band
 
     check_max_saturated(req.max_saturated)
+    check_until_error(req.until_error_deg)
+    check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     check_min_lights(
         req.min_lights,
         req.lights,
