@@ -17,7 +17,7 @@ import typer
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from rti_rig.app.usecases.next_fit import fit_model_for, next_fit
+from rti_rig.app.usecases.next_fit import fit_model_for, next_fit, next_step
 from rti_rig.cli.app import (
     app,
     err,
@@ -425,7 +425,7 @@ def _say_next(session: Path) -> None:
     if (session / MARKER).exists():
         return
     out.print(
-        f"Next: {escape(next_fit(session))}",
+        f"Next: {escape(next_step(session))}",
         soft_wrap=True,
         highlight=False,
     )

@@ -56,6 +56,13 @@ def test_export_lp_of_a_mosaic_session_says_its_images_are_not_pictures(
             app, ["run", str(cfg), "--out", str(out), "--lights", "4", "--no-verdict"]
         )
     assert r.exit_code == 0, r.output
+    # the run's next step: no fit of mosaics (it had named the fit, which refuses them)
+    next_said = " ".join(r.output.split()).split("Next: ", 1)[1]
+    if mode == "mosaic":
+        assert next_said.startswith('no fit of CFA mosaics (decode.mode = "mosaic")'), next_said
+        assert str(out / "raw") in next_said
+    else:
+        assert next_said.startswith(f"rti-rig fit {out} --out {out}-fit"), next_said
     lp = out / "export.lp"
     r = CliRunner().invoke(app, ["export-lp", str(out), "--out", str(lp)])
     said = " ".join(r.output.split())

@@ -136,3 +136,27 @@ def test_an_arm_turning_only_thirty_degrees_still_plans_a_normal_map(tmp_path: P
     lights, said = _plan_on_arm_turning(tmp_path, 15.0)
     assert np.linalg.cond(lights) < 10.0
     assert "tilted up to 25° in any direction" in said
+
+
+@pytest.mark.parametrize("lights", [1, 2])
+def test_a_test_shot_names_no_fit_as_its_next_step(tmp_path: Path, lights: int) -> None:
+    """1 or 2 lights: a test shot, which no fit takes; the run had ended "Next: rti-rig fit
+    S --out S-fit", which fit then refused."""
+    session = tmp_path / "s"
+    r = CliRunner().invoke(
+        app,
+        [
+            "run",
+            str(CONFIGS / "simulated_dome.toml"),
+            "--out",
+            str(session),
+            "--lights",
+            str(lights),
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    said = " ".join(r.output.split())
+    next_said = said.split("Next: ", 1)[1]
+    assert next_said.startswith("no fit: ") and "rti-rig fit" not in next_said, said
+    r = CliRunner().invoke(app, ["fit", str(session), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 2  # as the run said: no fit takes it
