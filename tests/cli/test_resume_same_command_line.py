@@ -132,7 +132,7 @@ def test_another_rig_given_with_the_sessions_own_options_is_refused_as_another_r
     line = ["run", str(arm), "--out", str(out), "--lights", "8", "--resume", str(out)]
     r = runner.invoke(app, line)
     assert r.exit_code == 2, r.output
-    assert "is a rig of kind 'arm', and this session was begun on a 'dome'" in said(r)
+    assert "is a rig of kind 'arm', and this session was begun on one of kind 'dome'" in said(r)
     assert "asks for another session" not in said(r)
     assert tree(out) == before
 

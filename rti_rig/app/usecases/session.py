@@ -1694,8 +1694,8 @@ def _rig_refusal(  # type: ignore[no-untyped-def]
     refused = []
     if other_kind:
         refused.append(
-            f"it is a rig of kind '{identity.get('kind')}', and this session was begun on a "
-            f"'{recorded.get('kind')}': a session cannot change kind of rig"
+            f"it is a rig of kind '{identity.get('kind')}', and this session was begun on "
+            f"one of kind '{recorded.get('kind')}': a session cannot change kind of rig"
         )
     elif recorded.get("backend") != identity.get("backend"):
         refused.append(
