@@ -1221,12 +1221,40 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
                 "'dome_shutter' needs a dome (its camera-release line fires the camera); on an "
                 "arm rig let the camera fire itself (trigger = 'none')",
             )
+        _check_dome_has_shutter(path, config, cam)
         # a busy DSLR is no note (it had been one until 2026-11-29): the controller switches
         # the LED off while a busy camera is awaited past max_on_s, and lights it again
         for note in (_untriggered_wait_note(loaded, cam), _resume_check_note(loaded, cam)):
             if note:
                 loaded = loaded.model_copy(update={"notes": (*loaded.notes, note)})
     return loaded
+
+
+def _check_dome_has_shutter(path: Path, config: Any, cam: Any) -> None:
+    """Refuse ``trigger = 'dome_shutter'`` on a dome whose firmware has no shutter command.
+
+    Why: ``check`` passed such a rig, and ``run`` stopped at its first image, the dome lit,
+    with "this firmware has no shutter command"."""
+    serial = config.dome.serial if config.dome is not None else None
+    if getattr(cam, "trigger", "none") != "dome_shutter" or serial is None:
+        return
+    if not serial.is_described:  # rti-rig's own protocols have a shutter verb
+        return
+    from rti_rig.drivers.led_dome.factory import protocol_for
+
+    try:
+        spec = protocol_for(serial)
+    except Exception:  # the dome's own refusal is said where its settings are checked
+        return
+    if spec.shutter is None:
+        raise ConfigError(
+            path,
+            "camera.device.trigger",
+            f"'dome_shutter' needs a dome firmware with a shutter command, and "
+            f"profile '{serial.profile}' has none: let the camera fire itself (trigger = "
+            "'none', the camera on an interval timer or tethered), or give the profile a "
+            "shutter command ([dome.serial.protocol], docs/domes.md)",
+        )
 
 
 def _check_dome_can_dim(path: Path, data: dict[str, Any], serial: Any) -> None:

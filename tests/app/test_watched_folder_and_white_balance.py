@@ -56,3 +56,26 @@ def test_white_balance_multipliers_at_or_below_zero_are_refused_by_key(
         camera_device_settings(load_rig_config(config))
     said = str(info.value)
     assert "white_balance" in said and "each above 0" in said, said
+
+
+def test_a_dome_fired_camera_on_a_firmware_without_shutter_is_refused_by_key(
+    tmp_path: Path,
+) -> None:
+    """``trigger = "dome_shutter"`` on minirti (no shutter command): ``check`` had passed, and
+    ``run`` stopped at its first image, the dome lit. The same table on rti-rig's own
+    protocol (which has one) loads."""
+    text = (CONFIGS / "emulated_minirti.toml").read_text(encoding="utf-8")
+    assert 'backend = "emulated"' in text and "\n[scene]" in text
+    text = text.replace('backend = "emulated"', 'backend = "hardware"')
+    text = text.replace('port = "emulated"', 'port = "/dev/ttyUSB0"').split("\n[scene]")[0]
+    text += f'\n[camera.device]\nkind = "folder_watch"\nfolder = "{tmp_path}"\n'
+    text += 'trigger = "dome_shutter"\n'
+    path = tmp_path / "minirti.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(ConfigError) as info:
+        load_rig_config(path)
+    assert info.value.key == "camera.device.trigger", str(info.value)
+    assert "profile 'minirti' has none" in str(info.value)
+    framed = _config(tmp_path, 'folder = "~/Pictures/rti-tether"', f'folder = "{tmp_path}"')
+    assert 'trigger = "dome_shutter"' in framed.read_text()
+    load_rig_config(framed)  # the shipped DSLR-by-shutter example: its firmware has one
