@@ -76,3 +76,12 @@ def test_a_plan_outside_the_band_given_with_it_is_refused_by_line(tmp_path: Path
     )
     assert r.exit_code == 0, _said(r)
     np.testing.assert_allclose(_elevations(out / "lights.lp"), _elevations(plan), atol=1e-3)
+
+
+def test_a_band_holding_no_led_is_said_of_the_band_not_of_a_count(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", DOME, "--out", str(out), "--max-elevation-deg", "5"])
+    assert r.exit_code == 2, _said(r)
+    text = _said(r)
+    assert "the dome has no LED between 0° and 5° elevation (its LEDs stand between" in text
+    assert "asked for" not in text and not out.exists()

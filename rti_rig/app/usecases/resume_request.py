@@ -484,7 +484,7 @@ def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded:
         if asked.plan is not None
         else f"--lights {asked.lights}"
         if asked.lights is not None
-        else "the default lights"
+        else "--lights not given (the rig's own count)"
     )
     if (wanted.method == "plan") != (recorded.method == "plan"):
         began = "a plan" if recorded.method == "plan" else "a homogeneous layout"

@@ -1138,7 +1138,19 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         # a band without --lights: every LED in it (or the config's default_lights, if fewer).
         # "asked for 48 lights but the dome has only 24 LEDs between 0° and 30°" had refused
         # a ceiling alone, the planning guide's advice for gilding, of a count never given
-        n = min(n, _in_band(geometry, req.min_elevation_deg, req.max_elevation_deg)) or n
+        inside = _in_band(geometry, req.min_elevation_deg, req.max_elevation_deg)
+        if not inside:  # said of the band asked, not of a count never given
+            from rti_rig.core.geometry import az_el_from_direction
+            from rti_rig.planner.uniform import band_text, count_in_band_text
+
+            lo, hi = req.min_elevation_deg, req.max_elevation_deg
+            has = count_in_band_text(
+                0, band_text(lo, hi), az_el_from_direction(geometry.directions)[1]
+            )
+            raise RtiRigError(
+                f"the dome has {has}; widen --min-elevation-deg / --max-elevation-deg"
+            )
+        n = min(n, inside)
     if req.lights is not None:
         check_light_count(n)
     else:
