@@ -65,7 +65,12 @@ def error_text(err: Any, known: Iterable[str] = ()) -> str:
     if err["type"] == "extra_forbidden":
         last = err["loc"][-1] if err.get("loc") else ""
         return unknown_key_text(str(last), known)
-    if err["type"] in ("value_error", "missing") or "input" not in err:
+    if err["type"] == "missing":
+        # pydantic's "Field required" said nothing of what to write, nor where
+        loc = [str(part) for part in err.get("loc", ()) if not isinstance(part, int)]
+        where = f"under [{'.'.join(loc[:-1])}]" if len(loc) > 1 else "at the top of the file"
+        return f"required, and not given: add a line {loc[-1] if loc else 'for it'} = … {where}"
+    if err["type"] == "value_error" or "input" not in err:
         return msg
     got = err["input"]
     if err["type"] == "string_type" and isinstance(got, int | float) and not isinstance(got, bool):
