@@ -528,7 +528,7 @@ class QAReport:
                     "obliquely to judge how bright it is: nowhere at n · l above 0.2; a light "
                     "that did not fire at all is still named from "
                     f"{self.faint_floor_deg:.1f}° above the object's mean surface up, and "
-                    "could not be told on this object below that: check those LEDs fired)"
+                    "could not be told on this object below that: check those lights fired)"
                 )
             if skipped:
                 why = (
@@ -541,7 +541,7 @@ class QAReport:
                 out.append(
                     f"{label} not judged on {_names(below)} (dark, but its light is at or below "
                     "the object's mean surface, where the object's own relief can shadow all it "
-                    "reaches: a misfire cannot be told from that; check the LED fired)"
+                    "reaches: a misfire cannot be told from that; check the light fired)"
                 )
             if unsure:
                 scatter = (
@@ -552,7 +552,7 @@ class QAReport:
                     f"than {_degrees(self.surface_margin_deg)} above the object's mean surface as "
                     f"fitted, and this session's uneven lights{scatter} "
                     "let the fit place that surface no closer: the light may be below the "
-                    "real surface, so a misfire cannot be told from that; check the LED fired)"
+                    "real surface, so a misfire cannot be told from that; check the light fired)"
                 )
             if grazing:
                 out.append(
@@ -562,7 +562,7 @@ class QAReport:
                     f"again. A light that did not fire at all is still named, and from "
                     f"{GRAZING_DIM_MIN_DEG:g}° up one whose brightest pixels read at most "
                     f"{NEIGHBOUR_DIM_RATIO:.0%} of its neighbours'; a dim light lower cannot "
-                    "be told: check the LED fired)"
+                    "be told: check the light fired)"
                 )
         glossy = [
             c.name

@@ -49,7 +49,7 @@ def test_a_light_below_the_tilted_surface_is_not_called_misfired(tmp_path: Path)
     assert "misfired" not in said, said
     # the check not made is said, with why and what to do
     assert "brightness not judged on image_009 (dark, but its light is at or below" in said
-    assert "check the LED fired" in said
+    assert "check the light fired" in said  # an arm has no LED: "the light"
 
     # a real misfire of a light above the surface (image_006 lights the whole plane) is named
     tif = session / "linear" / "image_006.tif"
