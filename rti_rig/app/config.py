@@ -998,7 +998,15 @@ def _lps_in_folder_said(folder: Path) -> str:
 
     Why: an RTIBuilder project folder had been told only "is a folder", its .lp one folder
     down not named."""
+    tomls = sorted(folder.glob("*.toml")) if folder.is_dir() else []
     lps = acquisition_lp_files(folder)
+    if tomls and not any(p.parent == folder and _images_beside(p) for p in lps):
+        # a folder of rig configs (rig_configs/): its configs named, not an LED-position .lp
+        # beside them, which had been advised as "a recorded acquisition" and then failed
+        # with every image missing
+        more = " ..." if len(tomls) > 4 else ""
+        names = ", ".join(shell_word(p) for p in tomls[:4])
+        return f" (this folder holds the rig config(s) {names}{more}: give one)"
     if not lps:
         return ""
     more = " ..." if len(lps) > 3 else ""
@@ -1011,6 +1019,18 @@ def _lps_in_folder_said(folder: Path) -> str:
     names = lp_name_from(folder, lps[0])
     where = "this folder holds" if own else "the RTIBuilder project's light list is"
     return f" ({where} {names}: give {shell_word(lps[0])})"
+
+
+def _images_beside(lp: Path) -> bool:
+    """Whether the first image ``lp`` lists is there: an acquisition's, not an LED-position
+    file's (whose names are labels of no file)."""
+    from rti_rig.core.lp_format import image_path, read_lp
+
+    try:
+        entries = read_lp(lp)
+    except Exception:
+        return False
+    return bool(entries) and image_path(lp.parent, entries[0].name).is_file()
 
 
 def rtibuilder_project_lp(folder: Path) -> Path | None:

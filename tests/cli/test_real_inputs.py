@@ -753,3 +753,14 @@ def test_an_image_named_by_two_clauses_is_counted_once(tmp_path: Path) -> None:
     said = " ".join(r.output.split())
     assert r.exit_code == 1 and f"{name} is a folder" in said, said
     assert "for the other" not in said, said
+
+
+def test_a_folder_of_rig_configs_given_as_the_rig_names_its_configs(tmp_path: Path) -> None:
+    """``run rig_configs`` had advised the LED-position ``example_dome_48.lp`` there as "a
+    recorded acquisition", which then failed with its 48 images missing."""
+    configs = Path(__file__).resolve().parents[2] / "rig_configs"
+    r = CliRunner().invoke(app, ["run", str(configs), "--out", str(tmp_path / "s")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "this folder holds the rig config(s)" in said and "emulated_dome.toml" in said
+    assert "example_dome_48.lp" not in said, said
