@@ -75,12 +75,22 @@ def test_an_adaptive_session_is_not_told_to_reshoot_one_image(tmp_path: Path) ->
 
 
 @pytest.mark.pty
-def test_a_planned_session_keeps_the_advice(tmp_path: Path) -> None:
+def test_a_planned_session_is_told_it_keeps_one_exposure(tmp_path: Path) -> None:
+    """A planned session's clipped images: "reshoot with less exposure" named images no
+    command could shoot again so (a resume with another exposure_s is refused, and
+    --reshoot-lost reshoots only what is lost); a new session with less exposure is what
+    mends them."""
     cfg = coin_dome(tmp_path)
     r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "48"])
     assert r.exit_code == 0, r.output
     text = said(r)
-    assert "reshoot with less exposure" in text and "cannot reshoot" not in text
+    assert "reshoot with less exposure" not in text and "cannot reshoot" not in text
+    assert "a session keeps one exposure: shoot it again as a new session with a shorter " in text
+    sed = cfg.read_text().replace("exposure_s = 0.05", "exposure_s = 0.02")
+    assert sed != cfg.read_text()
+    (tmp_path / "short.toml").write_text(sed)
+    r = runner.invoke(app, ["run", str(tmp_path / "short.toml"), "--resume", str(tmp_path / "s")])
+    assert r.exit_code == 2 and "exposure" in said(r)  # as the advice says: not by a resume
 
 
 @pytest.mark.parametrize("lights", [1, 2])

@@ -341,7 +341,9 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
             "chosen from it): the images named are fixed only by a new session"
         )
     else:
-        return qa
+        # a planned session keeps one exposure (a resume with another is refused): "reshoot
+        # with less exposure" named images no command could shoot again so
+        return qa.with_advice(lambda _name, phrase: PLANNED_ADVICE.get(phrase, phrase))
 
     table = REPLAYED_ADVICE if word == "flawed" else ADAPTIVE_ADVICE
 
@@ -368,6 +370,13 @@ REPLAYED_ADVICE = {
     MOVED_ADVICE: (
         "so it was recorded (a replayed acquisition cannot be reshot): align the images from "
         "the move on to the earlier ones before fitting, or fit one position's images alone"
+    ),
+}
+#: What a planned session is told in place of the advice it cannot follow image by image.
+PLANNED_ADVICE = {
+    LESS_EXPOSURE: (
+        "a session keeps one exposure: shoot it again as a new session with a shorter "
+        "camera.exposure_s, or with --auto-exposure"
     ),
 }
 #: What an adaptive session is told in their place (it can start again, not reshoot one image).
