@@ -50,6 +50,25 @@ class RawDecodeSettings(_Strict):
     mode: Literal["mosaic", "half", "demosaic"] = "demosaic"
     white_balance: Literal["unity", "camera"] | tuple[float, float, float, float] = "camera"
 
+    @field_validator("white_balance", mode="before")
+    @classmethod
+    def _one_of_its_forms(cls, v: object) -> object:
+        """A word it knows, or four numbers, said in one message. Why: pydantic's union said
+        "Input should be 'unity' or 'camera'" under the key
+        ``white_balance.literal['unity','camera']``, the four-number form not named."""
+        ok = v in ("unity", "camera") or (
+            isinstance(v, list | tuple)
+            and len(v) == 4
+            and all(isinstance(m, int | float) and not isinstance(m, bool) for m in v)
+        )
+        if not ok:
+            raise ValueError(
+                f'white_balance {v!r}: give "camera" (as shot), "unity" (the raw '
+                "channels' own ratios) or four multipliers (R, G, B, G2) each above 0, such as "
+                "[2.0, 1.0, 1.5, 1.0]"
+            )
+        return v
+
     @field_validator("white_balance")
     @classmethod
     def _positive_multipliers(cls, v: object) -> object:

@@ -47,7 +47,9 @@ def test_a_relative_watched_folder_is_the_configs_wherever_the_command_is_typed(
     assert _folder(SHIPPED) == Path("~/Pictures/rti-tether").expanduser()
 
 
-@pytest.mark.parametrize("multipliers", ["[-1, 1, 1, 1]", "[0, 0, 0, 0]", "[2, 1, nan, 1]"])
+@pytest.mark.parametrize(
+    "multipliers", ["[-1, 1, 1, 1]", "[0, 0, 0, 0]", "[2, 1, nan, 1]", '"daylight"', "[2, 1, 1]"]
+)
 def test_white_balance_multipliers_at_or_below_zero_are_refused_by_key(
     tmp_path: Path, multipliers: str
 ) -> None:
@@ -55,7 +57,7 @@ def test_white_balance_multipliers_at_or_below_zero_are_refused_by_key(
     with pytest.raises(ConfigError) as info:
         camera_device_settings(load_rig_config(config))
     said = str(info.value)
-    assert "white_balance" in said and "each above 0" in said, said
+    assert "key 'camera.device.decode.white_balance':" in said and "each above 0" in said, said
 
 
 def test_a_dome_fired_camera_on_a_firmware_without_shutter_is_refused_by_key(
