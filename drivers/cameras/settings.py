@@ -308,6 +308,18 @@ class FolderWatchSettings(_Strict):
     )
     decode: RawDecodeSettings = RawDecodeSettings()
 
+    @field_validator("patterns")
+    @classmethod
+    def _some_pattern(cls, v: tuple[str, ...]) -> tuple[str, ...]:
+        """At least one pattern, none empty. Why: ``patterns = []`` was taken, and the run
+        then waited out its timeout for a file none could match, the dome lit."""
+        if not v or any(not p.strip() for p in v):
+            raise ValueError(
+                'give the file patterns the camera\'s files match, such as ["*.CR2", '
+                '"*.cr2"] (none, or an empty one, matches no file)'
+            )
+        return v
+
     @field_validator("folder")
     @classmethod
     def _home(cls, v: Path) -> Path:

@@ -81,3 +81,14 @@ def test_a_dome_fired_camera_on_a_firmware_without_shutter_is_refused_by_key(
     framed = _config(tmp_path, 'folder = "~/Pictures/rti-tether"', f'folder = "{tmp_path}"')
     assert 'trigger = "dome_shutter"' in framed.read_text()
     load_rig_config(framed)  # the shipped DSLR-by-shutter example: its firmware has one
+
+
+@pytest.mark.parametrize("patterns", ["[]", '[""]'])
+def test_a_watched_folder_without_patterns_is_refused_by_key(tmp_path: Path, patterns: str) -> None:
+    """``patterns = []`` was taken, and the run waited out its timeout, the dome lit."""
+    text = SHIPPED.read_text(encoding="utf-8")
+    old = next(line for line in text.splitlines() if line.startswith("patterns = "))
+    config = _config(tmp_path, old, f"patterns = {patterns}")
+    with pytest.raises(ConfigError) as info:
+        camera_device_settings(load_rig_config(config))
+    assert "key 'camera.device.patterns':" in str(info.value), str(info.value)
