@@ -632,6 +632,33 @@ class OpenCvCamera:
             )
         return got * s.exposure_unit_s, float(units)
 
+    def test_shot(self) -> str:
+        """Read one frame as the camera streams it (no exposure set, nothing kept) and check it
+        as a capture would: its size the one negotiated, and an 8-bit frame only with a
+        ``response`` set; say what it was (for ``rti-rig check``).
+
+        Why: ``check`` took no frame of a UVC camera, and passed a config whose first capture
+        was refused ("the camera delivers 8-bit frames … set response"), the dome lit."""
+        cap = self._require_open()
+        ok, image = cap.read()
+        if not ok or image is None:
+            raise CaptureError(
+                self.name,
+                "no frame delivered (stream ended or device lost)" + self._ran_out(),
+                "test frame",
+            )
+        self._frames_read += 1
+        image = np.asarray(image)
+        try:
+            if self.settings.backend == "v4l2":
+                self._refuse_misshapen(image, "test frame")
+            self._refuse_unset_response(image)
+        except DeviceError as exc:
+            raise CaptureError(self.name, exc.message, "test frame") from exc
+        depth = "16-bit" if image.dtype == np.uint16 else "8-bit"
+        height, width = image.shape[:2]
+        return f"one test frame read: {width}×{height}, {depth}"
+
     def capture(self, exposure_s: float) -> Frame:
         """Set ``exposure_s``, drain queued frames, read one fresh frame as linear data."""
         s = self.settings

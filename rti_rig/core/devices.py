@@ -299,8 +299,9 @@ class ShutterSpeedCamera(Protocol):
 @runtime_checkable
 class TrialShotCamera(Protocol):
     """A camera that ``check`` has take one shot and decode it (a tethered DSLR: a body whose
-    RAW the installed LibRaw cannot read fails the check, not the session's first step);
-    ``test_shot`` returns what the shot established, as a phrase."""
+    RAW the installed LibRaw cannot read fails the check, not the session's first step; a UVC
+    camera: one frame read, its size and bit depth checked); ``test_shot`` returns what the
+    shot established, as a phrase."""
 
     def test_shot(self) -> str: ...
 

@@ -35,8 +35,9 @@ from rti_rig.drivers.cameras.opencv_camera import OpenCvCamera
         ),
         (
             OpenCvCamera,
-            [ExposureJudgingCamera, ExposureRefusingCamera],
-            [CardListingCamera, ConnectNotingCamera, ShutterSpeedCamera, TrialShotCamera],
+            # a test frame since 2026-12-05: check had passed 8-bit frames with no response
+            [ExposureJudgingCamera, ExposureRefusingCamera, TrialShotCamera],
+            [CardListingCamera, ConnectNotingCamera, ShutterSpeedCamera],
         ),
     ],
 )
