@@ -1634,11 +1634,34 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
         err = exc.errors()[0]  # said as every other table's (parse_rig_config)
         kind = camera_kind(raw.get("kind"))
         known = table_keys(kind.settings, err["loc"]) if kind is not None else []
-        raise ConfigError(
-            rig.path, _key_of(("camera", "device", *err["loc"])), _error_text(err, known)
-        ) from None
+        said = _other_kinds_key(err, raw.get("kind")) or _error_text(err, known)
+        raise ConfigError(rig.path, _key_of(("camera", "device", *err["loc"])), said) from None
     refuse_quoted_value(rig.path, raw, settings, ("camera", "device"))
     return settings
+
+
+def _other_kinds_key(err: Any, kind: object) -> str:
+    """What to say of a ``[camera.device]`` key spelt right for another camera kind ("" for
+    any other error). Why: ``decode`` under an ``opencv`` camera was told "unknown key …; did
+    you mean 'device'?", sending the user after a typo that was not one."""
+    from rti_rig.drivers.cameras.kinds import camera_kind, camera_kind_names
+
+    loc = err.get("loc") or ()
+    if err.get("type") != "extra_forbidden" or len(loc) != 1:
+        return ""
+    key = str(loc[0])
+    others = [
+        name
+        for name in camera_kind_names()
+        if name != kind and key in (camera_kind(name).settings.model_fields)
+    ]
+    if not others:
+        return ""
+    which = " or ".join(f"'{name}'" for name in others)
+    return (
+        f"'{key}' is a key of a {which} camera, and this one is kind '{kind}': remove it, or "
+        "set the kind of camera it is"
+    )
 
 
 def default_config_path() -> Path:

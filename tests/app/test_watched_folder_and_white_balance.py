@@ -92,3 +92,13 @@ def test_a_watched_folder_without_patterns_is_refused_by_key(tmp_path: Path, pat
     with pytest.raises(ConfigError) as info:
         camera_device_settings(load_rig_config(config))
     assert "key 'camera.device.patterns':" in str(info.value), str(info.value)
+
+
+def test_a_key_of_another_camera_kind_is_said_so_not_called_a_typo(tmp_path: Path) -> None:
+    """``decode`` under an ``opencv`` camera was told "unknown key …; did you mean 'device'?"."""
+    config = _config(tmp_path, 'kind = "folder_watch"', 'kind = "opencv"\ndevice = 0')
+    with pytest.raises(ConfigError) as info:
+        camera_device_settings(load_rig_config(config))
+    said = str(info.value)
+    assert "is a key of a" in said and "camera, and this one is kind 'opencv'" in said, said
+    assert "did you mean" not in said, said
