@@ -353,7 +353,14 @@ def parse_camera_settings(data: dict[str, object]) -> BaseModel:
                     "type": "value_error",
                     "loc": ("kind",),
                     "input": data.get("kind"),
-                    "ctx": {"error": ValueError(f"unknown camera kind; use one of {known}")},
+                    "ctx": {
+                        "error": ValueError(
+                            f"unknown camera kind; use one of {known}"
+                            if "kind" in data
+                            # absent, not unknown: said as the missing key it is
+                            else f"required, and not given: add a line kind = … (one of {known})"
+                        )
+                    },
                 }
             ],
         )

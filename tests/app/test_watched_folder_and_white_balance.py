@@ -102,3 +102,11 @@ def test_a_key_of_another_camera_kind_is_said_so_not_called_a_typo(tmp_path: Pat
     said = str(info.value)
     assert "is a key of a" in said and "camera, and this one is kind 'opencv'" in said, said
     assert "did you mean" not in said, said
+
+
+def test_a_camera_without_kind_is_told_to_add_it(tmp_path: Path) -> None:
+    config = _config(tmp_path, 'kind = "folder_watch"\n', "")
+    with pytest.raises(ConfigError) as info:
+        camera_device_settings(load_rig_config(config))
+    said = str(info.value)
+    assert "key 'camera.device.kind': required, and not given: add a line kind = …" in said, said
