@@ -1922,6 +1922,7 @@ class SelfTestReport:
                     "image"
                 )
         out += [f"  LED {c.index}: {c.message}" for c in self.failed]
+        out += self._index_base_hint()
         if self.light_latency_s and self.foreign_firmware is None and not self.simulated:
             lat = np.asarray(self.light_latency_s) * 1000
             out.append(
@@ -1959,6 +1960,26 @@ class SelfTestReport:
         else:
             out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
         return out
+
+    def _index_base_hint(self) -> list[str]:
+        """A line where the one LED refused as out of the board's range is the first or the
+        last: the board numbers its LEDs from another base than the config sends, and every
+        other LED stepped lit its neighbour.
+
+        Why: a board numbered from 0 under a config's ``index_base = 1`` "passed" 47 LEDs,
+        each the next one, and failed LED 47 as if it alone were dead."""
+        if len(self.failed) != 1 or len(self.checks) < 3:
+            return []
+        failed = self.failed[0]
+        ends = {min(c.index for c in self.checks), max(c.index for c in self.checks)}
+        if failed.index not in ends or "out of range" not in failed.message:
+            return []
+        return [
+            f"  only LED {failed.index}, at the end of the range, was out of the board's range: "
+            "the board most likely numbers its LEDs from another base than the rig config "
+            "sends (the framed and binary profiles' index_base, 0 or 1), and then every other "
+            "LED stepped lit its neighbour; set index_base to the board's"
+        ]
 
     def _passed_as(self) -> str:
         """What a step that ended without error established, as the walk's count names it:
