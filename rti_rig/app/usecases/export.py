@@ -201,6 +201,10 @@ def relight_move_advice(root: Path, new: str) -> str:
     lights.lp out for relight-cli, also for a name that sorts before it (the guide's
     ``demo_linear.lp``), which relight-cli reads first anyway: the session left without its
     own lights.lp for nothing."""
+    if Path(new).suffix.lower() != ".lp":
+        # relight-cli lists a folder's .lp files only: "then reads e.txt there" had been said
+        # just after the note that such a file is found by no tool under that name
+        return f"relight-cli reads only a file named .lp: name it {Path(new).stem}.lp there"
     try:
         order = _relight_order(root, new)
     except OSError:  # a folder that cannot be listed: the moves are the user's to judge
