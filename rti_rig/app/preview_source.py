@@ -219,6 +219,23 @@ def _lit_from_above(direction: Any, record: str, image: Path) -> tuple[float, fl
     return az, el
 
 
+def _refuse_disowned_label(root: Path) -> None:
+    """Refuse the light a disowned session records for its image (its labels may be wrong:
+    :mod:`rti_rig.runtime.disowned`), as fit and export-lp refuse the session, with the way
+    on that plan has: the light given by hand.
+
+    Why: plan was the one reader that took such a session's label, without a word."""
+    from rti_rig.runtime.disowned import DisownedSessionError, refuse_if_disowned
+
+    try:
+        refuse_if_disowned(root)
+    except DisownedSessionError as exc:
+        raise ScheduleError(
+            f"{exc}; to plan from its image, give the light it was shot under with "
+            "--preview-light AZ,EL"
+        ) from None
+
+
 def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any, str | None]]:
     """``(where, short name, direction, how it was read)`` of every record of ``image``'s light
     (module notes); how it was read is None unless said (:func:`_lp_record`)."""
@@ -226,6 +243,7 @@ def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any, str
     found = []
     root = session_of_image(image)
     if root is not None:
+        _refuse_disowned_label(root)
         steps, journaled = _recorded_steps(root)
         for step in steps:
             if any((root / n).resolve() == target for n in _files_of(step)):
@@ -414,6 +432,7 @@ def resolve_preview(
         if light_given:  # the user's light stands: the session's record of it is not read
             return PreviewSource(image)
         where = f"the session {path.resolve().name}"
+        _refuse_disowned_label(path)
         light = _lit_from_above(_step_light(path, steps[0], journaled, image), where, image)
         return PreviewSource(image, light, f"recorded by {where}")
     _refuse_a_rig_as_preview(path)
