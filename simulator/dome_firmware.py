@@ -114,6 +114,17 @@ def garble(data: bytes) -> bytes:
     return data[:i] + bytes([data[i] ^ 0x41]) + data[i + 1 :]
 
 
+#: An Arduino-like board's time in its bootloader after the reset an opening of its port causes
+#: (DTR), before the sketch prints its banner: what the board served on a pty by this module's
+#: command line has, and what a board that resets on open must have there. With none, the
+#: banner was written to the pty the moment the host's open() reached the device node, before
+#: pyserial's own open had ended: its flush of the input queue (``tcflush``, the last step of
+#: ``Serial.open``) then discarded it whenever the host was descheduled in between, as on a
+#: loaded machine (a probe heard the banner at 9600 baud and "(nothing)" at 115200). A real
+#: board's banner comes after its boot, long after the host's open has returned.
+RESET_BOOT_S = 0.5
+
+
 @dataclass
 class DomeFirmware:
     """The board: LEDs, a watchdog, a boot banner, and the faults of its plan.
@@ -518,7 +529,7 @@ def main(argv: list[str] | None = None) -> int:
         settings,
         led_count=leds,
         dead_leds=frozenset(args.dead),
-        boot_delay_s=0.5 if args.boot_delay_s is None else args.boot_delay_s,
+        boot_delay_s=RESET_BOOT_S if args.boot_delay_s is None else args.boot_delay_s,
         faults=FaultPlan(tuple(faults)),
     )
     with sigterm_as_ctrl_c(), emulated_dome_on_pty(firmware) as link:

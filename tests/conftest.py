@@ -79,7 +79,7 @@ def shipped_dome_on_pty(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterat
 
     from rti_rig.app.config import load_rig_config
     from rti_rig.core.clock import SystemClock
-    from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
+    from rti_rig.simulator.dome_firmware import RESET_BOOT_S, emulated_dome_on_pty, firmware_for
     from rti_rig.simulator.domes import SERIAL_FIRMWARES, board_for
     from rti_rig.simulator.pty_link import serve_on_pty
 
@@ -96,7 +96,12 @@ def shipped_dome_on_pty(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterat
         firmware: Any = board_for(profile, clock=SystemClock(), led_map=led_map)
         serving = serve_on_pty(firmware, profile)
     elif profile in OWN_DOME_PROTOCOLS:
-        firmware = firmware_for(serial_settings, led_count=48, clock=SystemClock())
+        # with its bootloader's time after each reset, as the emulator rti-rig ships serves it:
+        # a board with none "printed" its banner before the host's open had flushed its input
+        # (a probe under load heard "(nothing)" at 115200 baud; see RESET_BOOT_S)
+        firmware = firmware_for(
+            serial_settings, led_count=48, clock=SystemClock(), boot_delay_s=RESET_BOOT_S
+        )
         serving = emulated_dome_on_pty(firmware)
     else:
         raise ValueError(
