@@ -632,6 +632,23 @@ class OpenCvCamera:
             )
         return got * s.exposure_unit_s, float(units)
 
+    def _read_checked(self, cap: VideoCaptureLike, operation: str) -> np.ndarray:
+        """One frame read and checked as every frame is: delivered, of the size negotiated
+        (v4l2), and 8-bit only with a ``response`` set; raises naming ``operation``."""
+        ok, image = cap.read()
+        if not ok or image is None:
+            raise CaptureError(
+                self.name,
+                "no frame delivered (stream ended or device lost)" + self._ran_out(),
+                operation,
+            )
+        self._frames_read += 1
+        image = np.asarray(image)
+        if self.settings.backend == "v4l2":
+            self._refuse_misshapen(image, operation)
+        self._refuse_unset_response(image)
+        return image
+
     def test_shot(self) -> str:
         """Read one frame as the camera streams it (no exposure set, nothing kept) and check it
         as a capture would: its size the one negotiated, and an 8-bit frame only with a
@@ -639,21 +656,11 @@ class OpenCvCamera:
 
         Why: ``check`` took no frame of a UVC camera, and passed a config whose first capture
         was refused ("the camera delivers 8-bit frames … set response"), the dome lit."""
-        cap = self._require_open()
-        ok, image = cap.read()
-        if not ok or image is None:
-            raise CaptureError(
-                self.name,
-                "no frame delivered (stream ended or device lost)" + self._ran_out(),
-                "test frame",
-            )
-        self._frames_read += 1
-        image = np.asarray(image)
         try:
-            if self.settings.backend == "v4l2":
-                self._refuse_misshapen(image, "test frame")
-            self._refuse_unset_response(image)
-        except DeviceError as exc:
+            image = self._read_checked(self._require_open(), "test frame")
+        except CaptureError:
+            raise
+        except DeviceError as exc:  # said as the frame's fault, as a capture's would be
             raise CaptureError(self.name, exc.message, "test frame") from exc
         depth = "16-bit" if image.dtype == np.uint16 else "8-bit"
         height, width = image.shape[:2]
@@ -691,18 +698,7 @@ class OpenCvCamera:
                     "drain",
                 )
             self._frames_read += 1
-        ok, image = cap.read()
-        if not ok or image is None:
-            raise CaptureError(
-                self.name,
-                "no frame delivered (stream ended or device lost)" + self._ran_out(),
-                "read",
-            )
-        self._frames_read += 1
-        image = np.asarray(image)
-        if s.backend == "v4l2":
-            self._refuse_misshapen(image, "read")
-        self._refuse_unset_response(image)
+        image = self._read_checked(cap, "read")
         pixels, white = to_linear_uint16(
             image, s.response or "linear", s.black_level, s.white_level, order="bgr"
         )
