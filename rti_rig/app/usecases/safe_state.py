@@ -74,13 +74,7 @@ def lights_state(  # type: ignore[no-untyped-def]
     if isinstance(lighting, DomeLighting):
         policy = lighting.policy  # asked by type: a dome on a port keeps its all-off's outcome
         if policy is not None:
-            sentence = lights_state_sentence(policy)
-            report = policy.off_report
-            if teardown_failed and report is not None and report.lights_known_off:
-                # a red "teardown problem: all LEDs off … no reply" just above had read as
-                # the lights' state: it is the later all-off's outcome that holds
-                sentence += " (said of the last all-off, sent after the teardown problem above)"
-            return sentence
+            return lights_state_sentence(policy)
         known = lighting.known_state
         if known is not None:  # a simulated dome: what it was sent, which it keeps exactly
             return simulated_lights_sentence(known)
