@@ -924,6 +924,24 @@ def _with_watched_folder_path(data: dict[str, Any], folder: Path) -> dict[str, A
     return {**data, "camera": {**camera, "device": resolved}}  # type: ignore[dict-item]
 
 
+def _watched_folder_note(
+    data: dict[str, Any], settings: dict[str, Any], path: Path
+) -> tuple[str, ...]:
+    """A note naming the folder a relative watched ``folder`` is read as (the config's, since
+    2026-12-05; it had been the folder the command was typed in), where that is not the
+    folder of the same name here: a config written for the old rule is told which it watches."""
+    given = ((data.get("camera") or {}).get("device") or {}).get("folder")
+    used = ((settings.get("camera") or {}).get("device") or {}).get("folder")
+    if not isinstance(given, str) or given == used or used is None:
+        return ()
+    if Path(used) == (Path.cwd() / given).resolve():
+        return ()
+    return (
+        f"{shown_path(path)}: camera.device.folder = {given!r} is read relative to the rig "
+        f"config's folder: {used} (not {given!r} in the folder the command runs in)",
+    )
+
+
 #: A rig config, as ``run``, ``check`` and ``plan --rig`` read one (or an acquisition's .lp).
 _RIG_FILE = _TextFileKind(
     "a rig config or an .lp",
@@ -1000,7 +1018,7 @@ def _lps_in_folder_said(folder: Path) -> str:
     down not named."""
     tomls = sorted(folder.glob("*.toml")) if folder.is_dir() else []
     lps = acquisition_lp_files(folder)
-    if tomls and not any(p.parent == folder and _images_beside(p) for p in lps):
+    if tomls and not any(_images_beside(p) for p in lps):
         # a folder of rig configs (rig_configs/): its configs named, not an LED-position .lp
         # beside them, which had been advised as "a recorded acquisition" and then failed
         # with every image missing
@@ -1146,6 +1164,7 @@ def load_rig_config(path: Path | str, project_doing: str = "replaying") -> Loade
         # a new calibration file changes the rig as much as an edit of the config does
         sha256=hashlib.sha256(raw_bytes + correction_bytes).hexdigest(),
         raw=data,
+        notes=_watched_folder_note(data, settings, path),
     )
     try:
         return _checked(loaded, path, data)
@@ -1163,7 +1182,7 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
     if config.kind == "dome":
         notes: list[str] = []
         dirs, _ = dome_led_directions(loaded, notes)  # fail now, not when the session starts
-        loaded = loaded.model_copy(update={"notes": tuple(notes)})
+        loaded = loaded.model_copy(update={"notes": (*loaded.notes, *notes)})
         serial = config.dome.serial if config.dome else None
         if serial is not None and serial.is_described:
             # a firmware that reports nothing: its LED count and on-window are the config's

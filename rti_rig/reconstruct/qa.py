@@ -633,6 +633,8 @@ class QAReport:
             for said in (f", and {UNORDERED_SAID}", f"; but {UNORDERED_SAID}"):
                 tail = tail.replace(said, "")
             head = f"lights likely wrong: {UNORDERED_SAID}"
+            if self.lp_defect:  # the cause, established: said first, with its fix
+                head = f"lights.lp wrong: {self.lp_defect}; {head}"
             named = self.named
             held = len(self.reshoot) - sum(
                 1 for c in self.reshoot if all(lights_independent(p) for p in c.problems)
@@ -740,6 +742,9 @@ class QAReport:
             "good": self.good,
             "reshoot": [c.name for c in self.named] + list(self.lost_unfitted),
             "lights_likely_wrong": self.lights_likely_wrong,
+            # where lights.lp disagrees with the journal (good false, reshoot maybe empty):
+            # the fix is in it (export-lp), for a script that reads no verdict text
+            "lp_defect": self.lp_defect,
             "lights_mirrored": self.lights_mirrored,
             "mirror_ratio": self.mirror_ratio,
             "session_complete": self.session_complete,

@@ -1976,9 +1976,10 @@ class SelfTestReport:
             return []
         return [
             f"  only LED {failed.index}, at the end of the range, was out of the board's range: "
-            "the board most likely numbers its LEDs from another base than the rig config "
-            "sends (the framed and binary profiles' index_base, 0 or 1), and then every other "
-            "LED stepped lit its neighbour; set index_base to the board's"
+            "either the board numbers its LEDs from another base than the rig config sends "
+            "(the framed and binary profiles' index_base, 0 or 1: then every other LED stepped "
+            "lit its neighbour; set index_base to the board's), or the config lists more LEDs "
+            "than the board has (then the others are right; list the board's own)"
         ]
 
     def _passed_as(self) -> str:

@@ -46,3 +46,11 @@ def test_a_plan_given_replaces_the_sessions_count_and_a_count_its_plan() -> None
     merged = _merged(StartOptions(adaptive=True, given=("--adaptive",)), planned)
     # made adaptive: the plan and the metering (which an adaptive session refuses) dropped
     assert (merged.plan, merged.auto_exposure, merged.is_adaptive) == (None, False, True)
+
+
+def test_a_band_given_to_a_planned_session_asks_for_the_rigs_own_layout() -> None:
+    """A plan kept beside a given band had advised a run that refuses its lights outside it."""
+    planned = StartOptions(plan=Path("p.lp"))
+    asked = StartOptions(max_elevation_deg=30.0, given=("--max-elevation-deg",))
+    merged = _merged(asked, planned)
+    assert (merged.plan, merged.lights, merged.max_elevation_deg) == (None, None, 30.0)

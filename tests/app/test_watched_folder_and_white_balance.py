@@ -43,6 +43,11 @@ def test_a_relative_watched_folder_is_the_configs_wherever_the_command_is_typed(
     for cwd in (tmp_path, elsewhere):
         monkeypatch.chdir(cwd)
         assert _folder(config) == (tmp_path / "t_rel").resolve()
+    # typed elsewhere, the folder it reads is said (the rule was the working folder's)
+    notes = " ".join(load_rig_config(config).notes)
+    assert "is read relative to the rig config's folder" in notes, notes
+    monkeypatch.chdir(tmp_path)
+    assert not load_rig_config(config).notes  # the same folder either way: nothing to say
     # a home folder stays the user's, as the shipped config writes it
     assert _folder(SHIPPED) == Path("~/Pictures/rti-tether").expanduser()
 

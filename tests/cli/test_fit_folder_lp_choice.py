@@ -157,3 +157,47 @@ def test_a_captured_image_left_out_of_lights_lp_is_named(session: Path, tmp_path
     assert r.exit_code == 0, r.output
     assert "lights.lp does not list image_004, captured and on disk" in said(r)
     assert _qa(tmp_path / "fit")["good"] is False
+
+
+def test_a_shuffled_lights_lp_names_its_journal_and_fix_first(
+    session: Path, tmp_path: Path
+) -> None:
+    """Every line's direction moved to another: the QA also finds the lights likely wrong, and
+    that branch had dropped the journal's finding and its export-lp (a review of the defect's
+    first form found it)."""
+    s = tmp_path / "s"
+    shutil.copytree(session, s)
+    count, *lines = (s / "lights.lp").read_text().splitlines()
+    fields = [line.split() for line in lines]
+    rolled = [[f[0], *g[1:]] for f, g in zip(fields, fields[3:] + fields[:3], strict=True)]
+    (s / "lights.lp").write_text("\n".join([count, *(" ".join(f) for f in rolled)]) + "\n")
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    assert "QA verdict: lights.lp wrong: lights.lp gives" in said(r), said(r)
+    assert f"rti-rig export-lp {s} --out {s / 'lights.lp'}" in said(r)
+    qa = _qa(tmp_path / "fit")
+    assert qa["good"] is False and "another light than the journal" in qa["lp_defect"]
+
+
+def test_another_lp_with_measured_lights_is_a_note_not_a_defect(
+    session: Path, tmp_path: Path
+) -> None:
+    """An .lp of the user's beside the images (lights measured on a sphere, each nudged a
+    little) fitted on purpose: the journal's finding is a caveat, not "lights.lp wrong"."""
+    s = tmp_path / "s"
+    shutil.copytree(session, s)
+    count, *lines = (s / "lights.lp").read_text().splitlines()
+    nudged = []
+    for line in lines:
+        name, *xyz = line.split()
+        x, y, z = (float(v) for v in xyz)
+        x, y = x + 0.01, y - 0.01
+        n = (x * x + y * y + z * z) ** 0.5
+        nudged.append(f"{name} {x / n:.6f} {y / n:.6f} {z / n:.6f}")
+    (s / "measured.lp").write_text("\n".join([count, *nudged]) + "\n")
+    r = runner.invoke(app, ["fit", str(s / "measured.lp"), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    qa = _qa(tmp_path / "fit")
+    assert qa["lp_defect"] == "", qa["verdict"]
+    assert any("measured.lp gives" in c for c in qa["caveats"]), qa["caveats"]
+    assert "lights.lp wrong" not in qa["verdict"]

@@ -539,3 +539,17 @@ def test_a_resume_asking_a_request_no_session_takes_says_so_rather_than_advise_i
         ],
     )
     assert r.exit_code == 2 and "--min-lights 6 goes with --until-error" in said(r), r.output
+
+
+def test_a_resume_whose_request_no_layout_takes_says_so(stopped: Path, tmp_path: Path) -> None:
+    """``--lights 30 --max-elevation-deg 30`` put in a ``--lights 8`` session: the band holds
+    24 LEDs, so run refuses it; the refusal had advised it all the same (a review found it)."""
+    out = copy_of(stopped, tmp_path)
+    r = runner.invoke(
+        app, ["run", "--resume", str(out), "--lights", "30", "--max-elevation-deg", "30"]
+    )
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "start a new session" not in text, text
+    assert "no new session takes it with your options in place of its own (--lights 30 " in text
+    assert "24 LEDs between 0° and 30°" in text, text

@@ -85,3 +85,46 @@ def test_a_band_holding_no_led_is_said_of_the_band_not_of_a_count(tmp_path: Path
     text = _said(r)
     assert "the dome has no LED between 0° and 5° elevation (its LEDs stand between" in text
     assert "asked for" not in text and not out.exists()
+
+
+def test_plan_lights_on_the_band_edge_written_to_six_decimals_are_inside(tmp_path: Path) -> None:
+    """A ring at 40° written as an .lp writes it (six decimals) sits 3e-5° off 40: it had been
+    refused as "at 40.0°" outside --max-elevation-deg 40."""
+    import math
+
+    lines = []
+    for i, el in enumerate([20.0] * 6 + [40.0] * 6):
+        az = math.radians(60 * i + (30 if el == 40.0 else 0))
+        e = math.radians(el)
+        x, y, z = math.cos(e) * math.cos(az), math.cos(e) * math.sin(az), math.sin(e)
+        lines.append(f"img_{i:02d}.jpg {x:.6f} {y:.6f} {z:.6f}")
+    plan = tmp_path / "ring.lp"
+    plan.write_text(f"{len(lines)}\n" + "\n".join(lines) + "\n")
+    arm = str(REPO / "rig_configs" / "virtual_arm.toml")
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            arm,
+            "--plan",
+            str(plan),
+            "--max-elevation-deg",
+            "40",
+            "--out",
+            str(out),
+            "--no-verdict",
+        ],
+    )
+    assert r.exit_code == 0, _said(r)
+
+
+def test_a_replay_band_holding_no_image_is_said_of_its_images(tmp_path: Path) -> None:
+    acq = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
+    r = runner.invoke(
+        app, ["run", str(acq), "--out", str(tmp_path / "s"), "--max-elevation-deg", "1"]
+    )
+    assert r.exit_code == 2, _said(r)
+    text = _said(r)
+    assert "the acquisition" in text and "has no image between 0° and 1° elevation" in text, text
+    assert "widen --max-elevation-deg 1" in text and "LED" not in text, text

@@ -169,7 +169,10 @@ def _relight_reads(root: Path, new: str) -> str:
     its lines by order and checks only their count, so one exported before a resume (the
     images taken by then) or with images left out stops it with "Lp number of lights (…)
     different from the number of images found", naming neither file."""
-    first = _relight_order(root, new)[0]
+    order = _relight_order(root, new)
+    if not order:  # no .lp there, and an export named otherwise is none to it
+        return f"relight-cli given {shown_path(root)} finds no .lp there"
+    first = order[0]
     if first == LP_NAME:
         return (
             f"relight-cli given {shown_path(root)} reads the first .lp there by name, still "
@@ -188,7 +191,8 @@ def _relight_order(root: Path, new: str) -> list[str]:
     ``str.casefold`` read an export named ``ﬁnal.lp`` (a ligature, 0xFB01) as ``final.lp``,
     before lights.lp, and said relight-cli would read it, where Qt lists lights.lp first."""
     names = {p.name for p in root.iterdir() if p.suffix.lower() == ".lp" and p.is_file()}
-    names.add(new)
+    if Path(new).suffix.lower() == ".lp":  # relight-cli lists no other file
+        names.add(new)
     return sorted(names, key=qt_name_key)
 
 

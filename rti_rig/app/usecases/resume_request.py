@@ -197,6 +197,22 @@ def _new_session_advice(
                 **_limit(request.max_saturated),
             )
         )
+        if not request.is_adaptive:  # its layout on this rig, as run plans it (a band
+            # holding fewer LEDs than --lights, a plan outside it): never advised if refused
+            from rti_rig.app.usecases.session import new_session_schedule
+
+            new_session_schedule(
+                NewSessionRequest(
+                    Path(loaded.path),
+                    free_name(root, folder=True),
+                    lights=request.lights,
+                    plan=request.plan,
+                    min_elevation_deg=request.min_elevation_deg,
+                    max_elevation_deg=request.max_elevation_deg,
+                    allow_no_normals=request.allow_no_normals,
+                ),
+                loaded,
+            )
     except RtiRigError as exc:
         return f"no new session takes it {how} ({options}): {exc}"
     if request.is_adaptive and (request.auto_exposure or request.max_saturated is not None):
@@ -279,7 +295,9 @@ def _merged(asked: StartOptions, began: StartOptions) -> StartOptions:
             min_lights=None,
             objective=None,
         )
-    elif flags & (_ADAPTIVE_FLAGS | {"--lights"}):
+    elif flags & (_ADAPTIVE_FLAGS | {"--lights", "--min-elevation-deg", "--max-elevation-deg"}):
+        # a count, an adaptive option or a band asks for the rig's own layout: a plan kept
+        # beside a band given had advised a run that refuses the plan's lights outside it
         request = replace(request, plan=None)
     request = replace(
         request, **{_FIELD_OF[f]: getattr(asked, _FIELD_OF[f]) for f in flags & set(_FIELD_OF)}
@@ -478,7 +496,6 @@ def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded:
         max_elevation_deg=asked.max_elevation_deg,
         allow_no_normals=asked.allow_no_normals,
     )
-    wanted = new_session_schedule(request, loaded)
     what = (
         f"--plan {asked.plan}"
         if asked.plan is not None
@@ -486,6 +503,12 @@ def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded:
         if asked.lights is not None
         else "--lights not given (the rig's own count)"
     )
+    try:
+        wanted = new_session_schedule(request, loaded)
+    except RtiRigError as exc:  # a request no layout of this rig takes: a difference, said
+        # with the session's options, not a refusal of its own that hid them (it had been
+        # "asked for 30 lights but the dome has only 24 LEDs …" and nothing of the session)
+        return [f"{what}{_band_words(asked)}: {exc}"]
     if (wanted.method == "plan") != (recorded.method == "plan"):
         began = "a plan" if recorded.method == "plan" else "a homogeneous layout"
         return [f"{what} gives {_layout(wanted)}; the session ran {began}"]
@@ -507,6 +530,12 @@ def _schedule_differences(asked: StartOptions, manifest: dict[str, Any], loaded:
     if band:
         return band
     return _allow_difference(recorded, asked)
+
+
+def _band_words(asked: StartOptions) -> str:
+    """`` with --max-elevation-deg 30`` (the band options given, if any)."""
+    words = band_options((asked.min_elevation_deg, asked.max_elevation_deg)).strip()
+    return f" with {words}" if words else ""
 
 
 def _chooses_lights(asked: StartOptions) -> bool:

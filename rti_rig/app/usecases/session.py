@@ -1058,7 +1058,8 @@ def _refuse_plan_outside_band(req: NewSessionRequest, entries: Any, schedule: An
     outside = []
     for entry, step in zip(entries, schedule.steps, strict=True):
         el = float(az_el_from_direction(step.direction)[1])
-        if el < low - 1e-6 or el > high + 1e-6:
+        # to within an .lp's six decimals (a light on the edge, written so, moves ~3e-5°)
+        if el < low - 1e-3 or el > high + 1e-3:
             line = f"line {entry.line}" if entry.line is not None else entry.name
             outside.append(f"{line} ({entry.name}) at {el:.1f}°")
     if not outside:
@@ -1144,12 +1145,20 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
             from rti_rig.planner.uniform import band_text, count_in_band_text
 
             lo, hi = req.min_elevation_deg, req.max_elevation_deg
+            el = az_el_from_direction(geometry.directions)[1]
+            replay = loaded.config.backend == "replay"  # its "LEDs" are images
             has = count_in_band_text(
-                0, band_text(lo, hi), az_el_from_direction(geometry.directions)[1]
+                0,
+                band_text(lo, hi),
+                el,
+                *(("image", "its images' lights") if replay else ()),
             )
-            raise RtiRigError(
-                f"the dome has {has}; widen --min-elevation-deg / --max-elevation-deg"
+            rig = f"the acquisition {shown_path(loaded.path)}" if replay else "the dome"
+            widen = " / ".join(
+                [f"--min-elevation-deg {lo:g}"] * (lo != 0.0)
+                + [f"--max-elevation-deg {hi:g}"] * (hi != 90.0)
             )
+            raise RtiRigError(f"{rig} has {has}; widen {widen}")
         n = min(n, inside)
     if req.lights is not None:
         check_light_count(n)

@@ -306,6 +306,10 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
             "fit paired each with its own line, but relight pairs the lines with the folder's "
             f"JPEGs in name order, so it would give them the wrong lights; {again}"
         )
+    if lp.name != LP_NAME:
+        # another .lp of the user's (measured or corrected lights, fitted on purpose): a note,
+        # not a defect of the session's own record, which relight reads
+        return _integrity_noted(qa, note)
     return replace(qa, lp_defect=f"{qa.lp_defect}; {note}" if qa.lp_defect else note)
 
 
