@@ -657,8 +657,11 @@ class QAReport:
             return head + light + tail
         if self.lp_defect:  # what was fitted is not what was shot: said first, with the fix
             light = f"; {self.light_note}" if self.light_note else ""
-            named = [c.name for c in self.reshoot] + list(self.lost_unfitted)
-            also = f"; {self.verdict_word} as well: {', '.join(named)}" if named else ""
+            # what the checks against the lights found is said too, as found (evidence of
+            # the defect, mostly: an image "wrong light" under the edited line)
+            named = [f"{c.name} ({'; '.join(c.problems)})" for c in self.reshoot]
+            named += [f"{n} (lost since capture, not fitted)" for n in self.lost_unfitted]
+            also = f"; found as well: {', '.join(named)}" if named else ""
             return f"lights.lp wrong: {self.lp_defect}{also}{light}{tail}"
         if self.lights_mirrored and not self.reshoot and not self.lost_unfitted:
             # every image agrees with the fit: the mirror is the one finding, said first

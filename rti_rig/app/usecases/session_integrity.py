@@ -347,7 +347,10 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
     else:
         # a planned session keeps one exposure (a resume with another is refused): "reshoot
         # with less exposure" named images no command could shoot again so
-        return qa.with_advice(lambda _name, phrase: PLANNED_ADVICE.get(phrase, phrase))
+        images = tuple(
+            replace(c, problems=tuple(_planned_advice(p) for p in c.problems)) for c in qa.images
+        )
+        return replace(qa, images=images)
 
     table = REPLAYED_ADVICE if word == "flawed" else ADAPTIVE_ADVICE
 
@@ -383,6 +386,16 @@ PLANNED_ADVICE = {
         "camera.exposure_s, or with --auto-exposure"
     ),
 }
+
+
+def _planned_advice(problem: str) -> str:
+    """``problem`` with the advice a planned session cannot follow image by image replaced
+    (:data:`PLANNED_ADVICE`); every other word kept (a move's alternatives among them)."""
+    for phrase, said in PLANNED_ADVICE.items():
+        problem = problem.replace(phrase, said)
+    return problem
+
+
 #: What an adaptive session is told in their place (it can start again, not reshoot one image).
 ADAPTIVE_ADVICE = {
     FLAT_ADVICE: "a new session replaces it (an adaptive session cannot reshoot one image)",
