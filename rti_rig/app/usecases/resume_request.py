@@ -179,40 +179,28 @@ def _new_session_advice(
         options = " ".join(
             [options, *_exposure_words(request.auto_exposure, request.max_saturated)]
         )
+    new = NewSessionRequest(
+        Path(loaded.path),
+        free_name(root, folder=True),
+        lights=request.lights,
+        plan=request.plan,
+        min_elevation_deg=request.min_elevation_deg,
+        max_elevation_deg=request.max_elevation_deg,
+        auto_exposure=request.auto_exposure,
+        adaptive=request.adaptive,
+        until_error_deg=request.until_error_deg,
+        objective=request.objective,
+        min_lights=request.min_lights,
+        allow_no_normals=request.allow_no_normals,
+        **_limit(request.max_saturated),
+    )
     try:
-        check_option_pairs(
-            NewSessionRequest(
-                Path(loaded.path),
-                free_name(root, folder=True),
-                lights=request.lights,
-                plan=request.plan,
-                min_elevation_deg=request.min_elevation_deg,
-                max_elevation_deg=request.max_elevation_deg,
-                auto_exposure=request.auto_exposure,
-                adaptive=request.adaptive,
-                until_error_deg=request.until_error_deg,
-                objective=request.objective,
-                min_lights=request.min_lights,
-                allow_no_normals=request.allow_no_normals,
-                **_limit(request.max_saturated),
-            )
-        )
+        check_option_pairs(new)
         if not request.is_adaptive:  # its layout on this rig, as run plans it (a band
             # holding fewer LEDs than --lights, a plan outside it): never advised if refused
             from rti_rig.app.usecases.session import new_session_schedule
 
-            new_session_schedule(
-                NewSessionRequest(
-                    Path(loaded.path),
-                    free_name(root, folder=True),
-                    lights=request.lights,
-                    plan=request.plan,
-                    min_elevation_deg=request.min_elevation_deg,
-                    max_elevation_deg=request.max_elevation_deg,
-                    allow_no_normals=request.allow_no_normals,
-                ),
-                loaded,
-            )
+            new_session_schedule(new, loaded)
     except RtiRigError as exc:
         return f"no new session takes it {how} ({options}): {exc}"
     if request.is_adaptive and (request.auto_exposure or request.max_saturated is not None):
