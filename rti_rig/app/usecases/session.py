@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.app.usecases.replay_advice import new_session_command
-from rti_rig.app.usecases.run_options import run_words
+from rti_rig.app.usecases.run_options import band_options, run_words
 from rti_rig.core.errors import ConfigError, RtiRigError, ScheduleError
 from rti_rig.core.out_folders import free_folder_beside, free_name
 from rti_rig.core.rig_geometry import DomeGeometry, led_fields
@@ -1064,10 +1064,7 @@ def _refuse_plan_outside_band(req: NewSessionRequest, entries: Any, schedule: An
             outside.append(f"{line} ({entry.name}) at {el:.1f}°")
     if not outside:
         return
-    band = " ".join(
-        [f"--min-elevation-deg {low:g}"] * (low != 0.0)
-        + [f"--max-elevation-deg {high:g}"] * (high != 90.0)
-    )
+    band = band_options((low, high)).strip()
     more = f" and {len(outside) - 5} more" if len(outside) > 5 else ""
     raise RtiRigError(
         f"--plan {shown_path(req.plan)}: {len(outside)} of its {len(entries)} lights lie outside "
@@ -1182,7 +1179,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
 
         lo, hi = req.min_elevation_deg, req.max_elevation_deg
         _, el = az_el_from_direction(geometry.directions)
-        inside = int(((el >= lo - 1e-9) & (el <= hi + 1e-9)).sum())
+        inside = _in_band(geometry, lo, hi)
         if n > inside:
             band = band_text(lo, hi)
             fewer = [f"use --lights {inside} or fewer"] if inside else []
@@ -1286,12 +1283,8 @@ def _metering_options(req: NewSessionRequest, loaded) -> str:  # type: ignore[no
     lo, hi = req.min_elevation_deg, req.max_elevation_deg
     lights = 6
     geometry = rig_geometry(loaded)
-    if isinstance(geometry, DomeGeometry):
-        from rti_rig.core.geometry import az_el_from_direction
-
-        _, el = az_el_from_direction(geometry.directions)  # as the planner bands its LEDs
-        inside = int(((el >= lo - 1e-9) & (el <= hi + 1e-9)).sum())
-        lights = max(1, min(lights, inside))
+    if isinstance(geometry, DomeGeometry):  # as the planner bands its LEDs
+        lights = max(1, min(lights, _in_band(geometry, lo, hi)))
     return band_run_options(lights, lo, hi)
 
 
