@@ -37,6 +37,39 @@ err = Console(stderr=True)
 out = Console()
 
 
+def _print_version(given: bool) -> None:
+    """Print the versions a bug report needs and exit (``--version``): rti-rig's, as the
+    manifest of every session records it, with Python's, numpy's, OpenCV's and the platform.
+
+    Why: a user filing a problem, or checking that a lab's machines match, had only
+    ``pip show`` (which names the installed metadata, not the code an editable checkout runs)."""
+    if not given:
+        return
+    from rti_rig.runtime.session import software_versions
+
+    versions = software_versions()
+    out.print(
+        f"rti-rig {versions['rti_rig']} (Python {versions['python']}, numpy "
+        f"{versions['numpy']}, OpenCV {versions['opencv']}; {versions['platform']})",
+        highlight=False,
+        soft_wrap=True,
+    )
+    raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: bool = typer.Option(
+        False,
+        "--version",
+        callback=_print_version,
+        is_eager=True,
+        help="Show rti-rig's version (and Python's, numpy's, OpenCV's) and exit.",
+    ),
+) -> None:
+    """The options of ``rti-rig`` itself, before a command."""
+
+
 def _flags_show_no_type() -> None:
     """Show on/off flags in help without a value type: typer 0.29 labels them ``<bool>``, as if
     ``--force`` took a value (it takes none). Every command's flags at once, in one place."""
@@ -103,6 +136,10 @@ def _empty_paths_refused() -> None:
                     ctx=ctx,
                     param=self,
                 )
+            if getattr(self, "metavar", None) == FILE:
+                refusal = _folder_given_for_a_file(self, given)
+                if refusal is not None:
+                    raise UsageError(refusal, ctx=ctx)
         try:
             return original(self, ctx, value)
         except typer.BadParameter:
@@ -113,6 +150,31 @@ def _empty_paths_refused() -> None:
 
     process_value._rti_rig = True  # type: ignore[attr-defined]
     _TyperParameter.process_value = process_value  # type: ignore[method-assign]
+
+
+#: The metavar of an option that names a file to write (``plan --out``, ``--figure``,
+#: ``export-lp --out``…): help shows ``--out FILE``, and a value ending in a path separator,
+#: which names a folder, is refused (:func:`_folder_given_for_a_file`).
+FILE = "FILE"
+
+
+def _folder_given_for_a_file(param: object, given: list[object]) -> str | None:
+    """The refusal of a file option given a value ending in ``/`` (``--out plans/``), or
+    ``None``.
+
+    Why: :class:`~pathlib.Path` drops a trailing separator, so ``plan … --out plans/`` with no
+    folder ``plans`` wrote the plan as a *file* named ``plans``, said "Planned 12 lights →
+    plans", and a later ``mkdir plans`` failed on it; the user had named a folder."""
+    seps = tuple(s for s in (os.sep, os.altsep, "/") if s)
+    for value in given:
+        if isinstance(value, str) and value.endswith(seps) and value.rstrip("".join(seps)):
+            opts = [o for o in getattr(param, "opts", ()) if o.startswith("--")]
+            name = opts[0] if opts else str(getattr(param, "name", "the file"))
+            return (
+                f"{name} {value}: ends in {value[-1]!r}, which names a folder; give the name of "
+                f"the file to write in it ({name} {value}NAME)"
+            )
+    return None
 
 
 def _number_kind(annotation: object) -> type | None:
@@ -265,6 +327,27 @@ def quiet_library_logs() -> None:
             logger.addHandler(logging.NullHandler())
     for name in QUIET_DASK_LOGGERS:
         logging.getLogger(name).propagate = False
+    opencv_warnings_quiet()
+
+
+def opencv_warnings_quiet() -> None:
+    """Keep OpenCV's native warnings off the terminal (its errors still print), unless the
+    user set ``OPENCV_LOG_LEVEL`` themselves.
+
+    Why: a UVC camera that did not open printed OpenCV's ``[ WARN:0@0.204] global
+    cap_v4l.cpp:914 open VIDEOIO(V4L2:/dev/video0): can't open camera by index`` lines before
+    rti-rig's own message, which names the device and what to check. OpenCV's C++ logger
+    writes to stderr itself, outside Python's logging; it reads ``OPENCV_LOG_LEVEL`` when it
+    first logs, and an OpenCV already imported is told by its own call."""
+    if "OPENCV_LOG_LEVEL" in os.environ:
+        return
+    os.environ["OPENCV_LOG_LEVEL"] = "ERROR"
+    cv2 = sys.modules.get("cv2")
+    try:
+        if cv2 is not None:
+            cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)
+    except AttributeError:  # a build without the utils module keeps its own level
+        pass
 
 
 #: The logger every rti-rig module logs under (``rti_rig.dome``, ``rti_rig.dynamixel.arm`` …).

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out, print_notes, shown_path, stop_exit_code
+from rti_rig.cli.app import FILE, app, err, fail, out, print_notes, shown_path, stop_exit_code
 from rti_rig.cli.stopping import Terminated, sigterm_stops, stamp, stop_signal, written_since
 from rti_rig.core.deferred_signals import stop_words
 from rti_rig.core.errors import RtiRigError
@@ -87,6 +87,7 @@ def calibrate_lights(
         Path | None,
         typer.Option(
             "--out",
+            metavar=FILE,
             help="Calibration file to write (default: CARD_SESSION/light_calibration.toml).",
         ),
     ] = None,
@@ -360,7 +361,8 @@ def lights_from_sphere(
         ),
     ],
     out_file: Annotated[
-        Path, typer.Option("--out", help="The dome's .lp to write.", show_default=False)
+        Path,
+        typer.Option("--out", metavar=FILE, help="The dome's .lp to write.", show_default=False),
     ],
     force: Annotated[bool, typer.Option("--force", help="Replace an existing --out file.")] = False,
 ) -> None:

@@ -9,6 +9,7 @@ import typer
 from rich.markup import escape
 
 from rti_rig.cli.app import (
+    FILE,
     app,
     err,
     fail,
@@ -143,6 +144,7 @@ def plan(
         Path,
         typer.Option(
             "--out",
+            metavar=FILE,
             help="Plan file to write (.lp). A name that does not end in .lp is still written, "
             "with a note to rename it: relight, RTIBuilder and rti-rig fit only read files "
             "ending in .lp (rti-rig run --plan reads it as it is).",
@@ -152,6 +154,7 @@ def plan(
         Path | None,
         typer.Option(
             "--figure",
+            metavar=FILE,
             help="Also draw the plan as a map (.png, .svg or .pdf): the lights seen from above, "
             "numbered in firing order, on the dome's LEDs or the arm's reach.",
         ),

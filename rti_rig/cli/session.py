@@ -19,6 +19,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from rti_rig.app.usecases.next_fit import fit_model_for, next_fit, next_step
 from rti_rig.cli.app import (
+    FILE,
     app,
     err,
     fail,
@@ -2333,6 +2334,7 @@ def export_lp(
         Path,
         typer.Option(
             "--out",
+            metavar=FILE,
             help="The .lp file to write. A name that does not end in .lp is still written, "
             "with a note to rename it: relight, RTIBuilder and rti-rig fit only read files "
             "ending in .lp.",
