@@ -293,6 +293,10 @@ class OffReport:
     #: rig config's ``light_on_s``): an LED lit just before the stop stays lit up to that long,
     #: which "it switches each LED off by itself" alone left unsaid. None: not known.
     on_time_s: float | None = None
+    #: How many all-offs failed (given up unanswered, not sent) before this one, since the
+    #: last that went through: said of an all-off that went through, so that a teardown
+    #: problem printed for a failed all-off does not read as contradicted by "lights are off".
+    after_failed: int = 0
 
     @property
     def lights_known_off(self) -> bool:
@@ -302,6 +306,13 @@ class OffReport:
         if self.reopened_at is not None:
             return self._reopened_sentence()
         said = self._sentence()
+        if self.after_failed and self.outcome in (OffOutcome.ACKNOWLEDGED, OffOutcome.SENT_NO_ACK):
+            n = self.after_failed
+            said += (
+                f" (this all-off was sent after {n} that failed)"
+                if n > 1
+                else (" (this all-off was sent after one that failed)")
+            )
         if self.boots_lit and self.outcome in (OffOutcome.SENT_UNCONFIRMED, OffOutcome.NOT_SENT):
             said = said.removesuffix(_CUT_SUPPLY)  # said once, at the end of what follows
             said += (

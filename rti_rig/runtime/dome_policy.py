@@ -258,6 +258,9 @@ class DomePolicy:
         self._lit: _Lit | None = None
         #: What the last all-off attempt established (None: none attempted yet).
         self.off_report: OffReport | None = None
+        #: All-offs that failed (given up unanswered, or not sent) since the last one that
+        #: went through: the next that does says it came after them (:meth:`_off_went_through`).
+        self._failed_offs = 0
         #: The clock the link really waits on, when it is not the rig's simulated one: a real
         #: firmware's emulator on a pseudo-terminal answers (and blocks: 1.5 s per LED for
         #: rti-dome-m) in real time, which a dry run's rig time must count as the real rig
@@ -402,6 +405,7 @@ class DomePolicy:
                 self.off_report = OffReport(
                     self.link.off_outcome, on_time_s=self.link.light_window_s
                 )
+                self._off_went_through()
                 return
         self._spoke_before_drop = False
         self.reached = "not opened"
@@ -916,9 +920,11 @@ class DomePolicy:
             if exc.fault is LinkFault.FOREIGN:
                 self._switch_off_foreign("in place of this profile's all-off")
             else:
+                self._failed_offs += 1
                 self.off_report = _failed_off(exc)
             raise
         self.off_report = OffReport(self.link.off_outcome, on_time_s=self.link.light_window_s)
+        self._off_went_through()
         self._check_on_time("all off")
         if self._lit is not None:
             self.guard.record(self._lit.index, self._lit.since, self.clock.now())
@@ -1527,6 +1533,7 @@ class DomePolicy:
                     exc = again
                 except DeviceError as other:
                     log.info("%s: all off %s failed: %s", self.name, when, other)
+                    self._failed_offs += 1
                     self.off_report = OffReport(
                         OffOutcome.SENT_UNCONFIRMED, str(other), boots_lit=lit_at_boot
                     )
@@ -1537,6 +1544,7 @@ class DomePolicy:
                 self._switch_off_foreign(when)
                 return
             log.info("%s: all off %s failed: %s", self.name, when, exc)
+            self._failed_offs += 1
             self.off_report = replace(_failed_off(exc), boots_lit=lit_at_boot)
             if at_published_rate and lit_at_boot and exc.fault is not LinkFault.DISCONNECTED:
                 if self.link.bytes_heard:
@@ -1545,6 +1553,7 @@ class DomePolicy:
                     self._not_reopened_silent(lit_at_boot)
         except DeviceError as exc:
             log.info("%s: all off %s failed: %s", self.name, when, exc)
+            self._failed_offs += 1
             self.off_report = OffReport(
                 OffOutcome.SENT_UNCONFIRMED, str(exc), boots_lit=lit_at_boot
             )
@@ -1552,6 +1561,20 @@ class DomePolicy:
             self.off_report = OffReport(
                 self.link.off_outcome, when, on_time_s=self.link.light_window_s
             )
+            self._off_went_through()
+
+    def _off_went_through(self) -> None:
+        """Have the all-off just recorded as gone through say how many all-offs failed before
+        it (since the last that went through), then count afresh.
+
+        Why: a session whose teardown all-off went unanswered printed "teardown problem: all
+        LEDs off … no reply" and then, of the closing all-off the dome acknowledged, "lights
+        are off", with nothing saying that this was another all-off, sent after the failed
+        one; it read as a contradiction. The count is this policy's own record of its
+        all-offs, so the order it states was established, not inferred from the messages."""
+        if self._failed_offs and self.off_report is not None:
+            self.off_report = replace(self.off_report, after_failed=self._failed_offs)
+        self._failed_offs = 0
 
     def _all_off_after_reboot(self, reset: DomeLinkError, when: str) -> None:
         """The all-off once more after the one that met a reboot banner (found before it was
@@ -1588,6 +1611,7 @@ class DomePolicy:
             self.link.off_outcome,
             f"{when}, sent again after the board rebooted",
         )
+        self._off_went_through()
 
     def _not_reopened_silent(self, firmware: str) -> None:
         """Record why a port wholly silent since it opened is not reopened at the firmware's
