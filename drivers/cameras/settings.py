@@ -198,6 +198,24 @@ class OpenCvCameraSettings(_Strict):
             return self.drain_frames
         return 4 if self.backend == "v4l2" else 0
 
+    @field_validator("device")
+    @classmethod
+    def _device_index_or_path(cls, v: int | str) -> int | str:
+        """A camera's index (0 for /dev/video0) or its path: an index below 0 names no device.
+        Why: ``device = -1`` was taken at load and failed at connect as "cannot open
+        /dev/video-1", a name no system has; OpenCV's own "any camera" meaning of -1 would
+        open whichever camera came first, not the one the rig was set up with."""
+        if isinstance(v, int) and not isinstance(v, bool) and v < 0:
+            raise ValueError(
+                f"device = {v} names no camera: give its index (0 for /dev/video0; "
+                '`v4l2-ctl --list-devices` lists them) or its path, e.g. "/dev/video0"'
+            )
+        if isinstance(v, str) and not v.strip():
+            raise ValueError(
+                'device = "" names no camera: give its index (0 for /dev/video0) or its path'
+            )
+        return v
+
     @field_validator("fourcc")
     @classmethod
     def _four_chars(cls, v: str | None) -> str | None:

@@ -88,3 +88,15 @@ def test_master_dark_turns_lights_off_and_averages():
     state["on"] = True
     img = subtract_dark(cam.capture(1.0), dark)
     assert np.mean(img.pixels) / 65535 == pytest.approx(0.5, abs=5e-4)
+
+
+@pytest.mark.parametrize("device", [-1, -3, "", "  "])
+def test_a_uvc_device_that_names_no_camera_is_refused_at_load(device):
+    """``device = -1`` had been taken, and failed at connect as "cannot open /dev/video-1"."""
+    with pytest.raises(ValidationError, match="names no camera: give its index"):
+        parse_camera_settings({"kind": "opencv", "device": device})
+
+
+@pytest.mark.parametrize("device", [0, 3, "/dev/video0", "/dev/v4l/by-id/usb-cam-video-index0"])
+def test_a_uvc_device_index_or_path_is_taken(device):
+    assert parse_camera_settings({"kind": "opencv", "device": device}).device == device
