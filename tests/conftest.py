@@ -985,6 +985,16 @@ def said(result) -> str:  # type: ignore[no-untyped-def]
     return " ".join(result.output.split())
 
 
+def at_key(shown: str | Path, key: str, file: Path | None = None) -> str:
+    """How a config error names where it is: ``rig.toml, line 12: key 'camera.exposure_s'``
+    (``shown``: the config's path as the user gave it; ``file``: where it is, if not there).
+    The line is :func:`~rti_rig.core.toml_lines.key_line_in_file`'s, tested on its own."""
+    from rti_rig.core.toml_lines import key_line_in_file
+
+    line = key_line_in_file(file or shown, key)
+    return f"{shown}{'' if line is None else f', line {line}'}: key '{key}'"
+
+
 def journal(session: Path) -> list[dict]:
     """A session folder's journal entries."""
     return [json.loads(line) for line in (session / "journal.jsonl").read_text().splitlines()]

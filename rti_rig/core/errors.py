@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rti_rig.core.shell_words import shown_path
+from rti_rig.core.toml_lines import key_line_in_file
 
 
 class RtiRigError(Exception):
@@ -24,11 +25,19 @@ class RtiRigError(Exception):
 class ConfigError(RtiRigError):
     """A rig config is unreadable or invalid; names the file and the key."""
 
-    def __init__(self, path: Path | str, key: str | None, message: str) -> None:
+    def __init__(
+        self, path: Path | str, key: str | None, message: str, line: int | None = None
+    ) -> None:
         self.path = str(path)
         self.key = key
         self.message = message
-        where = f"{shown_path(self.path)}: key '{key}'" if key else shown_path(self.path)
+        #: The line the key is written on (found in the file when not given; None: not in it).
+        self.line = line if line is not None or not key else key_line_in_file(path, key)
+        where = shown_path(self.path)
+        if self.line is not None:
+            where += f", line {self.line}"
+        if key:
+            where += f": key '{key}'"
         super().__init__(f"{where}: {message}")
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from conftest import at_key
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -34,7 +35,7 @@ def test_auto_exposure_on_a_watched_folder_is_refused_naming_the_key(
     r = runner.invoke(app, [verb, str(WATCH), "--out", str(out), *rest, "--auto-exposure"])
     assert r.exit_code == 2, r.output
     text = said(r)
-    assert f"{WATCH}: key 'camera.device.kind'" in text
+    assert f"{at_key(WATCH, 'camera.device.kind')}" in text
     assert "--auto-exposure cannot meter a 'folder_watch' camera" in text
     assert "Drop --auto-exposure" in text and "exposure_s" in text
     # refused before the dome's port was looked for, and nothing written
@@ -47,6 +48,6 @@ def test_check_auto_exposure_on_a_watched_folder_is_refused_as_run_refuses_it() 
     r = runner.invoke(app, ["check", str(WATCH), "--auto-exposure"])
     assert r.exit_code == 2, r.output
     text = said(r)
-    assert f"{WATCH}: key 'camera.device.kind'" in text
+    assert f"{at_key(WATCH, 'camera.device.kind')}" in text
     assert "--auto-exposure cannot meter a 'folder_watch' camera" in text
     assert "open port" not in text and "Traceback" not in text

@@ -12,7 +12,7 @@ import shlex
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, said
+from conftest import CONFIGS, at_key, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -59,7 +59,7 @@ def test_a_dead_led_the_dome_has_not_is_refused_by_name(tmp_path: Path, dead: st
     r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
     text = said(r)
     assert r.exit_code == 2 and "Traceback" not in text, text
-    assert f"{cfg}: key 'emulator.dead_leds'" in text, text
+    assert f"{at_key(cfg, 'emulator.dead_leds')}" in text, text
     assert "not among this dome's 12 LEDs: give LED indices from 0 to 11" in text, text
     assert "LEDs stepped" not in text, text  # refused before the port opened
 
@@ -88,7 +88,7 @@ def test_an_own_firmware_board_without_current_sensing_is_checked_for_what_it_es
     r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
     text = said(r)
     assert r.exit_code == 2 and "Traceback" not in text, text
-    assert f"{cfg}: key 'emulator.reports_dead_leds'" in text, text
+    assert f"{at_key(cfg, 'emulator.reports_dead_leds')}" in text, text
     assert "set senses_led_current = false under [dome.serial]" in text, text
     assert "LEDs stepped" not in text and "passed:" not in text, text
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import said
+from conftest import at_key, said
 from typer.testing import CliRunner
 
 from rti_rig.app.config import load_rig_config
@@ -51,7 +51,10 @@ def test_a_device_minimum_above_the_camera_maximum_is_refused_by_check(tmp_path:
     r = runner.invoke(app, ["check", str(cfg)])
     text = said(r)
     assert r.exit_code == 2, text
-    assert f"{cfg}: key 'camera.max_exposure_s': no exposure the camera takes lies between " in text
+    assert (
+        f"{at_key(cfg, 'camera.max_exposure_s')}: no exposure the camera takes lies between "
+        in text
+    )
     assert (
         "min_exposure_s = 0.01 s in [camera.device] and [camera] max_exposure_s = 0.005 s" in text
     )
@@ -69,7 +72,7 @@ def test_a_camera_minimum_above_the_devices_default_maximum_is_refused_by_run(
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out)])
     text = said(r)
     assert r.exit_code == 2, text
-    assert f"{cfg}: key 'camera.min_exposure_s'" in text, text
+    assert f"{at_key(cfg, 'camera.min_exposure_s')}" in text, text
     assert (
         "between [camera] min_exposure_s = 3 s and max_exposure_s = 2 s in [camera.device] "
         "(its default)"

@@ -11,6 +11,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from conftest import at_key
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -41,6 +42,7 @@ def test_a_refused_key_names_the_config_as_given(
     r = CliRunner().invoke(app, ["check", "my.toml"])
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
-    assert f"error: my.toml: key '{key}':" in said, said
+    assert f"error: {at_key('my.toml', key, tmp_path / 'my.toml')}:" in said, said
+    assert "error: my.toml, line " in said, said  # each of these keys is written in the file
     assert f"{tmp_path / 'my.toml'}" not in said
     assert "Traceback" not in said

@@ -16,7 +16,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import UnlimitedLighting
+from conftest import UnlimitedLighting, at_key
 from typer.testing import CliRunner
 
 from rti_rig.app.config import load_rig_config
@@ -51,7 +51,7 @@ def test_an_exposure_longer_than_the_rtipy_window_is_refused_before_the_port_ope
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "6"])
     assert r.exit_code == 2, r.output
     text = said(r)
-    assert f"{cfg}: key 'camera.exposure_s'" in text
+    assert f"{at_key(cfg, 'camera.exposure_s')}" in text
     assert "the rtipy firmware lights each LED for 2 s" in text
     assert "dome.serial.protocol.light_on_s = 2" in text
     # the capture begins once the reply the sketch prints before lighting the LED is heard:
@@ -193,7 +193,7 @@ def test_a_led_count_above_the_nab_sketchs_64_is_refused_naming_the_key(tmp_path
     r = runner.invoke(app, ["check", str(cfg)])
     assert r.exit_code == 2, r.output
     text = said(r)
-    assert f"{cfg}: key 'dome.serial.protocol.led_count': led_count = 100" in text
+    assert f"{at_key(cfg, 'dome.serial.protocol.led_count')}: led_count = 100" in text
     assert "the nab-rti-v1 firmware drives at most 64 LEDs" in text
     assert "firmware reports" not in text and ".lp" not in text
     assert "handshake" not in text  # found at load, not after the port opened
@@ -207,7 +207,7 @@ def test_a_led_count_other_than_the_layouts_is_refused_naming_key_and_layout(
     assert r.exit_code == 2, r.output
     text = said(r)
     assert (
-        f"{cfg}: key 'dome.serial.protocol.led_count': led_count = 8 but [dome] layout "
+        f"{at_key(cfg, 'dome.serial.protocol.led_count')}: led_count = 8 but [dome] layout "
         "'fibonacci' (count = 12) gives 12 lights: set led_count = 12"
     ) in text
     assert "The firmware reports no count: this number is the rig config's own" in text
@@ -251,7 +251,7 @@ def test_a_camera_device_on_a_dry_run_is_refused(
     r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6"])
     assert r.exit_code == 2, r.output
     text = said(r)
-    assert f"{cfg}: key 'camera.device': backend = '{backend}' renders its own images" in text
+    assert f"{at_key(cfg, 'camera.device')}: backend = '{backend}' renders its own images" in text
     assert "set backend = 'hardware'" in text and "remove [camera.device]" in text
     assert not (tmp_path / "s").exists()
 
@@ -388,7 +388,7 @@ def test_two_different_baud_rates_are_refused_naming_both_keys(tmp_path: Path) -
     r = runner.invoke(app, ["check", str(cfg)])
     assert r.exit_code == 2, r.output
     text = said(r)
-    assert f"{cfg}: key 'dome.serial'" in text
+    assert f"{at_key(cfg, 'dome.serial')}" in text
     assert "dome.serial.baudrate = 115200 and dome.serial.protocol.baudrate = 9600 disagree" in text
     assert "remove one of the two keys" in text
     assert "LEDs stepped" not in text and "Traceback" not in text

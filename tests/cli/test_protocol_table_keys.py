@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from conftest import at_key
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -42,7 +43,7 @@ def test_an_unknown_protocol_key_is_named_in_full_as_in_every_table(
     cfg = _with_protocol_line(tmp_path, firmware, "bogus_key = 1")
     text = _check(cfg)
     assert (
-        f"{cfg}: key 'dome.serial.protocol.bogus_key': unknown key "
+        f"{at_key(cfg, 'dome.serial.protocol.bogus_key')}: unknown key "
         "(check its spelling and the table it is in)"
     ) in text, text
     assert "Extra inputs" not in text
@@ -51,6 +52,6 @@ def test_an_unknown_protocol_key_is_named_in_full_as_in_every_table(
 def test_a_wrong_type_in_the_protocol_table_names_the_key_and_the_value(tmp_path: Path) -> None:
     cfg = _with_protocol_line(tmp_path, "minirti", 'columns = "many"')
     text = _check(cfg)
-    assert f"{cfg}: key 'dome.serial.protocol.columns': Input should be a valid integer" in text
+    assert f"{at_key(cfg, 'dome.serial.protocol.columns')}: Input should be a valid integer" in text
     assert "(got 'many')" in text, text
     assert "key 'dome.serial':" not in text

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, at_key
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -116,7 +116,8 @@ def test_a_dome_lp_file_that_is_toml_is_told_what_the_key_names(tmp_path: Path) 
     assert "arigconfig?" not in said, r.output
     assert (
         "".join(
-            f"{rig}: key 'dome.lp_file': {other}: this is a TOML file, not an .lp: dome.lp_file "
+            f"{at_key(rig, 'dome.lp_file')}: {other}: this is a TOML file, not an .lp: "
+            "dome.lp_file "
             "names the dome's .lp light list".split()
         )
         in said

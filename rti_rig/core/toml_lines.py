@@ -1,0 +1,111 @@
+"""Where a key is written in a TOML file: the line a config error names beside the key.
+
+Why by hand: :mod:`tomllib` keeps no positions, and the libraries that keep a document's layout
+(tomlkit) expose none either; a user told "key 'camera.device.gain'" of a 90-line config had
+to search for it. This reads only what locates a key: table headers (``[a.b]``, ``[[a.b]]``,
+counted per array so that ``emulator.faults[1].kind`` is the second table's) and assignments
+(``key =``, ``a.b =``, quoted parts), skipping comments and multi-line strings. It never
+judges the file: tomllib has read it before any key is refused.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+_PART = r"""(?:[A-Za-z0-9_-]+|"(?:[^"\\]|\\.)*"|'[^']*')"""
+_DOTTED = rf"{_PART}(?:\s*\.\s*{_PART})*"
+_HEADER = re.compile(rf"^\s*(\[\[?)\s*({_DOTTED})\s*\]\]?\s*(?:#.*)?$")
+_ASSIGN = re.compile(rf"^\s*({_DOTTED})\s*=")
+_ONE_PART = re.compile(_PART)
+#: A key's parts as an error names them: ``dome.rings[2].count`` → dome, rings, [2], count.
+_KEY_PARTS = re.compile(r"\[\d+\]|[^.\[]+")
+
+#: Past this size a file is no rig config: not read for a line.
+_MAX_BYTES = 1 << 20
+
+
+def _parts(dotted: str) -> list[str]:
+    """The parts of a dotted TOML key, quotes removed (escapes are left as written: a key
+    that needs one is matched as written, or not at all)."""
+    return [p[1:-1] if p[:1] in "\"'" else p for p in _ONE_PART.findall(dotted)]
+
+
+def _indexed(parts: list[str], arrays: dict[str, int]) -> str:
+    """``parts`` as an error names the key, each array of tables among its prefixes given the
+    index of its latest table (``[emulator.faults.x]`` after two ``[[emulator.faults]]`` is
+    ``emulator.faults[1].x``)."""
+    out = ""
+    for part in parts:
+        out = f"{out}.{part}" if out else part
+        if out in arrays:
+            out += f"[{arrays[out]}]"
+    return out
+
+
+def key_lines(text: str) -> dict[str, tuple[int, bool]]:
+    """Each key and table of a TOML text, by the name an error gives it, with its first line
+    (from 1) and whether that line is an assignment (False: a table header)."""
+    found: dict[str, tuple[int, bool]] = {}
+    arrays: dict[str, int] = {}
+    table = ""
+    closing: str | None = None  # the quotes that end a multi-line string being skipped
+    for n, line in enumerate(text.splitlines(), 1):
+        if closing is not None:
+            if closing in line:
+                closing = None
+            continue
+        header = _HEADER.match(line)
+        if header:
+            parts = _parts(header[2])
+            if header[1] == "[[":  # one more table of the array: its own name not indexed
+                above = _indexed(parts[:-1], arrays)
+                path = f"{above}.{parts[-1]}" if above else parts[-1]
+                arrays[path] = arrays.get(path, -1) + 1
+                path += f"[{arrays[path]}]"
+            else:
+                path = _indexed(parts, arrays)
+            table = path
+            found.setdefault(table, (n, False))
+            continue
+        assign = _ASSIGN.match(line)
+        if assign is None:
+            continue
+        key = ".".join(_parts(assign[1]))
+        found.setdefault(f"{table}.{key}" if table else key, (n, True))
+        rest = line[assign.end() :]
+        for quotes in ('"""', "'''"):
+            if rest.count(quotes) == 1:
+                closing = quotes
+    return found
+
+
+def key_line(text: str, key: str) -> int | None:
+    """The line ``key`` (as an error names it) is written on in ``text``, or None.
+
+    A key inside a value written on one assignment (an inline table or array: ``decode = {
+    white_balance = [0, 1, 1, 1] }``) is on that assignment's line; a key its table lacks has
+    no line (a table header is never named as the line of a key it does not hold)."""
+    found = key_lines(text)
+    parts = _KEY_PARTS.findall(key)
+    for end in range(len(parts), 0, -1):
+        name = "".join(p if p.startswith("[") else f".{p}" for p in parts[:end]).lstrip(".")
+        if name in found:
+            line, assigned = found[name]
+            return line if end == len(parts) or assigned else None
+    return None
+
+
+def key_line_in_file(path: Path | str, key: str) -> int | None:
+    """:func:`key_line` of a TOML file; None when it cannot be read (gone, too large, not
+    text): a line is a help to the message, never a reason for another error."""
+    file = Path(path)
+    if file.suffix.lower() != ".toml":
+        return None
+    try:
+        if file.stat().st_size > _MAX_BYTES:
+            return None
+        text = file.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    return key_line(text, key)
