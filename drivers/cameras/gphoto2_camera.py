@@ -451,9 +451,7 @@ class Gphoto2Camera:
                 raise DeviceError(self.name, _port_gone(port, detected), "connect")
             model = match[0][0]
         elif len(detected) > 1:
-            raise DeviceError(
-                self.name, f"several cameras found {detected}: set 'port' to choose one", "connect"
-            )
+            raise DeviceError(self.name, _several_cameras(detected), "connect")
         else:
             model, port = detected[0]
         cam = gp.Camera()
@@ -1759,6 +1757,26 @@ def _number(text: str | None) -> float:
         return float(text) if text is not None else 0.0
     except ValueError:
         return 0.0
+
+
+def _several_cameras(detected: list[tuple[str, str]]) -> str:
+    """The refusal of a config with no ``port`` when several cameras are on the bus: each in
+    words and the line that takes it. Why: it had read "several cameras found [('Canon EOS
+    600D', 'usb:001,005'), ('Nikon D750', 'usb:001,006')]: set 'port' to choose one", a Python
+    list and no line to paste. Two bodies of one model are told apart by unplugging one: the
+    port is where a camera is plugged, not which camera it is."""
+    found = "; ".join(f"{model} on {where}" for model, where in detected)
+    lines = " or ".join(f'port = "{where}"' for _, where in detected)
+    same = (
+        " Two of them are the same model: unplug one to see which port is left."
+        if len({model for model, _ in detected}) < len(detected)
+        else ""
+    )
+    return (
+        f"{len(detected)} cameras found: {found}. Set the one to use in [camera.device]: "
+        f"{lines} (a usb: port is the USB device number, which changes each time a camera is "
+        f"plugged in again or wakes from its power saving).{same}"
+    )
 
 
 def _port_gone(port: str, detected: list[tuple[str, str]]) -> str:

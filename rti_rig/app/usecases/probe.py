@@ -41,7 +41,7 @@ from rti_rig.drivers.led_dome.codec_framed import FramedCodec, FramedSpec
 from rti_rig.drivers.led_dome.dome_profiles import nab_rti_v1 as nab
 from rti_rig.drivers.led_dome.dome_profiles import rtipy
 from rti_rig.drivers.led_dome.messages import Banner
-from rti_rig.drivers.led_dome.transport import SerialTransport, TransportError
+from rti_rig.drivers.led_dome.transport import PortHeldError, SerialTransport, TransportError
 from rti_rig.runtime.controller import EmergencyStop
 
 
@@ -134,7 +134,12 @@ class ProbeError:
 
 class _PortNotOpened(TransportError):
     """The opening of the probe's port failed (raised from :func:`_exchange`, the transport's
-    own error carried: its words and ``errno``), told from a port that failed once open."""
+    own error carried: its words, ``errno`` and whether another program holds the port's
+    lock), told from a port that failed once open."""
+
+    def __init__(self, message: str, *, errno: int | None = None, held: bool = False) -> None:
+        super().__init__(message, errno=errno)
+        self.held = held
 
 
 @dataclass
@@ -172,6 +177,9 @@ class ProbeResult:
     #: The port is there but this user may not open it (EACCES): its error says what to do,
     #: and advice to check the dome's cable and power is not given beside it.
     permission_denied: bool = False
+    #: The port is there but another program holds its lock (another rti-rig's check or
+    #: session on this dome): the advice is to wait for it or stop it, not to check the cable.
+    port_held: bool = False
     #: Config lines the firmware's answer showed beyond ``[dome.serial]`` (a default-profile
     #: board without checksums).
     extra_lines: list[str] = field(default_factory=list)
@@ -249,6 +257,15 @@ class ProbeResult:
                 "The port is there but this user may not open it, so no firmware was asked. "
                 "Do as the error says (join the device's group, log out and in again), then "
                 "probe again."
+            )
+        elif not_opened and self.port_held:
+            # held by another program: "check the port's name, that the dome is plugged in"
+            # sent a user to the cable of a dome another rti-rig was driving
+            out.append(
+                "Another program holds the port (another rti-rig's check or session on this "
+                "dome, or a serial monitor), so no firmware was asked and nothing was sent. "
+                "Let it finish or stop it (Ctrl-C in its terminal; `fuser "
+                f"{self.port}` names it on Linux), then probe again."
             )
         elif not_opened:
             # the port never opened: nothing was asked, so nothing can be concluded about a
@@ -389,7 +406,8 @@ def _exchange(
         try:
             t.open()
         except TransportError as exc:
-            raise _PortNotOpened(str(exc), errno=exc.errno) from exc
+            held = isinstance(exc, PortHeldError)
+            raise _PortNotOpened(str(exc), errno=exc.errno, held=held) from exc
         except EmergencyStop as exc:
             if not t.is_open:
                 # inside pyserial's open, which closes the port as the stop goes through: the
@@ -1282,6 +1300,7 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             # what the path is, from its opening's failure (a read's failure says nothing of it)
             result.not_serial = _not_a_serial_port(result.port, exc) if opening else None
             result.permission_denied = opening and exc.errno == errno.EACCES
+            result.port_held = isinstance(exc, _PortNotOpened) and exc.held
     return result
 
 

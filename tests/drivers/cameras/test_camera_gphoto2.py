@@ -252,8 +252,16 @@ def test_missing_python_gphoto2_says_how_to_install(monkeypatch):
 
 def test_several_cameras_need_a_port(tmp_path):
     body = dslr(detected=[("A", "usb:001,004"), ("B", "usb:001,005")])
-    with pytest.raises(DeviceError, match="several cameras"):
+    with pytest.raises(DeviceError) as refused:
         camera(body, tmp_path).connect()
+    # each camera in words and the line that takes it, not a Python list of tuples
+    said = str(refused.value)
+    assert "2 cameras found: A on usb:001,004; B on usb:001,005" in said, said
+    assert 'port = "usb:001,004" or port = "usb:001,005"' in said and "[(" not in said, said
+    assert "same model" not in said
+    twins = dslr(detected=[("A", "usb:001,004"), ("A", "usb:001,005")])
+    with pytest.raises(DeviceError, match="same model: unplug one"):
+        camera(twins, tmp_path).connect()
     with pytest.raises(DeviceError, match="no camera on port usb:002,001"):
         camera(body, tmp_path, port="usb:002,001").connect()
 
