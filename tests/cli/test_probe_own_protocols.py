@@ -154,3 +154,20 @@ def test_probe_writes_a_windows_device_path_as_a_line_toml_reads_back(
         if line.strip().startswith(("[", "port", "profile", "baudrate"))
     ]
     assert tomllib.loads("\n".join(lines))["dome"]["serial"]["port"] == port, lines
+
+
+def test_probe_of_a_firmware_that_reports_no_led_count_says_to_add_it_and_what_next(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The Nab sketch reports no LED count, and its lines pasted into a config of another
+    count were refused at load: the probe says to add led_count, then the check to run (the
+    probe had ended on its lines for every firmware but rti-rig's own)."""
+    port = "/dev/ttyACM5"
+    config = emulated_dome_as_hardware(tmp_path, "emulated_nab_rti_v1.toml", port)
+    with shipped_dome_on_pty(monkeypatch, config):
+        r = runner.invoke(app, ["probe", port, "--rig", str(config)], terminal_width=400)
+    words = said(r)
+    assert "Found: nab-rti-v1." in words, words
+    assert "does not report how many LEDs it drives (at most 64)" in words, words
+    assert "under [dome.serial.protocol] add led_count" in words, words
+    assert f"Next: put these lines in {config}, then run rti-rig check {config}" in words, words

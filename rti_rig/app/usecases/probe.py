@@ -296,9 +296,40 @@ class ProbeResult:
         else:
             out.append(f"Found: {self.profile}. Rig-config lines to use:")
             out += ["  " + line for line in self.config_lines()]
+            out += self._next_lines()
         out.append(f"Lights: {self.lights}")
         if self.note:
             out.append(f"Note: {self.note}")
+        return out
+
+    def _next_lines(self) -> list[str]:
+        """What to do with the lines of a firmware found usable: the LED count where the
+        firmware reports none, and the check to run (unless the note already ends in it).
+
+        Why: only the own protocols' notes named a check; for the Nab sketch, minirti,
+        nichlock, RTIPy and the others the probe ended on its lines, and those lines pasted
+        into the example config were refused at load for ``led_count`` (the profile's 64 or
+        126 against the 48 LEDs of the config's .lp): one round trip more per firmware."""
+        from rti_rig.drivers.led_dome.dome_profiles import max_led_count
+
+        out = []
+        most = None if self.profile is None else max_led_count(self.profile)
+        if most is not None:
+            out.append(
+                f"This firmware does not report how many LEDs it drives (at most {most}): "
+                "under [dome.serial.protocol] add led_count = the LEDs wired, as many as the "
+                "[dome] layout lists (the config is refused at load until they agree)."
+            )
+        check = self.check_command()
+        if check in (self.note or ""):
+            return out
+        if self.rig:
+            out.append(f"Next: put these lines in {shell_word(self.rig)}, then run {check}")
+        else:
+            out.append(
+                "Next: put these lines in your rig config, then run rti-rig check YOUR-RIG.toml "
+                "(probe --rig YOUR-RIG.toml prints that command for your config, to paste)"
+            )
         return out
 
 
