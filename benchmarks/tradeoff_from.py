@@ -74,6 +74,32 @@ PER_LIGHT_S = replay_seconds_per_light()
 PER_LIGHT_SAID = "the replayed dome's default timing"
 
 
+#: Said after the time's source when the acquisition is a session shot on an arm.
+ARM_TIMES_SAID = (
+    "; this acquisition was shot on an arm (its manifest says so), whose session time depends "
+    "on its moves between the lights, which this trade does not plan: the times below are a "
+    "dome's at that step, not the arm's. A dry run of the arm's config with --lights N says "
+    "the arm's"
+)
+
+
+def shot_on_an_arm(lp: Path) -> bool:
+    """Whether ``lp`` is a session's .lp whose manifest (beside it) records an arm rig.
+
+    Why: the trade on an arm session said "1.17 s a light (the replayed dome's default
+    timing)" and 58 s for 50 lights the arm had taken 124.8 s for, with no word that the
+    times were a dome's (``--rig`` refuses an arm's config, rightly: its time depends on the
+    moves). A manifest that cannot be read says nothing either way."""
+    import json
+
+    try:
+        manifest = json.loads((Path(lp).parent / "manifest.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    rig = manifest.get("rig") if isinstance(manifest, dict) else None
+    return isinstance(rig, dict) and rig.get("kind") == "arm"
+
+
 def rig_seconds_per_light(rig_path: Path) -> tuple[float, str]:
     """(seconds a light takes on the user's dome, the words that say where that comes from),
     from its rig config's ``[timing]`` and ``[camera] exposure_s``, summed as a dry run on the
@@ -406,15 +432,134 @@ def run_tradeoff_from(
     return rows, [names[i] for i in held]
 
 
+#: The mean normal errors (degrees, against every light's normals) the advice finds the
+#: fewest lights for; and the relighting targets: dB below the fit.rti of every light.
+NORMAL_TARGETS_DEG = (1.0, 2.0, 3.0)
+RELIGHT_TARGETS_DB = (0.5, 1.0, 2.0)
+
+#: The advice's planners: the summary's column keys, how a user says each, and the command
+#: that shoots N lights so (``{rig}``, ``{n}``, ``{floor}`` filled in).
+_PLANNERS = (
+    (("uniform", "normals", 0.0), "uniform", "rti-rig run {rig} --lights {n}"),
+    (
+        ("uniform", "normals", None),
+        "uniform above {floor:g}°",
+        "rti-rig run {rig} --lights {n} --min-elevation-deg {floor:g}",
+    ),
+    (
+        ("optimal", "normals", 0.0),
+        "optimal",
+        "rti-rig plan {rig} PREVIEW --method optimal --lights {n} --out plan.lp` then "
+        "`rti-rig run {rig} --plan plan.lp",
+    ),
+    (("adaptive", "normals", 0.0), "adaptive", "rti-rig run {rig} --adaptive --lights {n}"),
+    (
+        ("adaptive", "relight", 0.0),
+        "adaptive for relighting",
+        "rti-rig run {rig} --adaptive --objective relight --lights {n}",
+    ),
+)
+
+
+def _fewest(series: dict[int, Row], meets: Callable[[Row], bool]) -> int | None:
+    """The smallest N from which this planner meets the target at every larger N it has a
+    layout for (None: not at its largest). Why "from which": one layout per cell moves by
+    luck, and an N that meets the target only between two that do not is not one to rely on.
+    A high floor has no layout of the largest N (too few lights above it): its own largest
+    counts."""
+    found = None
+    for n in sorted(series, reverse=True):
+        if not meets(series[n]):
+            break
+        found = n
+    return found
+
+
+def how_many_lights(
+    rows: list[Row], floor: float, per_light_s: float, rig: str = "RIG"
+) -> list[str]:
+    """The summary's answer to what it is run for: for each target (mean normal error, and
+    relighting of the fit.rti `rti-rig fit` writes, below every light's), the fewest lights
+    each planner needs, the fastest of them with its session time, and the command.
+
+    Why: the tables gave 5 planners × 7 counts of cells and left a conservator to read the
+    answer out of them (QA, 2026-12-05)."""
+    counts = sorted({r.n for r in rows if r.method != "all"})
+    every = next(r for r in rows if r.method == "all")
+    by = {(r.method, r.objective, r.floor_deg, r.n): r for r in rows}
+    planners = []
+    for (method, objective, at), said, command in _PLANNERS:
+        f = floor if at is None else at
+        if at is None and floor == 0.0:
+            continue  # the best floor is 0°: the plain uniform column already
+        series = {
+            n: by[(method, objective, f, n)] for n in counts if (method, objective, f, n) in by
+        }
+        planners.append((said.format(floor=f), command.replace("{floor:g}", f"{f:g}"), series))
+
+    def line(target: str, meets: Callable[[Row], bool]) -> str:
+        found = [
+            (n, said, cmd)
+            for said, cmd, series in planners
+            if (n := _fewest(series, meets)) is not None
+        ]
+        if not found:
+            return (
+                f"- **{target}**: no planner reaches it up to {counts[-1]} lights of this "
+                f"acquisition (every light's own: {every.n})"
+            )
+        fastest = min(n for n, _, _ in found)
+        each = "; ".join(f"{said} {n}" for n, said, _ in sorted(found))
+        best = [(said, cmd) for n, said, cmd in found if n == fastest]
+        missing = [said for said, _, series in planners if all(said != s for _, s, _ in found)]
+        how = best[0][1].format(rig=rig, n=fastest)
+        fewest = " (the fewest the table tries: fewer may do)" if fastest == counts[0] else ""
+        out = (
+            f"- **{target}**: from **{fastest} lights**{fewest}, {fastest * per_light_s:.0f} s "
+            f"a session, with {best[0][0]}: `{how}`. Each planner: {each}"
+        )
+        if missing:
+            out += f"; not reached by {', '.join(missing)} (up to its most lights here)"
+        return out + "."
+
+    lines = [
+        "## How many lights this object needs",
+        "",
+        "Read from the tables below: a planner's count is the fewest lights from which it "
+        "meets the target at every larger count of the table too (one layout per cell moves "
+        "by luck). Normals: the mean error against every light's normals; relighting: the "
+        "fit.rti `rti-rig fit` writes, on the held-out lights, against that of every light "
+        f"({every.file_psnr_db:.1f} dB). `PREVIEW`: one image of the object lit at about 50°.",
+        "",
+    ]
+    for target in NORMAL_TARGETS_DEG:
+        lines.append(
+            line(f"Normals within {target:g}°", lambda r, t=target: r.normal_mean_deg <= t)
+        )
+    if np.isfinite(every.file_psnr_db):
+        for target in RELIGHT_TARGETS_DB:
+            lines.append(
+                line(
+                    f"Relighting within {target:g} dB",
+                    lambda r, t=target: bool(
+                        r.file_model and r.file_psnr_db >= every.file_psnr_db - t
+                    ),
+                )
+            )
+    return [*lines, ""]
+
+
 def summarise_from(
     rows: list[Row],
     seconds: float,
     command: str,
     held: list[str],
     per_light: tuple[float, str] = (PER_LIGHT_S, PER_LIGHT_SAID),
+    rig_word: str = "RIG",
 ) -> str:
     """The markdown summary; ``held``: the names of the held-out lights; ``per_light``: the
-    seconds a light takes and where they come from."""
+    seconds a light takes and where they come from; ``rig_word``: the rig config as the
+    advice's commands name it (``--rig``'s, shell-quoted; ``RIG`` without one)."""
     per_light_s, per_light_said = per_light
     floor = best_floor(rows, rows[0].scene)  # as the plots' line: on the N every floor serves
     by = {(r.method, r.objective, r.floor_deg, r.n): r for r in rows}
@@ -430,6 +575,7 @@ def summarise_from(
         f"chooses among the other {every.n}. Session time: "
         f"{per_light_s:.2f} s a light ({per_light_said}).",
         "",
+        *how_many_lights(rows, floor, per_light_s, rig_word),
         "| N | session s | uniform 0° | uniform, best floor here "
         f"({floor:g}°, hindsight) | optimal | adaptive | adaptive, `--objective relight` |",
         "|---|---|---|---|---|---|---|",
@@ -522,6 +668,8 @@ def bench_from(
     config edited in between would time the trade by another config than the one checked)."""
     if per_light is None:
         per_light = (PER_LIGHT_S, PER_LIGHT_SAID) if rig is None else rig_seconds_per_light(rig)
+    if rig is None and shot_on_an_arm(lp):
+        per_light = (per_light[0], per_light[1] + ARM_TIMES_SAID)
     t0 = time.perf_counter()
     rows, held = run_tradeoff_from(lp, progress)
     for row in rows:
@@ -533,14 +681,15 @@ def bench_from(
     command = f"rti-rig bench tradeoff --from {shell_word(lp)}"
     if rig is not None:
         command += f" --rig {shell_word(rig)}"
+    rig_word = "RIG" if rig is None else shell_word(rig)
     if out_dir is None:
-        return summarise_from(rows, time.perf_counter() - t0, command, held, per_light)
+        return summarise_from(rows, time.perf_counter() - t0, command, held, per_light, rig_word)
     out_dir.mkdir(parents=True, exist_ok=True)
     write_csv(rows, out_dir / "results.csv")
     for path in plot(rows, out_dir):
         if "arm_time" in path.name:  # a replayed acquisition is a dome: no arm time to plot
             path.unlink()
     command += f" --out {shell_word(out_dir)}" + (" --force" if force else "")
-    text = summarise_from(rows, time.perf_counter() - t0, command, held, per_light)
+    text = summarise_from(rows, time.perf_counter() - t0, command, held, per_light, rig_word)
     (out_dir / "summary.md").write_text(text + "\n", encoding="utf-8")
     return text
