@@ -450,6 +450,14 @@ def adaptive_stopped(tmp_path_factory: pytest.TempPathFactory) -> Path:
             "--adaptive not given",
             ["--adaptive", "--lights", "9"],
         ),
+        # a stop put in an adaptive session keeps its --lights as the cap beside it (dropped,
+        # the session of 7 had been advised one of up to 100 lights)
+        (
+            ["--until-error", "2"],
+            "--until-error 2, the session not given",
+            "--lights not given, the session 7",
+            ["--until-error", "2", "--lights", "7"],
+        ),
         # the session's own count without --adaptive: only what was left out differs, and the
         # request is taken as typed (a planned run of 7)
         (

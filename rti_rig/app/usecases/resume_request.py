@@ -292,10 +292,14 @@ def _merged(asked: StartOptions, began: StartOptions) -> StartOptions:
     )
     if "--until-error" in flags:
         # the stop decides the count (a planned session's --lights had become a cap its
-        # --min-lights could not exceed), and --until-error goes with the normals objective
+        # --min-lights could not exceed), and --until-error goes with the normals objective;
+        # an adaptive session's --lights stays, as the cap it is beside the stop ("the first
+        # reached stops"): dropped, `--adaptive --lights 30` given --until-error 2 had been
+        # advised a session of up to 100 lights (QA, 2026-12-05)
+        kept = began.lights if began.is_adaptive else None
         request = replace(
             request,
-            lights=asked.lights if "--lights" in flags else None,
+            lights=asked.lights if "--lights" in flags else kept,
             objective=asked.objective if "--objective" in flags else None,
         )
     if request.is_adaptive and not began.is_adaptive:
