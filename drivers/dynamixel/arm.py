@@ -1012,7 +1012,8 @@ class DynamixelArm(ReadBackCarrier):
             + [
                 f"{roles[sid]}: {exc}"
                 + (
-                    " (the arm may sag)"
+                    # a limp azimuth lets the arm turn about the vertical, not sag
+                    (" (the arm may sag)" if roles[sid] != "azimuth" else " (the arm turns freely)")
                     if isinstance(exc, HardwareFaultError) and exc.torque_on is False
                     else " — no reply: unpowered, it is limp and the arm may sag; powered, it "
                     "may still be moving to its last goal, a pose checked safe before it was "

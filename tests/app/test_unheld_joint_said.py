@@ -58,3 +58,19 @@ def test_a_servo_that_did_not_answer_is_said_as_before() -> None:
     said = not_sent_sentence(("stop",), unheld=(UnheldJoint("azimuth", 1, False, None),))
     assert HELD in said and SAG not in said and "id 1" not in said, said
     assert said.endswith("switch the arm's power supply off"), said
+
+
+@pytest.mark.parametrize("torque_on", [False, None])
+def test_a_limp_azimuth_is_said_to_let_the_arm_turn_not_sag(torque_on: bool | None) -> None:
+    """The azimuth turns about the vertical: limp, it lets the arm swing round if pushed. "so
+    the arm may sag; support the arm" had been said of it (QA, 2026-12-05)."""
+    said = not_sent_sentence(("stop",), unheld=(UnheldJoint("azimuth", 1, True, torque_on),))
+    assert "the azimuth servo (id 1)" in said, said
+    assert "so the arm turns freely about the vertical if pushed" in said, said
+    assert SAG not in said and "support the arm" not in said, said
+    # with the elevation limp too, the arm hangs on it: supported
+    both = not_sent_sentence(
+        ("stop",),
+        unheld=(UnheldJoint("azimuth", 1, True, False), UnheldJoint("elevation", 2, True, False)),
+    )
+    assert SAG in both and "support the arm and switch its power supply off" in both, both

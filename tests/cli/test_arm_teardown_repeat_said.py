@@ -27,6 +27,8 @@ def test_the_close_failing_as_the_stop_did_is_said_plainly(tmp_path: Path) -> No
     lights = said.split("the stop failed at a servo", 1)[1].split("; the arm's park", 1)[0]
     assert (
         "the azimuth servo (id 1) shut itself off after its fault (torque read off): that "
-        "joint is limp, so the arm may sag; support the arm and switch its power supply off"
+        "joint is limp, so the arm turns freely about the vertical if pushed; switch the arm's "
+        "power supply off"
     ) in lights, said
+    assert "may sag" not in lights, said  # the azimuth turns about the vertical: no sag
     assert "keeps its last goal under torque" not in said, said

@@ -166,7 +166,7 @@ def not_sent_sentence(
         faulted = [j for j in unheld if j.fault]
         for joint in faulted:
             known.append(_faulted_joint_said(joint))
-            may_sag = may_sag or joint.torque_on is not True
+            may_sag = may_sag or (joint.torque_on is not True and _bears_weight(joint))
         silent = [j for j in unheld if not j.fault and j.no_reply]
         if silent:
             known.append(_silent_joints_said(silent))
@@ -205,13 +205,28 @@ def _silent_joints_said(joints: list[UnheldJoint]) -> str:
     )
 
 
+def _bears_weight(joint: UnheldJoint) -> bool:
+    """Whether the arm hangs on ``joint``: every joint but the azimuth, which turns about the
+    vertical (a limp one lets the arm swing round if pushed, not sag)."""
+    return joint.joint != "azimuth"
+
+
+def _limp_said(joint: UnheldJoint) -> str:
+    """What a limp ``joint`` lets the arm do. Why: "that joint is limp, so the arm may sag" had
+    been said of the azimuth servo, sending an operator to hold up an arm that the limp joint
+    lets turn, not fall (QA, 2026-12-05)."""
+    if _bears_weight(joint):
+        return "so the arm may sag"
+    return "so the arm turns freely about the vertical if pushed"
+
+
 def _faulted_joint_said(joint: UnheldJoint) -> str:
     """What a servo that reported a fault as the stop read it was left doing, as read."""
     servo = f"the {joint.joint} servo (id {joint.servo_id})"
     if joint.torque_on is False:
         return (
             f"{servo} shut itself off after its fault (torque read off): that joint is limp, "
-            "so the arm may sag"
+            f"{_limp_said(joint)}"
         )
     if joint.torque_on is True:
         return (
@@ -220,8 +235,8 @@ def _faulted_joint_said(joint: UnheldJoint) -> str:
         )
     return (
         f"{servo} reported a fault and its torque could not be read: it may have shut itself "
-        "off (that joint limp, so the arm may sag) or keep its last goal under torque (so the "
-        "arm may hold there or still be moving to it)"
+        f"off (that joint limp, {_limp_said(joint)}) or keep its last goal under torque (so "
+        "the arm may hold there or still be moving to it)"
     )
 
 
