@@ -195,7 +195,7 @@ def select_model(
         psnr = None if rmse is None else float(20 * np.log10(ref / max(rmse, 1e-12)))
         within = rmse is not None and rmse <= limit
         if name == chosen:
-            note = note or "chosen: lowest order within tolerance"
+            note = note or "chosen: simplest model within tolerance"
         elif name == best:
             note = note or "best held-out error"
         evidence.append(

@@ -705,3 +705,27 @@ def test_an_out_folder_a_killed_fit_left_is_named_as_such(tmp_path: Path) -> Non
     (other / "notes.txt").write_text("mine")
     r = runner.invoke(app, ["fit", str(session), "--out", str(other)])
     assert r.exit_code == 2 and "is not empty" in " ".join(r.output.split()), r.output
+
+
+@pytest.mark.parametrize("typed", ["robust-ps", "ps-robust"])
+def test_a_model_asked_by_name_is_echoed_as_typed(clean, tmp_path: Path, typed: str) -> None:
+    """`--model robust-ps` (the name --help and the guide give) had been echoed as its alias,
+    "Model: ps-robust: chosen by --model" (QA, 2026-12-05)."""
+    session, _, _ = clean
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--model", typed, "--no-qa"])
+    assert r.exit_code == 0, r.output
+    assert f"Model: {typed}: chosen by --model" in " ".join(r.output.split()), r.output
+
+
+def test_the_auto_choice_is_said_as_the_simplest_model_not_an_order(clean, tmp_path: Path) -> None:
+    """A PTM or Lambert fit has no "order": "lambert: lowest order within 5%" had been said."""
+    session, _, _ = clean
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert ": the simplest model within 5% of the best held-out error (" in text, text
+    assert (
+        "lowest order" not in text and "lowest order" not in (out / "model_choice.md").read_text()
+    )

@@ -1313,8 +1313,9 @@ def _fit_all(
         (out / "model_choice.md").write_text(choice.to_markdown() + "\n", encoding="utf-8")
         files.append(out / "model_choice.md")
         reason_line = (
-            f"{choice.model}: lowest order within {choice.tolerance:.0%} of the best held-out "
-            f"error ({choice.best_model}), {choice.holdout}{left_out}"
+            # "simplest": lambert, ps and a PTM are among the models, and have no "order"
+            f"{choice.model}: the simplest model within {choice.tolerance:.0%} of the best "
+            f"held-out error ({choice.best_model}), {choice.holdout}{left_out}"
         )
     else:
         spec = model_spec(name)
@@ -1325,7 +1326,8 @@ def _fit_all(
                 f"least {spec.n_coefficients} lights; {shown_path(req.source)} has {n}: choose a "
                 "smaller model, or --model auto"
             )
-        reason_line = f"{model_name}: chosen by --model"
+        # named as typed: `--model robust-ps` had been echoed as its alias "ps-robust"
+        reason_line = f"{name}: chosen by --model"
     normal_source = _normal_source(model_name)
     skipped: list[str] = []  # said, never silently left out
     write_normals = req.write_normals
