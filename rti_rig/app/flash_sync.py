@@ -513,6 +513,8 @@ def _fix_for(exc: OSError) -> str:
         return "free space on that disk"
     if exc.errno == errno.EROFS:
         return "make that disk writable"
+    if exc.errno in (errno.EACCES, errno.EPERM):
+        return "check that you may write to that folder (ls -l shows its owner)"
     return "check that disk"
 
 

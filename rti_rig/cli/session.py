@@ -1080,6 +1080,13 @@ def _disk_fix(errno_name: str) -> str:
             "make that disk writable again (or copy the session folder to a writable disk and "
             "resume the copy)"
         )
+    if errno_name in ("EACCES", "EPERM"):
+        # a permission, not the disk: "check that disk" had been said of a session folder
+        # another user owns (QA, 2026-12-05)
+        return (
+            "check that you may write to the session folder and its files (ls -l shows "
+            "their owner; run as that user, or copy the folder and resume the copy)"
+        )
     return "check that disk"
 
 

@@ -149,3 +149,15 @@ def test_a_recorded_file_there_but_refused_by_the_system_is_said_with_its_reason
     assert f"cannot read the recorded file {refused}: Permission denied" in text, text
     assert "moved or deleted" not in text, text
     assert [e["index"] for e in journal(out)] == [0]
+
+
+@pytest.mark.parametrize("reason", ["EACCES", "EPERM"])
+def test_a_write_refused_for_permission_is_told_to_check_permissions_not_the_disk(
+    reason: str,
+) -> None:
+    """A resume of a session folder another user owns had been told "check that disk"."""
+    from rti_rig.cli.session import _disk_fix
+
+    said = _disk_fix(reason)
+    assert "check that you may write to the session folder" in said and "disk" not in said
+    assert _disk_fix("EIO") == "check that disk"
