@@ -84,9 +84,10 @@ def run(
         typer.Option(
             "--lights",
             help="Number of lights in a homogeneous layout (default: every LED of a dome, "
-            "or the arm's default_lights). At least 1; below "
-            f"{FIT_MINIMUMS.rti_file} a note says, before anything "
-            "lights, what `rti-rig fit` will not make of them (no fit.ptm, fit.rti or fit). "
+            "the arm's default_lights, or every image of a recorded acquisition's .lp). At "
+            f"least 1; below {FIT_MINIMUMS.rti_file} a note says, before anything "
+            "lights, what `rti-rig fit` will not make of them (no fit.ptm or fit.rti; below "
+            f"{FIT_MINIMUMS.normal} no fit at all). "
             "A camera-triggered dome (\\[dome.flash_sync]) refuses any number but all of its "
             "LEDs: its firmware lights them in its own order.",
         ),
