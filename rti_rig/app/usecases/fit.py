@@ -574,6 +574,20 @@ def acquisition_files(
                 f"{rebuild}"
             )
         lp = source / LP_NAME if (source / LP_NAME).is_file() else lps[0]
+        others = [p for p in lps if p.resolve() != lp.resolve()]
+        if notes is not None and others and not (source / MANIFEST).is_file():
+            # a folder that is no session, holding lights.lp and another .lp, was fitted from
+            # lights.lp without a word, where bench tradeoff --from refuses the folder (QA,
+            # 2026-12-05); a session's own lights.lp is never in doubt, an export beside it
+            # (demo_linear.lp) is the guide's advice: no note there
+            shown = ", ".join(lp_name_from(source, p) for p in others[:5]) + (
+                " …" if len(others) > 5 else ""
+            )
+            notes.append(
+                f"{shown_path(source)}: fitted from its {LP_NAME}, not the other .lp beside it "
+                f"({shown}); to fit one of those, give it in the folder's place (e.g. "
+                f"{shell_word(str(others[0]))})"
+            )
         if notes is not None and lp.parent != source:
             notes.append(
                 f"{shown_path(source)}: fitted from {shown_path(lp)} (RTIBuilder's layout)"
