@@ -363,6 +363,49 @@ def case_hint(missing: Sequence[Path]) -> str:
         + _twins_said(twins, len(missing))
         + _kin_said(kin, len(missing))
         + _invisible_said(hidden)
+        + _other_encoding_said(_other_encodings(missing))
+    )
+
+
+#: The byte encodings a file name written by an older Windows tool, or on a card or share
+#: mounted without UTF-8, is found in when the `.lp` names it in UTF-8 characters.
+_NAME_ENCODINGS = ("cp1252", "latin-1")
+
+
+def _other_encodings(missing: Sequence[Path]) -> list[tuple[str, str]]:
+    """The missing images whose file is there with the same characters in another encoding's
+    bytes (``pièce.jpg`` listed, its name's bytes Windows-1252 on disk), each with that
+    encoding."""
+    found: list[tuple[str, str]] = []
+    for path in missing:
+        for encoding in _NAME_ENCODINGS:
+            try:
+                other = os.fsdecode(path.name.encode(encoding))
+            except (UnicodeEncodeError, UnicodeDecodeError):
+                continue
+            if other != path.name and (path.parent / other).is_file():
+                found.append((path.name, encoding))
+                break
+    return found
+
+
+def _other_encoding_said(found: list[tuple[str, str]]) -> str:
+    """:func:`case_hint`'s clause for :func:`_other_encodings`.
+
+    Why: such a file had been called missing, as the user sees ``pièce.jpg`` in a file
+    manager that shows the bytes decoded its own way (QA, 2026-12-05). The file is not read in
+    its place (a name's bytes are the name), but named, with the rename that fixes it."""
+    if not found:
+        return ""
+    named = ", ".join(name for name, _ in found[:3]) + (
+        f" and {len(found) - 3} more" if len(found) > 3 else ""
+    )
+    encoding = "Windows-1252" if found[0][1] == "cp1252" else "Latin-1"
+    return (
+        f"; {named} {'is' if len(found) == 1 else 'are'} there with {encoding} bytes in the "
+        "file name, not UTF-8 (copied from an older Windows tool, or a card or share mounted "
+        "without UTF-8): rename the files to UTF-8 names, e.g. convmv -f cp1252 -t utf-8 "
+        "--notest on them, or mount the card with iocharset=utf8"
     )
 
 
@@ -618,17 +661,20 @@ def missing_images_advice(
     twins, kin = _name_twins(paths)  # listed once (case_hint's own, which had listed again)
     hidden = _invisible_names(paths)
     not_files = _not_files(paths)
+    encoded = _other_encodings(paths)
     named = (
         _not_files_said(not_files)
         + _twins_said(twins, len(paths))
         + _kin_said(kin, len(paths))
         + _invisible_said(hidden)
+        + _other_encoding_said(encoded)
     )
     # each missing image counted once, whatever clauses name it (a folder image05.jpg beside
     # image05.png is both "a folder" and "another extension": "the other -1" had been said)
     covered = set(not_files)
     covered |= {t.split(" -> ")[0] for t in [*twins, *kin]}
     covered |= {p.name for p in paths if not p.name.isprintable()}
+    covered |= {name for name, _ in encoded}
     if named and (rest := max(0, len(names) - len(covered))):
         # the images with no such file are missing all the same: their way out is said too
         tail = others if len(names) < total else ""
