@@ -358,7 +358,12 @@ def _fit_command(  # type: ignore[no-untyped-def]
         f"in {result.seconds:.1f} s"
     )
     if result.qa is not None:
-        out.print(f"QA verdict: {escape(result.qa.verdict)}")
+        from rti_rig.app.usecases.fit import reshoot_in_place
+
+        source = Path(request.source)
+        command = reshoot_in_place(source, result.qa) if source.is_dir() else None
+        again = f"; to reshoot those in place: {command}" if command else ""
+        out.print(f"QA verdict: {escape(result.qa.verdict + again)}")
     if moved_on is not None:
         err.print(
             f"[yellow]warning:[/] {escape(shown_path(request.source))} changed while it was "

@@ -154,6 +154,19 @@ def run(
             "was; their files are set aside in recovered/, never deleted.",
         ),
     ] = False,
+    reshoot: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--reshoot",
+            metavar="IMAGE",
+            help="With --resume on a session that completed: reshoot these images too, their "
+            "files intact (those the QA verdict names misfired, wrong light or moved, with the "
+            "object where it was): image_006, or several with commas (image_006,image_009); "
+            "their files are set aside in recovered/, never deleted. Not for an adaptive "
+            "session, whose later lights were chosen from its images.",
+            show_default=False,
+        ),
+    ] = None,
     rebuild_journal: Annotated[
         bool,
         typer.Option(
@@ -307,6 +320,7 @@ def run(
             accept_rig_change=accept_rig_change,
             objective=objective,
             reshoot_lost=reshoot_lost,
+            reshoot=tuple(reshoot or ()),
             rebuild_journal=rebuild_journal,
             start=start,
         )
@@ -323,6 +337,8 @@ def run(
             raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
         if reshoot_lost:
             raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
+        if reshoot:
+            raise RtiRigError("--reshoot goes with --resume SESSION_DIR only")
         if rebuild_journal:
             raise RtiRigError("--rebuild-journal goes with --resume SESSION_DIR only")
         refuse_unmetered_limit(max_saturated, auto_exposure, adaptive or until_error is not None)
@@ -862,6 +878,8 @@ def _resume_command(req: Any) -> str:
         words.append(f"--objective {_arg(req.objective)}")
     if req.reshoot_lost:
         words.append("--reshoot-lost")
+    if req.reshoot:
+        words.append(f"--reshoot {_arg(','.join(req.reshoot))}")
     if req.rebuild_journal:
         words.append("--rebuild-journal")
     return " ".join(words)
@@ -1335,7 +1353,7 @@ def _continue_command(opened) -> str:  # type: ignore[no-untyped-def]
         return f"rti-rig run --resume {_arg(opened.out_dir)}"
     if not opened.folder.begun:
         return _resume_command(req)
-    return _resume_command(replace(req, reshoot_lost=False, rebuild_journal=False))
+    return _resume_command(replace(req, reshoot_lost=False, reshoot=(), rebuild_journal=False))
 
 
 def _print_teardown_failures(  # type: ignore[no-untyped-def]

@@ -788,6 +788,7 @@ class SessionFolder:
         check_done: Callable[[dict[int, StepRecord]], None] | None = None,
         reshoot_lost: bool = False,
         rebuild_journal: bool = False,
+        also_reshoot: tuple[int, ...] = (),
     ) -> SessionFolder:
         """Open an interrupted session to capture the steps it has not done yet.
 
@@ -795,9 +796,10 @@ class SessionFolder:
         repaired; see :func:`prepare_resume` (``check_done`` may refuse the verified steps
         before anything in the folder changes; ``reshoot_lost`` reopens a completed session to
         reshoot what was lost since capture; ``rebuild_journal`` rebuilds a journal that lost
-        records from the manifest's).
+        records from the manifest's; ``also_reshoot``: steps to reshoot with the lost ones,
+        their images intact but named by the user, ``--reshoot``).
         """
-        state = prepare_resume(Path(root), check_done, reshoot_lost, rebuild_journal)
+        state = prepare_resume(Path(root), check_done, reshoot_lost, rebuild_journal, also_reshoot)
         folder = cls(Path(root), planned_steps(state.manifest))
         folder.manifest = state.manifest
         folder.resume = state
@@ -1959,6 +1961,7 @@ def prepare_resume(
     check_done: Callable[[dict[int, StepRecord]], None] | None = None,
     reshoot_lost: bool = False,
     rebuild_journal: bool = False,
+    also_reshoot: tuple[int, ...] = (),
 ) -> ResumeState:
     """:func:`_prepare_resume` with the folder locked (:func:`lock_session`) before anything in
     it is read or moved: held for the resumed run, released if the resume is refused."""
@@ -1967,7 +1970,7 @@ def prepare_resume(
     if root.is_dir():
         lock_session(root)
     try:
-        return _prepare_resume(root, check_done, reshoot_lost, rebuild_journal)
+        return _prepare_resume(root, check_done, reshoot_lost, rebuild_journal, also_reshoot)
     except BaseException:
         if not held:
             unlock_session(root)
@@ -1979,6 +1982,7 @@ def _prepare_resume(
     check_done: Callable[[dict[int, StepRecord]], None] | None = None,
     reshoot_lost: bool = False,
     rebuild_journal: bool = False,
+    also_reshoot: tuple[int, ...] = (),
 ) -> ResumeState:
     """Verify an interrupted session, repair its journal and set aside what is not committed.
 
@@ -1989,7 +1993,9 @@ def _prepare_resume(
     whose JPEG or linear TIFF is gone or changed since capture, or whose kept RAW original is
     gone (:func:`_lost_files`, what the QA verdict names) are reshot, their files set aside;
     every other step stands as it is (a TIFF re-saved with its pixels unchanged is no reason
-    to reshoot a finished session).
+    to reshoot a finished session). ``also_reshoot`` (with ``reshoot_lost``): steps reshot as
+    well though their files are intact, the user's choice (``--reshoot image_006``: an image
+    the QA verdict calls misfired); their files are set aside as a lost step's are.
 
     A step counts as done when its journal line is a well-formed record and every file it names
     is on disk with the journaled checksum. Journal lines that are not records (a torn last
@@ -2039,6 +2045,9 @@ def _prepare_resume(
         renamed = renamed_jpegs(root, [*scan.records, *restored.values()])
         lost = {i: _lost_files(root, rec, renamed) for i, rec in latest.items()}
         lost = {i: gone for i, gone in lost.items() if gone}
+        if reshoot_lost:
+            for i in also_reshoot:  # named to reshoot: set aside and shot again as if lost
+                lost.setdefault(i, ["named with --reshoot"])
         moved = f"; {renamed_note(renamed)}" if renamed else ""
         intact = not reshoot_lost and not lost and not renamed
         # the manifest and journal as read above (they had been read again for this)

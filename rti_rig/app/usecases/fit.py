@@ -1791,7 +1791,56 @@ def verdict_for_session(session: Path) -> str:
         raise RtiRigError(no_qa)
     qa = assess(frames, lights, names)
     _remember_pixels(frames)
-    return with_lost_files(qa, session).verdict
+    report = with_lost_files(qa, session)
+    command = reshoot_in_place(session, report)
+    return report.verdict + (f"; to reshoot those in place: {command}" if command else "")
+
+
+#: What an image's problem begins with when a reshoot with the object where it is cures it (a
+#: light that did not fire, or fired as another; one frame shaken): a saturated image, a move
+#: of the object part-way or a session where nothing changes would be shot the same again.
+_CURED_IN_PLACE = ("misfired", "wrong light", "object or camera moved: shifted")
+
+
+def reshoot_in_place(session: Path, report: Any) -> str | None:
+    """The ``run --resume S --reshoot IMAGES`` that reshoots the images the verdict names
+    whose every problem a reshoot in place cures (:data:`_CURED_IN_PLACE`, or brighter than
+    predicted: a stray flash), with ``--reshoot-lost`` where images were lost since capture;
+    None when there are none, or the session cannot reshoot one image (not completed,
+    adaptive, a replayed acquisition, a camera-triggered dome).
+
+    Why: the verdict said "reshoot: image_006 (misfired, no light …)" and no command did it
+    (``--reshoot-lost`` takes only lost images): the user had to shoot the whole session
+    again, or leave the object with a hole in its lights."""
+    from rti_rig.reconstruct.qa import BRIGHTER
+    from rti_rig.runtime.session import read_manifest
+
+    try:
+        manifest = read_manifest(session)
+    except (OSError, RtiRigError, ValueError):
+        return None
+    rig = manifest.get("rig") or {}
+    config = rig.get("config") or {}
+    dome = config.get("dome") or {}
+    if (
+        (manifest.get("runner") or {}).get("finish_reason") != "completed"
+        or "adaptive" in manifest
+        or rig.get("backend") == "replay"
+        or "flash_sync" in dome
+    ):
+        return None
+
+    def cured(problem: str) -> bool:
+        return problem.startswith(_CURED_IN_PLACE) or problem.endswith(BRIGHTER)
+
+    names = [
+        Path(c.name).stem for c in report.reshoot if c.problems and all(map(cured, c.problems))
+    ]
+    lost = list(getattr(report, "lost_unfitted", ()) or ())
+    if not names:
+        return None
+    words = f"rti-rig run --resume {shell_word(str(session))} --reshoot {','.join(names)}"
+    return words + (" --reshoot-lost" if lost else "")
 
 
 def qa_without_normals(lights: np.ndarray, session: Path | None = None) -> str | None:

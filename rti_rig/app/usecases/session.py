@@ -10,7 +10,7 @@ from __future__ import annotations
 import contextlib
 import math
 import signal
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -123,6 +123,10 @@ class ResumeRequest:
     #: A session that completed: reshoot the images lost or changed since capture (the QA
     #: verdict names them), with the object where it was.
     reshoot_lost: bool = False
+    #: A session that completed: reshoot these images too (``image_006`` or its file name),
+    #: their files intact but named by the user (``--reshoot``: an image the QA verdict calls
+    #: misfired); set aside in recovered/ as a lost image's are. Implies ``reshoot_lost``.
+    reshoot: tuple[str, ...] = ()
     #: A session whose journal lost records (deleted, cut short, overwritten): rebuild it from
     #: the manifest's records whose files and lights are as recorded (the rest set aside).
     rebuild_journal: bool = False
@@ -1932,7 +1936,7 @@ def rebuild_finished_session(req: ResumeRequest) -> list[str] | None:
     journal of a finished session had no way back at all."""
     from rti_rig.runtime.session import read_manifest, rebuild_finished_journal
 
-    if not req.rebuild_journal or req.reshoot_lost:
+    if not req.rebuild_journal or req.reshoot_lost or req.reshoot:
         return None
     manifest = read_manifest(req.session_dir)
     if (manifest.get("runner") or {}).get("finish_reason") != "completed":
@@ -1983,6 +1987,59 @@ def _say_if_complete(session_dir: Path) -> str:
     )  # pragma: no cover
 
 
+def reshoot_steps(manifest: dict[str, Any], named: Sequence[str], root: Path) -> tuple[int, ...]:
+    """The steps (0-based) of the images ``--reshoot`` names (``image_006``, ``image_006.jpg``,
+    several in one word with commas), refused by name before anything is opened or moved: a
+    name the session has no image of, a session that did not complete (its resume reshoots
+    what it cannot verify anyway), or an adaptive one (each light after an image was chosen
+    from it: the image reshot, they would no longer be what its evidence chose).
+
+    Why: the QA verdict names an intact image "misfired, no light" or "wrong light" and says
+    reshoot, and no command did (``--reshoot-lost`` reshoots only images lost or changed
+    since capture: it said "nothing to reshoot" of these)."""
+    from rti_rig.runtime.session import image_names, planned_steps
+
+    words = [w.strip() for given in named for w in given.split(",") if w.strip()]
+    if not words:
+        return ()
+    runner = manifest.get("runner") or {}
+    total = planned_steps(manifest)
+    names = image_names(total)
+    if runner.get("finish_reason") != "completed":
+        raise RtiRigError(
+            f"{shown_path(root)}: --reshoot is for a session that completed; this one did not, "
+            "and its resume shoots the rest first (nothing in the folder was changed): continue "
+            f"it with rti-rig run --resume {shell_word(str(root))}, then reshoot"
+        )
+    if "adaptive" in manifest:
+        raise RtiRigError(
+            f"{shown_path(root)}: --reshoot cannot reshoot an image of an adaptive session: "
+            "each light after it was chosen from it, and with the image reshot they would no "
+            "longer be what the session's evidence chose (nothing in the folder was changed); "
+            "shoot a new session for the object (its verdict says why the image is bad)"
+        )
+    steps: list[int] = []
+    unknown: list[str] = []
+    for word in words:
+        stem = Path(word).stem if Path(word).suffix.lower() in _IMAGE_SUFFIXES else word
+        if stem in names:
+            if names.index(stem) not in steps:
+                steps.append(names.index(stem))
+        else:
+            unknown.append(word)
+    if unknown:
+        raise RtiRigError(
+            f"--reshoot {', '.join(unknown)}: {shown_path(root)} has no image of that name; "
+            f"give its images as the verdict names them, {names[0]} to {names[-1]} (several "
+            "with commas: --reshoot image_006,image_009)"
+        )
+    return tuple(sorted(steps))
+
+
+#: The endings an image of a session is named with (``--reshoot image_006.jpg``).
+_IMAGE_SUFFIXES = (".jpg", ".jpeg", ".tif", ".tiff", ".png", ".dng")
+
+
 def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
     """Check the rig against the session, verify and repair the session on disk, open the
     rig and check the remaining steps on it.
@@ -1995,6 +2052,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
 
     check_max_saturated(req.max_saturated)
     manifest = read_manifest(req.session_dir)
+    also_reshoot = reshoot_steps(manifest, req.reshoot, Path(req.session_dir))
     if req.objective is not None or "adaptive" in manifest:
         from rti_rig.app.usecases.adaptive import check_resume_objective
 
@@ -2037,7 +2095,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     if flash_sync_of(loaded) is not None and runner.get("finish_reason") == "completed":
         # a finished session had been told only that a camera-triggered dome cannot resume
         # (so the user looked for what had interrupted it): it is complete, and says so
-        lost = "" if req.reshoot_lost else _say_if_complete(Path(req.session_dir))
+        lost = "" if req.reshoot_lost or req.reshoot else _say_if_complete(Path(req.session_dir))
         done = (
             f"{shown_path(req.session_dir)}: this session already completed all "
             f"{runner.get('steps_planned', len(manifest.get('steps') or []))} steps; nothing "
@@ -2080,7 +2138,11 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
 
         check_done = refuse_broken_run(Path(req.session_dir), planned_steps(manifest))
     folder = SessionFolder.reopen(
-        req.session_dir, check_done, req.reshoot_lost, req.rebuild_journal
+        req.session_dir,
+        check_done,
+        req.reshoot_lost or bool(also_reshoot),
+        req.rebuild_journal,
+        also_reshoot,
     )
     try:
         return _opened_resume(req, loaded, folder, identity, diffs, on_note, accepted)
@@ -2126,7 +2188,7 @@ def _opened_resume(  # type: ignore[no-untyped-def]
     images = [p for p in recovered if Path(p).suffix.lower() not in (".txt", ".lp")]
     moved = (
         f", {len(images)} file(s) of the images to reshoot set aside in {where}/ (never deleted)"
-        if req.reshoot_lost
+        if req.reshoot_lost or req.reshoot
         else f", {len(images)} unverified file(s) moved to {where}/"
         if images
         else f" (what it set aside is in {where}/)"
