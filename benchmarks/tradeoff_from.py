@@ -83,6 +83,19 @@ ARM_TIMES_SAID = (
 )
 
 
+def _session_rig(lp: Path) -> dict[str, Any]:
+    """The ``rig`` record of the session whose .lp ``lp`` is (its manifest beside it); empty
+    for an acquisition that is no session, or a manifest that cannot be read."""
+    import json
+
+    try:
+        manifest = json.loads((Path(lp).parent / "manifest.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    rig = manifest.get("rig") if isinstance(manifest, dict) else None
+    return rig if isinstance(rig, dict) else {}
+
+
 def shot_on_an_arm(lp: Path) -> bool:
     """Whether ``lp`` is a session's .lp whose manifest (beside it) records an arm rig.
 
@@ -90,14 +103,18 @@ def shot_on_an_arm(lp: Path) -> bool:
     timing)" and 58 s for 50 lights the arm had taken 124.8 s for, with no word that the
     times were a dome's (``--rig`` refuses an arm's config, rightly: its time depends on the
     moves). A manifest that cannot be read says nothing either way."""
-    import json
+    return _session_rig(lp).get("kind") == "arm"
 
-    try:
-        manifest = json.loads((Path(lp).parent / "manifest.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return False
-    rig = manifest.get("rig") if isinstance(manifest, dict) else None
-    return isinstance(rig, dict) and rig.get("kind") == "arm"
+
+def advice_rig(lp: Path, rig: Path | None) -> str:
+    """The rig config the advice's commands name: ``--rig``'s, else the one the session
+    (``lp``'s manifest) was shot with where it is still there, else ``RIG``."""
+    if rig is not None:
+        return shell_word(rig)
+    shot_with = _session_rig(lp).get("config_path")
+    if isinstance(shot_with, str) and Path(shot_with).is_file():
+        return shell_word(shot_with)
+    return "RIG"
 
 
 def rig_seconds_per_light(rig_path: Path) -> tuple[float, str]:
@@ -440,23 +457,28 @@ RELIGHT_TARGETS_DB = (0.5, 1.0, 2.0)
 #: The advice's planners: the summary's column keys, how a user says each, and the command
 #: that shoots N lights so (``{rig}``, ``{n}``, ``{floor}`` filled in).
 _PLANNERS = (
-    (("uniform", "normals", 0.0), "uniform", "rti-rig run {rig} --lights {n}"),
+    (("uniform", "normals", 0.0), "uniform", "rti-rig run {rig} --out SESSION --lights {n}"),
     (
         ("uniform", "normals", None),
-        "uniform above {floor:g}°",
-        "rti-rig run {rig} --lights {n} --min-elevation-deg {floor:g}",
+        "uniform above {floor:g}° (the floor that did best on this acquisition)",
+        "rti-rig run {rig} --out SESSION --lights {n} --min-elevation-deg {floor:g}",
     ),
     (
         ("optimal", "normals", 0.0),
         "optimal",
-        "rti-rig plan {rig} PREVIEW --method optimal --lights {n} --out plan.lp` then "
-        "`rti-rig run {rig} --plan plan.lp",
+        # as the table measured it: no preview (a level surface)
+        "rti-rig plan --rig {rig} --method optimal --lights {n} --out plan.lp` then "
+        "`rti-rig run {rig} --out SESSION --plan plan.lp",
     ),
-    (("adaptive", "normals", 0.0), "adaptive", "rti-rig run {rig} --adaptive --lights {n}"),
+    (
+        ("adaptive", "normals", 0.0),
+        "adaptive",
+        "rti-rig run {rig} --out SESSION --adaptive --lights {n}",
+    ),
     (
         ("adaptive", "relight", 0.0),
         "adaptive for relighting",
-        "rti-rig run {rig} --adaptive --objective relight --lights {n}",
+        "rti-rig run {rig} --out SESSION --adaptive --objective relight --lights {n}",
     ),
 )
 
@@ -509,14 +531,18 @@ def how_many_lights(
                 f"acquisition (every light's own: {every.n})"
             )
         fastest = min(n for n, _, _ in found)
+        first = next(said for n, said, _ in found if n == fastest)
+        row = dict((s, series) for s, _, series in planners)[first][fastest]
+        # an adaptive session also decides before each light (the row's mean decision time)
+        seconds = fastest * (per_light_s + (row.plan_s if row.method == "adaptive" else 0.0))
         each = "; ".join(f"{said} {n}" for n, said, _ in sorted(found))
         best = [(said, cmd) for n, said, cmd in found if n == fastest]
         missing = [said for said, _, series in planners if all(said != s for _, s, _ in found)]
         how = best[0][1].format(rig=rig, n=fastest)
         fewest = " (the fewest the table tries: fewer may do)" if fastest == counts[0] else ""
         out = (
-            f"- **{target}**: from **{fastest} lights**{fewest}, {fastest * per_light_s:.0f} s "
-            f"a session, with {best[0][0]}: `{how}`. Each planner: {each}"
+            f"- **{target}**: from **{fastest} lights**{fewest}, {seconds:.0f} s a session, "
+            f"with {best[0][0]}: `{how}`. Each planner: {each}"
         )
         if missing:
             out += f"; not reached by {', '.join(missing)} (up to its most lights here)"
@@ -529,7 +555,8 @@ def how_many_lights(
         "meets the target at every larger count of the table too (one layout per cell moves "
         "by luck). Normals: the mean error against every light's normals; relighting: the "
         "fit.rti `rti-rig fit` writes, on the held-out lights, against that of every light "
-        f"({every.file_psnr_db:.1f} dB). `PREVIEW`: one image of the object lit at about 50°.",
+        f"({every.file_psnr_db:.1f} dB). Session time: the lights at the step below, and an "
+        "adaptive session's decisions.",
         "",
     ]
     for target in NORMAL_TARGETS_DEG:
@@ -681,7 +708,7 @@ def bench_from(
     command = f"rti-rig bench tradeoff --from {shell_word(lp)}"
     if rig is not None:
         command += f" --rig {shell_word(rig)}"
-    rig_word = "RIG" if rig is None else shell_word(rig)
+    rig_word = advice_rig(lp, rig)
     if out_dir is None:
         return summarise_from(rows, time.perf_counter() - t0, command, held, per_light, rig_word)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -992,6 +992,10 @@ def at_key(shown: str | Path, key: str, file: Path | None = None) -> str:
     from rti_rig.core.toml_lines import key_line_in_file
 
     line = key_line_in_file(file or shown, key)
+    if line is not None:  # checked apart from the locator: the line holds the key's own name
+        text = Path(file or shown).read_text(encoding="utf-8-sig").splitlines()[line - 1]
+        last = key.rsplit(".", 1)[-1].split("[")[0]
+        assert last in text, f"line {line} of {shown} is not the line of {key}: {text!r}"
     return f"{shown}{'' if line is None else f', line {line}'}: key '{key}'"
 
 

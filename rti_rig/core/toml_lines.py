@@ -43,17 +43,46 @@ def _indexed(parts: list[str], arrays: dict[str, int]) -> str:
     return out
 
 
+def _depth(value: str) -> int:
+    """How many brackets and braces ``value`` (the rest of a line) leaves open, strings and a
+    comment skipped: above 0, the value goes on over the next lines."""
+    depth, quote, i = 0, "", 0
+    while i < len(value):
+        c = value[i]
+        if quote:
+            if c == "\\" and quote == '"':
+                i += 1
+            elif c == quote:
+                quote = ""
+        elif c in "\"'":
+            quote = c
+        elif c == "#":
+            break
+        elif c in "[{":
+            depth += 1
+        elif c in "]}":
+            depth -= 1
+        i += 1
+    return depth
+
+
 def key_lines(text: str) -> dict[str, tuple[int, bool]]:
     """Each key and table of a TOML text, by the name an error gives it, with its first line
-    (from 1) and whether that line is an assignment (False: a table header)."""
+    (from 1) and whether its whole value is on that line (False: a table header, or a value
+    that goes on over more lines, an array of inline tables say, whose keys are then on lines
+    of their own that an error's name does not point to)."""
     found: dict[str, tuple[int, bool]] = {}
     arrays: dict[str, int] = {}
     table = ""
     closing: str | None = None  # the quotes that end a multi-line string being skipped
-    for n, line in enumerate(text.splitlines(), 1):
+    open_brackets = 0  # of a value that goes on over the lines being skipped
+    for n, line in enumerate(text.removeprefix("\ufeff").splitlines(), 1):
         if closing is not None:
             if closing in line:
                 closing = None
+            continue
+        if open_brackets > 0:
+            open_brackets += _depth(line)
             continue
         header = _HEADER.match(line)
         if header:
@@ -72,20 +101,24 @@ def key_lines(text: str) -> dict[str, tuple[int, bool]]:
         if assign is None:
             continue
         key = ".".join(_parts(assign[1]))
-        found.setdefault(f"{table}.{key}" if table else key, (n, True))
         rest = line[assign.end() :]
         for quotes in ('"""', "'''"):
             if rest.count(quotes) == 1:
                 closing = quotes
+        open_brackets = 0 if closing else max(0, _depth(rest))
+        whole = closing is None and open_brackets == 0
+        found.setdefault(f"{table}.{key}" if table else key, (n, whole))
     return found
 
 
 def key_line(text: str, key: str) -> int | None:
     """The line ``key`` (as an error names it) is written on in ``text``, or None.
 
-    A key inside a value written on one assignment (an inline table or array: ``decode = {
-    white_balance = [0, 1, 1, 1] }``) is on that assignment's line; a key its table lacks has
-    no line (a table header is never named as the line of a key it does not hold)."""
+    A key inside a value written whole on one line (an inline table or array: ``decode = {
+    white_balance = [0, 1, 1, 1] }``) is on that assignment's line; a key inside a value that
+    goes on over several lines (``rings = [`` then a table per line) has none, nor has a key
+    its table lacks (a table header, or the first line of such a value, is never named as the
+    line of a key it does not hold: a wrong line is worse than none)."""
     found = key_lines(text)
     parts = _KEY_PARTS.findall(key)
     for end in range(len(parts), 0, -1):
@@ -105,7 +138,7 @@ def key_line_in_file(path: Path | str, key: str) -> int | None:
     try:
         if file.stat().st_size > _MAX_BYTES:
             return None
-        text = file.read_text(encoding="utf-8")
+        text = file.read_text(encoding="utf-8-sig")  # a byte-order mark, as tomllib takes
     except (OSError, UnicodeDecodeError):
         return None
     return key_line(text, key)

@@ -51,7 +51,7 @@ def test_the_fewest_lights_is_from_which_every_larger_count_meets_the_target() -
     one = next(line for line in lines if line.startswith("- **Normals within 1°**"))
     # the fewest: 9, by the floor layout and by adaptive; the first planner's command is given
     assert "from **9 lights**, 18 s a session, with uniform above 20°" in one, one
-    assert "`rti-rig run my-dome.toml --lights 9 --min-elevation-deg 20`" in one, one
+    assert "`rti-rig run my-dome.toml --out SESSION --lights 9 --min-elevation-deg 20`" in one, one
     assert "adaptive 9" in one and "adaptive for relighting 12" in one and "uniform 18" in one
     assert "not reached by optimal" in one, one
     three = next(line for line in lines if line.startswith("- **Normals within 3°**"))
@@ -78,7 +78,7 @@ def test_relighting_is_judged_on_the_written_file_against_every_lights() -> None
     within = next(line for line in lines if line.startswith("- **Relighting within 1 dB**"))
     # every light's file: 32.0 dB; within 1 dB means 31.0 or more
     assert "from **9 lights**, 9 s a session, with adaptive for relighting" in within, within
-    assert "`rti-rig run RIG --adaptive --objective relight --lights 9`" in within, within
+    assert "`rti-rig run RIG --out SESSION --adaptive --objective relight --lights 9`" in within
     assert "uniform 12" in within, within
 
 
@@ -112,3 +112,26 @@ def test_the_summary_opens_with_the_advice_and_an_arm_sessions_times_are_said_a_
     )
     assert r.exit_code == 0, r.output
     assert "shot on an arm" not in (tmp_path / "d" / "summary.md").read_text(encoding="utf-8")
+
+
+def test_every_advised_command_is_one_rti_rig_parses(tmp_path: Path) -> None:
+    """Each command the advice may print is run with a rig config that is not there: refused
+    for the config, never as a usage error (the optimal one had been `plan RIG PREVIEW`, which
+    `plan` refuses: it takes the rig with --rig)."""
+    import shlex
+
+    from benchmarks.tradeoff_from import _PLANNERS
+
+    rig = tmp_path / "no-such-rig.toml"
+    for _, _, template in _PLANNERS:
+        text = template.replace("{floor:g}", "20").format(rig=rig, n=9)
+        text = text.replace("SESSION", str(tmp_path / "s")).replace(
+            "plan.lp", str(tmp_path / "p.lp")
+        )
+        for command in text.split("` then `"):
+            words = shlex.split(command)
+            assert words[0] == "rti-rig", command
+            r = CliRunner().invoke(app, words[1:], terminal_width=400)
+            said = " ".join(r.output.split())
+            assert r.exit_code == 2 and "no-such-rig.toml" in said, (command, said)
+            assert "Usage:" not in said and "No such option" not in said, (command, said)

@@ -73,7 +73,7 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
     assert "on the same 3 held-out lights for every plan" in text
     # what it is run for, answered first: the fewest lights per target, with a command
     assert text.index("## How many lights this object needs") < text.index("| N |")
-    assert "- **Normals within 2°**" in text and "`rti-rig run RIG " in text, text
+    assert "- **Normals within 2°**" in text and "`rti-rig run RIG --out SESSION " in text, text
     # and what the user opens: the fit.rti `rti-rig fit` would write, on the same lights
     assert "**Relighting as `rti-rig fit` writes it**" in text
     for row in rows:

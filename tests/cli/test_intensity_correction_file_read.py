@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, at_key
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -96,7 +96,8 @@ def test_an_image_or_binary_file_given_as_the_calibration_is_refused_as_one(
     assert r.exit_code == 2, r.output
     text = " ".join(r.output.split())
     assert (
-        f"{cfg}: {KEY}: {cal}: {what}: give the light_calibration.toml that rti-rig "
+        f"{at_key(cfg, 'dome.serial.intensity_correction_file')}: {cal}: {what}: give the "
+        "light_calibration.toml that rti-rig "
         "calibrate-lights wrote"
     ) in text, text
     assert "codec" not in text and "Traceback" not in text, text

@@ -34,6 +34,13 @@ kind = "bogus"
 
 [emulator.faults.extra]
 why = "a sub-table of the second fault"   # line 23
+
+[ring_table]
+rings = [              # line 26
+  { elevation_deg = 10.0, count = 12 },
+  { elevation_deg = 25.0, count = 12 },
+]
+after = 1              # line 30
 '''
 
 
@@ -50,6 +57,8 @@ why = "a sub-table of the second fault"   # line 23
         ("emulator.faults[1].at_command", 19),
         ("emulator.faults[1].kind", 20),
         ("emulator.faults[1].extra.why", 23),
+        ("ring_table.rings", 26),
+        ("ring_table.after", 30),  # after a value over several lines: counted on
     ],
 )
 def test_a_key_is_found_on_the_line_it_is_written(key: str, line: int) -> None:
@@ -64,6 +73,10 @@ def test_a_key_is_found_on_the_line_it_is_written(key: str, line: int) -> None:
         "camera.width",  # a key its table lacks: the header is not its line
         "emulator.faults[2].kind",
         "scene.name",
+        # inside a value over several lines: its first line is not the key's (a wrong line is
+        # worse than none; the shipped simulated_dome.toml's rings had been named line 11)
+        "ring_table.rings[1].count",
+        "ring_table.elevation_deg",
     ],
 )
 def test_a_key_not_written_has_no_line(key: str) -> None:
@@ -84,3 +97,9 @@ def test_a_file_that_cannot_be_read_gives_no_line(tmp_path: Path) -> None:
     binary.write_bytes(b"\xff\xfe\x00name = 1")
     assert key_line_in_file(binary, "name") is None
     assert key_line_in_file(tmp_path, "name") is None  # a folder
+
+
+def test_a_file_with_a_byte_order_mark_finds_its_first_key(tmp_path: Path) -> None:
+    cfg = tmp_path / "bom.toml"
+    cfg.write_bytes("\ufeffname = 1\nkind = 2\n".encode())
+    assert key_line_in_file(cfg, "name") == 1 and key_line_in_file(cfg, "kind") == 2
