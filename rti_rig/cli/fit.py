@@ -362,7 +362,7 @@ def _fit_command(  # type: ignore[no-untyped-def]
 
         source = Path(request.source)
         command = reshoot_in_place(source, result.qa) if source.is_dir() else None
-        again = f"; to reshoot those in place: {command}" if command else ""
+        again = f"; {command}" if command else ""
         out.print(f"QA verdict: {escape(result.qa.verdict + again)}")
     if moved_on is not None:
         err.print(

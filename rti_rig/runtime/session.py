@@ -1445,6 +1445,10 @@ class ResumeState:
     #: capture, set aside to be shot again, said as the verdict says them
     #: (:func:`lost_since_capture_said`'s words: ``image_005: raw/image_005.dng changed``)
     lost_since_capture: list[str] = field(default_factory=list)
+    #: a session not finished: its committed images an earlier resume set aside to reshoot
+    #: (``--reshoot`` cut short), whose files are in recovered/ as captured: shot again now,
+    #: and said so, never "lost" (``image_004 (in recovered/20261206T001242)``)
+    set_aside_before: list[str] = field(default_factory=list)
     #: where a ``lights.lp`` that was not rti-rig's own listing of the journal's lights (edited
     #: by hand) was kept before the resume wrote it again (``recovered/STAMP/lights.lp``, also
     #: in ``recovered``), said by :func:`edited_lp_note`; None when there was none
@@ -2033,6 +2037,7 @@ def _prepare_resume(
         )
     rebuilt: dict[int, dict[str, Any]] | None = None  # the records taken back
     lost_now: list[str] = []  # a session not finished: committed images lost since capture
+    aside_before: list[str] = []  # ... and those an earlier resume set aside to reshoot
     restored: dict[int, dict[str, Any]] = {}  # --reshoot-lost: the manifest's, restored
     if runner.get("finish_reason") == "completed":
         finished = runner.get("steps_done", total)
@@ -2120,11 +2125,15 @@ def _prepare_resume(
             done = verified_steps(root, scan.records)
         latest = _latest_records(scan.records)
         renamed = renamed_jpegs(root, scan.records)
-        lost_now = [
-            f"{names[i]}: {', '.join(gone)}"
-            for i, rec in sorted(latest.items())
-            if i not in done and (gone := _lost_files(root, rec, renamed))
-        ]
+        lost_now = []
+        for i, rec in sorted(latest.items()):
+            if i in done or not (gone := _lost_files(root, rec, renamed)):
+                continue
+            earlier = _set_aside_earlier(root, rec)
+            if earlier is not None:  # rti-rig's own move: a reshoot asked for, cut short
+                aside_before.append(f"{names[i]} (in {earlier})")
+            else:
+                lost_now.append(f"{names[i]}: {', '.join(gone)}")
     stamp = _new_stamp(root)
     if check_done is not None:
         check_done(done)
@@ -2210,8 +2219,36 @@ def _prepare_resume(
         journal_repair=repair,
         journal_rebuild=rebuild,
         lost_since_capture=lost_now,
+        set_aside_before=aside_before,
         edited_lp=edited_lp,
     )
+
+
+def _set_aside_earlier(root: Path, rec: dict[str, Any]) -> str | None:
+    """The ``recovered/STAMP`` folder where an earlier resume set aside every file of the
+    step ``rec`` journals that is no longer in its place, each with its journaled checksum;
+    None when any of them is not there so (then it is lost).
+
+    Why: a ``--reshoot`` (or ``--reshoot-lost``) cut short moves the steps to reshoot aside
+    before it shoots them; the plain resume it then advises had said of them "lost since
+    capture: what was captured is no longer there", of files rti-rig itself had moved."""
+    recovered = root / "recovered"
+    if not recovered.is_dir():
+        return None
+    gone = [n for n, digest in rec["sha256"].items() if _sha256_or_none(root / n) != digest]
+    for stamp in sorted(recovered.iterdir(), reverse=True):
+        if gone and all(_sha256_or_none(stamp / n) == rec["sha256"][n] for n in gone):
+            return f"recovered/{stamp.name}"
+    return None
+
+
+def _sha256_or_none(path: Path) -> str | None:
+    """The SHA-256 of ``path``'s bytes, None when it cannot be read (missing)."""
+
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
 
 
 def _refuse_complete(

@@ -44,7 +44,12 @@ def test_a_misfired_image_is_reshot_in_place_with_the_command_its_verdict_gives(
     assert r.exit_code == 0, r.output
     text = said(r)
     assert "QA verdict: reshoot: image_004 (misfired, no light" in text, text
-    command = text.split("to reshoot those in place: ", 1)[1].split(" Next:", 1)[0]
+    lead = (
+        "; to reshoot image_004 in place, once what made the light wrong is mended (an LED "
+        "that did not fire, a loose connector, a swapped LED): "
+    )
+    assert lead in text, text
+    command = text.split(lead, 1)[1].split(" Next:", 1)[0]
     assert command == f"rti-rig run --resume {out} --reshoot image_004", text
     kept = {k: v for k, v in _tree(out).items() if k.startswith(("image_", "linear/"))}
     journal_lines = (out / "journal.jsonl").read_text().count("\n")
@@ -135,3 +140,60 @@ def test_reshoot_without_resume_is_refused(tmp_path: Path) -> None:
     )  # fmt: skip
     assert r.exit_code == 2 and "--reshoot goes with --resume SESSION_DIR only" in said(r)
     assert not (tmp_path / "n").exists()
+
+
+def test_reshoot_with_rebuild_journal_names_the_option_given(
+    finished: Path, tmp_path: Path
+) -> None:
+    out = tmp_path / "s"
+    shutil.copytree(finished, out)
+    before = _tree(out)
+    r = runner.invoke(
+        app,
+        ["run", "--resume", str(out), "--reshoot", "image_002", "--rebuild-journal"],
+        terminal_width=400,
+    )
+    assert r.exit_code == 2, r.output
+    assert "--rebuild-journal and --reshoot go one at a time" in said(r), said(r)
+    assert "--reshoot-lost" not in said(r) and _tree(out) == before
+
+
+def test_a_reshoot_cut_short_is_said_set_aside_not_lost_by_the_resume_after(
+    finished: Path, tmp_path: Path
+) -> None:
+    """The plain resume a --reshoot stopped part-way advises had said of the images it had
+    set aside "lost since capture: what was captured is no longer there"."""
+    from rti_rig.app.usecases.session import (
+        ResumeRequest,
+        open_resumed_session,
+        run_opened_session,
+    )
+    from rti_rig.runtime.controller import CancelToken, StepCompleted
+
+    out = tmp_path / "s"
+    shutil.copytree(finished, out)
+    opened = open_resumed_session(ResumeRequest(out, reshoot=("image_003,image_006",)))
+    cancel = CancelToken()
+
+    def on_event(event: object) -> None:
+        if isinstance(event, StepCompleted):
+            cancel.cancel()
+
+    run_opened_session(opened, cancel=cancel, on_event=on_event)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"], terminal_width=400)
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "lost since capture" not in text and "no longer there" not in text, text
+    assert "1 image(s) an earlier resume set aside to reshoot (image_006 (in recovered/" in text
+    assert "8 image(s) in the session" in text, text
+
+
+def test_a_replayed_acquisition_is_refused_a_reshoot(finished: Path) -> None:
+    """A replay gives the recording's image again: its reshoot could not help."""
+    from rti_rig.app.usecases.session import reshoot_steps
+    from rti_rig.runtime.session import read_manifest
+
+    manifest = read_manifest(finished)
+    manifest["rig"]["backend"] = "replay"
+    with pytest.raises(Exception, match="cannot help a replayed acquisition"):
+        reshoot_steps(manifest, ("image_002",), finished)

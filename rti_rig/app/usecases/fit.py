@@ -1793,7 +1793,7 @@ def verdict_for_session(session: Path) -> str:
     _remember_pixels(frames)
     report = with_lost_files(qa, session)
     command = reshoot_in_place(session, report)
-    return report.verdict + (f"; to reshoot those in place: {command}" if command else "")
+    return report.verdict + (f"; {command}" if command else "")
 
 
 #: What an image's problem begins with when a reshoot with the object where it is cures it (a
@@ -1822,11 +1822,14 @@ def reshoot_in_place(session: Path, report: Any) -> str | None:
     rig = manifest.get("rig") or {}
     config = rig.get("config") or {}
     dome = config.get("dome") or {}
+    camera = (config.get("camera") or {}).get("device") or {}
     if (
         (manifest.get("runner") or {}).get("finish_reason") != "completed"
         or "adaptive" in manifest
         or rig.get("backend") == "replay"
         or "flash_sync" in dome
+        # an image sequence starts again from its first file: its resume is refused
+        or (camera.get("kind") == "opencv" and camera.get("backend") == "images")
     ):
         return None
 
@@ -1840,7 +1843,12 @@ def reshoot_in_place(session: Path, report: Any) -> str | None:
     if not names:
         return None
     words = f"rti-rig run --resume {shell_word(str(session))} --reshoot {','.join(names)}"
-    return words + (" --reshoot-lost" if lost else "")
+    words += " --reshoot-lost" if lost else ""
+    # a dead or weak LED, or a wrong LED map, gives the same image again until it is mended
+    return (
+        f"to reshoot {', '.join(names)} in place, once what made the light wrong is mended (an "
+        f"LED that did not fire, a loose connector, a swapped LED): {words}"
+    )
 
 
 def qa_without_normals(lights: np.ndarray, session: Path | None = None) -> str | None:

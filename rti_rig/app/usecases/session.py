@@ -2011,6 +2011,12 @@ def reshoot_steps(manifest: dict[str, Any], named: Sequence[str], root: Path) ->
             "and its resume shoots the rest first (nothing in the folder was changed): continue "
             f"it with rti-rig run --resume {shell_word(str(root))}, then reshoot"
         )
+    if (manifest.get("rig") or {}).get("backend") == "replay":
+        raise RtiRigError(
+            f"{shown_path(root)}: --reshoot cannot help a replayed acquisition: its images are "
+            "the recording's, and a reshoot gives the same image again (nothing in the folder "
+            "was changed); mend the acquisition itself"
+        )
     if "adaptive" in manifest:
         raise RtiRigError(
             f"{shown_path(root)}: --reshoot cannot reshoot an image of an adaptive session: "
@@ -2052,6 +2058,12 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
 
     check_max_saturated(req.max_saturated)
     manifest = read_manifest(req.session_dir)
+    if req.reshoot and req.rebuild_journal:
+        raise RtiRigError(
+            f"{shown_path(req.session_dir)}: --rebuild-journal and --reshoot go one at a time "
+            "(nothing in the folder was changed): rebuild the journal first (rti-rig run --resume "
+            f"{shell_word(str(req.session_dir))} --rebuild-journal), then reshoot"
+        )
     also_reshoot = reshoot_steps(manifest, req.reshoot, Path(req.session_dir))
     if req.objective is not None or "adaptive" in manifest:
         from rti_rig.app.usecases.adaptive import check_resume_objective
@@ -2209,6 +2221,15 @@ def _opened_resume(  # type: ignore[no-untyped-def]
         from rti_rig.runtime.session import edited_lp_note
 
         on_note(Note(edited_lp_note(folder.root, resume.edited_lp), "warning"))
+    earlier = resume.set_aside_before if resume else []
+    if earlier:
+        shown = ", ".join(earlier[:8]) + (" …" if len(earlier) > 8 else "")
+        on_note(
+            Note(
+                f"{len(earlier)} image(s) an earlier resume set aside to reshoot ({shown}, as "
+                "captured, never deleted): shot again now, with the object where it was"
+            )
+        )
     lost = resume.lost_since_capture if resume else []
     if lost:
         # in the verdict's words, with what this resume does about them: it had said only "N
