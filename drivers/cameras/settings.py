@@ -214,6 +214,12 @@ class OpenCvCameraSettings(_Strict):
             raise ValueError(
                 'device = "" names no camera: give its index (0 for /dev/video0) or its path'
             )
+        if isinstance(v, str) and v.strip().lstrip("+-").isdigit():
+            # OpenCV opens a text as a file or URL: "0" in quotes is no camera index
+            raise ValueError(
+                f'device = "{v}" is a number in quotes, which is read as a file name: write '
+                "the camera's index without quotes (device = 0 for /dev/video0) or its path"
+            )
         return v
 
     @field_validator("fourcc")

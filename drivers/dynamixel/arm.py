@@ -1015,7 +1015,9 @@ class DynamixelArm(ReadBackCarrier):
                     # a limp azimuth lets the arm turn about the vertical, not sag
                     (" (the arm may sag)" if roles[sid] != "azimuth" else " (the arm turns freely)")
                     if isinstance(exc, HardwareFaultError) and exc.torque_on is False
-                    else " — no reply: unpowered, it is limp and the arm may sag; powered, it "
+                    else " — no reply: unpowered, it is limp and "
+                    + ("the arm may sag" if roles[sid] != "azimuth" else "the arm turns freely")
+                    + "; powered, it "
                     "may still be moving to its last goal, a pose checked safe before it was "
                     "sent; look at the arm before touching it"
                     if _no_reply(exc)

@@ -384,6 +384,7 @@ class DomePolicy:
     def connect(self) -> None:
         self._ending = False
         self._teardown_gave_up = False
+        self._failed_offs = 0  # a new connection: the all-offs that failed were another's
         self._read_ledger()
         if self.settings.intensity_correction is not None and not self.link.can_dim:
             # before the port opens (the Nab sketch boots lit): every corrected level of an
@@ -527,6 +528,7 @@ class DomePolicy:
                 "confirm every LED."
             )
         self._run(self.link.all_off, "all off")  # start from the safe state
+        self._failed_offs = 0  # an all-off went through: none failed since
         if self.link.off_outcome is not OffOutcome.ACKNOWLEDGED:
             # an all-off nothing answers (RTIPy's wait for its window, Elexol's unanswered
             # bytes) shows no board: RTIPy's profile at a wrong baud rate had lost its port,

@@ -109,10 +109,10 @@ def test_a_stopped_check_whose_stop_failed_is_not_said_left_where_it_stopped(
     assert (
         "Check stopped (SIGTERM): lamp off was requested, but the stop failed at a servo (not "
         "sent, or sent and not acknowledged): the azimuth servo (id 1) gives no reply, so "
-        "nothing is known of it: unpowered, a servo is limp and the arm may sag; powered, it "
-        "keeps its last goal under torque, and the arm may hold there or still be moving to "
-        "it; look at the arm before touching it, support the arm and switch its power supply "
-        "off; the arm was not parked (the "
+        "nothing is known of it: unpowered, a servo is limp and the arm turns freely about the "
+        "vertical if pushed; powered, it keeps its last goal under torque, and the arm may hold "
+        "there or still be moving to it; look at the arm before touching it, switch the arm's "
+        "power supply off; the arm was not parked (the "
         "check was stopped (SIGTERM), and a stopped check does not park; the stop did not hold "
         "every joint (see the teardown above): its position is not read as where it is left)"
         in said

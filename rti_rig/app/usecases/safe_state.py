@@ -170,7 +170,7 @@ def not_sent_sentence(
         silent = [j for j in unheld if not j.fault and j.no_reply]
         if silent:
             known.append(_silent_joints_said(silent))
-            may_sag = True
+            may_sag = may_sag or any(_bears_weight(j) for j in silent)
         if not (faulted or silent) or any(not (j.fault or j.no_reply) for j in unheld):
             known.append(
                 "a servo no command reaches keeps its last goal under torque, so the arm may "
@@ -198,9 +198,15 @@ def _silent_joints_said(joints: list[UnheldJoint]) -> str:
     power supply, of servos that, unpowered, are limp (the arm free to sag)."""
     servos = " and ".join(f"the {j.joint} servo (id {j.servo_id})" for j in joints)
     verb, them = ("gives", "it") if len(joints) == 1 else ("give", "them")
+    # a limp azimuth lets the arm turn about the vertical; a joint the arm hangs on, sag
+    limp = (
+        "the arm may sag"
+        if any(_bears_weight(j) for j in joints)
+        else "the arm turns freely about the vertical if pushed"
+    )
     return (
         f"{servos} {verb} no reply, so nothing is known of {them}: unpowered, a servo is limp and "
-        "the arm may sag; powered, it keeps its last goal under torque, and the arm may hold "
+        f"{limp}; powered, it keeps its last goal under torque, and the arm may hold "
         "there or still be moving to it"
     )
 

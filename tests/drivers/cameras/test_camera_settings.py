@@ -97,6 +97,12 @@ def test_a_uvc_device_that_names_no_camera_is_refused_at_load(device):
         parse_camera_settings({"kind": "opencv", "device": device})
 
 
+@pytest.mark.parametrize("device", ["-1", "0", " 2"])
+def test_a_uvc_index_in_quotes_is_refused_at_load(device):
+    with pytest.raises(ValidationError, match="is a number in quotes, which is read as a file"):
+        parse_camera_settings({"kind": "opencv", "device": device})
+
+
 @pytest.mark.parametrize("device", [0, 3, "/dev/video0", "/dev/v4l/by-id/usb-cam-video-index0"])
 def test_a_uvc_device_index_or_path_is_taken(device):
     assert parse_camera_settings({"kind": "opencv", "device": device}).device == device
