@@ -24,7 +24,12 @@ def test_an_until_error_request_drops_the_sessions_count_and_relight_objective()
     assert (merged.lights, merged.until_error_deg, merged.min_lights) == (None, 2.0, 30)
     relight = StartOptions(adaptive=True, lights=8, objective="relight")
     merged = _merged(StartOptions(until_error_deg=2.0, given=("--until-error",)), relight)
-    assert merged.objective is None and merged.lights is None
+    # an adaptive session's count stays, as the cap beside the stop (dropped, a session of 30
+    # had been advised one of up to 100 lights: QA, 2026-12-05); the relight objective goes
+    assert merged.objective is None and merged.lights == 8
+    # ... unless a minimum given above it: the stop decides the count
+    above = StartOptions(until_error_deg=2.0, min_lights=9, given=("--until-error", "--min-lights"))
+    assert _merged(above, relight).lights is None
     # a count given with it stays: the first of the two reached stops
     both = StartOptions(until_error_deg=2.0, lights=12, given=("--until-error", "--lights"))
     assert _merged(both, relight).lights == 12

@@ -297,6 +297,8 @@ def _merged(asked: StartOptions, began: StartOptions) -> StartOptions:
         # reached stops"): dropped, `--adaptive --lights 30` given --until-error 2 had been
         # advised a session of up to 100 lights (QA, 2026-12-05)
         kept = began.lights if began.is_adaptive else None
+        if kept is not None and "--min-lights" in flags and (asked.min_lights or 0) > kept:
+            kept = None  # a minimum above the session's count: the stop decides the count
         request = replace(
             request,
             lights=asked.lights if "--lights" in flags else kept,
