@@ -88,6 +88,8 @@ def _session_rig(lp: Path) -> dict[str, Any]:
     for an acquisition that is no session, or a manifest that cannot be read."""
     import json
 
+    # read for its rig alone, tolerantly: read_manifest's checks of a whole session are not
+    # this note's to make (a manifest it would refuse still says what rig shot the images)
     try:
         manifest = json.loads((Path(lp).parent / "manifest.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -520,19 +522,19 @@ def how_many_lights(
         planners.append((said.format(floor=f), command.replace("{floor:g}", f"{f:g}"), series))
 
     def line(target: str, meets: Callable[[Row], bool]) -> str:
-        found = [
-            (n, said, cmd)
+        reached = [
+            (n, said, cmd, series)
             for said, cmd, series in planners
             if (n := _fewest(series, meets)) is not None
         ]
+        found = [(n, said, cmd) for n, said, cmd, _ in reached]
         if not found:
             return (
                 f"- **{target}**: no planner reaches it up to {counts[-1]} lights of this "
                 f"acquisition (every light's own: {every.n})"
             )
         fastest = min(n for n, _, _ in found)
-        first = next(said for n, said, _ in found if n == fastest)
-        row = dict((s, series) for s, _, series in planners)[first][fastest]
+        row = next(series[n] for n, _, _, series in reached if n == fastest)
         # an adaptive session also decides before each light (the row's mean decision time)
         seconds = fastest * (per_light_s + (row.plan_s if row.method == "adaptive" else 0.0))
         each = "; ".join(f"{said} {n}" for n, said, _ in sorted(found))

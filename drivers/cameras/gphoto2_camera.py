@@ -1765,7 +1765,7 @@ def _several_cameras(detected: list[tuple[str, str]]) -> str:
     600D', 'usb:001,005'), ('Nikon D750', 'usb:001,006')]: set 'port' to choose one", a Python
     list and no line to paste. Two bodies of one model are told apart by unplugging one: the
     port is where a camera is plugged, not which camera it is."""
-    found = "; ".join(f"{model} on {where}" for model, where in detected)
+    found = _cameras_said(detected)
     lines = " or ".join(f'port = "{where}"' for _, where in detected)
     same = (
         " Two of them are the same model: unplug one to see which port is left."
@@ -1774,9 +1774,20 @@ def _several_cameras(detected: list[tuple[str, str]]) -> str:
     )
     return (
         f"{len(detected)} cameras found: {found}. Set the one to use in [camera.device]: "
-        f"{lines} (a usb: port is the USB device number, which changes each time a camera is "
-        f"plugged in again or wakes from its power saving).{same}"
+        f"{lines} ({USB_PORT_SAID}).{same}"
     )
+
+
+#: Why a ``usb:BUS,DEVICE`` port is no camera's lasting name (said with a port to set).
+USB_PORT_SAID = (
+    "a usb: port is the USB device number, which changes each time the camera is plugged in "
+    "again or wakes from its power saving"
+)
+
+
+def _cameras_said(detected: list[tuple[str, str]]) -> str:
+    """The cameras gphoto2 found, in words: ``Canon EOS 600D on usb:001,005; …``."""
+    return "; ".join(f"{model} on {where}" for model, where in detected)
 
 
 def _port_gone(port: str, detected: list[tuple[str, str]]) -> str:
@@ -1790,13 +1801,8 @@ def _port_gone(port: str, detected: list[tuple[str, str]]) -> str:
     there may be two bodies, and a resume must not shoot the rest on the wrong one): it names
     what is there and the line to change; the port is not part of the session's rig identity,
     so the resume then goes on."""
-    found = "; ".join(f"{model} on {where}" for model, where in detected)
-    usb = (
-        " (a usb: port is the USB device number, which changes each time the camera is "
-        "plugged in again or wakes from its power saving)"
-        if port.startswith("usb:")
-        else ""
-    )
+    found = _cameras_said(detected)
+    usb = f" ({USB_PORT_SAID})" if port.startswith("usb:") else ""
     fix = (
         f'set port = "{detected[0][1]}" in [camera.device], or remove the port line to '
         "use the only camera found"

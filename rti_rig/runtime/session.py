@@ -2127,13 +2127,13 @@ def _prepare_resume(
         renamed = renamed_jpegs(root, scan.records)
         lost_now = []
         for i, rec in sorted(latest.items()):
-            if i in done or not (gone := _lost_files(root, rec, renamed)):
+            if i in done or not (gone := _lost_entries(root, rec, renamed)):
                 continue
-            earlier = _set_aside_earlier(root, rec)
+            earlier = _set_aside_earlier(root, rec, [name for name, _ in gone])
             if earlier is not None:  # rti-rig's own move: a reshoot asked for, cut short
                 aside_before.append(f"{names[i]} (in {earlier})")
             else:
-                lost_now.append(f"{names[i]}: {', '.join(gone)}")
+                lost_now.append(f"{names[i]}: {', '.join(f'{n} {how}' for n, how in gone)}")
     stamp = _new_stamp(root)
     if check_done is not None:
         check_done(done)
@@ -2224,10 +2224,11 @@ def _prepare_resume(
     )
 
 
-def _set_aside_earlier(root: Path, rec: dict[str, Any]) -> str | None:
+def _set_aside_earlier(root: Path, rec: dict[str, Any], gone: list[str]) -> str | None:
     """The ``recovered/STAMP`` folder where an earlier resume set aside every file of the
-    step ``rec`` journals that is no longer in its place, each with its journaled checksum;
-    None when any of them is not there so (then it is lost).
+    step ``rec`` journals that is no longer in its place (``gone``, as :func:`_lost_entries`
+    found them), each with its journaled checksum; None when any of them is not there so
+    (then it is lost).
 
     Why: a ``--reshoot`` (or ``--reshoot-lost``) cut short moves the steps to reshoot aside
     before it shoots them; the plain resume it then advises had said of them "lost since
@@ -2235,20 +2236,10 @@ def _set_aside_earlier(root: Path, rec: dict[str, Any]) -> str | None:
     recovered = root / "recovered"
     if not recovered.is_dir():
         return None
-    gone = [n for n, digest in rec["sha256"].items() if _sha256_or_none(root / n) != digest]
     for stamp in sorted(recovered.iterdir(), reverse=True):
-        if gone and all(_sha256_or_none(stamp / n) == rec["sha256"][n] for n in gone):
+        if gone and all(file_sha256(stamp / n) == rec["sha256"][n] for n in gone):
             return f"recovered/{stamp.name}"
     return None
-
-
-def _sha256_or_none(path: Path) -> str | None:
-    """The SHA-256 of ``path``'s bytes, None when it cannot be read (missing)."""
-
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
-        return None
 
 
 def _refuse_complete(

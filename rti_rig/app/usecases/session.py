@@ -2027,7 +2027,7 @@ def reshoot_steps(manifest: dict[str, Any], named: Sequence[str], root: Path) ->
     steps: list[int] = []
     unknown: list[str] = []
     for word in words:
-        stem = Path(word).stem if Path(word).suffix.lower() in _IMAGE_SUFFIXES else word
+        stem = word if word in names else Path(word).stem  # image_006 or image_006.jpg
         if stem in names:
             if names.index(stem) not in steps:
                 steps.append(names.index(stem))
@@ -2040,10 +2040,6 @@ def reshoot_steps(manifest: dict[str, Any], named: Sequence[str], root: Path) ->
             "with commas: --reshoot image_006,image_009)"
         )
     return tuple(sorted(steps))
-
-
-#: The endings an image of a session is named with (``--reshoot image_006.jpg``).
-_IMAGE_SUFFIXES = (".jpg", ".jpeg", ".tif", ".tiff", ".png", ".dng")
 
 
 def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
