@@ -1306,6 +1306,13 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
     cannot = _cannot_resume(opened)
     if _reshoot_not_begun(opened, ending, cannot):
         resume_hint = f"Continue with: {_resume_before_begin(opened, ending)}"
+    if opened.folder.put_back:  # a reshoot that never shot: the session as it was
+        from rti_rig.app.usecases.session import put_back_said
+
+        return (
+            f"{put_back_said(opened.folder.put_back)} To reshoot once the rig is mended, the "
+            f"same command: {_resume_before_begin(opened, ending)}"
+        )
     stop = _Stop(ending, opened.out_dir, opened.resumed, cannot, resume_hint)
     return next(said(stop) for holds, said in _STOP_SAID if holds(stop))
 

@@ -707,6 +707,8 @@ class SessionFolder:
         self.run_end: dict[str, Any] | None = None
         #: every committed step (earlier runs' verified ones and this run's), by index
         self.committed: dict[int, StepRecord] = {}
+        #: the files a reshoot that never shot put back (:meth:`put_back_unshot`), to be said
+        self.put_back: list[str] = []
 
     @staticmethod
     def check_new(root: Path) -> None:
@@ -809,6 +811,47 @@ class SessionFolder:
     @property
     def done(self) -> dict[int, StepRecord]:
         return dict(self.resume.done) if self.resume else {}
+
+    def put_back_unshot(self) -> list[str]:
+        """Undo a reshoot's reopen of a completed session that never shot (its rig did not
+        open, or a Ctrl-C came first): every image file it set aside goes back where it was
+        and ``lights.lp`` lists every image again; returns the files put back (relative to
+        the folder), none when this reopen was not such a one or moved anything else (a
+        hand-edited ``lights.lp``: then the folder stays as the reopen left it).
+
+        Why: the images named with ``--reshoot`` were moved to ``recovered/`` before the rig
+        opened; with the dome's port held, the session stayed "completed" with those images
+        missing, and every later command (a plain resume, the verdict) called them "missing
+        or changed since capture", files rti-rig itself had moved."""
+        state = self.resume
+        runner = (state.manifest.get("runner") if state else None) or {}
+        if state is None or runner.get("finish_reason") != "completed" or not state.recovered:
+            return []
+        if self.committed != state.done or state.edited_lp is not None:
+            return []  # something was shot, or a user's file is involved: left as it is
+        back: list[tuple[Path, Path]] = []
+        for rel in state.recovered:
+            parts = Path(rel).parts
+            if len(parts) < 3 or parts[0] != "recovered" or not parts[-1].startswith("image_"):
+                return []
+            back.append((self.root / rel, self.root.joinpath(*parts[2:])))
+        if any(place.exists() or not aside.is_file() for aside, place in back):
+            return []
+        with signals_deferred():
+            for aside, place in back:
+                try:
+                    os.replace(aside, place)
+                except OSError as exc:
+                    raise SessionWriteError(place, exc) from None
+            records = scan_journal(self.root, image_names(self.total_steps)).records
+            _relist_verified(self.root, verified_steps(self.root, records), "")
+            for aside, _ in back:  # the folders the reopen made and left empty now
+                for folder in aside.parents:
+                    if not folder.is_relative_to(self.root / "recovered"):
+                        break
+                    if folder.is_dir() and not any(folder.iterdir()):
+                        folder.rmdir()
+        return [place.relative_to(self.root).as_posix() for _, place in back]
 
     @property
     def images_kept(self) -> int:
@@ -1268,6 +1311,11 @@ class SessionFolder:
         source_result: dict[str, Any] | None = None,
     ) -> None:
         if not self.begun:
+            # a reshoot whose rig never connected: its images back, the session as it was
+            self.put_back = self.put_back_unshot()
+            if self.put_back and self.resume is not None:
+                records = scan_journal(self.root, self.names).records
+                self.committed = verified_steps(self.root, records)
             return
         if source_result is not None:
             self.manifest.setdefault("adaptive", {})["result"] = source_result

@@ -2159,8 +2159,23 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         # process that stays (a test, a program calling this) had kept every other one out
         from rti_rig.runtime.session import unlock_session
 
-        unlock_session(folder.root)
+        try:
+            back = folder.put_back_unshot()  # a reshoot that never shot leaves no hole
+        finally:
+            unlock_session(folder.root)
+        if back:
+            on_note(Note(put_back_said(back), "warning"))
         raise
+
+
+def put_back_said(files: list[str]) -> str:
+    """What a reshoot that never shot says of the images it put back
+    (:meth:`SessionFolder.put_back_unshot`'s ``files``)."""
+    images = sorted({Path(p).stem for p in files})
+    return (
+        f"Nothing was reshot: {', '.join(images)} put back as captured, and lights.lp lists "
+        "every image again: the session is as it was before this resume."
+    )
 
 
 def _refuse_image_sequence_resume(loaded: Any, root: Path) -> None:
