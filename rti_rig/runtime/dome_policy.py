@@ -1533,9 +1533,10 @@ class DomePolicy:
                     self._all_off_after_reboot(exc, when)
                 except DomeLinkError as again:
                     exc = again
+                    self._failed_offs += 1  # the first, met by the banner (this one: below)
                 except DeviceError as other:
                     log.info("%s: all off %s failed: %s", self.name, when, other)
-                    self._failed_offs += 1
+                    self._failed_offs += 2  # the one the banner met and the one sent again
                     self.off_report = OffReport(
                         OffOutcome.SENT_UNCONFIRMED, str(other), boots_lit=lit_at_boot
                     )

@@ -1194,3 +1194,19 @@ def test_a_port_back_after_the_teardowns_window_still_gets_its_closing_all_off()
     assert [r["outcome"] for r in dome.stats.reconnections] == ["did not come back", "reconnected"]
     assert dome.off_report is not None and dome.off_report.outcome is OffOutcome.ACKNOWLEDGED
     assert fw.lit is None
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+def test_an_all_off_sent_again_after_a_reboot_counts_both_that_failed(profile):
+    """The board rebooted as the fail-safe all-off arrived (command 3) and again as the one
+    sent after its banner arrived (command 4): two all-offs failed, and the next one, which
+    went through, had said it came "after one that failed"."""
+    dome, fw, _clock = make(profile, [Fault(3, FaultKind.RESET), Fault(4, FaultKind.RESET)])
+    dome.connect()
+    dome._fail_safe()  # what a failed light or capture calls
+    assert dome.off_report.outcome is not OffOutcome.ACKNOWLEDGED
+    assert "failed too" in dome.off_report.detail
+    dome.all_off()
+    assert fw.lit is None
+    assert dome.off_report.after_failed == 2
+    assert "(this all-off was sent after 2 that failed)" in dome.off_report.sentence()
