@@ -256,7 +256,7 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
             f"dome (with no --lights): {_card_again(root, rig)}"
         )
     directions = _step_directions(root, steps)
-    _refuse_unverified(root, steps, len(planned))
+    refuse_unverified(root, steps, len(planned))
     correction = serial.get("intensity_correction")
     max_level = int(serial.get("max_level", 255))
     exposures = np.array([float(s["exposure_s"]) for s in steps])
@@ -387,10 +387,18 @@ def _refuse_saturated(
     )
 
 
-def _refuse_unverified(root: Path, steps: list[dict[str, Any]], total: int) -> None:
-    """Refuse a card session whose linear TIFFs are not as captured (checked against the
-    journal's checksums): one halved TIFF had read as a dome "0.37 of the median", and the
-    correction written from it would have dimmed every other LED."""
+def refuse_unverified(
+    root: Path,
+    steps: list[dict[str, Any]],
+    total: int,
+    what: str = "card",
+    instead: str = "shoot the card again",
+) -> None:
+    """Refuse a card (or sphere: ``what``) session whose linear TIFFs are not as captured
+    (checked against the journal's checksums), saying what to do ``instead`` of restoring
+    them: one halved TIFF had read as a dome "0.37 of the median", and the correction written
+    from it would have dimmed every other LED; two sphere images swapped had given two LEDs
+    directions 30° off, written into the dome's .lp without a word."""
     scan = scan_journal(root, image_names(total))
     verified = verified_steps(root, scan.records, only="linear_image")
     recorded = {rec["index"] for rec in scan.records}
@@ -408,9 +416,9 @@ def _refuse_unverified(root: Path, steps: list[dict[str, Any]], total: int) -> N
     if bad:
         shown = "; ".join(bad[:6]) + (f"; and {len(bad) - 6} more" if len(bad) > 6 else "")
         raise SessionError(
-            f"{shown_path(root)}: {len(bad)} card image(s) not as captured ({shown}): a "
+            f"{shown_path(root)}: {len(bad)} {what} image(s) not as captured ({shown}): a "
             "calibration measured from them would misjudge those LEDs, or all of them; restore the "
-            "originals from a backup copy of the folder, or shoot the card again"
+            f"originals from a backup copy of the folder, or {instead}"
         )
 
 

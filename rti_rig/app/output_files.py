@@ -21,11 +21,18 @@ def rig_inputs(rig: Path, loaded: LoadedRig) -> dict[str, Path | None]:
     calibration's TOML over the LED ``.lp``, a plan over the intensity correction), after
     which every command on that rig was refused at load. A replay rig (a recorded
     acquisition's ``.lp``) reads its recorded images too: ``plan --rig ACQ/dirs.lp --out
-    ACQ/image_011.jpg --force`` had written the plan over a recorded image."""
+    ACQ/image_011.jpg --force`` had written the plan over a recorded image. An emulated
+    dome's ``led_directions_file`` too (``lights-from-sphere --out`` onto the shipped
+    example_dome_48.lp had replaced the rehearsal's truth with its measurement)."""
     inputs: dict[str, Path | None] = {"RIG": rig}
     dome = loaded.config.dome
     if dome is None:
         return inputs
+    real = loaded.config.emulator.led_directions_file
+    if real is not None:  # where the emulated LEDs really are: a rehearsal's truth
+        inputs["emulated dome's LED directions (emulator.led_directions_file)"] = (
+            loaded.folder / real
+        )
     if dome.lp_file:
         inputs["rig's LED calibration (lp_file)"] = loaded.folder / dome.lp_file
         if loaded.config.backend == "replay":

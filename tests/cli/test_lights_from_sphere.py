@@ -288,3 +288,86 @@ def test_a_camera_triggered_dome_measures_its_leds_with_its_design_standing_in(
     assert "do not use this session" in words, words
     assert 'This dome\'s layout is "fibonacci": if it stands in for directions not yet ' in words
     assert "list the LEDs as the dome's design places them, in the order its firmware" in words
+
+
+def _sphere_args(session: Path, out: Path) -> list[str]:
+    return ["lights-from-sphere", str(session), "--sphere", _circle(), "--out", str(out)]
+
+
+def _copy(session: Path, to: Path) -> Path:
+    import shutil
+
+    shutil.copytree(session, to)
+    return to
+
+
+@pytest.mark.parametrize(
+    ("target", "refusal"),
+    [
+        ("manifest.json", "would replace a file of the session in"),
+        ("journal.jsonl", "would replace a file of the session in"),
+        ("image_001.jpg", "would replace a file of the session in"),
+        ("linear/image_001.tif", "would replace a file of the session in"),
+        ("RIG", "is the session's rig config this command reads"),
+        ("TRUTH", "is the emulated dome's LED directions (emulator.led_directions_file)"),
+    ],
+)
+def test_force_never_replaces_the_sessions_files_or_what_its_rig_reads(
+    sphere_session: Path, tmp_path: Path, target: str, refusal: str
+) -> None:
+    """``--out S/manifest.json --force`` (or a session image, the rig config, the emulator's
+    truth) had been replaced by the .lp, exit 0: the session was then refused as not JSON,
+    and the advice said to edit "the dome's config", an .lp by then."""
+    import json
+
+    session = _copy(sphere_session, tmp_path / "s")
+    manifest = json.loads((session / "manifest.json").read_text())
+    rig = Path(manifest["rig"]["config_path"])
+    truth = tmp_path / "truth.lp"
+    truth.write_bytes(TRUTH.read_bytes())  # the emulator's file, a copy of its own
+    config = tmp_path / "rig.toml"
+    config.write_text(rig.read_text().replace(str(TRUTH), str(truth)))
+    manifest["rig"]["config_path"] = str(config)
+    (session / "manifest.json").write_text(json.dumps(manifest))
+    out = {"RIG": config, "TRUTH": truth}.get(target, session / target)
+    before = out.read_bytes()
+    r = CliRunner().invoke(app, [*_sphere_args(session, out), "--force"], terminal_width=400)
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert refusal in said(r), said(r)
+    assert out.read_bytes() == before
+
+
+def test_images_changed_since_capture_are_refused_by_name(
+    sphere_session: Path, tmp_path: Path
+) -> None:
+    """Two images swapped (their JPEGs and TIFFs) had given those LEDs directions 30° off,
+    written into the dome's .lp without a word."""
+    session = _copy(sphere_session, tmp_path / "s")
+    for folder, ext in ((session, "jpg"), (session / "linear", "tif")):
+        a, b = folder / f"image_005.{ext}", folder / f"image_006.{ext}"
+        a_bytes = a.read_bytes()
+        a.write_bytes(b.read_bytes())
+        b.write_bytes(a_bytes)
+    out = tmp_path / "dome.lp"
+    r = CliRunner().invoke(app, _sphere_args(session, out), terminal_width=400)
+    assert r.exit_code == 2, r.output
+    assert (
+        "2 sphere image(s) not as captured (linear/image_005.tif (LED 4) changed since capture; "
+        "linear/image_006.tif (LED 5) changed since capture)"
+    ) in said(r), said(r)
+    assert f"rti-rig run --resume {session} --reshoot-lost" in said(r), said(r)
+    assert not out.exists()
+
+
+def test_a_session_whose_labels_are_not_verified_is_refused(
+    sphere_session: Path, tmp_path: Path
+) -> None:
+    """fit and export-lp refuse a session with LABELS_NOT_VERIFIED.txt (a camera-triggered
+    dome that may have doubled a step); a dome's .lp measured from it had been written."""
+    session = _copy(sphere_session, tmp_path / "s")
+    (session / "LABELS_NOT_VERIFIED.txt").write_text("the dome's count went on\n")
+    out = tmp_path / "dome.lp"
+    r = CliRunner().invoke(app, _sphere_args(session, out), terminal_width=400)
+    assert r.exit_code == 2, r.output
+    assert "may be labelled with the wrong lights, so it is not used" in said(r), said(r)
+    assert not out.exists()
