@@ -264,7 +264,14 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
         out.print(
             f"Lights as shot, with the intensity correction in force: spread "
             f"{100 * cal.shot_spread:.1f} % RMS"
-            + (" — the dome is even." if cal.shot_spread < even_enough else ".")
+            + (
+                ""
+                if cal.shot_spread >= even_enough
+                else " — the dome is even."
+                if cal.measured.all()
+                else f" — the {len(measured)} LEDs measured are even (the "
+                f"{geometry.count - len(measured)} others were not shot, so not checked)."
+            )
         )
         out.print(
             f"{each[0].upper()}{each[1:]}'s own light, without the correction, is still "
@@ -299,10 +306,25 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
         "level it with care."
     )
     out.print(f"Calibration → {escape(shown_path(target))}")
-    if in_force and cal.shot_spread < even_enough:
+    if in_force and cal.shot_spread < even_enough and cal.measured.all():
         out.print(
             "The correction in force is good: no new calibration is needed. To use this "
             f"one instead, set under {escape('[dome.serial]')} in "
+            f"{escape(shown_path(rig_config))}:",
+            highlight=False,
+        )
+    elif in_force and cal.shot_spread < even_enough:
+        # 6 of 48 LEDs shot had said "the dome is even … no new calibration is needed" of a
+        # dome whose 42 others no image had shown
+        from rti_rig.app.usecases.run_options import run_words
+        from rti_rig.core.out_folders import free_folder_beside
+
+        again = run_words(rig_config, free_folder_beside(card_session, "card"))
+        out.print(
+            f"The correction in force is good for the {len(measured)} LEDs measured; to check "
+            f"the other {geometry.count - len(measured)}, shoot the card under every LED "
+            f"({escape(again)}, without --lights) and calibrate from that session. To use "
+            f"this one meanwhile, set under {escape('[dome.serial]')} in "
             f"{escape(shown_path(rig_config))}:",
             highlight=False,
         )

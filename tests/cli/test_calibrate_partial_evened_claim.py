@@ -73,3 +73,31 @@ def test_one_led_not_measured_is_said_in_the_singular(tmp_path: Path) -> None:
         in text
     ), text
     assert "1 not measured are" not in out.read_text()
+
+
+def test_a_partial_card_shot_under_a_good_correction_claims_no_more_than_its_leds(
+    tmp_path: Path,
+) -> None:
+    """6 of 48 LEDs shot under the correction they were calibrated for had said "the dome is
+    even" and "no new calibration is needed", of a dome whose 42 other LEDs no image showed."""
+    rig = card_rig(tmp_path)
+    first = tmp_path / "first"
+    r = runner.invoke(app, ["run", str(rig), "--out", str(first), "--lights", "6"])
+    assert r.exit_code == 0, r.output
+    _calibrate(first, rig, tmp_path / "first.toml")
+    line = f'intensity_correction_file = "{tmp_path / "first.toml"}"\n'
+    corrected = card_rig(tmp_path, line, "cal.toml")
+    again = tmp_path / "again"
+    r = runner.invoke(app, ["run", str(corrected), "--out", str(again), "--lights", "6"])
+    assert r.exit_code == 0, r.output
+
+    text = _calibrate(again, corrected, tmp_path / "again.toml")
+
+    assert "6 of 48 LEDs measured" in text, text
+    assert "the dome is even" not in text and "no new calibration is needed" not in text, text
+    assert "the 6 LEDs measured are even (the 42 others were not shot, so not checked)" in text
+    assert (
+        "The correction in force is good for the 6 LEDs measured; to check the other 42, shoot "
+        f"the card under every LED (rti-rig run {corrected} --out {tmp_path / 'again-card'}, "
+        "without --lights)"
+    ) in text, text
