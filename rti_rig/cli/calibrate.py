@@ -417,6 +417,8 @@ def lights_from_sphere(
                 highlight=False,
                 soft_wrap=True,
             )
+            for note in result.notes:
+                err.print(f"[yellow]warning:[/] {escape(note)}", highlight=False, soft_wrap=True)
             out.print(
                 f"To use it, {_sphere_lp_line(result)}.",
                 markup=False,

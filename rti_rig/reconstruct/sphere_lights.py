@@ -227,3 +227,85 @@ def angle_deg(a: tuple[float, float, float], b: tuple[float, float, float]) -> f
     """The angle between two unit directions, in degrees."""
     dot = float(np.clip(np.dot(np.asarray(a), np.asarray(b)), -1.0, 1.0))
     return math.degrees(math.acos(dot))
+
+
+#: The share of rays from the given centre that must cross one clear edge (the sphere's
+#: outline) for the outline to count as found; fewer, and nothing is said of the circle.
+OUTLINE_RAYS_FOUND = 0.8
+#: An edge is clear where the step across it is at least this fraction of the image's range
+#: (its 99th minus its 1st percentile): a black sphere on a lit ground steps by about all of it.
+OUTLINE_MIN_STEP = 0.25
+#: How far past the given circle, as a fraction of its radius, each ray looks for the outline.
+OUTLINE_SEARCH = 0.3
+
+
+def outline_circle(median: NDArray[np.floating], circle: Circle, rays: int = 120) -> Circle | None:
+    """The sphere's outline as the images show it, searched near ``circle`` in ``median`` (the
+    per-pixel median over the session's images: the highlights gone, the sphere's disc against
+    its ground); None where no clear outline is found (a black sphere on black velvet, a
+    chrome sphere mirroring a ground like itself).
+
+    Why: a circle given a few pixels off (3 px at R = 48) had moved every LED by 7° (a pixel is
+    about 115°/R), and the .lp was written without a word, though the sphere's outline stood
+    in every image. Along each ray from the given centre the edge is the steepest step
+    (sub-pixel, by the parabola through the step's peak); a circle is fitted to the edges by
+    least squares (Kåsa's algebraic fit), after dropping rays whose edge lies off it (a stand,
+    a shadow)."""
+    img = np.asarray(median, dtype=np.float32)
+    lo, hi = np.percentile(img, [1.0, 99.0])
+    if not hi > lo:
+        return None
+    radii = np.arange(
+        circle.radius * (1 - OUTLINE_SEARCH), circle.radius * (1 + OUTLINE_SEARCH), 0.25
+    )
+    angles = np.linspace(0.0, 2 * np.pi, rays, endpoint=False)
+    xs = (circle.x + np.cos(angles)[:, None] * radii[None, :]).astype(np.float32)
+    ys = (circle.y + np.sin(angles)[:, None] * radii[None, :]).astype(np.float32)
+    profiles = cv2.remap(img, xs, ys, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    # the step across 1 px (4 samples either side), so noise and antialiasing do not place it
+    step = profiles[:, 8:] - profiles[:, :-8]
+    peak = np.argmax(np.abs(step), axis=1)
+    signed = step[np.arange(rays), peak]
+    height = np.abs(signed)
+    # the noise's own steps (their median absolute deviation as a sigma): a featureless
+    # ground's steepest steps are noise, a few sigma high and of either sign
+    sigma = 1.4826 * float(np.median(np.abs(step - np.median(step))))
+    clear = (height >= OUTLINE_MIN_STEP * (hi - lo)) & (height >= 8.0 * sigma)
+    # one outline: its step has one sign all round (a dark disc on a light ground, or not)
+    polarity = np.sign(np.median(signed[clear])) if clear.any() else 0.0
+    inner = (peak > 0) & (peak < step.shape[1] - 1)
+    keep = clear & inner & (np.sign(signed) == polarity)
+    if keep.sum() < OUTLINE_RAYS_FOUND * rays:
+        return None
+    idx = np.flatnonzero(keep)
+    a = np.abs(step[idx, peak[idx] - 1])
+    b = height[idx]
+    c = np.abs(step[idx, peak[idx] + 1])
+    denom = a - 2 * b + c
+    shift = np.where(np.abs(denom) > 1e-12, 0.5 * (a - c) / np.where(denom == 0, 1, denom), 0.0)
+    r = radii[0] + 0.25 * (peak[idx] + 4 + np.clip(shift, -0.5, 0.5))
+    ex = circle.x + np.cos(angles[idx]) * r
+    ey = circle.y + np.sin(angles[idx]) * r
+    fitted = _kasa(ex, ey)
+    for _ in range(2):  # rays whose edge is not the sphere's (a stand, a shadow) dropped
+        off = np.abs(np.hypot(ex - fitted.x, ey - fitted.y) - fitted.radius)
+        near = off <= max(1.0, 3.0 * float(np.median(off)))
+        if near.sum() < OUTLINE_RAYS_FOUND * rays:
+            return None
+        ex, ey = ex[near], ey[near]
+        fitted = _kasa(ex, ey)
+    return fitted
+
+
+def _kasa(x: NDArray[np.float64], y: NDArray[np.float64]) -> Circle:
+    """The circle through points (x, y) in the least-squares sense of x² + y² + Dx + Ey + F."""
+    design = np.column_stack([x, y, np.ones_like(x)])
+    (d, e, f), *_ = np.linalg.lstsq(design, -(x * x + y * y), rcond=None)
+    cx, cy = -d / 2, -e / 2
+    return Circle(float(cx), float(cy), float(math.sqrt(max(cx * cx + cy * cy - f, 0.0))))
+
+
+def circle_offset_px(a: Circle, b: Circle) -> float:
+    """How far apart two circles are, in pixels: the larger of their centres' distance and
+    their radii's difference (either moves the highlights' normals)."""
+    return max(math.hypot(a.x - b.x, a.y - b.y), abs(a.radius - b.radius))

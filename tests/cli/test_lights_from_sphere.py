@@ -7,6 +7,7 @@ the command's `.lp` must give those back (the session's own lights.lp says the s
 from __future__ import annotations
 
 import os
+import re
 import sys
 from pathlib import Path
 from typing import Any
@@ -371,3 +372,39 @@ def test_a_session_whose_labels_are_not_verified_is_refused(
     assert r.exit_code == 2, r.output
     assert "may be labelled with the wrong lights, so it is not used" in said(r), said(r)
     assert not out.exists()
+
+
+def test_a_circle_pixels_off_the_spheres_outline_is_said_with_the_outline(
+    sphere_session: Path, tmp_path: Path
+) -> None:
+    """--sphere 3 px off (R = 48) had moved every LED by 7°, written without a word, though
+    the sphere's outline stood in every image."""
+    x, y, radius = sphere_circle(SIDE, SIDE)
+    out = tmp_path / "off.lp"
+    r = CliRunner().invoke(
+        app,
+        ["lights-from-sphere", str(sphere_session), "--sphere", _circle(3), "--out", str(out)],
+        terminal_width=400,
+    )
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    found = re.search(
+        r"warning: the sphere's outline in the images is at ([\d.]+),([\d.]+),([\d.]+) "
+        r"\(column, row, radius; open \S+image_001\.jpg to see it\), (\d\.\d) px from "
+        r"--sphere \S+: every direction is off by about 2\.4° per pixel the circle is off, so "
+        r"these may be off by up to (\d+)°; if that outline is the sphere's, measure again with "
+        r"--sphere (\S+)",
+        text,
+    )
+    assert found is not None, text
+    outline = [float(v) for v in found.groups()[:3]]
+    assert np.abs(np.subtract(outline, (x, y, radius))).max() <= 0.2, outline
+    assert 2.8 <= float(found[4]) <= 3.2 and found[5] == "7", text
+    assert found[6] == ",".join(found.groups()[:3]), text
+    # the outline's circle, as said, gives the dome's LEDs; the right circle gives no warning
+    good = tmp_path / "good.lp"
+    argv = ["lights-from-sphere", str(sphere_session), "--sphere", found[6]]
+    r = CliRunner().invoke(app, [*argv, "--out", str(good)], terminal_width=400)
+    assert r.exit_code == 0 and "warning" not in said(r), said(r)
+    errors = _angles(directions_of(read_lp(good)), directions_of(read_lp(TRUTH)))
+    assert np.median(errors) < 0.6, errors

@@ -105,3 +105,42 @@ def test_no_direction_is_invented_from_noise_a_hot_pixel_or_two_spots(
 def test_a_circle_outside_the_frame_is_refused() -> None:
     with pytest.raises(SphereCircleError, match="inside"):
         find_highlight(np.zeros(SHAPE), Circle(100.0, 50.0, 40.0), 65535)
+
+
+def _disc(circle: Circle, inside: float = 0.02, ground: float = 0.6) -> np.ndarray:
+    """A dark disc on a lit ground, antialiased over a pixel (8×8 samples per pixel)."""
+    fine = 8
+    rows, cols = np.mgrid[0 : SHAPE[0] * fine, 0 : SHAPE[1] * fine].astype(float)
+    rows, cols = (rows + 0.5) / fine - 0.5, (cols + 0.5) / fine - 0.5
+    hit = np.hypot(cols - circle.x, rows - circle.y) < circle.radius
+    cover = hit.reshape(SHAPE[0], fine, SHAPE[1], fine).mean(axis=(1, 3))
+    return ground + (inside - ground) * cover
+
+
+@pytest.mark.parametrize(("dx", "dy", "dr"), [(0, 0, 0), (3, 0, 0), (0, -2.5, 0), (1, 1, -4)])
+def test_the_outline_is_found_where_the_disc_is_wherever_the_circle_given(
+    dx: float, dy: float, dr: float
+) -> None:
+    from rti_rig.reconstruct.sphere_lights import circle_offset_px, outline_circle
+
+    truth = Circle(60.3, 49.6, 38.7)
+    rng = np.random.default_rng(4)
+    image = _disc(truth) + rng.normal(0.0, 0.01, SHAPE)
+    given = Circle(truth.x + dx, truth.y + dy, truth.radius + dr)
+    found = outline_circle(image, given)
+    assert found is not None
+    assert circle_offset_px(found, truth) < 0.15, found
+
+
+@pytest.mark.parametrize("ground", ["noise", "ramp", "same as the sphere"])
+def test_no_outline_is_invented_where_there_is_none(ground: str) -> None:
+    from rti_rig.reconstruct.sphere_lights import outline_circle
+
+    rng = np.random.default_rng(1)
+    _rows, cols = np.mgrid[0 : SHAPE[0], 0 : SHAPE[1]].astype(float)
+    image = {
+        "noise": 0.1 + rng.normal(0.0, 0.01, SHAPE),
+        "ramp": cols / SHAPE[1],
+        "same as the sphere": _disc(CIRCLE, 0.02, 0.02) + rng.normal(0.0, 0.002, SHAPE),
+    }[ground]
+    assert outline_circle(image, CIRCLE) is None

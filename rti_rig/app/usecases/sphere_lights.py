@@ -10,6 +10,7 @@ named with why, and no ``.lp`` is written: a guessed line would be fitted as if 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -30,7 +31,9 @@ from rti_rig.reconstruct.sphere_lights import (
     Rejected,
     SphereCircleError,
     as_grey,
+    circle_offset_px,
     find_highlight,
+    outline_circle,
 )
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.flash_sync import CameraTriggeredLighting
@@ -56,6 +59,8 @@ class SphereLights:
     highlights: tuple[Highlight, ...]
     #: the rig config the session was shot with (its manifest's), None if it names none
     config: Path | None = None
+    #: what the user should hear of the measurement (a circle the images' outline disputes)
+    notes: tuple[str, ...] = ()
 
 
 def _steps_by_led(root: Path, manifest: dict[str, Any]) -> list[dict[str, Any]]:
@@ -191,8 +196,12 @@ def lights_from_sphere(request: SphereRequest) -> SphereLights:
     found: list[Highlight] = []
     names: list[str] = []
     refused: list[str] = []
+    crops: list[np.ndarray] = []  # around the sphere, for its outline
+    every = -(-len(steps) // _OUTLINE_IMAGES)  # at most that many kept: a median's worth
     for led, step in enumerate(steps):
         grey, white, name = _grey_image(root, step)
+        if led % every == 0:
+            crops.append(_around(grey, request.circle))
         try:
             result = find_highlight(grey, request.circle, white)
         except SphereCircleError as exc:
@@ -211,4 +220,56 @@ def lights_from_sphere(request: SphereRequest) -> SphereLights:
     entries = [LpEntry(f"led_{k:0{width}d}.jpg", h.direction) for k, h in enumerate(found)]
     write_lp(out, entries)
     shot_with = Path(config) if isinstance(config, str) and config else None
-    return SphereLights(out, tuple(names), tuple(found), shot_with)
+    notes = _circle_disputed(crops, request.circle, shown_path(root / str(steps[0]["image"])))
+    return SphereLights(out, tuple(names), tuple(found), shot_with, notes)
+
+
+#: How far around the circle (× its radius) the outline is looked for: the crop kept of each
+#: image, so a 24-megapixel session's outline costs the sphere's pixels, not the frames'.
+_AROUND = 1.4
+#: The images whose median shows the outline, at most (evenly spread over the LEDs: each
+#: highlight is in one of them, so the median has none); a 600 px sphere's crops then take
+#: under 200 MB.
+_OUTLINE_IMAGES = 15
+
+
+def _around(grey: np.ndarray, circle: Circle) -> np.ndarray:
+    """The part of ``grey`` around ``circle`` (float32), where its outline is searched."""
+    x0, y0 = _crop_origin(circle)
+    reach = int(np.ceil(_AROUND * circle.radius))
+    x1, y1 = int(np.floor(circle.x)) + reach + 1, int(np.floor(circle.y)) + reach + 1
+    return grey[y0:y1, x0:x1].astype(np.float32)
+
+
+def _crop_origin(circle: Circle) -> tuple[int, int]:
+    reach = int(np.ceil(_AROUND * circle.radius))
+    return max(0, int(np.floor(circle.x)) - reach), max(0, int(np.floor(circle.y)) - reach)
+
+
+def _circle_disputed(crops: list[np.ndarray], circle: Circle, first: str) -> tuple[str, ...]:
+    """A note when the sphere's outline in the images (their median: the highlights gone)
+    is found clearly and lies off the circle given by more than a pixel and by more than
+    about 1° of direction (a pixel is about 115°/R); none otherwise.
+
+    Why: ``--sphere`` 3 px off (R = 48) had moved every LED by 7°, written without a word,
+    though the outline stood in every image (:func:`outline_circle`). A note, not a refusal:
+    an outline can be another's (a stand, a shadow on a dark ground), the user judges."""
+    x0, y0 = _crop_origin(circle)
+    local = Circle(circle.x - x0, circle.y - y0, circle.radius)
+    found = outline_circle(np.median(np.stack(crops), axis=0), local)
+    if found is None:
+        return ()
+    seen = Circle(found.x + x0, found.y + y0, found.radius)
+    off = circle_offset_px(seen, circle)
+    per_px = math.degrees(2.0 / circle.radius)  # a normal's tilt doubles in the reflection
+    if off <= max(1.0, 1.0 / per_px):
+        return ()
+    given = ",".join(f"{v:g}" for v in (circle.x, circle.y, circle.radius))
+    shown = ",".join(f"{v:.1f}" for v in (seen.x, seen.y, seen.radius))
+    return (
+        f"the sphere's outline in the images is at {shown} (column, row, radius; open "
+        f"{first} to see it), {off:.1f} px from --sphere {given}: every direction is off by "
+        f"about {per_px:.1f}° per pixel the circle is off, so these may be off by up to "
+        f"{off * per_px:.0f}°; if that outline is the sphere's, measure again with --sphere "
+        f"{shown}",
+    )
