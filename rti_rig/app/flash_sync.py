@@ -650,10 +650,18 @@ def refuse_options(loaded, out: Path, **given: bool) -> None:  # type: ignore[no
     }
     for option, present in given.items():
         if present:
+            # nothing was fired by this command: "long-press … to rewind it" had read as if it
+            # had stepped the dome; only a resume's session has (its count went on)
+            rewind = (
+                "Long-press the dome's start button to rewind it, then run"
+                if option == "--resume"
+                else "Nothing was fired. Run, with the dome at its first LED (long-press its "
+                "start button if it has flashed since it was last rewound),"
+            )
             raise RtiRigError(
                 f"{shown_path(loaded.path)}: {option} cannot be used with a camera-triggered dome "
-                f"({fs.firmware}): {why[option]}. Long-press the dome's start button to rewind "
-                f"it, then run the whole sequence: rti-rig run {shell_word(str(loaded.path))} "
+                f"({fs.firmware}): {why[option]}. {rewind} the whole sequence: rti-rig run "
+                f"{shell_word(str(loaded.path))} "
                 f"--out {shell_word(str(free_name(Path(out), folder=True)))}"
             )
 

@@ -455,4 +455,13 @@ def _sphere_lp_line(result: SphereLights) -> str:
     except NotTomlText:  # a name no TOML file can hold: the user copies the file to one
         named = '"…" (copy the file to a UTF-8 name first)'
     where = f"the dome's config {shown_path(config)}" if config else "the dome's config"
-    return f'set layout = "lp" and lp_file = {named} under [dome] in {where}, in place of its count'
+    if result.layout == "lp":  # a dome measured again: only the file changes
+        return f"set lp_file = {named} under [dome] in {where}, in place of the one it names"
+    # the other layout's keys are refused beside layout = "lp": "in place of its count" had
+    # been said of a ring dome, whose [[dome.rings]] tables must go
+    replaced = {"fibonacci": "its count", "rings": "its [[dome.rings]] tables"}.get(
+        str(result.layout), "its layout's keys"
+    )
+    return (
+        f'set layout = "lp" and lp_file = {named} under [dome] in {where}, in place of {replaced}'
+    )

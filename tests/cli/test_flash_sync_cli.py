@@ -385,6 +385,7 @@ def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None
     (out / "photo_x.jpg").rename(out / "image_020.jpg")
     image = out / "image_003.jpg"
     for extra, change in ((["--reshoot-lost"], False), ([], True), (["--reshoot-lost"], False)):
+        lost = image.read_bytes().endswith(b"x")  # the images lost by now
         if change:  # one image changed, one missing since capture
             image.write_bytes(image.read_bytes() + b"x")
             (out / "image_010.jpg").unlink()
@@ -396,10 +397,12 @@ def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None
         assert "this session already completed all 60 steps; nothing to resume" in text
         assert "cannot be used" not in text and "Next:" not in text
         assert "Traceback" not in text
-        if extra:  # --reshoot-lost keeps its refusal, and names no image
+        if extra and not lost:  # --reshoot-lost of an intact session: refused, no image named
             assert "cannot reshoot single images either" in text, text
             assert "long-press the dome's start button" in text and "image_0" not in text
         else:
+            # with --reshoot-lost too: it had said "nothing to resume" and not which images
+            # were lost, which fit named
             # the images lost are named (the refusal had said only "nothing to resume"),
             # with what this dome can do: never --reshoot-lost, which it refuses
             assert "2 of its images are missing or changed since capture" in text, text
@@ -583,7 +586,11 @@ def test_refusals_give_the_run_of_the_config_actually_used(tmp_path: Path, rigs)
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())
     # the run into the preview's own --out (nothing was written to it), not a template DIR
-    assert f"run the whole sequence: {run_it} {shlex.quote(str(tmp_path / 'p'))}" in text, text
+    assert (
+        "Nothing was fired. Run, with the dome at its first LED (long-press its start button if "
+        "it has flashed since it was last rewound), the whole sequence: "
+        f"{run_it} {shlex.quote(str(tmp_path / 'p'))}"
+    ) in text, text
     assert "CONFIG" not in text and rigs == []
     out = tmp_path / "s"
     assert runner.invoke(app, ["run", str(cfg), "--out", str(out), "--no-verdict"]).exit_code == 0

@@ -66,6 +66,7 @@ def test_directions_are_the_domes_real_leds(sphere_session: Path, tmp_path: Path
     )
     assert r.exit_code == 0, r.output
     assert "48 LED directions" in r.output and 'layout = "lp"' in r.output
+    assert said(r).endswith("in place of its count."), said(r)
     truth = directions_of(read_lp(TRUTH))
     errors = _angles(directions_of(read_lp(out)), truth)
     # measured 2026-12-02: median 0.13°, worst 0.24°, mostly the sphere's parallax to lamps at
@@ -279,6 +280,9 @@ def test_a_camera_triggered_dome_measures_its_leds_with_its_design_standing_in(
     )
     assert r.exit_code == 0, said(r)
     assert _angles(directions_of(read_lp(lp)), true).max() < 0.5
+    # a ring dome's tables are what the .lp replaces (its "count" had been named)
+    assert "under [dome] in the dome's config" in said(r), said(r)
+    assert said(r).endswith("in place of its [[dome.rings]] tables."), said(r)
 
     fib = tmp_path / "fib"
     fib.mkdir()

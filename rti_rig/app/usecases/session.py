@@ -1953,6 +1953,21 @@ def rebuild_finished_session(req: ResumeRequest) -> list[str] | None:
     return rebuild_finished_journal(Path(req.session_dir))
 
 
+def _lost_said(session_dir: Path, reshoot: bool) -> str:
+    """:func:`_say_if_complete`, or with ``reshoot`` (``--reshoot-lost``, ``--reshoot``) the
+    images lost alone: an intact session is then no success to end on (the reshoot asked for
+    is refused). Why: ``--reshoot-lost`` on a camera-triggered session with image_007 deleted
+    had said "nothing to resume", not which image was lost, which fit named."""
+    if not reshoot:
+        return _say_if_complete(session_dir)
+    from rti_rig.runtime.session import CompleteJournalNotWhole, SessionComplete
+
+    try:
+        return _say_if_complete(session_dir)
+    except (SessionComplete, CompleteJournalNotWhole):
+        return ""
+
+
 def _say_if_complete(session_dir: Path) -> str:
     """Raise :class:`~rti_rig.runtime.session.SessionComplete` if the completed session in
     ``session_dir`` has every image as captured (exit 0, the next step named), as any other
@@ -2103,7 +2118,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     if flash_sync_of(loaded) is not None and runner.get("finish_reason") == "completed":
         # a finished session had been told only that a camera-triggered dome cannot resume
         # (so the user looked for what had interrupted it): it is complete, and says so
-        lost = "" if req.reshoot_lost or req.reshoot else _say_if_complete(Path(req.session_dir))
+        lost = _lost_said(Path(req.session_dir), bool(req.reshoot_lost or req.reshoot))
         done = (
             f"{shown_path(req.session_dir)}: this session already completed all "
             f"{runner.get('steps_planned', len(manifest.get('steps') or []))} steps; nothing "

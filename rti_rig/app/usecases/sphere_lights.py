@@ -61,6 +61,9 @@ class SphereLights:
     config: Path | None = None
     #: what the user should hear of the measurement (a circle the images' outline disputes)
     notes: tuple[str, ...] = ()
+    #: the [dome] layout the session was shot with ("fibonacci", "rings", "lp"; its
+    #: manifest's), whose keys the measured .lp replaces; None if it names none
+    layout: str | None = None
 
 
 def _steps_by_led(root: Path, manifest: dict[str, Any]) -> list[dict[str, Any]]:
@@ -221,7 +224,9 @@ def lights_from_sphere(request: SphereRequest) -> SphereLights:
     write_lp(out, entries)
     shot_with = Path(config) if isinstance(config, str) and config else None
     notes = _circle_disputed(crops, request.circle, shown_path(root / str(steps[0]["image"])))
-    return SphereLights(out, tuple(names), tuple(found), shot_with, notes)
+    layout = (((manifest.get("rig") or {}).get("config") or {}).get("dome") or {}).get("layout")
+    shot_layout = layout if isinstance(layout, str) else None
+    return SphereLights(out, tuple(names), tuple(found), shot_with, notes, shot_layout)
 
 
 #: How far around the circle (× its radius) the outline is looked for: the crop kept of each
