@@ -412,3 +412,23 @@ def test_a_circle_pixels_off_the_spheres_outline_is_said_with_the_outline(
     assert r.exit_code == 0 and "warning" not in said(r), said(r)
     errors = _angles(directions_of(read_lp(good)), directions_of(read_lp(TRUTH)))
     assert np.median(errors) < 0.6, errors
+
+
+def test_the_sphere_sessions_verdict_sends_to_the_measurement_not_a_reshoot(
+    sphere_session: Path, tmp_path: Path
+) -> None:
+    """Shot on the stand-in layout, the sphere's verdict reads "lights likely wrong … not
+    named one by one, since wrong lights alone explain that", and had then offered "to
+    reshoot image_011 in place … --reshoot image_011", which could cure nothing."""
+    argv = ["fit", str(sphere_session), "--out", str(tmp_path / "f"), "--no-ptm", "--no-hsh"]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    assert r.exit_code == 0, r.output
+    verdict = next(ln for ln in said(r).split("QA verdict: ")[1:])
+    assert verdict.startswith("lights likely wrong"), verdict
+    assert "--reshoot" not in verdict, verdict
+    assert (
+        'this dome\'s layout is "fibonacci": if it stands in for LED directions not yet measured '
+        "(a session of a sphere, to measure them), that is why, and nothing is to reshoot: "
+        f"measure them with rti-rig lights-from-sphere {sphere_session} --sphere X,Y,R --out "
+        "my_dome.lp"
+    ) in verdict, verdict

@@ -1807,7 +1807,9 @@ def reshoot_in_place(session: Path, report: Any) -> str | None:
     whose every problem a reshoot in place cures (:data:`_CURED_IN_PLACE`, or brighter than
     predicted: a stray flash), with ``--reshoot-lost`` where images were lost since capture;
     None when there are none, or the session cannot reshoot one image (not completed,
-    adaptive, a replayed acquisition, a camera-triggered dome).
+    adaptive, a replayed acquisition, a camera-triggered dome). Where the verdict finds the
+    lights likely wrong as a whole, no image's reshoot is offered: a dome whose layout is a
+    stand-in is said to be one instead (:func:`_stand_in_said`).
 
     Why: the verdict said "reshoot: image_006 (misfired, no light …)" and no command did it
     (``--reshoot-lost`` takes only lost images): the user had to shoot the whole session
@@ -1823,6 +1825,10 @@ def reshoot_in_place(session: Path, report: Any) -> str | None:
     config = rig.get("config") or {}
     dome = config.get("dome") or {}
     camera = (config.get("camera") or {}).get("device") or {}
+    if getattr(report, "lights_likely_wrong", False):
+        # one image's reshoot cures nothing when most recorded lights are wrong (the verdict
+        # names none one by one for it): it had been offered all the same
+        return _stand_in_said(session, dome)
     if (
         (manifest.get("runner") or {}).get("finish_reason") != "completed"
         or "adaptive" in manifest
@@ -1848,6 +1854,21 @@ def reshoot_in_place(session: Path, report: Any) -> str | None:
     return (
         f"to reshoot {', '.join(names)} in place, once what made the light wrong is mended (an "
         f"LED that did not fire, a loose connector, a swapped LED): {words}"
+    )
+
+
+def _stand_in_said(session: Path, dome: dict[str, Any]) -> str | None:
+    """Why a dome session's lights may be wrong as a whole: a ``fibonacci`` layout is the
+    stand-in a new dome is shot with before its LEDs are measured (docs/guide.md), and its
+    sphere session's verdict then reads "lights likely wrong"; None for another layout."""
+    if dome.get("layout") != "fibonacci":
+        return None
+    return (
+        'this dome\'s layout is "fibonacci": if it stands in for LED directions not yet '
+        "measured (a session of a sphere, to measure them), that is why, and nothing is to "
+        "reshoot: measure them with rti-rig lights-from-sphere "
+        f"{shell_word(str(session))} --sphere X,Y,R --out my_dome.lp (the sphere's centre "
+        "column, row and radius in pixels)"
     )
 
 
