@@ -408,3 +408,53 @@ def test_a_batch_session_whose_result_cannot_be_read_back_but_whose_fit_stands_i
     assert f"{tmp_path / 'A'}: finished on its worker; its report could not be read here" in said
     assert f"its fit stands complete in {out.resolve() / 'A'}" in said, said
     assert "failed" not in said and (out / "A" / "fit.json").exists()
+
+
+@pytest.mark.parametrize("first", ["client", "server"])
+def test_a_port_that_answers_as_another_service_is_said_not_a_dask_scheduler(
+    tmp_path: Path, first: str
+) -> None:
+    """A proxy or web server on the port had been read by Dask as a message of 3 EiB: "cannot
+    reach the Dask scheduler (MemoryError: Unable to allocate 3.01 EiB …). Start one with
+    `dask scheduler`"."""
+    import contextlib
+    import socket
+    import threading
+
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+    done = threading.Event()
+
+    def answer() -> None:
+        server.settimeout(0.2)
+        while not done.is_set():
+            try:
+                conn, _ = server.accept()
+            except TimeoutError:
+                continue
+            with conn:
+                conn.settimeout(2.0)
+                if first == "client":  # as an HTTP server: the request, then its refusal
+                    with contextlib.suppress(TimeoutError):
+                        conn.recv(4096)
+                conn.sendall(b"HTTP/1.0 426 Upgrade Required\r\n\r\n")
+
+    thread = threading.Thread(target=answer, daemon=True)
+    thread.start()
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    address = f"tcp://127.0.0.1:{port}"
+    try:
+        argv = ["fit", str(session), "--out", str(tmp_path / "o"), "--scheduler", address]
+        r = runner.invoke(app, argv, terminal_width=400)
+    finally:
+        done.set()
+        thread.join(5.0)
+        server.close()
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "Traceback" not in said and "MemoryError" not in said and "EiB" not in said, said
+    assert (
+        f"--scheduler '{address}': what answers there is not a Dask scheduler (its reply is not "
+        "a Dask message"
+    ) in said, said
+    assert not (tmp_path / "o" / "fit.json").exists()

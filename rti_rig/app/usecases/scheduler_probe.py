@@ -677,6 +677,15 @@ def probe(address: str, timeout: float) -> Reached:
             "check this machine's network and name servers (/etc/resolv.conf), or give the "
             "scheduler's IP address, such as tcp://192.0.2.10:8786"
         ) from None
+    except (MemoryError, OverflowError):
+        # Dask read another service's first bytes (an HTTP server's "HTTP/1.0 426 …") as the
+        # length of its message and tried to make room for 3 EiB: the user had been shown
+        # "MemoryError: Unable to allocate 3.01 EiB" and told to start a scheduler
+        raise SchedulerError(
+            f"--scheduler {address!r}: what answers there is not a Dask scheduler (its reply "
+            "is not a Dask message: an HTTP or SSH server, a proxy, or another service on "
+            "that port?): give the address `dask scheduler` prints, such as tcp://HOST:8786"
+        ) from None
     except Exception as exc:  # reset, a TLS failure, a reply that is not Dask's
         raise unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
     if not _is_scheduler(identity):
