@@ -815,6 +815,27 @@ def test_a_fit_of_a_session_whose_images_are_gone_names_them_all_and_the_way_out
     assert (done / "rest.lp").read_bytes() == b"an earlier export"
 
 
+def test_a_linear_tiff_overwritten_whole_is_named_with_the_sessions_ways_out(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A linear TIFF overwritten by other bytes of its own length: the decoder's refusal had
+    said "cannot be read as a TIFF (TiffFileError …); … or leave it out of the .lp", an edit
+    of the session's lights.lp, not its ways out."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    tif = done / "linear" / "image_005.tif"
+    tif.write_bytes(bytes(range(256)) * (tif.stat().st_size // 256 + 1))
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 2, r.output
+    out = said(r)
+    assert (
+        "1 image(s) its lights.lp lists cannot be read as captured (linear/image_005.tif: its "
+        "header does not read as an image's (damaged, or another file over it))"
+    ) in out, out
+    assert f"rti-rig run --resume {done} --reshoot-lost" in out, out
+    assert "leave it out of the .lp" not in out and "Traceback" not in out, out
+
+
 def test_a_camera_original_changed_since_capture_is_lost_said_alike_and_reshot_on_request(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

@@ -48,7 +48,12 @@ from rti_rig.core import opencv_files
 from rti_rig.core.acquisition_images import check_image_files, mixed_depth_words
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, PHOTOMETRIC_STEREO, AutoFit, auto_models
-from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation, png_alpha_note
+from rti_rig.core.image_files import (
+    MOSAIC_TIFF_LABEL,
+    header_layout,
+    image_truncation,
+    png_alpha_note,
+)
 from rti_rig.core.json_values import strict_dumps
 from rti_rig.core.lp_format import (
     LpEntry,
@@ -635,6 +640,13 @@ def acquisition_files(
         # short read, told to "leave it out of the .lp" of a session whose .lp it rewrites
         damaged = [(p, "gone") for p in paths if not p.is_file()]
         damaged += [(p, why) for p in paths if p.is_file() and (why := image_truncation(p))]
+        # overwritten whole (its length kept): it had been refused by the decoder, told to
+        # "leave it out of the .lp" of a session, not the session's own ways out
+        damaged += [
+            (p, "its header does not read as an image's (damaged, or another file over it)")
+            for p in paths
+            if p.is_file() and all(p != d for d, _ in damaged) and header_layout(p) is None
+        ]
         _refuse_lost_images(lp, damaged)
     else:
         _refuse_unusable_images(lp, entries, paths)
