@@ -287,9 +287,22 @@ def _fit_command(  # type: ignore[no-untyped-def]
             raise RtiRigError("--hsh-order sets fit.rti's order, which --no-hsh does not write")
         if model != "auto":
             try:
-                model_spec(model)
+                spec = model_spec(model)
             except ValueError:
                 raise RtiRigError(f"--model {model!r} is not known; choose {MODEL_HELP}") from None
+            if (
+                hsh_order is not None
+                and spec.name.startswith("hsh")
+                and spec.name != f"hsh{hsh_order}"
+            ):
+                # fit.rti was written at the order asked, the model named in no file, with
+                # "Model: hsh2: chosen by --model" above "fit.rti: hsh1: asked for"
+                raise RtiRigError(
+                    f"--model {model} and --hsh-order {hsh_order} disagree: an HSH --model is "
+                    "the fit.rti written; give one of them (--model "
+                    f"{spec.name} for order {spec.name[3:]}, or --hsh-order {hsh_order} with "
+                    "another --model)"
+                )
         request = FitRequest(
             sources[0],
             out_dir,

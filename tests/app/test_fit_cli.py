@@ -192,6 +192,13 @@ def test_an_hsh_order_that_does_not_exist_is_refused(clean, tmp_path: Path) -> N
     r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--hsh-order", "2", "--no-hsh"])
     assert r.exit_code == 2 and "which --no-hsh does not write" in " ".join(r.output.split())
     assert not out.exists() or not any(out.iterdir())
+    # an HSH model of another order: fit.rti had been written at --hsh-order, the model
+    # "chosen by --model" in no file
+    argv = ["fit", str(session), "--out", str(out), "--model", "hsh2", "--hsh-order", "1"]
+    r = runner.invoke(app, argv)
+    assert r.exit_code == 2, r.output
+    assert "--model hsh2 and --hsh-order 1 disagree" in " ".join(r.output.split()), r.output
+    assert not out.exists() or not any(out.iterdir())
 
 
 def test_a_refused_fit_leaves_nothing_so_the_corrected_command_runs(tmp_path: Path) -> None:
