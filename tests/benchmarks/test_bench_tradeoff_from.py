@@ -447,6 +447,35 @@ def test_a_batch_fit_whose_out_is_a_file_is_refused_as_a_file(tmp_path: Path) ->
     assert a_file.read_text() == "12\n"
 
 
+def test_a_batch_fit_whose_out_takes_no_file_is_refused_once_by_its_name(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A read-only --out (an empty read-only mount) had failed each session on its own hidden
+    partial folder ("--out OUT/.a.5928-a1d00730.partial: cannot write there"), and the batch
+    ended as if the others had fitted. The tests run as root, whom modes do not stop: the new
+    file in --out is refused as a read-only file system refuses it."""
+    import errno
+    import tempfile
+
+    sources = [str(_acquisition(tmp_path / name, 6)) for name in ("a", "b")]
+    out = tmp_path / "ro"
+    out.mkdir()
+    real = tempfile.mkstemp
+
+    def read_only(*args: object, **kwargs: object) -> tuple[int, str]:
+        if Path(str(kwargs.get("dir", ""))) == out:
+            raise OSError(errno.EROFS, "Read-only file system")
+        return real(*args, **kwargs)  # type: ignore[call-overload, no-any-return]
+
+    monkeypatch.setattr(tempfile, "mkstemp", read_only)
+    r = CliRunner().invoke(app, ["fit", *sources, "--out", str(out)], terminal_width=400)
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert text.count(f"--out {out}: cannot write there") == 1, text
+    assert "Read-only file system" in text and ".partial" not in text, text
+    assert list(out.iterdir()) == []
+
+
 def test_an_out_the_user_may_not_look_into_is_refused_by_name(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -41,7 +41,7 @@ from rti_rig.app.usecases.fit_owners import (
     write_owner_record,
 )
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.out_folders import refuse_a_file_in_the_way
+from rti_rig.core.out_folders import ensure_writable_folder
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.session import JOURNAL, file_sha256
 
@@ -273,16 +273,14 @@ def prepare_batch(sources: list[Path], root: Path) -> dict[Path, tuple[str, ...]
             "(another --out) or rename one of the folders"
         )
     # a file given for --out is said to be one (it had been "cannot create the batch folder
-    # (File exists)"), in the words of ensure_writable_folder; its probe file is not written
-    # here, as two batches may plan into one folder at once
-    refuse_a_file_in_the_way(root)
+    # (File exists)"), and a folder that takes no file (read-only) is said of --out, once: each
+    # session had failed on its own hidden partial folder, "--out OUT/.s1.5928-a1d0.partial:
+    # cannot write there", and the batch ended as if the others had fitted. Its probe file has
+    # a name of its own, so two batches may plan into one folder at once
     try:
-        root.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise FitInputError(
-            f"--out {shown_path(root)}: cannot create the batch folder "
-            f"({exc.strerror or exc}); choose a folder you can write to"
-        ) from None
+        ensure_writable_folder(root)
+    except RtiRigError as exc:
+        raise FitInputError(str(exc)) from None
     notes: dict[Path, tuple[str, ...]] = {}
     for source in sources:
         final = batch_out_dir(root, source)
