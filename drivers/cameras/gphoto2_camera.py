@@ -87,6 +87,19 @@ NAME_KEYS = {
 }
 
 
+#: The decoder's advice to fetch a damaged RAW again from the card, where the camera kept none.
+_NO_CARD_COPY = re.compile(r"copy (?:it|the shot) again from the camera's card", re.IGNORECASE)
+
+
+def _no_card_copy(match: re.Match[str]) -> str:
+    """What stands in for :data:`_NO_CARD_COPY` when the card holds no copy of the shot."""
+    said = (
+        "there is no copy of it on the camera to copy again; the kept file is the only one, "
+        "and a resumed session shoots this image again"
+    )
+    return said[0].upper() + said[1:] if match.group(0)[0].isupper() else said
+
+
 class CameraGoneError(CaptureError):
     """The camera stopped answering mid-session (switched off, unplugged, powered down).
 
@@ -1333,13 +1346,20 @@ class Gphoto2Camera:
         if self.output_dir is not None and self.output_dir.name == ".incoming":
             where += " (a resume moves it to the session's recovered/ folder, never deleting it)"
         copy = self._copy_said(camera_name)
+        on_card = copy in ("kept", "still on the card (its delete there failed)")
         if camera_name in self._kept_for_decode:
             copy = f"stays on its card at {folder.rstrip('/')}/{camera_name}, not deleted"
+            on_card = True
+        problem = exc.problem if isinstance(exc, RawDecodeError) else exc.message
+        if not on_card:
+            # the decoder's "copy it again from the camera's card" had followed "the camera's
+            # copy deleted" (or a capture to its RAM, which keeps none) in one sentence
+            problem = _NO_CARD_COPY.sub(_no_card_copy, problem)
         return CaptureError(
             self.name,
             f"the camera's file {camera_name} would not decode; it is kept at {shown_path(where)}, "
             f"the camera's copy {copy}. "
-            + (exc.problem if isinstance(exc, RawDecodeError) else exc.message)
+            + problem
             + (
                 ". `rti-rig check` finds a RAW this LibRaw cannot read with a test shot, "
                 "before a session lights anything"

@@ -236,3 +236,27 @@ def test_a_raw_of_another_size_is_named_where_it_is_kept_as_paths_that_paste(
     tiff, raw = kept.split(", the camera's own file(s) as ")
     assert Path(tiff).is_absolute() and Path(tiff).is_file(), said
     assert Path(raw).is_absolute() and Path(raw).read_bytes() == render(Body(render, shots=1))
+
+
+def test_a_raw_that_would_not_decode_shot_to_ram_is_not_sent_to_the_card(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Shot to the camera's RAM (the shipped DSLR example's target), a download LibRaw cannot
+    read had been said "the camera's copy deleted" and, in the same sentence, "if no other
+    program opens the file either, it is damaged: copy it again from the camera's card": a
+    card that never held it."""
+    cfg = _config(tmp_path, "Internal RAM")
+    body = Body(render=lambda b: _raw(b) if b.shots < 1 else b"II*\x00damaged" * 100)
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "2"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "the camera's file IMG_0002.CR2 would not decode" in said, said
+    assert "the camera's copy deleted." in said, said  # delete_from_camera, as shipped
+    assert "from the camera's card" not in said, said
+    assert (
+        "it is damaged: there is no copy of it on the camera to copy again; the kept file is the "
+        "only one, and a resumed session shoots this image again"
+    ) in said, said
+    assert (out / "raw" / ".incoming" / "cap0002_IMG_0002.CR2").is_file()
