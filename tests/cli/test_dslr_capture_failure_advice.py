@@ -199,14 +199,7 @@ def test_a_raw_that_would_not_decode_is_left_on_the_card_as_its_error_says(
     damaged on the way, a format newer than this LibRaw). Its card copy had been deleted
     before the decode, while the error went on "if no other program opens the file either,
     it is damaged: copy it again from the camera's card": the one good copy was gone."""
-    cfg = _config(tmp_path, "Memory card")
-    body = Body(render=lambda b: _raw(b) if b.shots < 1 else b"II*\x00damaged" * 100)
-    out = tmp_path / "s"
-    r, said, lit_at_end = _shot_with(
-        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "2"]
-    )
-    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
-    assert "the camera's file IMG_0002.CR2 would not decode" in said, said
+    out, body, said = _second_raw_undecodable(tmp_path, monkeypatch, "Memory card")
     on_card = "/store_00020001/DCIM/100CANON/IMG_0002.CR2"
     assert f"the camera's copy stays on its card at {on_card}, not deleted" in said, said
     assert "IMG_0002.CR2" in body.card and body.deleted == ["IMG_0001.CR2"], body.deleted
@@ -245,14 +238,7 @@ def test_a_raw_that_would_not_decode_shot_to_ram_is_not_sent_to_the_card(
     read had been said "the camera's copy deleted" and, in the same sentence, "if no other
     program opens the file either, it is damaged: copy it again from the camera's card": a
     card that never held it."""
-    cfg = _config(tmp_path, "Internal RAM")
-    body = Body(render=lambda b: _raw(b) if b.shots < 1 else b"II*\x00damaged" * 100)
-    out = tmp_path / "s"
-    r, said, lit_at_end = _shot_with(
-        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "2"]
-    )
-    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
-    assert "the camera's file IMG_0002.CR2 would not decode" in said, said
+    out, _, said = _second_raw_undecodable(tmp_path, monkeypatch, "Internal RAM")
     assert "the camera's copy deleted." in said, said  # delete_from_camera, as shipped
     assert "from the camera's card" not in said, said
     assert (
@@ -260,3 +246,20 @@ def test_a_raw_that_would_not_decode_shot_to_ram_is_not_sent_to_the_card(
         "only one, and a resumed session shoots this image again"
     ) in said, said
     assert (out / "raw" / ".incoming" / "cap0002_IMG_0002.CR2").is_file()
+
+
+def _second_raw_undecodable(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, target: str
+) -> tuple[Path, Body, str]:
+    """A 2-light run shot to ``target`` whose second RAW downloads as bytes LibRaw cannot
+    read: the session folder, the camera body and what the run said (checked to have
+    stopped on that RAW, lights off, no traceback)."""
+    cfg = _config(tmp_path, target)
+    body = Body(render=lambda b: _raw(b) if b.shots < 1 else b"II*\x00damaged" * 100)
+    out = tmp_path / "s"
+    r, said, lit_at_end = _shot_with(
+        monkeypatch, cfg, body, ["run", str(cfg), "--out", str(out), "--lights", "2"]
+    )
+    assert r.exit_code == 2 and "Traceback" not in said and lit_at_end is None, said
+    assert "the camera's file IMG_0002.CR2 would not decode" in said, said
+    return out, body, said
