@@ -1310,8 +1310,8 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
         from rti_rig.app.usecases.session import put_back_said
 
         return (
-            f"{put_back_said(opened.folder.put_back)} To reshoot once the rig is mended, the "
-            f"same command: {_resume_before_begin(opened, ending)}"
+            f"{put_back_said(opened.folder.put_back)} To reshoot, once what stopped it is put "
+            f"right, the same command: {_resume_before_begin(opened, ending)}"
         )
     stop = _Stop(ending, opened.out_dir, opened.resumed, cannot, resume_hint)
     return next(said(stop) for holds, said in _STOP_SAID if holds(stop))
@@ -1606,6 +1606,16 @@ def _stopped_before_capture(  # type: ignore[no-untyped-def]
 
     failed = _print_failures(_close_left_open(opened))
     lights = lights_state(opened.rig, failed)
+    if opened.folder.put_back is not None:  # the close put a reshoot's images back
+        from rti_rig.app.usecases.session import put_back_said
+
+        said = (
+            f"Stopped ({why}) before the session went on: {lights}. "
+            f"{put_back_said(opened.folder.put_back)} To reshoot, the same command: "
+            f"{_resume_before_begin(opened)}"
+        )
+        err.print(f"[yellow]{escape(said)}[/]")
+        return typer.Exit(code=stop_exit_code(signum))
     if opened.resumed:
         said = (
             f"Stopped ({why}) before the session went on: no new image was captured; {lights}; "

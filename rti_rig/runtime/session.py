@@ -670,6 +670,17 @@ def unlock_session(root: Path) -> None:
         os.close(fd)  # closing the descriptor releases its flock
 
 
+@dataclass(frozen=True)
+class PutBack:
+    """What a reshoot that never began put back (:meth:`SessionFolder.put_back_unshot`): the
+    files (relative to the session folder), and the images among them that are as captured
+    and those still missing or changed since capture (``--reshoot-lost``'s), by name."""
+
+    files: tuple[str, ...]
+    as_captured: tuple[str, ...]
+    not_as_captured: tuple[str, ...]
+
+
 class SessionFolder:
     """Writes one session: created empty (or reopened to resume), filled step by step.
 
@@ -707,8 +718,8 @@ class SessionFolder:
         self.run_end: dict[str, Any] | None = None
         #: every committed step (earlier runs' verified ones and this run's), by index
         self.committed: dict[int, StepRecord] = {}
-        #: the files a reshoot that never shot put back (:meth:`put_back_unshot`), to be said
-        self.put_back: list[str] = []
+        #: what a reshoot that never shot put back (:meth:`put_back_unshot`), to be said
+        self.put_back: PutBack | None = None
 
     @staticmethod
     def check_new(root: Path) -> None:
@@ -812,46 +823,79 @@ class SessionFolder:
     def done(self) -> dict[int, StepRecord]:
         return dict(self.resume.done) if self.resume else {}
 
-    def put_back_unshot(self) -> list[str]:
-        """Undo a reshoot's reopen of a completed session that never shot (its rig did not
-        open, or a Ctrl-C came first): every image file it set aside goes back where it was
-        and ``lights.lp`` lists every image again; returns the files put back (relative to
-        the folder), none when this reopen was not such a one or moved anything else (a
-        hand-edited ``lights.lp``: then the folder stays as the reopen left it).
+    def put_back_unshot(self) -> PutBack | None:
+        """Undo a reshoot's reopen of a completed session that never began to shoot (its rig
+        did not open or connect, or a stop came before the capture): every image file it set
+        aside goes back where it was and ``lights.lp`` lists every step again, as the
+        completed session had; returns what was put back, None when this reopen was not such
+        a one or did more than set image files aside (a hand-edited ``lights.lp`` kept, the
+        journal repaired or its records restored, a RAW download set aside: then the folder
+        stays as the reopen left it, each of those said by the resume as it did them).
 
         Why: the images named with ``--reshoot`` were moved to ``recovered/`` before the rig
         opened; with the dome's port held, the session stayed "completed" with those images
         missing, and every later command (a plain resume, the verdict) called them "missing
-        or changed since capture", files rti-rig itself had moved."""
+        or changed since capture", files rti-rig itself had moved. What ``--reshoot-lost`` set
+        aside (lost or changed since capture) goes back as it was found, and is said so."""
         state = self.resume
         runner = (state.manifest.get("runner") if state else None) or {}
-        if state is None or runner.get("finish_reason") != "completed" or not state.recovered:
-            return []
-        if self.committed != state.done or state.edited_lp is not None:
-            return []  # something was shot, or a user's file is involved: left as it is
+        if (
+            state is None
+            or self.begun
+            or runner.get("finish_reason") != "completed"
+            or not state.recovered
+            or state.edited_lp is not None
+            or state.journal_repair
+            or state.journal_rebuild
+        ):
+            return None
         back: list[tuple[Path, Path]] = []
         for rel in state.recovered:
             parts = Path(rel).parts
             if len(parts) < 3 or parts[0] != "recovered" or not parts[-1].startswith("image_"):
-                return []
+                return None
             back.append((self.root / rel, self.root.joinpath(*parts[2:])))
         if any(place.exists() or not aside.is_file() for aside, place in back):
-            return []
+            return None
         with signals_deferred():
             for aside, place in back:
                 try:
                     os.replace(aside, place)
                 except OSError as exc:
                     raise SessionWriteError(place, exc) from None
-            records = scan_journal(self.root, image_names(self.total_steps)).records
-            _relist_verified(self.root, verified_steps(self.root, records), "")
+            records = scan_journal(self.root, self.names).records
+            latest = _latest_records(records)
+            write_lp_atomic(
+                self.root / LP_NAME,
+                [
+                    LpEntry(r.image, r.actual_direction)
+                    for r in (_to_record(latest[i]) for i in sorted(latest))
+                ],
+            )
             for aside, _ in back:  # the folders the reopen made and left empty now
                 for folder in aside.parents:
                     if not folder.is_relative_to(self.root / "recovered"):
                         break
                     if folder.is_dir() and not any(folder.iterdir()):
                         folder.rmdir()
-        return [place.relative_to(self.root).as_posix() for _, place in back]
+        intact = verified_steps(self.root, records)
+        stems = sorted({Path(place.name).stem for _, place in back})
+        by_stem = {Path(str(rec["image"])).stem: i for i, rec in latest.items()}
+        return PutBack(
+            files=tuple(place.relative_to(self.root).as_posix() for _, place in back),
+            as_captured=tuple(s for s in stems if by_stem.get(s) in intact),
+            not_as_captured=tuple(s for s in stems if by_stem.get(s) not in intact),
+        )
+
+    def put_back_now(self) -> None:
+        """:meth:`put_back_unshot` once (kept in :attr:`put_back`), and the committed steps
+        read again from the folder when anything went back."""
+        if self.put_back is not None:
+            return
+        self.put_back = self.put_back_unshot()
+        if self.put_back is not None:
+            records = scan_journal(self.root, self.names).records
+            self.committed = verified_steps(self.root, records)
 
     @property
     def images_kept(self) -> int:
@@ -1312,10 +1356,7 @@ class SessionFolder:
     ) -> None:
         if not self.begun:
             # a reshoot whose rig never connected: its images back, the session as it was
-            self.put_back = self.put_back_unshot()
-            if self.put_back and self.resume is not None:
-                records = scan_journal(self.root, self.names).records
-                self.committed = verified_steps(self.root, records)
+            self.put_back_now()
             return
         if source_result is not None:
             self.manifest.setdefault("adaptive", {})["result"] = source_result

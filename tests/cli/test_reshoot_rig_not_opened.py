@@ -54,9 +54,9 @@ def test_a_reshoot_whose_arm_does_not_connect_puts_the_images_back(tmp_path: Pat
     assert "Nothing was commanded: the arm could not be connected" in text, text
     assert (
         "Nothing was reshot: image_003, image_005 put back as captured, and lights.lp lists "
-        "every image again: the session is as it was before this resume" in text
+        "every image again: the session's images are as they were before this resume." in text
     ), text
-    assert f"To reshoot once the rig is mended, the same command: rti-rig run {broken} " in text
+    assert f"once what stopped it is put right, the same command: rti-rig run {broken} " in text
     assert f"--resume {out} --reshoot image_003,image_005" in text, text
     # every file as it was: the images, their TIFFs, lights.lp listing all six, no recovered/
     assert _tree(out) == before
@@ -104,3 +104,53 @@ def test_a_reshoot_refused_as_the_rig_opens_puts_the_images_back(
     monkeypatch.undo()
     r = runner.invoke(app, ["run", "--resume", str(out)], terminal_width=400)
     assert "this session is complete: all 6 steps were captured" in said(r), said(r)
+
+
+def test_a_reshoot_lost_whose_arm_does_not_connect_puts_back_what_it_found(tmp_path: Path) -> None:
+    """--reshoot-lost sets aside what is lost or changed: put back, it is said as found, not
+    "as captured", and lights.lp lists every image as the completed session had."""
+    first = tmp_path / "first"
+    first.mkdir()
+    out = tmp_path / "s"
+    cfg = inprocess_arm_config(first)
+    argv = ["run", str(cfg), "--out", str(out), "--lights", "6", "--no-verdict"]
+    assert runner.invoke(app, argv).exit_code == 0
+    (out / "image_004.jpg").unlink()  # lost since capture: its TIFF is set aside to reshoot
+    before = _tree(out)
+    again = tmp_path / "again"
+    again.mkdir()
+    broken = inprocess_arm_config(again, servo_fault(1, 1))
+    argv = ["run", str(broken), "--resume", str(out), "--reshoot-lost", "--reshoot", "image_002"]
+    r = runner.invoke(app, argv, terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert (
+        "Nothing was reshot: image_002 put back as captured; image_004 put back as found (still "
+        "missing or changed since capture), and lights.lp lists every image again"
+    ) in text, text
+    assert _tree(out) == before and not (out / "recovered").exists()
+
+
+def test_a_reshoot_stopped_before_its_capture_began_puts_the_images_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C once the rig had opened, before the capture began (metering, the handover),
+    had left the images set aside and the session "completed" with a hole."""
+    from rti_rig.app.usecases import session as usecase
+
+    out = tmp_path / "s"
+    cfg = inprocess_arm_config(tmp_path)
+    argv = ["run", str(cfg), "--out", str(out), "--lights", "6", "--no-verdict"]
+    assert runner.invoke(app, argv).exit_code == 0
+    before = _tree(out)
+
+    def stopped(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(usecase, "run_opened_session", stopped)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot", "image_003"])
+    text = said(r)
+    assert r.exit_code == 130, text
+    assert "Nothing was reshot: image_003 put back as captured" in text, text
+    assert f"To reshoot, the same command: rti-rig run --resume {out} --reshoot image_003" in text
+    assert _tree(out) == before and not (out / "recovered").exists()

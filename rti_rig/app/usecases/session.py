@@ -282,7 +282,12 @@ class OpenedSession:
                     # overload unsaid)
                     self.close_failures += rig.close()
         finally:
-            unlock_session(self.folder.root)  # a resume's lock, also for a run never started
+            try:  # a reshoot stopped before its capture began: the images it set aside back
+                self.folder.put_back_now()
+            except Exception as exc:  # never in place of why the run stopped
+                self.close_failures.append(f"put back the images set aside: {exc}")
+            finally:
+                unlock_session(self.folder.root)  # a resume's lock, also for a run never started
 
     def __enter__(self) -> OpenedSession:
         return self
@@ -2175,21 +2180,31 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         from rti_rig.runtime.session import unlock_session
 
         try:
-            back = folder.put_back_unshot()  # a reshoot that never shot leaves no hole
+            folder.put_back_now()  # a reshoot that never shot leaves no hole
+        except Exception as exc:  # said, never in place of why the resume did not open
+            on_note(Note(f"the images set aside could not be put back: {exc}", "warning"))
         finally:
             unlock_session(folder.root)
-        if back:
-            on_note(Note(put_back_said(back), "warning"))
+        if folder.put_back is not None:
+            on_note(Note(put_back_said(folder.put_back), "warning"))
         raise
 
 
-def put_back_said(files: list[str]) -> str:
-    """What a reshoot that never shot says of the images it put back
-    (:meth:`SessionFolder.put_back_unshot`'s ``files``)."""
-    images = sorted({Path(p).stem for p in files})
+def put_back_said(back: Any) -> str:
+    """What a reshoot that never shot says of what it put back (a
+    :class:`~rti_rig.runtime.session.PutBack`): those as captured, and those that were not
+    (``--reshoot-lost``'s, put back as they were found)."""
+    parts = []
+    if back.as_captured:
+        parts.append(f"{', '.join(back.as_captured)} put back as captured")
+    if back.not_as_captured:
+        parts.append(
+            f"{', '.join(back.not_as_captured)} put back as found (still missing or changed "
+            "since capture)"
+        )
     return (
-        f"Nothing was reshot: {', '.join(images)} put back as captured, and lights.lp lists "
-        "every image again: the session is as it was before this resume."
+        f"Nothing was reshot: {'; '.join(parts)}, and lights.lp lists every image again: the "
+        "session's images are as they were before this resume."
     )
 
 
