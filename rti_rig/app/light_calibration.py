@@ -393,6 +393,7 @@ def refuse_unverified(
     total: int,
     what: str = "card",
     instead: str = "shoot the card again",
+    harm: str = "a calibration measured from them would misjudge those LEDs, or all of them",
 ) -> None:
     """Refuse a card (or sphere: ``what``) session whose linear TIFFs are not as captured
     (checked against the journal's checksums), saying what to do ``instead`` of restoring
@@ -416,9 +417,8 @@ def refuse_unverified(
     if bad:
         shown = "; ".join(bad[:6]) + (f"; and {len(bad) - 6} more" if len(bad) > 6 else "")
         raise SessionError(
-            f"{shown_path(root)}: {len(bad)} {what} image(s) not as captured ({shown}): a "
-            "calibration measured from them would misjudge those LEDs, or all of them; restore the "
-            f"originals from a backup copy of the folder, or {instead}"
+            f"{shown_path(root)}: {len(bad)} {what} image(s) not as captured ({shown}): "
+            f"{harm}; restore the originals from a backup copy of the folder, or {instead}"
         )
 
 

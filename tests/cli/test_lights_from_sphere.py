@@ -283,6 +283,22 @@ def test_a_camera_triggered_dome_measures_its_leds_with_its_design_standing_in(
     # a ring dome's tables are what the .lp replaces (its "count" had been named)
     assert "under [dome] in the dome's config" in said(r), said(r)
     assert said(r).endswith("in place of its [[dome.rings]] tables."), said(r)
+    # an image changed since capture: this dome cannot reshoot one, and is not told to
+    tif = out / "linear" / "image_007.tif"
+    data = bytearray(tif.read_bytes())
+    data[-1] ^= 0xFF
+    tif.write_bytes(bytes(data))
+    again = tmp_path / "again.lp"
+    r = CliRunner().invoke(
+        app,
+        ["lights-from-sphere", str(out), "--sphere", f"{x},{y},{radius}", "--out", str(again)],
+        terminal_width=400,
+    )
+    assert r.exit_code == 2 and not again.exists(), said(r)
+    assert "1 sphere image(s) not as captured (linear/image_007.tif" in said(r), said(r)
+    assert "directions measured from them would be wrong for those LEDs" in said(r), said(r)
+    assert "cannot continue a session or reshoot single images" in said(r), said(r)
+    assert "--reshoot-lost" not in said(r), said(r)
 
     fib = tmp_path / "fib"
     fib.mkdir()
@@ -393,21 +409,22 @@ def test_a_circle_pixels_off_the_spheres_outline_is_said_with_the_outline(
     assert r.exit_code == 0, r.output
     text = said(r)
     found = re.search(
-        r"warning: the sphere's outline in the images is at ([\d.]+),([\d.]+),([\d.]+) "
-        r"\(column, row, radius; open \S+image_001\.jpg to see it\), (\d\.\d) px from "
-        r"--sphere \S+: every direction is off by about 2\.4° per pixel the circle is off, so "
-        r"these may be off by up to (\d+)°; if that outline is the sphere's, measure again with "
-        r"--sphere (\S+)",
+        r"warning: the sphere's outline in the images is centred at column ([\d.]+), row "
+        r"([\d.]+) \(open \S+image_001\.jpg to see it\), (\d\.\d) px from the centre of "
+        r"--sphere \S+: near the sphere's centre a direction moves about 2\.4° per pixel the "
+        r"circle is off \(more towards its rim\), so these may be off by (\d+)° or more; if "
+        r"that is the sphere's outline, measure again with --sphere (\S+) \(the radius as "
+        r"given: check it against the image too\)",
         text,
     )
     assert found is not None, text
-    outline = [float(v) for v in found.groups()[:3]]
-    assert np.abs(np.subtract(outline, (x, y, radius))).max() <= 0.2, outline
-    assert 2.8 <= float(found[4]) <= 3.2 and found[5] == "7", text
-    assert found[6] == ",".join(found.groups()[:3]), text
+    centre = [float(v) for v in found.groups()[:2]]
+    assert np.abs(np.subtract(centre, (x, y))).max() <= 0.2, centre
+    assert 2.8 <= float(found[3]) <= 3.2 and found[4] == "7", text
+    assert found[5] == f"{found[1]},{found[2]},{radius:g}", text
     # the outline's circle, as said, gives the dome's LEDs; the right circle gives no warning
     good = tmp_path / "good.lp"
-    argv = ["lights-from-sphere", str(sphere_session), "--sphere", found[6]]
+    argv = ["lights-from-sphere", str(sphere_session), "--sphere", found[5]]
     r = CliRunner().invoke(app, [*argv, "--out", str(good)], terminal_width=400)
     assert r.exit_code == 0 and "warning" not in said(r), said(r)
     errors = _angles(directions_of(read_lp(good)), directions_of(read_lp(TRUTH)))

@@ -31,13 +31,12 @@ from rti_rig.reconstruct.sphere_lights import (
     Rejected,
     SphereCircleError,
     as_grey,
-    circle_offset_px,
     find_highlight,
     outline_circle,
 )
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.flash_sync import CameraTriggeredLighting
-from rti_rig.runtime.session import planned_steps, read_manifest
+from rti_rig.runtime.session import planned_steps, read_manifest, unresumable
 
 
 @dataclass(frozen=True)
@@ -189,12 +188,17 @@ def lights_from_sphere(request: SphereRequest) -> SphereLights:
     check_output_file(out, request.force, _shot_with_inputs(config))
     refuse_if_disowned(root)
     steps = _steps_by_led(root, manifest)
+    # a camera-triggered dome cannot reshoot one image: what it can do instead is said
+    instead = unresumable(root)
     refuse_unverified(
         root,
         steps,
         planned_steps(manifest),
         "sphere",
-        f"reshoot them: rti-rig run --resume {shell_word(str(root))} --reshoot-lost",
+        f"reshoot them: rti-rig run --resume {shell_word(str(root))} --reshoot-lost"
+        if instead is None
+        else instead[0].lower() + instead[1:],
+        "directions measured from them would be wrong for those LEDs",
     )
     found: list[Highlight] = []
     names: list[str] = []
@@ -252,29 +256,35 @@ def _crop_origin(circle: Circle) -> tuple[int, int]:
 
 
 def _circle_disputed(crops: list[np.ndarray], circle: Circle, first: str) -> tuple[str, ...]:
-    """A note when the sphere's outline in the images (their median: the highlights gone)
-    is found clearly and lies off the circle given by more than a pixel and by more than
-    about 1° of direction (a pixel is about 115°/R); none otherwise.
+    """A note when the centre of the sphere's outline in the images (their median: the
+    highlights gone) is found clearly and lies off the circle's centre given by more than a
+    pixel and by more than about 1° of direction near the sphere's centre (a pixel is about
+    115°/R there, more towards the rim); none otherwise.
 
     Why: ``--sphere`` 3 px off (R = 48) had moved every LED by 7°, written without a word,
-    though the outline stood in every image (:func:`outline_circle`). A note, not a refusal:
-    an outline can be another's (a stand, a shadow on a dark ground), the user judges."""
+    though the outline stood in every image (:func:`outline_circle`). The centre only: a
+    glossy sphere's bright rim, a chrome sphere's band mirroring the ground and a shadow's
+    halo are rings about the same centre, which the steepest step along a ray may take for
+    the outline, so the radius found is no evidence (a warning had then advised a worse
+    radius); the centre stays right to a twentieth of a pixel. A note, not a refusal: an
+    outline can be another's (a stand, a shadow on a dark ground), the user judges."""
     x0, y0 = _crop_origin(circle)
     local = Circle(circle.x - x0, circle.y - y0, circle.radius)
     found = outline_circle(np.median(np.stack(crops), axis=0), local)
     if found is None:
         return ()
-    seen = Circle(found.x + x0, found.y + y0, found.radius)
-    off = circle_offset_px(seen, circle)
+    cx, cy = found.x + x0, found.y + y0
+    off = math.hypot(cx - circle.x, cy - circle.y)
     per_px = math.degrees(2.0 / circle.radius)  # a normal's tilt doubles in the reflection
     if off <= max(1.0, 1.0 / per_px):
         return ()
     given = ",".join(f"{v:g}" for v in (circle.x, circle.y, circle.radius))
-    shown = ",".join(f"{v:.1f}" for v in (seen.x, seen.y, seen.radius))
+    again = f"{cx:.1f},{cy:.1f},{circle.radius:g}"
     return (
-        f"the sphere's outline in the images is at {shown} (column, row, radius; open "
-        f"{first} to see it), {off:.1f} px from --sphere {given}: every direction is off by "
-        f"about {per_px:.1f}° per pixel the circle is off, so these may be off by up to "
-        f"{off * per_px:.0f}°; if that outline is the sphere's, measure again with --sphere "
-        f"{shown}",
+        f"the sphere's outline in the images is centred at column {cx:.1f}, row {cy:.1f} "
+        f"(open {first} to see it), {off:.1f} px from the centre of --sphere {given}: near the "
+        f"sphere's centre a direction moves about {per_px:.1f}° per pixel the circle is off "
+        f"(more towards its rim), so these may be off by {off * per_px:.0f}° or more; if that "
+        f"is the sphere's outline, measure again with --sphere {again} (the radius as given: "
+        "check it against the image too)",
     )
