@@ -255,6 +255,20 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
         f"(lowest {lowest:.1f}° above the card)."
     )
     in_force = card.correction is not None
+    # the LEDs no image shows, and those shown but left out as too low: "the 1 others were
+    # not shot" had been said of an LED --min-elevation-deg left out of a full card session
+    not_shot = geometry.count - len(set(int(i) for i in card.leds))
+    below = geometry.count - len(measured) - not_shot
+    unmeasured = ", ".join(
+        [
+            *([f"{not_shot} not shot"] if not_shot else []),
+            *(
+                [f"{below} below --min-elevation-deg {request.min_elevation_deg:g}°"]
+                if below
+                else []
+            ),
+        ]
+    )
     #: what is left after a correction in force that needs no further calibration
     even_enough = 0.01
     if in_force:
@@ -269,8 +283,8 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
                 if cal.shot_spread >= even_enough
                 else " — the dome is even."
                 if cal.measured.all()
-                else f" — the {len(measured)} LEDs measured are even (the "
-                f"{geometry.count - len(measured)} others were not shot, so not checked)."
+                else f" — the {len(measured)} LEDs measured are even ({unmeasured}, so "
+                "not checked)."
             )
         )
         out.print(
@@ -320,11 +334,21 @@ def _calibrate_and_report(request: CalibrateRequest, reported: list[bool]) -> No
         from rti_rig.core.out_folders import free_folder_beside
 
         again = run_words(rig_config, free_folder_beside(card_session, "card"))
+        ways = [
+            *(
+                [
+                    f"shoot the card under every LED ({again}, without --lights) and calibrate "
+                    "from that session"
+                ]
+                if not_shot
+                else []
+            ),
+            *(["give a lower --min-elevation-deg"] if below else []),
+        ]
         out.print(
             f"The correction in force is good for the {len(measured)} LEDs measured; to check "
-            f"the other {geometry.count - len(measured)}, shoot the card under every LED "
-            f"({escape(again)}, without --lights) and calibrate from that session. To use "
-            f"this one meanwhile, set under {escape('[dome.serial]')} in "
+            f"the others ({unmeasured}), {escape(' and '.join(ways))}. To use this one "
+            f"meanwhile, set under {escape('[dome.serial]')} in "
             f"{escape(shown_path(rig_config))}:",
             highlight=False,
         )

@@ -95,9 +95,30 @@ def test_a_partial_card_shot_under_a_good_correction_claims_no_more_than_its_led
 
     assert "6 of 48 LEDs measured" in text, text
     assert "the dome is even" not in text and "no new calibration is needed" not in text, text
-    assert "the 6 LEDs measured are even (the 42 others were not shot, so not checked)" in text
+    assert "the 6 LEDs measured are even (42 not shot, so not checked)" in text
     assert (
-        "The correction in force is good for the 6 LEDs measured; to check the other 42, shoot "
-        f"the card under every LED (rti-rig run {corrected} --out {tmp_path / 'again-card'}, "
-        "without --lights)"
+        "The correction in force is good for the 6 LEDs measured; to check the others (42 not "
+        f"shot), shoot the card under every LED (rti-rig run {corrected} --out "
+        f"{tmp_path / 'again-card'}, without --lights)"
     ) in text, text
+
+
+def test_an_led_left_out_as_too_low_is_not_said_unshot(tmp_path: Path) -> None:
+    """Every LED shot under a good correction, one left out by --min-elevation-deg: it had
+    been said "the 1 others were not shot", with a full card run to check it (just done)."""
+    rig = card_rig(tmp_path)
+    first = tmp_path / "first"
+    shoot(rig, first)
+    _calibrate(first, rig, tmp_path / "first.toml")
+    corrected = card_rig(
+        tmp_path, f'intensity_correction_file = "{tmp_path / "first.toml"}"\n', "cal.toml"
+    )
+    full = tmp_path / "full"
+    shoot(corrected, full)
+    argv = ["calibrate-lights", str(full), "--rig", str(corrected), "--out"]
+    r = runner.invoke(app, [*argv, str(tmp_path / "full.toml"), "--min-elevation-deg", "9.65"])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "47 LEDs measured are even (1 below --min-elevation-deg 9.65°, so not checked)" in text
+    assert "not shot" not in text and "without --lights" not in text, text
+    assert "to check the others (1 below --min-elevation-deg 9.65°), give a lower" in text, text
