@@ -65,14 +65,20 @@ def print_verdict(session: Path | None) -> None:
         # for the verdict (``session._verdict_terminable``) raises the stopping module's
         # Terminated, as every command's does: it is the only handler installed while the
         # verdict is computed, so a Terminated here is the verdict's stop
-        signum = stop_signal(exc)
-        from rti_rig.core.out_folders import fit_beside
+        raise verdict_skipped(exc, session) from None
 
-        err.print(
-            f"[yellow]QA verdict skipped ({stop_words(signum)}):[/] the session is complete; "
-            f"{escape(fit_beside(session))} gives the verdict"
-        )
-        raise typer.Exit(code=stop_exit_code(signum)) from None
+
+def verdict_skipped(exc: BaseException, session: Path) -> typer.Exit:
+    """Say that the verdict of the complete ``session`` was cut short by the stop ``exc`` (a
+    KeyboardInterrupt or Terminated) and which command gives it; the exit that stop has."""
+    signum = stop_signal(exc)
+    from rti_rig.core.out_folders import fit_beside
+
+    err.print(
+        f"[yellow]QA verdict skipped ({stop_words(signum)}):[/] the session is complete; "
+        f"{escape(fit_beside(session))} gives the verdict"
+    )
+    return typer.Exit(code=stop_exit_code(signum))
 
 
 def _say_verdict_warnings(caught: list[warnings.WarningMessage]) -> None:

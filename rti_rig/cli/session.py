@@ -414,18 +414,24 @@ def run(
             f" {escape(fit_beside(opened.out_dir))} gives it",
         )
         if not no_verdict:
-            from rti_rig.cli.fit import print_verdict
+            from rti_rig.cli.fit import print_verdict, verdict_skipped
 
-            with _verdict_terminable():
-                try:
-                    print_verdict(opened.out_dir)
-                except typer.Exit:
-                    # a Ctrl-C or SIGTERM said by the verdict: its exit (130 or 143), after
-                    # the unsafe end's words, which that exit had skipped
-                    _refuse_unsafe_end(unsafe, exit_code=None)
-                    raise
-                except Exception as exc:
-                    _verdict_failed(exc, opened.out_dir)
+            try:
+                with _verdict_terminable():
+                    try:
+                        print_verdict(opened.out_dir)
+                    except typer.Exit:
+                        # a Ctrl-C or SIGTERM said by the verdict: its exit (130 or 143),
+                        # after the unsafe end's words, which that exit had skipped
+                        _refuse_unsafe_end(unsafe, exit_code=None)
+                        raise
+                    except Exception as exc:
+                        _verdict_failed(exc, opened.out_dir)
+            except (KeyboardInterrupt, Terminated) as exc:
+                # a stop as the verdict's handlers went in, before its own try (CI met it
+                # once: "rti-rig: stopped (Ctrl-C)", the verdict's words unsaid)
+                _refuse_unsafe_end(unsafe, exit_code=None)
+                raise verdict_skipped(exc, opened.out_dir) from None
         _refuse_unsafe_end(unsafe)
         _say_next(opened.out_dir)
 
@@ -746,6 +752,15 @@ def _verdict_terminable() -> Iterator[None]:
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
         raise Terminated(as_received(signum))  # a hang-up's: SIGHUP
 
+    stopped: list[int] = []
+
+    def interrupted(signum, frame) -> None:  # type: ignore[no-untyped-def]
+        # once: a second SIGINT while the first is said (a script's repeated kill -INT) had
+        # cut the words short with a bare "stopped (Ctrl-C)"
+        if not stopped:
+            stopped.append(signum)
+            raise KeyboardInterrupt
+
     handlers: dict[int, Any] = {signal.SIGTERM: terminated}
     if handlers_settable() and signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
         # a run started with SIGINT ignored (a script's `run … &`) is stopped by one while it
@@ -753,7 +768,7 @@ def _verdict_terminable() -> Iterator[None]:
         # a capture went unanswered in the seconds of QA that follow. Now it ends the verdict
         # as a Ctrl-C does (exit 130, the command that gives the verdict said); a handler of
         # a caller's own (run called from Python) is left to answer as it chooses
-        handlers[signal.SIGINT] = signal.default_int_handler
+        handlers[signal.SIGINT] = interrupted
     with signal_handlers(handlers):
         yield
 

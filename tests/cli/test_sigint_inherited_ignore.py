@@ -18,6 +18,7 @@ import threading
 import time
 from pathlib import Path
 
+import pytest
 from conftest import CONFIGS
 
 #: the longest a step of this test waits (a loaded CI machine), never the time it takes
@@ -67,3 +68,27 @@ def test_sigint_in_the_verdict_of_a_run_started_with_it_ignored_ends_the_verdict
     assert "Traceback" not in said
     runner = json.loads((out / "manifest.json").read_text())["runner"]
     assert runner["finish_reason"] == "completed", runner
+
+
+def test_a_stop_before_the_verdicts_own_try_is_said_as_the_verdicts(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A SIGINT as the verdict's handlers went in, before the verdict's own ``try`` (CI met it
+    once in the test above): the run had said only "rti-rig: stopped (Ctrl-C)", not that the
+    session is complete and which command gives its verdict."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+    from rti_rig.cli import fit as cli_fit
+
+    def stopped_at_once(session: Path | None) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli_fit, "print_verdict", stopped_at_once)
+    out = tmp_path / "s"
+    argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), "--lights", "12"]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    assert "QA verdict skipped (Ctrl-C): the session is complete;" in said, said
+    assert f"rti-rig fit {out} --out {out}-fit gives the verdict" in said, said
