@@ -827,7 +827,8 @@ class SessionFolder:
         """Undo a reshoot's reopen of a completed session that never began to shoot (its rig
         did not open or connect, or a stop came before the capture): every image file it set
         aside goes back where it was and ``lights.lp`` lists every step again, as the
-        completed session had; returns what was put back, None when this reopen was not such
+        completed session had, and :attr:`committed` is what the folder then holds as captured;
+        returns what was put back, None when this reopen was not such
         a one or did more than set image files aside (a hand-edited ``lights.lp`` kept, the
         journal repaired or its records restored, a RAW download set aside: then the folder
         stays as the reopen left it, each of those said by the resume as it did them).
@@ -865,13 +866,8 @@ class SessionFolder:
                     raise SessionWriteError(place, exc) from None
             records = scan_journal(self.root, self.names).records
             latest = _latest_records(records)
-            write_lp_atomic(
-                self.root / LP_NAME,
-                [
-                    LpEntry(r.image, r.actual_direction)
-                    for r in (_to_record(latest[i]) for i in sorted(latest))
-                ],
-            )
+            # every step listed, as the completed session had (lost ones too: as found)
+            _relist_verified(self.root, {i: _to_record(r) for i, r in latest.items()}, "")
             for aside, _ in back:  # the folders the reopen made and left empty now
                 for folder in aside.parents:
                     if not folder.is_relative_to(self.root / "recovered"):
@@ -879,6 +875,7 @@ class SessionFolder:
                     if folder.is_dir() and not any(folder.iterdir()):
                         folder.rmdir()
         intact = verified_steps(self.root, records)
+        self.committed = intact  # what the folder holds as captured now
         stems = sorted({Path(place.name).stem for _, place in back})
         by_stem = {Path(str(rec["image"])).stem: i for i, rec in latest.items()}
         return PutBack(
@@ -888,14 +885,10 @@ class SessionFolder:
         )
 
     def put_back_now(self) -> None:
-        """:meth:`put_back_unshot` once (kept in :attr:`put_back`), and the committed steps
-        read again from the folder when anything went back."""
-        if self.put_back is not None:
-            return
-        self.put_back = self.put_back_unshot()
-        if self.put_back is not None:
-            records = scan_journal(self.root, self.names).records
-            self.committed = verified_steps(self.root, records)
+        """:meth:`put_back_unshot` once, what it put back kept in :attr:`put_back` (a second
+        call finds the files in place and would say nothing was)."""
+        if self.put_back is None:
+            self.put_back = self.put_back_unshot()
 
     @property
     def images_kept(self) -> int:

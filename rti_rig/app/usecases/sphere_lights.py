@@ -244,15 +244,15 @@ _OUTLINE_IMAGES = 15
 
 def _around(grey: np.ndarray, circle: Circle) -> np.ndarray:
     """The part of ``grey`` around ``circle`` (float32), where its outline is searched."""
-    x0, y0 = _crop_origin(circle)
-    reach = int(np.ceil(_AROUND * circle.radius))
-    x1, y1 = int(np.floor(circle.x)) + reach + 1, int(np.floor(circle.y)) + reach + 1
+    x0, y0, x1, y1 = _crop_box(circle)
     return grey[y0:y1, x0:x1].astype(np.float32)
 
 
-def _crop_origin(circle: Circle) -> tuple[int, int]:
+def _crop_box(circle: Circle) -> tuple[int, int, int, int]:
+    """(first column, first row, end column, end row) of the crop :func:`_around` takes."""
     reach = int(np.ceil(_AROUND * circle.radius))
-    return max(0, int(np.floor(circle.x)) - reach), max(0, int(np.floor(circle.y)) - reach)
+    cx, cy = int(np.floor(circle.x)), int(np.floor(circle.y))
+    return max(0, cx - reach), max(0, cy - reach), cx + reach + 1, cy + reach + 1
 
 
 def _circle_disputed(crops: list[np.ndarray], circle: Circle, first: str) -> tuple[str, ...]:
@@ -268,7 +268,7 @@ def _circle_disputed(crops: list[np.ndarray], circle: Circle, first: str) -> tup
     the outline, so the radius found is no evidence (a warning had then advised a worse
     radius); the centre stays right to a twentieth of a pixel. A note, not a refusal: an
     outline can be another's (a stand, a shadow on a dark ground), the user judges."""
-    x0, y0 = _crop_origin(circle)
+    x0, y0, _, _ = _crop_box(circle)
     local = Circle(circle.x - x0, circle.y - y0, circle.radius)
     found = outline_circle(np.median(np.stack(crops), axis=0), local)
     if found is None:
