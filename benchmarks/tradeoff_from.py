@@ -34,7 +34,8 @@ averaged to grey, and shrunk to at most ``MAX_PX`` wide for speed.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from itertools import pairwise
 from pathlib import Path
 from typing import Any
@@ -43,6 +44,7 @@ import cv2
 import numpy as np
 
 from benchmarks.tradeoff import Row, best_floor, plot, write_csv
+from rti_rig.core.errors import RtiRigError
 from rti_rig.core.shell_words import shell_word
 
 COUNTS = (6, 9, 12, 18, 24, 36, 48)
@@ -456,6 +458,49 @@ def run_tradeoff_from(
 NORMAL_TARGETS_DEG = (1.0, 2.0, 3.0)
 RELIGHT_TARGETS_DB = (0.5, 1.0, 2.0)
 
+
+@dataclass(frozen=True)
+class Targets:
+    """What the advice finds the fewest lights for: mean normal errors (degrees) and
+    relighting losses (dB below every light's fit.rti). Why options: the fixed 1°/2°/3° and
+    0.5/1/2 dB are not every lab's; a collection's own tolerance is what the trade is run to
+    answer."""
+
+    normals_deg: tuple[float, ...] = NORMAL_TARGETS_DEG
+    relight_db: tuple[float, ...] = RELIGHT_TARGETS_DB
+
+    def options(self) -> str:
+        """The command-line options that give these targets ('' for the defaults)."""
+        said = ""
+        if self.normals_deg != NORMAL_TARGETS_DEG:
+            said += "".join(f" --target-deg {t:g}" for t in self.normals_deg)
+        if self.relight_db != RELIGHT_TARGETS_DB:
+            said += "".join(f" --target-db {t:g}" for t in self.relight_db)
+        return said
+
+
+def checked_targets(degrees: Sequence[float], decibels: Sequence[float]) -> Targets:
+    """The targets given (each list sorted, repeats dropped; the default where none is given),
+    or a refusal naming the option: a normal error is above 0° and below 90°, a relighting
+    loss above 0 dB (a target of 0 is met by every light alone, NaN by none)."""
+    for value in degrees:
+        if not 0.0 < value < 90.0:  # NaN fails both
+            raise RtiRigError(
+                f"--target-deg {value:g}: a mean normal error target is above 0 and below 90 "
+                "degrees (e.g. --target-deg 1.5)"
+            )
+    for value in decibels:
+        if not 0.0 < value < 100.0:
+            raise RtiRigError(
+                f"--target-db {value:g}: a relighting target is the dB below every light's "
+                "fit.rti a file may lose: above 0 and below 100 (e.g. --target-db 0.5)"
+            )
+    return Targets(
+        tuple(sorted(set(degrees))) or NORMAL_TARGETS_DEG,
+        tuple(sorted(set(decibels))) or RELIGHT_TARGETS_DB,
+    )
+
+
 #: The advice's planners: the summary's column keys, how a user says each, and the command
 #: that shoots N lights so (``{rig}``, ``{n}``, ``{floor}`` filled in).
 _PLANNERS = (
@@ -500,14 +545,20 @@ def _fewest(series: dict[int, Row], meets: Callable[[Row], bool]) -> int | None:
 
 
 def how_many_lights(
-    rows: list[Row], floor: float, per_light_s: float, rig: str = "RIG"
+    rows: list[Row],
+    floor: float,
+    per_light_s: float,
+    rig: str = "RIG",
+    targets: Targets | None = None,
 ) -> list[str]:
     """The summary's answer to what it is run for: for each target (mean normal error, and
     relighting of the fit.rti `rti-rig fit` writes, below every light's), the fewest lights
     each planner needs, the fastest of them with its session time, and the command.
+    ``targets``: the lab's own (``--target-deg``/``--target-db``); the defaults without.
 
     Why: the tables gave 5 planners × 7 counts of cells and left a conservator to read the
     answer out of them (QA, 2026-12-05)."""
+    targets = targets or Targets()
     counts = sorted({r.n for r in rows if r.method != "all"})
     every = next(r for r in rows if r.method == "all")
     by = {(r.method, r.objective, r.floor_deg, r.n): r for r in rows}
@@ -561,12 +612,12 @@ def how_many_lights(
         "adaptive session's decisions.",
         "",
     ]
-    for target in NORMAL_TARGETS_DEG:
+    for target in targets.normals_deg:
         lines.append(
             line(f"Normals within {target:g}°", lambda r, t=target: r.normal_mean_deg <= t)
         )
     if np.isfinite(every.file_psnr_db):
-        for target in RELIGHT_TARGETS_DB:
+        for target in targets.relight_db:
             lines.append(
                 line(
                     f"Relighting within {target:g} dB",
@@ -585,6 +636,7 @@ def summarise_from(
     held: list[str],
     per_light: tuple[float, str] = (PER_LIGHT_S, PER_LIGHT_SAID),
     rig_word: str = "RIG",
+    targets: Targets | None = None,
 ) -> str:
     """The markdown summary; ``held``: the names of the held-out lights; ``per_light``: the
     seconds a light takes and where they come from; ``rig_word``: the rig config as the
@@ -604,7 +656,7 @@ def summarise_from(
         f"chooses among the other {every.n}. Session time: "
         f"{per_light_s:.2f} s a light ({per_light_said}).",
         "",
-        *how_many_lights(rows, floor, per_light_s, rig_word),
+        *how_many_lights(rows, floor, per_light_s, rig_word, targets),
         "| N | session s | uniform 0° | uniform, best floor here "
         f"({floor:g}°, hindsight) | optimal | adaptive | adaptive, `--objective relight` |",
         "|---|---|---|---|---|---|---|",
@@ -687,6 +739,7 @@ def bench_from(
     force: bool = False,
     rig: Path | None = None,
     per_light: tuple[float, str] | None = None,
+    targets: Targets | None = None,
 ) -> str:
     """Run, write results.csv, the plots and summary.md into ``out_dir`` (nothing written when
     it is None: the summary is only returned); return the summary (its command line says
@@ -710,15 +763,21 @@ def bench_from(
     command = f"rti-rig bench tradeoff --from {shell_word(lp)}"
     if rig is not None:
         command += f" --rig {shell_word(rig)}"
+    targets = targets or Targets()
+    command += targets.options()
     rig_word = advice_rig(lp, rig)
     if out_dir is None:
-        return summarise_from(rows, time.perf_counter() - t0, command, held, per_light, rig_word)
+        return summarise_from(
+            rows, time.perf_counter() - t0, command, held, per_light, rig_word, targets
+        )
     out_dir.mkdir(parents=True, exist_ok=True)
     write_csv(rows, out_dir / "results.csv")
     for path in plot(rows, out_dir):
         if "arm_time" in path.name:  # a replayed acquisition is a dome: no arm time to plot
             path.unlink()
     command += f" --out {shell_word(out_dir)}" + (" --force" if force else "")
-    text = summarise_from(rows, time.perf_counter() - t0, command, held, per_light, rig_word)
+    text = summarise_from(
+        rows, time.perf_counter() - t0, command, held, per_light, rig_word, targets
+    )
     (out_dir / "summary.md").write_text(text + "\n", encoding="utf-8")
     return text

@@ -103,6 +103,22 @@ def bench_tradeoff(
             "is longer (RTIPy's); else the replayed dome's defaults, 1.17 s a light.",
         ),
     ] = None,
+    target_deg: Annotated[
+        list[float] | None,
+        typer.Option(
+            "--target-deg",
+            help="With --from: a mean normal error (degrees) to find the fewest lights for; "
+            "repeat for several (default 1, 2 and 3).",
+        ),
+    ] = None,
+    target_db: Annotated[
+        list[float] | None,
+        typer.Option(
+            "--target-db",
+            help="With --from: a relighting loss (dB below every light's fit.rti) to find the "
+            "fewest lights for; repeat for several (default 0.5, 1 and 2).",
+        ),
+    ] = None,
 ) -> None:
     """Error against number of lights and session time, for every planner, on simulated scenes
     (or on your own acquisition with --from).
@@ -138,7 +154,7 @@ def bench_tradeoff(
 
     with warnings.catch_warnings():  # restored after: the CLI may run inside a test process
         warnings.showwarning = _as_note
-        _tradeoff(out_dir, quick, from_lp, force, rig)
+        _tradeoff(out_dir, quick, from_lp, force, rig, (target_deg or [], target_db or []))
 
 
 def _acquisition_lp(given: Path, notes: list[str] | None = None) -> Path:
@@ -231,6 +247,36 @@ def _check_out_folder(out_dir: Path, force: bool, acquisition: Sequence[Path] = 
     ensure_writable_folder(out_dir)
 
 
+def _first_missing(folder: Path) -> Path | None:
+    """The outermost of ``folder`` and its parents that does not exist yet (None if it
+    exists): what :func:`_check_out_folder` will create."""
+    missing = None
+    for path in (folder.absolute(), *folder.absolute().parents):
+        if path.exists() or path.is_symlink():
+            break
+        missing = path
+    return missing
+
+
+def _unmake(folder: Path | None, made: Path | None) -> None:
+    """Remove the folders this run created for ``--out`` (``folder`` up to ``made``) while
+    they are still empty. Why: a trade stopped or refused before its results were written
+    said "nothing written to OUT" and left OUT behind, empty, so the same command run again
+    met a folder it had made itself; a folder that was there before, or holds anything, is
+    never touched."""
+    if folder is None or made is None:
+        return
+    path = folder.absolute()
+    while True:
+        try:
+            path.rmdir()  # only an empty folder goes
+        except OSError:
+            return
+        if path == made:
+            return
+        path = path.parent
+
+
 def _nothing_written(options: str) -> str:
     """What is said after a trade-off run without ``--out``: the same command with a folder not
     there yet (``options``: its own, as shell words). Why: "give --out DIR" pasted as printed
@@ -297,13 +343,37 @@ def _stopped_midway(
 
 
 def _tradeoff(
-    out_dir: Path | None, quick: bool, from_lp: Path | None, force: bool, rig: Path | None = None
+    out_dir: Path | None,
+    quick: bool,
+    from_lp: Path | None,
+    force: bool,
+    rig: Path | None = None,
+    given_targets: tuple[Sequence[float], Sequence[float]] = ((), ()),
 ) -> None:
-    """The body of ``bench tradeoff``, once the command has found the benchmarks."""
+    """The body of ``bench tradeoff``, once the command has found the benchmarks;
+    ``given_targets``: ``--target-deg`` and ``--target-db`` as given."""
     import time
 
     from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
-    from benchmarks.tradeoff_from import bench_from, check_acquisition, rig_seconds_per_light
+    from benchmarks.tradeoff_from import (
+        bench_from,
+        check_acquisition,
+        checked_targets,
+        rig_seconds_per_light,
+    )
+
+    if any(given_targets) and from_lp is None:  # accepted and ignored, they would change nothing
+        raise fail(
+            RtiRigError(
+                "--target-deg and --target-db set the advice of the trade on your own "
+                "acquisition: they go with --from ACQ/dirs.lp (the simulated trade gives no "
+                "advice)"
+            )
+        )
+    try:  # before minutes of computing, not after
+        targets = checked_targets(*given_targets)
+    except RtiRigError as exc:
+        raise fail(exc) from None
 
     per_light: tuple[float, str] | None = None  # the rig's time per light, read once
     if rig is not None:  # its config read before minutes of computing, not after
@@ -338,18 +408,28 @@ def _tradeoff(
             print_notes(notes)  # what the reader noted, said with the refusal as on a pass
             raise fail(exc) from None
         print_notes(notes)
+    made: Path | None = None  # the first folder of --out this run creates, if any
     if out_dir is not None:  # before minutes of computing, not after
+        made = _first_missing(out_dir)
         try:
             _check_out_folder(out_dir, force, acquisition)
         except RtiRigError as exc:
+            _unmake(out_dir, made)
             raise fail(exc) from None
     if from_lp is not None:
         try:
             with sigterm_stops():
                 text = bench_from(
-                    from_lp, out_dir, _plain, force=force, rig=rig, per_light=per_light
+                    from_lp,
+                    out_dir,
+                    _plain,
+                    force=force,
+                    rig=rig,
+                    per_light=per_light,
+                    targets=targets,
                 )
         except (KeyboardInterrupt, Terminated) as exc:
+            _unmake(out_dir, made)
             # said, with what is on disk (only "stopped (Ctrl-C)" had been, an --out folder
             # left empty without a word): the trade on an acquisition is written at its end
             signum = stop_signal(exc)
@@ -364,14 +444,17 @@ def _tradeoff(
             )
             raise typer.Exit(code=stop_exit_code(signum)) from None
         except RtiRigError as exc:
+            _unmake(out_dir, made)
             raise fail(exc) from None
         except ValueError as exc:
+            _unmake(out_dir, made)
             raise fail(RtiRigError(str(exc))) from None
         _plain(text)
         if out_dir is None:
             again = f" --from {shell_word(from_lp)}"
             if rig is not None:
                 again += f" --rig {shell_word(rig)}"
+            again += targets.options()
             _plain(_nothing_written(again))
         return
 
@@ -391,6 +474,7 @@ def _tradeoff(
         # "stopped (Ctrl-C)": every scene measured was lost, --out left empty)
         signum = stop_signal(exc)
         _stopped_midway(rows, settings, out_dir, command, time.perf_counter() - t0, signum)
+        _unmake(out_dir, made)  # only if nothing was written into it
         raise typer.Exit(code=stop_exit_code(signum)) from None
     text = summarise(rows, settings, time.perf_counter() - t0, command)
     if out_dir is not None:

@@ -1949,8 +1949,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
                 except BaseException:
                     # a run that ends before its first image (a dome that could not be
                     # connected) leaves no bar: an empty "capturing 0/6" had stood above
-                    # "Nothing was captured"
-                    if progress.tasks[0].completed == len(folder.done) == 0:
+                    # "Nothing was captured", and a resume's "capturing 4/6" (the images of
+                    # earlier runs) above "Nothing was commanded", as if this run took them
+                    if not stepped:
                         progress.update(task, visible=False)
                     raise
                 finally:

@@ -1307,7 +1307,15 @@ def parse_lp(
             + ", not 1; read as directions (normalised). If the file gives lamp positions "
             "rather than directions, they are only right for a distant lamp"
         )
-    if declared is not None and declared != len(entries):
+    if declared is None:
+        # read all the same (the lines say what they are), but said: the profile every known
+        # reader accepts opens with the count, so another tool may refuse the file as it is
+        notes.append(
+            f"{shown_path(source)}, line {first_no}: no count line (the .lp every known reader "
+            f"accepts opens with the number of lights); the {len(entries)} listed lights are "
+            f"used. To give it to another tool, add a first line '{len(entries)}'"
+        )
+    elif declared != len(entries):
         notes.append(
             f"{shown_path(source)}, line {first_no}: count line says {declared} lights but the "
             f"file lists {len(entries)}; the {len(entries)} listed lights are used"

@@ -385,6 +385,11 @@ def test_a_stopped_run_keeps_and_says_the_scenes_measured_whole(  # type: ignore
     r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick"])
     assert r.exit_code == 130, r.output
     assert "Stopped (Ctrl-C) before a scene was measured whole: nothing written" in r.output
+    # with an --out the run made: not left behind, empty
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick", "--out", "none"])
+    assert r.exit_code == 130, r.output
+    assert "nothing written to none" in " ".join(r.output.split())
+    assert not (tmp_path / "none").exists()
 
 
 def test_retime_arm_refuses_by_name_what_is_not_a_full_run(

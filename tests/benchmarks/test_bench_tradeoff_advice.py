@@ -135,3 +135,66 @@ def test_every_advised_command_is_one_rti_rig_parses(tmp_path: Path) -> None:
             said = " ".join(r.output.split())
             assert r.exit_code == 2 and "no-such-rig.toml" in said, (command, said)
             assert "Usage:" not in said and "No such option" not in said, (command, said)
+
+
+def test_a_labs_own_targets_are_the_advices(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`--target-deg` and `--target-db` replace the fixed 1°/2°/3° and 0.5/1/2 dB: the advice
+    answers the tolerance the lab gives, and the command written in summary.md repeats them
+    (pasted, it gives the same advice)."""
+    import benchmarks.tradeoff_from as tradeoff_from
+    from tests.benchmarks.test_bench_tradeoff_from import _stand_in_rows
+
+    monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", lambda *_a: _stand_in_rows())
+    out = tmp_path / "o"
+    argv = ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out)]
+    argv += ["--target-deg", "4", "--target-deg", "1.5", "--target-db", "0.3"]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    assert r.exit_code == 0, r.output
+    text = (out / "summary.md").read_text(encoding="utf-8")
+    advice = [line for line in text.splitlines() if line.startswith("- **")]
+    assert [line.split("**")[1] for line in advice] == [
+        "Normals within 1.5°",
+        "Normals within 4°",
+        "Relighting within 0.3 dB",
+    ], advice
+    assert "--target-deg 1.5 --target-deg 4 --target-db 0.3" in text, text
+    # the defaults without them
+    r = CliRunner().invoke(app, argv[:4], terminal_width=400)
+    assert r.exit_code == 0, r.output
+    said = [line.split("**")[1] for line in r.output.splitlines() if line.startswith("- **")]
+    assert said[:3] == ["Normals within 1°", "Normals within 2°", "Normals within 3°"], said
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "fragment"),
+    [
+        ("--target-deg", "0", "--target-deg 0: a mean normal error target is above 0"),
+        ("--target-deg", "90", "--target-deg 90: a mean normal error target is above 0"),
+        ("--target-deg", "nan", "--target-deg nan: a mean normal error target"),
+        ("--target-db", "-1", "--target-db -1: a relighting target is the dB below"),
+        ("--target-db", "inf", "--target-db inf: a relighting target"),
+    ],
+)
+def test_a_target_no_trade_can_answer_is_refused_by_name_before_anything_runs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, option: str, value: str, fragment: str
+) -> None:
+    import benchmarks.tradeoff_from as tradeoff_from
+
+    def never(*_a: object) -> None:
+        raise AssertionError("the trade ran")
+
+    monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", never)
+    out = tmp_path / "o"
+    argv = ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out), option, value]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    assert r.exit_code == 2, r.output
+    assert fragment in " ".join(r.output.split()), r.output
+    assert not out.exists()
+
+
+def test_targets_without_an_acquisition_are_refused(tmp_path: Path) -> None:
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick", "--target-deg", "2"])
+    assert r.exit_code == 2, r.output
+    assert "they go with --from ACQ/dirs.lp" in " ".join(r.output.split()), r.output

@@ -771,6 +771,25 @@ def test_a_stop_during_the_trade_on_an_acquisition_says_nothing_was_written(
         f"Stopped (Ctrl-C) during the trade on {shown_path(lp)}: nothing written to "
         f"{shown_path(out)} (its results are written once every layout is measured)" in said
     ), said
+    # the folder the run made for its results is not left behind, empty: the same command run
+    # again had met a folder it had made itself
+    assert not out.exists()
+    nested = tmp_path / "new" / "deeper"
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp), "--out", str(nested)])
+    assert r.exit_code == 130, r.output
+    assert not (tmp_path / "new").exists()
+    # a folder that was there before stays, and so does anything in it
+    (kept := tmp_path / "kept").mkdir()
+    (kept / "mine.txt").write_text("x", encoding="utf-8")
+    r = CliRunner().invoke(
+        app, ["bench", "tradeoff", "--from", str(lp), "--out", str(kept), "--force"]
+    )
+    assert r.exit_code == 130, r.output
+    assert (kept / "mine.txt").read_text(encoding="utf-8") == "x"
+    (kept / "mine.txt").unlink()
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp), "--out", str(kept)])
+    assert r.exit_code == 130, r.output
+    assert kept.is_dir()
 
 
 def test_the_trades_seconds_a_light_are_the_replayed_runs(tmp_path: Path) -> None:

@@ -52,6 +52,9 @@ def test_a_reshoot_whose_arm_does_not_connect_puts_the_images_back(tmp_path: Pat
     assert r.exit_code == 2, text
     assert "Traceback" not in text
     assert "Nothing was commanded: the arm could not be connected" in text, text
+    # no bar of the images captured before stands above it, as if this run had taken them:
+    # "capturing 4/6" had been shown before "Nothing was commanded"
+    assert "capturing" not in text, text
     assert (
         "Nothing was reshot: image_003, image_005 put back as captured, and lights.lp lists "
         "every image again: the session's images are as they were before this resume." in text

@@ -256,6 +256,20 @@ def test_count_line_that_disagrees_is_reported_and_the_lines_used() -> None:
     assert parse_lp("2\na_1.jpg 0 0 1\na_2.jpg 0 1 0\n", notes=(n := [])) and n == []
 
 
+def test_a_missing_count_line_is_read_and_said() -> None:
+    """A file with no count line is read from its lines, with a note giving the line to add:
+    it had been read without a word, and the profile every known reader accepts opens with
+    the count, so a file passed on from here could be refused there."""
+    notes: list[str] = []
+    entries = parse_lp("\n# dome A\na_1.jpg 0 0 1\na_2.jpg 0 1 0\n", "bare.lp", notes=notes)
+    assert [e.name for e in entries] == ["a_1.jpg", "a_2.jpg"]
+    assert notes[-1] == (
+        "bare.lp, line 3: no count line (the .lp every known reader accepts opens with the "
+        "number of lights); the 2 listed lights are used. To give it to another tool, add a "
+        "first line '2'"
+    ), notes
+
+
 def test_light_a_hair_below_the_horizon_is_clamped_and_reported() -> None:
     """z = -0.0012 (calibration noise, seen in a real file) is kept at the horizon."""
     notes: list[str] = []
