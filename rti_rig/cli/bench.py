@@ -208,7 +208,16 @@ def _acquisition_lp(given: Path, notes: list[str] | None = None) -> Path:
     )
 
 
-def _check_out_folder(out_dir: Path, force: bool, acquisition: Sequence[Path] = ()) -> None:
+def _in_assembly_files(lp: Path) -> bool:
+    """Whether ``lp`` is an RTIBuilder project's, in its ``assembly-files/`` folder."""
+    from rti_rig.core.lp_format import ASSEMBLY_FILES
+
+    return lp.resolve().parent.name.casefold() == ASSEMBLY_FILES
+
+
+def _check_out_folder(
+    out_dir: Path, force: bool, acquisition: Sequence[Path] = (), given: Sequence[Path] = ()
+) -> None:
     """Refuse, before minutes of computing, a folder whose files the results would replace.
 
     A session folder (or one inside it) is refused even with ``--force``: nothing captured is
@@ -233,6 +242,11 @@ def _check_out_folder(out_dir: Path, force: bool, acquisition: Sequence[Path] = 
     # the folder an image is listed in, and the one its file is in when it is a link (images
     # linked into a project's jpeg-exports/ from a card's copy resolve to the card's folder)
     held = {p.parent.resolve() for p in acquisition} | {p.resolve().parent for p in acquisition}
+    # and the folder given as --from, and an RTIBuilder project's own (its .lp is in
+    # assembly-files/, its images in jpeg-exports/): `--out PROJ --force` had put the results
+    # beside those two folders, where only they had been refused
+    held |= {f.resolve() for f in given if f.is_dir()}
+    held |= {p.resolve().parent.parent for p in acquisition[:1] if _in_assembly_files(p)}
     if out_dir.resolve() in held:
         raise RtiRigError(
             f"--out {shown_path(out_dir)} holds the acquisition --from reads (its .lp or images): "
@@ -397,6 +411,7 @@ def _tradeoff(
             )
         )
     acquisition: list[Path] = []  # the --from .lp and its images: never written among
+    given_from = [] if from_lp is None else [from_lp]  # as given: a folder, before its .lp
     if from_lp is not None:
         # its images before the --out folder is made: a refused acquisition had left an
         # empty --out folder behind
@@ -412,7 +427,7 @@ def _tradeoff(
     if out_dir is not None:  # before minutes of computing, not after
         made = _first_missing(out_dir)
         try:
-            _check_out_folder(out_dir, force, acquisition)
+            _check_out_folder(out_dir, force, acquisition, given_from)
         except RtiRigError as exc:
             _unmake(out_dir, made)
             raise fail(exc) from None

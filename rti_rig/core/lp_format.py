@@ -251,6 +251,8 @@ def _trailing_parts(name: str) -> list[str]:
     for part in reversed(pure.parts[1:] if pure.anchor else pure.parts):
         if part in ("", ".", "..") or "/" in part or "\\" in part:
             break
+        if _name_bytes(part) > NAME_MAX_BYTES:  # no folder here has it: looked up, it raised
+            break
         parts.insert(0, part)
     return parts
 
@@ -733,9 +735,47 @@ def _is_file_at(name: str) -> bool:
         return False
 
 
+#: The longest file or folder name, in bytes, that Linux's file systems hold (ext4, XFS, Btrfs:
+#: NAME_MAX) and macOS's APFS in UTF-8 bytes; NTFS counts 255 UTF-16 units instead, so a name a
+#: Windows tool wrote can be longer here than any file this machine can look up.
+NAME_MAX_BYTES = 255
+
+
+def _refuse_long_parts(name: str, source: str, lineno: int) -> None:
+    """Refuse a name one of whose parts no file here can have: looked up, it had raised
+    "File name too long" as a traceback (``check``, ``fit``, ``bench``) or an "unexpected
+    OSError" (``run``). 94 CJK characters are a legal NTFS name and 274 bytes in UTF-8."""
+    pure = _pure_name(name)
+    # an absolute name's folders are another machine's, looked for only where they fit
+    # (:func:`_trailing_parts`): only its file name must be one a file here can have
+    parts = [pure.name] if is_absolute_name(name) else list(pure.parts)
+    for part in parts:
+        size = _name_bytes(part)
+        if size > NAME_MAX_BYTES:
+            shown = part if len(part) <= 40 else f"{part[:20]}…{part[-12:]}"
+            raise LpFormatError(
+                source,
+                lineno,
+                f"image name part {shown!r} is {size} bytes long: no file or folder on this "
+                f"machine's file systems can have a name over {NAME_MAX_BYTES} bytes (a name a "
+                "Windows tool wrote may be longer in UTF-8 than there); rename it shorter and "
+                "write the new name on this line",
+            )
+
+
+def _name_bytes(part: str) -> int:
+    """The bytes a file name takes on this machine (UTF-8 where the locale cannot say)."""
+    try:
+        return len(os.fsencode(part))
+    except UnicodeEncodeError:
+        return len(part.encode("utf-8", "surrogatepass"))
+
+
 def _check_name(name: str, source: str, lineno: int) -> None:
     """Reject relative names that would resolve outside the `.lp` file's own folder (an
-    absolute name is a tool's path on its own machine: see :func:`image_path`)."""
+    absolute name is a tool's path on its own machine: see :func:`image_path`), and names no
+    file here can have (:func:`_refuse_long_parts`)."""
+    _refuse_long_parts(name, source, lineno)
     if is_absolute_name(name):
         return
     # read as the .lp's readers read it: "\\" a folder separator wherever it appears
@@ -1201,8 +1241,8 @@ def parse_lp(
                     else _heading_hint(first)
                 ),
             ) from None
-        if declared <= 0:
-            raise LpFormatError(source, first_no, f"count {declared} must be positive")
+        # a count of 0 or below disagrees with the lines as 47 above 48 does: noted below and
+        # the lines used (it had been refused, "count 0 must be positive", with nothing to do)
         content = content[1:]
 
     entries: list[LpEntry] = []
@@ -1276,7 +1316,7 @@ def parse_lp(
             flat = math.hypot(x, y)
             x, y, z, norm = x / flat, y / flat, 0.0, 1.0
         if upper_hemisphere and z / norm < -1e-9:
-            below.append((lineno, name, z / norm))
+            below.append((lineno, name, z / norm, z))
         _check_name(name, source, lineno)
         if name in seen:
             raise LpFormatError(
@@ -1334,17 +1374,19 @@ def _reads_as_light(line: str) -> bool:
     )
 
 
-def _refuse_below_plane(below: list[tuple[int, str, float]], lights: int, source: str) -> None:
+def _refuse_below_plane(
+    below: list[tuple[int, str, float, float]], lights: int, source: str
+) -> None:
     """Refuse lights below the object plane, saying which way out fits the file.
 
     Why two messages: most of a file's lights below the plane is a z axis pointing the other
     way (another tool's convention), one of 72 is not, yet it had been told "check the sign
     convention" too, with no word of how far below it was or what to do with that one line."""
-    lineno, name, z = below[0]
+    lineno, name, z, written = below[0]
     more = len(below) - 1
     others = (
         f" ({more} more line{'s' if more > 1 else ''} below the plane: "
-        f"{', '.join(str(n) for n, _, _ in below[1:6])}{' ...' if more > 5 else ''})"
+        f"{', '.join(str(n) for n, *_ in below[1:6])}{' ...' if more > 5 else ''})"
         if more
         else ""
     )
@@ -1357,10 +1399,14 @@ def _refuse_below_plane(below: list[tuple[int, str, float]], lights: int, source
             "towards the camera (docs/conventions.md); negate the z column",
         )
     elevation = math.degrees(math.asin(max(-1.0, z)))
+    # the file's z, and the direction's where the vector is not of unit length (the
+    # direction's alone had quoted a z of -0.0101 for a line written -0.0099)
+    as_unit = f" ({z:.4f} as a direction)" if f"{written:.4f}" != f"{z:.4f}" else ""
     raise LpFormatError(
         source,
         lineno,
-        f"the light of {name!r} is {-elevation:.1f}° below the object plane (z = {z:.4f}; "
+        f"the light of {name!r} is {-elevation:.1f}° below the object plane (z = "
+        f"{written:.4f}{as_unit}; "
         f"less than {HORIZON_TOLERANCE} below is read as the horizon): no light there can have lit "
         "the object. If it is a light at the horizon whose calibration is off, set its z to 0; "
         f"otherwise remove the line and leave its image out{others}",

@@ -171,6 +171,22 @@ def test_tradeoff_from_an_rtibuilder_project_folder_takes_its_assembly_files_lp(
     assert _acquisition_lp(lp.parents[1] / given).resolve() == lp.resolve()
 
 
+@pytest.mark.parametrize("given", [".", "assembly-files/icon.lp", "jpeg-exports"])
+def test_tradeoff_never_writes_into_the_project_given_as_from(tmp_path: Path, given: str) -> None:
+    """`--out PROJ --force` with the project (or its .lp, or its jpeg-exports) as --from is
+    refused, as --out PROJ/jpeg-exports is: it had put results.csv, summary.md and four plots
+    beside assembly-files/ and jpeg-exports/ (QA, 2026-12-06)."""
+    lp = _project(tmp_path, lights=12)  # a trade-off takes 10 or more
+    project = lp.parents[1]
+    before = sorted(p.name for p in project.iterdir())
+    argv = ["bench", "tradeoff", "--from", str(project / given), "--out", str(project)]
+    r = CliRunner().invoke(app, [*argv, "--force"], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "holds the acquisition --from reads" in said and "even with --force" in said, said
+    assert sorted(p.name for p in project.iterdir()) == before
+
+
 def test_an_image_missing_from_an_rtibuilder_project_is_to_be_copied_beside_its_siblings(
     tmp_path: Path,
 ) -> None:

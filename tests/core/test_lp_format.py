@@ -117,7 +117,9 @@ def test_each_light_keeps_its_line_and_equality_ignores_it() -> None:
         ("1\na_1.jpg 0 0 nan\n", 2, "not finite"),
         ("1\na_1.jpg 0 1\n", 2, "expected 'name x y z'"),
         ("two\na_1.jpg 0 0 1\n", 1, "not a whole number"),
-        ("0\n", 1, "must be positive"),
+        # a name no file here can have: looked up, it had raised "File name too long"
+        ("1\n" + "文" * 90 + ".jpg 0 0 1\n", 2, "is 274 bytes long: no file or folder"),
+        ("1\n" + "d" * 256 + "/a.jpg 0 0 1\n", 2, "rename it shorter and write the new name"),
         # a column after the name (an intensity) is no name with a space in it
         ("1\na_1.jpg 0.6 0 0.8 1.0\n", 2, "found 5 fields"),
         ("1\na_1.JPG 1.0 0.6 0 0.8\n", 2, "before it 1.0 is an extra column"),
@@ -700,3 +702,40 @@ def test_utf16_with_its_mark_is_read_in_any_script(tmp_path: Path) -> None:
     lp = tmp_path / "dirs.lp"
     lp.write_bytes("\ufeff2\nснимок1.jpg 0 0 1\nснимок2.jpg 0 1 0\n".encode("utf-16-le"))
     assert [e.name for e in read_lp(lp)] == ["снимок1.jpg", "снимок2.jpg"]
+
+
+def test_a_count_of_zero_or_below_disagrees_as_any_other_and_the_lines_are_used() -> None:
+    """'0' or '-3' above listed lights is a count that disagrees: noted, the lines used, as 47
+    above 48 is (it had been refused, "count 0 must be positive", with nothing to do); a file
+    with no light line is still refused as such."""
+    for count in ("0", "-3"):
+        notes: list[str] = []
+        entries = parse_lp(f"{count}\na_1.jpg 0 0 1\na_2.jpg 0 1 0\n", "c.lp", notes=notes)
+        assert len(entries) == 2
+        assert notes == [
+            f"c.lp, line 1: count line says {count} lights but the file lists 2; the 2 listed "
+            "lights are used"
+        ]
+    with pytest.raises(LpFormatError, match="no light lines after the count line"):
+        parse_lp("0\n", "c.lp")
+
+
+def test_an_absolute_names_folder_too_long_here_is_not_looked_for(tmp_path: Path) -> None:
+    """A Windows tool's path whose folder is longer in UTF-8 than a name here can be: the
+    file beside the .lp is found (looking the folder up had raised "File name too long")."""
+    (tmp_path / "a_1.jpg").write_bytes(b"x")
+    name = "C:\\caps\\" + "é" * 200 + "\\a_1.jpg"
+    (entry,) = parse_lp(f"1\n{name} 0 0 1\n", "w.lp")
+    assert image_path(tmp_path, entry.name) == tmp_path / "a_1.jpg"
+
+
+def test_a_light_below_the_plane_is_refused_quoting_the_files_z() -> None:
+    """The refusal quotes the z the line holds, and the direction's beside it where they
+    differ: "z = -0.0101" had been said of a line written -0.0099 (length 0.98)."""
+    text = "4\na_1.jpg 0.98 0 -0.0099\na_2.jpg 0 0 1\na_3.jpg 0 1 0.1\na_4.jpg 1 0 0.1\n"
+    with pytest.raises(LpFormatError) as info:
+        parse_lp(text, "b.lp", upper_hemisphere=True)
+    assert "(z = -0.0099 (-0.0101 as a direction); less than 0.01 below" in str(info.value)
+    with pytest.raises(LpFormatError) as info:
+        parse_lp(text.replace("0.98 0 -0.0099", "0.9999 0 -0.0120"), "b.lp", upper_hemisphere=True)
+    assert "(z = -0.0120; less than 0.01 below" in str(info.value)
