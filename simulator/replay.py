@@ -98,6 +98,15 @@ def linear_frame(
     return img.astype(np.uint16, copy=False), None
 
 
+def _stamp(path: Path) -> tuple[int, int, int] | None:
+    """A file's size, mtime and ctime (ns), or None where it cannot be read."""
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return st.st_size, st.st_mtime_ns, st.st_ctime_ns
+
+
 class LitLed(Protocol):
     """What the replay camera needs of the dome: which LED is lit (``None`` when all are off)."""
 
@@ -129,9 +138,33 @@ class ReplayCamera:
         self._readout_s = readout_s
         self._transfer_s = transfer_s
         self._connected = False
+        #: each recorded file's (size, mtime_ns, ctime_ns) as the run opened the camera
+        self._stamps: list[tuple[int, int, int] | None] = []
 
     def connect(self) -> None:
+        # taken as the rig opens, just after the session hashed the acquisition for its
+        # manifest: a file rewritten since then is told at its step
+        self._stamps = [_stamp(p) for p in self._images]
         self._connected = True
+
+    def _refuse_changed(self, lit: int) -> None:
+        """Refuse the step of a recorded file rewritten since the run began: it had been
+        copied into the session as it was then, the manifest still recording the file the run
+        began with, and nothing said (QA, 2026-12-06). A resume hashes the whole acquisition
+        and refuses a changed one; within a run, a write is seen by its stamp, which any write
+        or replacement changes (the ctime only the kernel sets)."""
+        path = self._images[lit]
+        before = self._stamps[lit] if lit < len(self._stamps) else None
+        if before is None or _stamp(path) in (before, None):  # a file gone: _recorded says so
+            return
+        raise CaptureError(
+            self.name,
+            f"the recorded file {shown_path(path)} was changed since this run began (written "
+            "or replaced while the acquisition was replayed): the session would mix two "
+            "versions of the acquisition. Put the file back as it was, from a copy, and "
+            "resume; or start a new session from the acquisition as it is now",
+            "capture",
+        )
 
     def close(self) -> None:
         self._connected = False
@@ -173,7 +206,9 @@ class ReplayCamera:
             source = None
         else:
             path = self._images[lit]
+            self._refuse_changed(lit)
             stored = self._recorded(path)
+            self._refuse_changed(lit)  # and not while it was read
             colour = file_colour(path) if stored.ndim == 3 else None
             pixels, converted = linear_frame(stored, colour)
             if pixels.shape[:2] != self._shape[:2]:

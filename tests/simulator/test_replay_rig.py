@@ -608,3 +608,44 @@ def test_a_config_of_backend_replay_is_refused_with_the_lp_to_give(tmp_path: Pat
         assert f"rti-rig run {acq / 'dirs.lp'} --out" in said and "Traceback" not in said
         assert f"rti-rig run {acq / 'dirs.lp'} --resume SESSION" in said, said
     assert not (tmp_path / "s").exists()
+
+
+def test_an_image_rewritten_while_it_is_replayed_stops_the_run_naming_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An image of the acquisition rewritten during the run (an export writing over it while
+    the session ran) had been copied into the session as it was then, with exit 0, the
+    manifest recording the file the run began with (QA, 2026-12-06). The run stops at its step
+    naming the file; the images before it are kept, and with the original put back the resume
+    continues."""
+    from rti_rig.simulator import replay
+
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    names = [e.name for e in read_lp(acq / "dirs.lp")]
+    real_capture = replay.ReplayCamera.capture
+    shots: list[int] = []
+
+    def capture(self, exposure_s):  # type: ignore[no-untyped-def]
+        if self._dome.lit is not None:
+            shots.append(self._dome.lit)
+            if len(shots) == 2:  # during the run, every image of it rewritten (re-exported)
+                for name in names:
+                    data = (acq / name).read_bytes()
+                    (acq / name).write_bytes(data)
+        return real_capture(self, exposure_s)
+
+    monkeypatch.setattr(replay.ReplayCamera, "capture", capture)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--lights", "6"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "Traceback" not in said
+    assert "was changed since this run began (written or replaced while the acquisition" in said
+    assert "Put the file back as it was, from a copy, and resume" in said, said
+    assert [e["image"] for e in _journal(out)] == ["image_001.jpg"]  # the step before it kept
+    # the bytes are the same (rewritten, not changed): the resume, which hashes them, goes on
+    monkeypatch.setattr(replay.ReplayCamera, "capture", real_capture)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(out / "lights.lp")) == 6
