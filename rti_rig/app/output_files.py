@@ -93,8 +93,11 @@ def check_output_file(
         return
     for what, path in inputs.items():
         if path is not None and path.exists() and out_file.samefile(path):
+            # a session's rig's files are not read by the command that writes beside them
+            reads = "" if "session's" in what else " this command reads"
             raise RtiRigError(
-                f"{option} {shown_path(out_file)} is the {what} this command reads; choose another"
+                f"{option} {shown_path(out_file)} is the {what}{reads}; it is never replaced, "
+                "even with --force: choose another"
             )
     for folder in out_file.resolve().parents:
         if (folder / MANIFEST).is_file():
@@ -156,3 +159,25 @@ def lp_name_note(out_file: Path, *, run_reads_it: bool = False) -> str | None:
         f"{run}relight, RTIBuilder and rti-rig fit find an .lp by its name; name it {named} to use "
         f"it there{taken}"
     )
+
+
+def session_rig_inputs(config: object) -> dict[str, Path | None]:
+    """The files the rig config a session names reads (the config itself, its ``lp_file``,
+    its intensity correction, its LED map), for :func:`check_output_file`: ``--out
+    rig.toml --force`` had replaced the dome's config with the .lp, and the advice that
+    followed told the user to edit "the dome's config", an .lp by then. The config alone
+    when it cannot be loaded (moved, or broken: nothing here reads it)."""
+    if not isinstance(config, str) or not config:
+        return {}
+    path = Path(config)
+    try:
+        from rti_rig.app.config import load_rig_config
+
+        inputs = rig_inputs(path, load_rig_config(path))
+    except (OSError, RtiRigError):
+        inputs = {"RIG": path}
+    # "the RIG this command reads" is said of a --rig given: these are the manifest's
+    return {
+        ("session's rig config" if k == "RIG" else f"{k} of the session's rig"): p
+        for k, p in inputs.items()
+    }

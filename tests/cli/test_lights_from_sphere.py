@@ -329,7 +329,7 @@ def _copy(session: Path, to: Path) -> Path:
         ("journal.jsonl", "would replace a file of the session in"),
         ("image_001.jpg", "would replace a file of the session in"),
         ("linear/image_001.tif", "would replace a file of the session in"),
-        ("RIG", "is the session's rig config this command reads"),
+        ("RIG", "is the session's rig config; it is never replaced, even with --force"),
         ("TRUTH", "is the emulated dome's LED directions (emulator.led_directions_file)"),
     ],
 )

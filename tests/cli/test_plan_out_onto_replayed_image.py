@@ -27,7 +27,7 @@ def test_a_plan_is_not_written_over_an_image_of_the_replayed_acquisition(tmp_pat
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     refusal = f"--out {victim} is the recorded image image05.jpg of the rig's .lp"
-    assert f"{refusal} this command reads; choose another" in said
+    assert f"{refusal} this command reads; it is never replaced, even with --force" in said
     assert "Traceback" not in said
     assert hashlib.sha256(victim.read_bytes()).hexdigest() == before
     # an .lp of the user's own beside the images is still theirs to replace

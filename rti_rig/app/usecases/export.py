@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from rti_rig.app.output_files import check_output_file, lp_name_note
+from rti_rig.app.output_files import check_output_file, lp_name_note, session_rig_inputs
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.core.qt_names import qt_name_key
@@ -97,7 +97,11 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     scan = scan_journal(root, image_names(total) if total else None)
     entries, left_out = session_lp_report(root, req.linear, scan, manifest)
     _refuse_another_session(Path(req.out_file), root, entries[0].name if entries else None)
-    check_output_file(req.out_file, req.force, {})  # never the session's own files
+    # never the session's own files, nor the rig config it names and what that reads (a
+    # dome's lp_file calibration, a replayed acquisition's .lp and images): `--out
+    # ACQ/dirs.lp --force` had replaced the acquisition's 12 lights with the session's 6
+    config = (manifest.get("rig") or {}).get("config_path")
+    check_output_file(req.out_file, req.force, session_rig_inputs(config))
     in_session = _in_session_said(Path(req.out_file), root)  # said before lights.lp is written
     write_lp(req.out_file, entries)
     # lights.lp one image short of the session (a run stopped between a step's record file

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from rti_rig.app.light_calibration import refuse_unverified
-from rti_rig.app.output_files import check_output_file, rig_inputs
+from rti_rig.app.output_files import check_output_file, session_rig_inputs
 from rti_rig.app.usecases.run_options import run_words
 from rti_rig.core.errors import RtiRigError, SessionError
 from rti_rig.core.image_files import read_linear_tiff
@@ -123,25 +123,6 @@ def _steps_by_led(root: Path, manifest: dict[str, Any]) -> list[dict[str, Any]]:
     return [by_led[k] for k in range(count)]
 
 
-def _shot_with_inputs(config: object) -> dict[str, Path | None]:
-    """The files the rig config a session names reads (the config itself, its ``lp_file``,
-    its intensity correction, its LED map), for :func:`check_output_file`: ``--out
-    rig.toml --force`` had replaced the dome's config with the .lp, and the advice that
-    followed told the user to edit "the dome's config", an .lp by then. The config alone
-    when it cannot be loaded (moved, or broken: nothing here reads it)."""
-    if not isinstance(config, str) or not config:
-        return {}
-    path = Path(config)
-    try:
-        from rti_rig.app.config import load_rig_config
-
-        inputs = rig_inputs(path, load_rig_config(path))
-    except (OSError, RtiRigError):
-        inputs = {"RIG": path}
-    # "the RIG this command reads" is said of a --rig given: this one is the manifest's
-    return {("session's rig config" if k == "RIG" else k): p for k, p in inputs.items()}
-
-
 def _grey_image(root: Path, step: dict[str, Any]) -> tuple[np.ndarray, float, str]:
     """A step's image as linear grey (its linear TIFF where the session kept one), the value
     of a clipped pixel, and the image's name to say."""
@@ -185,7 +166,7 @@ def lights_from_sphere(request: SphereRequest) -> SphereLights:
     manifest = read_manifest(root)
     config = (manifest.get("rig") or {}).get("config_path")
     # a session's files, the rig config and what it reads are never replaced, --force or not
-    check_output_file(out, request.force, _shot_with_inputs(config))
+    check_output_file(out, request.force, session_rig_inputs(config))
     refuse_if_disowned(root)
     steps = _steps_by_led(root, manifest)
     # a camera-triggered dome cannot reshoot one image: what it can do instead is said
