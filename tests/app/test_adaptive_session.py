@@ -526,8 +526,20 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
     r = runner.invoke(app, line)
     assert r.exit_code == 0, r.output
     assert (cut / "lights.lp").read_bytes() == (out / "lights.lp").read_bytes()
-    r = runner.invoke(app, [*line[:-2], "--lights", "6", "--resume", str(cut)])
-    assert r.exit_code == 2 and "--lights 6, the session not given" in said(r), said(r)
+    # and with --lights 6, the count it designs for: the same session, choice for choice (it
+    # had been refused as "--lights 6, the session not given", and a new session advised)
+    cut2 = tmp_path / "cut2"
+    interrupted(cfg, cut2, after_step=2, lights=None)
+    again = ["run", str(cfg), "--adaptive"]
+    r = runner.invoke(app, [*again, "--lights", "6", "--resume", str(cut2)])
+    assert r.exit_code == 0, said(r)
+    assert (cut2 / "lights.lp").read_bytes() == (out / "lights.lp").read_bytes()
+    assert manifest(cut2)["adaptive"]["lights_given"] is False  # the session as it began
+    # another count is still another session
+    cut3 = tmp_path / "cut3"
+    interrupted(cfg, cut3, after_step=2, lights=None)
+    r = runner.invoke(app, [*again, "--lights", "5", "--resume", str(cut3)])
+    assert r.exit_code == 2 and "--lights 5, the session not given" in said(r), said(r)
     from rti_rig.app.config import load_rig_config
     from rti_rig.app.usecases.adaptive import ARM_MAX_LIGHTS, default_max_lights
 

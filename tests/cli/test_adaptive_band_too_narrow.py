@@ -198,15 +198,26 @@ def test_lights_no_adaptive_session_takes_are_refused_first_with_the_range(
     """--lights 4 (below the start's 4 + 1) and --lights 14 (above the Nab dome's 12 LEDs) in a
     band too narrow: the band's refusal came first, repeating the N asked ("this adaptive
     session (--lights 14) needs 14") and advising another count, so the range was learnt only
-    from the advice. The count is refused first, with the range, and no command repeats it."""
+    from the advice. The count is refused first, with the range, and no command repeats it;
+    the count advised comes with a band that holds it, as "give at most 12" alone was then
+    refused for the band (QA, 2026-12-06): the two given together run."""
     out = tmp_path / "s"
     args = ["run", str(NAB), "--out", str(out), "--adaptive", "--lights", lights]
     r = runner.invoke(app, [*args, "--max-elevation-deg", "12"])
     text = said(r)
     assert r.exit_code == 2, text
     assert f"--adaptive --lights {lights}: an adaptive session on this dome takes 5 to 12" in text
-    assert "rti-rig run" not in text and "band" not in text, text
+    advised = "5" if lights == "4" else "12"
+    words = "at least" if lights == "4" else "at most"
+    held = f"give {words} {advised}, in a band that holds {advised} (this one between 0° and 12°"
+    assert held in text and "elevation holds 0): --max-elevation-deg " in text, text
+    assert "rti-rig run" not in text, text
     assert not out.exists()
+    ceiling = text.split("elevation holds 0): --max-elevation-deg ")[1].split()[0]
+    args[-1] = advised
+    r = runner.invoke(app, [*args, "--max-elevation-deg", ceiling, "--no-verdict"])
+    assert r.exit_code == 0, said(r)
+    assert len(_elevations(out)) == int(advised)
 
 
 @pytest.mark.parametrize(

@@ -1824,7 +1824,11 @@ def _arm_widen_to_hold(  # type: ignore[no-untyped-def]
 
 
 def _check_lights_range(
-    lights: int | None, until_error_deg: float | None, leds: int | None
+    lights: int | None,
+    until_error_deg: float | None,
+    leds: int | None,
+    band: tuple[float, float] = _FULL_BAND,
+    el: NDArray[np.float64] | None = None,
 ) -> None:
     """Refuse an adaptive ``--lights N`` no session can take, with the range it can: at least
     one more than the start, at most a dome's LEDs (``leds``; an arm's are known later, from
@@ -1832,7 +1836,12 @@ def _check_lights_range(
 
     Why: a band too narrow was refused first, repeating the N asked ("this adaptive session
     (--lights 14) needs 14") and advising another count in its command, so the user learnt
-    only from the advice that their own --lights was out of range, and not what range was."""
+    only from the advice that their own --lights was out of range, and not what range was.
+
+    With a band (``band``, the dome's LED elevations ``el``) that holds fewer than the count
+    advised, the advice gives a band that holds it: "give at most 12" had been said under
+    ``--max-elevation-deg 20`` (1 LED), and ``--lights 12`` was then refused for the band,
+    the user refused twice (QA, 2026-12-06)."""
     if lights is None:
         return
     top = leds if leds is not None and leds > START_LIGHTS else None
@@ -1846,10 +1855,22 @@ def _check_lights_range(
             f"{asked}: an adaptive session starts from {START_LIGHTS} lights "
             f"and chooses from there; give at least {START_LIGHTS + 1}"
         )
+    advised = START_LIGHTS + 1 if lights <= START_LIGHTS else top
+    wider = (
+        _band_holding(el, advised, band)
+        if el is not None and tuple(band) != _FULL_BAND and _held(el, band) < advised
+        else None
+    )
     raise RtiRigError(
         f"{asked}: an adaptive session on this dome takes {START_LIGHTS + 1} to {top} lights "
         f"(it starts from {START_LIGHTS} and chooses the next ones from the dome's {top} LEDs): "
-        + (f"give at least {START_LIGHTS + 1}" if lights <= START_LIGHTS else f"give at most {top}")
+        + (f"give at least {advised}" if lights <= START_LIGHTS else f"give at most {advised}")
+        + (
+            ""
+            if wider is None
+            else f", in a band that holds {advised} (this one{_band_words(band)} holds "
+            f"{_held(el, band)}):{band_options(wider)}"  # type: ignore[arg-type]
+        )
     )
 
 
@@ -1909,7 +1930,9 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
             _refuse_nothing_to_choose(
                 loaded, offered, lights, until_error_deg, band, min_lights, objective, out_dir
             )
-    _check_lights_range(lights, until_error_deg, None if elevations is None else len(elevations))
+    _check_lights_range(
+        lights, until_error_deg, None if elevations is None else len(elevations), band, elevations
+    )
     if offered is not None:  # --lights N is one a session can take: a band advised keeps it
         _refuse_nothing_to_choose(
             loaded, offered, lights, until_error_deg, band, min_lights, objective, out_dir

@@ -443,7 +443,12 @@ def _adaptive_differences(asked: StartOptions, header: dict[str, Any]) -> list[s
 
     diffs = []
     began = lights_asked(header)  # not the default_lights an --adaptive alone designs for
-    if asked.lights != began:
+    # --lights N where the session, begun without it, designs for the config's N anyway
+    # (default_lights): the same session, choice for choice, as a planned resume's --lights
+    # is judged by the layout it gives (it had been refused, and a new session advised)
+    designed = header.get("design_lights")
+    same_design = began is None and designed is not None and asked.lights == int(designed)
+    if asked.lights != began and not same_design:
         diffs.append(f"--lights {_or_none(asked.lights)}, the session {_or_none(began)}")
     if not _same_number(asked.until_error_deg, header.get("until_error_deg")):
         diffs.append(
