@@ -649,3 +649,41 @@ def test_an_image_rewritten_while_it_is_replayed_stops_the_run_naming_it(
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert len(read_lp(out / "lights.lp")) == 6
+
+
+def test_a_resume_on_another_acquisition_says_so_and_advises_a_count_it_has(
+    tmp_path: Path,
+) -> None:
+    """Resumed on another recorded acquisition (fewer lights, at other directions), a session
+    had been told "one was edited, replaced or re-exported since", and advised a new session
+    with its own --lights 12, which that acquisition of 11 refused (QA, 2026-12-06)."""
+    from rti_rig.app.usecases.session import NewSessionRequest
+    from rti_rig.runtime.controller import FinishReason
+
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    out = tmp_path / "s"
+    run = cut_new_session(NewSessionRequest(acq / "dirs.lp", out, lights=12), after_step=2)
+    assert run.finish_reason is FinishReason.CANCELLED
+    other = tmp_path / "other"
+    shutil.copytree(ACQ, other)
+    lines = (other / "dirs.lp").read_text(encoding="utf-8").splitlines()
+    (other / "dirs.lp").write_text("\n".join(["11", *lines[1:12]]) + "\n", encoding="utf-8")
+    r = runner.invoke(app, ["run", str(other / "dirs.lp"), "--resume", str(out)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert f"{other / 'dirs.lp'} is another acquisition than the one this session began with" in (
+        said
+    ), said
+    assert "(11 lights, the session's 18 lights)" in said, said
+    assert "edited" not in said, said
+    assert f"Continue it on its own acquisition, {acq / 'dirs.lp'}: rti-rig run --resume {out}" in (
+        said
+    ), said
+    command = re.search(r"new session from this one \(rti-rig run ([^()]+)\)$", said)
+    assert command, said
+    args = shlex.split(command.group(1))
+    assert args[args.index("--lights") + 1] == "11", args
+    r = runner.invoke(app, ["run", *args, "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(Path(args[2]) / "lights.lp")) == 11

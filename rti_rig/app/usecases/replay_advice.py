@@ -47,7 +47,10 @@ def allowed_no_normals(manifest: dict[str, Any], provenance: dict[str, Any]) -> 
 
 
 def new_session_command(
-    config_path: Path | str, manifest: dict[str, Any], session_dir: Path | str
+    config_path: Path | str,
+    manifest: dict[str, Any],
+    session_dir: Path | str,
+    most: int | None = None,
 ) -> str:
     """``rti-rig run CONFIG --out NEW`` with the session's layout options: its ``--plan``, its
     adaptive options (:func:`~rti_rig.app.usecases.run_options.adaptive_options`, ``--lights``
@@ -55,20 +58,28 @@ def new_session_command(
     0–90°, and ``--allow-no-normals`` (see :func:`allowed_no_normals`), each as the manifest
     recorded it. The plan is recorded as an absolute path, so the command runs from any folder
     (a manifest from before that record holds the path as it was typed, repeated as it is:
-    where it was relative to is unknown)."""
+    where it was relative to is unknown). ``most``: the lights ``config_path`` has, where it
+    is another acquisition than the session's: a count above them is advised as them (a
+    command with the session's --lights 12 had been advised for an acquisition of 11, and was
+    refused when run)."""
     words = [
         "rti-rig run",
         shell_word(str(config_path)),
         "--out",
         shell_word(str(new_session_dir(session_dir))),
     ]
-    return " ".join(words) + session_options(manifest)
+    return " ".join(words) + session_options(manifest, most)
 
 
-def session_options(manifest: dict[str, Any]) -> str:
+def session_options(manifest: dict[str, Any], most: int | None = None) -> str:
     """`` --lights 8``, `` --plan P``, `` --adaptive --lights 6 …``: the layout options the
     session of ``manifest`` began with, as :func:`new_session_command` repeats them (and a
-    resume given other options says them)."""
+    resume given other options says them); ``most`` caps their counts
+    (:func:`new_session_command`)."""
+
+    def capped(n: int) -> int:
+        return n if most is None else min(n, most)
+
     words = [""]
     schedule = manifest.get("schedule") or {}
     provenance = schedule.get("provenance") or {}
@@ -82,8 +93,8 @@ def session_options(manifest: dict[str, Any]) -> str:
         words.append(
             adaptive_options(
                 float(until) if until is not None else None,
-                int(lights) if lights is not None else None,  # --lights was given
-                int(floor) if floor is not None else None,
+                capped(int(lights)) if lights is not None else None,  # --lights was given
+                capped(int(floor)) if floor is not None else None,
                 # a word, not a path: shell_word's ``$'...'`` form is for names on disk
                 shlex.quote(str(adaptive.get("objective") or "normals")),
             )
@@ -92,7 +103,7 @@ def session_options(manifest: dict[str, Any]) -> str:
     elif provenance.get("plan_file"):
         words.append(f"--plan {shell_word(str(provenance['plan_file']))}")
     elif provenance.get("n") is not None:
-        words.append(f"--lights {int(provenance['n'])}")
+        words.append(f"--lights {capped(int(provenance['n']))}")
         band = provenance
     if allowed_no_normals(manifest, provenance) and not isinstance(adaptive, dict):
         words.append("--allow-no-normals")

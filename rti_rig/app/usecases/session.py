@@ -1598,6 +1598,12 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             if k in recorded and k != "recorded_images"
         )
     )
+    if only_images_other and _other_lights(recorded, identity):
+        # its lights too: another acquisition, not an edited image of this one (it had been
+        # said "one was edited", and the new session advised with a --lights it lacks)
+        raise RigChangedError(
+            _another_acquisition(config_path, recorded, identity, manifest, session_dir)
+        )
     if only_images_other:
         # a replayed acquisition is a rig whose camera returns its files: they are its images
         raise RigChangedError(
@@ -1662,6 +1668,53 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     if not diffs:  # the same rig: its positions as the session recorded them (rounding aside)
         identity = same_rig(recorded, identity)
     return identity, diffs
+
+
+def _other_lights(recorded: dict[str, Any], identity: dict[str, Any]) -> bool:
+    """Whether a replayed acquisition's lights differ from the session's: their count, or
+    their directions (:func:`~rti_rig.app.rig_identity.moved_lights`: beyond rounding)."""
+    from rti_rig.app.rig_identity import moved_lights
+
+    if recorded.get("lights") != identity.get("lights"):
+        return True
+    before, now = recorded.get("light_directions"), identity.get("light_directions")
+    if before is None or now is None:  # a session from before the directions were recorded
+        return recorded.get("light_positions") != identity.get("light_positions")
+    return bool(moved_lights(before, now))
+
+
+def _another_acquisition(
+    config_path: Path,
+    recorded: dict[str, Any],
+    identity: dict[str, Any],
+    manifest: dict[str, Any],
+    session_dir: Path | str,
+) -> str:
+    """Why a resume on another recorded acquisition than the session's is refused, and the
+    two ways on: the session's own .lp, or a new session from this one (its counts within
+    this acquisition's lights)."""
+    last = (manifest.get("rig") or {}).get("config_path")
+    lights_now = str(identity.get("lights") or "").replace("LEDs", "lights")
+    lights_then = str(recorded.get("lights") or "").replace("LEDs", "lights")
+    count = (
+        int(lights_now.split()[0])
+        if lights_now.split()[:1] and lights_now.split()[0].isdigit()
+        else None
+    )
+    which = (
+        f"{lights_now}, the session's {lights_then}"
+        if lights_now != lights_then
+        else f"{lights_now} as the session's, at other directions"
+    )
+    own = (f", {shown_path(last)}" if last else "") + (
+        f": rti-rig run --resume {shell_word(str(session_dir))}"
+    )
+    return (
+        f"{shown_path(config_path)} is another acquisition than the one this session began "
+        f"with: its lights and images differ ({which}): a resume would mix two acquisitions in "
+        f"one session. Continue it on its own acquisition{own}; or start a new session from "
+        "this one (" + new_session_command(config_path, manifest, session_dir, most=count) + ")"
+    )
 
 
 #: How many differences make a config given in place of the session's own another rig, not
