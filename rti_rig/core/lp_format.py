@@ -458,6 +458,43 @@ def _invisible_names(missing: Sequence[Path]) -> list[str]:
     return said
 
 
+def _spaced_names(missing: Sequence[Path]) -> list[tuple[str, str]]:
+    """``(listed, there)`` for missing images with a space in their name where a file is there
+    whose name has a run of spaces (or a tab) at that place: ``img  00.jpg`` listed in an .lp
+    is read ``img 00.jpg``, as relight reads it."""
+    found: list[tuple[str, str]] = []
+    listings: dict[Path, list[str]] = {}
+    for path in missing:
+        if " " not in path.name:
+            continue
+        if path.parent not in listings:
+            try:
+                listings[path.parent] = [
+                    e.name for e in path.parent.iterdir() if any(c.isspace() for c in e.name)
+                ]
+            except OSError:
+                listings[path.parent] = []
+        there = [n for n in listings[path.parent] if " ".join(n.split()) == path.name]
+        if there and there[0] != path.name:
+            found.append((path.name, there[0]))
+    return found
+
+
+def _spaced_said(spaced: list[tuple[str, str]]) -> str:
+    """The clause for names read with one space where the file's has a run of them.
+
+    Why: a file named with two spaces in a row, listed so in the .lp, had been said missing
+    under the name with one (QA, 2026-12-06), with the advice to copy it where it was."""
+    if not spaced:
+        return ""
+    more = f" and {len(spaced) - 3} more" if len(spaced) > 3 else ""
+    pairs = ", ".join(f"{listed!r} is there as {there!r}" for listed, there in spaced[:3])
+    return (
+        f"; {pairs}{more}: an .lp's names are read with each run of spaces as one space (as "
+        "relight reads them); rename the files with single spaces, and write the names so"
+    )
+
+
 def _invisible_said(hidden: list[str]) -> str:
     """:func:`case_hint`'s clause for names holding invisible characters.
 
@@ -664,8 +701,10 @@ def missing_images_advice(
     hidden = _invisible_names(paths)
     not_files = _not_files(paths)
     encoded = _other_encodings(paths)
+    spaced = _spaced_names(paths)
     named = (
         _not_files_said(not_files)
+        + _spaced_said(spaced)
         + _twins_said(twins, len(paths))
         + _kin_said(kin, len(paths))
         + _invisible_said(hidden)
@@ -677,6 +716,7 @@ def missing_images_advice(
     covered |= {t.split(" -> ")[0] for t in [*twins, *kin]}
     covered |= {p.name for p in paths if not p.name.isprintable()}
     covered |= {name for name, _ in encoded}
+    covered |= {name for name, _ in spaced}
     if named and (rest := max(0, len(names) - len(covered))):
         # the images with no such file are missing all the same: their way out is said too
         tail = others if len(names) < total else ""

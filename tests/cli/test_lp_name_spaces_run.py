@@ -1,0 +1,34 @@
+"""An image named with a run of spaces, listed so in its .lp, is said to be there.
+
+An .lp's names are read as relight reads them, each run of spaces as one, so `img  01.jpg`
+is looked for as `img 01.jpg`. It had been said missing under that name, with the advice to
+copy it where it already was (QA, 2026-12-06).
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+ACQ = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay"
+
+
+def test_a_name_with_a_run_of_spaces_is_named_with_the_file_that_is_there(
+    tmp_path: Path,
+) -> None:
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    (acq / "image01.jpg").rename(acq / "img  01.jpg")
+    lp = acq / "dirs.lp"
+    lp.write_text(lp.read_text(encoding="utf-8").replace("image01.jpg", "img  01.jpg"))
+    r = CliRunner().invoke(app, ["check", str(lp)], terminal_width=4000)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1, said
+    assert "(img 01.jpg); 'img 01.jpg' is there as 'img  01.jpg': an .lp's names are read" in (
+        r.output.replace("\n", " ")
+    ), r.output
+    assert "copy them where their names point" not in said, said
