@@ -2161,6 +2161,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
     if adaptive_result is not None:
         from rti_rig.app.usecases.adaptive import (
             ARM_MAX_LIGHTS,
+            claim_caveat,
             estimate_phrase,
             few_lights_note,
             short_of_target_note,
@@ -2175,6 +2176,14 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
             + (f"; {estimates}" if estimates else ""),
             highlight=False,
         )
+        header = opened.folder.manifest.get("adaptive") or {}
+        band = (
+            float(header.get("min_elevation_deg") or 0.0),
+            float(90.0 if header.get("max_elevation_deg") is None else header["max_elevation_deg"]),
+        )
+        caveat = claim_caveat(adaptive_result, band)
+        if caveat is not None:  # one line, as the notes below
+            err.print(f"[yellow]note:[/] {escape(caveat)}", highlight=False, soft_wrap=True)
         short = few_lights_note(adaptive_result, lambda m: _with_min_lights(opened, m))
         if short is not None:  # one line: the command it ends with pastes whole
             err.print(f"[yellow]note:[/] {escape(short)}", highlight=False, soft_wrap=True)
