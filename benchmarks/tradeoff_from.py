@@ -473,9 +473,9 @@ class Targets:
         """The command-line options that give these targets ('' for the defaults)."""
         said = ""
         if self.normals_deg != NORMAL_TARGETS_DEG:
-            said += "".join(f" --target-deg {t:g}" for t in self.normals_deg)
+            said += "".join(f" --target-deg {t:.10g}" for t in self.normals_deg)
         if self.relight_db != RELIGHT_TARGETS_DB:
-            said += "".join(f" --target-db {t:g}" for t in self.relight_db)
+            said += "".join(f" --target-db {t:.10g}" for t in self.relight_db)
         return said
 
 
@@ -614,13 +614,13 @@ def how_many_lights(
     ]
     for target in targets.normals_deg:
         lines.append(
-            line(f"Normals within {target:g}°", lambda r, t=target: r.normal_mean_deg <= t)
+            line(f"Normals within {target:.10g}°", lambda r, t=target: r.normal_mean_deg <= t)
         )
     if np.isfinite(every.file_psnr_db):
         for target in targets.relight_db:
             lines.append(
                 line(
-                    f"Relighting within {target:g} dB",
+                    f"Relighting within {target:.10g} dB",
                     lambda r, t=target: bool(
                         r.file_model and r.file_psnr_db >= every.file_psnr_db - t
                     ),

@@ -98,6 +98,17 @@ def linear_frame(
     return img.astype(np.uint16, copy=False), None
 
 
+def _sha256(path: Path) -> str | None:
+    """The file's SHA-256, or None where it cannot be read."""
+    import hashlib
+
+    try:
+        with open(path, "rb") as fh:
+            return hashlib.file_digest(fh, "sha256").hexdigest()
+    except OSError:
+        return None
+
+
 def _stamp(path: Path) -> tuple[int, int, int] | None:
     """A file's size, mtime and ctime (ns), or None where it cannot be read."""
     try:
@@ -126,8 +137,11 @@ class ReplayCamera:
         readout_s: float = 0.3,
         transfer_s: float = 0.7,
         names: Sequence[str] | None = None,
+        digests: Sequence[str | None] | None = None,
     ) -> None:
         self.name = "replay camera"
+        #: each recorded file's SHA-256 as the run began (None: not known)
+        self._digests = list(digests) if digests is not None else [None] * len(images)
         self._images = [Path(p) for p in images]
         # each image's name as the session records it: its path relative to the .lp (two
         # files of one name in two subfolders had both been recorded by their file name)
@@ -148,19 +162,27 @@ class ReplayCamera:
         self._connected = True
 
     def _refuse_changed(self, lit: int) -> None:
-        """Refuse the step of a recorded file rewritten since the run began: it had been
+        """Refuse the step of a recorded file changed since the run began: it had been
         copied into the session as it was then, the manifest still recording the file the run
         began with, and nothing said (QA, 2026-12-06). A resume hashes the whole acquisition
-        and refuses a changed one; within a run, a write is seen by its stamp, which any write
-        or replacement changes (the ctime only the kernel sets)."""
+        and refuses a changed one; within a run, a file whose stamp moved (a write, a
+        replacement; also a chmod, a sync client's tag, a backup's hard link, which change
+        nothing in it) is hashed and judged by its bytes against the digest of the run's
+        start."""
         path = self._images[lit]
         before = self._stamps[lit] if lit < len(self._stamps) else None
-        if before is None or _stamp(path) in (before, None):  # a file gone: _recorded says so
+        now = _stamp(path)
+        if before is None or now in (before, None):  # a file gone: _recorded says so
+            return
+        expected = self._digests[lit] if lit < len(self._digests) else None
+        if expected is None or _sha256(path) in (expected, None):
+            self._stamps[lit] = now  # the same bytes: not hashed again
             return
         raise CaptureError(
             self.name,
-            f"the recorded file {shown_path(path)} was changed since this run began (written "
-            "or replaced while the acquisition was replayed): the session would mix two "
+            f"the recorded file {shown_path(path)} was changed since this run began (its bytes "
+            "differ from those the run began with: written or replaced while the acquisition "
+            "was replayed): the session would mix two "
             "versions of the acquisition. Put the file back as it was, from a copy, and "
             "resume; or start a new session from the acquisition as it is now",
             "capture",

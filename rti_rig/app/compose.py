@@ -476,6 +476,11 @@ def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
     dome = SimulatedDome(geometry, LightState(), clock, cfg.timing.light_switch_s)
     dome.name = "replayed dome"
     images = [image_path(folder, name) for name in geometry.names]
+    from rti_rig.app.rig_identity import recorded_images_stamped
+
+    # each file's digest as the run begins (the identity's, from the process's cache): a
+    # file whose stamp changes during the run is judged by its bytes against it
+    _, stamped = recorded_images_stamped(folder, geometry.names)
     camera = ReplayCamera(
         images,
         dome,
@@ -486,6 +491,7 @@ def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
         # recorded as the path relative to the .lp: unambiguous where two subfolders hold a
         # file of one name (RTIBuilder's ../jpeg-exports/… climbs out of assembly-files/)
         names=[lp_name_from(folder, p) for p in images],
+        digests=[(stamped.get(name) or [None] * 4)[3] for name in geometry.names],
     )
     return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
 

@@ -1048,7 +1048,10 @@ def _images_beside(lp: Path) -> bool:
         entries = read_lp(lp)
     except Exception:
         return False
-    return bool(entries) and image_path(lp.parent, entries[0].name).is_file()
+    try:
+        return bool(entries) and image_path(lp.parent, entries[0].name).is_file()
+    except OSError:  # a name no file here can have (too long): not found, as one missing
+        return False
 
 
 def rtibuilder_project_lp(folder: Path) -> Path | None:

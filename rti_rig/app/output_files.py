@@ -178,6 +178,12 @@ def session_rig_inputs(config: object) -> dict[str, Path | None]:
         inputs = {"RIG": path}
     # "the RIG this command reads" is said of a --rig given: these are the manifest's
     return {
-        ("session's rig config" if k == "RIG" else f"{k} of the session's rig"): p
+        (
+            "session's rig config"
+            if k == "RIG"
+            else k.replace("rig's", "session's rig's", 1)
+            if "rig's" in k
+            else f"{k} of the session's rig"
+        ): p
         for k, p in inputs.items()
     }

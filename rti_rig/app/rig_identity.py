@@ -266,12 +266,15 @@ def recorded_images_stamped(
 
 
 def _file_digest(path: Path) -> str:
-    """The SHA-256 of the file at ``path``, read in blocks (OSError when it cannot be)."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda f=f: f.read(1 << 20), b""):  # type: ignore[misc]
-            digest.update(block)
-    return digest.hexdigest()
+    """The SHA-256 of the file at ``path`` (OSError when it cannot be read), through the
+    process's checksum cache (:func:`rti_rig.runtime.session.file_sha256`): the replay rig's
+    build asks again for the digests the identity has just taken, and reads nothing twice."""
+    from rti_rig.runtime.session import file_sha256
+
+    digest = file_sha256(path)
+    if digest is None:
+        raise FileNotFoundError(2, "not a file", str(path))
+    return digest
 
 
 def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[str]:

@@ -266,8 +266,11 @@ def _first_missing(folder: Path) -> Path | None:
     exists): what :func:`_check_out_folder` will create."""
     missing = None
     for path in (folder.absolute(), *folder.absolute().parents):
-        if path.exists() or path.is_symlink():
-            break
+        try:
+            if path.exists() or path.is_symlink():
+                break
+        except OSError:  # a folder not to be looked into: nothing here is this run's to remove
+            return None
         missing = path
     return missing
 

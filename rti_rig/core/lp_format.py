@@ -221,10 +221,27 @@ def image_path(lp_dir: Path, name: str) -> Path:
     if not is_absolute_name(name):
         literal = lp_dir / name
         portable = lp_dir / PureWindowsPath(name).as_posix() if "\\" in name else literal
-        beside = literal if literal.exists() and not portable.exists() else portable
-        return beside if beside.exists() else _in_project_exports(lp_dir, name) or beside
+        beside = literal if _exists(literal) and not _exists(portable) else portable
+        return beside if _exists(beside) else _in_project_exports(lp_dir, name) or beside
     candidates = _absolute_name_candidates(lp_dir, name)
-    return next((c for c in candidates if c.is_file()), lp_dir / image_file_name(name))
+    return next((c for c in candidates if _is_file(c)), lp_dir / image_file_name(name))
+
+
+def _exists(path: Path) -> bool:
+    """``path.exists()``, False where the system cannot look it up (a name too long for it:
+    Python raises there, where it answers False for a name that is not there)."""
+    try:
+        return path.exists()
+    except OSError:
+        return False
+
+
+def _is_file(path: Path) -> bool:
+    """``path.is_file()``, False where the system cannot look it up (as :func:`_exists`)."""
+    try:
+        return path.is_file()
+    except OSError:
+        return False
 
 
 def _in_project_exports(lp_dir: Path, name: str) -> Path | None:
@@ -240,7 +257,7 @@ def _in_project_exports(lp_dir: Path, name: str) -> Path | None:
     if lp_dir.name.casefold() != ASSEMBLY_FILES or len(_pure_name(name).parts) != 1:
         return None
     exported = lp_dir.parent / "jpeg-exports" / name
-    return exported if exported.is_file() else None
+    return exported if _is_file(exported) else None
 
 
 def _trailing_parts(name: str) -> list[str]:
@@ -285,7 +302,7 @@ def image_name_ambiguity(lp_dir: Path, name: str) -> str | None:
     if not is_absolute_name(name):
         return None
     lp_dir = Path(lp_dir)
-    existing = [c for c in _under_lp_dir(lp_dir, _trailing_parts(name)) if c.is_file()]
+    existing = [c for c in _under_lp_dir(lp_dir, _trailing_parts(name)) if _is_file(c)]
     if len(existing) < 2:
         return None
     chosen, others = existing[0], existing[1:]
@@ -316,6 +333,8 @@ def image_paths(lp_path: Path, entries: Sequence[LpEntry]) -> list[Path]:
     so is a name that could be either of two different files
     (:func:`image_name_ambiguity`)."""
     lp_dir = Path(lp_path).parent
+    for e in entries:  # before any is looked up: no file here can have such a name
+        _refuse_long_parts(e.name, str(lp_path), e.line)
     for e in entries:
         why = image_name_ambiguity(lp_dir, e.name)
         if why is not None:
@@ -458,6 +477,9 @@ def _invisible_names(missing: Sequence[Path]) -> list[str]:
     return said
 
 
+_RUN_OF_SPACES = re.compile(r"[ \t]{2,}|\t")
+
+
 def _spaced_names(missing: Sequence[Path]) -> list[tuple[str, str]]:
     """``(listed, there)`` for missing images with a space in their name where a file is there
     whose name has a run of spaces (or a tab) at that place: ``img  00.jpg`` listed in an .lp
@@ -474,7 +496,9 @@ def _spaced_names(missing: Sequence[Path]) -> list[tuple[str, str]]:
                 ]
             except OSError:
                 listings[path.parent] = []
-        there = [n for n in listings[path.parent] if " ".join(n.split()) == path.name]
+        # a run of two or more spaces or tabs, read as one: not a no-break space, nor a space
+        # at the name's end, which the .lp's reading does not make (they are missing otherwise)
+        there = [n for n in listings[path.parent] if _RUN_OF_SPACES.sub(" ", n) == path.name]
         if there and there[0] != path.name:
             found.append((path.name, there[0]))
     return found
@@ -776,8 +800,8 @@ def _is_file_at(name: str) -> bool:
 
 
 #: The longest file or folder name, in bytes, that Linux's file systems hold (ext4, XFS, Btrfs:
-#: NAME_MAX) and macOS's APFS in UTF-8 bytes; NTFS counts 255 UTF-16 units instead, so a name a
-#: Windows tool wrote can be longer here than any file this machine can look up.
+#: NAME_MAX); NTFS counts 255 UTF-16 units instead, so a name a Windows tool wrote can be longer
+#: in UTF-8 than any file a Linux machine can look up.
 NAME_MAX_BYTES = 255
 
 
@@ -813,9 +837,7 @@ def _name_bytes(part: str) -> int:
 
 def _check_name(name: str, source: str, lineno: int) -> None:
     """Reject relative names that would resolve outside the `.lp` file's own folder (an
-    absolute name is a tool's path on its own machine: see :func:`image_path`), and names no
-    file here can have (:func:`_refuse_long_parts`)."""
-    _refuse_long_parts(name, source, lineno)
+    absolute name is a tool's path on its own machine: see :func:`image_path`)."""
     if is_absolute_name(name):
         return
     # read as the .lp's readers read it: "\\" a folder separator wherever it appears
@@ -1288,7 +1310,7 @@ def parse_lp(
     entries: list[LpEntry] = []
     seen: dict[str, int] = {}
     off_unit: list[tuple[int, float]] = []
-    below: list[tuple[int, str, float]] = []
+    below: list[tuple[int, str, float, float]] = []
     for lineno, line in content:
         tokens = line.split()
         if len(tokens) == 3 and all(_is_number(t) for t in tokens):

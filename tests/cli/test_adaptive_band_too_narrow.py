@@ -275,3 +275,21 @@ def test_the_band_advised_to_a_dome_keeps_the_objective_asked(tmp_path: Path) ->
     assert (
         f"--out {out} --adaptive --lights 6 --objective relight --max-elevation-deg 37 (6 lights"
     ) in text, text
+
+
+def test_a_count_only_every_elevation_holds_is_advised_without_a_band(tmp_path: Path) -> None:
+    """--lights 200 between 10° and 30° on a 48-LED dome: only every elevation holds 48, and
+    the advice had ended in a colon with no option after it."""
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app,
+        ["run", str(CONFIGS / "emulated_dome.toml"), "--out", str(out), "--adaptive",
+         "--lights", "200", "--min-elevation-deg", "10", "--max-elevation-deg", "30"],
+    )  # fmt: skip
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "give at most 48, in a band that holds 48 (this one between 10° and 30° elevation " in (
+        text
+    )
+    assert "every elevation (drop --min-elevation-deg and --max-elevation-deg)" in text, text
+    assert not out.exists()

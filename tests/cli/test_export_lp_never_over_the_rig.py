@@ -62,7 +62,7 @@ def test_a_domes_lp_file_calibration_is_never_replaced(tmp_path: Path) -> None:
     r = runner.invoke(app, ["run", str(config), "--out", str(out), "--lights", "6", "--no-verdict"])
     assert r.exit_code == 0, r.output
     for target, what in (
-        (rig / "dome.lp", "is the rig's LED calibration (lp_file) of the session's rig"),
+        (rig / "dome.lp", "is the session's rig's LED calibration (lp_file)"),
         (config, "is the session's rig config"),
     ):
         before = _sha(target)

@@ -32,3 +32,16 @@ def test_a_name_with_a_run_of_spaces_is_named_with_the_file_that_is_there(
         r.output.replace("\n", " ")
     ), r.output
     assert "copy them where their names point" not in said, said
+
+
+def test_a_no_break_space_is_not_said_to_be_a_run_of_spaces(tmp_path: Path) -> None:
+    """The hint is for runs of spaces or tabs only: a no-break space in the file's name is not
+    what the reading collapses, and saying so would be wrong."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    (acq / "image01.jpg").rename(acq / "img\u00a001.jpg")
+    lp = acq / "dirs.lp"
+    lp.write_text(lp.read_text(encoding="utf-8").replace("image01.jpg", "img 01.jpg"))
+    r = CliRunner().invoke(app, ["check", str(lp)], terminal_width=4000)
+    assert r.exit_code == 1, r.output
+    assert "(img 01.jpg)" in r.output and "each run of spaces" not in r.output, r.output

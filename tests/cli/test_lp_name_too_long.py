@@ -24,7 +24,6 @@ ACQ = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay"
         ["check", "{lp}"],
         ["fit", "{lp}", "--out", "{tmp}/f"],
         ["run", "{lp}", "--out", "{tmp}/r"],
-        ["plan", "--rig", "{lp}", "--lights", "6", "--out", "{tmp}/p.lp"],
         ["bench", "tradeoff", "--from", "{lp}"],
     ],
 )
@@ -45,3 +44,21 @@ def test_an_image_name_too_long_here_is_refused_by_line(tmp_path: Path, argv: li
     assert "Traceback" not in said and "unexpected" not in said, said
     assert f"{lp}, line 4: image name part" in said and "is 274 bytes long" in said, said
     assert not (tmp_path / "f").exists() and not (tmp_path / "r").exists()
+
+
+def test_a_plan_of_such_an_acquisition_needs_only_its_directions(tmp_path: Path) -> None:
+    """`plan --rig ACQ/dirs.lp` reads the lights, not the images: it plans (it had been
+    refused once the long name was checked where the .lp is read)."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    lines = (acq / "dirs.lp").read_text(encoding="utf-8").splitlines()
+    name, rest = lines[3].split(" ", 1)
+    lines[3] = f"{'文' * 90}.jpg {rest}"
+    (acq / name).unlink()
+    (acq / "dirs.lp").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    out = tmp_path / "p.lp"
+    argv = ["plan", "--rig", str(acq / "dirs.lp"), "--lights", "6", "--out", str(out)]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    assert r.exit_code == 0, r.output
+    assert "Traceback" not in r.output
+    assert out.is_file()

@@ -617,7 +617,10 @@ def test_an_image_rewritten_while_it_is_replayed_stops_the_run_naming_it(
     the session ran) had been copied into the session as it was then, with exit 0, the
     manifest recording the file the run began with (QA, 2026-12-06). The run stops at its step
     naming the file; the images before it are kept, and with the original put back the resume
-    continues."""
+    continues. A file whose stamp alone moved (a chmod, a backup's utime, a sync client's
+    tag: the same bytes) is judged by its bytes and the run goes on."""
+    import os
+
     from rti_rig.simulator import replay
 
     acq = tmp_path / "acq"
@@ -626,25 +629,45 @@ def test_an_image_rewritten_while_it_is_replayed_stops_the_run_naming_it(
     real_capture = replay.ReplayCamera.capture
     shots: list[int] = []
 
-    def capture(self, exposure_s):  # type: ignore[no-untyped-def]
+    def touched(self, exposure_s):  # type: ignore[no-untyped-def]
         if self._dome.lit is not None:
             shots.append(self._dome.lit)
-            if len(shots) == 2:  # during the run, every image of it rewritten (re-exported)
+            if len(shots) == 2:  # every image of it: mode set again, times set back
                 for name in names:
-                    data = (acq / name).read_bytes()
-                    (acq / name).write_bytes(data)
+                    st = (acq / name).stat()
+                    os.chmod(acq / name, st.st_mode & 0o7777)
+                    os.utime(acq / name, ns=(st.st_atime_ns, st.st_mtime_ns))
         return real_capture(self, exposure_s)
 
-    monkeypatch.setattr(replay.ReplayCamera, "capture", capture)
+    monkeypatch.setattr(replay.ReplayCamera, "capture", touched)
+    same = tmp_path / "same"
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(same), "--lights", "6"])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(same / "lights.lp")) == 6
+
+    originals = {name: (acq / name).read_bytes() for name in names}
+    shots.clear()
+
+    def rewritten(self, exposure_s):  # type: ignore[no-untyped-def]
+        if self._dome.lit is not None:
+            shots.append(self._dome.lit)
+            if len(shots) == 2:  # during the run, every image of it re-exported: other bytes
+                for name in names:
+                    (acq / name).write_bytes(originals[name] + b"\0")
+        return real_capture(self, exposure_s)
+
+    monkeypatch.setattr(replay.ReplayCamera, "capture", rewritten)
     out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--lights", "6"])
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "Traceback" not in said
-    assert "was changed since this run began (written or replaced while the acquisition" in said
+    assert "was changed since this run began (its bytes differ from those the run began" in said
     assert "Put the file back as it was, from a copy, and resume" in said, said
     assert [e["image"] for e in _journal(out)] == ["image_001.jpg"]  # the step before it kept
-    # the bytes are the same (rewritten, not changed): the resume, which hashes them, goes on
+    # the originals put back, the resume (which hashes them) goes on
+    for name in names:
+        (acq / name).write_bytes(originals[name])
     monkeypatch.setattr(replay.ReplayCamera, "capture", real_capture)
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
@@ -687,3 +710,15 @@ def test_a_resume_on_another_acquisition_says_so_and_advises_a_count_it_has(
     r = runner.invoke(app, ["run", *args, "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert len(read_lp(Path(args[2]) / "lights.lp")) == 11
+    # the session's own .lp edited in place (lines cut) is no other acquisition: said as an
+    # edit, to be put back (naming it "another" had advised a resume refused the same way)
+    lines = (acq / "dirs.lp").read_text(encoding="utf-8").splitlines()
+    (acq / "dirs.lp").write_text("\n".join(["11", *lines[1:12]]) + "\n", encoding="utf-8")
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--resume", str(out)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "another acquisition" not in said and "Put the original files back" in said, said
+    command = re.search(r"as it is now \(rti-rig run ([^()]+)\)$", said)
+    assert command, said
+    args = shlex.split(command.group(1))
+    assert args[args.index("--lights") + 1] == "11", args  # a count it has

@@ -1897,7 +1897,12 @@ def _check_lights_range(
             ""
             if wider is None
             else f", in a band that holds {advised} (this one{_band_words(band)} holds "
-            f"{_held(el, band)}):{band_options(wider)}"  # type: ignore[arg-type]
+            f"{_held(el, band)}):"  # type: ignore[arg-type]
+            + (
+                band_options(wider)
+                if tuple(wider) != _FULL_BAND
+                else " every elevation (drop --min-elevation-deg and --max-elevation-deg)"
+            )
         )
     )
 

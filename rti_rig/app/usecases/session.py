@@ -1598,7 +1598,9 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             if k in recorded and k != "recorded_images"
         )
     )
-    if only_images_other and _other_lights(recorded, identity):
+    last = (manifest.get("rig") or {}).get("config_path")
+    another_file = not last or not _same_file(Path(config_path), Path(str(last)))
+    if only_images_other and another_file and _other_lights(recorded, identity):
         # its lights too: another acquisition, not an edited image of this one (it had been
         # said "one was edited", and the new session advised with a --lights it lacks)
         raise RigChangedError(
@@ -1614,7 +1616,7 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             "ones a resume would take would come from two different acquisitions. Put the original "
             f"files back to continue (rti-rig run --resume {shell_word(str(session_dir))}), "
             "or start a new session from the acquisition as it is now ("
-            + new_session_command(config_path, manifest, session_dir)
+            + new_session_command(config_path, manifest, session_dir, most=_light_count(identity))
             + ")"
         )
     replay = recorded.get("backend") == identity.get("backend") == "replay"
@@ -1683,6 +1685,12 @@ def _other_lights(recorded: dict[str, Any], identity: dict[str, Any]) -> bool:
     return bool(moved_lights(before, now))
 
 
+def _light_count(identity: dict[str, Any]) -> int | None:
+    """A dome's LED count as its identity says it (``"11 LEDs"``), None if it does not."""
+    words = str(identity.get("lights") or "").split()
+    return int(words[0]) if words and words[0].isdigit() else None
+
+
 def _another_acquisition(
     config_path: Path,
     recorded: dict[str, Any],
@@ -1696,11 +1704,7 @@ def _another_acquisition(
     last = (manifest.get("rig") or {}).get("config_path")
     lights_now = str(identity.get("lights") or "").replace("LEDs", "lights")
     lights_then = str(recorded.get("lights") or "").replace("LEDs", "lights")
-    count = (
-        int(lights_now.split()[0])
-        if lights_now.split()[:1] and lights_now.split()[0].isdigit()
-        else None
-    )
+    count = _light_count(identity)
     which = (
         f"{lights_now}, the session's {lights_then}"
         if lights_now != lights_then
