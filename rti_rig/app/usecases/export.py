@@ -100,8 +100,11 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     # never the session's own files, nor the rig config it names and what that reads (a
     # dome's lp_file calibration, a replayed acquisition's .lp and images): `--out
     # ACQ/dirs.lp --force` had replaced the acquisition's 12 lights with the session's 6
+    # (read only where the file exists, the one case they are compared with: a new file never
+    # loads the rig config, which an export needs nothing of)
     config = (manifest.get("rig") or {}).get("config_path")
-    check_output_file(req.out_file, req.force, session_rig_inputs(config))
+    rig_files = session_rig_inputs(config) if Path(req.out_file).exists() else {}
+    check_output_file(req.out_file, req.force, rig_files)
     in_session = _in_session_said(Path(req.out_file), root)  # said before lights.lp is written
     write_lp(req.out_file, entries)
     # lights.lp one image short of the session (a run stopped between a step's record file
