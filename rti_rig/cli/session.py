@@ -2164,6 +2164,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
             claim_caveat,
             estimate_phrase,
             few_lights_note,
+            header_band,
             short_of_target_note,
         )
 
@@ -2177,11 +2178,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
             highlight=False,
         )
         header = opened.folder.manifest.get("adaptive") or {}
-        band = (
-            float(header.get("min_elevation_deg") or 0.0),
-            float(90.0 if header.get("max_elevation_deg") is None else header["max_elevation_deg"]),
-        )
-        caveat = claim_caveat(adaptive_result, band)
+        caveat = claim_caveat(adaptive_result, header_band(header))
         if caveat is not None:  # one line, as the notes below
             err.print(f"[yellow]note:[/] {escape(caveat)}", highlight=False, soft_wrap=True)
         short = few_lights_note(adaptive_result, lambda m: _with_min_lights(opened, m))

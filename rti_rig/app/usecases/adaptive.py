@@ -1320,6 +1320,16 @@ RTI_FILE_LIGHTS = (
 )
 
 
+def header_band(header: dict[str, Any]) -> tuple[float, float]:
+    """The elevation band an adaptive session's manifest header records; every elevation for
+    a session begun before adaptive sessions took a band (the keys absent)."""
+    lo, hi = header.get("min_elevation_deg"), header.get("max_elevation_deg")
+    return (
+        _FULL_BAND[0] if lo is None else float(lo),
+        _FULL_BAND[1] if hi is None else float(hi),
+    )
+
+
 def claim_caveat(result: dict[str, Any], band: tuple[float, float]) -> str | None:
     """What a claimed ``--until-error`` target does not cover (None: nothing claimed).
 
@@ -2163,11 +2173,7 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
         header["start_lights"],
         design=header.get("design_lights") is not None,
         objective=began,
-        # absent in sessions begun before adaptive sessions took a band: every elevation
-        band=(
-            float(header.get("min_elevation_deg", _FULL_BAND[0])),
-            float(header.get("max_elevation_deg", _FULL_BAND[1])),
-        ),
+        band=header_band(header),
         positions=_recorded_positions(rig, folder),
         # the session's own (none recorded: begun before the rule, resumed without it)
         ring_span_deg=(header.get("constants") or {}).get("app.usecases.adaptive.RING_SPAN_DEG"),

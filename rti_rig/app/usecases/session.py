@@ -1686,9 +1686,9 @@ def _other_lights(recorded: dict[str, Any], identity: dict[str, Any]) -> bool:
 
 
 def _light_count(identity: dict[str, Any]) -> int | None:
-    """A dome's LED count as its identity says it (``"11 LEDs"``), None if it does not."""
-    words = str(identity.get("lights") or "").split()
-    return int(words[0]) if words and words[0].isdigit() else None
+    """A dome's LED count, from the directions its identity records (None: none recorded)."""
+    directions = identity.get("light_directions")
+    return len(directions) if isinstance(directions, list) else None
 
 
 def _another_acquisition(
@@ -1702,13 +1702,11 @@ def _another_acquisition(
     two ways on: the session's own .lp, or a new session from this one (its counts within
     this acquisition's lights)."""
     last = (manifest.get("rig") or {}).get("config_path")
-    lights_now = str(identity.get("lights") or "").replace("LEDs", "lights")
-    lights_then = str(recorded.get("lights") or "").replace("LEDs", "lights")
-    count = _light_count(identity)
+    count, before = _light_count(identity), _light_count(recorded)
     which = (
-        f"{lights_now}, the session's {lights_then}"
-        if lights_now != lights_then
-        else f"{lights_now} as the session's, at other directions"
+        f"{count} lights, the session's {before} lights"
+        if count != before
+        else f"{count} lights as the session's, at other directions"
     )
     own = (f", {shown_path(last)}" if last else "") + (
         f": rti-rig run --resume {shell_word(str(session_dir))}"
