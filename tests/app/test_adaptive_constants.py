@@ -19,6 +19,7 @@ OWNERS = {
     "UPPER_FACTOR": adaptive_until,
     "UPPER_QUANTILE": adaptive_until,
     "RING_SPAN_DEG": usecase,
+    "UNSOLVED_DEG": adaptive_until,
 }
 
 
