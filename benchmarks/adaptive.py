@@ -216,7 +216,7 @@ def adaptive_run(
     until: float | None = None,
     scale: float = 1.0,
     objective: str = "normals",
-) -> tuple[list[int], dict[int, float], float]:
+) -> tuple[list[int], dict[int | str, float | None], float]:
     """The chooser on pre-shot images: chosen indices, raw estimate after k images (k ≥ 4),
     and the mean decision time (s). ``objective``: as ``run --adaptive --objective``."""
     # as `run --adaptive --lights N` (N known); DESIGN False: light by light (for comparison)
@@ -234,7 +234,7 @@ def adaptive_run(
     chooser = AdaptiveChooser(
         dirs, start, n_max, until, scale=scale, design_lights=design, objective=objective
     )
-    estimates: dict[int, float] = {}
+    estimates: dict[int | str, float | None] = {}
     times = []
     for i in range(n_max + 1):
         t0 = time.perf_counter()
@@ -243,6 +243,9 @@ def adaptive_run(
             times.append(time.perf_counter() - t0)
         if ev.get("estimated_error_deg") is not None:
             estimates[i] = float(ev["estimated_error_deg"])
+        # the upper estimate of the last decision (the stop's): what the shipped stop compared,
+        # unsolved pixels included (not the point × UPPER_FACTOR alone)
+        estimates["upper"] = ev.get("upper_error_deg")
         if c is None:
             break
         chooser.observe(c, dirs[c], grey[c])
@@ -378,8 +381,9 @@ def until_error_rows(results: dict, scale: float, slope: float) -> list[str]:
                 data.normals, data.candidate_images[idx], data.candidate_dirs[idx]
             )[0]
             estimate = est.get(len(used)) if est else None
-            # the stop compares the upper estimate (format 8: the point × UPPER_FACTOR)
-            upper = None if estimate is None else UPPER_FACTOR * estimate
+            # the stop compares the upper estimate (the point × UPPER_FACTOR, plus the
+            # unsolved pixels' share × UNSOLVED_DEG): as the stop recorded it
+            upper = est.get("upper") if estimate is not None else None
             stopped = (
                 "upper estimate reached"
                 if upper is not None and upper <= target
@@ -1103,8 +1107,8 @@ def main(argv: list[str] | None = None) -> str:
             "",
             "`--until-error` on each simulated scene (all 240 candidates, capped at 60 lights):",
             "",
-            "| scene | target | lights used | estimate at stop | upper estimate (the stop's, "
-            f"×{UPPER_FACTOR:g}) | measured | why it stopped |",
+            "| scene | target | lights used | estimate at stop | upper estimate (the stop's: "
+            f"×{UPPER_FACTOR:g}, plus unsolved pixels × 90°) | measured | why it stopped |",
             "|---|---|---|---|---|---|---|",
             *until_rows,
             "",

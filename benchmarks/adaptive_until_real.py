@@ -17,6 +17,11 @@ finely.
 Run: ``python -m benchmarks.adaptive_until_real [--draws K] [--targets 2,3,4,6] [--cap 60]
 [--write]`` (reads ../shared/data/neuralrti-example beside the repository; ``--write`` puts the
 table into docs/adaptive.md).
+
+Since 2026-12-06 the shipped stop adds the unsolved pixels' share × ``UNSOLVED_DEG`` to the
+upper estimate (``planner.adaptive_until``); this benchmark replays the factor alone (format
+8's rule, from which the factor was derived); on the shared real acquisition the share is zero
+at every light, so the stops are the shipped ones.
 """
 
 from __future__ import annotations

@@ -14,6 +14,12 @@ squares of log measured / raw estimate over every light count k ≥ 6 of the oth
 
 Run: ``python -m benchmarks.adaptive_until_sim [--scenes a,b] [--cap 60] [--greedy]
 [--targets 1,2,4] [--write]`` (``--write`` puts the tables into docs/adaptive.md).
+
+Since 2026-12-06 the shipped stop adds the unsolved pixels' share × ``UNSOLVED_DEG`` to the
+upper estimate (``planner.adaptive_until``); this benchmark replays the factor alone (format
+8's rule, from which the factor was derived), so its stops can come earlier than the shipped
+ones where the robust fit leaves pixels unsolved (the coin and the industrial part below 11
+and 7 lights).
 """
 
 from __future__ import annotations

@@ -29,9 +29,9 @@ stop as a promise; a point estimate under 2° is one half the time.
 The upper estimate also counts the pixels no image so far determines (:data:`UNSOLVED_DEG`,
 :func:`unsolved_fraction`): seen under some light but lit by too few for the robust fit to
 solve them. The point estimate is simulated on the object model, which has no normal for such
-a pixel to be wrong about, so under a low ceiling (four grazing lights leaving a fifth of a
-relief in shadow) a claim had measured 8–14× its upper estimate (docs/adaptive.md, "The stop's
-claim on the shipped rigs").
+a pixel to be wrong about, so under a low ceiling (four grazing lights leaving a sixth of a
+relief unsolved) the shipped dome had claimed 1.5° at 4 lights and measured 9° (docs/adaptive.md,
+"The stop's claim on the shipped rigs").
 """
 
 from __future__ import annotations

@@ -214,15 +214,17 @@ def test_a_resumed_session_keeps_the_upper_factor_it_began_with(
     m = json.loads((out / "manifest.json").read_text())
     assert m["adaptive"]["upper_factor"] == UPPER_FACTOR
     m["adaptive"]["upper_factor"] = 3.0  # as a session begun by a version with another factor
+    m["adaptive"]["unsolved_deg"] = 45.0  # and another weight for its unsolved pixels
     (out / "manifest.json").write_text(json.dumps(m))
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output
     steps = journal(out)
     assert [s["led"] for s in steps] == [s["led"] for s in journal(ref)]
     assert {s["decision"]["upper_factor"] for s in steps[7:]} == {3.0}
+    assert {s["decision"]["unsolved_deg"] for s in steps[7:]} == {45.0}
     result = manifest(out)["adaptive"]["result"]
-    assert result["upper_factor"] == 3.0
-    assert result["upper_error_deg"] == pytest.approx(3.0 * result["estimated_error_deg"], abs=1e-3)
+    assert result["upper_factor"] == 3.0 and result["unsolved_deg"] == 45.0
+    assert result["upper_error_deg"] == pytest.approx(_upper(result), abs=5e-3)
 
 
 @pytest.mark.slow
@@ -310,22 +312,29 @@ def test_the_stops_reason_and_the_final_line_print_one_upper_estimate_alike() ->
     from types import SimpleNamespace
 
     from rti_rig.app.usecases.adaptive import AdaptiveChooser, estimate_phrase
-    from rti_rig.planner.adaptive_until import upper_error_deg
 
-    fake = SimpleNamespace(
-        upper_factor=1.95, until_error_deg=4.0, min_lights=None, unsolved=0.0, unsolved_deg=90.0
-    )
-    fake.upper = lambda e: upper_error_deg(e, 1.95)
-    fake.stop_terms = lambda e: AdaptiveChooser.stop_terms(fake, e)  # type: ignore[arg-type]
-    est = 3.98500001 / 1.95
-    assert f"{fake.upper(est):.2f}" == "3.99"  # the case: unrounded and recorded differ
-    reason = AdaptiveChooser._reached_reason(fake, est)  # type: ignore[arg-type]
-    line = estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0})
-    shown = re.search(r"upper estimate ([\d.]+)°", line)
-    assert shown is not None and f"upper estimate {shown.group(1)}°" in reason
-    assert f"estimate {fake.stop_terms(est)['estimated_error_deg']:.2f}°" in reason
-    # after a reason giving both figures, the final line gives neither again
-    assert estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0}, reason) == ""
+    # without unsolved pixels, and with 1 % of them (the reason then says the term)
+    for unsolved in (0.0, 0.01):
+        fake = SimpleNamespace(
+            upper_factor=1.95,
+            until_error_deg=4.0,
+            min_lights=None,
+            unsolved=unsolved,
+            unsolved_deg=90.0,
+        )
+        fake.upper = lambda e, f=fake: AdaptiveChooser.upper(f, e)  # type: ignore[misc]
+        fake.stop_terms = lambda e, f=fake: AdaptiveChooser.stop_terms(f, e)  # type: ignore[misc]
+        est = (3.98500001 - 90.0 * unsolved) / 1.95
+        assert f"{fake.upper(est):.2f}" == "3.99"  # the case: unrounded and recorded differ
+        reason = AdaptiveChooser._reached_reason(fake, est)  # type: ignore[arg-type]
+        line = estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0})
+        shown = re.search(r"upper estimate ([\d.]+)°", line)
+        assert shown is not None and f"upper estimate {shown.group(1)}°" in reason
+        assert f"estimate {fake.stop_terms(est)['estimated_error_deg']:.2f}°" in reason
+        assert ("+ 1.0 % of pixels unsolved × 90°" in reason) == (unsolved > 0), reason
+        assert ("+ 1.0 % of pixels unsolved × 90°" in line) == (unsolved > 0), line
+        # after a reason giving both figures, the final line gives neither again
+        assert estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0}, reason) == ""
 
 
 def test_a_relight_session_s_upper_estimate_is_not_tied_to_until_error() -> None:

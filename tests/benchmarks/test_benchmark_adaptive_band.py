@@ -137,3 +137,37 @@ def test_a_band_is_written_to_its_own_section_and_checked_as_the_cli_checks_it(
     with pytest.raises(SystemExit) as caught:  # the simulator is skipped only within a band
         bench.main(["--sim-draws", "0"])
     assert caught.value.code == 2 and "--sim-draws 0" in capsys.readouterr().err
+
+
+def test_the_until_error_rows_print_the_upper_estimate_the_stop_compared(monkeypatch) -> None:
+    """`until_error_rows` prints the stop's upper estimate as the chooser recorded it (unsolved
+    pixels included), not the point × UPPER_FACTOR recomputed, which had printed a smaller
+    figure than the stop compared for a session whose unsolved pixels held it back."""
+    from types import SimpleNamespace
+
+    from rti_rig.core.geometry import fibonacci_cap
+    from rti_rig.core.rig_geometry import DomeGeometry
+    from rti_rig.planner.adaptive_until import UPPER_FACTOR
+
+    dirs = fibonacci_cap(120, 0.0, 90.0)
+    dome = DomeGeometry(dirs, tuple(f"c{i:03d}" for i in range(len(dirs))))
+    rng = np.random.default_rng(0)
+    normals = rng.normal([0.0, 0.0, 3.0], 1.0, size=(24, 24, 3))
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    grey = np.clip(np.einsum("hwk,ck->chw", normals, dirs), 0, None).astype(np.float32)
+    first, _, _ = bench.adaptive_run(grey, dirs, dome, 4, until=1e-9)
+    # a patch lit by two of the starting lights only: seen, and never solved
+    grey[:, :8, :8] = 0.0
+    grey[first[:2], :8, :8] = 0.5
+    data = SimpleNamespace(
+        candidate_dirs=dirs, normals=normals, candidate_images=np.repeat(grey[..., None], 3, -1)
+    )
+    monkeypatch.setattr(bench, "TARGETS_DEG", (1e-9,))
+    import rti_rig.planner.adaptive as chooser_module
+
+    # until_error_rows sets the estimate's slope on the module: put back after the test
+    monkeypatch.setattr(chooser_module, "DISCARD_SLOPE", chooser_module.DISCARD_SLOPE)
+    (row,) = bench.until_error_rows({"patch": {"data": (data, grey, dome)}}, 1.0, 0.0)
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    estimate, upper = float(cells[3].rstrip("°")), float(cells[4].rstrip("°"))
+    assert upper > UPPER_FACTOR * estimate + 0.5, row  # the patch's share × 90° is in it

@@ -93,3 +93,22 @@ def test_a_session_begun_before_the_term_is_judged_with_it(tmp_path: Path) -> No
     assert result["lights_used"] > 4, result
     assert result["unsolved_deg"] == 90.0, result
     assert np.isfinite(_measured_deg(out)) and _measured_deg(out) <= 1.5
+
+
+def test_a_session_resumes_with_the_weight_it_recorded(tmp_path: Path) -> None:
+    """A session that recorded its own weight for the unsolved pixels (a build with another
+    UNSOLVED_DEG) is judged with it to the end, as the factor is: here 0°, which claims at the
+    four starting lights as the build before the term did."""
+    from conftest import interrupted
+
+    out = tmp_path / "s"
+    interrupted(DOME, out, after_step=3, lights=None, until=1.5, band=(0.0, 15.0))
+    path = out / "manifest.json"
+    manifest = json.loads(path.read_text())
+    manifest["adaptive"]["unsolved_deg"] = 0.0
+    path.write_text(json.dumps(manifest, indent=2))
+    said = _run("--resume", str(out))
+    result = json.loads(path.read_text())["adaptive"]["result"]
+    assert result["target_claimed"] and result["lights_used"] == 4, said
+    assert result["unsolved_deg"] == 0.0 and result["unsolved_fraction"] > 0.05, result
+    assert "pixels unsolved" not in result["stop"]["reason"], result  # weighed at 0°: no term

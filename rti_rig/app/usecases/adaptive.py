@@ -1345,7 +1345,7 @@ def unsolved_words(terms: dict[str, Any]) -> str:
     unsolved): said, so that an upper estimate far above factor × estimate is read for what
     it is (pixels no image determines yet) and not as a misprint."""
     share, each = terms.get("unsolved_fraction"), terms.get("unsolved_deg")
-    if not share or each is None:
+    if not share or not each:  # none unsolved, or a session weighing them at 0°: no term
         return ""
     return f" + {100 * share:.1f} % of pixels unsolved × {each:g}°"
 
