@@ -89,12 +89,9 @@ def test_every_layout_scored_keeps_to_the_band(monkeypatch, band, floors) -> Non
     assert top < 46.0 if band[1] < 90 else bottom > 19.0
 
 
-def test_the_band_s_adaptive_session_is_the_cli_s(monkeypatch) -> None:
-    """The session's start is `adaptive_plan`'s (the CLI's): its candidates are the band's, so
-    the start and every decision are in it; without a band the same session leaves it."""
-    from types import SimpleNamespace
-
-    from rti_rig.app.usecases.adaptive import adaptive_plan
+def _lambert_dome():  # type: ignore[no-untyped-def]
+    """A 120-light dome over every elevation and a 24×24 Lambertian scene's grey images under
+    each light: (directions, geometry, normals, images)."""
     from rti_rig.core.geometry import fibonacci_cap
     from rti_rig.core.rig_geometry import DomeGeometry
 
@@ -104,6 +101,17 @@ def test_the_band_s_adaptive_session_is_the_cli_s(monkeypatch) -> None:
     normals = rng.normal([0.0, 0.0, 3.0], 1.0, size=(24, 24, 3))
     normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
     grey = np.clip(np.einsum("hwk,ck->chw", normals, dirs), 0, None).astype(np.float32)
+    return dirs, dome, normals, grey
+
+
+def test_the_band_s_adaptive_session_is_the_cli_s(monkeypatch) -> None:
+    """The session's start is `adaptive_plan`'s (the CLI's): its candidates are the band's, so
+    the start and every decision are in it; without a band the same session leaves it."""
+    from types import SimpleNamespace
+
+    from rti_rig.app.usecases.adaptive import adaptive_plan
+
+    dirs, dome, _, grey = _lambert_dome()
     free, _, _ = bench.adaptive_run(grey, dirs, dome, 8)
     assert _elevations(dirs[free]).max() > 45.0  # every elevation: the ceiling would bind
     monkeypatch.setattr(bench, "BAND", (0.0, 45.0))
@@ -145,16 +153,9 @@ def test_the_until_error_rows_print_the_upper_estimate_the_stop_compared(monkeyp
     figure than the stop compared for a session whose unsolved pixels held it back."""
     from types import SimpleNamespace
 
-    from rti_rig.core.geometry import fibonacci_cap
-    from rti_rig.core.rig_geometry import DomeGeometry
     from rti_rig.planner.adaptive_until import UPPER_FACTOR
 
-    dirs = fibonacci_cap(120, 0.0, 90.0)
-    dome = DomeGeometry(dirs, tuple(f"c{i:03d}" for i in range(len(dirs))))
-    rng = np.random.default_rng(0)
-    normals = rng.normal([0.0, 0.0, 3.0], 1.0, size=(24, 24, 3))
-    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
-    grey = np.clip(np.einsum("hwk,ck->chw", normals, dirs), 0, None).astype(np.float32)
+    dirs, dome, normals, grey = _lambert_dome()
     first, _, _ = bench.adaptive_run(grey, dirs, dome, 4, until=1e-9)
     # a patch lit by two of the starting lights only: seen, and never solved
     grey[:, :8, :8] = 0.0
