@@ -337,6 +337,19 @@ def test_the_stops_reason_and_the_final_line_print_one_upper_estimate_alike() ->
         assert estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0}, reason) == ""
 
 
+def test_a_small_unsolved_share_is_not_printed_as_none() -> None:
+    from rti_rig.app.usecases.adaptive import unsolved_words
+
+    assert unsolved_words({"unsolved_fraction": 0.0004, "unsolved_deg": 90.0}) == (
+        " + 0.04 % of pixels unsolved × 90°"
+    )
+    assert unsolved_words({"unsolved_fraction": 0.0123, "unsolved_deg": 90.0}) == (
+        " + 1.2 % of pixels unsolved × 90°"
+    )
+    assert unsolved_words({"unsolved_fraction": 0.0, "unsolved_deg": 90.0}) == ""
+    assert unsolved_words({"unsolved_fraction": None, "unsolved_deg": 90.0}) == ""
+
+
 def test_a_relight_session_s_upper_estimate_is_not_tied_to_until_error() -> None:
     """A relight session's last line said "(×1.95: what --until-error would be compared with)",
     though --until-error is refused with --objective relight."""

@@ -1347,7 +1347,9 @@ def unsolved_words(terms: dict[str, Any]) -> str:
     share, each = terms.get("unsolved_fraction"), terms.get("unsolved_deg")
     if not share or not each:  # none unsolved, or a session weighing them at 0°: no term
         return ""
-    return f" + {100 * share:.1f} % of pixels unsolved × {each:g}°"
+    # a share under 0.1 % to two significant digits: "0.0 %" had read as none
+    percent = f"{100 * share:.1f}" if share >= 0.001 else f"{100 * share:.2g}"
+    return f" + {percent} % of pixels unsolved × {each:g}°"
 
 
 #: The fewest lights `rti-rig fit` writes each relighting file from (the file, its model, the
