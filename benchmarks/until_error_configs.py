@@ -96,10 +96,9 @@ def config_text(case: Case) -> str:
     )
 
 
-def measured_error(session: Path, truth: NDArray[np.float64]) -> tuple[float, float]:
-    """Mean and median angle (°) of robust photometric stereo on the session's linear images
-    and lights.lp to ``truth``, as the calibration measures it."""
-    from benchmarks.tradeoff import normal_error
+def session_stack(session: Path) -> tuple[list[dict], NDArray[np.float32], NDArray[np.float64]]:  # type: ignore[type-arg]
+    """A session's journal steps, its linear images (units of white) and each image's light
+    as lights.lp records it, in shooting order."""
     from rti_rig.core.image_files import read_linear_tiff
     from rti_rig.core.lp_format import read_lp
 
@@ -108,25 +107,40 @@ def measured_error(session: Path, truth: NDArray[np.float64]) -> tuple[float, fl
         [read_linear_tiff(session / s["linear_image"]).astype(np.float32) / 65535 for s in steps]
     )
     by_name = {e.name: e.direction for e in read_lp(session / "lights.lp")}
-    lights = np.array([by_name[s["image"]] for s in steps])
+    return steps, images, np.array([by_name[s["image"]] for s in steps])
+
+
+def measured_error(session: Path, truth: NDArray[np.float64]) -> tuple[float, float]:
+    """Mean and median angle (°) of robust photometric stereo on the session's linear images
+    and lights.lp to ``truth``, as the calibration measures it."""
+    from benchmarks.tradeoff import normal_error
+
+    _, images, lights = session_stack(session)
     mean, median, _ = normal_error(truth, images, lights)
     return mean, median
 
 
-def run_case(case: Case, folder: Path) -> dict:  # type: ignore[type-arg]
-    """Run ``case`` through the CLI in ``folder`` and measure it."""
+def run_cli(case: Case, folder: Path, *options: str) -> tuple[Path, dict]:  # type: ignore[type-arg]
+    """``rti-rig run`` on ``case``'s config (written to ``folder``) with ``--until-error``,
+    its ceiling and ``options``, as a user runs it (a subprocess): the session and the
+    config read."""
     config = folder / case.config
     text = config_text(case)
     config.write_text(text, encoding="utf-8")
-    cfg = tomllib.loads(text)
     session = folder / "s"
     argv = [sys.executable, "-m", "rti_rig", "run", str(config), "--out", str(session)]
-    argv += ["--until-error", f"{case.target_deg:g}", "--no-verdict"]
+    argv += ["--until-error", f"{case.target_deg:g}", "--no-verdict", *options]
     if case.ceiling_deg is not None:
         argv += ["--max-elevation-deg", f"{case.ceiling_deg:g}"]
     done = subprocess.run(argv, capture_output=True, text=True, cwd=REPO)
     if done.returncode != 0:
         raise SystemExit(f"{case.label()}: the session failed:\n{done.stderr[-2000:]}")
+    return session, tomllib.loads(text)
+
+
+def run_case(case: Case, folder: Path) -> dict:  # type: ignore[type-arg]
+    """Run ``case`` through the CLI in ``folder`` and measure it."""
+    session, cfg = run_cli(case, folder)
     result = json.loads((session / "manifest.json").read_text())["adaptive"]["result"]
     mean, median = measured_error(session, truth_normals(cfg))
     return {

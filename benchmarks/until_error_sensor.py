@@ -25,11 +25,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
-import sys
 import tempfile
 import time
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -38,23 +35,9 @@ from numpy.typing import NDArray
 from benchmarks.adaptive import DOC
 from benchmarks.report import machine_line, write_section
 from benchmarks.tradeoff import normal_error
-from benchmarks.until_error_configs import REPO, Case, config_text, truth_normals
+from benchmarks.until_error_configs import Case, run_cli, session_stack, truth_normals
 
 COUNTS = (4, 6, 8, 12)
-
-
-def _session(folder: Path) -> tuple[Path, dict]:  # type: ignore[type-arg]
-    case = Case("simulated_arm.toml", True, None, 1e-6)
-    config = folder / case.config
-    text = config_text(case)
-    config.write_text(text, encoding="utf-8")
-    session = folder / "s"
-    argv = [sys.executable, "-m", "rti_rig", "run", str(config), "--out", str(session)]
-    argv += ["--lights", str(max(COUNTS)), "--until-error", "1e-6", "--no-verdict"]
-    done = subprocess.run(argv, capture_output=True, text=True, cwd=REPO)
-    if done.returncode != 0:
-        raise SystemExit(f"the session failed:\n{done.stderr[-2000:]}")
-    return session, tomllib.loads(text)
 
 
 def _noisy(clean: NDArray[np.float32], camera: NDArray[np.float32]) -> NDArray[np.float32]:
@@ -70,21 +53,13 @@ def _noisy(clean: NDArray[np.float32], camera: NDArray[np.float32]) -> NDArray[n
 
 
 def measure() -> list[dict]:  # type: ignore[type-arg]
-    from rti_rig.core.image_files import read_linear_tiff
-    from rti_rig.core.lp_format import read_lp
     from rti_rig.simulator.sim_scene import renderer_for
 
+    # directional lights (as the calibration's), to the cap: every decision records its estimates
+    case = Case("simulated_arm.toml", True, None, 1e-6)
     with tempfile.TemporaryDirectory() as tmp:
-        session, cfg = _session(Path(tmp))
-        steps = [json.loads(x) for x in (session / "journal.jsonl").read_text().splitlines()]
-        by_name = {e.name: e.direction for e in read_lp(session / "lights.lp")}
-        lights = np.array([by_name[s["image"]] for s in steps])
-        camera = np.stack(
-            [
-                read_linear_tiff(session / s["linear_image"]).astype(np.float32) / 65535
-                for s in steps
-            ]
-        )
+        session, cfg = run_cli(case, Path(tmp), "--lights", str(max(COUNTS)))
+        steps, camera, lights = session_stack(session)
         result = json.loads((session / "manifest.json").read_text())["adaptive"]["result"]
     h, w = int(cfg["camera"]["height"]), int(cfg["camera"]["width"])
     render = renderer_for(cfg["scene"]["name"], h, w, int(cfg["scene"].get("seed", 0)), None)

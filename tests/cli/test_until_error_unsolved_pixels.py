@@ -13,7 +13,6 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -92,7 +91,7 @@ def test_a_session_begun_before_the_term_is_judged_with_it(tmp_path: Path) -> No
     assert result["target_claimed"], said
     assert result["lights_used"] > 4, result
     assert result["unsolved_deg"] == 90.0, result
-    assert np.isfinite(_measured_deg(out)) and _measured_deg(out) <= 1.5
+    assert _measured_deg(out) <= 1.5  # a NaN fails it too
 
 
 def test_a_session_resumes_with_the_weight_it_recorded(tmp_path: Path) -> None:
