@@ -32,6 +32,10 @@ solve them. The point estimate is simulated on the object model, which has no no
 a pixel to be wrong about, so under a low ceiling (four grazing lights leaving a sixth of a
 relief unsolved) the shipped dome had claimed 1.5° at 4 lights and measured 9° (docs/adaptive.md,
 "The stop's claim on the shipped rigs").
+
+Lamps near the object enter the point estimate itself, not a term here: given the rig's lamp
+geometry the estimate's simulation renders point lamps (``adaptive_bias.NearLamps``), so the
+factor multiplies their bias too (docs/adaptive.md, "Lamps near the object").
 """
 
 from __future__ import annotations

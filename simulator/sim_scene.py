@@ -158,6 +158,14 @@ def lambert_radiance(
     return scene.albedo * (irradiance * cos)[..., None]
 
 
+def field_width_mm(width_px: int) -> float:
+    """The width (mm) of the object field a library scene spans at ``width_px`` pixels (what
+    :func:`renderer_for` renders: the library's default pixel size)."""
+    from rti_rig.simulator.scenes import DEFAULT_PIXEL_SIZE_MM
+
+    return float(width_px) * DEFAULT_PIXEL_SIZE_MM
+
+
 def renderer_for(
     name: str,
     height_px: int,

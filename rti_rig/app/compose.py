@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 from rti_rig.app.config import LoadedRig, emulated_led_directions, rig_geometry
 from rti_rig.core.clock import Clock, SystemClock, VirtualClock
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, LampGeometry
 from rti_rig.runtime.duty_ledger import DutyLedger
 from rti_rig.runtime.lighting import ArmLighting, DomeLighting
 from rti_rig.runtime.rig import Rig, RigResources
@@ -41,7 +41,22 @@ def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
         rig = _build_simulated(loaded, clock)
     rig.bytes_per_image = bytes_per_image(loaded)  # what the controller's disk checks count
     rig.size_from_frame = size_from_frame(loaded)  # the first real frame's size, counted
+    rig.lamps = lamp_geometry(loaded)
     return rig
+
+
+def lamp_geometry(loaded: LoadedRig) -> LampGeometry | None:
+    """The lamps' distance and the frame's field on the object: the config's ``[lamps]``, else
+    a simulated or emulated scene's own (its point lamps' ``light_distance_mm``, the library
+    scene's field at the camera's width); None: neither (distant lamps assumed)."""
+    cfg = loaded.config
+    if cfg.lamps is not None:
+        return LampGeometry(cfg.lamps.distance_mm, cfg.lamps.field_width_mm)
+    if cfg.backend in ("simulated", "emulated") and cfg.scene.light_distance_mm is not None:
+        from rti_rig.simulator.sim_scene import field_width_mm
+
+        return LampGeometry(cfg.scene.light_distance_mm, field_width_mm(cfg.camera.width))
+    return None
 
 
 #: The simulated scenes are lit so that this exposure fills 3/4 of the sensor's well with a white

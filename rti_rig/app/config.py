@@ -225,6 +225,22 @@ class SceneConfig(_Strict):
     raw: bool = False  # deliver frames through a DNG and the rawpy decode path, as a DSLR would
 
 
+class LampsConfig(_Strict):
+    """Where the lamps are relative to what the camera sees (``[lamps]``, optional).
+
+    ``distance_mm``: the lamps' distance from the object's centre (a dome's radius, an arm's
+    reach); ``field_width_mm``: the width of the object field the frame spans. Given, the
+    adaptive stop's estimate renders the lamps as point lamps at that distance (each pixel lit
+    from its own direction and distance, which a fit reading one direction per light gets
+    wrong); not given, it assumes distant lamps and says so. Hardware rigs only: a simulated or
+    emulated scene with ``light_distance_mm`` gives both itself (docs/adaptive.md, "Lamps near
+    the object").
+    """
+
+    distance_mm: float = Field(gt=0)
+    field_width_mm: float = Field(gt=0)
+
+
 class EmulatorFault(_Strict):
     """One byte-level fault of the emulated dome firmware, at its n-th command (1-based), or
     of the emulated servo bus, at its n-th instruction packet (:data:`ARM_FAULT_KINDS`): a
@@ -339,6 +355,7 @@ class RigConfig(_Strict):
     timing: TimingConfig = TimingConfig()
     scene: SceneConfig = SceneConfig()
     emulator: EmulatorConfig = EmulatorConfig()
+    lamps: LampsConfig | None = None
 
     def _refuse_real_port_when_emulated(self) -> None:
         """Refuse a real port in an emulated dry run's config, naming the key.
@@ -577,6 +594,17 @@ class RigConfig(_Strict):
             )
         self._arm_faults_are_replies()
         self._sync_faults_have_a_flash_dome()
+        if self.lamps is not None and self.backend in ("simulated", "emulated", "replay"):
+            # the estimate would render lamps the rendered (or recorded) images do not have
+            raise ValueError(
+                f"[lamps] describes a hardware rig's lamps; a {self.backend} rig's come from "
+                + (
+                    "its recorded images (their lamps are not known)"
+                    if self.backend == "replay"
+                    else "its [scene] (light_distance_mm, over the scene's own field)"
+                )
+                + ": remove the [lamps] table"
+            )
         if self.backend in ("simulated", "emulated"):
             from rti_rig.simulator.scenes import MIN_SIZE_PX
 

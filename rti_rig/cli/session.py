@@ -193,7 +193,8 @@ def run(
             "--until-error",
             help="Adaptive: stop once the upper estimate of the mean normal error (the estimate × "
             "a factor calibrated on the simulator, plus 90° × the share of pixels the images "
-            "leave unsolved, docs/adaptive.md) is at most this many degrees (with --lights: "
+            "leave unsolved; lamps near the object rendered where the config's [lamps] or "
+            "scene puts them, docs/adaptive.md) is at most this many degrees (with --lights: "
             "whichever comes first). Without --lights the disk must hold its starting lights "
             "(or --min-lights) before it starts; the rest is checked image by image (a "
             "session the disk stops is kept: --resume).",
@@ -2179,7 +2180,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
             highlight=False,
         )
         header = opened.folder.manifest.get("adaptive") or {}
-        caveat = claim_caveat(adaptive_result, header_band(header))
+        caveat = claim_caveat(adaptive_result, header_band(header), header.get("lamps"))
         if caveat is not None:  # one line, as the notes below
             err.print(f"[yellow]note:[/] {escape(caveat)}", highlight=False, soft_wrap=True)
         short = few_lights_note(adaptive_result, lambda m: _with_min_lights(opened, m))

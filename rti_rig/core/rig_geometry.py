@@ -97,6 +97,30 @@ def led_said(index: int, direction: ArrayLike, name: str | None = None) -> str:
     return f"{number} ({rest})"
 
 
+@dataclass(frozen=True)
+class LampGeometry:
+    """How far the lamps are from the object and how wide the frame's field is on it (mm).
+
+    Why: a lamp at a few times the field's width lights each pixel from its own direction and
+    at its own distance, while every fit (this project's, relight's, RTIBuilder's) reads one
+    direction per light. What that costs the normals depends on these two figures only; the
+    adaptive stop's estimate renders it (``planner.adaptive_bias.NearLamps``)."""
+
+    distance_mm: float
+    field_width_mm: float
+
+    def __post_init__(self) -> None:
+        if not (self.distance_mm > 0 and self.field_width_mm > 0):
+            raise ValueError(
+                f"lamp distance {self.distance_mm} mm and field width {self.field_width_mm} mm "
+                "must both be > 0"
+            )
+
+    def record(self) -> dict[str, float]:
+        """As a session's settings record it."""
+        return {"distance_mm": self.distance_mm, "field_width_mm": self.field_width_mm}
+
+
 @dataclass(frozen=True, eq=False)
 class DomeGeometry:
     """A dome: LED ``i`` lights from ``directions[i]`` and is called ``names[i]``."""

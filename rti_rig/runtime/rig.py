@@ -16,7 +16,7 @@ from typing import Any, Protocol, TypeVar
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Camera
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, LampGeometry
 from rti_rig.runtime.lighting import Lighting
 
 log = logging.getLogger("rti_rig.rig")
@@ -141,6 +141,9 @@ class Rig:
     #: it implies and the bound on one image's files at that size (the composition root's
     #: :func:`rti_rig.app.disk_estimate.size_from_frame`); None: the config's size stands.
     size_from_frame: Callable[[int, int], tuple[int, int, int]] | None = None
+    #: The lamps' distance and the frame's field on the object, as the composition root reads
+    #: them from the config (``[geometry]``, or a simulated scene's own); None: not given.
+    lamps: LampGeometry | None = None
 
     def bind_session(self, root: Path) -> None:
         """Tell the devices which session folder this run writes (before ``connect``)."""
