@@ -9,28 +9,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from adaptive_states import open_model
 
 from rti_rig.app.usecases.adaptive import robust_fit
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.planner.adaptive_bias import NearLamps, ObjectModel, render, simulate_error_deg
 
 
-def _model(p: int = 400, spec: float = 0.0, seed: int = 0) -> ObjectModel:
-    rng = np.random.default_rng(seed)
-    n = rng.normal(size=(p, 3)) * [0.3, 0.3, 1.0]
-    n[:, 2] = np.abs(n[:, 2]) + 0.6
-    n /= np.linalg.norm(n, axis=1, keepdims=True)
-    return ObjectModel(
-        normals=n,
-        albedo=rng.uniform(0.3, 0.8, p),
-        spec_strength=spec,
-        spec_exponent=32.0,
-        noise=0.002,
-        shadow_el=np.full((p, 1), -np.inf),
-        shadow_az=np.zeros((p, 1)),
-        lights=np.zeros((0, 3)),
-        shadowed=np.zeros((p, 0), dtype=bool),
-    )
+def _model(p: int = 400, spec: float = 0.0) -> ObjectModel:
+    return open_model(0, p, spec)
 
 
 def _field(p: int, width_mm: float, seed: int = 1) -> np.ndarray:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from adaptive_states import open_model
 
 from rti_rig.app.usecases.adaptive import relight_fit
 from rti_rig.core.geometry import fibonacci_cap
@@ -27,21 +28,7 @@ CANDIDATES = fibonacci_cap(90, 0.0, 90.0)
 
 
 def _model(seed: int = 0, p: int = 300, spec: float = 0.0) -> ObjectModel:
-    rng = np.random.default_rng(seed)
-    n = rng.normal(size=(p, 3)) * [0.4, 0.4, 1.0]
-    n[:, 2] = np.abs(n[:, 2]) + 0.5
-    n /= np.linalg.norm(n, axis=1, keepdims=True)
-    return ObjectModel(
-        normals=n,
-        albedo=rng.uniform(0.3, 0.8, p),
-        spec_strength=spec,
-        spec_exponent=32.0,
-        noise=0.004,
-        shadow_el=np.full((p, 1), -np.inf),
-        shadow_az=np.zeros((p, 1)),
-        lights=np.zeros((0, 3)),
-        shadowed=np.zeros((p, 0), dtype=bool),
-    )
+    return open_model(seed, p, spec)
 
 
 def _objective(weights=None, basis: str = "ptm", seed: int = 0):  # type: ignore[no-untyped-def]
