@@ -193,7 +193,7 @@ def run(
             "--until-error",
             help="Adaptive: stop once the upper estimate of the mean normal error (the estimate × "
             "a factor calibrated on the simulator, plus 90° × the share of pixels the images "
-            "leave unsolved; lamps near the object rendered where the config's [lamps] or "
+            "leave unsolved; lamps near the object rendered where the config's \\[lamps] or "
             "scene puts them, docs/adaptive.md) is at most this many degrees (with --lights: "
             "whichever comes first). Without --lights the disk must hold its starting lights "
             "(or --min-lights) before it starts; the rest is checked image by image (a "
