@@ -232,9 +232,9 @@ class LampsConfig(_Strict):
     reach); ``field_width_mm``: the width of the object field the frame spans. Given, the
     adaptive stop's estimate renders the lamps as point lamps at that distance (each pixel lit
     from its own direction and distance, which a fit reading one direction per light gets
-    wrong); not given, it assumes distant lamps and says so. Hardware rigs only: a simulated or
-    emulated scene with ``light_distance_mm`` gives both itself (docs/adaptive.md, "Lamps near
-    the object").
+    wrong); not given, it assumes distant lamps and says so. Hardware and replay rigs: a
+    simulated or emulated scene with ``light_distance_mm`` gives both itself (docs/adaptive.md,
+    "Lamps near the object").
     """
 
     distance_mm: float = Field(gt=0)
@@ -594,16 +594,13 @@ class RigConfig(_Strict):
             )
         self._arm_faults_are_replies()
         self._sync_faults_have_a_flash_dome()
-        if self.lamps is not None and self.backend in ("simulated", "emulated", "replay"):
-            # the estimate would render lamps the rendered (or recorded) images do not have
+        if self.lamps is not None and self.backend in ("simulated", "emulated"):
+            # the estimate would render lamps the rendered images do not have
             raise ValueError(
-                f"[lamps] describes a hardware rig's lamps; a {self.backend} rig's come from "
-                + (
-                    "its recorded images (their lamps are not known)"
-                    if self.backend == "replay"
-                    else "its [scene] (light_distance_mm, over the scene's own field)"
-                )
-                + ": remove the [lamps] table"
+                f"[lamps] describes a real rig's lamps (hardware, or a replayed acquisition); "
+                f"the lamps of a rig with backend '{self.backend}' come from its [scene] "
+                "(light_distance_mm, over the scene's own field): remove the [lamps] table, "
+                "or set [scene] light_distance_mm"
             )
         if self.backend in ("simulated", "emulated"):
             from rti_rig.simulator.scenes import MIN_SIZE_PX

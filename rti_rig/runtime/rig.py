@@ -142,7 +142,7 @@ class Rig:
     #: :func:`rti_rig.app.disk_estimate.size_from_frame`); None: the config's size stands.
     size_from_frame: Callable[[int, int], tuple[int, int, int]] | None = None
     #: The lamps' distance and the frame's field on the object, as the composition root reads
-    #: them from the config (``[geometry]``, or a simulated scene's own); None: not given.
+    #: them from the config (``[lamps]``, or a simulated scene's own); None: not given.
     lamps: LampGeometry | None = None
 
     def bind_session(self, root: Path) -> None:

@@ -122,3 +122,30 @@ def test_distant_lamps_say_nothing_of_lamps(tmp_path: Path) -> None:
     result = _adaptive(out)["result"]
     assert not result["target_claimed"] and "distant_lamps_estimate_deg" not in result, result
     assert "Under lamps far from the object" not in said, said
+
+
+def test_the_lamps_are_placed_at_the_states_own_pixels() -> None:
+    """Sampled pixels dark under every light leave the fit's state (and the object model): the
+    lamps' geometry follows the state's rows and columns, not the sample's order (a position
+    per sampled pixel had slid every pixel after the first dark one onto a neighbour's place)."""
+    import numpy as np
+
+    from rti_rig.app.usecases.adaptive import AdaptiveChooser
+    from rti_rig.core.geometry import direction_from_az_el
+    from rti_rig.core.rig_geometry import LampGeometry
+
+    lights = direction_from_az_el([0.0, 90.0, 180.0, 270.0], [30.0, 40.0, 30.0, 40.0])
+    chooser = AdaptiveChooser(lights, [0, 1, 2, 3], 8, lamps=LampGeometry(400.0, 12.8))
+    shading = 0.1 + 0.4 * np.clip(lights[:, 2], 0, 1)  # a flat grey object facing the camera
+    for i, direction in enumerate(lights):
+        image = np.full((96, 128), shading[i], dtype=np.float32)
+        image[:, :40] = 0.0  # a black background at the left: dark under every light
+        chooser.observe(i, direction, image)
+    state = chooser.state()
+    assert state is not None and state.cols is not None
+    assert len(state.cols) < 2000 and state.cols.min() >= 40  # the premise: dark ones dropped
+    near = chooser.near(state)
+    assert near is not None and len(near.xy_mm) == len(state.normals)
+    per_px = 12.8 / 128
+    assert np.allclose(near.xy_mm[:, 0], (state.cols - 63.5) * per_px)
+    assert np.allclose(near.xy_mm[:, 1], (47.5 - state.rows) * per_px)

@@ -352,7 +352,6 @@ class AdaptiveChooser:
         #: estimate renders directional lights): the stop's estimate renders point lamps at
         #: that distance (``planner.adaptive_bias.NearLamps``); the choice of light does not
         self.lamps = lamps
-        self._near: NearLamps | None = None
         #: the elevation band (°) the candidates were cut to (None: every elevation): words
         #: of the decisions' evidence only (each design named by the floor the band applied,
         #: ``planner.adaptive.applied_floor``), never a choice
@@ -426,22 +425,22 @@ class AdaptiveChooser:
         if self.bias_aware:
             model = object_model(state)
             if model is not None:
-                return simulate_error_deg(model, state.lights, robust_fit, near=self.near())
+                return simulate_error_deg(model, state.lights, robust_fit, near=self.near(state))
         return estimate_error_deg(state, 1.0)
 
-    def near(self) -> NearLamps | None:
-        """The lamps' geometry at the sampled pixels of the small images (None: no lamp
-        geometry given, or no image yet): each pixel's place on the object plane, the frame
-        spanning ``lamps.field_width_mm``."""
-        if self.lamps is None or not self.images:
+    def near(self, state: SurfaceState) -> NearLamps | None:
+        """The lamps' geometry at the state's pixels (None: no lamp geometry given, or the
+        state does not place its pixels): each pixel's place on the object plane, the small
+        image spanning ``lamps.field_width_mm``. From the state's own rows and columns: its
+        pixels are the sampled ones not dark under every light, in sample order, so a
+        position per sampled pixel would slide past the first dark one."""
+        if self.lamps is None or not self.images or state.rows is None or state.cols is None:
             return None
-        if self._near is None:
-            h, w = self.images[0].shape[:2]
-            rows, cols = np.unravel_index(sample_index(h * w), (h, w))
-            per_px = self.lamps.field_width_mm / w
-            xy = np.stack([(cols - (w - 1) / 2) * per_px, ((h - 1) / 2 - rows) * per_px], 1)
-            self._near = NearLamps(self.lamps.distance_mm, xy.astype(np.float64))
-        return self._near
+        h, w = self.images[0].shape[:2]
+        per_px = self.lamps.field_width_mm / w
+        rows, cols = np.asarray(state.rows), np.asarray(state.cols)
+        xy = np.stack([(cols - (w - 1) / 2) * per_px, ((h - 1) / 2 - rows) * per_px], 1)
+        return NearLamps(self.lamps.distance_mm, xy.astype(np.float64))
 
     def estimate(self, state: SurfaceState) -> float:
         """The calibrated estimate of the mean normal error (°) now: ``scale`` × raw. Notes
@@ -671,6 +670,8 @@ class AdaptiveChooser:
             **self.stop_terms(est),
             # a session run to its maximum is never asked for the step past it: the stop here
             "stop": self.stop_evidence or self._cap_stop(est),
+            # the lamps the estimate rendered (None: distant), as the claim's note says them
+            "lamps": None if self.lamps is None else self.lamps.record(),
             **({} if distant is None else {"distant_lamps_estimate_deg": round(distant, 4)}),
         }
 
@@ -1445,8 +1446,8 @@ def claim_caveat(
     else:
         near = (
             f"it renders the lamps as points {lamps['distance_mm']:g} mm away over a "
-            f"{lamps['field_width_mm']:g} mm field, as the config gives them (the estimate is "
-            "only as right as those two figures)"
+            f"{lamps['field_width_mm']:g} mm field, as the rig's config or scene gives them "
+            "(the estimate is only as right as those two figures)"
         )
     return (
         "the target is claimed on an estimate calibrated under directional lights over every "
@@ -1538,15 +1539,19 @@ def short_of_target_note(
     )
     distant = result.get("distant_lamps_estimate_deg")
     if distant is not None:
-        factor = float(result.get("upper_factor") or adaptive_until.UPPER_FACTOR)
-        would = factor * float(distant)
+        would = adaptive_until.upper_error_deg(
+            float(distant),
+            result.get("upper_factor"),
+            float(result.get("unsolved_fraction") or 0.0),
+            result.get("unsolved_deg"),
+        )
         text += (
             f" Under lamps far from the object the same images would estimate {distant:.2f}° "
-            f"(upper {would:.2f}° before unsolved pixels): "
+            f"(upper {would:.2f}°): "
             + (
                 "the lamps' nearness is what keeps the target out of reach, and more lights "
-                "barely reduce it (a fit reads one direction per light: a bias, not noise; on "
-                "the shipped simulated arm the estimate fell from 0.95° at 8 lights to 0.88° at "
+                "reduce it slowly (a fit reads one direction per light: a bias, not noise; on "
+                "the shipped simulated arm the estimate was 1.16° at 4 lights and still 0.88° at "
                 '100; docs/adaptive.md, "Lamps near the object").'
                 if would <= until
                 else "the lamps' nearness is part of the gap, not all of it."
