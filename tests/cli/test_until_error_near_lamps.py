@@ -81,15 +81,23 @@ def test_a_claim_on_the_shipped_arm_is_true_and_says_the_lamps(tmp_path: Path) -
     assert "give the config's [lamps]" not in said, said
 
 
-def test_without_lamps_the_claim_says_it_assumed_distant_ones(tmp_path: Path) -> None:
+def test_without_lamps_the_claim_says_what_it_assumed(tmp_path: Path) -> None:
+    """A scene of directional lights says so (its lamps are its scene's: no ``[lamps]`` to
+    give); a real rig without ``[lamps]`` is told the estimate assumed distant lamps and which
+    keys give its own."""
+    from rti_rig.app.usecases.adaptive import claim_caveat
+
     config = _directional_arm(tmp_path)
     out = tmp_path / "s"
     said = _run(str(config), "--out", str(out), "--until-error", "2.5")
     adaptive = _adaptive(out)
-    assert adaptive["lamps"] is None, adaptive
+    assert adaptive["lamps"] is None and adaptive["result"]["lamps"] is None, adaptive
     assert adaptive["result"]["target_claimed"], said
-    assert "it assumes lamps far from the object" in said, said
-    assert "give the config's [lamps] distance_mm and field_width_mm" in said, said
+    assert "its scene's lights are directional, as the estimate assumes" in said, said
+    assert "[lamps]" not in said, said
+    real = claim_caveat(adaptive["result"], (0.0, 90.0), None, simulated=False)
+    assert real is not None and "it assumes lamps far from the object" in real, real
+    assert "give the config's [lamps] distance_mm and field_width_mm" in real, real
 
 
 def test_a_session_resumes_with_the_lamps_it_recorded(tmp_path: Path) -> None:

@@ -1414,10 +1414,14 @@ def header_band(header: dict[str, Any]) -> tuple[float, float]:
 
 
 def claim_caveat(
-    result: dict[str, Any], band: tuple[float, float], lamps: dict[str, Any] | None = None
+    result: dict[str, Any],
+    band: tuple[float, float],
+    lamps: dict[str, Any] | None = None,
+    simulated: bool = False,
 ) -> str | None:
     """What a claimed ``--until-error`` target does not cover (None: nothing claimed).
-    ``lamps``: the lamp geometry the session's settings recorded (None: distant lamps).
+    ``lamps``: the lamp geometry the estimate rendered (None: distant lamps); ``simulated``:
+    the rig's scene is rendered (its lamps are its scene's: no ``[lamps]`` to advise).
 
     Why: the upper estimate is calibrated on the simulator's scenes at 96 px, under directional
     lights, over every elevation. Through the front door on the shipped rigs
@@ -1436,7 +1440,9 @@ def claim_caveat(
         if (lo, hi) != _FULL_BAND
         else ""
     )
-    if lamps is None:
+    if lamps is None and simulated:
+        near = "its scene's lights are directional, as the estimate assumes"
+    elif lamps is None:
         near = (
             "it assumes lamps far from the object (a fit reads each light as one direction: "
             "the simulated arm's lamps at 400 mm had measured 2.7× an estimate that assumed "
