@@ -381,8 +381,8 @@ def until_error_rows(results: dict, scale: float, slope: float) -> list[str]:
                 data.normals, data.candidate_images[idx], data.candidate_dirs[idx]
             )[0]
             estimate = est.get(len(used)) if est else None
-            # the stop compares the upper estimate (the point × UPPER_FACTOR, plus the
-            # unsolved pixels' share × UNSOLVED_DEG): as the stop recorded it
+            # the stop compares the upper estimate (the larger of the point × UPPER_FACTOR and
+            # the misfit bound, plus the unsolved pixels' share × UNSOLVED_DEG): as recorded
             upper = est.get("upper") if estimate is not None else None
             stopped = (
                 "upper estimate reached"
@@ -1108,7 +1108,8 @@ def main(argv: list[str] | None = None) -> str:
             "`--until-error` on each simulated scene (all 240 candidates, capped at 60 lights):",
             "",
             "| scene | target | lights used | estimate at stop | upper estimate (the stop's: "
-            f"×{UPPER_FACTOR:g}, plus unsolved pixels × 90°) | measured | why it stopped |",
+            f"×{UPPER_FACTOR:g} or the misfit bound, plus unsolved pixels × 90°) | measured | "
+            "why it stopped |",
             "|---|---|---|---|---|---|---|",
             *until_rows,
             "",

@@ -126,6 +126,10 @@ class SurfaceState:
     rows: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
     cols: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
     height: NDArray[np.float64] | None = field(default=None, compare=False, repr=False)
+    #: the fit's RMS residual over the observations it kept (P,) and how many it kept (P,):
+    #: the stop's misfit bound (``planner.adaptive_until.misfit_deg``; None: not known)
+    residual: NDArray[np.float64] | None = field(default=None, compare=False, repr=False)
+    used: NDArray[np.int64] | None = field(default=None, compare=False, repr=False)
     #: what one decision derives from the state more than once (the inverse information, the
     #: keep table): computed once per state; the arrays above are not changed after creation
     cache: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)

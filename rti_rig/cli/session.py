@@ -191,10 +191,12 @@ def run(
         float | None,
         typer.Option(
             "--until-error",
-            help="Adaptive: stop once the upper estimate of the mean normal error (the estimate × "
-            "a factor calibrated on the simulator, plus 90° × the share of pixels the images "
-            "leave unsolved; lamps near the object rendered where the config's \\[lamps] or "
-            "scene puts them, docs/adaptive.md) is at most this many degrees (with --lights: "
+            help="Adaptive: stop once the upper estimate of the mean normal error (the larger of "
+            "the estimate × a factor calibrated on the simulator and a bound from the residuals "
+            "of the pixels the fit does not explain, plus 90° × the share of pixels the images "
+            "leave unsolved, read at the camera's resolution; lamps near the object "
+            "rendered where the config's \\[lamps] or scene puts them, docs/adaptive.md) is at "
+            "most this many degrees (with --lights: "
             "whichever comes first). Without --lights the disk must hold its starting lights "
             "(or --min-lights) before it starts; the rest is checked image by image (a "
             "session the disk stops is kept: --resume).",

@@ -20,6 +20,7 @@ OWNERS = {
     "UPPER_QUANTILE": adaptive_until,
     "RING_SPAN_DEG": usecase,
     "UNSOLVED_DEG": adaptive_until,
+    "MISFIT_NOISE_K": adaptive_until,
 }
 
 

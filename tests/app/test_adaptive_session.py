@@ -260,9 +260,10 @@ def test_until_error_stops_when_the_estimate_is_reached(
     stop = m["adaptive"]["result"]["stop"]
     assert stop["kind"] == "stop" and f"--until-error {target:g}" in stop["reason"]
     assert stop["upper_error_deg"] <= target
-    # the point estimate × the factor, plus each pixel no image solves yet at unsolved_deg
+    # the larger of the point estimate × the factor and the misfit bound, plus each pixel no
+    # image solves yet at unsolved_deg
     assert stop["upper_error_deg"] == pytest.approx(
-        stop["upper_factor"] * stop["estimated_error_deg"]
+        max(stop["upper_factor"] * stop["estimated_error_deg"], stop["misfit_deg"] or 0.0)
         + stop["unsolved_fraction"] * stop["unsolved_deg"],
         abs=5e-3,
     )

@@ -43,10 +43,11 @@ def _printed_tol(value: float) -> float:
 
 
 def _upper(rec: dict) -> float:  # type: ignore[type-arg]
-    """The upper estimate a record's terms give: the point estimate × the factor, plus each
-    unsolved pixel at ``unsolved_deg``."""
+    """The upper estimate a record's terms give: the larger of the point estimate × the factor
+    and the images' misfit bound, plus each unsolved pixel at ``unsolved_deg``."""
     share = rec["unsolved_fraction"] or 0.0
-    return rec["upper_factor"] * rec["estimated_error_deg"] + share * rec["unsolved_deg"]
+    first = max(rec["upper_factor"] * rec["estimated_error_deg"], rec.get("misfit_deg") or 0.0)
+    return first + share * rec["unsolved_deg"]
 
 
 def _adaptive_line(text: str) -> str:
@@ -321,6 +322,7 @@ def test_the_stops_reason_and_the_final_line_print_one_upper_estimate_alike() ->
             min_lights=None,
             unsolved=unsolved,
             unsolved_deg=90.0,
+            misfit=None,
         )
         fake.upper = lambda e, f=fake: AdaptiveChooser.upper(f, e)  # type: ignore[misc]
         fake.stop_terms = lambda e, f=fake: AdaptiveChooser.stop_terms(f, e)  # type: ignore[misc]
@@ -335,6 +337,39 @@ def test_the_stops_reason_and_the_final_line_print_one_upper_estimate_alike() ->
         assert ("+ 1.0 % of pixels unsolved × 90°" in line) == (unsolved > 0), line
         # after a reason giving both figures, the final line gives neither again
         assert estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0}, reason) == ""
+
+
+def test_a_stop_held_by_the_misfit_bound_says_so_in_both_places() -> None:
+    """When the images' misfit bound is the upper estimate's first term, the reason and the
+    final line name it with the estimate it exceeds (the upper estimate is then not ×1.95 of
+    the estimate, and had read as a misprint), and print one figure alike."""
+    from types import SimpleNamespace
+
+    from rti_rig.app.usecases.adaptive import AdaptiveChooser, estimate_phrase
+
+    fake = SimpleNamespace(
+        upper_factor=1.95,
+        until_error_deg=4.0,
+        min_lights=None,
+        unsolved=0.01,
+        unsolved_deg=90.0,
+        misfit=3.0,
+    )
+    fake.upper = lambda e, f=fake: AdaptiveChooser.upper(f, e)  # type: ignore[misc]
+    fake.stop_terms = lambda e, f=fake: AdaptiveChooser.stop_terms(f, e)  # type: ignore[misc]
+    est = 0.5
+    reason = AdaptiveChooser._reached_reason(fake, est)  # type: ignore[arg-type]
+    assert "upper estimate 3.90° (misfit bound 3.00° of pixels the fit does not explain, " in (
+        reason
+    ), reason
+    assert "above the estimate 0.50° × 1.95 + 1.0 % of pixels unsolved × 90°" in reason, reason
+    line = estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0})
+    assert "upper estimate 3.90° (misfit bound 3.00°" in line, line
+    assert estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0}, reason) == ""
+    # the bound under the simulated term: the words are the factor's, as before
+    fake.misfit = 0.5
+    reason = AdaptiveChooser._reached_reason(fake, 1.0)  # type: ignore[arg-type]
+    assert "misfit" not in reason and "(estimate 1.00° × 1.95" in reason, reason
 
 
 def test_a_small_unsolved_share_is_not_printed_as_none() -> None:

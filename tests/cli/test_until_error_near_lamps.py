@@ -102,13 +102,14 @@ def test_without_lamps_the_claim_says_what_it_assumed(tmp_path: Path) -> None:
 
 def test_a_session_resumes_with_the_lamps_it_recorded(tmp_path: Path) -> None:
     """A session that recorded distant lamps (``lamps`` null, as a build before the rendering
-    judged it) is judged so to the end: it claims 1.5° at the four starting lights as that
-    build did; one whose settings have no ``lamps`` at all is judged with the rig's."""
+    judged it) is judged so to the end: at the four starting lights its upper estimate renders
+    no lamps (2.70°, against 3.81° with the rig's) and claims 3°; one whose settings have no
+    ``lamps`` at all is judged with the rig's, and does not."""
     from conftest import interrupted
 
     for recorded, claims_at_four in ((None, True), ("absent", False)):
         out = tmp_path / f"s-{recorded}"
-        interrupted(ARM, out, after_step=2, lights=6, until=1.5)
+        interrupted(ARM, out, after_step=2, lights=6, until=3.0)
         path = out / "manifest.json"
         manifest = json.loads(path.read_text())
         if recorded == "absent":

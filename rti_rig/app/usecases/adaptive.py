@@ -71,6 +71,8 @@ from rti_rig.planner.adaptive_bias import NearLamps, simulate_error_deg
 from rti_rig.planner.adaptive_relight import OBJECTIVES
 from rti_rig.planner.adaptive_until import (
     choose_until,
+    misfit_decides,
+    misfit_deg,
     reaches_target,
     unsolved_fraction,
     upper_error_deg,
@@ -186,6 +188,22 @@ def sample_pixels(images: NDArray) -> NDArray[np.float32]:
     return np.ascontiguousarray(flat[:, sample_index(flat.shape[1])])
 
 
+def camera_sample(pixels: NDArray, white_level: float = 65535.0) -> NDArray[np.float32]:
+    """The chooser's pixel sample (:func:`sample_index`) of a whole frame at the camera's
+    resolution, grey, in units of white: what the stop's unsolved share and misfit bound are
+    taken on (``planner.adaptive_until.misfit_deg``). Why not the small image's: an area average to
+    :data:`FIT_PX` lights a shadowed pit with its lit rim, so a pixel a user's fit cannot solve
+    (or solves from a penumbra) looked solved and clean there — on the shipped arm under a 15°
+    ceiling 1.1 % of the camera's pixels were unsolved at 12 lights against 0.3 % of the small
+    image's. Indexing only the sampled pixels costs nothing on a 24-MP frame."""
+    px = np.asarray(pixels)
+    h, w = px.shape[:2]
+    rows, cols = np.unravel_index(sample_index(h * w), (h, w))
+    picked = px[rows, cols].astype(np.float32)  # (P,) or (P, C): no copy of the frame
+    grey = picked.mean(axis=1) if picked.ndim == 2 else picked
+    return grey / np.float32(white_level)
+
+
 def sample_index(pixels: int) -> NDArray[np.intp]:
     """The flat indices of the chooser's pixel sample in an image of ``pixels`` pixels."""
     rng = np.random.default_rng(0)
@@ -266,6 +284,8 @@ def fit_sample(
         rows=None if where is None else where[0][seen],
         cols=None if where is None else where[1][seen],
         height=height,
+        residual=resid,
+        used=ps.used_lights.ravel()[seen].astype(np.int64),
     )
 
 
@@ -347,7 +367,19 @@ class AdaptiveChooser:
         band: tuple[float, float] | None = None,
         unsolved_deg: float | None = None,
         lamps: LampGeometry | None = None,
+        misfit_noise_k: float | None = None,
     ) -> None:
+        #: the misfit bound's allowance for noise (None: this build's
+        #: ``adaptive_until.MISFIT_NOISE_K``; a resume passes the session's own)
+        self.misfit_noise_k = (
+            adaptive_until.MISFIT_NOISE_K if misfit_noise_k is None else float(misfit_noise_k)
+        )
+        #: the last estimate's misfit bound from the images (°; None: none taken yet, or no
+        #: pixel with a residual)
+        self.misfit: float | None = None
+        #: each image's sample at the camera's resolution (:func:`camera_sample`), when the
+        #: caller gives it: what the unsolved share and the misfit bound are taken on
+        self.camera_samples: list[NDArray[np.float32]] = []
         #: the lamps' distance and the frame's field on the object (None: not known, the
         #: estimate renders directional lights): the stop's estimate renders point lamps at
         #: that distance (``planner.adaptive_bias.NearLamps``); the choice of light does not
@@ -361,8 +393,8 @@ class AdaptiveChooser:
         #: lights and an HSH fit 5 (RTI_FILE_LIGHTS), and a stop at 4 gives a normal map and
         #: no RTI.
         self.min_lights = min_lights
-        #: the stop's upper estimate = the point estimate × this (None: this build's
-        #: ``adaptive_until.UPPER_FACTOR``, read now; a resume passes the session's own)
+        #: the stop's upper estimate's simulated term = the point estimate × this (None: this
+        #: build's ``adaptive_until.UPPER_FACTOR``, read now; a resume passes the session's own)
         self.upper_factor = adaptive_until.UPPER_FACTOR if upper_factor is None else upper_factor
         #: what each pixel no image solves yet adds to the upper estimate (°; None: this
         #: build's ``adaptive_until.UNSOLVED_DEG``; a resume passes the session's own)
@@ -401,10 +433,22 @@ class AdaptiveChooser:
         self.used: list[int] = []
         self.stop_evidence: dict[str, Any] | None = None
 
-    def observe(self, candidate: int, direction: NDArray[np.float64], image: NDArray) -> None:
+    def observe(
+        self,
+        candidate: int,
+        direction: NDArray[np.float64],
+        image: NDArray,
+        camera: NDArray[np.float32] | None = None,
+    ) -> None:
+        """Take a captured image: ``image`` the small grey copy the decisions are fitted on,
+        ``camera`` its sample at the camera's resolution (:func:`camera_sample`; None: the
+        small image's own sample is used for the stop's evidence too, as a benchmark's 96-px
+        scene is its own full resolution)."""
         self.used.append(int(candidate))
         self.lights.append(np.asarray(direction, dtype=np.float64))
         self.samples.append(sample_pixels(np.asarray(image)[None])[0])
+        if camera is not None:
+            self.camera_samples.append(np.asarray(camera, dtype=np.float32))
         if self.bias_aware:  # the small image itself, for the relief (cast shadows)
             self.images.append(np.asarray(image, dtype=np.float32))
 
@@ -444,17 +488,46 @@ class AdaptiveChooser:
 
     def estimate(self, state: SurfaceState) -> float:
         """The calibrated estimate of the mean normal error (°) now: ``scale`` × raw. Notes
-        the state's unsolved fraction too (:attr:`unsolved`), which the upper estimate adds:
-        every figure the stop compares is of the same state."""
-        self.unsolved = unsolved_fraction(state.valid)
+        the images' own evidence too, which the upper estimate weighs: the unsolved fraction
+        (:attr:`unsolved`) and the misfit bound (:attr:`misfit`), both at the camera's
+        resolution when the images' camera samples are given (:meth:`image_evidence`): every
+        figure the stop compares is of the same images."""
+        self.unsolved, self.misfit = self.image_evidence(state)
         return self.scale * self.raw_estimate(state)
 
+    def image_evidence(self, state: SurfaceState) -> tuple[float, float | None]:
+        """The unsolved share of the seen pixels and the misfit bound (°) of the robust fit
+        (``planner.adaptive_until.misfit_deg``), on the camera-resolution samples when every
+        image gave one (fitted as the state is: :func:`fit_sample`), else on the state's own
+        (the small images'). The share is the larger of the camera's and the small images':
+        the upper estimate is then never below what it was before the camera's was read, so
+        a session begun before it replays on --resume as it was decided (a step it shot past
+        is never found to be a stop)."""
+        share = unsolved_fraction(state.valid)
+        if self.camera_samples and len(self.camera_samples) == len(self.lights):
+            camera = fit_sample(np.stack(self.camera_samples), np.stack(self.lights))
+            if camera is not None:  # else (refused at full size): the small images' evidence
+                state = camera
+                share = max(share, unsolved_fraction(camera.valid))
+        if state.residual is None or state.used is None or state.valid is None:
+            return share, None
+        bound = misfit_deg(
+            state.residual,
+            state.used,
+            state.albedo,
+            state.valid,
+            state.lit,
+            state.lights,
+            self.misfit_noise_k,
+        )
+        return share, bound
+
     def upper(self, estimate_deg: float) -> float:
-        """The upper estimate (°) the stop compares with the target: the point estimate ×
-        ``upper_factor``, plus the unsolved pixels' share at ``unsolved_deg`` each
-        (``planner.adaptive_until.upper_error_deg``)."""
+        """The upper estimate (°) the stop compares with the target: the larger of the point
+        estimate × ``upper_factor`` and the images' misfit bound, plus the unsolved pixels'
+        share at ``unsolved_deg`` each (``planner.adaptive_until.upper_error_deg``)."""
         return upper_error_deg(
-            estimate_deg, self.upper_factor, self.unsolved or 0.0, self.unsolved_deg
+            estimate_deg, self.upper_factor, self.unsolved or 0.0, self.unsolved_deg, self.misfit
         )
 
     def stop_terms(self, estimate_deg: float | None) -> dict[str, Any]:
@@ -475,6 +548,9 @@ class AdaptiveChooser:
                 None if estimate_deg is None or self.unsolved is None else round(self.unsolved, 4)
             ),
             "unsolved_deg": self.unsolved_deg,
+            "misfit_deg": (
+                None if estimate_deg is None or self.misfit is None else round(self.misfit, 4)
+            ),
         }
 
     def _cap_stop(self, est: float | None) -> dict[str, Any]:
@@ -503,7 +579,12 @@ class AdaptiveChooser:
         """Whether the stop may claim --until-error (``adaptive_until.reaches_target``)."""
         assert self.until_error_deg is not None
         return reaches_target(
-            est, self.until_error_deg, self.upper_factor, self.unsolved or 0.0, self.unsolved_deg
+            est,
+            self.until_error_deg,
+            self.upper_factor,
+            self.unsolved or 0.0,
+            self.unsolved_deg,
+            self.misfit,
         )
 
     def _past_minimum(self, index: int) -> bool:
@@ -517,9 +598,9 @@ class AdaptiveChooser:
         assert self.until_error_deg is not None
         places = places_against(terms["upper_error_deg"], self.until_error_deg)
         reason = (
-            f"upper estimate {terms['upper_error_deg']:.{places}f}° (estimate "
-            f"{terms['estimated_error_deg']:.{places}f}° × {self.upper_factor:g}"
-            f"{unsolved_words(terms)}) ≤ --until-error {self.until_error_deg:g}°"
+            f"upper estimate {terms['upper_error_deg']:.{places}f}° ("
+            f"{first_term_words(terms, places)}{unsolved_words(terms)}) ≤ --until-error "
+            f"{self.until_error_deg:g}°"
         )
         if self.min_lights is not None and index == self.min_lights:
             reason += f", at the --min-lights {self.min_lights} asked for"
@@ -991,6 +1072,7 @@ class AdaptiveSteps:
         min_lights: int | None = None,
         unsolved_deg: float | None = None,
         lamps: LampGeometry | str | None = "rig",
+        misfit_noise_k: float | None = None,
     ) -> None:
         self.plan = plan
         self.until_error_deg = until_error_deg
@@ -1023,6 +1105,7 @@ class AdaptiveSteps:
             # "rig": the rig's own (the composition root's ``[lamps]`` or scene); a resume
             # passes the session's
             lamps=getattr(rig, "lamps", None) if lamps == "rig" else lamps,
+            misfit_noise_k=misfit_noise_k,
         )
         self._pending: dict[int, int] = {}
         self._outcome: dict[str, Any] | None = None
@@ -1062,6 +1145,7 @@ class AdaptiveSteps:
             "estimate_scale": self.chooser.scale,
             "upper_factor": self.chooser.upper_factor,
             "unsolved_deg": self.chooser.unsolved_deg,
+            "misfit_noise_k": self.chooser.misfit_noise_k,
             "lamps": None if self.chooser.lamps is None else self.chooser.lamps.record(),
             "constants": decision_constants(),
         }
@@ -1083,6 +1167,7 @@ class AdaptiveSteps:
             self._pending.pop(index),
             np.asarray(record.actual_direction),
             small_grey(frame.pixels),  # as --resume reads it back from the linear TIFF
+            camera_sample(frame.pixels),  # the stop's evidence at the camera's resolution
         )
 
     def replay(self, folder) -> None:  # type: ignore[no-untyped-def]
@@ -1127,7 +1212,12 @@ class AdaptiveSteps:
                     "cannot be continued deterministically: start a new session"
                 )
             pixels = read_linear_tiff(Path(folder.root) / rec.linear_image)
-            self.chooser.observe(candidate, np.asarray(rec.actual_direction), small_grey(pixels))
+            self.chooser.observe(
+                candidate,
+                np.asarray(rec.actual_direction),
+                small_grey(pixels),
+                camera_sample(pixels),
+            )
         if other_rig:
             self._keep_start_unused(folder, len(done))
         elif not getattr(folder, "rig_change", None) and (
@@ -1374,11 +1464,34 @@ def estimate_phrase(result: dict[str, Any], reason: str = "") -> str:
     target = result.get("until_error_deg")
     places = 2 if target is None else places_against(up, float(target))
     upper_said = f"upper estimate {up:.{places}f}°" in reason
-    if upper_said and f"(estimate {est:.{places}f}°" in reason:
+    if upper_said and f"estimate {est:.{places}f}° ×" in reason:
         return ""  # the reason gives both figures and the factor
+    if misfit_decides(float(est), factor, result.get("misfit_deg")):
+        # the upper estimate is not ×factor of the point estimate: say what it is
+        first = first_term_words(result)
+        if upper_said:
+            return f"{text} (the upper estimate is {first}{plus}{role})"
+        return f"{text}, upper estimate {up:.2f}° ({first}{plus}{role})"
     if upper_said:
         return f"{text} (the upper estimate is ×{factor:g} of it{plus}{role})"
     return f"{text}, upper estimate {up:.2f}° (×{factor:g}{plus}{role})"
+
+
+def first_term_words(terms: dict[str, Any], places: int = 2) -> str:
+    """The upper estimate's first term in words: the point estimate × its factor, or, when the
+    images' misfit bound is the larger (``planner.adaptive_until.misfit_decides``), that
+    bound, with the estimate it exceeds — said, so that an upper estimate far above factor ×
+    estimate is read for what it is (pixels the fit does not explain, not a misprint)."""
+    est = float(terms["estimated_error_deg"])
+    factor = float(terms.get("upper_factor") or adaptive_until.UPPER_FACTOR)
+    misfit = terms.get("misfit_deg")
+    simulated = f"estimate {est:.{places}f}° × {factor:g}"
+    if not misfit_decides(est, factor, misfit):
+        return simulated
+    return (
+        f"misfit bound {float(misfit):.{places}f}° of pixels the fit does not explain, above "
+        f"the {simulated}"
+    )
 
 
 def unsolved_words(terms: dict[str, Any]) -> str:
@@ -1430,13 +1543,18 @@ def claim_caveat(
     under every band tried, but the arm's lamps at 400 mm measured 2.7× its upper estimate
     until the estimate rendered them (:class:`rti_rig.planner.adaptive_bias.NearLamps`; then
     no claim broke over every elevation), and a ceiling of 15° on the arm 1.8–3.3× (pixels a cast
-    shadow darkens in some lights, kept by the fit): said with the claim."""
+    shadow darkens in some lights, kept by the fit) until the upper estimate weighed the images'
+    misfit bound (then no claim broke, and none at 1.5° or 0.8° was made under 15° on the
+    arm): said with the claim, since a band no calibration covered may hold what neither term
+    sees."""
     if not result.get("target_claimed"):
         return None
     lo, hi = band
     banded = (
         f"this band ({lo:g}°–{hi:g}°) was never calibrated: under a ceiling of 15° the "
-        "simulated arm measured 1.8–3.3× its upper estimate (cast shadows the fit keeps); "
+        "simulated arm had measured up to 3.3× an upper estimate from its object model alone "
+        "(cast shadows the fit keeps, which the upper estimate now bounds from the images' "
+        "residuals); "
         if (lo, hi) != _FULL_BAND
         else ""
     )
@@ -1550,6 +1668,7 @@ def short_of_target_note(
             result.get("upper_factor"),
             float(result.get("unsolved_fraction") or 0.0),
             result.get("unsolved_deg"),
+            result.get("misfit_deg"),
         )
         text += (
             f" Under lamps far from the object the same images would estimate {distant:.2f}° "
@@ -1561,6 +1680,8 @@ def short_of_target_note(
                 '100; docs/adaptive.md, "Lamps near the object").'
                 if would <= until
                 else "the lamps' nearness is part of the gap, not all of it."
+                if would < float(up) - 0.005
+                else "the lamps' nearness is not what keeps the target out of reach."
             )
         )
     reach = offered if most is None else min(offered, most)
@@ -2327,6 +2448,9 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
         # the lamps the session's stop was judged with (absent in sessions begun before the
         # stop rendered near lamps: the rig's, as the unsolved term above)
         lamps=recorded_lamps(header["lamps"]) if "lamps" in header else "rig",
+        # absent in sessions begun before the misfit bound: judged with this build's, as the
+        # unsolved term above (the images can only hold a claim back)
+        misfit_noise_k=header.get("misfit_noise_k"),
     )
     source.lights_given = lights_given(header)
     source.replay(folder)

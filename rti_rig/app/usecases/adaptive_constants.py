@@ -46,12 +46,23 @@ DECISION_MODULES = (
 #: nothing at run time. ``UNSOLVED_DEG`` (what each unsolved pixel adds to the upper estimate)
 #: decides only when to stop too: a resume takes the session's own (``unsolved_deg``), and one begun
 #: before the term existed is judged with this build's (its claim had left those pixels out: the
-#: stop may come later; each light is the one it would have chosen). ``RING_SPAN_DEG`` (when a
+#: stop may come later; each light is the one it would have chosen). ``MISFIT_NOISE_K`` (the misfit
+#: bound's allowance for noise) decides only when to stop as well: a resume takes the session's
+#: own (``misfit_noise_k``), and a session begun before the bound is judged with it (it can only
+#: hold a claim back). ``RING_SPAN_DEG`` (when a
 #: band's start is spread round one ring) is the session's own on a resume too
 #: (``resume_adaptive_source``): one begun before it existed resumes without it, as it began (a new
 #: constant had refused every earlier session, those it changes nothing for too). A test checks that
 #: no decision module defines another constant under these names (it would be exempted too).
-RESTORED_ON_RESUME = frozenset({"UPPER_FACTOR", "UPPER_QUANTILE", "RING_SPAN_DEG", "UNSOLVED_DEG"})
+RESTORED_ON_RESUME = frozenset(
+    {
+        "UPPER_FACTOR",
+        "UPPER_QUANTILE",
+        "RING_SPAN_DEG",
+        "UNSOLVED_DEG",
+        "MISFIT_NOISE_K",
+    }
+)
 
 #: Constants of a decision module that only word the advice a session prints (how many lights
 #: `rti-rig fit` needs for each file), never a choice of light: recorded, not compared, so a
