@@ -216,9 +216,16 @@ def adaptive_run(
     until: float | None = None,
     scale: float = 1.0,
     objective: str = "normals",
+    image_terms: dict[str, dict[int, float | None]] | None = None,
 ) -> tuple[list[int], dict[int | str, float | None], float]:
     """The chooser on pre-shot images: chosen indices, raw estimate after k images (k ≥ 4),
-    and the mean decision time (s). ``objective``: as ``run --adaptive --objective``."""
+    and the mean decision time (s). ``objective``: as ``run --adaptive --objective``.
+
+    ``image_terms``, if given, is filled with the stop's two terms read from the images after
+    k images (``"misfit"``: the misfit bound in degrees, ``"unsolved"``: the unsolved share;
+    ``planner.adaptive_until.upper_error_deg``), so that a benchmark can replay the shipped
+    stop (the larger of the point estimate × the factor and the bound, plus the unsolved
+    term) at any target and factor: neither term depends on the estimate's scale."""
     # as `run --adaptive --lights N` (N known); DESIGN False: light by light (for comparison)
     design = n_max if until is None and DESIGN else None
     led: np.ndarray | None = None  # with a band: the LED (index into dirs) of each candidate
@@ -243,6 +250,10 @@ def adaptive_run(
             times.append(time.perf_counter() - t0)
         if ev.get("estimated_error_deg") is not None:
             estimates[i] = float(ev["estimated_error_deg"])
+            if image_terms is not None:
+                # unrounded, as the stop compares them (the evidence records 4 places)
+                image_terms.setdefault("misfit", {})[i] = chooser.misfit
+                image_terms.setdefault("unsolved", {})[i] = chooser.unsolved
         # the upper estimate of the last decision (the stop's): what the shipped stop compared,
         # unsolved pixels included (not the point × UPPER_FACTOR alone)
         estimates["upper"] = ev.get("upper_error_deg")

@@ -2,8 +2,10 @@
 optimal`, at N = 6 … 100 on a dome and on an arm.
 
 * **Adaptive decision** (what `run --adaptive` does between two images): shrink the newest
-  24-megapixel frame (6000×4000 RGB, 16-bit) to the fit's 128 px and sample it, robust
-  photometric stereo on the samples of the images so far, and the choice: light by light among
+  24-megapixel frame (6000×4000 RGB, 16-bit) to the fit's 128 px and sample it, and sample it
+  at full size; robust photometric stereo on the samples of the images so far, the estimate,
+  the stop's evidence at full size (the robust fit of the full-size samples, their unsolved
+  share and misfit bound), and the choice: light by light among
   the rig's candidates (N images so far, as `--until-error` alone does: within the design for
   the next guessed N of ``planner.adaptive_until``; ``--greedy``: format 5's bound-only choice),
   or the rest of an
@@ -36,6 +38,7 @@ from threadpoolctl import threadpool_limits
 from benchmarks.adaptive import DOC
 from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import (
+    camera_sample,
     fit_sample,
     relief_px,
     relight_fit,
@@ -48,7 +51,12 @@ from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.planner.adaptive import START_LIGHTS, choose_in_design, choose_next, object_model
 from rti_rig.planner.adaptive_bias import simulate_error_deg
-from rti_rig.planner.adaptive_until import choose_until
+from rti_rig.planner.adaptive_until import (
+    MISFIT_NOISE_K,
+    choose_until,
+    misfit_deg,
+    unsolved_fraction,
+)
 from rti_rig.planner.make_plan import plan_with_report
 from rti_rig.planner.objectives import candidates_for
 from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
@@ -66,6 +74,20 @@ def _state(samples: np.ndarray, lights: np.ndarray, images: np.ndarray):  # type
     state = fit_sample(samples, lights, where, relief_px(images, lights))
     assert state is not None
     return state
+
+
+def _image_evidence(camera: np.ndarray, lights: np.ndarray) -> None:
+    """The stop's evidence at the camera's resolution, as ``AdaptiveChooser.image_evidence``
+    reads it in every decision: the robust fit of the images' full-size samples, the share of
+    them unsolved and the misfit bound (``planner.adaptive_until``)."""
+    state = fit_sample(camera, lights)
+    assert state is not None
+    unsolved_fraction(state.valid)
+    assert state.residual is not None and state.used is not None and state.valid is not None
+    misfit_deg(
+        state.residual, state.used, state.albedo, state.valid, state.lit, state.lights,
+        MISFIT_NOISE_K,
+    )  # fmt: skip
 
 
 def _median(fn, repeats: int) -> float:
@@ -109,7 +131,8 @@ def main(argv: list[str] | None = None) -> str:
     load_before = os.getloadavg()
     frame = np.random.default_rng(0).integers(0, 65535, (4000, 6000, 3), dtype=np.uint16)
     shrink = _median(lambda: small_grey(frame), args.repeats)
-    print(f"shrink 24 MP -> 128 px: {shrink:.3f} s", flush=True)
+    full_sample = _median(lambda: camera_sample(frame), args.repeats)
+    print(f"shrink 24 MP -> 128 px: {shrink:.3f} s; full-size sample {full_sample:.4f} s")
     rows = []
     for rig_name, geometry in (("200-LED dome", dome), ("arm", arm)):
         cands = candidates_for(geometry).directions
@@ -126,10 +149,15 @@ def main(argv: list[str] | None = None) -> str:
             def decide(
                 samples=samples, lights=lights, available=available, cands=cands, images=images
             ) -> None:
-                # the newest frame shrunk and sampled, the fit on the sample (and the relief on
-                # the small images), the bias-aware estimate (a simulated fit), the choice
+                # the newest frame shrunk and sampled, and sampled at full size; the fit on the
+                # sample (and the relief on the small images), the bias-aware estimate (a
+                # simulated fit), the stop's image evidence at full size (the small images'
+                # samples stand in for the earlier frames' full-size ones: the same shape and
+                # work), the choice
                 sample_pixels(small_grey(frame)[None])
+                camera_sample(frame)
                 state = _state(samples, lights, images)
+                _image_evidence(samples, lights)
                 simulate_error_deg(object_model(state), lights, robust_fit)
                 if GREEDY:  # format 5's path: the bound's best light
                     choose_next(state, cands, available)
@@ -150,7 +178,9 @@ def main(argv: list[str] | None = None) -> str:
                 images=images[:half],
             ) -> None:
                 sample_pixels(small_grey(frame)[None])
+                camera_sample(frame)
                 state = _state(samples, lights, images)
+                _image_evidence(samples, lights)
                 simulate_error_deg(object_model(state), lights, robust_fit)
                 choose_in_design(
                     state,
@@ -207,8 +237,11 @@ def main(argv: list[str] | None = None) -> str:
         + "/".join(f"{x:.1f}" for x in os.getloadavg())
         + " at the end.",
         "",
-        f"Shrinking one 24-MP frame (6000×4000×3, 16-bit) to the fit's 128 px: {shrink:.3f} s "
-        "(inside every decision below, with sampling the new image's 2000 pixels).",
+        f"Shrinking one 24-MP frame (6000×4000×3, 16-bit) to the fit's 128 px: {shrink:.3f} s; "
+        f"its 2000-pixel sample at full size (`camera_sample`): {full_sample:.4f} s (both "
+        "inside every decision below, with sampling the new image's 2000 pixels, and the "
+        "stop's evidence at full size: the robust fit of every image's full-size sample, its "
+        "unsolved share and misfit bound).",
         "",
     ]
     if decisions_only:

@@ -20,13 +20,17 @@ Rules (``upper_k`` after k lights; ``point_k`` = the shipped point estimate):
   refitted, a design completed) is not trusted until it has stayed down W lights — a term for
   error that no longer falls as fast as the simulated one; F as above, of measured / that max.
 
+* ``<rule>+images``: the rule's factor as above, and the images' terms weighed as the shipped
+  stop weighs them (``planner.adaptive_until.upper_error_deg``): the larger of the factor ×
+  the point estimate and the misfit bound, plus the unsolved share × ``UNSOLVED_DEG``. The
+  shipped stop is ``f1.95+images``; it is always replayed (traces written before the traces
+  held the image terms replay it without them, and say so).
+
 Run: ``python -m benchmarks.adaptive_until_bound TRACES.json [--targets ...]``.
 
-Since 2026-12-06 the shipped stop adds the unsolved pixels' share × ``UNSOLVED_DEG`` to the
-upper estimate (``planner.adaptive_until``); this benchmark replays the factor alone (format
-8's rule, from which the factor was derived), so its stops can come earlier than the shipped
-ones where the robust fit leaves pixels unsolved (the coin and the industrial part below 11
-and 7 lights).
+The factor was derived on the point estimate alone (the rules without ``+images``), before the
+stop weighed the images (2026-12-06): the ``+images`` rows measure what the images' terms add
+to it on the calibration's own sessions, not a factor chosen with them.
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from rti_rig.planner.adaptive import SIM_ESTIMATE_SCALE
+from rti_rig.planner.adaptive_until import UPPER_FACTOR, UPPER_QUANTILE, upper_error_deg
 
 TARGETS = (0.25, 0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0)
 QUANTILES = (0.5, 0.75, 0.9, 0.95, 1.0)
@@ -60,6 +65,9 @@ def load(path: Path, scale: float) -> list[dict]:
                 "point": {k: scale * raw[k] for k in ks},
                 "measured": meas,
                 "cap": max(meas),
+                # the stop's image terms (absent from traces written before they were kept)
+                "misfit": {int(k): v for k, v in (r.get("misfit") or {}).items()},
+                "unsolved": {int(k): v for k, v in (r.get("unsolved") or {}).items()},
             }
         )
     return out
@@ -93,9 +101,11 @@ def evaluate(
     w: int,
     targets: tuple[float, ...],
     fixed: float | None = None,
+    images: bool = False,
 ) -> dict:
     """The rule's stops on every session at every target, each scene's factor chosen on the
-    other scenes (``fixed``: one given factor for all, e.g. the shipped one on fresh draws)."""
+    other scenes (``fixed``: one given factor for all, e.g. the shipped one on fresh draws;
+    ``images``: the images' misfit bound and unsolved share weighed as the shipped stop does)."""
     scenes = sorted({s["scene"] for s in sessions})
     per_scene: dict[str, float] = {}
     claims = above = lights = caps = cap_above = 0
@@ -110,7 +120,13 @@ def evaluate(
         per_scene[scene] = f
         for s in (s for s in sessions if s["scene"] == scene):
             win = windowed(s, w)
-            upper = {k: f * v for k, v in win.items()}
+            if images:
+                upper = {
+                    k: upper_error_deg(v, f, s["unsolved"].get(k) or 0.0, None, s["misfit"].get(k))
+                    for k, v in win.items()
+                }
+            else:
+                upper = {k: f * v for k, v in win.items()}
             for t in targets:
                 k, claimed = stop(s, upper, t)
                 m = s["measured"][k]
@@ -136,8 +152,9 @@ def evaluate(
     }
 
 
-def name(q: float | None, w: int) -> str:
-    return "point" if q is None else f"q{q:g}" + (f"-w{w}" if w else "")
+def name(q: float | None, w: int, fixed: float | None = None, images: bool = False) -> str:
+    base = f"f{fixed:g}" if fixed is not None else "point" if q is None else f"q{q:g}"
+    return base + (f"-w{w}" if w else "") + ("+images" if images else "")
 
 
 def main(argv: list[str] | None = None) -> str:
@@ -168,13 +185,23 @@ def main(argv: list[str] | None = None) -> str:
         "claims (median, max) | cap stops (above target) |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    rules: list[tuple[float | None, int, float | None]] = [(None, 0, None)]
-    rules += [(q, w, None) for w in WINDOWS for q in QUANTILES]
-    rules += [(None, 0, float(f)) for f in args.fixed.split(",") if f]
+    rules: list[tuple[float | None, int, float | None, bool]] = [(None, 0, None, False)]
+    rules += [(q, w, None, False) for w in WINDOWS for q in QUANTILES]
+    fixed_factors = [float(f) for f in args.fixed.split(",") if f]
+    rules += [(None, 0, f, False) for f in fixed_factors]
+    # the images' terms: on the quantile the factor was chosen by, and on the shipped factor
+    rules += [(UPPER_QUANTILE, 0, None, True)]
+    rules += [(None, 0, f, True) for f in dict.fromkeys([*fixed_factors, UPPER_FACTOR])]
+    have = sum(bool(s["misfit"]) for s in sessions)
+    if have < len(sessions):
+        lines[0] += (
+            f" {len(sessions) - have} of {len(sessions)} sessions' traces hold no image terms "
+            "(written before they were kept): `+images` rows weigh nothing for those."
+        )
     results = {}
-    for q, w, fixed in rules:
-        r = evaluate(sessions, q, w, targets, fixed)
-        label = name(q, w) if fixed is None else f"f{fixed:g}"
+    for q, w, fixed, images in rules:
+        r = evaluate(sessions, q, w, targets, fixed, images)
+        label = name(q, w, fixed, images)
         results[label] = r
         rat = np.array(r["ratios"]) if r["ratios"] else np.array([np.nan])
         per = ", ".join(f"{r['factors'][s]:.2f}" for s in scenes)

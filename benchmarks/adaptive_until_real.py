@@ -18,10 +18,12 @@ Run: ``python -m benchmarks.adaptive_until_real [--draws K] [--targets 2,3,4,6] 
 [--write]`` (reads ../shared/data/neuralrti-example beside the repository; ``--write`` puts the
 table into docs/adaptive.md).
 
-Since 2026-12-06 the shipped stop adds the unsolved pixels' share × ``UNSOLVED_DEG`` to the
-upper estimate (``planner.adaptive_until``); this benchmark replays the factor alone (format
-8's rule, from which the factor was derived); on the shared real acquisition the share is zero
-at every light, so the stops are the shipped ones.
+Rules replayed from the same sessions: the point estimate × each ``--upper-factors`` factor
+(1: format 7's stop; ``UPPER_FACTOR``: format 8's), and always the stop as it ships
+(``planner.adaptive_until.upper_error_deg``: the larger of the point estimate ×
+``UPPER_FACTOR`` and the images' misfit bound, plus the unsolved share × ``UNSOLVED_DEG``),
+both image terms read on the same grey images the decisions see (this benchmark has no frame
+at the camera's resolution beside them: the recorded JPEGs are read as one image each).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from __future__ import annotations
 import argparse
 import os
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +41,7 @@ from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import small_grey
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.planner.adaptive import SIM_ESTIMATE_SCALE
-from rti_rig.planner.adaptive_until import UPPER_FACTOR
+from rti_rig.planner.adaptive_until import UPPER_FACTOR, upper_error_deg
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "adaptive.md"
 
@@ -60,10 +63,10 @@ def run(
     format 7's stop on the point estimate; ``UPPER_FACTOR``: format 8's."""
     from benchmarks.planner_real_data import DATA, evaluate, load, reference
 
-    dome, images, _ = load(data or DATA)
+    dome, images_of, _ = load(data or DATA)
     dirs = dome.directions
-    ref, mask = reference(images, dirs)
-    grey = np.stack([small_grey(im, 1.0) for im in images])
+    ref, mask = reference(images_of, dirs)
+    grey = np.stack([small_grey(im, 1.0) for im in images_of])
     rng = np.random.default_rng(0)  # benchmarks.adaptive.real's draws
     rows = []
     for d in range(draws):
@@ -76,6 +79,7 @@ def run(
         # stops at a target is the prefix, up to the first light count whose estimate (× the
         # rule's factor) is at most that target, of the one run to the cap
         t0 = time.perf_counter()
+        terms: dict[str, dict[int, float | None]] = {}
         used, est, _ = adaptive_run(
             grey[keep],
             dirs[keep],
@@ -83,6 +87,7 @@ def run(
             min(cap, len(keep)),
             until=1e-9,  # to the cap: every rule's stop is a prefix of it
             scale=SIM_ESTIMATE_SCALE,
+            image_terms=terms,
         )
         seconds = time.perf_counter() - t0
         ks = sorted(k for k in est if isinstance(k, int))
@@ -95,41 +100,65 @@ def run(
         if trace:  # the error measured along the session (does it fall as lights are added?)
             along = [
                 f"{k}: {est.get(k, float('nan')):.2f}/"
-                f"{evaluate(keep[np.array(used[:k])], images, dirs, ref, mask, 'ptm')[0]:.2f}"
+                f"{evaluate(keep[np.array(used[:k])], images_of, dirs, ref, mask, 'ptm')[0]:.2f}"
                 for k in TRACE
                 if k <= len(used)
             ]
             print(f"draw {d} estimate/measured after k lights: " + ", ".join(along), flush=True)
         memo: dict[int, float] = {}
-        for factor in factors:
+        rules = [(f, False) for f in factors] + [(UPPER_FACTOR, True)]
+        for factor, images in rules:
+            upper = partial(rule_upper, est, terms, factor=factor, images=images)
             for target in targets:
-                k = next((k for k in ks if factor * est[k] <= target), len(used))
+                k = next((k for k in ks if upper(k) <= target), len(used))
                 if k not in memo:
                     idx = keep[np.array(used[:k])]
-                    memo[k] = evaluate(idx, images, dirs, ref, mask, "ptm")[0]
+                    memo[k] = evaluate(idx, images_of, dirs, ref, mask, "ptm")[0]
                 measured = memo[k]
                 estimate = est.get(k)
-                reached = estimate is not None and factor * estimate <= target
+                reached = estimate is not None and upper(k) <= target
                 rows.append(
                     {
                         "draw": d,
                         "leds": len(keep),
                         "target": target,
                         "factor": factor,
+                        "images": images,
                         "lights": k,
                         "estimate": estimate,
+                        "upper": None if estimate is None else upper(k),
+                        "misfit": terms.get("misfit", {}).get(k),
                         "measured": measured,
                         "reached": reached,
                         "seconds": seconds,
                     }
                 )
                 print(
-                    f"draw {d} factor {factor:g} target {target:g}: {k} lights, estimate "
-                    f"{estimate if estimate is None else round(estimate, 2)}, measured "
+                    f"draw {d} {rule_name(factor, images)} target {target:g}: {k} lights, "
+                    f"estimate {estimate if estimate is None else round(estimate, 2)}, measured "
                     f"{measured:.2f}",
                     flush=True,
                 )
     return rows
+
+
+def rule_upper(
+    est: dict, terms: dict[str, dict[int, float | None]], k: int, factor: float, images: bool
+) -> float:
+    """What a rule compares with the target after ``k`` lights: the point estimate × ``factor``
+    or, with ``images``, the shipped upper estimate (``upper_error_deg``) on the session's
+    image terms."""
+    if not images:
+        return factor * est[k]
+    unsolved = terms.get("unsolved", {}).get(k) or 0.0
+    return upper_error_deg(est[k], factor, unsolved, None, terms.get("misfit", {}).get(k))
+
+
+def rule_name(factor: float, images: bool) -> str:
+    """How a table names a stop rule."""
+    if images:
+        return f"as shipped (max(point × {factor:g}, misfit bound) + unsolved × 90°)"
+    return "point estimate" if factor == 1.0 else f"upper (point × {factor:g})"
 
 
 def report(rows: list[dict], cmd: str, elapsed: float) -> str:
@@ -139,21 +168,32 @@ def report(rows: list[dict], cmd: str, elapsed: float) -> str:
         "",
         "The shared real dome (`neuralrti-example`, 72 LEDs), `--until-error` with the shipped "
         f"point estimate (the simulated error × {SIM_ESTIMATE_SCALE}, calibrated on the "
-        "simulator only), the stop on the point estimate (format 7) or on the upper one (the "
-        "point × the factor, format 8; estimate columns: the point estimate), capped at 60 "
+        "simulator only), the stop on the point estimate (format 7), on the upper one (the "
+        "point × the factor, format 8) or as it ships (the larger of the point × the factor "
+        "and the images' misfit bound, plus the unsolved share × 90°, read on the decisions' "
+        "grey images); estimate columns: the point estimate. Capped at 60 "
         "lights. Draw 0: every LED; the others: "
         f"{REAL_REMOVED} LEDs out (the real draws of `benchmarks.adaptive`). Measured: mean "
         "angle on the object mask to robust PS on all 72 lights.",
         "",
         "| stop on | target | draws | lights used (median, range) | estimate at stop (mean) | "
         "measured (mean) | measured / estimate (geometric mean, range) | "
-        "measured above target | why it stopped |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "measured above target | why it stopped | upper estimate at stop (mean) | misfit "
+        "bound at stop (mean) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    keys = sorted({(r.get("factor", 1.0), r["target"]) for r in rows})
-    for factor, target in keys:
-        rs = [r for r in rows if r["target"] == target and r.get("factor", 1.0) == factor]
-        rule = "point estimate" if factor == 1.0 else f"upper (point × {factor:g})"
+    keys = sorted({(r.get("images", False), r.get("factor", 1.0), r["target"]) for r in rows})
+    for images, factor, target in keys:
+        rs = [
+            r
+            for r in rows
+            if r["target"] == target
+            and r.get("factor", 1.0) == factor
+            and r.get("images", False) == images
+        ]
+        rule = rule_name(factor, images)
+        up = np.array([np.nan if r.get("upper") is None else r["upper"] for r in rs])
+        mis = np.array([np.nan if r.get("misfit") is None else r["misfit"] for r in rs])
         n = np.array([r["lights"] for r in rs])
         est = np.array([np.nan if r["estimate"] is None else r["estimate"] for r in rs])
         meas = np.array([r["measured"] for r in rs])
@@ -166,9 +206,14 @@ def report(rows: list[dict], cmd: str, elapsed: float) -> str:
             f"{np.nanmean(est):.2f}° | {meas.mean():.2f}° | ×{gm:.2f} "
             f"({np.nanmin(ratio):.2f}–{np.nanmax(ratio):.2f}) | "
             f"{int((meas > target).sum())} of {len(rs)} | "
-            f"{'estimate' if factor == 1.0 else 'upper'} reached {why}, cap {len(rs) - why} |"
+            f"{'estimate' if factor == 1.0 and not images else 'upper'} reached {why}, cap "
+            f"{len(rs) - why} | {_mean(up)} | {_mean(mis)} |"
         )
     return "\n".join(lines)
+
+
+def _mean(values: np.ndarray) -> str:
+    return "" if not np.isfinite(values).any() else f"{np.nanmean(values):.2f}°"
 
 
 def main(argv: list[str] | None = None) -> str:

@@ -121,6 +121,14 @@ def measured_error(session: Path, truth: NDArray[np.float64]) -> tuple[float, fl
     return mean, median
 
 
+def session_error_deg(config: Path, session: Path) -> float:
+    """The mean normal error (°) of ``session``, shot on the simulated rig ``config`` (a TOML
+    file), as the stop's calibration measures it (:func:`measured_error` against the
+    config's scene's true normals): what the front-door tests compare a claim with."""
+    cfg = tomllib.loads(Path(config).read_text(encoding="utf-8"))
+    return measured_error(session, truth_normals(cfg))[0]
+
+
 def run_cli(case: Case, folder: Path, *options: str) -> tuple[Path, dict]:  # type: ignore[type-arg]
     """``rti-rig run`` on ``case``'s config (written to ``folder``) with ``--until-error``,
     its ceiling and ``options``, as a user runs it (a subprocess): the session and the

@@ -50,3 +50,34 @@ def test_the_point_rule_and_the_window(tmp_path: Path) -> None:
     text = main([str(_traces(tmp_path)), "--targets", "1,3.5", "--scale", "1", "--detail", "q1"])
     assert "| q1 | 3.00, 3.00, 2.00 | 3.00 |" in text
     assert "**above**" in text
+
+
+def test_the_images_rows_weigh_the_misfit_bound_and_the_unsolved_share(tmp_path: Path) -> None:
+    """``+images``: the shipped stop (``upper_error_deg``) replayed on the traced image terms:
+    a misfit bound above the factor × the point estimate, or unsolved pixels, hold a claim
+    back; the factor-alone rule ignores them."""
+    path = _traces(tmp_path)
+    data = json.loads(path.read_text())
+    for s in data["sessions"]:
+        s["misfit"] = {str(k): (4.0 if k < 9 else 0.0) for k in range(4, 11)}
+        s["unsolved"] = {str(k): 0.0 for k in range(4, 11)}
+    data["sessions"][0]["unsolved"]["9"] = 0.04  # 3.6° at 9 lights on scene a
+    path.write_text(json.dumps(data))
+    sessions = load(path, scale=1.0)
+    alone = {r[0]: r for r in evaluate(sessions, None, 0, (3.5,), fixed=1.0)["rows"]}
+    shipped = {r[0]: r for r in evaluate(sessions, None, 0, (3.5,), 1.0, images=True)["rows"]}
+    assert alone["a"][3] == 4  # 8/4 = 2 ≤ 3.5 at once
+    assert shipped["b"][3] == 9  # the bound, 4°, holds every count below 9
+    assert shipped["b"][5] == pytest.approx(8 / 9)
+    assert shipped["a"][3] == 10  # at 9 its unsolved share adds 3.6° to 8/9: past 3.5°
+    text = main([str(path), "--targets", "3.5", "--scale", "1"])
+    assert "| f1.95+images | 1.95, 1.95, 1.95 |" in text
+    assert "hold no image terms" not in text
+
+
+def test_traces_without_image_terms_say_so(tmp_path: Path) -> None:
+    text = main([str(_traces(tmp_path)), "--targets", "3.5", "--scale", "1", "--fixed", "1.95"])
+    assert "3 of 3 sessions' traces hold no image terms" in text
+    f = next(ln for ln in text.splitlines() if ln.startswith("| f1.95 |"))
+    g = next(ln for ln in text.splitlines() if ln.startswith("| f1.95+images |"))
+    assert f.split("|")[3:] == g.split("|")[3:]  # nothing weighed: the same stops

@@ -47,3 +47,28 @@ def test_report_separates_the_point_and_upper_stops() -> None:
     upper = next(ln for ln in text.splitlines() if ln.startswith("| upper (point × 2) | 2°"))
     assert "1 of 1" in point and "estimate reached 1, cap 0" in point
     assert "0 of 1" in upper and "upper reached 0, cap 1" in upper
+
+
+def test_the_shipped_rule_weighs_the_images_terms() -> None:
+    """``rule_upper`` with images is ``upper_error_deg``; its rows are named as shipped and
+    show the upper estimate and the misfit bound each stop compared."""
+    from benchmarks.adaptive_until_real import rule_upper
+
+    est = {4: 2.0, 5: 1.0}
+    terms = {"misfit": {4: 5.0, 5: 0.5}, "unsolved": {4: 0.0, 5: 0.01}}
+    assert rule_upper(est, terms, 4, factor=2.0, images=False) == 4.0
+    assert rule_upper(est, terms, 4, factor=2.0, images=True) == 5.0  # the bound above 2 × 2
+    assert rule_upper(est, terms, 5, factor=2.0, images=True) == 2.0 + 0.9  # + 1 % × 90°
+    assert rule_upper(est, {}, 5, factor=2.0, images=True) == 2.0  # no terms traced: nothing
+    rows = [
+        {**_row(2.0, 60, 1.0, 1.5), "factor": 2.0, "reached": False, "upper": 2.9},
+        {
+            **_row(2.0, 60, 1.0, 1.5),
+            **{"factor": 2.0, "images": True, "reached": False, "upper": 5.0, "misfit": 5.0},
+        },
+    ]
+    text = report(rows, "python -m benchmarks.adaptive_until_real", 1.0)
+    shipped = next(ln for ln in text.splitlines() if ln.startswith("| as shipped"))
+    assert shipped.endswith("| upper reached 0, cap 1 | 5.00° | 5.00° |"), shipped
+    upper = next(ln for ln in text.splitlines() if ln.startswith("| upper (point × 2) | 2°"))
+    assert upper.endswith("| 2.90° |  |"), upper

@@ -26,14 +26,9 @@ runner = CliRunner()
 
 
 def _measured_deg(config: Path, session: Path) -> float:
-    """The session's mean normal error (°) as the stop's calibration measures it: robust
-    photometric stereo on its linear images and lights.lp against the scene's true normals."""
-    import tomllib
+    from benchmarks.until_error_configs import session_error_deg
 
-    from benchmarks.until_error_configs import measured_error, truth_normals
-
-    cfg = tomllib.loads(config.read_text(encoding="utf-8"))
-    return measured_error(session, truth_normals(cfg))[0]
+    return session_error_deg(config, session)
 
 
 def _run(*args: str) -> str:

@@ -11,7 +11,6 @@ simulated scene) puts them, and a session records the geometry it was judged wit
 from __future__ import annotations
 
 import json
-import tomllib
 from pathlib import Path
 
 from typer.testing import CliRunner
@@ -34,11 +33,9 @@ def _adaptive(session: Path) -> dict:  # type: ignore[type-arg]
 
 
 def _measured_deg(session: Path, config: Path = ARM) -> float:
-    """The session's mean normal error (°) as the stop's calibration measures it."""
-    from benchmarks.until_error_configs import measured_error, truth_normals
+    from benchmarks.until_error_configs import session_error_deg
 
-    cfg = tomllib.loads(config.read_text(encoding="utf-8"))
-    return measured_error(session, truth_normals(cfg))[0]
+    return session_error_deg(config, session)
 
 
 def _directional_arm(tmp_path: Path) -> Path:
