@@ -130,11 +130,24 @@ def rig_seconds_per_light(rig_path: Path) -> tuple[float, str]:
     axis had always been the replayed dome's defaults (1.17 s a light), where a DSLR dome's
     step takes seconds. An arm is refused: its time depends on its moves between the lights,
     which an acquisition's directions do not give it. Raises ``RtiRigError`` naming the file."""
-    from rti_rig.app.config import load_rig_config
+    return rig_facts(rig_path)[0]
+
+
+def rig_facts(rig_path: Path) -> tuple[tuple[float, str], int]:
+    """:func:`rig_seconds_per_light` and the dome's LED count (:func:`rig_led_count`), from
+    one reading of the config: what the CLI reads before minutes of computing, so that the
+    trade is timed and its advice bounded by the config it checked."""
+    from rti_rig.app.config import load_rig_config, rig_geometry
+
+    loaded = load_rig_config(rig_path)
+    per_light = _seconds_per_light(rig_path, loaded.config)
+    return per_light, len(rig_geometry(loaded).directions)
+
+
+def _seconds_per_light(rig_path: Path, cfg: Any) -> tuple[float, str]:
     from rti_rig.core.errors import RtiRigError
     from rti_rig.core.shell_words import shown_path
 
-    cfg = load_rig_config(rig_path).config
     if cfg.kind != "dome":
         raise RtiRigError(
             f"--rig {shown_path(rig_path)} is an arm's config: an arm's session time depends on "
@@ -153,6 +166,13 @@ def rig_seconds_per_light(rig_path: Path) -> tuple[float, str]:
     if held is not None and held[0] > seconds:
         return held[0], f"{shown_path(rig_path)}: {held[1]}"
     return seconds, said
+
+
+def rig_led_count(rig_path: Path) -> int:
+    """How many LEDs the dome config ``rig_path`` has (the lights a session on it can fire):
+    the advice names no session of more lights than that (an 8-LED dome had been told to run
+    36, which it refused)."""
+    return rig_facts(rig_path)[1]
 
 
 def timed_firmware_seconds(cfg: Any) -> tuple[float, str] | None:
@@ -550,11 +570,14 @@ def how_many_lights(
     per_light_s: float,
     rig: str = "RIG",
     targets: Targets | None = None,
+    rig_lights: int | None = None,
 ) -> list[str]:
     """The summary's answer to what it is run for: for each target (mean normal error, and
     relighting of the fit.rti `rti-rig fit` writes, below every light's), the fewest lights
     each planner needs, the fastest of them with its session time, and the command.
     ``targets``: the lab's own (``--target-deg``/``--target-db``); the defaults without.
+    ``rig_lights``: the LEDs of ``--rig``'s dome: a count above them gets no command (the
+    rig would refuse it), and says so.
 
     Why: the tables gave 5 planners × 7 counts of cells and left a conservator to read the
     answer out of them (QA, 2026-12-05)."""
@@ -593,10 +616,17 @@ def how_many_lights(
         missing = [said for said, _, series in planners if all(said != s for _, s, _ in found)]
         how = best[0][1].format(rig=rig, n=fastest)
         fewest = " (the fewest the table tries: fewer may do)" if fastest == counts[0] else ""
-        out = (
-            f"- **{target}**: from **{fastest} lights**{fewest}, {seconds:.0f} s a session, "
-            f"with {best[0][0]}: `{how}`. Each planner: {each}"
-        )
+        if rig_lights is not None and fastest > rig_lights:
+            out = (
+                f"- **{target}**: from **{fastest} lights**{fewest} of this acquisition, more "
+                f"than the {rig_lights} LEDs of {rig}: no session on it reaches this target "
+                f"as this acquisition's lights do. Each planner: {each}"
+            )
+        else:
+            out = (
+                f"- **{target}**: from **{fastest} lights**{fewest}, {seconds:.0f} s a "
+                f"session, with {best[0][0]}: `{how}`. Each planner: {each}"
+            )
         if missing:
             out += f"; not reached by {', '.join(missing)} (up to its most lights here)"
         return out + "."
@@ -612,6 +642,14 @@ def how_many_lights(
         "adaptive session's decisions.",
         "",
     ]
+    if rig_lights is not None and rig_lights < max(counts[-1], every.n):
+        lines[-1:-1] = [
+            "",
+            f"{rig} has {rig_lights} LEDs, fewer than this acquisition's lights: the counts "
+            "below are measured on the acquisition's, and hold for your dome only as far as "
+            "its LEDs light the object as these did; no command is given for more lights "
+            "than it has.",
+        ]
     for target in targets.normals_deg:
         lines.append(
             line(f"Normals within {target:.10g}°", lambda r, t=target: r.normal_mean_deg <= t)
@@ -637,10 +675,12 @@ def summarise_from(
     per_light: tuple[float, str] = (PER_LIGHT_S, PER_LIGHT_SAID),
     rig_word: str = "RIG",
     targets: Targets | None = None,
+    rig_lights: int | None = None,
 ) -> str:
     """The markdown summary; ``held``: the names of the held-out lights; ``per_light``: the
     seconds a light takes and where they come from; ``rig_word``: the rig config as the
-    advice's commands name it (``--rig``'s, shell-quoted; ``RIG`` without one)."""
+    advice's commands name it (``--rig``'s, shell-quoted; ``RIG`` without one);
+    ``rig_lights``: the LEDs of ``--rig``'s dome (None: no ``--rig``)."""
     per_light_s, per_light_said = per_light
     floor = best_floor(rows, rows[0].scene)  # as the plots' line: on the N every floor serves
     by = {(r.method, r.objective, r.floor_deg, r.n): r for r in rows}
@@ -656,7 +696,7 @@ def summarise_from(
         f"chooses among the other {every.n}. Session time: "
         f"{per_light_s:.2f} s a light ({per_light_said}).",
         "",
-        *how_many_lights(rows, floor, per_light_s, rig_word, targets),
+        *how_many_lights(rows, floor, per_light_s, rig_word, targets, rig_lights),
         "| N | session s | uniform 0° | uniform, best floor here "
         f"({floor:g}°, hindsight) | optimal | adaptive | adaptive, `--objective relight` |",
         "|---|---|---|---|---|---|---|",
@@ -740,6 +780,7 @@ def bench_from(
     rig: Path | None = None,
     per_light: tuple[float, str] | None = None,
     targets: Targets | None = None,
+    rig_lights: int | None = None,
 ) -> str:
     """Run, write results.csv, the plots and summary.md into ``out_dir`` (nothing written when
     it is None: the summary is only returned); return the summary (its command line says
@@ -747,9 +788,13 @@ def bench_from(
     config, whose timing gives the session time (:func:`rig_seconds_per_light`); else the
     replayed dome's defaults. ``per_light``: that time, when the caller has already read it
     from ``rig`` (the CLI reads the config before minutes of computing; read again here, a
-    config edited in between would time the trade by another config than the one checked)."""
+    config edited in between would time the trade by another config than the one checked);
+    ``rig_lights``: its LED count, read with it (:func:`rig_facts`)."""
     if per_light is None:
-        per_light = (PER_LIGHT_S, PER_LIGHT_SAID) if rig is None else rig_seconds_per_light(rig)
+        if rig is None:
+            per_light = (PER_LIGHT_S, PER_LIGHT_SAID)
+        else:
+            per_light, rig_lights = rig_facts(rig)
     if rig is None and shot_on_an_arm(lp):
         per_light = (per_light[0], per_light[1] + ARM_TIMES_SAID)
     t0 = time.perf_counter()
@@ -768,7 +813,7 @@ def bench_from(
     rig_word = advice_rig(lp, rig)
     if out_dir is None:
         return summarise_from(
-            rows, time.perf_counter() - t0, command, held, per_light, rig_word, targets
+            rows, time.perf_counter() - t0, command, held, per_light, rig_word, targets, rig_lights
         )
     out_dir.mkdir(parents=True, exist_ok=True)
     write_csv(rows, out_dir / "results.csv")
@@ -777,7 +822,7 @@ def bench_from(
             path.unlink()
     command += f" --out {shell_word(out_dir)}" + (" --force" if force else "")
     text = summarise_from(
-        rows, time.perf_counter() - t0, command, held, per_light, rig_word, targets
+        rows, time.perf_counter() - t0, command, held, per_light, rig_word, targets, rig_lights
     )
     (out_dir / "summary.md").write_text(text + "\n", encoding="utf-8")
     return text

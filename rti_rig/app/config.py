@@ -232,9 +232,10 @@ class LampsConfig(_Strict):
     reach); ``field_width_mm``: the width of the object field the frame spans. Given, the
     adaptive stop's estimate renders the lamps as point lamps at that distance (each pixel lit
     from its own direction and distance, which a fit reading one direction per light gets
-    wrong); not given, it assumes distant lamps and says so. Hardware and replay rigs: a
-    simulated or emulated scene with ``light_distance_mm`` gives both itself (docs/adaptive.md,
-    "Lamps near the object").
+    wrong); not given, it assumes distant lamps and says so. Hardware rigs only: a simulated
+    or emulated scene with ``light_distance_mm`` gives both itself, and a replayed
+    acquisition's ``.lp`` has no config to give them in (docs/adaptive.md, "Lamps near the
+    object").
     """
 
     distance_mm: float = Field(gt=0)
@@ -597,7 +598,7 @@ class RigConfig(_Strict):
         if self.lamps is not None and self.backend in ("simulated", "emulated"):
             # the estimate would render lamps the rendered images do not have
             raise ValueError(
-                f"[lamps] describes a real rig's lamps (hardware, or a replayed acquisition); "
+                f"[lamps] describes a hardware rig's lamps; "
                 f"the lamps of a rig with backend '{self.backend}' come from its [scene] "
                 "(light_distance_mm, over the scene's own field): remove the [lamps] table, "
                 "or set [scene] light_distance_mm"

@@ -100,7 +100,8 @@ def bench_tradeoff(
             "--rig",
             help="With --from: your dome's rig config, whose \\[timing] and \\[camera] "
             "exposure_s give the session time, or its firmware's own hold window where that "
-            "is longer (RTIPy's); else the replayed dome's defaults, 1.17 s a light.",
+            "is longer (RTIPy's); else the replayed dome's defaults, 1.17 s a light. The "
+            "advice names no session of more lights than that dome has LEDs.",
         ),
     ] = None,
     target_deg: Annotated[
@@ -376,7 +377,7 @@ def _tradeoff(
         bench_from,
         check_acquisition,
         checked_targets,
-        rig_seconds_per_light,
+        rig_facts,
     )
 
     if any(given_targets) and from_lp is None:  # accepted and ignored, they would change nothing
@@ -393,6 +394,7 @@ def _tradeoff(
         raise fail(exc) from None
 
     per_light: tuple[float, str] | None = None  # the rig's time per light, read once
+    rig_lights: int | None = None  # and its LEDs, from the same reading
     if rig is not None:  # its config read before minutes of computing, not after
         if from_lp is None:
             raise fail(
@@ -402,7 +404,7 @@ def _tradeoff(
                 )
             )
         try:
-            per_light = rig_seconds_per_light(rig)
+            per_light, rig_lights = rig_facts(rig)
         except RtiRigError as exc:
             raise fail(exc) from None
 
@@ -445,6 +447,7 @@ def _tradeoff(
                     rig=rig,
                     per_light=per_light,
                     targets=targets,
+                    rig_lights=rig_lights,
                 )
         except (KeyboardInterrupt, Terminated) as exc:
             _unmake(out_dir, made)

@@ -2185,8 +2185,11 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         # the lamps the estimate rendered, as the result records them (a session resumed from
         # before the key was recorded is judged with the rig's, which its settings do not say)
         lamps = adaptive_result.get("lamps", header.get("lamps"))
-        simulated = opened.rig.loaded.config.backend in ("simulated", "emulated")
-        caveat = claim_caveat(adaptive_result, header_band(header), lamps, simulated)
+        backend = opened.rig.loaded.config.backend
+        simulated = backend in ("simulated", "emulated")
+        caveat = claim_caveat(
+            adaptive_result, header_band(header), lamps, simulated, backend == "replay"
+        )
         if caveat is not None:  # one line, as the notes below
             err.print(f"[yellow]note:[/] {escape(caveat)}", highlight=False, soft_wrap=True)
         short = few_lights_note(adaptive_result, lambda m: _with_min_lights(opened, m))

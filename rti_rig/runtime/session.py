@@ -440,6 +440,17 @@ def steps_to_hold(total: int, done: int, sure: int) -> int:
     return min(left, max(1, sure - done)) if left else 0
 
 
+def megabytes_said(need: int, free: int) -> tuple[str, str]:
+    """``need`` and ``free`` bytes as "N MB", with as many decimals (up to 3) as it takes for
+    the two to read differently when they differ: "need about 10 MB, 10 MB free" had refused
+    a session for 0.4 MB (QA, 2026-12-06)."""
+    for places in range(4):
+        said = (f"{need / 1e6:.{places}f} MB", f"{free / 1e6:.{places}f} MB")
+        if said[0] != said[1] or need == free:
+            return said
+    return said
+
+
 def check_free_space(
     root: Path, steps: int, bytes_per_image: int, *, holds_images: bool = False
 ) -> None:
@@ -461,7 +472,7 @@ def check_free_space(
         )
         raise NoSpaceError(
             f"not enough free disk space for {steps} image(s) under {probe}: need about "
-            f"{need / 1e6:.0f} MB, {free / 1e6:.0f} MB free; {advice}",
+            f"{megabytes_said(need, free)[0]}, {megabytes_said(need, free)[1]} free; {advice}",
             probe,
             steps,
             need,

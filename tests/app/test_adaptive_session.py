@@ -313,6 +313,10 @@ def test_until_error_stops_when_the_estimate_is_reached(
         # "give a positive angle" had been said of inf, which is one
         (["--until-error", "inf"], "--until-error inf: give the target as a finite positive"),
         (["--until-error", "nan"], "--until-error nan: give the target as a finite positive"),
+        # a target of 200° had been claimed at the starting lights: every normal the camera
+        # sees is within 90° of it, so a map that says nothing meets such a target
+        (["--until-error", "200"], "--until-error 200: give the target as a finite positive"),
+        (["--until-error", "90"], "degrees, below 90 (a normal map that says nothing errs"),
         # the reason and a way to meter it (it had said "chooses its own lights")
         (
             ["--adaptive", "--lights", "6", "--auto-exposure"],
@@ -380,7 +384,7 @@ def test_until_error_alone_on_a_rig_of_few_lights_still_judges_them(tmp_path: Pa
         "rings = [{ elevation_deg = 40.0, count = 4 }]",
     )
     cfg = write_config(tmp_path, text)
-    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--until-error", "90"])
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--until-error", "89"])
     assert r.exit_code == 0, r.output
     assert "Adaptive: 4 lights; stopped:" in said(r)
 
@@ -484,7 +488,7 @@ def test_a_completed_session_s_outcome_is_in_the_controller_s_own_manifest_write
 
     cfg = write_config(tmp_path, SMALL_DOME)
     out = tmp_path / "s"
-    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 6, 1000.0)
+    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 6, 89.0)
     with rig:
         run_session(rig, schedule, folder, source=source)
     m = manifest(out)

@@ -198,3 +198,42 @@ def test_targets_without_an_acquisition_are_refused(tmp_path: Path) -> None:
     r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick", "--target-deg", "2"])
     assert r.exit_code == 2, r.output
     assert "they go with --from ACQ/dirs.lp" in " ".join(r.output.split()), r.output
+
+
+def test_no_command_is_advised_for_more_lights_than_the_rigs_dome_has(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`--rig` an 8-LED dome: a target the acquisition reaches from 9 lights gets no command
+    (it had advised `run RIG --adaptive --lights 36` on an 8-LED dome, which `run` refused),
+    and the summary says its counts are the acquisition's; a count the dome can shoot keeps
+    its command."""
+    import benchmarks.tradeoff_from as tradeoff_from
+    from benchmarks.tradeoff import Row
+    from benchmarks.tradeoff_from import PER_LIGHT_S
+
+    def row(method: str, n: int, deg: float, objective: str = "normals") -> Row:
+        return Row("acq/dirs.lp", method, objective, n, 0.0, deg, deg, 1.0, "ptm", 20.0, 0.5,
+                   n * PER_LIGHT_S, float("nan"), 0.0, "hsh1", 20.0)  # fmt: skip
+
+    rows = [row(m, n, {6: 2.5, 9: 1.5}[n]) for n in (6, 9) for m in ("uniform", "optimal")]
+    rows += [row("adaptive", n, {6: 2.5, 9: 1.5}[n]) for n in (6, 9)]
+    rows += [row("adaptive", n, 2.5, "relight") for n in (6, 9)] + [row("all", 15, 0.0)]
+    monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", lambda *_a: (rows, ["a.jpg"]))
+    rig = Path(__file__).resolve().parents[2] / "rig_configs" / "emulated_rtipy.toml"
+    assert tradeoff_from.rig_led_count(rig) == 8  # the premise
+    out = tmp_path / "o"
+    argv = ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out), "--rig", str(rig)]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    assert r.exit_code == 0, r.output
+    text = " ".join((out / "summary.md").read_text(encoding="utf-8").split())
+    two = text[text.index("- **Normals within 2°**") :].split(" - **")[0]
+    assert "from **9 lights** of this acquisition, more than the 8 LEDs of" in two, two
+    assert "`rti-rig run" not in two, two
+    three = text[text.index("- **Normals within 3°**") :].split(" - **")[0]
+    assert "--lights 6`" in three, three
+    assert "has 8 LEDs, fewer than this acquisition's lights" in text, text
+    # without --rig: the commands as before (RIG), no word of a dome's LEDs
+    r = CliRunner().invoke(app, argv[:4], terminal_width=400)
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert "--lights 9`" in text and "LEDs of" not in text, text

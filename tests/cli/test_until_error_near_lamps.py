@@ -155,3 +155,16 @@ def test_the_lamps_are_placed_at_the_states_own_pixels() -> None:
     per_px = 12.8 / 128
     assert np.allclose(near.xy_mm[:, 0], (state.cols - 63.5) * per_px)
     assert np.allclose(near.xy_mm[:, 1], (47.5 - state.rows) * per_px)
+
+
+def test_a_replayed_acquisitions_claim_gives_no_advice_it_cannot_take(tmp_path: Path) -> None:
+    """A recorded acquisition's .lp is the rig: it has no config to give ``[lamps]`` in (a
+    TOML of backend 'replay' is refused), so the claim says the estimate assumed distant lamps
+    without advising the keys (it had, and the advice could not be followed: QA)."""
+    acq = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay" / "dirs.lp"
+    out = tmp_path / "s"
+    said = _run(str(acq), "--out", str(out), "--until-error", "20")
+    assert _adaptive(out)["result"]["target_claimed"], said
+    assert "it assumes lamps far from the object" in said, said
+    assert "a recorded acquisition's .lp gives no lamp distance to render" in said, said
+    assert "[lamps]" not in said, said

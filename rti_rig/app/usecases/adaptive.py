@@ -1531,10 +1531,13 @@ def claim_caveat(
     band: tuple[float, float],
     lamps: dict[str, Any] | None = None,
     simulated: bool = False,
+    replay: bool = False,
 ) -> str | None:
     """What a claimed ``--until-error`` target does not cover (None: nothing claimed).
     ``lamps``: the lamp geometry the estimate rendered (None: distant lamps); ``simulated``:
-    the rig's scene is rendered (its lamps are its scene's: no ``[lamps]`` to advise).
+    the rig's scene is rendered (its lamps are its scene's: no ``[lamps]`` to advise);
+    ``replay``: the rig is a recorded acquisition's ``.lp``, which has no config to give
+    ``[lamps]`` in (the advice to give it could not be followed: QA, 2026-12-06).
 
     Why: the upper estimate is calibrated on the simulator's scenes at 96 px, under directional
     lights, over every elevation. Through the front door on the shipped rigs
@@ -1564,8 +1567,14 @@ def claim_caveat(
         near = (
             "it assumes lamps far from the object (a fit reads each light as one direction: "
             "the simulated arm's lamps at 400 mm had measured 2.7× an estimate that assumed "
-            "so); give the config's [lamps] distance_mm and field_width_mm for the estimate "
-            "to render yours"
+            "so); "
+            + (
+                "a recorded acquisition's .lp gives no lamp distance to render, so lamps a few "
+                "field-widths from the object are not in the estimate"
+                if replay
+                else "give the config's [lamps] distance_mm and field_width_mm for the "
+                "estimate to render yours"
+            )
         )
     else:
         near = (
@@ -1762,11 +1771,15 @@ def hint_count(geometry: object, band: tuple[float, float]) -> int:
 
 
 def check_until_error(until_error_deg: float | None) -> None:
-    """Refuse an ``--until-error`` that is no finite positive angle (before anything opens)."""
-    if until_error_deg is not None and not (np.isfinite(until_error_deg) and until_error_deg > 0):
+    """Refuse an ``--until-error`` that is no angle above 0° and below 90° (before anything
+    opens). Why below 90°: every pixel the camera sees faces it within 90°, so a normal map
+    that says nothing (each normal at the camera) errs by less; a target of 200° had been
+    "claimed" at the starting lights, as `bench tradeoff --target-deg` already refused."""
+    if until_error_deg is not None and not (0.0 < until_error_deg < 90.0):  # NaN fails both
         raise RtiRigError(
             f"--until-error {until_error_deg:g}: give the target as a finite positive angle in "
-            "degrees: the mean normal error to stop at, such as 2"
+            "degrees, below 90 (a normal map that says nothing errs by less): the mean normal "
+            "error to stop at, such as 2"
         )
 
 

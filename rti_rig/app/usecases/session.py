@@ -872,7 +872,12 @@ def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  
     is refused ("drop --out"); nor did it say that the images taken are kept or how to go on,
     which the same disk refusal had said when it came after the rig opened. The caller adds
     the command to continue with (it knows the options the resume was given)."""
-    from rti_rig.runtime.session import LP_NAME, recorded_frame_size, steps_to_hold
+    from rti_rig.runtime.session import (
+        LP_NAME,
+        megabytes_said,
+        recorded_frame_size,
+        steps_to_hold,
+    )
 
     done, total = len(folder.done), folder.total_steps
     header = folder.manifest.get("adaptive")
@@ -898,10 +903,11 @@ def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  
             else "it is still sure to take (its --until-error stop may come at any light after "
             "them; each is checked for room as it comes)"
         )
+        need_mb, free_mb = megabytes_said(exc.need, exc.free)
         raise NoSpaceError(
             f"not enough free disk space to go on with {shown_path(root)}: the {exc.steps} "
-            f"image(s) {still} need about {exc.need / 1e6:.0f} MB on the disk holding {exc.where}, "
-            f"{exc.free / 1e6:.0f} MB free; free at least {math.ceil(exc.shortfall / 1e6)} MB "
+            f"image(s) {still} need about {need_mb} on the disk holding {exc.where}, "
+            f"{free_mb} free; free at least {math.ceil(exc.shortfall / 1e6)} MB "
             f"there. {kept}",
             exc.where,
             exc.steps,
@@ -2149,6 +2155,13 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         )
     config_path = req.rig_config or Path(rig_entry["config_path"])
     if req.rig_config is None and not config_path.is_file():
+        plain = not (req.reshoot_lost or req.reshoot or req.rebuild_journal)
+        if plain and (manifest.get("runner") or {}).get("finish_reason") == "completed":
+            # a complete, intact session needs no rig to be said so (exit 0, `fit` named): a
+            # resume of one whose config had since moved had been refused for the config
+            # (QA, 2026-12-06); one with images lost or changed goes on to the refusal below
+            # (its reshoot needs the rig)
+            _say_if_complete(Path(req.session_dir))
         # a replay rig is an acquisition's .lp, moved with its images: ask for that, not a TOML
         replay = config_path.suffix.lower() == ".lp"
         what = "recorded acquisition it replayed" if replay else "rig config it was shot with"
