@@ -232,12 +232,22 @@ def main(argv: list[str] | None = None) -> str:
         help="the stop's factors on the point estimate to compare (1: format 7's stop on the "
         "point estimate; the shipped UPPER_FACTOR: format 8's upper estimate)",
     )
+    ap.add_argument(
+        "--clipped-censored",
+        action="store_true",
+        help="the object model reads observations at white as lower bounds "
+        "(planner.adaptive_bias.CLIPPED_CENSORED; off in what ships)",
+    )
     ap.add_argument("--write", action="store_true", help="write the table into docs/adaptive.md")
     args = ap.parse_args(argv)
     if args.greedy:
         import rti_rig.app.usecases.adaptive as usecase
 
         usecase.UNTIL_DESIGN = False
+    if args.clipped_censored:
+        import rti_rig.planner.adaptive_bias as bias
+
+        bias.CLIPPED_CENSORED = True
     targets = tuple(float(t) for t in args.targets.split(","))
     t0 = time.perf_counter()
     factors = tuple(float(f) for f in args.upper_factors.split(","))
@@ -246,6 +256,7 @@ def main(argv: list[str] | None = None) -> str:
         f"python -m benchmarks.adaptive_until_real --draws {args.draws} "
         f"--targets {args.targets} --cap {args.cap} --upper-factors {args.upper_factors}"
         + (" --greedy" if args.greedy else "")
+        + (" --clipped-censored" if args.clipped_censored else "")
     )
     how = (
         "Light by light as format 5 chose (the bound's best light, one at a time). "
