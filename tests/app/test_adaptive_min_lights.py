@@ -27,7 +27,7 @@ from rti_rig.runtime.controller import FinishReason
 runner = CliRunner()
 
 #: a target every estimate on the small dome is under (the upper estimates are a few degrees)
-LOOSE = "90"
+LOOSE = "89"
 
 
 def _run(cfg: Path, out: Path, *extra: str):  # type: ignore[no-untyped-def]
