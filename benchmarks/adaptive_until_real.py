@@ -37,11 +37,12 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.adaptive import REAL_REMOVED, adaptive_run
+from benchmarks.adaptive_until_sim import shipped_upper
 from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import small_grey
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.planner.adaptive import SIM_ESTIMATE_SCALE
-from rti_rig.planner.adaptive_until import UPPER_FACTOR, upper_error_deg
+from rti_rig.planner.adaptive_until import UPPER_FACTOR
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "adaptive.md"
 
@@ -150,8 +151,7 @@ def rule_upper(
     image terms."""
     if not images:
         return factor * est[k]
-    unsolved = terms.get("unsolved", {}).get(k) or 0.0
-    return upper_error_deg(est[k], factor, unsolved, None, terms.get("misfit", {}).get(k))
+    return shipped_upper({"raw": est, **terms}, k, 1.0, factor)
 
 
 def rule_name(factor: float, images: bool) -> str:

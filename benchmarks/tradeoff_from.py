@@ -25,7 +25,7 @@ every plan chosen among the lights not held out:
   with `--objective relight`.
 
 Session time: N lights at the replayed dome's 1.17 s a light (the default dome timing), or at
-the step of the dome ``--rig`` gives (:func:`rig_seconds_per_light`, its firmware's own hold
+the step of the dome ``--rig`` gives (:func:`rig_facts`, its firmware's own hold
 window included where it times its LEDs itself). The
 images are read as the replay rig reads them (JPEG decoded and linearised, 16-bit as they are),
 averaged to grey, and shrunk to at most ``MAX_PX`` wide for speed.
@@ -121,22 +121,19 @@ def advice_rig(lp: Path, rig: Path | None) -> str:
     return "RIG"
 
 
-def rig_seconds_per_light(rig_path: Path) -> tuple[float, str]:
-    """(seconds a light takes on the user's dome, the words that say where that comes from),
-    from its rig config's ``[timing]`` and ``[camera] exposure_s``, summed as a dry run on the
-    simulated dome counts a step.
+def rig_facts(rig_path: Path) -> tuple[tuple[float, str], int]:
+    """From one reading of the user's dome config: (seconds a light takes on it, the words that
+    say where that comes from) — its ``[timing]`` and ``[camera] exposure_s``, summed as a dry
+    run on the simulated dome counts a step — and its LED count. What the CLI reads before
+    minutes of computing, so that the trade is timed and its advice bounded by the config it
+    checked.
 
     Why: the trade is for deciding how many lights the user's own objects need, and its time
     axis had always been the replayed dome's defaults (1.17 s a light), where a DSLR dome's
-    step takes seconds. An arm is refused: its time depends on its moves between the lights,
-    which an acquisition's directions do not give it. Raises ``RtiRigError`` naming the file."""
-    return rig_facts(rig_path)[0]
-
-
-def rig_facts(rig_path: Path) -> tuple[tuple[float, str], int]:
-    """:func:`rig_seconds_per_light` and the dome's LED count (:func:`rig_led_count`), from
-    one reading of the config: what the CLI reads before minutes of computing, so that the
-    trade is timed and its advice bounded by the config it checked."""
+    step takes seconds; and an 8-LED dome had been advised a 36-light session, which `run`
+    refused (the advice names no session of more lights than the dome has). An arm is
+    refused: its time depends on its moves between the lights, which an acquisition's
+    directions do not give it. Raises ``RtiRigError`` naming the file."""
     from rti_rig.app.config import load_rig_config, rig_geometry
 
     loaded = load_rig_config(rig_path)
@@ -166,13 +163,6 @@ def _seconds_per_light(rig_path: Path, cfg: Any) -> tuple[float, str]:
     if held is not None and held[0] > seconds:
         return held[0], f"{shown_path(rig_path)}: {held[1]}"
     return seconds, said
-
-
-def rig_led_count(rig_path: Path) -> int:
-    """How many LEDs the dome config ``rig_path`` has (the lights a session on it can fire):
-    the advice names no session of more lights than that (an 8-LED dome had been told to run
-    36, which it refused)."""
-    return rig_facts(rig_path)[1]
 
 
 def timed_firmware_seconds(cfg: Any) -> tuple[float, str] | None:
@@ -785,7 +775,7 @@ def bench_from(
     """Run, write results.csv, the plots and summary.md into ``out_dir`` (nothing written when
     it is None: the summary is only returned); return the summary (its command line says
     ``--force`` when the folder's files were replaced with it). ``rig``: the user's dome
-    config, whose timing gives the session time (:func:`rig_seconds_per_light`); else the
+    config, whose timing gives the session time (:func:`rig_facts`); else the
     replayed dome's defaults. ``per_light``: that time, when the caller has already read it
     from ``rig`` (the CLI reads the config before minutes of computing; read again here, a
     config edited in between would time the trade by another config than the one checked);

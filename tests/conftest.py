@@ -928,6 +928,18 @@ def interrupted(  # type: ignore[no-untyped-def]
         return run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
 
 
+def begun_before(session: Path, setting: str, constant: str) -> None:
+    """Make ``session``'s manifest one an earlier build began: its adaptive settings without
+    ``setting`` and its constants without ``constant`` (the stop's terms a later build added,
+    whose absence a resume must handle)."""
+    path = session / "manifest.json"
+    data = json.loads(path.read_text())
+    header = data["adaptive"]
+    del header[setting]
+    del header["constants"][constant]
+    path.write_text(json.dumps(data, indent=2))
+
+
 def cut_new_session(request: Any, after_step: int) -> Any:
     """The run of a new session opened by ``request`` (a ``NewSessionRequest``), cancelled once
     step ``after_step`` (0-based) is committed, as Ctrl-C does: a session for a resume to

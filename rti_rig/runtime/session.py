@@ -470,9 +470,10 @@ def check_free_space(
             if holds_images
             else "free space or choose another --out"
         )
+        need_mb, free_mb = megabytes_said(need, free)
         raise NoSpaceError(
             f"not enough free disk space for {steps} image(s) under {probe}: need about "
-            f"{megabytes_said(need, free)[0]}, {megabytes_said(need, free)[1]} free; {advice}",
+            f"{need_mb}, {free_mb} free; {advice}",
             probe,
             steps,
             need,

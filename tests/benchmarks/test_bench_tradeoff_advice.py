@@ -220,7 +220,7 @@ def test_no_command_is_advised_for_more_lights_than_the_rigs_dome_has(
     rows += [row("adaptive", n, 2.5, "relight") for n in (6, 9)] + [row("all", 15, 0.0)]
     monkeypatch.setattr(tradeoff_from, "run_tradeoff_from", lambda *_a: (rows, ["a.jpg"]))
     rig = Path(__file__).resolve().parents[2] / "rig_configs" / "emulated_rtipy.toml"
-    assert tradeoff_from.rig_led_count(rig) == 8  # the premise
+    assert tradeoff_from.rig_facts(rig)[1] == 8  # the premise: an 8-LED dome
     out = tmp_path / "o"
     argv = ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out), "--rig", str(rig)]
     r = CliRunner().invoke(app, argv, terminal_width=400)

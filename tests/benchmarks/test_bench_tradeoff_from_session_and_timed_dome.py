@@ -112,7 +112,7 @@ def test_a_timed_firmwares_hold_window_is_in_the_session_time(
 def test_an_untimed_dome_keeps_its_timing_sum(tmp_path: Path) -> None:
     """The simulated dome (no timed firmware): its [timing] and exposure, 1.17 s a light, the
     dry run's own figure (9.4 s for 8 lights)."""
-    from benchmarks.tradeoff_from import rig_seconds_per_light
+    from benchmarks.tradeoff_from import rig_facts
 
-    seconds, said = rig_seconds_per_light(ROOT / "rig_configs" / "simulated_dome.toml")
+    (seconds, said), _ = rig_facts(ROOT / "rig_configs" / "simulated_dome.toml")
     assert seconds == pytest.approx(1.17) and "transfer_s 0.7" in said

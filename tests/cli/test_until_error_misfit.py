@@ -92,16 +92,11 @@ def test_each_decision_records_the_bound_it_weighed(tmp_path: Path) -> None:
 def test_a_session_begun_before_the_bound_is_judged_with_it(tmp_path: Path) -> None:
     """A session whose settings do not record the bound's noise allowance (begun by an earlier
     build) resumes — the bound decides only when to stop — and is judged with it."""
-    from conftest import interrupted
+    from conftest import begun_before, interrupted
 
     out = tmp_path / "s"
     interrupted(ARM, out, after_step=5, lights=10, until=1.5, band=(0.0, 15.0))
-    path = out / "manifest.json"
-    manifest = json.loads(path.read_text())
-    header = manifest["adaptive"]
-    del header["misfit_noise_k"]
-    del header["constants"]["planner.adaptive_until.MISFIT_NOISE_K"]
-    path.write_text(json.dumps(manifest, indent=2))
+    begun_before(out, "misfit_noise_k", "planner.adaptive_until.MISFIT_NOISE_K")
     said = _run("--resume", str(out))
     result = _result(out)
     assert result["misfit_deg"] is not None and not result["target_claimed"], said

@@ -71,18 +71,13 @@ def test_a_session_begun_before_the_term_is_judged_with_it(tmp_path: Path) -> No
     """A session whose settings do not record the term (begun by an earlier build) resumes
     (the term decides only when to stop) and is judged with it: its claim had left the
     unsolved pixels out."""
-    from conftest import interrupted
+    from conftest import begun_before, interrupted
 
     out = tmp_path / "s"
     interrupted(DOME, out, after_step=3, lights=None, until=1.5, band=(0.0, 15.0))
-    path = out / "manifest.json"
-    manifest = json.loads(path.read_text())
-    header = manifest["adaptive"]
-    del header["unsolved_deg"]
-    del header["constants"]["planner.adaptive_until.UNSOLVED_DEG"]
-    path.write_text(json.dumps(manifest, indent=2))
+    begun_before(out, "unsolved_deg", "planner.adaptive_until.UNSOLVED_DEG")
     said = _run("--resume", str(out))
-    result = json.loads(path.read_text())["adaptive"]["result"]
+    result = json.loads((out / "manifest.json").read_text())["adaptive"]["result"]
     assert result["target_claimed"], said
     assert result["lights_used"] > 4, result
     assert result["unsolved_deg"] == 90.0, result
