@@ -2150,7 +2150,8 @@ def _prepare_resume(
         moved = f"; {renamed_note(renamed)}" if renamed else ""
         intact = not reshoot_lost and not lost and not renamed
         # the manifest and journal as read above (they had been read again for this)
-        if intact and not unchecked_images(root, scan, manifest)[0]:
+        unchecked, why = unchecked_images(root, scan, manifest)
+        if intact and not unchecked:
             _refuse_complete(root, manifest, total, finished, scan)
         if manifest.get("adaptive") and finished < total:  # an adaptive session that stopped
             stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
@@ -2158,9 +2159,9 @@ def _prepare_resume(
                 f"{shown_path(root)}: this adaptive session already completed: it stopped after "
                 f"{finished} of at most {total} lights ({stop.get('reason', 'its stopping rule')})"
                 + _lost_note(root, latest, lost, adaptive=True)
+                + (_unchecked_note(root, unchecked, why, scan) if unchecked else "")
             )
         if reshoot_lost and not lost and not manifest.get("adaptive"):
-            unchecked, why = unchecked_images(root)
             if unchecked:  # nothing found lost is not nothing lost
                 raise SessionError(
                     f"{shown_path(root)}: --reshoot-lost finds nothing lost among the images it "
@@ -2183,6 +2184,8 @@ def _prepare_resume(
             )
         if not lost or manifest.get("adaptive") or not reshoot_lost:
             note = _lost_note(root, latest, lost, adaptive=bool(manifest.get("adaptive")))
+            if unchecked:
+                note += _unchecked_note(root, unchecked, why, scan)
             raise ImagesLostSinceCapture(
                 f"{shown_path(root)}: this session already completed all {total} steps"
                 + note
@@ -3409,6 +3412,22 @@ def _lost_note(
     return (
         f"; but {len(lost)} of its images {'is' if len(lost) == 1 else 'are'} missing or changed "
         f"since capture ({shown}): " + lost_image_advice(root, adaptive)
+    )
+
+
+def _unchecked_note(root: Path, unchecked: list[str], why: str, scan: JournalScan) -> str:
+    """What a completed session's refused resume says of its images no journal record vouches
+    for (:func:`unchecked_images`), and the mends.
+
+    Why: a completed session whose journal (and step record files) had been deleted was told
+    only "this session already completed all 24 steps", exit 2: no image named, no mend, where
+    a stopped session in the same state names both."""
+    shown = ", ".join(unchecked[:8]) + (" …" if len(unchecked) > 8 else "")
+    return (
+        f"; but {shown} cannot be checked against the checksums taken at capture ({why}): "
+        f"restore {JOURNAL} from a backup copy of the folder, then run this again"
+        + rebuild_advice(root, scan)
+        + " (nothing in this folder was changed)"
     )
 
 

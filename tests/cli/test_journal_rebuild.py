@@ -391,6 +391,39 @@ def test_a_completed_session_whose_journal_is_lost_is_made_whole(
     assert f"the QA verdict of rti-rig fit {out} --out {out}-fit names any image" in said(r)
 
 
+@pytest.mark.parametrize("how", ["deleted", "truncated"])
+def test_a_plain_resume_of_a_completed_session_without_its_journal_names_the_mend(
+    made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, how: str
+) -> None:
+    """The same session resumed without --rebuild-journal: it had been told only "this session
+    already completed all 8 steps", exit 2, no image named and no mend (a stopped session in
+    the same state names both). It names the images it cannot check, why, and the rebuild,
+    and changes nothing."""
+    _, ref, _ = made
+    out = tmp_path / "done"
+    shutil.copytree(ref, out)
+    journal = out / "journal.jsonl"
+    if how == "deleted":
+        journal.unlink()
+        unchecked, why = "image_001, image_002, image_003", "journal.jsonl is missing"
+    else:
+        journal.write_bytes(b"".join(journal.read_bytes().splitlines(keepends=True)[:5]))
+        unchecked, why = "image_006, image_007, image_008", "no record of them in journal.jsonl"
+    before = _files(out)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "already completed all 8 steps; but " + unchecked in text, text
+    assert f"cannot be checked against the checksums taken at capture ({why})" in text, text
+    assert f"rti-rig run --resume {out} --rebuild-journal" in text, text
+    assert "Traceback" not in r.output
+    assert _files(out) == before
+    _no_rig(monkeypatch)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])  # the mend named
+    assert r.exit_code == 0, r.output
+    assert _images(out) == _images(ref)
+
+
 def test_a_completed_session_with_a_record_given_another_light_is_refused_untouched(
     made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

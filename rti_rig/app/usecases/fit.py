@@ -1895,16 +1895,19 @@ def qa_without_normals(lights: np.ndarray, session: Path | None = None) -> str |
     and a QA of a regularised normal map would judge images against a guess.
     """
     from rti_rig.app.normals_determined import undetermined_normals
+    from rti_rig.app.usecases.next_fit import model_for_lights
 
     reason = undetermined_normals(lights, "lights of this session")
     if reason is None:
         return None
-    fit = (
-        ""
-        if session is None
-        # a folder that does not exist yet beside the session: FOLDER pasted made a folder so named
-        else f"; `{fit_beside(session)}` still writes the relighting files"
-    )
+    model = model_for_lights(lights)
+    if session is None:
+        fit = ""
+    elif model is None:  # 3 such lights: no model of the fit takes them
+        fit = f"; nor can `rti-rig fit` write a relighting file of {len(lights)} such lights"
+    else:  # a folder that does not exist yet beside the session: FOLDER pasted made one so named
+        files = "fit.rti" if model else "the relighting files"  # --model hsh1: fit.rti alone
+        fit = f"; `{fit_beside(session)}{model}` still writes {files}"
     return (
         f"the QA judges every image against a normal map, and {reason}. No option of "
         f"`rti-rig fit` gives a verdict on such lights{fit}. For a verdict, capture again with "

@@ -1,4 +1,4 @@
-"""The fit a complete session is told to run next, with ``--model ps`` where only that fits.
+"""The fit a complete session is told to run next, with the ``--model`` where only that fits.
 
 Why one place: a session whose lights the default fit (``--model auto``) cannot take (three
 lights of a band: too few for a PTM or an HSH file, enough for a normal map) was told
@@ -9,29 +9,55 @@ command, pasted, was refused.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rti_rig.core.out_folders import fit_beside
 
+if TYPE_CHECKING:
+    import numpy as np
 
-def fit_model_for(session: Path) -> str:
-    """`` --model ps`` where the fit's default ``--model auto`` fits nothing of the lights in
-    ``session``'s lights.lp but photometric stereo makes their normal map ("" otherwise, and
-    where there is no lights.lp to read: the fit's own refusal says why)."""
-    import numpy as np  # here: the CLI imports this module, and its --help loads no numpy
 
+def model_for_lights(lights: np.ndarray) -> str | None:
+    """The ``--model`` words a fit of ``lights`` needs: ``" --model ps"`` where the default
+    ``--model auto`` fits nothing but photometric stereo makes their normal map, ``" --model
+    hsh1"`` where they cannot determine a normal and auto fits nothing but an order-1 HSH
+    (its 4 coefficients) can be fitted, ``""`` where the default fits them; None where no
+    model of ``rti-rig fit`` takes them.
+
+    Why: ``run --allow-no-normals`` of 3 or 4 raking lights at one azimuth named ``rti-rig fit
+    S --out S-fit`` as the fit that "still writes the relighting files", and that fit refused
+    them (without photometric stereo auto's simplest model needs 5)."""
     from rti_rig.app.normals_determined import undetermined_normals
     from rti_rig.core.fit_minimums import FIT_MINIMUMS, AutoFit
+
+    n = len(lights)
+    determined = n >= FIT_MINIMUMS.normal and undetermined_normals(lights) is None
+    if AutoFit(n, determined).fits:
+        return ""
+    if determined:
+        return " --model ps"
+    return " --model hsh1" if n >= FIT_MINIMUMS.hsh(1) else None
+
+
+def _lights_of(session: Path) -> np.ndarray | None:
+    """The directions in ``session``'s lights.lp, or None where there is none to read (the
+    fit's own refusal then says why)."""
+    import numpy as np  # here: the CLI imports this module, and its --help loads no numpy
+
     from rti_rig.core.lp_format import read_lp
 
     try:
         entries = read_lp(Path(session) / "lights.lp")
     except Exception:
-        return ""
-    lights = np.array([e.direction for e in entries], dtype=np.float64)
-    determined = len(entries) >= FIT_MINIMUMS.normal and undetermined_normals(lights) is None
-    if determined and not AutoFit(len(entries), True).fits:
-        return " --model ps"
-    return ""
+        return None
+    return np.array([e.direction for e in entries], dtype=np.float64).reshape(-1, 3)
+
+
+def fit_model_for(session: Path) -> str:
+    """:func:`model_for_lights` of the lights in ``session``'s lights.lp ("" where there is no
+    lights.lp to read, or where no model takes them: :func:`next_step` says so)."""
+    lights = _lights_of(session)
+    return "" if lights is None else model_for_lights(lights) or ""
 
 
 def next_fit(session: Path) -> str:
@@ -50,19 +76,22 @@ def next_step(session: Path) -> str:
     import json
 
     from rti_rig.core.fit_minimums import FIT_MINIMUMS
-    from rti_rig.core.lp_format import read_lp
     from rti_rig.core.shell_words import shell_word
 
     root = Path(session)
-    try:
-        count = len(read_lp(root / "lights.lp"))
-    except Exception:
-        count = None
+    lights = _lights_of(root)
+    count = None if lights is None else len(lights)
     if count is not None and count < FIT_MINIMUMS.normal:
         return (
             f"no fit: {count} light{' makes' if count == 1 else 's make'} a test shot (a normal "
             f"map needs {FIT_MINIMUMS.normal}); look at the images, or shoot a session of more "
             "lights"
+        )
+    if lights is not None and model_for_lights(lights) is None:
+        return (
+            f"no fit: {count} lights that cannot determine a normal are too few for any model "
+            f"of `rti-rig fit` (an order-1 HSH needs {FIT_MINIMUMS.hsh(1)}); look at the "
+            "images, or shoot a session of more lights"
         )
     try:
         with (root / "journal.jsonl").open(encoding="utf-8") as journal:
