@@ -906,10 +906,15 @@ def _heading_hint(line: str) -> str:
         return ""
     if any(t.lower().endswith(_IMAGE_ENDINGS) for t in tokens):
         return ""
-    return (
-        " (a title or a row of column headings? an .lp has none: delete the line, or start "
-        "it with '#' to keep it as a comment)"
-    )
+    return TITLE_HINT
+
+
+#: What a line of words where a light goes is taken for, and its mend (not said of a session's
+#: own lights.lp, whose line is a light cut short: its mend is a listing written again).
+TITLE_HINT = (
+    " (a title or a row of column headings? an .lp has none: delete the line, or start "
+    "it with '#' to keep it as a comment)"
+)
 
 
 #: A number as C's ``strtod`` and Qt's ``toDouble`` read one (relight, RTIBuilder): ASCII

@@ -2372,13 +2372,50 @@ def _refuse_complete(
         "TIFF matches its journaled checksum); nothing to resume, nothing was changed"
     )
     fit = fit_beside(root)
-    if not (root / LP_NAME).is_file():
+    lp = root / LP_NAME
+    if not lp.is_file():
         # fit refuses a session folder without it (naming export-lp): the next step had been
         # named as fit alone, which then failed
         said += f"; only its {LP_NAME} is missing"
-        own = shell_word(str(root / LP_NAME))
+        own = shell_word(str(lp))
         fit = f"rti-rig export-lp {folder} --out {own} writes it from the journal, then {fit}"
+    elif not _lp_is_the_journals(lp, scan):
+        # a lights.lp cut short, emptied or edited had been called intact here, and fit then
+        # refused it or judged it wrong: said, with the mend (nothing is changed by a resume)
+        said += (
+            f"; but its {LP_NAME} is not the listing rti-rig wrote from {JOURNAL} (edited, "
+            "cut short or emptied since?)"
+        )
+        if _journal_lights_are_the_manifests(manifest, scan):
+            fit = f"unless that edit was on purpose, {lp_again(lp)}, then {fit}"
+        else:  # the journal's lights edited too: a listing written from it would be wrong
+            said += f", and {JOURNAL} does not give every image the light {MANIFEST} records"
+            fit = f"restore the folder from a backup copy, then {fit}"
     raise SessionComplete(said, fit, root)
+
+
+def _journal_lights_are_the_manifests(manifest: dict[str, Any], scan: JournalScan) -> bool:
+    """Whether each image's latest journal record gives it the light the manifest's record of
+    its step does (a complete session's manifest holds them all): only then is a listing
+    written again from the journal the one the run wrote."""
+    recorded = {
+        step.get("image"): step.get("actual_direction")
+        for step in manifest.get("steps") or []
+        if isinstance(step, dict)
+    }
+    latest = _latest_records(scan.records).values()
+    return all(recorded.get(r.get("image")) == r.get("actual_direction") for r in latest)
+
+
+def _lp_is_the_journals(lp: Path, scan: JournalScan) -> bool:
+    """Whether a complete session's ``lp`` is what the run wrote of its journal's lights,
+    every step listed (:func:`_run_wrote_lp`); an unreadable file is not."""
+    try:
+        data = lp.read_bytes()
+    except OSError:
+        return False
+    done = {int(r["index"]) for r in scan.records}
+    return _run_wrote_lp(data, scan.records, done, may_lack=())
 
 
 #: How a run that did not finish ended, by the manifest's finish_reason (for a refusal).
@@ -3156,6 +3193,19 @@ def _run_wrote_lp(
     if steps != sorted(set(steps)):
         return False  # reordered, or a light given twice
     return may_lack is None or set(done) - set(steps) <= set(may_lack)
+
+
+def lp_again(lp: Path, linear: bool = False) -> str:
+    """ "move lights.lp aside and write it again from the journal: rti-rig export-lp S --out
+    S/lights.lp": what a session's ``lp`` that is not the journal's listing (edited, cut short,
+    emptied) is mended by, in one set of words for the fit's verdict, its refusal of a
+    ``lights.lp`` that cannot be read, and a complete session's resume. ``linear``: the
+    listing names the linear TIFFs (``export-lp --linear``)."""
+    folder = shell_word(str(lp.parent))
+    return (
+        f"move {lp.name} aside and write it again from the journal: rti-rig export-lp {folder} "
+        f"--out {shell_word(str(lp))}" + (" --linear" if linear else "")
+    )
 
 
 def edited_lp_note(root: Path, kept: str, run: bool = True) -> str:

@@ -46,7 +46,7 @@ from rti_rig.app.usecases.fit_signal import no_signal_warning
 from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core import opencv_files
 from rti_rig.core.acquisition_images import check_image_files, mixed_depth_words
-from rti_rig.core.errors import ConfigError, RtiRigError
+from rti_rig.core.errors import ConfigError, LpFormatError, RtiRigError
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, PHOTOMETRIC_STEREO, AutoFit, auto_models
 from rti_rig.core.image_files import (
     MOSAIC_TIFF_LABEL,
@@ -56,6 +56,7 @@ from rti_rig.core.image_files import (
 )
 from rti_rig.core.json_values import strict_dumps
 from rti_rig.core.lp_format import (
+    TITLE_HINT,
     LpEntry,
     acquisition_lp_files,
     case_hint,
@@ -99,6 +100,7 @@ from rti_rig.runtime.session import (
     journaled_checksums,
     list_unwritten_step,
     lost_image_advice,
+    lp_again,
     read_manifest,
     refuse_if_in_use,
     remember_pixel_digest,
@@ -755,9 +757,30 @@ def _listed_entries(lp: Path, notes: list[str] | None = None) -> list[LpEntry]:
     fitted, which stays true)."""
     pending = unwritten_step(lp.parent) if lp.name == LP_NAME else None
     if pending is None or not _writable(lp):
-        return read_lp(lp, upper_hemisphere=True, notes=notes)
+        try:
+            return read_lp(lp, upper_hemisphere=True, notes=notes)
+        except LpFormatError as exc:
+            raise _own_lp_unreadable(lp, exc) from None
     before, entry, _ = pending
     return parse_lp(format_lp([*before, entry]), str(lp), upper_hemisphere=True, notes=notes)
+
+
+def _own_lp_unreadable(lp: Path, exc: LpFormatError) -> LpFormatError:
+    """``exc``, of a session's own ``lights.lp`` (its folder holds a journal), with the mend
+    of a listing rti-rig wrote: written again from the journal.
+
+    Why: a finished session's lights.lp cut short was told "line 9: expected 'name x y z',
+    found 1 field(s): 'image_0' (a title or a row of column headings? … delete the line …)",
+    advice that deletes a light, and an emptied one "the file is empty" with no mend."""
+    if lp.name != LP_NAME or not (lp.parent / JOURNAL).is_file():
+        return exc
+    return LpFormatError(
+        exc.path,
+        exc.line,
+        exc.message.replace(TITLE_HINT, "")
+        + f"; it is the session's listing of the lights that fired (cut short, emptied or "
+        f"edited since?): {lp_again(lp)}",
+    )
 
 
 def _writable(lp: Path) -> bool:

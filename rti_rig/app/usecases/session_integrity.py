@@ -44,6 +44,7 @@ from rti_rig.runtime.session import (
     image_names,
     journal_mend_note,
     lost_image_advice,
+    lp_again,
     originals_lost,
     planned_steps,
     read_manifest,
@@ -278,11 +279,8 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
         unlisted = sorted(n for n in candidates if n not in lost)
     if not differ and not reordered and not unlisted:
         return qa
-    folder = shell_word(str(source))
-    again = (
-        f"move {lp.name} aside and write it again from the journal: rti-rig export-lp {folder} "
-        f"--out {shell_word(str(source / lp.name))}"
-        + (" --linear" if any(e.name.startswith(f"{LINEAR_DIR}/") for e in entries) else "")
+    again = lp_again(
+        source / lp.name, linear=any(e.name.startswith(f"{LINEAR_DIR}/") for e in entries)
     )
     if differ:
         shown = ", ".join(differ[:8]) + (f" and {len(differ) - 8} more" if len(differ) > 8 else "")
