@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import math
+import os
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -18,7 +19,15 @@ from typing import Any, Literal, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from rti_rig.app.flash_sync import FlashSyncSettings, SyncFaultConfig
 from rti_rig.core.errors import ConfigError, LpFormatError
@@ -78,6 +87,13 @@ class DomeConfig(_Strict):
     #: The camera's flash signal steps the dome (docs/domes.md); the host only shoots.
     flash_sync: FlashSyncSettings | None = None
 
+    @field_validator("lp_file")
+    @classmethod
+    def _home_expanded(cls, lp_file: str | None) -> str | None:
+        """``~/domes/dome.lp`` names the user's home, as the camera's ``folder`` does: it had
+        been looked for as a folder named ``~`` beside the config."""
+        return None if lp_file is None else os.path.expanduser(lp_file)
+
     @model_validator(mode="after")
     def _layout_has_its_keys(self) -> DomeConfig:
         if self.flash_sync is not None and self.serial is not None:
@@ -132,6 +148,26 @@ class ArmConfig(_Strict):
     dynamixel: ArmSettings | None = None
     #: emulated backend: "pty" runs the real SDK and pyserial on a pseudo-terminal.
     transport: Literal["pty", "inprocess"] = "pty"
+
+    @field_validator("park_elevation_deg")
+    @classmethod
+    def _park_clear_of_the_camera(cls, park: float, info: ValidationInfo) -> float:
+        """A simulated arm parked at 89° (inside the keep-out cone around the camera) had
+        passed check and parked there, where the Dynamixel arm's settings refuse such a pose.
+        A park above the band's ceiling but clear of the cone is left alone: a ceiling
+        lowered for one object (``max_elevation_deg = 30``) need not move the park. (A
+        Dynamixel arm parks where ``[arm.dynamixel]`` says, checked there.)"""
+        cone = info.data.get("keep_out_half_angle_deg")
+        top = None if cone is None else 90.0 - cone
+        if park < 0.0 or (top is not None and park > top + 1e-9):
+            where = "below the object's plane" if park < 0.0 else "inside the keep-out cone"
+            raise ValueError(
+                f"{park:g} is {where}: the lamp would park "
+                + ("under the object" if park < 0.0 else "in the camera's way")
+                + f"; give a park pose from 0 to {top if top is not None else 90:g} degrees"
+                + " (90 minus keep_out_half_angle_deg)"
+            )
+        return park
 
     @model_validator(mode="after")
     def _limits_consistent(self) -> ArmConfig:

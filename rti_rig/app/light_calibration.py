@@ -191,9 +191,13 @@ def refuse_other_rig(root: Path, rig: dict[str, Any], rig_name: str | None) -> N
     already, given another rig's config, had been sent to write its file elsewhere
     (``--out``), and only then told that the card is another rig's."""
     if rig_name is not None and rig.get("name") != rig_name:
+        # the name is what tells two domes of one model apart (the same LEDs, positions and
+        # firmware): a card is one dome's. A renamed config had been left with no way on
         raise SessionError(
             f"{shown_path(root)} was shot on rig '{rig.get('name')}', not '{rig_name}': calibrate "
-            "a dome from its own card session"
+            "a dome from its own card session (each dome's LEDs differ, even on two domes of "
+            f"one model); if '{rig_name}' is that same dome renamed, give its config's name "
+            f"back, name = {toml_basic_string(str(rig.get('name')))}, to calibrate it"
         )
 
 

@@ -39,6 +39,13 @@ def test_another_rigs_card_is_refused_before_its_existing_calibration(tmp_path: 
     assert "was shot on rig" in said(r) and "not 'another-dome'" in said(r), said(r)
     assert "exists" not in said(r), said(r)  # not sent to write elsewhere first
     assert written.read_bytes() == before
+    # the way on for a dome only renamed: its name given back (pasted, that config calibrates)
+    old = re.search(r'(?m)^name = "[^"]*"', text)
+    assert old is not None
+    assert (
+        f"if 'another-dome' is that same dome renamed, give its config's name back, {old[0]}"
+        in (said(r))
+    ), said(r)
 
 
 def test_an_on_off_dome_given_another_domes_correction_is_told_to_remove_it(
