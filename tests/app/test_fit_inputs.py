@@ -203,7 +203,7 @@ def test_a_session_missing_a_linear_tiff_says_its_8_bit_file_stood_in(
     r = runner.invoke(app, ["fit", str(session), "--out", str(tmp_path / "out"), *FIT])
     assert r.exit_code == 0, r.output
     text = " ".join(r.output.split())
-    assert "1 of 36 image(s) have no linear/ TIFF" in text and f"{stem}.jpg" in text, text
+    assert "1 of 36 image(s) have no readable linear/ TIFF" in text and f"{stem}.jpg" in text, text
     notes = json.loads((tmp_path / "out" / "fit.json").read_text())["input_notes"]
     assert any("read from their 8-bit file instead" in n for n in notes)
     # a session whose every TIFF is there says nothing of the kind

@@ -628,15 +628,19 @@ def acquisition_files(
     refuse_if_disowned(lp.parent)  # a session whose labels a late slip check disowned
     entries = _listed_entries(lp, notes)
     lights = directions_of(entries)
+    session = (lp.parent / JOURNAL).is_file()  # it wrote a linear TIFF for every image
     paths, names, stand_ins = [], [], []
     for e, listed in zip(entries, image_paths(lp, entries), strict=True):
         stem = Path(image_file_name(e.name)).stem
         linear = lp.parent / "linear" / f"{stem}.tif"
-        paths.append(linear if linear.is_file() else listed)
+        # a session's TIFF cut short or emptied (a copy interrupted) is read as a missing one
+        # is, from its 8-bit file: the whole fit had been refused for it, and the verdict
+        # names it as changed since capture all the same
+        readable = linear.is_file() and not (session and _unreadable(linear) and listed.is_file())
+        paths.append(linear if readable else listed)
         names.append(stem)
-        if not linear.is_file():
+        if not readable:
             stand_ins.append(e.name)
-    session = (lp.parent / JOURNAL).is_file()  # it wrote a linear TIFF for every image
     if session:
         # gone, or cut short (a copy interrupted): the fit had stopped part-way at the first
         # short read, told to "leave it out of the .lp" of a session whose .lp it rewrites
@@ -659,11 +663,17 @@ def acquisition_files(
         shown = ", ".join(stand_ins[:5]) + (" ..." if len(stand_ins) > 5 else "")
         beside = " beside linear 16-bit data" if len(stand_ins) < len(entries) else ""
         notes.append(
-            f"{len(stand_ins)} of {len(entries)} image(s) have no linear/ TIFF and were read "
-            f"from their 8-bit file instead ({shown}): lossy, sRGB-decoded data{beside}; "
-            "restore the TIFFs from a copy for a fully linear fit"
+            f"{len(stand_ins)} of {len(entries)} image(s) have no readable linear/ TIFF and "
+            f"were read from their 8-bit file instead ({shown}): lossy, sRGB-decoded "
+            f"data{beside}; restore the TIFFs from a copy for a fully linear fit"
         )
     return lp, lights, paths, names
+
+
+def _unreadable(tiff: Path) -> bool:
+    """Whether ``tiff`` is cut short or its header reads as no image's (as the refusal of a
+    session's lost images tells them: :func:`image_truncation`, :func:`header_layout`)."""
+    return bool(image_truncation(tiff)) or header_layout(tiff) is None
 
 
 def _refuse_unusable_images(lp: Path, entries: list[LpEntry], paths: list[Path]) -> None:
