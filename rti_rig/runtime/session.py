@@ -3571,7 +3571,19 @@ def read_manifest(root: Path) -> dict[str, Any]:
             f"object){damaged}"
         )
     if data.get("format") != FORMAT:
-        raise SessionError(f"{shown_path(path)}: unknown session format {data.get('format')!r}")
+        # "unknown session format None" had been all that was said of a manifest whose
+        # "format" key was deleted or edited
+        got = data.get("format")
+        said = 'has no "format" key' if got is None else f"says format {json.dumps(got)}"
+        newer = (
+            " (a newer rti-rig's? then run this with that version)"
+            if isinstance(got, str) and got.startswith("rti-rig-session/")
+            else ""
+        )
+        raise SessionError(
+            f'{shown_path(path)} {said}, not "{FORMAT}", the session format this rti-rig '
+            f"reads{newer}{damaged}"
+        )
     return data
 
 

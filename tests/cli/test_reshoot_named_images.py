@@ -93,6 +93,9 @@ def finished(tmp_path_factory: pytest.TempPathFactory) -> Path:
         (["image_009"], "--reshoot image_009: {s} has no image of that name; give its images "
          "as the verdict names them, image_001 to image_008"),
         (["image_002,photo.jpg"], "--reshoot photo.jpg: {s} has no image of that name"),
+        # a script's variable unset: it had resumed as if --reshoot were not given
+        ([""], "--reshoot '': name the images to reshoot, as the QA verdict names them"),
+        ([" , "], "--reshoot ' , ': name the images to reshoot"),
     ],
 )  # fmt: skip
 def test_a_name_the_session_has_no_image_of_is_refused_before_anything_moves(

@@ -2081,6 +2081,12 @@ def reshoot_steps(manifest: dict[str, Any], named: Sequence[str], root: Path) ->
     from rti_rig.runtime.session import image_names, planned_steps
 
     words = [w.strip() for given in named for w in given.split(",") if w.strip()]
+    if named and not words:
+        # --reshoot "" (a script's variable unset) had resumed as if it were not given
+        raise RtiRigError(
+            f"--reshoot {shell_word(named[0])}: name the images to reshoot, as the QA verdict "
+            "names them (image_006, or several: image_006,image_010); nothing was changed"
+        )
     if not words:
         return ()
     runner = manifest.get("runner") or {}
