@@ -62,6 +62,20 @@ from rti_rig.drivers.led_dome.settings import (
 )
 
 
+class KeyValueError(ValueError):
+    """A value refused by a table's own check that compares keys (``exposure_s`` against
+    ``max_exposure_s``): ``key``, the table's key to blame, and ``text``, what is wrong.
+
+    Why: such a check runs on the whole table, so pydantic placed its error at the table, and
+    ``exposure_s = 1e9`` was said as "line 19: key 'camera'", the ``[camera]`` line, not the
+    key's own (as :class:`ProtocolKeyError` does for ``[dome.serial.protocol]``)."""
+
+    def __init__(self, key: str, text: str) -> None:
+        self.key = key
+        self.text = text
+        super().__init__(f"{key}: {text}")
+
+
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
@@ -172,11 +186,16 @@ class ArmConfig(_Strict):
     @model_validator(mode="after")
     def _limits_consistent(self) -> ArmConfig:
         if self.max_elevation_deg <= self.min_elevation_deg:
-            raise ValueError("max_elevation_deg must be above min_elevation_deg")
+            raise KeyValueError(
+                "max_elevation_deg",
+                f"{self.max_elevation_deg:g} must be above min_elevation_deg "
+                f"{self.min_elevation_deg:g}",
+            )
         if self.max_elevation_deg > 90.0 - self.keep_out_half_angle_deg + 1e-9:
-            raise ValueError(
-                "max_elevation_deg reaches into the keep-out cone around the camera: "
-                f"keep it at most {90.0 - self.keep_out_half_angle_deg:g}"
+            raise KeyValueError(
+                "max_elevation_deg",
+                f"{self.max_elevation_deg:g} reaches into the keep-out cone around the camera: "
+                f"keep it at most {90.0 - self.keep_out_half_angle_deg:g}",
             )
         return self
 
@@ -205,14 +224,17 @@ class CameraConfig(_Strict):
     @model_validator(mode="after")
     def _exposure_in_range(self) -> CameraConfig:
         if self.min_exposure_s > self.max_exposure_s:
-            raise ValueError(
-                f"min_exposure_s {self.min_exposure_s:g} is above max_exposure_s "
-                f"{self.max_exposure_s:g}: the limits are the wrong way round"
+            raise KeyValueError(
+                "min_exposure_s",
+                f"{self.min_exposure_s:g} is above max_exposure_s "
+                f"{self.max_exposure_s:g}: the limits are the wrong way round",
             )
         if not self.min_exposure_s <= self.exposure_s <= self.max_exposure_s:
-            raise ValueError(
-                f"exposure_s {self.exposure_s} is outside "
-                f"[{self.min_exposure_s}, {self.max_exposure_s}]"
+            raise KeyValueError(
+                "exposure_s",
+                f"{self.exposure_s:g} s is outside min_exposure_s {self.min_exposure_s:g} to "
+                f"max_exposure_s {self.max_exposure_s:g}: give an exposure within them (or "
+                "widen them)",
             )
         return self
 
@@ -758,6 +780,8 @@ def _problem(err: Any) -> tuple[str | None, str]:
     cause = err.get("ctx", {}).get("error")
     if isinstance(cause, ProtocolKeyError):
         return _key_of((*err["loc"], "protocol", *cause.loc)), cause.text
+    if isinstance(cause, KeyValueError):
+        return _key_of((*err["loc"], cause.key)), cause.text
     known = table_keys(RigConfig, err["loc"]) if err["type"] == "extra_forbidden" else ()
     return _key_of(err["loc"]) or None, _error_text(err, known)
 

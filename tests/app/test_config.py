@@ -31,7 +31,7 @@ def test_shipped_configs_load(dome_config_path: Path, arm_config_path: Path) -> 
         (("count = 8", "cuont = 8"), "dome.rings[0].count", "'dome.rings[0].cuont': unknown key"),
         (('kind = "dome"', 'kind = "cupola"'), "kind", "'dome' or 'arm'"),
         (('backend = "simulated"', 'backend = "usb"'), "backend", "simulated"),
-        (("exposure_s = 0.05", "exposure_s = 100.0"), "camera", "outside"),
+        (("exposure_s = 0.05", "exposure_s = 100.0"), "camera.exposure_s", "outside"),
         (("width = 64", 'width = "wide"'), "camera.width", "integer"),
         (('layout = "rings"', 'layout = "lp"'), "dome", "needs key 'lp_file'"),
         # a key another layout reads is refused, not ignored (an lp_file naming no file passed)
@@ -51,10 +51,16 @@ def test_shipped_configs_load(dome_config_path: Path, arm_config_path: Path) -> 
             "timing.settle_s",
             "less than or equal to 600",
         ),
+        # a check of the whole [camera] table blames the key, not the table's line
         (
             ("exposure_s = 0.05", "exposure_s = 0.05\nmin_exposure_s = 40.0"),
-            "camera",
-            "min_exposure_s 40 is above max_exposure_s 30: the limits are the wrong way round",
+            "camera.min_exposure_s",
+            "40 is above max_exposure_s 30: the limits are the wrong way round",
+        ),
+        (
+            ("exposure_s = 0.05", "exposure_s = 1e9"),
+            "camera.exposure_s",
+            "1e+09 s is outside min_exposure_s 0.0001 to max_exposure_s 30",
         ),
     ],
 )

@@ -44,3 +44,16 @@ def test_a_park_above_a_lowered_ceiling_but_clear_of_the_cone_is_taken(tmp_path:
     cfg = _virtual_arm(tmp_path, ("max_elevation_deg = 80.0", "max_elevation_deg = 30.0"))
     r = CliRunner().invoke(app, ["check", str(cfg)])
     assert r.exit_code == 0, r.output
+
+
+@pytest.mark.parametrize(
+    ("ceiling", "words"),
+    [("85", "85 reaches into the keep-out cone"), ("3", "3 must be above min_elevation_deg 5")],
+)
+def test_a_ceiling_refused_is_said_at_its_own_key(tmp_path: Path, ceiling: str, words: str) -> None:
+    """The [arm] table's own checks had blamed the table ("line 8: key 'arm'")."""
+    cfg = _virtual_arm(tmp_path, ("max_elevation_deg = 80.0", f"max_elevation_deg = {ceiling}"))
+    line = 1 + cfg.read_text().splitlines().index(f"max_elevation_deg = {ceiling}")
+    r = CliRunner().invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2, r.output
+    assert f"line {line}: key 'arm.max_elevation_deg': {words}" in said(r), said(r)
