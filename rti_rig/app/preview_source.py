@@ -177,14 +177,31 @@ def _step_light(
     )
     if verified_steps(root, [latest], only=kind):
         return latest["actual_direction"]
-    if step is not latest:  # the manifest lists the step
+    if step is not latest and _as_the_manifest_records(root, step, kind):
         journal = f"{JOURNAL}'s record of it does not match the image on disk"
         return _manifest_light(root, step, image, journal)
     raise ScheduleError(
         f"{shown_path(image)}: the image is not as the session {shown_path(root)} captured it "
-        "(changed or replaced since; its checksum differs from its journal's), so the light "
-        "recorded for it may not be the one that lit it: give the light with --preview-light AZ,EL"
+        "(changed or replaced since; its checksum differs from the one recorded at capture), so "
+        "the light recorded for it may not be the one that lit it: put the captured file back, "
+        "or give the light with --preview-light AZ,EL"
     )
+
+
+def _as_the_manifest_records(root: Path, step: dict[str, Any], kind: str | None) -> bool:
+    """Whether the manifest's ``step`` (its journal record not matching the image) vouches for
+    the image: its checksum matches, or the step holds none to compare (a manifest damaged or
+    edited: its light is taken, as before).
+
+    Why: an image copied over a preview's (another session's image_030, lit from az 0°, el
+    10°) was planned from as lit by the preview's recorded light (az 112.5°, el 55°), the
+    manifest's step taken without its checksum being compared, where fit refuses it."""
+    if not isinstance(step.get("sha256"), dict):
+        return True
+    try:
+        return bool(verified_steps(root, [step], only=kind))
+    except (KeyError, TypeError, ValueError):
+        return True
 
 
 def _linear_image(root: Path, step: dict[str, Any]) -> str:
