@@ -630,30 +630,29 @@ def acquisition_files(
     lights = directions_of(entries)
     session = (lp.parent / JOURNAL).is_file()  # it wrote a linear TIFF for every image
     paths, names, stand_ins = [], [], []
+    damage: dict[Path, str | None] = {}  # a session's files checked, each read once
     for e, listed in zip(entries, image_paths(lp, entries), strict=True):
         stem = Path(image_file_name(e.name)).stem
         linear = lp.parent / "linear" / f"{stem}.tif"
+        if session and linear.is_file():
+            damage[linear] = _damage(linear)
         # a session's TIFF cut short or emptied (a copy interrupted) is read as a missing one
         # is, from its 8-bit file: the whole fit had been refused for it, and the verdict
         # names it as changed since capture all the same
-        readable = linear.is_file() and not (session and _unreadable(linear) and listed.is_file())
+        readable = linear.is_file() and not (damage.get(linear) and listed.is_file())
         paths.append(linear if readable else listed)
         names.append(stem)
         if not readable:
             stand_ins.append(e.name)
     if session:
         # gone, or cut short (a copy interrupted): the fit had stopped part-way at the first
-        # short read, told to "leave it out of the .lp" of a session whose .lp it rewrites
-        damaged = [(p, "gone") for p in paths if not p.is_file()]
-        damaged += [(p, why) for p in paths if p.is_file() and (why := image_truncation(p))]
+        # short read, told to "leave it out of the .lp" of a session whose .lp it rewrites;
         # overwritten whole (its length kept): it had been refused by the decoder, told to
-        # "leave it out of the .lp" of a session, not the session's own ways out
-        damaged += [
-            (p, "its header does not read as an image's (damaged, or another file over it)")
-            for p in paths
-            if p.is_file() and all(p != d for d, _ in damaged) and header_layout(p) is None
-        ]
-        _refuse_lost_images(lp, damaged)
+        # "leave it out of the .lp" of a session, not the session's own ways out. Named gone
+        # first, then cut short, then overwritten
+        damaged = [(p, why) for p in paths if (why := damage[p] if p in damage else _damage(p))]
+        order = {"gone": 0, _OVERWRITTEN: 2}
+        _refuse_lost_images(lp, sorted(damaged, key=lambda d: order.get(d[1], 1)))
     else:
         _refuse_unusable_images(lp, entries, paths)
     if notes is not None and stand_ins and (len(stand_ins) < len(entries) or session):
@@ -670,10 +669,18 @@ def acquisition_files(
     return lp, lights, paths, names
 
 
-def _unreadable(tiff: Path) -> bool:
-    """Whether ``tiff`` is cut short or its header reads as no image's (as the refusal of a
-    session's lost images tells them: :func:`image_truncation`, :func:`header_layout`)."""
-    return bool(image_truncation(tiff)) or header_layout(tiff) is None
+#: What a session's image whose header reads as no image's is said to be.
+_OVERWRITTEN = "its header does not read as an image's (damaged, or another file over it)"
+
+
+def _damage(path: Path) -> str | None:
+    """Why a session's image file cannot be read as captured ("gone", cut short, or
+    :data:`_OVERWRITTEN`), or None: what the refusal of its lost images names
+    (:func:`image_truncation`, :func:`header_layout`), and what makes a linear TIFF be read
+    from its JPEG instead."""
+    if not path.is_file():
+        return "gone"
+    return image_truncation(path) or (_OVERWRITTEN if header_layout(path) is None else None)
 
 
 def _refuse_unusable_images(lp: Path, entries: list[LpEntry], paths: list[Path]) -> None:

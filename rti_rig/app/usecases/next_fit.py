@@ -87,7 +87,8 @@ def next_step(session: Path) -> str:
             f"map needs {FIT_MINIMUMS.normal}); look at the images, or shoot a session of more "
             "lights"
         )
-    if lights is not None and model_for_lights(lights) is None:
+    model = None if lights is None else model_for_lights(lights)
+    if lights is not None and model is None:
         return (
             f"no fit: {count} lights that cannot determine a normal are too few for any model "
             f"of `rti-rig fit` (an order-1 HSH needs {FIT_MINIMUMS.hsh(1)}); look at the "
@@ -105,4 +106,4 @@ def next_step(session: Path) -> str:
             f"{shell_word(str(root / 'raw'))} to demosaiced linear TIFFs with your RAW "
             "converter, list them in an .lp and fit that"
         )
-    return next_fit(root)
+    return fit_beside(root) + (model or "")  # next_fit's, the lights read once
