@@ -80,8 +80,19 @@ POSITION_TOLERANCE_RAD = 2e-4
 THREE_DECIMALS_RAD = 3**0.5 * 0.5e-3
 
 #: The keys that change what the images are, not where the light comes from: a session cannot
-#: take images that differ in them, accepted or not (nothing downstream corrects for them).
-IMAGE_KEYS = ("camera_size", "exposure_s", "gain", "camera_device", "decode", "recorded_images")
+#: take images that differ in them, accepted or not (nothing downstream corrects for them). A
+#: dry run's scene is its object (name, seed), its noise and its lamps' distance: another one
+#: had been accepted with --accept-rig-change, and an adaptive session then chose its lights
+#: from images of two objects, fitted as one ("QA verdict: good").
+IMAGE_KEYS = (
+    "camera_size",
+    "exposure_s",
+    "gain",
+    "camera_device",
+    "decode",
+    "recorded_images",
+    "scene",
+)
 
 
 def _digest(value: Any) -> str:

@@ -141,7 +141,8 @@ def run(
             "--accept-rig-change",
             help="With --resume: go on although the rig's lights differ from the session's (a "
             "repaired LED, recalibrated positions); the change is recorded in the manifest. "
-            "A change to the images (exposure, gain, size, decoding, camera) is refused.",
+            "A change to the images (exposure, gain, size, decoding, camera, a dry run's "
+            "scene) is refused.",
         ),
     ] = False,
     reshoot_lost: Annotated[

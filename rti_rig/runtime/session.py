@@ -1580,6 +1580,10 @@ _REQUIRED = {
 }
 
 
+#: What :func:`_record_problem` says of a record past the planned steps.
+OUTSIDE_SCHEDULE = "is outside the schedule's"
+
+
 def _record_problem(entry: object, names: list[str] | None) -> str | None:
     """Why a parsed journal line is not a step record (``None`` if it is one)."""
     if not isinstance(entry, dict):
@@ -1599,7 +1603,7 @@ def _record_problem(entry: object, names: list[str] | None) -> str | None:
         return f"index {idx!r} is not a step number"
     if names is not None:
         if not 0 <= idx < len(names):
-            return f"index {idx} is outside the schedule's {len(names)} steps"
+            return f"index {idx} {OUTSIDE_SCHEDULE} {len(names)} steps"
         own = {entry["image"], entry["linear_image"]}
         originals = entry.get("originals") or {}
         # besides its JPEG and TIFF a step may keep the camera's own files, under raw/
@@ -1624,6 +1628,33 @@ def _to_record(entry: dict[str, Any]) -> StepRecord:
             raise ValueError(f"{key} has {len(vec)} components")
         rec[key] = vec
     return StepRecord(**rec)
+
+
+def _refuse_steps_beyond(
+    root: Path, manifest: dict[str, Any], scan: JournalScan, total: int
+) -> None:
+    """Refuse, before anything moves, a resume of a session whose journal records steps past
+    the ones its manifest plans: one of the two files was edited, or comes from another
+    session, and which one holds the truth is not for a resume to guess.
+
+    Why: such records had been rejected as "outside the schedule" and their images moved to
+    ``recovered/`` as unverified, then shot again (an adaptive session's ``max_lights`` edited
+    from 12 to 8 set images 9–11 aside, and refused only after)."""
+    beyond = [line for line, _text, why in scan.rejected if OUTSIDE_SCHEDULE in why]
+    if not beyond:
+        return
+    planned = (
+        f"its adaptive settings' max_lights {total}"
+        if isinstance(manifest.get("adaptive"), dict)
+        else f"the {total} steps of its schedule"
+    )
+    lines = ", ".join(str(n) for n in beyond[:5]) + (" …" if len(beyond) > 5 else "")
+    raise SessionError(
+        f"{shown_path(root)}: {JOURNAL} records steps beyond what {MANIFEST} plans ({planned}; "
+        f"line{'s' if len(beyond) > 1 else ''} {lines} of {JOURNAL}): the two files disagree, so "
+        f"one was edited or comes from another session. Nothing in the folder was changed: "
+        f"restore {MANIFEST} (or {JOURNAL}) from a backup copy of the folder and resume again"
+    )
 
 
 def scan_journal(root: Path, names: list[str] | None = None) -> JournalScan:
@@ -2117,6 +2148,7 @@ def _prepare_resume(
     runner = manifest.get("runner") or {}
     names = image_names(total)
     scan = scan_journal(root, names)
+    _refuse_steps_beyond(root, manifest, scan, total)
     if rebuild_journal and reshoot_lost:
         raise SessionError(
             f"{shown_path(root)}: --rebuild-journal and --reshoot-lost go one at a time: rebuild "
@@ -3369,6 +3401,12 @@ def _lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None) -> 
     instead = unresumable(root)
     if instead is not None:  # --reshoot-lost is refused for it
         return f"put the originals back from a copy; {instead}"
+    if adaptive and _only_the_last_lost(root, scan):
+        return (
+            "put the originals back from a copy, or let its resume set the files aside and "
+            "shoot the image again (no light was chosen from it yet), with the object where it "
+            f"was: rti-rig run --resume {shell_word(str(root))}"
+        )
     if adaptive:
         return (
             "put the originals back from a copy (an adaptive session cannot reshoot one image: "
@@ -3400,6 +3438,23 @@ def _lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None) -> 
         "put the originals back from a copy, or reshoot exactly those, with the object where "
         f"it was: rti-rig run --resume {shell_word(str(root))} --reshoot-lost"
     )
+
+
+def _only_the_last_lost(root: Path, scan: JournalScan | None) -> bool:
+    """Whether the one image lost since capture of session ``root``, not finished, is its
+    last journaled one: a resume sets it aside and shoots it again, an adaptive session's
+    too (no later light was chosen from it). Why: the verdict had told such a session that
+    "an adaptive session cannot reshoot one image", of the one image its resume reshoots."""
+    try:
+        if (read_manifest(root).get("runner") or {}).get("finish_reason") == "completed":
+            return False
+    except SessionError:
+        return False
+    latest = _latest_records(_journal_records(root, scan) or [])
+    if not latest:
+        return False
+    last = Path(latest[max(latest)]["image"]).stem
+    return set(files_lost_since_capture(root, scan)) == {last}
 
 
 def _set_aside_as_captured(root: Path, scan: JournalScan | None = None) -> list[str]:
@@ -3584,7 +3639,46 @@ def read_manifest(root: Path) -> dict[str, Any]:
             f'{shown_path(path)} {said}, not "{FORMAT}", the session format this rti-rig '
             f"reads{newer}{damaged}"
         )
+    problem = _adaptive_table_problem(data)
+    if problem:
+        raise SessionError(f"{shown_path(path)} {problem}{damaged}")
     return data
+
+
+def _adaptive_table_problem(data: dict[str, Any]) -> str | None:
+    """Why an adaptive session's manifest cannot say how many steps it may take (None: it
+    can, or the session is not adaptive).
+
+    Why: :func:`planned_steps` had fallen back on the schedule's 4 starting lights where the
+    ``adaptive`` table or its ``max_lights`` was removed, null or edited, and a resume then set
+    every later image aside as "outside the schedule" (or crashed on a null), before anything
+    was refused: a manifest edited by hand or damaged by a sync moved captured images."""
+    schedule = data.get("schedule")
+    method = schedule.get("method") if isinstance(schedule, dict) else None
+    if "adaptive" not in data:
+        if method == "adaptive":
+            return (
+                'has no "adaptive" table of settings, though its schedule\'s method is '
+                '"adaptive": it cannot say how many lights the session may take'
+            )
+        return None
+    table = data["adaptive"]
+    if not isinstance(table, dict):
+        return f'holds "adaptive": {json.dumps(table)}, not the adaptive session\'s settings'
+    most = table.get("max_lights")
+    steps = schedule.get("steps") if isinstance(schedule, dict) else None
+    start = len(steps) if isinstance(steps, list) else 0
+    if not isinstance(most, int) or isinstance(most, bool) or most < max(start, 1):
+        said = (
+            "has no max_lights"
+            if "max_lights" not in table
+            else (f"says max_lights {json.dumps(most)}")
+        )
+        return (
+            f'{said} in its "adaptive" settings, not a number of lights of at least its '
+            f"schedule's {start} starting lights"
+        )
+    return None
 
 
 def _lost_files(

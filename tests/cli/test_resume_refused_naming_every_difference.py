@@ -13,7 +13,6 @@ captured, is unchanged.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from conftest import CONFIGS, cut_new_session, journal, said
@@ -66,7 +65,7 @@ def test_another_rig_is_refused_once_naming_every_difference_and_the_way_out(
         # what no flag accepts: the backend (since 2026-12-04: a backend change had gone
         # through with --accept-rig-change) and what the images are
         assert "Its backend is 'emulated', and this session was begun on 'simulated'" in text
-        assert "camera size changes what this session's images are" in text, text
+        assert "camera size, simulated scene change what this session's images are" in text, text
         assert "cannot be accepted into this session, even with --accept-rig-change" in text
         # the way out: the session's own config, as its manifest records it, or a new session
         assert f"Resume with the session's own config, {SIMULATED}" in text, text
@@ -106,14 +105,16 @@ def test_another_rig_with_the_camera_size_matched_is_still_another_rig(tmp_path:
 
 
 def test_the_sessions_own_config_edited_twice_is_told_both_edits_at_once(tmp_path: Path) -> None:
-    """An exposure (never accepted) and a scene (accepted with the flag) edited in the
-    session's own config: the refusal named the exposure alone, and the scene only once the
-    exposure was set back."""
+    """An exposure and a scene edited in the session's own config: the refusal named the
+    exposure alone, and the scene only once the exposure was set back. Neither is accepted,
+    with the flag or without (a dry run's scene is its object: another seed had gone through
+    with --accept-rig-change, and the session held images of two objects, fitted as one)."""
     own = tmp_path / "dome.toml"
     original = SIMULATED.read_text(encoding="utf-8")
     own.write_text(original, encoding="utf-8")
     out = tmp_path / "r1"
     _cut(out, own)
+    before = _files(out)
     own.write_text(
         original.replace("exposure_s = 0.05", "exposure_s = 0.04").replace("seed = 0", "seed = 1"),
         encoding="utf-8",
@@ -124,15 +125,21 @@ def test_the_sessions_own_config_edited_twice_is_told_both_edits_at_once(tmp_pat
         assert r.exit_code == 2, r.output
         assert f"{own} does not describe the rig this session began on (" in text, text
         assert "exposure (s): 0.05 → 0.04; simulated scene: changed)" in text, text
-        assert "Exposure (s) changes what this session's images are" in text, text
+        assert "Exposure (s), simulated scene change what this session's images are" in text, text
         assert "It is this session's own config, edited since the session began: set it back" in (
             text
         )
-        assert "The other difference, if deliberate, --accept-rig-change records" in text, text
         assert "another rig" not in text, text
     own.write_text(original.replace("seed = 0", "seed = 1"), encoding="utf-8")
-    r = _resume(out, None, "--accept-rig-change")
+    for flag in ([], ["--accept-rig-change"]):
+        r = _resume(out, None, *flag)
+        text = said(r)
+        assert r.exit_code == 2, r.output
+        assert "Simulated scene changes what this session's images are" in text, text
+        assert "cannot be accepted into this session, even with --accept-rig-change" in text, text
+        assert "set it back" in text, text
+    assert _files(out) == before  # nothing captured, nothing written
+    own.write_text(original, encoding="utf-8")  # set back, as told: the session goes on
+    r = _resume(out, None)
     assert r.exit_code == 0, r.output
-    assert json.loads((out / "manifest.json").read_text())["runs"][-1]["rig_change"] == [
-        "simulated scene: changed"
-    ]
+    assert len(journal(out)) == 6

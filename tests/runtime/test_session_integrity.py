@@ -122,15 +122,23 @@ def test_resume_on_another_rig_is_refused_with_what_differs(
         assert "set it back to continue" in said(r)
     assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before  # untouched
 
-    # a deliberate change to the rest of the rig (here the dry run's scene) goes through with
-    # the flag, and is recorded
+    # nor another dry-run scene: another object (it had been accepted with the flag)
     cfg.write_text(SMALL_DOME.replace("seed = 3", "seed = 4"))
+    for flag in ([], ["--accept-rig-change"]):
+        r = runner.invoke(app, ["run", "--resume", str(out), *flag])
+        assert r.exit_code == 2 and "simulated scene: changed" in said(r), r.output
+        assert "cannot be accepted into this session, even with --accept-rig-change" in said(r)
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before  # untouched
+
+    # a deliberate change to the rest of the rig (here an upper ring re-measured a degree
+    # round) goes through with the flag, and is recorded
+    cfg.write_text(SMALL_DOME.replace("azimuth_offset_deg = 45.0", "azimuth_offset_deg = 46.0"))
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 2 and "add --accept-rig-change to record it" in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(out), "--accept-rig-change"])
     assert r.exit_code == 0, r.output
     run = manifest(out)["runs"][-1]
-    assert run["rig_change"] == ["simulated scene: changed"]
+    assert [d.split(":")[0] for d in run["rig_change"]] == ["light positions"], run
 
 
 def test_resume_with_the_same_rig_needs_no_flag(

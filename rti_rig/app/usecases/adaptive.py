@@ -39,6 +39,7 @@ from rti_rig.app.usecases.adaptive_constants import (
     decision_constants,
     describe_differences,
 )
+from rti_rig.app.usecases.adaptive_recorded import refuse_damaged_settings
 from rti_rig.app.usecases.run_options import (
     HINT_UNTIL_ERROR_DEG,
     adaptive_options,
@@ -1208,8 +1209,11 @@ class AdaptiveSteps:
                     )
                 raise RtiRigError(
                     f"{shown_path(folder.root)}: step {i + 1} was decided differently when the "
-                    "session began (another rig config, software version or image on disk); it "
-                    "cannot be continued deterministically: start a new session"
+                    "session began (another rig config, software version or image on disk, or "
+                    "the session's manifest.json or journal.jsonl edited since); it cannot be "
+                    "continued deterministically. Nothing was recorded or captured: if one of "
+                    "those was changed, put it back as it was (the files from a backup copy of "
+                    "the folder) and resume again, else start a new session"
                 )
             pixels = read_linear_tiff(Path(folder.root) / rec.linear_image)
             self.chooser.observe(
@@ -2359,6 +2363,7 @@ def check_resume_objective(manifest: dict, root: Path, objective: str | None) ->
         )
     refuse_other_format(header, root)
     refuse_other_constants(header, root)
+    refuse_damaged_settings(header, root)
     began = header.get("objective")
     if began not in OBJECTIVES:
         raise RtiRigError(

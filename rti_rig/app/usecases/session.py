@@ -1792,7 +1792,8 @@ def _rig_refusal(  # type: ignore[no-untyped-def]
         refused.append(
             f"{labels} change{'' if len(image_diffs) > 1 else 's'} what "
             "this session's images are (another exposure or gain reads as a brighter or darker "
-            "light, another size or decoding as another picture), and fit, relight and "
+            "light, another size or decoding as another picture, another simulated scene as "
+            "another object), and fit, relight and "
             "RTIBuilder take a session's images as one set"
         )
     if refused:

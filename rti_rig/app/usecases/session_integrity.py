@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -584,9 +584,10 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
     of = f"of at most {total}" if manifest.get("adaptive") else f"of {total}"
     # of the images taken, those lost since: "12 of 12 images" of a session not finished (a
     # --reshoot-lost stopped part-way) had read as a contradiction
-    lost = len(files_lost_since_capture(source))
+    gone = files_lost_since_capture(source)
+    lost = len(gone)
     since = f", {lost} of them lost since" if lost else ""
-    instead = unresumable(source)
+    instead = unresumable(source) or _adaptive_gap(manifest, source, gone, journal, total)
     note = (
         f"the session is not finished ({taken} {of} images{since}; {how}): this verdict judges "
         "the images taken so far; "
@@ -603,6 +604,36 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
         )
     )
     return _noted(qa, note)
+
+
+def _adaptive_gap(
+    manifest: dict[str, Any],
+    source: Path,
+    gone: dict[str, list[str]],
+    journal: list[dict[str, Any]],
+    total: int,
+) -> str | None:
+    """What to do instead of a plain resume of an adaptive session ``source`` that lost an
+    image before its last (None: not adaptive, or no such image).
+
+    Why: the verdict had said "continue it with rti-rig run --resume" of such a session,
+    which the resume refuses (each later light was chosen from that image:
+    ``refuse_broken_run``)."""
+    if not manifest.get("adaptive") or not gone:
+        return None
+    order = {name: i for i, name in enumerate(image_names(total))}
+    last = max((r["index"] for r in journal), default=-1)
+    before = sorted((n for n in gone if order.get(n, last) < last), key=order.__getitem__)
+    if not before:
+        return None
+    one = len(before) == 1
+    return (
+        f"an adaptive session cannot reshoot {', '.join(before)} in place (the lights after "
+        f"{'it' if one else 'them'} were chosen from {'its' if one else 'their'} image): put the "
+        "original files back (from a backup copy of the folder; a resume sets "
+        f"what it cannot verify aside in recovered/) to continue it with rti-rig run --resume "
+        f"{shell_word(str(source))}, or start a new session"
+    )
 
 
 def _with_stopped_while_committing(qa: QAReport, source: Path) -> QAReport:
