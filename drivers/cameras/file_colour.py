@@ -291,7 +291,8 @@ def file_colour_notice(
 ) -> str | None:
     """The session notice for a file that is not said to be sRGB (None for sRGB): what was
     assumed, or that the colours are another space's, recorded as such and not converted; for
-    a ``bits`` 16 file said sRGB by its Exif alone, that it was taken as linear."""
+    a ``bits`` 16 file said sRGB by its Exif alone, or saying nothing, that it was taken as
+    linear."""
     if colour.space == "srgb":
         if colour.linear_curve and bits == 8:
             # taken as linear against the 8-bit reading a config or a reader would give: said,
@@ -304,6 +305,15 @@ def file_colour_notice(
         if not colour.exif_only or bits != 16:
             return None
         return exif_only_16_bit_notice(whose) if colour.exif_linear else exif_encoded_notice(whose)
+    if colour.space == "untagged" and bits == 16:
+        # read as linear, as every 16-bit file without a profile is (a raw converter's
+        # output): it had been said "assumed sRGB", of pixels no sRGB curve was undone from
+        return (
+            f"{whose} are 16-bit and say no colour space (no ICC profile, no Exif "
+            "ColorSpace): taken as linear data, as a raw converter writes them, no curve "
+            "undone; if they are sRGB-encoded, export them with the sRGB ICC profile embedded "
+            "and rti-rig undoes its curve"
+        )
     if colour.space == "untagged":
         return (
             f"{whose} say no colour space (no ICC profile, no Exif ColorSpace): "

@@ -192,3 +192,27 @@ def test_a_jpeg_whose_icc_profile_is_damaged_is_read_by_what_else_it_says(tmp_pa
         ".jpg",
     )
     assert step["file_colour"]["said_by"] == "its Exif ColorSpace 1 (sRGB)", step
+
+
+def test_a_replay_of_untagged_16_bit_files_says_they_are_taken_as_linear(tmp_path: Path) -> None:
+    """16-bit PNGs that say no colour space are read as linear data (a raw converter's
+    output), their pixels the session's linear frames as they are; the run had said
+    "assumed sRGB (the file does not say)" of them, a curve it never undid."""
+    acq = tmp_path / "acq"
+
+    def untagged_png(path: Path, k: int) -> None:
+        cv2.imwrite(str(path), np.full((16, 16, 3), 9000 + 4000 * k, np.uint16))
+
+    _ring_acquisition(acq, ".png", untagged_png)
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--no-verdict"], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    assert "are 16-bit and say no colour space" in said and "taken as linear data" in said, said
+    assert "assumed sRGB" not in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    step = manifest["steps"][1]
+    frame = tifffile.imread(out / step["linear_image"])
+    assert (frame == 13000).all(), frame.ravel()[:3]  # as recorded: no curve undone
