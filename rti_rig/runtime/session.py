@@ -3383,17 +3383,47 @@ def held_by_acquisition(root: Path, scan: JournalScan | None = None) -> dict[str
         return {}
     held: dict[str, str] = {}
     renamed = renamed_jpegs(Path(root), records)
+    moved = _acquisition_moved(Path(root))
     for rec in _latest_records(records).values():
         sources = rec.get("copied_from") or {}
         for name, how in _lost_entries(Path(root), rec, renamed):
             source = sources.get(name)
-            if (
-                how == "missing"
-                and isinstance(source, str)
-                and file_sha256(Path(source)) == rec["sha256"].get(name)
-            ):
-                held[name] = source
+            if how != "missing" or not isinstance(source, str):
+                continue
+            for path in (Path(source), *([moved(Path(source))] if moved else [])):
+                if path is not None and file_sha256(path) == rec["sha256"].get(name):
+                    held[name] = str(path)
+                    break
     return held
+
+
+def _acquisition_moved(root: Path) -> Callable[[Path], Path | None] | None:
+    """Where a replay session's recorded file (its path when copied) is now, if the
+    acquisition was moved and the session resumed from the new place (``rig.config_path``, the
+    ``.lp`` last run, in another folder than the one it began with); None otherwise.
+
+    Why: the verdict of such a session said a deleted copy's "original capture is lost … put
+    the originals back from a copy", its acquisition still holding the file under the new
+    folder (the records keep each file's path at its capture)."""
+    try:
+        rig = read_manifest(root).get("rig") or {}
+    except SessionError:
+        return None
+    dome = (rig.get("config") or {}).get("dome") or {}
+    began, now = dome.get("lp_file"), rig.get("config_path")
+    if not isinstance(began, str) or not isinstance(now, str) or not now.lower().endswith(".lp"):
+        return None
+    before, after = Path(began).parent, Path(now).parent
+    if before == after:
+        return None
+
+    def moved(source: Path) -> Path | None:
+        try:
+            return after / source.relative_to(before)
+        except ValueError:
+            return None
+
+    return moved
 
 
 def _lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None) -> str:

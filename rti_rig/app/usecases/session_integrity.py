@@ -506,28 +506,21 @@ def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
     Why: the verdict named the session's images only, "clipped in the recording", so a user
     replaying their own acquisition could not tell which of its photographs was clipped."""
     rig = manifest.get("rig") or {}
-    lp_file = ((rig.get("config") or {}).get("dome") or {}).get("lp_file")
     steps = manifest.get("steps")
-    if not isinstance(lp_file, str) or not isinstance(steps, list):
+    if not isinstance(steps, list):
         return {}
-    try:
-        entries = read_lp(Path(lp_file))
-    except (RtiRigError, OSError):
-        return {}
-    # named only where the `.lp` and its images are still the ones the session replayed (their
-    # digest, recorded when it began): an `.lp` edited since (lines reordered or removed) or
-    # images re-exported had the verdict name other photographs, and a session from before
-    # the digest was recorded cannot tell. Files whose stamps are the ones recorded with it
-    # are not hashed again (:func:`~rti_rig.app.rig_identity.recorded_images_stamped` says why
-    # that is safe enough): every verdict had hashed every image of the acquisition
-    from rti_rig.app.rig_identity import recorded_images_digest
-
-    identity = (manifest.get("rig") or {}).get("identity") or {}
-    began = identity.get("recorded_images")
-    if began is None or began != recorded_images_digest(
-        Path(lp_file).parent, [e.name for e in entries], identity.get("recorded_files")
+    # the `.lp` the session began with, else the one it was last resumed from (the
+    # acquisition moved since: the names had been dropped, the old path read)
+    for lp_file in (
+        ((rig.get("config") or {}).get("dome") or {}).get("lp_file"),
+        rig.get("config_path"),
     ):
+        entries = _replayed_entries(manifest, lp_file)
+        if entries is not None:
+            break
+    else:
         return {}
+    assert isinstance(lp_file, str)
     names: dict[str, str] = {}
     for step in steps:
         if not isinstance(step, dict):
@@ -536,6 +529,33 @@ def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
         if isinstance(led, int) and 0 <= led < len(entries) and isinstance(image, str):
             names[Path(image).stem] = _recorded_file_shown(Path(lp_file).parent, entries[led].name)
     return names
+
+
+def _replayed_entries(manifest: dict, lp_file: object) -> list | None:  # type: ignore[type-arg]
+    """The lines of ``lp_file`` if it is the `.lp` session ``manifest`` replayed, as it was
+    then; None if it cannot be read, or it (or its images) are not the ones replayed.
+
+    Named only where the `.lp` and its images are still the ones the session replayed (their
+    digest, recorded when it began): an `.lp` edited since (lines reordered or removed) or
+    images re-exported had the verdict name other photographs, and a session from before the
+    digest was recorded cannot tell. Files whose stamps are the ones recorded with it are not
+    hashed again (:func:`~rti_rig.app.rig_identity.recorded_images_stamped` says why that is
+    safe enough): every verdict had hashed every image of the acquisition."""
+    if not isinstance(lp_file, str) or not lp_file.lower().endswith(".lp"):
+        return None
+    try:
+        entries = read_lp(Path(lp_file))
+    except (RtiRigError, OSError):
+        return None
+    from rti_rig.app.rig_identity import recorded_images_digest
+
+    identity = (manifest.get("rig") or {}).get("identity") or {}
+    began = identity.get("recorded_images")
+    if began is None or began != recorded_images_digest(
+        Path(lp_file).parent, [e.name for e in entries], identity.get("recorded_files")
+    ):
+        return None
+    return entries
 
 
 def _recorded_file_shown(lp_dir: Path, name: str) -> str:
