@@ -143,3 +143,27 @@ def test_the_sessions_own_config_edited_twice_is_told_both_edits_at_once(tmp_pat
     r = _resume(out, None)
     assert r.exit_code == 0, r.output
     assert len(journal(out)) == 6
+
+
+def test_the_new_session_advised_for_a_dome_with_fewer_leds_fits_on_it(tmp_path: Path) -> None:
+    """A 10-light session resumed on a dome of 8 LEDs and another camera: the refusal's
+    new-session command had repeated --lights 10, which that dome refuses."""
+    from conftest import SMALL_DOME, write_config
+
+    from rti_rig.app.usecases.session import NewSessionRequest
+
+    twelve = write_config(tmp_path, SMALL_DOME, "twelve.toml")
+    out = tmp_path / "s"
+    cut_new_session(NewSessionRequest(twelve, out, 10), after_step=2)
+    eight = write_config(
+        tmp_path,
+        SMALL_DOME.replace(
+            "  { elevation_deg = 50.0, count = 4, azimuth_offset_deg = 45.0 },\n", ""
+        ).replace("width = 64", "width = 48"),
+        "eight.toml",
+    )
+    r = _resume(out, eight)
+    text = said(r)
+    assert r.exit_code == 2, r.output
+    assert f"rti-rig run {eight} --out " in text and " --lights 8" in text, text
+    assert "--lights 10" not in text, text

@@ -1803,7 +1803,9 @@ def _rig_refusal(  # type: ignore[no-untyped-def]
             + said[1:]
             + ": that cannot be accepted into this session, even with --accept-rig-change. "
         )
-    new = new_session_command(config_path, manifest, session_dir)
+    # its counts within the lights this rig has (the session's --lights 12 had been advised
+    # for a dome of 10 LEDs, and refused when pasted)
+    new = new_session_command(config_path, manifest, session_dir, most=_light_count(identity))
     if other_rig:
         back = (
             _back_to_own_config(config_path, manifest, session_dir)
