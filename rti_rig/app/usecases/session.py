@@ -1553,6 +1553,17 @@ def _changed_recorded_files(recorded: dict[str, Any], identity: dict[str, Any]) 
     return f" ({which} {differs} from the one{'s' if len(changed) > 1 else ''} recorded)"
 
 
+def _same_files_listed_otherwise(recorded: dict[str, Any], identity: dict[str, Any]) -> bool:
+    """Whether a replayed acquisition's files are all the ones recorded, each with its
+    recorded checksum, although the digest of the images in their `.lp` order differs: the
+    `.lp`'s lines were reordered or paired with other lights (False where the session recorded
+    no per-file checksums)."""
+    before, now = recorded.get("recorded_files"), identity.get("recorded_files")
+    if not isinstance(before, dict) or not isinstance(now, dict) or set(before) != set(now):
+        return False
+    return not _changed_recorded_files(recorded, identity)
+
+
 def check_resume_rig(  # type: ignore[no-untyped-def]
     manifest: dict[str, Any],
     loaded,
@@ -1611,6 +1622,20 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         # said "one was edited", and the new session advised with a --lights it lacks)
         raise RigChangedError(
             _another_acquisition(config_path, recorded, identity, manifest, session_dir)
+        )
+    if only_images_other and _same_files_listed_otherwise(recorded, identity):
+        # every recorded file as it was: the .lp's lines were reordered or repaired (it had
+        # been blamed on an image "edited, replaced or re-exported", none named)
+        raise RigChangedError(
+            f"{shown_path(config_path)} lists the same recorded files as when this session "
+            "began, each as it was, but not in the same order or not with the same lights: "
+            "the .lp was edited since. The session's images were paired with its lights by "
+            "their lines, so a resume cannot go on with them. Put the .lp back as it was (from "
+            "a backup copy) to continue (rti-rig run --resume "
+            f"{shell_word(str(session_dir))}), or start a new session from the acquisition as "
+            "it is now ("
+            + new_session_command(config_path, manifest, session_dir, most=_light_count(identity))
+            + ")"
         )
     if only_images_other:
         # a replayed acquisition is a rig whose camera returns its files: they are its images
