@@ -1329,11 +1329,20 @@ def parse_lp(
                 "lp-builder.py?); put each image's file name before its light, in shooting order",
             )
         if len(tokens) < 4:
+            # the file's last line short of its fields: a copy or a save cut short (the
+            # refusal had said what was found and nothing to do)
+            cut = (
+                " (the last line: the file cut short? copy it again from where it came from, "
+                "or remove the line and leave its image out)"
+                if lineno == content[-1][0] and not (_csv_hint(line) or _heading_hint(line))
+                else ""
+            )
             raise LpFormatError(
                 source,
                 lineno,
                 f"expected 'name x y z', found {len(tokens)} field(s): {line!r}"
-                + (_csv_hint(line) or _heading_hint(line)),
+                + (_csv_hint(line) or _heading_hint(line))
+                + cut,
             )
         if hint := _heading_hint(line):
             # a heading row ('image x y z', 'filename\tlx\tly\tlz'): no light, and no number to
@@ -1386,8 +1395,23 @@ def parse_lp(
             below.append((lineno, name, z / norm, z))
         _check_name(name, source, lineno)
         if name in seen:
+            # what to do, not only what is wrong: a line repeated (a paste) or two lights
+            # given one image's name
+            first_entry = next(e for e in entries if e.name == name)
+            same = all(
+                abs(a - b) < 1e-6
+                for a, b in zip(first_entry.direction, (x / norm, y / norm, z / norm), strict=True)
+            )
             raise LpFormatError(
-                source, lineno, f"image name {name!r} already used on line {seen[name]}"
+                source,
+                lineno,
+                f"image name {name!r} already used on line {seen[name]}"
+                + (
+                    f", with the same light: the line repeated? delete line {lineno}"
+                    if same
+                    else ", with another light: each image has one light; give this line the "
+                    "name of the image it lit, or delete the line that is wrong"
+                ),
             )
         seen[name] = lineno
         if abs(length - 1.0) > UNIT_TOLERANCE:
