@@ -87,6 +87,7 @@ from rti_rig.reconstruct.qa_exposure import (
     exposure_ratios,
     exposure_scatter,
 )
+from rti_rig.reconstruct.qa_repeated import REPEATED, repeated_pictures, repeated_problem
 from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
 from rti_rig.reconstruct.qa_unchanging import (
     FLAT_ADVICE,
@@ -774,7 +775,7 @@ def lights_independent(problem: str) -> bool:
     images that do not change, black throughout), where the others (wrong light, brighter or
     dimmer than predicted, exposure against its elevation, moved) are found against a fit of
     the recorded lights and follow from a wrong ``.lp`` alone."""
-    return problem.startswith(("saturated", FLAT_FRAME, UNCHANGING, BLACK_THROUGHOUT))
+    return problem.startswith(("saturated", FLAT_FRAME, UNCHANGING, BLACK_THROUGHOUT, REPEATED))
 
 
 def _readvised(problem: str, name: str, advice: Callable[[str, str], str]) -> str:
@@ -1577,6 +1578,8 @@ def assess(
     # the dim or bright claims its level against the fit would give it
     flat = {} if all_black or unchanged is not None else flat_images(small, small_sat, dark, lt)
     flat_mask = np.isin(np.arange(n), list(flat))  # no direction is judged in them (_evidence)
+    # an image that is an earlier one again, pixel for pixel (qa_repeated)
+    repeated = {} if all_black or unchanged is not None else repeated_pictures(small)
 
     # per-image evidence on a full-resolution crop where the object has lit structure (a
     # second pass reads only its rows)
@@ -1981,6 +1984,11 @@ def assess(
             # frame with no picture of the object in it
             problems = [p for p in problems if p.startswith("saturated")]
             problems.append(flat_problem(*flat[i]))
+            bright_claim = None
+        if i in repeated:
+            # its level and direction against the fit are those of another light's picture
+            problems = [p for p in problems if p.startswith("saturated")]
+            problems.append(repeated_problem(names[repeated[i]]))
             bright_claim = None
         if step is not None and _in_open_range(step, i):
             problems.append(_may_have_moved(step, names))

@@ -123,6 +123,9 @@ def check_rig(
     if on_start is not None:
         on_start()
     if loaded.config.backend == "replay":
+        repeated = repeated_files(Path(loaded.path))
+        if repeated:
+            return FailedReplayCheck(Path(loaded.path).name, repeated, tuple(loaded.notes))
         return ReplayCheck.of(loaded)
     if loaded.config.dome is not None and loaded.config.dome.flash_sync is not None:
         from rti_rig.app.flash_sync import flash_sync_check
@@ -528,6 +531,34 @@ class ReplayCheck:
             *config_note_lines(self),
             "RESULT: PASS",
         ]
+
+
+def repeated_files(lp: Path) -> tuple[str, ...]:
+    """Each image of the acquisition ``lp`` that is, byte for byte, the file of an earlier
+    line: what to do about it.
+
+    Why: a frame delivered twice (a camera that missed its trigger) or a file copied over
+    another passed the check ("RESULT: PASS"): two photographs are never equal to the last
+    bit, so such a file is the picture of another light."""
+    from rti_rig.core.lp_format import image_paths, read_lp
+    from rti_rig.runtime.session import file_sha256
+
+    first: dict[str, Path] = {}
+    said = []
+    for path in image_paths(lp, read_lp(lp, upper_hemisphere=True)):
+        digest = file_sha256(path)
+        if digest is None:
+            continue
+        if digest in first:
+            said.append(
+                f"{path.name} is the same file as {first[digest].name}, byte for byte, though "
+                "another light is listed for it (a frame delivered twice, or a file copied "
+                f"over): put its own light's picture in its place, or remove its line from "
+                f"{lp.name}"
+            )
+        else:
+            first[digest] = path
+    return tuple(said)
 
 
 @dataclass(frozen=True)

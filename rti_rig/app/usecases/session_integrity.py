@@ -511,10 +511,9 @@ def _replayed_names(manifest: dict) -> dict[str, str]:  # type: ignore[type-arg]
         return {}
     # the `.lp` the session began with, else the one it was last resumed from (the
     # acquisition moved since: the names had been dropped, the old path read)
-    for lp_file in (
-        ((rig.get("config") or {}).get("dome") or {}).get("lp_file"),
-        rig.get("config_path"),
-    ):
+    began = ((rig.get("config") or {}).get("dome") or {}).get("lp_file")
+    last = rig.get("config_path")
+    for lp_file in dict.fromkeys((began, last)):  # the same one: read once
         entries = _replayed_entries(manifest, lp_file)
         if entries is not None:
             break
