@@ -1289,6 +1289,21 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
             if problem.startswith("intensity_correction"):
                 used_file = "intensity_correction_file" in data["dome"]["serial"]
                 key = "dome.serial.intensity_correction" + ("_file" if used_file else "")
+            else:
+                # where the count comes from, and which of the two to change (it had said
+                # "… but 48 LEDs given", given by what left unsaid)
+                dome = config.dome
+                given = (
+                    f"dome.lp_file ({dome.lp_file}) lists {len(dirs)}"
+                    if dome is not None and dome.layout == "lp"
+                    else f"the dome's layout gives {len(dirs)}"
+                )
+                problem = (
+                    f"expected_led_count = {serial.expected_led_count}, but {given} LEDs: set "
+                    f"expected_led_count = {len(dirs)} if the dome has {len(dirs)} LEDs, else "
+                    "give the lights of this dome (a dome's .lp lists one line per LED, in the "
+                    "firmware's numbering)"
+                )
             raise ConfigError(path, key, problem)
         from rti_rig.app.flash_sync import check_exposure
 
