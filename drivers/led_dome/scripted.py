@@ -25,6 +25,7 @@ import re
 from typing import Any
 
 from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLinkError, LinkFault, OffOutcome
+from rti_rig.drivers.led_dome.damaged_reply import one_byte_off
 from rti_rig.drivers.led_dome.port_opening import PortOpening
 from rti_rig.drivers.led_dome.protocol_spec import CommandSpec, ProtocolSpec
 from rti_rig.drivers.led_dome.transport import Transport, TransportError
@@ -661,10 +662,13 @@ class ScriptedDomeDriver(PortOpening):
                     text = self.boot_text
                 if text.strip():
                     self._rx.clear()
+                    damaged = wanted is not None and one_byte_off(wanted, text)
                     raise self._error(
-                        f"unexpected reply {text[-120:]!r} within {deadline - sent:.2f} s",
+                        f"unexpected reply {text[-120:]!r} within {deadline - sent:.2f} s"
+                        + (" (the expected reply with one byte damaged)" if damaged else ""),
                         name,
                         LinkFault.GARBLED,
+                        damaged_reply=damaged,
                     )
                 raise self._error(
                     f"no reply within {deadline - sent:.2f} s (lost or late)",
@@ -807,9 +811,21 @@ class ScriptedDomeDriver(PortOpening):
             self._heard_text = (self._heard_text + data.decode("latin-1"))[-HEARD_KEPT:]
 
     def _error(
-        self, message: str, command: str, fault: LinkFault, *, slow_boot: bool = False
+        self,
+        message: str,
+        command: str,
+        fault: LinkFault,
+        *,
+        slow_boot: bool = False,
+        damaged_reply: bool = False,
     ) -> DomeLinkError:
         retryable = fault not in (LinkFault.REJECTED, LinkFault.WAITING, LinkFault.FOREIGN)
         return DomeLinkError(
-            self.device, message, command, fault, retryable=retryable, slow_boot=slow_boot
+            self.device,
+            message,
+            command,
+            fault,
+            retryable=retryable,
+            slow_boot=slow_boot,
+            damaged_reply=damaged_reply,
         )

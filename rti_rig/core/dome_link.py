@@ -54,6 +54,7 @@ class DomeLinkError(DeviceError):
         permission_denied: bool = False,
         sent: bool = True,
         slow_boot: bool = False,
+        damaged_reply: bool = False,
     ) -> None:
         super().__init__(device, message, command)
         self.fault = fault
@@ -66,6 +67,10 @@ class DomeLinkError(DeviceError):
         #: this flag, not by finding the advice's words in the error: rewording either
         #: message had changed which the report said.
         self.slow_boot = slow_boot
+        #: The unmatched reply was the expected one with a single byte damaged, lost or added:
+        #: the board answers in the link's profile over a line that damaged a byte (a resend
+        #: survives it; the advice is the cable), not a wrong port, baud rate or profile.
+        self.damaged_reply = damaged_reply
         #: The port could not be opened because another program holds its lock (another
         #: rti-rig check or run on this dome): nothing about the board is known or wrong.
         self.port_held = port_held

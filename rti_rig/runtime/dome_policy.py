@@ -711,6 +711,7 @@ class DomePolicy:
                 exc.fault,
                 retryable=False,
                 code=exc.code,
+                damaged_reply=exc.damaged_reply,
             ) from exc
         raise exc
 
@@ -729,8 +730,10 @@ class DomePolicy:
     def _board_spoke_profile(self, exc: DomeLinkError) -> bool:
         """Whether the board on the port has shown, since it was opened, that it speaks the
         link's protocol profile: its boot banner or ready text, a well-formed reply (the link's
-        ``profile_heard``), or the fault itself (a reboot banner, a firmware error reply)."""
-        if exc.fault in (LinkFault.RESET, LinkFault.REJECTED):
+        ``profile_heard``), or the fault itself (a reboot banner, a firmware error reply, its
+        expected reply with one byte damaged: a board without a banner, such as the Elexol
+        24R1, had been told to check its port and baud rate when its first reply was)."""
+        if exc.fault in (LinkFault.RESET, LinkFault.REJECTED) or exc.damaged_reply:
             return True
         return exc.fault in _NOT_ITS_BOARD and self.link.profile_heard
 

@@ -38,6 +38,7 @@ from rti_rig.core.toml_strings import NotTomlText, toml_basic_string
 from rti_rig.drivers.led_dome.codec_binary import BinaryCodec
 from rti_rig.drivers.led_dome.codec_default import DefaultCodec
 from rti_rig.drivers.led_dome.codec_framed import FramedCodec, FramedSpec
+from rti_rig.drivers.led_dome.damaged_reply import one_byte_off
 from rti_rig.drivers.led_dome.dome_profiles import nab_rti_v1 as nab
 from rti_rig.drivers.led_dome.dome_profiles import rtipy
 from rti_rig.drivers.led_dome.messages import Banner
@@ -912,6 +913,8 @@ _NICHLOCK_SAYS = (
 
 #: What the Elexol 24R1 board answers to ``?``.
 _ELEXOL_SAYS = "USB I/O 24R1"
+#: The same, as the pattern a damaged answer is measured against (:func:`one_byte_off`).
+_ELEXOL_REPLY = re.compile(re.escape(_ELEXOL_SAYS))
 
 
 #: The rates besides 9600 and 115200 that nichlock's settings menu offers and the probe listens
@@ -1252,8 +1255,19 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             if _nichlock_found(result, text, rate) or _own_protocol_found(result, text, rate):
                 return result
         text = _exchange(result, "'?' at 38400 baud", 38400, 0.2, b"?", 0.5, _For.ELEXOL)
+        damaged = _ELEXOL_SAYS not in text and one_byte_off(_ELEXOL_REPLY, text)
+        if damaged:
+            # its answer with one byte damaged on the line: asked again (``?`` lights nothing;
+            # the board's FTDI port does not reset on opening), not "no known firmware"
+            said = "'?' again at 38400 baud (the answer came with one byte damaged)"
+            text = _exchange(result, said, 38400, 0.2, b"?", 0.5, _For.ELEXOL)
         if _ELEXOL_SAYS in text:
             result.profile, result.baudrate = "elexol-24r1", 38400
+            if damaged:
+                result.note = (
+                    "its first answer came with one byte damaged on the line; if that recurs, "
+                    "check the USB cable and hub (the session resends what was garbled)"
+                )
             return result
         said = "'m' (free RAM) at 115200 baud"
         text = _exchange(result, said, 115200, wait, b"m", 0.5, _For.NICHLOCK)
