@@ -388,6 +388,26 @@ def _keep_state(latch: LatchedErrors, emulator: DynamixelBusEmulator) -> None:
         latch.save_state(emulator.powered_state())
 
 
+def _refuse_missing_watch_folder(loaded: LoadedRig, settings: object) -> None:
+    """Refuse a watched-folder camera whose folder is not there, before any port opens.
+
+    Why: the camera connects after the dome, so a missing folder was found only once the dome's
+    port had opened: a Nab board resets there and boots with every LED lit (light dose on the
+    object) to be switched off again, for a session that could never take a picture."""
+    from rti_rig.core.errors import ConfigError
+    from rti_rig.core.shell_words import shown_path
+    from rti_rig.drivers.cameras.settings import FolderWatchSettings
+
+    if isinstance(settings, FolderWatchSettings) and not settings.folder.is_dir():
+        raise ConfigError(
+            loaded.path,
+            "camera.device.folder",
+            f"the watched folder {shown_path(settings.folder)} does not exist or is not a "
+            "folder: create it, or set 'folder' to the one the camera's tethering program "
+            "saves into (no port was opened, nothing lit)",
+        )
+
+
 def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
     """Real devices: the dome or arm on its port, the camera from [camera.device]."""
     from rti_rig.app.config import camera_device_settings
@@ -396,6 +416,7 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
     cfg = loaded.config
     geometry = rig_geometry(loaded)
     camera_settings = camera_device_settings(loaded)
+    _refuse_missing_watch_folder(loaded, camera_settings)
     if cfg.dome is not None and cfg.dome.flash_sync is not None:  # the camera steps the dome
         from rti_rig.app.flash_sync import build_flash_sync_rig
 
