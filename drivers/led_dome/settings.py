@@ -324,7 +324,9 @@ class DomeSerialSettings(_Strict):
         except ValidationError as exc:
             first = exc.errors()[0]
             known = table_keys(ProtocolSpec, tuple(first["loc"]))
-            raise ProtocolKeyError(tuple(first["loc"]), error_text(first, known)) from None
+            raise ProtocolKeyError(
+                tuple(first["loc"]), error_text(first, known, ProtocolSpec)
+            ) from None
 
     def led_count_source(self) -> str:
         """Where a firmware profile's LED count comes from, as a check or error should say it.

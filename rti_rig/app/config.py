@@ -783,7 +783,7 @@ def _problem(err: Any) -> tuple[str | None, str]:
     if isinstance(cause, KeyValueError):
         return _key_of((*err["loc"], cause.key)), cause.text
     known = table_keys(RigConfig, err["loc"]) if err["type"] == "extra_forbidden" else ()
-    return _key_of(err["loc"]) or None, _error_text(err, known)
+    return _key_of(err["loc"]) or None, _error_text(err, known, RigConfig)
 
 
 def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
@@ -1757,7 +1757,8 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
         err = exc.errors()[0]  # said as every other table's (parse_rig_config)
         kind = camera_kind(raw.get("kind"))
         known = table_keys(kind.settings, err["loc"]) if kind is not None else []
-        said = _other_kinds_key(err, raw.get("kind")) or _error_text(err, known)
+        model = kind.settings if kind is not None else None
+        said = _other_kinds_key(err, raw.get("kind")) or _error_text(err, known, model)
         raise ConfigError(rig.path, _key_of(("camera", "device", *err["loc"])), said) from None
     refuse_quoted_value(rig.path, raw, settings, ("camera", "device"))
     return settings

@@ -43,10 +43,10 @@ def _indexed(parts: list[str], arrays: dict[str, int]) -> str:
     return out
 
 
-def _depth(value: str) -> int:
-    """How many brackets and braces ``value`` (the rest of a line) leaves open, strings and a
-    comment skipped: above 0, the value goes on over the next lines."""
-    depth, quote, i = 0, "", 0
+def _structure(value: str) -> str:
+    """The brackets, braces and commas of ``value`` (the rest of a line), strings and a
+    comment skipped."""
+    out, quote, i = [], "", 0
     while i < len(value):
         c = value[i]
         if quote:
@@ -58,31 +58,62 @@ def _depth(value: str) -> int:
             quote = c
         elif c == "#":
             break
-        elif c in "[{":
-            depth += 1
-        elif c in "]}":
-            depth -= 1
+        elif c in "[]{},":
+            out.append(c)
         i += 1
-    return depth
+    return "".join(out)
+
+
+class _OpenArray:
+    """A value that goes on over several lines, read line by line for the inline tables of
+    an array (``rings = [`` then ``{ elevation_deg = 10.0, count = 12 },`` per line): each
+    written whole on its line is found as ``rings[i]``, so a key refused in it (a negative
+    elevation) is named with that line. Why: the shipped configs write their rings so, and
+    their errors had named no line at all."""
+
+    def __init__(self, key: str) -> None:
+        self.key = key
+        self.depth = 0
+        self.element = 0  # commas at the array's own depth: the index of the next element
+        self.table_from: int | None = None  # the line an element's inline table opened on
+
+    def read(self, line: str, n: int, found: dict[str, tuple[int, bool]]) -> None:
+        for c in _structure(line):
+            if c in "[{":
+                if c == "{" and self.depth == 1:
+                    self.table_from = n
+                self.depth += 1
+            elif c in "]}":
+                self.depth -= 1
+                if c == "}" and self.depth == 1 and self.table_from is not None:
+                    name = f"{self.key}[{self.element}]"
+                    found.setdefault(name, (self.table_from, self.table_from == n))
+                    self.table_from = None
+            elif self.depth == 1:
+                self.element += 1
+
+    @property
+    def open(self) -> bool:
+        return self.depth > 0
 
 
 def key_lines(text: str) -> dict[str, tuple[int, bool]]:
     """Each key and table of a TOML text, by the name an error gives it, with its first line
     (from 1) and whether its whole value is on that line (False: a table header, or a value
-    that goes on over more lines, an array of inline tables say, whose keys are then on lines
-    of their own that an error's name does not point to)."""
+    that goes on over more lines, whose keys are on lines of their own; an inline table of
+    such an array, written on one line, is found by its index: ``rings[2]``)."""
     found: dict[str, tuple[int, bool]] = {}
     arrays: dict[str, int] = {}
     table = ""
     closing: str | None = None  # the quotes that end a multi-line string being skipped
-    open_brackets = 0  # of a value that goes on over the lines being skipped
+    value: _OpenArray | None = None  # a value that goes on over the lines being read
     for n, line in enumerate(text.removeprefix("\ufeff").splitlines(), 1):
         if closing is not None:
             if closing in line:
                 closing = None
             continue
-        if open_brackets > 0:
-            open_brackets += _depth(line)
+        if value is not None and value.open:
+            value.read(line, n, found)
             continue
         header = _HEADER.match(line)
         if header:
@@ -105,9 +136,12 @@ def key_lines(text: str) -> dict[str, tuple[int, bool]]:
         for quotes in ('"""', "'''"):
             if rest.count(quotes) == 1:
                 closing = quotes
-        open_brackets = 0 if closing else max(0, _depth(rest))
-        whole = closing is None and open_brackets == 0
-        found.setdefault(f"{table}.{key}" if table else key, (n, whole))
+        name = f"{table}.{key}" if table else key
+        value = None if closing else _OpenArray(name)
+        if value is not None:
+            value.read(rest, n, found)
+        whole = value is None or not value.open
+        found.setdefault(name, (n, whole))
     return found
 
 
@@ -115,9 +149,9 @@ def key_line(text: str, key: str) -> int | None:
     """The line ``key`` (as an error names it) is written on in ``text``, or None.
 
     A key inside a value written whole on one line (an inline table or array: ``decode = {
-    white_balance = [0, 1, 1, 1] }``) is on that assignment's line; a key inside a value that
-    goes on over several lines (``rings = [`` then a table per line) has none, nor has a key
-    its table lacks (a table header, or the first line of such a value, is never named as the
+    white_balance = [0, 1, 1, 1] }``) is on that assignment's line, and one inside an inline
+    table of an array written over several lines (``rings = [`` then a table per line) is on
+    that table's line; a key elsewhere in such a value has none, nor has a key its table lacks (a table header, or the first line of such a value, is never named as the
     line of a key it does not hold: a wrong line is worse than none)."""
     found = key_lines(text)
     parts = _KEY_PARTS.findall(key)

@@ -48,6 +48,56 @@ def table_keys(model: Any, loc: tuple[Any, ...]) -> list[str]:
     return sorted({f.alias or name for m in models for name, f in m.model_fields.items()})
 
 
+def field_of(model: Any, loc: tuple[Any, ...]) -> Any:
+    """The pydantic field (its ``FieldInfo``) at location ``loc`` below ``model``, None where
+    no model holds it (a free dict's key, an element of a list)."""
+    models = [model]
+    for part in loc[:-1]:
+        if isinstance(part, int):
+            continue
+        fields = [m.model_fields[part] for m in models if part in m.model_fields]
+        models = [m for f in fields for m in _models_in(f.annotation)]
+    last = loc[-1] if loc else None
+    if isinstance(last, int):
+        return None
+    found = [m.model_fields[last] for m in models if last in m.model_fields]
+    return found[0] if found else None
+
+
+#: pydantic's bound errors, the constraint each names, and its words for a user
+_BOUNDS = {
+    "greater_than": ("gt", "more than"),
+    "greater_than_equal": ("ge", "at least"),
+    "less_than": ("lt", "less than"),
+    "less_than_equal": ("le", "at most"),
+}
+
+
+def _number(v: Any) -> str:
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+def _bounds_text(err: Any, field: Any) -> str | None:
+    """A bound error as the whole range the key takes ("must be more than 0 and at most 1"),
+    the field's description after it when it has one. Why: pydantic's "Input should be greater
+    than 0" named one end of the range, so a fix within it could be refused at the other."""
+    if err["type"] not in _BOUNDS:
+        return None
+    limits = [
+        (attr, getattr(m, attr))
+        for m in getattr(field, "metadata", ())
+        for attr in ("gt", "ge", "lt", "le")
+        if getattr(m, attr, None) is not None
+    ]
+    if not limits:
+        attr = _BOUNDS[err["type"]][0]
+        limits = [(attr, err.get("ctx", {}).get(attr))]
+    words = {a: w for a, w in _BOUNDS.values()}
+    said = " and ".join(f"{words[a]} {_number(v)}" for a, v in limits)
+    about = getattr(field, "description", None)
+    return f"must be {said} (got {err['input']!r})" + (f": {about}" if about else "")
+
+
 def unknown_key_text(key: str, known: Iterable[str] = ()) -> str:
     """What an unknown ``key`` is told, with the known key of its table it is closest to.
 
@@ -57,10 +107,11 @@ def unknown_key_text(key: str, known: Iterable[str] = ()) -> str:
     return UNKNOWN_KEY + (f"; did you mean '{close[0]}'?" if close else "")
 
 
-def error_text(err: Any, known: Iterable[str] = ()) -> str:
+def error_text(err: Any, known: Iterable[str] = (), model: Any = None) -> str:
     """One pydantic error in a user's words: what is wrong, the value given, and for a number
     where the driver wants the camera's own text (``iso = 100``), how to write it. ``known``:
-    the keys of the table an unknown key was found in, the closest of them suggested."""
+    the keys of the table an unknown key was found in, the closest of them suggested;
+    ``model``: the model validated, whose field's whole range a bound error says."""
     msg = str(err["msg"]).removeprefix("Value error, ")
     if err["type"] == "extra_forbidden":
         last = err["loc"][-1] if err.get("loc") else ""
@@ -72,6 +123,9 @@ def error_text(err: Any, known: Iterable[str] = ()) -> str:
         return f"required, and not given: add a line {loc[-1] if loc else 'for it'} = … {where}"
     if err["type"] == "value_error" or "input" not in err:
         return msg
+    bounded = _bounds_text(err, field_of(model, tuple(err["loc"])) if model else None)
+    if bounded is not None:
+        return bounded
     got = err["input"]
     if err["type"] == "string_type" and isinstance(got, int | float) and not isinstance(got, bool):
         return f'{msg} (got {got!r}: write it in quotes, "{got}", as the camera names it)'

@@ -27,7 +27,11 @@ def test_shipped_configs_load(dome_config_path: Path, arm_config_path: Path) -> 
 @pytest.mark.parametrize(
     ("edit", "key", "fragment"),
     [
-        (("count = 8", "count = -8"), "dome.rings[0].count", "greater than 0"),
+        (
+            ("count = 8", "count = -8"),
+            "dome.rings[0].count",
+            "must be more than 0 and at most 1000 (got -8)",
+        ),
         (("count = 8", "cuont = 8"), "dome.rings[0].count", "'dome.rings[0].cuont': unknown key"),
         (('kind = "dome"', 'kind = "cupola"'), "kind", "'dome' or 'arm'"),
         (('backend = "simulated"', 'backend = "usb"'), "backend", "simulated"),
@@ -45,11 +49,11 @@ def test_shipped_configs_load(dome_config_path: Path, arm_config_path: Path) -> 
             "dome",
             "count (read only with layout = 'fibonacci') would be ignored",
         ),
-        (("seed = 3", "seed = -1"), "scene.seed", "greater than or equal to 0"),
+        (("seed = 3", "seed = -1"), "scene.seed", "must be at least 0 (got -1)"),
         (
             ("seed = 3", "seed = 3\n[timing]\nsettle_s = 1e6"),
             "timing.settle_s",
-            "less than or equal to 600",
+            "must be at least 0 and at most 600 (got 1000000.0)",
         ),
         # a check of the whole [camera] table blames the key, not the table's line
         (

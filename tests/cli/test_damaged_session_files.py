@@ -155,7 +155,7 @@ def test_a_negative_scene_seed_is_a_named_config_error(tmp_path: Path) -> None:
     cfg.write_text(text.replace("seed = 0", "seed = -1"))
     r = runner.invoke(app, ["check", str(cfg)])
     assert r.exit_code != 0 and "Traceback" not in r.output
-    assert "seed" in said(r) and "greater than or equal to 0" in said(r), r.output
+    assert "seed" in said(r) and "must be at least 0 (got -1)" in said(r), r.output
 
 
 def test_an_unwritable_out_is_refused_before_the_rig_lights(

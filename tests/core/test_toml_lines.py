@@ -41,6 +41,14 @@ rings = [              # line 26
   { elevation_deg = 25.0, count = 12 },
 ]
 after = 1              # line 30
+[first_inline]
+rings = [ { count = 1 },   # line 32
+  { count = "a, {b}" },    # line 33: a comma and braces in a string are no structure
+]
+[scalars]
+rings = [ [1, 2],
+  { count = 3 },           # line 37
+]
 '''
 
 
@@ -58,7 +66,14 @@ after = 1              # line 30
         ("emulator.faults[1].kind", 20),
         ("emulator.faults[1].extra.why", 23),
         ("ring_table.rings", 26),
+        # an inline table of an array over several lines: its own line (the shipped configs'
+        # rings had been named with no line)
+        ("ring_table.rings[0].count", 27),
+        ("ring_table.rings[1].elevation_deg", 28),
         ("ring_table.after", 30),  # after a value over several lines: counted on
+        ("first_inline.rings[0].count", 32),  # an element on the assignment's own line
+        ("first_inline.rings[1].count", 33),
+        ("scalars.rings[1].count", 37),  # elements counted past a nested array
     ],
 )
 def test_a_key_is_found_on_the_line_it_is_written(key: str, line: int) -> None:
@@ -75,7 +90,7 @@ def test_a_key_is_found_on_the_line_it_is_written(key: str, line: int) -> None:
         "scene.name",
         # inside a value over several lines: its first line is not the key's (a wrong line is
         # worse than none; the shipped simulated_dome.toml's rings had been named line 11)
-        "ring_table.rings[1].count",
+        "ring_table.rings[2].count",
         "ring_table.elevation_deg",
     ],
 )
