@@ -151,8 +151,9 @@ def key_line(text: str, key: str) -> int | None:
     A key inside a value written whole on one line (an inline table or array: ``decode = {
     white_balance = [0, 1, 1, 1] }``) is on that assignment's line, and one inside an inline
     table of an array written over several lines (``rings = [`` then a table per line) is on
-    that table's line; a key elsewhere in such a value has none, nor has a key its table lacks (a table header, or the first line of such a value, is never named as the
-    line of a key it does not hold: a wrong line is worse than none)."""
+    that table's line; a key elsewhere in such a value has none, nor has a key its table
+    lacks (a table header, or the first line of such a value, is never named as the line of
+    a key it does not hold: a wrong line is worse than none)."""
     found = key_lines(text)
     parts = _KEY_PARTS.findall(key)
     for end in range(len(parts), 0, -1):
