@@ -39,6 +39,14 @@ SOURCES = {
 }
 
 
+@pytest.fixture(autouse=True)
+def _tether_folder(tmp_path: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A home holding the watched folder the shipped folder-watch config names
+    (``~/Pictures/rti-tether``): a rig whose folder is missing is refused as it is built."""
+    (tmp_path / "Pictures" / "rti-tether").mkdir(parents=True)
+    monkeypatch.setenv("HOME", str(tmp_path))
+
+
 def _source_name(rig: Rig) -> str:
     lighting: Any = rig.lighting
     if isinstance(lighting, DomeLighting):
