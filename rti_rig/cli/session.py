@@ -401,7 +401,7 @@ def run(
         # ended (it stopped no image: the manifest keeps the capture's end, "completed")
         late = late_term[0] if late_term else opened.stopped_once_over
         if late is not None:  # the summary is out; the verdict, not computed, is fit's to give
-            _refuse_unsafe_end(unsafe, exit_code=None)
+            _refuse_unsafe_end(unsafe, opened.rig, exit_code=None)
             err.print(
                 f"[yellow]Stopped ({stop_words(late)}) once the session had ended: it "
                 "is complete; its QA "
@@ -428,16 +428,16 @@ def run(
                     except typer.Exit:
                         # a Ctrl-C or SIGTERM said by the verdict: its exit (130 or 143),
                         # after the unsafe end's words, which that exit had skipped
-                        _refuse_unsafe_end(unsafe, exit_code=None)
+                        _refuse_unsafe_end(unsafe, opened.rig, exit_code=None)
                         raise
                     except Exception as exc:
                         _verdict_failed(exc, opened.out_dir)
             except (KeyboardInterrupt, Terminated) as exc:
                 # a stop as the verdict's handlers went in, before its own try (CI met it
                 # once: "rti-rig: stopped (Ctrl-C)", the verdict's words unsaid)
-                _refuse_unsafe_end(unsafe, exit_code=None)
+                _refuse_unsafe_end(unsafe, opened.rig, exit_code=None)
                 raise verdict_skipped(exc, opened.out_dir) from None
-        _refuse_unsafe_end(unsafe)
+        _refuse_unsafe_end(unsafe, opened.rig)
         _say_next(opened.out_dir)
 
 
@@ -1650,20 +1650,29 @@ def _stopped_before_capture(  # type: ignore[no-untyped-def]
     return typer.Exit(code=stop_exit_code(signum))
 
 
-def _refuse_unsafe_end(unsafe: bool, exit_code: int | None = 1) -> None:
+def _refuse_unsafe_end(unsafe: bool, rig: Any, exit_code: int | None = 1) -> None:
     """Exit 1 after a complete session whose teardown failed or left the lights unsure (said,
     with no exit, when ``exit_code`` is None: a stop that comes with its own exit).
 
     Why: the images are all there, but the rig was not brought to a known safe state (a final
     all-off not sent or unanswered, a lamp or stop refused). The run had exited 0, so a script
     chaining ``run && fit`` or a lab's batch took it for a clean end while the dome might be
-    lit.
+    lit. An arm's user is told of its joints too: "switch the dome or lamp off" had been all
+    they were told of an arm whose servo had faulted limp over the object.
     """
     if unsafe:
+        from rti_rig.runtime.lighting import ArmLighting, park_check
+
+        if isinstance(rig.lighting, ArmLighting):
+            by_hand = (
+                "switch the lamp off and support the arm, a joint of which may be limp; once "
+                f"its fault is cleared, {park_check(rig.lighting.config)} parks it"
+            )
+        else:
+            by_hand = "switch the dome off"
         err.print(
             "[red]The session is complete, but the rig was not brought to a known safe state "
-            "(above):[/] make it safe by hand (switch the dome or lamp off) before taking the "
-            "object out."
+            f"(above):[/] make it safe by hand ({escape(by_hand)}) before taking the object out."
         )
         if exit_code is not None:
             raise typer.Exit(code=exit_code)
@@ -2235,7 +2244,7 @@ def _exit_if_park_stopped(  # type: ignore[no-untyped-def]
     and lost its plan hint."""
     if _park_stopped_by(opened.rig) != signal.SIGINT:
         return
-    _refuse_unsafe_end(unsafe, exit_code=None)
+    _refuse_unsafe_end(unsafe, opened.rig, exit_code=None)
     err.print(
         f"[yellow]Stopped (Ctrl-C) during the arm's park, once {what} had ended: it is "
         f"complete{head}[/]{tail}",
@@ -2372,7 +2381,7 @@ def preview(
         # complete preview with exit 0, where it had been 130 (said "Emergency stop")
         late = late_term[0] if late_term else opened.stopped_once_over
         if late is not None:  # the preview and its summary are out; the run's word on the stop
-            _refuse_unsafe_end(unsafe, exit_code=None)
+            _refuse_unsafe_end(unsafe, opened.rig, exit_code=None)
             err.print(
                 f"[yellow]Stopped ({stop_words(late)}) once the preview was taken: it "
                 "is complete in "
@@ -2387,7 +2396,7 @@ def preview(
             f" in {escape(_arg(out_dir))}",
             " (plan from it as above)",
         )
-        _refuse_unsafe_end(unsafe)
+        _refuse_unsafe_end(unsafe, opened.rig)
 
 
 def _metered_apart(opened) -> tuple[float, float] | None:  # type: ignore[no-untyped-def]

@@ -448,9 +448,25 @@ class ArmLighting:
         back; ``run`` then said "parked" with no word of the release, and "held where it
         stopped, torque on" of a park a Ctrl-C stopped near the park pose, an arm whose
         close had just let it go limp. Recorded even when the close raised (its error is the
-        caller's to say): a release sent before the failure still happened."""
+        caller's to say): a release sent before the failure still happened.
+
+        A close that failed after the park was read back takes the "parked" back: the
+        emulated arm's elevation servo, overloaded at the close's read, went limp and the arm
+        fell from the park pose, while the run said, and the manifest kept, "the arm parked"
+        beside the fault."""
         try:
             self.carrier.close()
+        except Exception:
+            if self.end is not None and self.end.outcome == "parked":
+                self.end = replace(
+                    self.end,
+                    outcome="park-unconfirmed",
+                    why=(
+                        "its close failed after the park was read back: a joint may have "
+                        "gone limp since and let the arm sag from the park pose"
+                    ),
+                )
+            raise
         finally:
             self._record_release()
 

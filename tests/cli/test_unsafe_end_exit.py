@@ -54,4 +54,4 @@ def test_a_dome_gone_at_the_final_all_off_fails_the_run(
     assert len(read_lp(out / "lights.lp")) == 2  # the images are kept all the same
     assert what in said
     assert "session is complete, but the rig was not brought to a known safe state" in said
-    assert "switch the dome or lamp off" in said
+    assert "make it safe by hand (switch the dome off)" in said
