@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.core.rig_geometry import in_band
 from rti_rig.planner.adaptive_bias import (
     FitFn,
     ObjectModel,
@@ -605,10 +606,10 @@ def homogeneous_completion(
     if n_total <= k:
         return np.zeros(0, dtype=np.intp)
     el = _elevations(candidates)
-    inband = np.flatnonzero(available & (el >= floor_deg - 1e-9))
+    inband = np.flatnonzero(available & in_band(el, floor_deg))
     if inband.size < n_total - k:
         return None
-    lo = max(floor_deg, float(el[el >= floor_deg - 1e-9].min()))
+    lo = max(floor_deg, float(el[in_band(el, floor_deg)].min()))
     hi = float(el.max())
     ideal = fibonacci_cap(n_total, lo, hi) if hi > lo else fibonacci_cap(n_total, 0.0, 90.0)
     # the homogeneous layout itself (ideal matched to every candidate of the band, as
@@ -617,7 +618,7 @@ def homogeneous_completion(
     # the homogeneous layout of that floor, whatever lights are out of service (when the lights
     # used are the candidates themselves, to 1e-6 rad: a dome; an arm recording slightly other
     # directions takes the general matching below)
-    band = np.flatnonzero(el >= floor_deg - 1e-9)
+    band = np.flatnonzero(in_band(el, floor_deg))
     _, whole = linear_sum_assignment(_angles(ideal, candidates[band]))
     layout = band[whole]
     if k:
@@ -671,7 +672,7 @@ def start_subset(
     el = _elevations(layout)
     pool = np.arange(len(layout))
     if objective in START_ABOVE_FLOOR if above_floor is None else above_floor:
-        pool = np.flatnonzero(el >= floor_deg - 1e-9)
+        pool = np.flatnonzero(in_band(el, floor_deg))
         if len(pool) < k:  # too few above the floor: the highest
             return sorted(int(i) for i in np.argsort(-el, kind="stable")[:k])
     # the target spans the lights it may be matched to: from the floor (or their lowest, if

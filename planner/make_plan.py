@@ -33,7 +33,7 @@ from rti_rig.core.errors import ScheduleError
 from rti_rig.core.fit_minimums import NORMAL_MIN_LIGHTS
 from rti_rig.core.geometry import az_el_from_direction, fibonacci_cap
 from rti_rig.core.lp_format import MAX_LIGHTS
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, in_band
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.planner.builtin_methods import MANY_LIGHTS, MIN_LIGHTS_FOR_EXCHANGE
 from rti_rig.planner.light_origin import LightOrigin
@@ -106,7 +106,7 @@ def _elevation_range(
     if isinstance(geometry, ArmGeometry):
         return geometry.elevation_band(min_elevation_deg)
     _, el = az_el_from_direction(geometry.directions)
-    above = el[el >= min_elevation_deg - 1e-9]
+    above = el[in_band(el, min_elevation_deg)]
     if len(above) == 0:
         raise ScheduleError(
             f"the dome has no LED at or above {min_elevation_deg:g}° elevation; lower "

@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, in_band
 from rti_rig.core.rti_bases import N_COEFFICIENTS, design_matrix
 from rti_rig.planner import rank_one
 
@@ -134,7 +134,7 @@ def candidates_for(
     """
     if isinstance(geometry, DomeGeometry):
         _, el = az_el_from_direction(geometry.directions)
-        idx = np.flatnonzero((el >= min_elevation_deg - 1e-9) & (el <= max_elevation_deg + 1e-9))
+        idx = np.flatnonzero(in_band(el, min_elevation_deg, max_elevation_deg))
         if len(idx) == 0:
             raise ScheduleError(
                 f"the dome has no LED between {min_elevation_deg:g}° and "

@@ -12,7 +12,7 @@ import numpy as np
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, in_band
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.planner.from_lp import SNAP_TOLERANCE_DEG
 from rti_rig.planner.uniform import arm_below
@@ -80,7 +80,7 @@ def preview_schedule(
         az, el = PREVIEW_AZ_EL_DEG[0], min(max(PREVIEW_AZ_EL_DEG[1], lo_band), hi_band)
     if not 0.0 <= el <= 90.0:
         raise ScheduleError(f"preview light elevation {el:g}° is outside 0..90°")
-    if not lo_band - 1e-9 <= el <= hi_band + 1e-9:  # only a light asked for can be
+    if not in_band(el, lo_band, hi_band):  # only a light asked for can be
         raise ScheduleError(
             f"--light {az:g},{el:g}: its elevation {el:g}° is {_band_option(el, band)} (the "
             f"band {lo_band:g}–{hi_band:g}°): give a light within the band, or widen it"
@@ -92,7 +92,7 @@ def preview_schedule(
         prov["elevation_band_deg"] = [float(lo_band), float(hi_band)]
     if isinstance(geometry, DomeGeometry):
         _, els = az_el_from_direction(geometry.directions)
-        allowed = np.flatnonzero((els >= lo_band - 1e-9) & (els <= hi_band + 1e-9))
+        allowed = np.flatnonzero(in_band(els, lo_band, hi_band))
         if allowed.size == 0:
             raise ScheduleError(
                 f"the dome has no LED between {lo_band:g}° and {hi_band:g}° elevation; widen "

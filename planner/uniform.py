@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, even_layout
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, in_band
 from rti_rig.core.schedule import LightSchedule
 
 
@@ -76,7 +76,7 @@ def select_uniform_leds(
     if n <= 0:
         raise ScheduleError(f"--lights must be at least 1, got {n}")
     _, el = az_el_from_direction(dome.directions)
-    candidates = np.flatnonzero((el >= min_elevation_deg - 1e-9) & (el <= max_elevation_deg + 1e-9))
+    candidates = np.flatnonzero(in_band(el, min_elevation_deg, max_elevation_deg))
     if n > len(candidates):
         band = band_text(min_elevation_deg, max_elevation_deg)
         # ``fewest``: the smallest --lights the caller takes (a plan's 3: "use --lights 1 or

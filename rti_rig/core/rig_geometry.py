@@ -155,6 +155,22 @@ class DomeGeometry:
         return i, float(ang[i])
 
 
+#: How far outside an elevation band (degrees) a light may lie and still be in it: an `.lp`
+#: keeps six decimals, which move a light on the band's edge by up to ~3e-5° (a 10° ring read
+#: from a dome's `.lp` lies at 9.99998°). Far below any LED's or pose's precision. Why one
+#: value for every band test: the planner and ``run`` compared with 1e-9°, so ``run
+#: --min-elevation-deg 10`` on a dome described by its `.lp` dropped the whole 10° ring
+#: without a word, while ``run --plan`` with the same band (1e-3°) took it.
+BAND_SLACK_DEG = 1e-3
+
+
+def in_band(elevations: ArrayLike, low_deg: float, high_deg: float = 90.0) -> NDArray[np.bool_]:
+    """Which of ``elevations`` (degrees, an array) lie from ``low_deg`` to ``high_deg``, to
+    within :data:`BAND_SLACK_DEG`."""
+    el = np.asarray(elevations, dtype=np.float64)
+    return (el >= low_deg - BAND_SLACK_DEG) & (el <= high_deg + BAND_SLACK_DEG)
+
+
 def hint_light_count(geometry: object, low_deg: float = 0.0, high_deg: float = 90.0) -> int:
     """How many lights a hint's ``plan`` or ``run --lights`` command asks for:
     :data:`PLAN_DEFAULT_LIGHTS`, or fewer on a dome with fewer LEDs between ``low_deg`` and
@@ -167,8 +183,8 @@ def hint_light_count(geometry: object, low_deg: float = 0.0, high_deg: float = 9
     if not isinstance(geometry, DomeGeometry):
         return PLAN_DEFAULT_LIGHTS
     _, elevations = az_el_from_direction(geometry.directions)
-    in_band = int(((elevations >= low_deg - 1e-6) & (elevations <= high_deg + 1e-6)).sum())
-    return max(NORMAL_MIN_LIGHTS, min(PLAN_DEFAULT_LIGHTS, in_band))
+    held = int(in_band(elevations, low_deg, high_deg).sum())
+    return max(NORMAL_MIN_LIGHTS, min(PLAN_DEFAULT_LIGHTS, held))
 
 
 #: How far past an arm's limit (degrees) a direction may lie and count as on it: an `.lp`

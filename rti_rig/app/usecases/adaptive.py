@@ -52,7 +52,7 @@ from rti_rig.core.devices import Frame
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
 from rti_rig.core.image_files import read_linear_tiff
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, LampGeometry
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, LampGeometry, in_band
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.planner import adaptive_until
@@ -2047,7 +2047,7 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
 
 def _held(el: NDArray[np.float64], band: tuple[float, float]) -> int:
     """How many of the elevations ``el`` (°) ``band`` holds, as :func:`candidates_for` counts."""
-    return int(((el >= band[0] - 1e-9) & (el <= band[1] + 1e-9)).sum())
+    return int(in_band(el, band[0], band[1]).sum())
 
 
 def _band_holding(

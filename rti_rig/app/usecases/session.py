@@ -19,7 +19,7 @@ from rti_rig.app.usecases.replay_advice import new_session_command
 from rti_rig.app.usecases.run_options import band_options, run_words
 from rti_rig.core.errors import ConfigError, RtiRigError, ScheduleError
 from rti_rig.core.out_folders import free_folder_beside, free_name
-from rti_rig.core.rig_geometry import DomeGeometry, led_fields
+from rti_rig.core.rig_geometry import DomeGeometry, in_band, led_fields
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.controller import (
@@ -1074,7 +1074,7 @@ def _refuse_plan_outside_band(req: NewSessionRequest, entries: Any, schedule: An
     for entry, step in zip(entries, schedule.steps, strict=True):
         el = float(az_el_from_direction(step.direction)[1])
         # to within an .lp's six decimals (a light on the edge, written so, moves ~3e-5°)
-        if el < low - 1e-3 or el > high + 1e-3:
+        if not in_band(el, low, high):
             line = f"line {entry.line}" if entry.line is not None else entry.name
             outside.append(f"{line} ({entry.name}) at {el:.1f}°")
     if not outside:
@@ -1094,7 +1094,7 @@ def _in_band(geometry: DomeGeometry, low: float, high: float) -> int:
     from rti_rig.core.geometry import az_el_from_direction
 
     _, el = az_el_from_direction(geometry.directions)
-    return int(((el >= low - 1e-9) & (el <= high + 1e-9)).sum())
+    return int(in_band(el, low, high).sum())
 
 
 def new_session_schedule(  # type: ignore[no-untyped-def]
