@@ -415,6 +415,9 @@ class EarlierFit:
     outgrown: str | None = None
     #: what a skip says after "skipped (finished earlier)"
     note: str = ""
+    #: why the output folder is no fit to judge (files with no ``fit.json``, or a file): the
+    #: session is then failed, the folder left as it is
+    foreign: str | None = None
     #: the earlier fit's record brought up to date with the images a hash confirmed unchanged
     #: (new sizes or times, e.g. a copy), for the caller to keep (:func:`keep_confirmed`)
     confirmed: RecordUpdate | None = field(default=None, compare=False)
@@ -422,7 +425,7 @@ class EarlierFit:
     @property
     def stands(self) -> bool:
         """The earlier fit is kept and the session skipped."""
-        return self.found and self.outgrown is None
+        return self.found and self.outgrown is None and self.foreign is None
 
     @property
     def skip_detail(self) -> str:
@@ -446,6 +449,11 @@ def earlier_fit(final: Path, source: Path) -> EarlierFit:
     form kept before the lights were recorded as directions)."""
     if not final.exists():
         return EarlierFit(found=False)
+    foreign = _no_fit(final)
+    if foreign == "":
+        return EarlierFit(found=False)  # an empty folder: the fit goes into it
+    if foreign is not None:
+        return EarlierFit(found=True, foreign=foreign)
     try:
         summary = json.loads((final / "fit.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -494,6 +502,65 @@ def earlier_fit(final: Path, source: Path) -> EarlierFit:
     if changed is None:
         return EarlierFit(found=True, confirmed=update)
     return EarlierFit(True, CHANGED_SINCE + changed)
+
+
+def _no_fit(final: Path) -> str | None:
+    """Why ``final`` (which exists) holds no fit to judge, "" when it is an empty folder, None
+    when it holds a ``fit.json``.
+
+    Why: a folder of a session's name holding anything but a fit (a user's notes, a folder
+    made ahead) was "skipped (finished earlier)", exit 0 and "every fit is written", with no
+    fit anywhere; and refitting into it would have thrown its files away."""
+    if not final.is_dir():
+        return (
+            f"{shown_path(final)} is a file, not a fit's folder: move it aside, or fit into "
+            "another --out"
+        )
+    if (final / "fit.json").exists():
+        return None
+    try:
+        held = sorted(p.name for p in final.iterdir())
+    except OSError as exc:
+        return f"{shown_path(final)} cannot be read ({exc.strerror or exc})"
+    if not held:
+        return ""
+    more = f" and {len(held) - 3} more" if len(held) > 3 else ""
+    return (
+        f"{shown_path(final)} holds files but no fit (no fit.json: {', '.join(held[:3])}{more}), "
+        "so it was left as it is: move them aside, or fit into another --out"
+    )
+
+
+def _set_aside_kept(set_aside: Path, final: Path) -> str:
+    """Remove an earlier fit set aside by a refit, unless it holds files the fit did not write
+    (its ``fit.json`` lists those it wrote): it is then kept beside ``final``, and what is said
+    of the session says where. Why: a refit had removed the earlier fit's folder whole, with a
+    user's notes or a condition report put in it."""
+    import shutil
+
+    try:
+        summary = json.loads((set_aside / "fit.json").read_text(encoding="utf-8"))
+        written = {str(n) for n in summary.get("files") or ()} | {"fit.json"}
+        others = sorted(p.name for p in set_aside.iterdir() if p.name not in written)
+    except (OSError, ValueError, AttributeError, TypeError):
+        others = ["(what it holds could not be told from its fit.json)"]
+    if not others:
+        shutil.rmtree(set_aside, ignore_errors=True)
+        return ""
+    from rti_rig.core.out_folders import free_folder_beside
+
+    kept = free_folder_beside(final, "earlier-fit")
+    more = f" and {len(others) - 3} more" if len(others) > 3 else ""
+    named = ", ".join(others[:3])
+    held = f"; its earlier fit's folder held files the fit had not written ({named}{more})"
+    try:
+        set_aside.rename(kept)
+    except OSError as exc:  # left under its backup's name, which the next batch removes
+        return (
+            f"{held}: it could not be renamed ({exc.strerror or exc}) and is left as "
+            f"{shown_path(set_aside)}: move it out of --out before the next batch into it"
+        )
+    return f"{held}: it is kept, with them, as {shown_path(kept)}"
 
 
 #: How :func:`earlier_fit` begins the words on a session whose images or lights changed since.
@@ -599,6 +666,8 @@ def fit_one(
     said = finish_swap(root, final)
     earlier = earlier_fit(final, source)
     keep_confirmed(earlier)
+    if earlier.foreign is not None:
+        return BatchItem(source, final, Outcome.FAILED, f": {earlier.foreign}", notes=said)
     if earlier.stands:
         return BatchItem(source, final, Outcome.SKIPPED, earlier.skip_detail, notes=said)
     attempt = AttemptFolder.new(final.name)
@@ -649,6 +718,7 @@ def _fit_attempt(
         # replacing a finished output. It is kept; this attempt's copy is discarded.
         shutil.rmtree(partial, ignore_errors=True)
         return BatchItem(source, final, Outcome.DONE, DONE_ELSEWHERE, notes=said)
+    kept_said = ""
     if outgrown is not None and final.exists():
         # the earlier fit is set aside only now that its successor is complete, under a
         # backup's name: a batch killed between the renames is finished by the next run's
@@ -665,7 +735,7 @@ def _fit_attempt(
                 set_aside.rename(final)
                 shutil.rmtree(partial, ignore_errors=True)
                 raise
-            shutil.rmtree(set_aside, ignore_errors=True)
+            kept_said = _set_aside_kept(set_aside, final)
     try:
         if partial.exists():
             partial.rename(final)  # atomic; refused when a finished folder is already there
@@ -681,7 +751,7 @@ def _fit_attempt(
     for stale in partial_folders(root, final.name):
         if owner_gone(stale):
             remove_attempt_folder(stale)
-    detail = "" if outgrown is None else f" ({outgrown})"
+    detail = ("" if outgrown is None else f" ({outgrown})") + kept_said
     if moved_on is not None:
         # the fit is of the session as it was read, and its record says so: the next batch
         # refits it; said on the session's line, as "done" alone claims it matches
