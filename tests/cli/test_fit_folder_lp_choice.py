@@ -131,6 +131,28 @@ def _qa(fit: Path) -> dict:  # type: ignore[type-arg]
     return json.loads((fit / "qa.json").read_text())
 
 
+@pytest.mark.parametrize(("decimals", "wrong"), [(3, False), (2, True)])
+def test_a_lights_lp_rounded_to_three_decimals_is_the_journals_lights(
+    session: Path, tmp_path: Path, decimals: int, wrong: bool
+) -> None:
+    """lights.lp rewritten with three decimals (a spreadsheet's, another tool's): every light
+    moves by up to ~0.05°, rounding noise, which had been judged "lights.lp wrong: lights.lp
+    gives image_001, … another light than the journal records" (the .lp's own six decimals
+    were all it took). Two decimals move a light by up to ~0.5°: still named."""
+    s = tmp_path / "s"
+    shutil.copytree(session, s)
+    lines = (s / "lights.lp").read_text().splitlines()
+    rounded = [lines[0]] + [
+        " ".join([w[0], *(f"{float(v):.{decimals}f}" for v in w[1:])])
+        for w in (line.split() for line in lines[1:])
+    ]
+    (s / "lights.lp").write_text("\n".join(rounded) + "\n")
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    assert ("another light than the journal" in said(r)) is wrong, said(r)
+    assert _qa(tmp_path / "fit")["good"] is not wrong
+
+
 def test_a_lights_lp_out_of_name_order_is_named_for_relight(session: Path, tmp_path: Path) -> None:
     """lights.lp's lines reversed by hand: the fit pairs by name and said "good", but relight
     pairs the lines with the JPEGs in name order, every image under another's light."""

@@ -221,9 +221,12 @@ def _developed_stand(gone: list[str], held: dict[str, str]) -> str:
     )
 
 
-#: How far (radians) an .lp's light may be from the journal's and still be the same one: the
-#: .lp's six decimals round a direction by about 1e-6 rad.
-_SAME_LIGHT_RAD = 1e-4
+#: How far (radians) an .lp's light may be from the journal's and still be the same one:
+#: 0.1°. Rounding is no edit: lights.lp written again with three decimals (a spreadsheet's,
+#: another tool's) moves each light by up to ~0.05°, and had been judged "lights.lp wrong" of
+#: every image (1e-4 rad, 0.006°); a light edited or swapped moves by degrees, two decimals'
+#: rounding by up to ~0.5°, both still named. An LED's calibration is good to a degree at best.
+_SAME_LIGHT_RAD = math.radians(0.1)
 
 
 def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QAReport:  # type: ignore[type-arg]
