@@ -841,6 +841,31 @@ def acquisition_inputs(source: Path, files: dict[str, Path] | None = None) -> di
         return None
 
 
+def _shapes_differ(lp: Path, shapes: list[tuple[int, ...]], paths: list[Path]) -> str:
+    """Which images are not of the acquisition's size, by name, against the size most of its
+    images have. Why: "images of S/lights.lp differ in shape: [(400, 400, 3), (512, 512,
+    3)]" named no file, so a user had to open every image to find the one replaced."""
+    from collections import Counter
+
+    common = Counter(shapes).most_common(1)[0][0]
+    odd = [(p, s) for p, s in zip(paths, shapes, strict=True) if s != common]
+
+    def size(shape: tuple[int, ...]) -> str:
+        return f"{shape[1]}×{shape[0]}" + (f"×{shape[2]}" if len(shape) > 2 else "")
+
+    shown = ", ".join(
+        f"{p.relative_to(lp.parent) if p.is_relative_to(lp.parent) else p} ({size(s)})"
+        for p, s in odd[:5]
+    )
+    more = f" and {len(odd) - 5} more" if len(odd) > 5 else ""
+    return (
+        f"images of {shown_path(lp)} differ in size: {len(shapes) - len(odd)} are "
+        f"{size(common)} (width × height × channels), but {shown}{more} "
+        f"{'is' if len(odd) == 1 else 'are'} not: replaced or edited since capture? Put the "
+        "originals back from a copy, or leave those out of the .lp"
+    )
+
+
 def load_acquisition(
     source: Path,
     notes: list[str] | None = None,
@@ -864,7 +889,7 @@ def load_acquisition(
         notes.extend(colour_notes(lp, said, len(paths), sixteen))
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
-        raise FitInputError(f"images of {shown_path(lp)} differ in shape: {sorted(shapes)}")
+        raise FitInputError(_shapes_differ(lp, [f.shape for f in frames], paths))
     if notes is not None and not any(p.parent.name == "linear" for p in paths):
         # (a session's linear/ with stand-ins is said by acquisition_files); a converted
         # file's reading is its own file's, said by colour_notes, neither of the two guesses
