@@ -35,32 +35,33 @@ def _models_in(annotation: Any) -> list[Any]:
     return [m for arg in get_args(annotation) for m in _models_in(arg)]
 
 
-def table_keys(model: Any, loc: tuple[Any, ...]) -> list[str]:
-    """The keys of the table holding the key at pydantic location ``loc`` below ``model``:
-    what an unknown key there is compared with. Empty where that table is no model's (a free
-    dict such as ``[camera.device]``, checked by its driver's own model)."""
+def _table_models(model: Any, loc: tuple[Any, ...]) -> list[Any]:
+    """The models of the table holding the key at pydantic location ``loc`` below ``model``
+    (none where that table is no model's: a free dict such as ``[camera.device]``)."""
     models = [model]
     for part in loc[:-1]:
         if isinstance(part, int):
             continue  # an element of a list of tables: the list's annotation is its model's
         fields = [m.model_fields[part] for m in models if part in m.model_fields]
         models = [m for f in fields for m in _models_in(f.annotation)]
+    return models
+
+
+def table_keys(model: Any, loc: tuple[Any, ...]) -> list[str]:
+    """The keys of the table holding the key at pydantic location ``loc`` below ``model``:
+    what an unknown key there is compared with. Empty where that table is no model's (a free
+    dict such as ``[camera.device]``, checked by its driver's own model)."""
+    models = _table_models(model, loc)
     return sorted({f.alias or name for m in models for name, f in m.model_fields.items()})
 
 
 def field_of(model: Any, loc: tuple[Any, ...]) -> Any:
     """The pydantic field (its ``FieldInfo``) at location ``loc`` below ``model``, None where
     no model holds it (a free dict's key, an element of a list)."""
-    models = [model]
-    for part in loc[:-1]:
-        if isinstance(part, int):
-            continue
-        fields = [m.model_fields[part] for m in models if part in m.model_fields]
-        models = [m for f in fields for m in _models_in(f.annotation)]
     last = loc[-1] if loc else None
-    if isinstance(last, int):
+    if last is None or isinstance(last, int):
         return None
-    found = [m.model_fields[last] for m in models if last in m.model_fields]
+    found = [m.model_fields[last] for m in _table_models(model, loc) if last in m.model_fields]
     return found[0] if found else None
 
 
@@ -71,6 +72,9 @@ _BOUNDS = {
     "less_than": ("lt", "less than"),
     "less_than_equal": ("le", "at most"),
 }
+
+#: each constraint's words, by its attribute (``gt`` → "more than")
+_LIMIT_WORDS = dict(_BOUNDS.values())
 
 
 def _number(v: Any) -> str:
@@ -86,14 +90,13 @@ def _bounds_text(err: Any, field: Any) -> str | None:
     limits = [
         (attr, getattr(m, attr))
         for m in getattr(field, "metadata", ())
-        for attr in ("gt", "ge", "lt", "le")
+        for attr in _LIMIT_WORDS
         if getattr(m, attr, None) is not None
     ]
     if not limits:
         attr = _BOUNDS[err["type"]][0]
         limits = [(attr, err.get("ctx", {}).get(attr))]
-    words = {a: w for a, w in _BOUNDS.values()}
-    said = " and ".join(f"{words[a]} {_number(v)}" for a, v in limits)
+    said = " and ".join(f"{_LIMIT_WORDS[a]} {_number(v)}" for a, v in limits)
     about = getattr(field, "description", None)
     return f"must be {said} (got {err['input']!r})" + (f": {about}" if about else "")
 
