@@ -5,7 +5,10 @@ except where the PTM is ridge-regularised (one ring, the horizon) or over its no
 (lights on one side only): there its Lambertian reading was 22-71° off. This measures, on the
 simulator's scenes (as benchmarks.fit_auto_normals renders them), the mean normal error of the
 PTM's reading, of robust photometric stereo and of least-squares Lambert on such light sets,
-so the fallback is chosen by evidence: no estimator is best on every scene.
+so the fallback is chosen by evidence: no estimator is best on every scene. Since 2026-12-07 it
+also measures well-conditioned low bands, where the reading extrapolates (the column "reading
+bias": ``reading_bias_deg`` of the lights), and says
+which normals a fit writes on each set.
 
 Run: ``python -m benchmarks.ptm_normals_fallback [--write]`` (``--write`` replaces the section
 ``ptm_normals_fallback`` of docs/reconstruction.md).
@@ -21,9 +24,10 @@ import numpy as np
 
 from benchmarks.fit_auto_normals import DOC, SCENES, SIZE, angles, render, rings
 from benchmarks.report import machine_line, write_section
+from rti_rig.app.usecases.fit import conditioned_normal_source
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.reconstruct import fit_photometric_stereo
-from rti_rig.reconstruct.ptm import fit_ptm
+from rti_rig.reconstruct.ptm import fit_ptm, reading_bias_deg
 
 
 def one_side() -> np.ndarray:
@@ -36,6 +40,13 @@ LIGHT_SETS = {
     "one side, 18": one_side,
     "ring at 35°, 12": lambda: rings(((35, 12, 0),)),
     "ring at 20°, 16": lambda: rings(((20, 16, 0),)),
+    # well conditioned, read off by reading_bias_deg: the dome below 30° and other low bands
+    "rings at 10°/25°, 16": lambda: rings(((10, 8, 0), (25, 8, 15))),
+    "rings at 15°/30°, 24": lambda: rings(((15, 12, 0), (30, 12, 15))),
+    "rings at 10°/40°, 6": lambda: rings(((10, 3, 0), (40, 3, 60))),
+    "rings at 15°/45°, 9": lambda: rings(((15, 5, 0), (45, 4, 20))),
+    # below the limit, the PTM kept: robust PS was 44° off on the coin here
+    "rings at 15°/40°/70°, 7": lambda: rings(((15, 4, 0), (40, 2, 20), (70, 1, 0))),
 }
 
 
@@ -49,7 +60,12 @@ def row(scene: str, name: str, seed: int = 0) -> str:
     e = [angles(m.normals(), truth).mean() for m in (ptm,)]
     e += [angles(m.normals, truth).mean() for m in (robust, ls)]
     better = "either" if abs(e[1] - e[2]) < 0.05 else "robust PS" if e[1] < e[2] else "Lambert"
-    return f"| {scene} | {name} | {e[0]:.1f} | {e[1]:.2f} | {e[2]:.2f} | {better} |"
+    source, _ = conditioned_normal_source("ptm", lights)
+    used = {"ptm": "the PTM", "ps-robust": "robust PS", "": "none"}[source]
+    bias = f"{reading_bias_deg(lights):.1f}" if source else "-"
+    return (
+        f"| {scene} | {name} | {bias} | {e[0]:.1f} | {e[1]:.2f} | {e[2]:.2f} | {better} | {used} |"
+    )
 
 
 def main(argv: list[str] | None = None) -> str:
@@ -66,9 +82,9 @@ def main(argv: list[str] | None = None) -> str:
             f"({time.perf_counter() - t0:.0f} s). {machine_line()} Simulated scenes "
             f"{SIZE[0]}×{SIZE[1]} px; mean angle to the true normals.",
             "",
-            "| scene | lights | the PTM's reading (°) | robust PS (°) | least-squares Lambert (°) "
-            "| better here |",
-            "|---|---|---|---|---|---|",
+            "| scene | lights | reading bias on these lights (°) | the PTM's reading (°) | "
+            "robust PS (°) | least-squares Lambert (°) | better here | `fit --model ptm` uses |",
+            "|---|---|---|---|---|---|---|---|",
             *rows,
         ]
     )

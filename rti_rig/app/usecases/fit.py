@@ -1696,6 +1696,16 @@ def _refuse_undetermined_normals(req: FitRequest, model_name: str, lights: np.nd
     )
 
 
+#: Above this :func:`~rti_rig.reconstruct.ptm.reading_bias_deg` of the lights, a PTM's normal
+#: maps come from robust photometric stereo. Measured on the simulator's five scenes (docs/
+#: reconstruction.md, the ptm_normals_fallback table): light sets reading 3.1-6.5° off (bands
+#: below 30-45°, 6-24 lights) gave robust PS the better normals on the matte scenes (0.1-2.6°
+#: against 1.7-14°) and the coin, and worse ones on the brushed-steel part by 0.3-3.7°; the
+#: sets below it kept the PTM, among them 7 lights at 15/40/70° (2.5°), where robust PS was
+#: 44° off on the coin, and every real layout read (1.0-2.3°).
+PTM_READING_BIAS_LIMIT_DEG = 3.0
+
+
 def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str]:
     """The normal maps' estimator in place of ``source`` (``"ptm"`` or ``"ps-robust"``, the
     estimators a relighting model brings along), and what to tell the user.
@@ -1713,26 +1723,41 @@ def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str
     reconstruction.md, "No normals from a PTM"). Where they do not, no normal maps are
     written and the relighting files are, regularised as always: a PTM fit had written 71°-off
     normals, an HSH fit had been refused whole for its normals. ``--model ps``, ``lambert`` or
-    ``robust-ps`` asks for normals by name and is refused instead.
+    ``robust-ps`` asks for normals by name and is refused instead. A PTM well conditioned on
+    lights that leave the reading to extrapolate (all below 30-45°) is read off by more than
+    :data:`PTM_READING_BIAS_LIMIT_DEG` and is treated the same way: its normals had been 3-14°
+    off on matte scenes while the QA, judging its own photometric stereo, expected 0.1°.
     """
     from rti_rig.app.normals_determined import undetermined_normals
     from rti_rig.core.rti_bases import design_matrix
+    from rti_rig.reconstruct.ptm import BIAS_PROBE_TILT_DEG, reading_bias_deg
     from rti_rig.reconstruct.solve import NOISE_GAIN_LIMIT, condition_words, solve_matrix
 
     undetermined = undetermined_normals(lights, "lights of this session")
     if source == "ptm":
         _, ptm = solve_matrix(design_matrix("ptm", lights), "ptm", warn=False)
-        if ptm.trusted:  # neither regularised nor over the noise-gain limit
+        bias = reading_bias_deg(lights) if ptm.trusted else 0.0
+        if ptm.trusted and (bias <= PTM_READING_BIAS_LIMIT_DEG or undetermined is not None):
             return "ptm", ""
-        terms = f"its {ptm.n_coefficients} terms"
-        why = (
-            "ridge-regularised on these lights ("
-            f"{condition_words(ptm.condition_number, ptm.cond_limit, terms)}), and its "
-            "normals would be biased"
-            if ptm.regularised
-            else f"ill-conditioned on these lights (noise gain {ptm.noise_gain:.3g}, limit "
-            f"{NOISE_GAIN_LIMIT:g}), and its normals would be far off"
-        )
+        if ptm.trusted:
+            why = (
+                f"well conditioned, but its Lambertian reading is {bias:.1f}° off on these "
+                f"lights (a Lambertian surface tilted up to {BIAS_PROBE_TILT_DEG:g}°, limit "
+                f"{PTM_READING_BIAS_LIMIT_DEG:g}°): they leave part of the hemisphere the "
+                "reading spans empty"
+            )
+        elif ptm.regularised:
+            terms = f"its {ptm.n_coefficients} terms"
+            why = (
+                "ridge-regularised on these lights ("
+                f"{condition_words(ptm.condition_number, ptm.cond_limit, terms)}), and its "
+                "normals would be biased"
+            )
+        else:
+            why = (
+                f"ill-conditioned on these lights (noise gain {ptm.noise_gain:.3g}, limit "
+                f"{NOISE_GAIN_LIMIT:g}), and its normals would be far off"
+            )
         if undetermined is None:
             return "ps-robust", (
                 f"normals from robust photometric stereo, not the PTM: the PTM is {why}"
