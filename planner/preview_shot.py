@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from rti_rig.core.errors import ScheduleError
+from rti_rig.core.fit_minimums import NORMAL_MIN_LIGHTS
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, in_band
 from rti_rig.core.schedule import LightSchedule
@@ -39,6 +40,27 @@ def _band_option(el: float, band: tuple[float, float]) -> str:
     45``): the user fixes what the message names."""
     lo, hi = band
     return f"above --max-elevation-deg {hi:g}" if el > hi else f"below --min-elevation-deg {lo:g}"
+
+
+def refuse_unplannable_band(geometry: object, band: tuple[float, float]) -> None:
+    """Refuse a preview whose band holds a dome LED or two but fewer than a plan needs.
+
+    Why: a preview is the input of a plan in its band. On a dome with 2 LEDs at 85°, ``rti-rig
+    preview DOME --min-elevation-deg 80`` shot one of them and printed "Plan from it: rti-rig
+    plan ... --lights 3 --min-elevation-deg 80", refused when pasted ("asked for 3 lights but
+    the dome has only 2 LEDs"). A band with no LED is refused by :func:`preview_schedule`,
+    naming the same way out; an arm's band holds any number of lights.
+    """
+    if not isinstance(geometry, DomeGeometry):
+        return
+    lo, hi = band
+    held = int(in_band(az_el_from_direction(geometry.directions)[1], lo, hi).sum())
+    if 0 < held < NORMAL_MIN_LIGHTS:
+        raise ScheduleError(
+            f"the dome has only {held} LED{'s' if held > 1 else ''} between {lo:g}° and "
+            f"{hi:g}° elevation, and a plan in that band needs at least {NORMAL_MIN_LIGHTS} "
+            "(a surface normal's 3 unknowns); widen --min-elevation-deg / --max-elevation-deg"
+        )
 
 
 def preview_schedule(

@@ -2586,11 +2586,12 @@ def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> Op
     """A one-image session under the preview light (the planner's input)."""
     from rti_rig.app.config import load_rig_config, rig_geometry
     from rti_rig.planner.make_plan import check_elevation_band
-    from rti_rig.planner.preview_shot import preview_schedule
+    from rti_rig.planner.preview_shot import preview_schedule, refuse_unplannable_band
 
     check_max_saturated(req.max_saturated)
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     loaded = load_rig_config(req.rig_config)
+    refuse_unplannable_band(rig_geometry(loaded), (req.min_elevation_deg, req.max_elevation_deg))
     from rti_rig.app.flash_sync import refuse_options
 
     refuse_options(loaded, req.out_dir, preview=True)  # nothing was written to it
