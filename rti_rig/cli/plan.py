@@ -242,7 +242,7 @@ def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:
     """Plan, write and report (and draw the map): the body of :func:`plan`, run under its stop
     handling; ``done`` gets ``planned`` once the plan is written and ``drawn`` once the map is.
     """
-    from rti_rig.app.usecases.plan import draw_plan_figure, plan_lights
+    from rti_rig.app.usecases.plan import draw_plan_figure, next_run_command, plan_lights
 
     try:
         planned = done["planned"] = _plan_showing_progress(request, plan_lights)
@@ -257,6 +257,7 @@ def _plan_and_report(request: PlanLightsRequest, done: dict[str, Any]) -> None:
         markup=False,
         highlight=False,
     )
+    out.print(f"Next: {escape(next_run_command(planned))}", highlight=False, soft_wrap=True)
     if request.figure is not None:
         # after the report: a map that cannot be drawn must not hide a plan that was written
         try:

@@ -118,6 +118,9 @@ class PlannedLights:
     objective: str
     #: What the tolerant ``.lp`` reader accepted but the user should know (file, line, what).
     notes: tuple[str, ...] = ()
+    #: The rig the plan is for, as ``run`` takes it (the preview session's recorded config
+    #: where no ``--rig`` was given): the CLI's next step names it.
+    rig: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -281,7 +284,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     if not req.rig_given:
         preview_rig = _rig_of_preview(req)
         req = replace(req, rig=preview_rig.config, rig_given=True)
-    planned = _plan_lights(req, preview_rig)
+    planned = replace(_plan_lights(req, preview_rig), rig=req.rig)
     if preview_rig is None:
         return planned
     return replace(planned, notes=(preview_rig.note, *planned.notes))
@@ -669,20 +672,30 @@ def _uniform_command(req: PlanLightsRequest) -> str:
     )
 
 
-def run_plan_command(rig: Path, plan_file: Path) -> str:
-    """The ``rti-rig run`` command line that runs ``plan_file`` on ``rig`` with
-    ``--allow-no-normals``: the rig config given to ``plan`` (a bare ``.lp`` rig named as
-    :func:`_config_shown` names it), the plan, and a folder beside the plan that does not
-    exist yet.
+def run_plan_command(rig: Path, plan_file: Path, allow_no_normals: bool = True) -> str:
+    """The ``rti-rig run`` command line that runs ``plan_file`` on ``rig``, with
+    ``--allow-no-normals`` where asked: the rig config given to ``plan`` (a bare ``.lp`` rig
+    named as :func:`_config_shown` names it), the plan, and a folder beside the plan that does
+    not exist yet.
 
     Why: the advice had been ``rti-rig run --plan PLAN.lp --allow-no-normals``, which ``run``
     refuses ("give a RIG_CONFIG and --out DIR"), then ``--out DIR``, which pasted made a
     folder named DIR."""
     plan = shell_word(str(plan_file))
-    return (
-        f"rti-rig run {_config_shown(rig)} --plan {plan} --out {_run_folder(plan_file)} "
-        "--allow-no-normals"
-    )
+    allow = " --allow-no-normals" if allow_no_normals else ""
+    return f"rti-rig run {_config_shown(rig)} --plan {plan} --out {_run_folder(plan_file)}{allow}"
+
+
+def next_run_command(planned: PlannedLights) -> str:
+    """The ``run`` that shoots a written plan, for ``plan`` to end with: on the rig it was
+    planned for (the preview session's where no ``--rig`` was given), with
+    ``--allow-no-normals`` only where its lights need it (``run --plan`` refuses them without).
+
+    Why: ``plan`` ended at "Planned 12 lights → plan.lp"; ``preview`` and ``run`` each print
+    the command that comes next, and the plan, the step between them, did not."""
+    lights = np.array([s.direction for s in planned.schedule.steps], dtype=np.float64)
+    undetermined = undetermined_normals(lights, "planned lights") is not None
+    return run_plan_command(planned.rig or Path("RIG.toml"), planned.out_file, undetermined)
 
 
 def _lp_labels(labels: list[str]) -> list[str]:
