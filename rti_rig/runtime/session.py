@@ -3228,15 +3228,15 @@ def _run_wrote_lp(
 
 
 def lp_again(lp: Path, linear: bool = False) -> str:
-    """ "move lights.lp aside and write it again from the journal: rti-rig export-lp S --out
-    S/lights.lp": what a session's ``lp`` that is not the journal's listing (edited, cut short,
-    emptied) is mended by, in one set of words for the fit's verdict, its refusal of a
-    ``lights.lp`` that cannot be read, and a complete session's resume. ``linear``: the
+    """ "write it again from the journal (the present one is kept in recovered/): rti-rig
+    export-lp S --out S/lights.lp": what a session's ``lp`` that is not the journal's listing
+    (edited, cut short, emptied) is mended by, in one set of words for the fit's verdict, its
+    refusal of a ``lights.lp`` that cannot be read, and a complete session's resume. ``linear``: the
     listing names the linear TIFFs (``export-lp --linear``)."""
     folder = shell_word(str(lp.parent))
     return (
-        f"move {lp.name} aside and write it again from the journal: rti-rig export-lp {folder} "
-        f"--out {shell_word(str(lp))}" + (" --linear" if linear else "")
+        f"write it again from the journal (the present one is kept in recovered/): rti-rig "
+        f"export-lp {folder} --out {shell_word(str(lp))}" + (" --linear" if linear else "")
     )
 
 
@@ -3251,6 +3251,17 @@ def edited_lp_note(root: Path, kept: str, run: bool = True) -> str:
         f"record of the lights that fired; to keep your edit, make it again in {lp}"
         + (" once this run has ended" if run else "")
     )
+
+
+def set_aside_session_lp(root: Path) -> str:
+    """Move session ``root``'s ``lights.lp`` into a new ``recovered/STAMP/`` before ``export-lp``
+    writes it again from the journal; returns where it went, relative to ``root``.
+
+    Why: the verdict on a hand-edited ``lights.lp`` advised "move lights.lp aside and write it
+    again from the journal: rti-rig export-lp S --out S/lights.lp", and that command, pasted,
+    was refused ("would replace a file of the session"): the tool now does the moving, as a
+    resume does with an edited ``lights.lp``, and nothing of the user's is lost."""
+    return _set_aside(root, root / LP_NAME, _new_stamp(root), fresh=True)
 
 
 def _set_aside(root: Path, path: Path, stamp: str, fresh: bool = False) -> str:

@@ -69,7 +69,8 @@ def test_a_damaged_listing_is_named_with_its_mend_which_works(
     text = said(r)
     assert "but its lights.lp is not the listing rti-rig wrote from journal.jsonl" in text, text
     mend = f"rti-rig export-lp {out} --out {lp}"
-    assert f"move lights.lp aside and write it again from the journal: {mend}" in text, text
+    kept = "write it again from the journal (the present one is kept in recovered/)"
+    assert f"{kept}: {mend}" in text, text
     assert lp.read_bytes() == damaged  # a resume of a complete session changes nothing
 
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
@@ -81,10 +82,12 @@ def test_a_damaged_listing_is_named_with_its_mend_which_works(
     else:  # read, and judged wrong by the verdict (tests/cli/test_resume_edited_lights_lp.py)
         assert "lights.lp wrong" in said(r), r.output
 
-    lp.rename(out / "lights-damaged.lp")  # the mend, as said
-    r = runner.invoke(app, mend.split()[1:])
+    r = runner.invoke(app, mend.split()[1:])  # the mend, as said: it had been refused
     assert r.exit_code == 0, r.output
     assert lp.read_bytes() == (finished / "lights.lp").read_bytes()
+    (kept_lp,) = (out / "recovered").glob("*/lights.lp")  # the damaged one, never lost
+    assert kept_lp.read_bytes() == damaged
+    assert f"kept as {kept_lp}" in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0 and "not the listing" not in said(r), r.output
 

@@ -108,10 +108,11 @@ def test_an_export_into_its_own_session_says_so_and_never_replaces_its_lights_lp
     ) in text, text
     assert own.read_bytes() == captured
 
+    # the session's own lights.lp, already the journal's listing: left as it is
     r = wide.invoke(app, ["export-lp", str(a), "--out", str(own), "--force"])
-    assert r.exit_code == 2, r.output
-    assert "would replace a file of the session" in said(r), said(r)
-    assert own.read_bytes() == captured
+    assert r.exit_code == 0, r.output
+    assert f"{own} is already the listing of the journal: left as it is" in said(r), said(r)
+    assert own.read_bytes() == captured and not (a / "recovered").exists()
 
     own.unlink()  # lost: export-lp writes it again, and says what it wrote
     # an export beside the lost lights.lp says the command that writes it again, pasteable

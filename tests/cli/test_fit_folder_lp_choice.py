@@ -92,11 +92,18 @@ def test_export_lp_force_replaces_the_users_own_lp_in_the_session(
     r = runner.invoke(app, ["export-lp", str(s), "--out", str(mine), "--linear", "--force"])
     assert r.exit_code == 0, r.output
     assert mine.read_text().startswith("8\nlinear/image_001.tif")
-    for own in ("lights.lp", "manifest.json", "journal.jsonl", "image_001.jpg"):
+    for own in ("manifest.json", "journal.jsonl", "image_001.jpg"):
         before = (s / own).read_bytes()
         r = runner.invoke(app, ["export-lp", str(s), "--out", str(s / own), "--force"])
         assert r.exit_code == 2 and "never overwritten" in said(r), (own, r.output)
         assert (s / own).read_bytes() == before
+    # lights.lp, the listing the run writes from the journal: never of another kind (--linear)
+    before = (s / "lights.lp").read_bytes()
+    r = runner.invoke(app, ["export-lp", str(s), "--out", str(s / "lights.lp"), "--linear"])
+    assert r.exit_code == 2 and "never overwritten" in said(r), r.output
+    r = runner.invoke(app, ["export-lp", str(s), "--out", str(s / "lights.lp")])  # the same
+    assert r.exit_code == 0 and "left as it is" in said(r), r.output
+    assert (s / "lights.lp").read_bytes() == before
 
 
 def test_a_lights_lp_edited_since_capture_is_named_against_the_journal(

@@ -13,11 +13,12 @@ from pathlib import Path
 
 from rti_rig.app.output_files import check_output_file, lp_name_note, session_rig_inputs
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.lp_format import LpEntry, write_lp
+from rti_rig.core.lp_format import LpEntry, format_lp, write_lp
 from rti_rig.core.qt_names import qt_name_key
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
+    LINEAR_DIR,
     LP_NAME,
     MANIFEST,
     JournalScan,
@@ -36,6 +37,7 @@ from rti_rig.runtime.session import (
     renamed_since_capture,
     scan_journal,
     session_lp_report,
+    set_aside_session_lp,
     unchecked_images,
 )
 
@@ -103,10 +105,14 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     # (read only where the file exists, the one case they are compared with: a new file never
     # loads the rig config, which an export needs nothing of)
     config = (manifest.get("rig") or {}).get("config_path")
-    rig_files = session_rig_inputs(config) if Path(req.out_file).exists() else {}
-    check_output_file(req.out_file, req.force, rig_files)
-    in_session = _in_session_said(Path(req.out_file), root)  # said before lights.lp is written
-    write_lp(req.out_file, entries)
+    own = _own_listing(Path(req.out_file), root, entries, req.linear)
+    if own is None:
+        rig_files = session_rig_inputs(config) if Path(req.out_file).exists() else {}
+        check_output_file(req.out_file, req.force, rig_files)
+        in_session = _in_session_said(Path(req.out_file), root)  # before lights.lp is written
+        write_lp(req.out_file, entries)
+    else:
+        in_session = own
     # lights.lp one image short of the session (a run stopped between a step's record file
     # and its journal line): completed once the export is written, so that both list alike
     relisted = list_unwritten_step(root, scan)
@@ -135,6 +141,40 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
         ),
         misnamed=lp_name_note(Path(req.out_file)) or "",
         in_session=in_session,
+    )
+
+
+def _own_listing(out_file: Path, root: Path, entries: list[LpEntry], linear: bool) -> str | None:
+    """What becomes of session ``root``'s own ``lights.lp`` when ``out_file`` is it and it
+    exists, said; None for any other file (checked and written as one, so refused).
+
+    The session's ``lights.lp`` is the one file of a session ``export-lp`` writes over, and
+    only with a listing of the kind it holds (the JPEGs, or with ``--linear`` the linear
+    TIFFs; an empty or unreadable one as the run writes it, the JPEGs): it is the listing the
+    run writes from the journal, so writing it again from the journal replaces no capture.
+    One that already is that listing is left as it is; any other (edited by hand, cut short)
+    is moved into ``recovered/`` first (:func:`set_aside_session_lp`), never lost. Why: the
+    verdict's advice for an edited ``lights.lp`` was this very command, and it was refused as
+    "would replace a file of the session"."""
+    own = root / LP_NAME
+    if not own.is_file() or out_file.resolve() != own.resolve():
+        return None
+    try:
+        present: bytes | None = own.read_bytes()
+    except OSError:
+        present = None  # unreadable as it is: kept all the same, never overwritten unread
+    lists_linear = present is not None and any(
+        line.startswith(f"{LINEAR_DIR}/".encode()) for line in present.splitlines()
+    )
+    if linear != lists_linear:
+        return None  # another kind of listing: not the session's own mended
+    if present == format_lp(entries).encode("ascii"):
+        return f"{shown_path(own)} is already the listing of the journal: left as it is"
+    kept = set_aside_session_lp(root)
+    write_lp(own, entries)
+    return (
+        f"{shown_path(own)} was not the listing of the journal (edited by hand, or cut short): "
+        f"kept as {shown_path(root / kept)}, and {LP_NAME} written again from the journal"
     )
 
 
