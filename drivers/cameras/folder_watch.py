@@ -363,6 +363,30 @@ def _not_a_tiff(path: Path) -> bool:
     return len(head) == 4 and any(head) and head not in TIFF_MAGIC
 
 
+#: Bytes a file must hold, all text, before :func:`_text_file` calls it text: every image
+#: header holds a NUL or a byte UTF-8 does not allow well within them (a TIFF's and most RAWs'
+#: in their first 4 bytes, a JPEG's in its first; a Fuji RAF's within its first 60, after its
+#: text magic and model name), where a file still being written may be a few text-like bytes.
+TEXT_FILE_MIN_BYTES = 256
+
+
+def _text_file(path: Path, length: int = 4096) -> bool:
+    """Whether ``path``'s first bytes (up to ``length``, at least :data:`TEXT_FILE_MIN_BYTES`)
+    are text: UTF-8 with no NUL. No image file begins so."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(length)
+    except OSError:
+        return False
+    if len(head) < TEXT_FILE_MIN_BYTES or b"\0" in head:
+        return False
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        return len(head) == length and exc.start >= length - 3  # a character cut at the end
+    return True
+
+
 def _tiff_end_written(path: Path, start: int, end: int, length: int = 64) -> bool:
     """Whether the last bytes (up to ``length``) of ``path``'s region ``start``–``end`` (the
     piece its TIFF structure names last) are not all zero.
@@ -1481,6 +1505,18 @@ class FolderWatchCamera:
                         path,
                         "is no TIFF (its first bytes are written and are not a TIFF header: a "
                         "damaged file, or another kind saved under a TIFF name)",
+                    ) from exc
+                if _text_file(path) and tried is not None and _identity(path) == tried:
+                    # a sidecar (an XMP a raw developer writes beside each shot), a note: it
+                    # had been given timeout_s to change, then "raise stable_polls", which
+                    # cannot make text an image
+                    raise self._damaged(
+                        message,
+                        path,
+                        "is a text file, not an image (a sidecar such as an XMP, or a note), "
+                        "and matches patterns",
+                        f"Narrow patterns in [camera.device] (now {list(s.patterns)}) to the "
+                        'camera\'s image files, such as "IMG_*.CR2" or "*.tif"',
                     ) from exc
                 if isinstance(exc, ImageReadError) and exc.several:
                     # two full-size images, both written: more bytes cannot make one of them

@@ -889,3 +889,23 @@ def test_a_paused_tiff_with_a_private_tag_of_an_unlisted_type_is_waited_for(tmp_
     frame = cam.capture(0.5)
     assert frame.pixels.shape[:2] == (64, 64)
     assert clock.now() >= 3.0
+
+
+def test_a_text_file_that_matches_patterns_is_said_to_be_no_image_at_once(tmp_path):
+    """An XMP sidecar a raw developer writes beside each shot, matched by ``patterns =
+    ["IMG_*"]``: it stopped the session after ``timeout_s`` with "did not change … raise
+    stable_polls or poll_interval_s", though it is whole and no wait makes text an image."""
+    xmp = '<?xpacket begin="\ufeff"?><x:xmpmeta xmlns:x="adobe:ns:meta/">é</x:xmpmeta>\n'
+    clock = ScriptedClock(
+        {0.5: lambda: (tmp_path / "IMG_0001.xmp").write_text(xmp * 40, encoding="utf-8")}
+    )
+    cam = watch(tmp_path, clock, patterns=("IMG_*",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert "IMG_0001.xmp is a text file, not an image" in said, said
+    assert "Narrow patterns in [camera.device] (now ['IMG_*'])" in said, said
+    assert "stable_polls or poll_interval_s" not in said, said
+    assert clock.now() < 5.0  # said at once, not after the 30 s timeout
+    assert (tmp_path / "IMG_0001.xmp").exists()  # left where the program saved it
