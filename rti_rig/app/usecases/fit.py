@@ -1902,6 +1902,9 @@ def verdict_for_session(session: Path) -> str:
 #: light that did not fire, or fired as another; one frame shaken): a saturated image, a move
 #: of the object part-way or a session where nothing changes would be shot the same again.
 _CURED_IN_PLACE = ("misfired", "wrong light", "object or camera moved: shifted")
+#: ... and a frame delivered twice (``qa_repeated.REPEATED``: a missed trigger, a stale
+#: frame): its verdict said "reshoot it" and the command offered left it out.
+_CAMERA_CURED = "the same picture as"
 
 
 def reshoot_in_place(session: Path, report: Any) -> str | None:
@@ -1942,21 +1945,30 @@ def reshoot_in_place(session: Path, report: Any) -> str | None:
         return None
 
     def cured(problem: str) -> bool:
-        return problem.startswith(_CURED_IN_PLACE) or problem.endswith(BRIGHTER)
+        return problem.startswith((*_CURED_IN_PLACE, _CAMERA_CURED)) or problem.endswith(BRIGHTER)
 
-    names = [
-        Path(c.name).stem for c in report.reshoot if c.problems and all(map(cured, c.problems))
-    ]
+    chosen = [c for c in report.reshoot if c.problems and all(map(cured, c.problems))]
+    names = [Path(c.name).stem for c in chosen]
     lost = list(getattr(report, "lost_unfitted", ()) or ())
     if not names:
         return None
     words = f"rti-rig run --resume {shell_word(str(session))} --reshoot {','.join(names)}"
     words += " --reshoot-lost" if lost else ""
-    # a dead or weak LED, or a wrong LED map, gives the same image again until it is mended
-    return (
-        f"to reshoot {', '.join(names)} in place, once what made the light wrong is mended (an "
-        f"LED that did not fire, a loose connector, a swapped LED): {words}"
-    )
+    # a dead or weak LED, or a wrong LED map, gives the same image again until it is mended;
+    # a camera that returned an earlier frame, until its trigger is
+    camera = [any(p.startswith(_CAMERA_CURED) for p in c.problems) for c in chosen]
+    causes = []
+    if not all(camera):
+        causes.append(
+            "what made the light wrong is mended (an LED that did not fire, a loose "
+            "connector, a swapped LED)"
+        )
+    if any(camera):
+        causes.append(
+            "what made the camera deliver an earlier frame is mended (a missed trigger, a "
+            "stale frame)"
+        )
+    return f"to reshoot {', '.join(names)} in place, once {' and '.join(causes)}: {words}"
 
 
 def _stand_in_said(session: Path, dome: dict[str, Any]) -> str | None:
