@@ -55,11 +55,17 @@ def refuse_unplannable_band(geometry: object, band: tuple[float, float]) -> None
         return
     lo, hi = band
     held = int(in_band(az_el_from_direction(geometry.directions)[1], lo, hi).sum())
+    leds = f"{held} LED{'s' if held > 1 else ''}"
+    if 0 < held < NORMAL_MIN_LIGHTS and tuple(band) == FULL_BAND_DEG:
+        raise ScheduleError(
+            f"the dome has only {leds}, and a plan needs at least {NORMAL_MIN_LIGHTS} (a surface "
+            "normal's 3 unknowns): no plan can be made for it from a preview"
+        )
     if 0 < held < NORMAL_MIN_LIGHTS:
         raise ScheduleError(
-            f"the dome has only {held} LED{'s' if held > 1 else ''} between {lo:g}° and "
-            f"{hi:g}° elevation, and a plan in that band needs at least {NORMAL_MIN_LIGHTS} "
-            "(a surface normal's 3 unknowns); widen --min-elevation-deg / --max-elevation-deg"
+            f"the dome has only {leds} between {lo:g}° and {hi:g}° elevation, and a plan in "
+            f"that band needs at least {NORMAL_MIN_LIGHTS} (a surface normal's 3 unknowns); "
+            "widen --min-elevation-deg / --max-elevation-deg"
         )
 
 

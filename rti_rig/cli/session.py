@@ -2498,4 +2498,8 @@ def export_lp(
     # escaped: a file in a folder named 'coin [draft]' had been said as 'coin .lp' (rich read
     # '[draft]' as markup)
     n = len(done.entries)
-    out.print(f"{n} light{'' if n == 1 else 's'} → {escape(shown_path(out_file))}")
+    lights = f"{n} light{'' if n == 1 else 's'}"
+    if done.written:
+        out.print(f"{lights} → {escape(shown_path(out_file))}")
+    else:  # the session's own lights.lp, already the journal's listing (said above)
+        out.print(f"{lights}, as {escape(shown_path(out_file))} already lists them")

@@ -41,7 +41,7 @@ images to reshoot and why, followed by every check that was not made (:attr:`QAR
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
@@ -687,18 +687,22 @@ class QAReport:
                 if p.startswith((MOVED_FROM, UNCHANGING, BLACK_THROUGHOUT)):
                     carriers.setdefault(p, []).append(c)
         ranged = {p: run for p, run in carriers.items() if len(run) >= 3}
+        shared = _shared_advice([[p for p in c.problems if p not in ranged] for c in self.reshoot])
         parts = []
         for c in self.reshoot:
             for p in c.problems:
                 if p in ranged and ranged[p][0] is c:
                     run = ranged[p]
                     parts.append(f"{run[0].name} ... {run[-1].name} ({len(run)} images: {p})")
-            rest = [p for p in c.problems if p not in ranged]
+            rest = [_without_advice(p, shared) for p in c.problems if p not in ranged]
             if rest:
                 parts.append(f"{c.name} ({'; '.join(rest)})")
+        once = "".join(
+            f"; for the {n} {kind} images: {advice}" for advice, (n, kind) in shared.items()
+        )
         light = f"; {self.light_note}" if self.light_note else ""
         mirrored = f"{MIRRORED_SAID}; " if self.lights_mirrored else ""
-        return mirrored + f"{self.verdict_word}: " + ", ".join(parts + lost) + light + tail
+        return mirrored + f"{self.verdict_word}: " + ", ".join(parts + lost) + once + light + tail
 
     def bright_within_light_scatter(self) -> list[ImageCheck]:
         """The images called brighter than predicted whose light's own output can explain it
@@ -768,6 +772,48 @@ class QAReport:
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
+
+
+#: Images that must share a problem's advice before the verdict says it once for them all.
+SHARED_ADVICE_MIN = 3
+
+
+def _shared_advice(problems: list[list[str]]) -> dict[str, tuple[int, str]]:
+    """``{advice: (images, kind)}``: each advice (what follows a problem's first "; ") that
+    the problems of at least :data:`SHARED_ADVICE_MIN` images end with, and what those
+    problems are ("saturated": the words before their first ":").
+
+    Why: an overexposed session's verdict named 48 images, each with the same 200 characters
+    of advice ("a session keeps one exposure: shoot it again as a new session …"), where
+    each image's own finding is its clipped share."""
+    seen: dict[str, list[str]] = {}
+    for image in problems:
+        # in the problems' order (a set's had followed the string hash: the verdict's clauses
+        # changed order from run to run)
+        for advice, kind in dict.fromkeys(a for a in map(_advice_of, image) if a is not None):
+            seen.setdefault(advice, []).append(kind)
+    return {
+        advice: (len(kinds), kinds[0])
+        for advice, kinds in seen.items()
+        if len(kinds) >= SHARED_ADVICE_MIN and len(set(kinds)) == 1
+    }
+
+
+def _advice_of(problem: str) -> tuple[str, str] | None:
+    """(advice, kind) of ``problem``: what follows its first "; " and the one word before its
+    first ":" ("saturated"); None where it has no such two parts. Problems led by more words
+    ("a flat frame: …", "the same picture as image_001, though … (…: …)") keep their advice:
+    there it is part of the finding, and their words made no label."""
+    head, sep, advice = problem.partition("; ")
+    kind, colon, _ = head.partition(":")
+    one_word = kind.isalpha()
+    return (advice, kind) if sep and colon and advice and one_word else None
+
+
+def _without_advice(problem: str, shared: Mapping[str, object]) -> str:
+    """``problem`` without its advice where that is said once for all (:func:`_shared_advice`)."""
+    head, _, advice = problem.partition("; ")
+    return head if advice in shared else problem
 
 
 def lights_independent(problem: str) -> bool:

@@ -3253,15 +3253,40 @@ def edited_lp_note(root: Path, kept: str, run: bool = True) -> str:
     )
 
 
-def set_aside_session_lp(root: Path) -> str:
-    """Move session ``root``'s ``lights.lp`` into a new ``recovered/STAMP/`` before ``export-lp``
-    writes it again from the journal; returns where it went, relative to ``root``.
+def rewrite_session_lp(root: Path, entries: list[LpEntry]) -> str | None:
+    """Write session ``root``'s ``lights.lp`` again as ``entries`` (the journal's listing,
+    from ``export-lp``), under the session's lock, keeping a copy of the one there in a new
+    ``recovered/STAMP/``: returns that copy's path relative to ``root`` ("" where there was no
+    file left to keep), or None where the file already is that listing (nothing written).
 
-    Why: the verdict on a hand-edited ``lights.lp`` advised "move lights.lp aside and write it
-    again from the journal: rti-rig export-lp S --out S/lights.lp", and that command, pasted,
-    was refused ("would replace a file of the session"): the tool now does the moving, as a
-    resume does with an edited ``lights.lp``, and nothing of the user's is lost."""
-    return _set_aside(root, root / LP_NAME, _new_stamp(root), fresh=True)
+    A copy, then the new listing renamed over the old whole: stopped at any point, the session
+    has a ``lights.lp``. Why: the verdict on a hand-edited ``lights.lp`` advised "rti-rig
+    export-lp S --out S/lights.lp", and that command, pasted, was refused ("would replace a
+    file of the session"); the advice had said to move the file aside by hand first."""
+    path = root / LP_NAME
+    wanted = format_lp(entries).encode("ascii")
+    held = str(root.resolve()) in _LOCKED
+    lock_session(root)  # a run or resume begun since: refused, nothing changed
+    try:
+        try:
+            if path.read_bytes() == wanted:
+                return None
+        except FileNotFoundError:
+            write_lp_atomic(path, entries)
+            return ""
+        except OSError:
+            pass  # unreadable as it is: copied all the same, never replaced uncopied
+        dest = free_name(root / "recovered" / _new_stamp(root) / LP_NAME)
+        try:
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(path, dest)
+        except OSError as exc:
+            raise SessionWriteError(dest, exc) from None
+        write_lp_atomic(path, entries)
+        return dest.relative_to(root).as_posix()
+    finally:
+        if not held:
+            unlock_session(root)
 
 
 def _set_aside(root: Path, path: Path, stamp: str, fresh: bool = False) -> str:

@@ -87,7 +87,7 @@ def test_a_damaged_listing_is_named_with_its_mend_which_works(
     assert lp.read_bytes() == (finished / "lights.lp").read_bytes()
     (kept_lp,) = (out / "recovered").glob("*/lights.lp")  # the damaged one, never lost
     assert kept_lp.read_bytes() == damaged
-    assert f"kept as {kept_lp}" in said(r), r.output
+    assert f"the one there is kept as {kept_lp}" in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0 and "not the listing" not in said(r), r.output
 

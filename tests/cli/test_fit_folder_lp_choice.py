@@ -103,6 +103,7 @@ def test_export_lp_force_replaces_the_users_own_lp_in_the_session(
     assert r.exit_code == 2 and "never overwritten" in said(r), r.output
     r = runner.invoke(app, ["export-lp", str(s), "--out", str(s / "lights.lp")])  # the same
     assert r.exit_code == 0 and "left as it is" in said(r), r.output
+    assert "already lists them" in said(r) and "→" not in said(r), r.output
     assert (s / "lights.lp").read_bytes() == before
 
 

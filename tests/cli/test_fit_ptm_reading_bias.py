@@ -43,7 +43,8 @@ def test_low_lights_on_the_shipped_dome_get_robust_ps_normals(tmp_path: Path) ->
     said = _said(["fit", str(session), "--out", str(tmp_path / "f")])
     assert "Model: ptm" in said  # what auto chooses here: the case at issue
     assert "normals from robust photometric stereo, not the PTM" in said, said
-    assert "its Lambertian reading is 5.6° off on these lights" in said, said
+    bias = float(said.split("its Lambertian reading is ", 1)[1].split("° off on these lights")[0])
+    assert 4.0 < bias < 8.0, said  # 5.6° as measured: a property of these 16 lights
     assert "Normals: robust photometric stereo" in said, said
     fit = json.loads((tmp_path / "f" / "fit.json").read_text())
     assert fit["normals_from"] == "ps-robust"

@@ -53,3 +53,16 @@ def test_the_plan_a_preview_prints_runs_as_printed(tmp_path: Path) -> None:
     r = runner.invoke(app, [*line, "--out", str(plan)])
     assert r.exit_code == 0, r.output
     assert plan.exists()
+
+
+def test_a_dome_of_two_leds_is_told_no_plan_can_be_made_not_to_widen(tmp_path: Path) -> None:
+    text = (REPO / "rig_configs" / "simulated_dome.toml").read_text(encoding="utf-8")
+    start, end = text.index("rings = ["), text.index("]\n", text.index("rings = [")) + 2
+    two = "rings = [\n  { elevation_deg = 40.0, count = 2, azimuth_offset_deg = 0.0 },\n]\n"
+    config = tmp_path / "two.toml"
+    config.write_text(text[:start] + two + text[end:], encoding="utf-8")
+    r = runner.invoke(app, ["preview", str(config), "--out", str(tmp_path / "P")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "the dome has only 2 LEDs, and a plan needs at least 3" in said, said
+    assert "widen" not in said and not (tmp_path / "P").exists()

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from rti_rig.app.output_files import check_output_file, lp_name_note, session_rig_inputs
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.lp_format import LpEntry, format_lp, write_lp
+from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.core.qt_names import qt_name_key
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.runtime.disowned import refuse_if_disowned
@@ -35,9 +35,9 @@ from rti_rig.runtime.session import (
     refuse_if_in_use,
     renamed_note,
     renamed_since_capture,
+    rewrite_session_lp,
     scan_journal,
     session_lp_report,
-    set_aside_session_lp,
     unchecked_images,
 )
 
@@ -82,6 +82,9 @@ class ExportedLp:
     #: What was written into the session's own folder and what was left as captured ("" for
     #: a file written elsewhere: :attr:`outside_session` says that).
     in_session: str = ""
+    #: False where ``--out`` was the session's own lights.lp, already its journal's listing:
+    #: nothing was written (the CLI says so, not "N lights → …").
+    written: bool = True
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -106,13 +109,14 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     # loads the rig config, which an export needs nothing of)
     config = (manifest.get("rig") or {}).get("config_path")
     own = _own_listing(Path(req.out_file), root, entries, req.linear)
+    written = True
     if own is None:
         rig_files = session_rig_inputs(config) if Path(req.out_file).exists() else {}
         check_output_file(req.out_file, req.force, rig_files)
         in_session = _in_session_said(Path(req.out_file), root)  # before lights.lp is written
         write_lp(req.out_file, entries)
     else:
-        in_session = own
+        in_session, written = own
     # lights.lp one image short of the session (a run stopped between a step's record file
     # and its journal line): completed once the export is written, so that both list alike
     relisted = list_unwritten_step(root, scan)
@@ -141,49 +145,50 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
         ),
         misnamed=lp_name_note(Path(req.out_file)) or "",
         in_session=in_session,
+        written=written,
     )
 
 
-def _own_listing(out_file: Path, root: Path, entries: list[LpEntry], linear: bool) -> str | None:
+def _own_listing(
+    out_file: Path, root: Path, entries: list[LpEntry], linear: bool
+) -> tuple[str, bool] | None:
     """What becomes of session ``root``'s own ``lights.lp`` when ``out_file`` is it and it
-    exists, said; None for any other file (checked and written as one, so refused).
+    exists, said, and whether it was written; None for any other file (checked and written as
+    one, so refused).
 
     The session's ``lights.lp`` is the one file of a session ``export-lp`` writes over, and
     only with a listing of the kind it holds (the JPEGs, or with ``--linear`` the linear
     TIFFs; an empty or unreadable one as the run writes it, the JPEGs): it is the listing the
-    run writes from the journal, so writing it again from the journal replaces no capture.
-    One that already is that listing is left as it is; any other (edited by hand, cut short)
-    is moved into ``recovered/`` first (:func:`set_aside_session_lp`), never lost. Why: the
-    verdict's advice for an edited ``lights.lp`` was this very command, and it was refused as
-    "would replace a file of the session"."""
+    run writes from the journal, so writing it again from the journal replaces no capture,
+    and the one there is kept (:func:`rewrite_session_lp`)."""
     own = root / LP_NAME
     if not own.is_file() or out_file.resolve() != own.resolve():
         return None
     try:
-        present: bytes | None = own.read_bytes()
+        present = own.read_bytes()
     except OSError:
-        present = None  # unreadable as it is: kept all the same, never overwritten unread
-    lists_linear = present is not None and any(
-        line.startswith(f"{LINEAR_DIR}/".encode()) for line in present.splitlines()
-    )
+        present = b""  # unreadable as it is: taken as the run writes it, the JPEGs
+    lists_linear = any(line.startswith(f"{LINEAR_DIR}/".encode()) for line in present.splitlines())
     if linear != lists_linear:
         return None  # another kind of listing: not the session's own mended
-    if present == format_lp(entries).encode("ascii"):
-        return f"{shown_path(own)} is already the listing of the journal: left as it is"
-    kept = set_aside_session_lp(root)
-    write_lp(own, entries)
+    kept = rewrite_session_lp(root, entries)
+    if kept is None:
+        return f"{shown_path(own)} is already the listing of the journal: left as it is", False
+    if not kept:
+        return f"{shown_path(own)} written again from the journal", True
     return (
-        f"{shown_path(own)} was not the listing of the journal (edited by hand, or cut short): "
-        f"kept as {shown_path(root / kept)}, and {LP_NAME} written again from the journal"
-    )
+        f"{shown_path(own)} differed from the listing of the journal: the one there is kept as "
+        f"{shown_path(root / kept)}, and {LP_NAME} is written again from the journal"
+    ), True
 
 
 def _in_session_said(out_file: Path, root: Path) -> str:
     """What an export written at the top of its own session folder does there ("" elsewhere).
 
     Why: it was written there without a word, beside the session's captured files, and whether
-    the session's own lights.lp was replaced (it never is: :func:`check_output_file` refuses
-    it), or which of the two ``rti-rig fit`` of the folder reads, was left to guess."""
+    the session's own lights.lp was replaced (only ever by its own listing again, with the one
+    there kept: :func:`_own_listing`), or which of the two ``rti-rig fit`` of the folder reads,
+    was left to guess."""
     if out_file.resolve().parent != root.resolve():
         return ""
     own = root / LP_NAME

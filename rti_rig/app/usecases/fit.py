@@ -1736,8 +1736,9 @@ def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str
     undetermined = undetermined_normals(lights, "lights of this session")
     if source == "ptm":
         _, ptm = solve_matrix(design_matrix("ptm", lights), "ptm", warn=False)
-        bias = reading_bias_deg(lights) if ptm.trusted else 0.0
-        if ptm.trusted and (bias <= PTM_READING_BIAS_LIMIT_DEG or undetermined is not None):
+        # measured only where robust PS could take over (a trusted PTM, Lambert determined)
+        bias = reading_bias_deg(lights) if ptm.trusted and undetermined is None else 0.0
+        if ptm.trusted and bias <= PTM_READING_BIAS_LIMIT_DEG:
             return "ptm", ""
         if ptm.trusted:
             why = (
@@ -1902,9 +1903,6 @@ def verdict_for_session(session: Path) -> str:
 #: light that did not fire, or fired as another; one frame shaken): a saturated image, a move
 #: of the object part-way or a session where nothing changes would be shot the same again.
 _CURED_IN_PLACE = ("misfired", "wrong light", "object or camera moved: shifted")
-#: ... and a frame delivered twice (``qa_repeated.REPEATED``: a missed trigger, a stale
-#: frame): its verdict said "reshoot it" and the command offered left it out.
-_CAMERA_CURED = "the same picture as"
 
 
 def reshoot_in_place(session: Path, report: Any) -> str | None:
@@ -1920,6 +1918,10 @@ def reshoot_in_place(session: Path, report: Any) -> str | None:
     (``--reshoot-lost`` takes only lost images): the user had to shoot the whole session
     again, or leave the object with a hole in its lights."""
     from rti_rig.reconstruct.qa import BRIGHTER
+
+    # a frame delivered twice (a missed trigger, a stale frame): its verdict said "reshoot
+    # it" and the command offered had left it out
+    from rti_rig.reconstruct.qa_repeated import REPEATED as _CAMERA_CURED
     from rti_rig.runtime.session import read_manifest
 
     try:

@@ -284,7 +284,9 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     if not req.rig_given:
         preview_rig = _rig_of_preview(req)
         req = replace(req, rig=preview_rig.config, rig_given=True)
-    planned = replace(_plan_lights(req, preview_rig), rig=req.rig)
+    planned = _plan_lights(req, preview_rig)
+    # an RTIBuilder project folder is planned on its .lp, and run as that (set inside)
+    planned = replace(planned, rig=planned.rig or req.rig)
     if preview_rig is None:
         return planned
     return replace(planned, notes=(preview_rig.note, *planned.notes))
@@ -603,8 +605,8 @@ def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: li
     if reason is not None:
         notes.append(
             f"{reason}; planned as asked (--allow-no-normals): "
-            f"{fit_without_normals(len(lights))}; run it with "
-            f"{run_plan_command(req.rig, req.out_file)}"
+            f"{fit_without_normals(len(lights))}; run it with --allow-no-normals too (the "
+            "plan's Next line says the whole command)"
         )
 
 
@@ -672,7 +674,7 @@ def _uniform_command(req: PlanLightsRequest) -> str:
     )
 
 
-def run_plan_command(rig: Path, plan_file: Path, allow_no_normals: bool = True) -> str:
+def run_plan_command(rig: Path, plan_file: Path, allow_no_normals: bool) -> str:
     """The ``rti-rig run`` command line that runs ``plan_file`` on ``rig``, with
     ``--allow-no-normals`` where asked: the rig config given to ``plan`` (a bare ``.lp`` rig
     named as :func:`_config_shown` names it), the plan, and a folder beside the plan that does
