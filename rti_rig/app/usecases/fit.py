@@ -1932,6 +1932,11 @@ def reshoot_in_place(session: Path, report: Any) -> str | None:
     config = rig.get("config") or {}
     dome = config.get("dome") or {}
     camera = (config.get("camera") or {}).get("device") or {}
+    if getattr(report, "lp_defect", ""):
+        # the .lp is the established cause (edited since capture): written again from the
+        # journal, the images are as captured; a reshoot of the image under the edited line
+        # had been offered beside that mend, "once what made the light wrong is mended"
+        return None
     if getattr(report, "lights_likely_wrong", False):
         # one image's reshoot cures nothing when most recorded lights are wrong (the verdict
         # names none one by one for it): it had been offered all the same
