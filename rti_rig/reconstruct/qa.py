@@ -99,6 +99,12 @@ from rti_rig.reconstruct.qa_unchanging import (
     unchanging_problem,
     unchanging_spread,
 )
+from rti_rig.reconstruct.qa_underexposed import (
+    MORE_EXPOSURE,
+    UNDEREXPOSED,
+    UNDEREXPOSED_PEAK,
+    underexposed_problem,
+)
 from rti_rig.reconstruct.signal_check import every_image_black, sample_grid, sample_pixels
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
@@ -404,6 +410,11 @@ class ImageCheck:
     #: light is judged on: too little lit to judge, so its brightness is not judged
     #: (``gain_judged``) rather than called a misfire that a reshoot would repeat.
     grazing_unjudged: bool = False
+    #: The image's brightest level (:data:`PEAK_PERCENTILE` of the frame reduced by area) as a
+    #: share of full scale; NaN where there is none (float frames). The brightest image's
+    #: names a session under-exposed throughout (:mod:`qa_underexposed`); each image's shows
+    #: how much of the camera's range its light used.
+    peak_level: float = float("nan")
 
 
 #: The saturation check's advice (replaced where a session cannot follow it).
@@ -422,7 +433,14 @@ MOVED_ADVICE = "reshoot the whole session"
 #: phrase here. Why one list: "reshoot with less exposure" alone had been replaced, so an
 #: imported acquisition was still told of a flat frame "reshoot it" and of images that never
 #: changed "then reshoot", advice for an object no longer under any dome.
-REDO_ADVICE = (LESS_EXPOSURE, FLAT_ADVICE, UNCHANGING_ADVICE, BLACK_ADVICE, MOVED_ADVICE)
+REDO_ADVICE = (
+    LESS_EXPOSURE,
+    FLAT_ADVICE,
+    UNCHANGING_ADVICE,
+    BLACK_ADVICE,
+    MOVED_ADVICE,
+    MORE_EXPOSURE,
+)
 
 
 @dataclass(frozen=True)
@@ -684,7 +702,7 @@ class QAReport:
         carriers: dict[str, list[ImageCheck]] = {}
         for c in self.reshoot:
             for p in c.problems:
-                if p.startswith((MOVED_FROM, UNCHANGING, BLACK_THROUGHOUT)):
+                if p.startswith((MOVED_FROM, UNCHANGING, BLACK_THROUGHOUT, UNDEREXPOSED)):
                     carriers.setdefault(p, []).append(c)
         ranged = {p: run for p, run in carriers.items() if len(run) >= 3}
         shared = _shared_advice([[p for p in c.problems if p not in ranged] for c in self.reshoot])
@@ -821,7 +839,9 @@ def lights_independent(problem: str) -> bool:
     images that do not change, black throughout), where the others (wrong light, brighter or
     dimmer than predicted, exposure against its elevation, moved) are found against a fit of
     the recorded lights and follow from a wrong ``.lp`` alone."""
-    return problem.startswith(("saturated", FLAT_FRAME, UNCHANGING, BLACK_THROUGHOUT, REPEATED))
+    return problem.startswith(
+        ("saturated", FLAT_FRAME, UNCHANGING, BLACK_THROUGHOUT, REPEATED, UNDEREXPOSED)
+    )
 
 
 def _readvised(problem: str, name: str, advice: Callable[[str, str], str]) -> str:
@@ -1952,6 +1972,9 @@ def assess(
         if all_black  # judged with a full scale: ``peak`` is finite
         else ""
     )
+    # every image far darker than the camera's range allows (qa_underexposed): the images
+    # agree, so no check of one against the others finds it
+    underexposed = None if all_black else underexposed_problem(peak)
     for i in range(n):
         problems = []
         bright_claim: str | None = None  # the one problem that says "brighter", if any
@@ -2036,6 +2059,8 @@ def assess(
             problems = [p for p in problems if p.startswith("saturated")]
             problems.append(repeated_problem(names[repeated[i]]))
             bright_claim = None
+        if underexposed is not None:
+            problems.append(underexposed)
         if step is not None and _in_open_range(step, i):
             problems.append(_may_have_moved(step, names))
         elif step_moved[i] and step is not None:
@@ -2089,6 +2114,7 @@ def assess(
                 exposure_ratio=float(exposure[i]),
                 exposure_limit=float(limit[i]),
                 bright_problem=bright_claim,
+                peak_level=float(peak[i]),
             )
         )
     flagged = {c.index for c in checks if c.problems}
@@ -2123,6 +2149,7 @@ def assess(
         "exposure_scatter_z": EXPOSURE_SCATTER_Z,
         "exposure_mate_deg": EXPOSURE_MATE_DEG,
         "mirror_ratio": MIRROR_RATIO,
+        "underexposed_peak": UNDEREXPOSED_PEAK,
     }
     mirrored = mirror_ratio(ps.normals, ps.valid)
     return QAReport(

@@ -25,6 +25,7 @@ from rti_rig.reconstruct.qa import (
     BLACK_ADVICE,
     FLAT_ADVICE,
     LESS_EXPOSURE,
+    MORE_EXPOSURE,
     MOVED_ADVICE,
     UNCHANGING_ADVICE,
     QAReport,
@@ -375,6 +376,7 @@ REPLAYED_ADVICE = {
     FLAT_ADVICE: "so it was recorded (a replayed acquisition cannot be reshot)",
     UNCHANGING_ADVICE: "so they were recorded (a replayed acquisition cannot be reshot)",
     BLACK_ADVICE: "so they were recorded (a replayed acquisition cannot be reshot)",
+    MORE_EXPOSURE: "so they were recorded (a replayed acquisition cannot be reshot)",
     MOVED_ADVICE: (
         "so it was recorded (a replayed acquisition cannot be reshot): align the images from "
         "the move on to the earlier ones before fitting, or fit one position's images alone"
@@ -385,6 +387,10 @@ PLANNED_ADVICE = {
     LESS_EXPOSURE: (
         "a session keeps one exposure: shoot it again as a new session with a shorter "
         "camera.exposure_s, or with --auto-exposure"
+    ),
+    MORE_EXPOSURE: (
+        "a session keeps one exposure: shoot it again as a new session with a longer "
+        "camera.exposure_s (or more light), or with --auto-exposure"
     ),
 }
 
@@ -402,6 +408,7 @@ ADAPTIVE_ADVICE = {
     FLAT_ADVICE: "a new session replaces it (an adaptive session cannot reshoot one image)",
     UNCHANGING_ADVICE: "check that each light fires, then start a new session",
     BLACK_ADVICE: "mend that, then start a new session",
+    MORE_EXPOSURE: "start a new session with a longer camera.exposure_s (or more light)",
     MOVED_ADVICE: (
         "start a new session (an adaptive session cannot reshoot part of one), or align the "
         "images from the move on to the earlier ones before fitting"
@@ -418,6 +425,7 @@ IMPORTED_ADVICE = {
     FLAT_ADVICE: "so it is in the acquisition",
     UNCHANGING_ADVICE: "so they are in the acquisition: no fit of them can be trusted",
     BLACK_ADVICE: "so they are in the acquisition: there is nothing to fit",
+    MORE_EXPOSURE: "so they are in the acquisition: its fit is the noisier for it",
     # a move part-way through: the acquisition holds two positions of the object, which no
     # reshoot here mends (it had been told "reshoot the whole session")
     MOVED_ADVICE: (
