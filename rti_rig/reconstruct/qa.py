@@ -327,6 +327,9 @@ BRIGHTER = "brighter than the other images predict"
 #: The caveat of the light directions of images that do not change with their light (said
 #: once: the verdict names the fault itself).
 UNCHANGING_DIRECTIONS = "light directions not checked: with every image alike, none tells its light"
+#: ... and in an acquisition black throughout, in place of blaming the object: a dome session
+#: at 1/500 of its exposure had been told "a glossy, saturated or non-Lambertian surface".
+BLACK_DIRECTIONS = "light directions not checked: images this dark tell no light"
 #: The exposure check's words (:mod:`~rti_rig.reconstruct.qa_exposure`): "about N× too bright
 #: for its light" is a bright image too, which a dome's uneven LEDs can explain.
 TOO_BRIGHT = "too bright for its light"
@@ -828,10 +831,14 @@ def _advice_of(problem: str) -> tuple[str, str] | None:
     return (advice, kind) if sep and colon and advice and one_word else None
 
 
-def _without_advice(problem: str, shared: Mapping[str, object]) -> str:
-    """``problem`` without its advice where that is said once for all (:func:`_shared_advice`)."""
-    head, _, advice = problem.partition("; ")
-    return head if advice in shared else problem
+def _without_advice(problem: str, shared: Mapping[str, tuple[int, str]]) -> str:
+    """``problem`` without its advice where that is said once for all (:func:`_shared_advice`),
+    for problems of its kind only: "for the 4 saturated images: …" counts no other problem, and
+    a problem of several words ("a flat frame: …") with the same advice had lost it."""
+    said = _advice_of(problem)
+    if said is None or said[0] not in shared or shared[said[0]][1] != said[1]:
+        return problem
+    return problem.partition("; ")[0]
 
 
 def lights_independent(problem: str) -> bool:
@@ -2168,8 +2175,10 @@ def assess(
         # (a fit of one picture) had been said of them
         direction_note=(
             ev.direction_note
-            if unchanged is None or not ev.direction_note
+            if not ev.direction_note or (unchanged is None and not all_black)
             else UNCHANGING_DIRECTIONS
+            if unchanged is not None
+            else BLACK_DIRECTIONS
         ),
         drift_note=drift_note,
         shift_note=shift_note,

@@ -10,11 +10,13 @@ session's (0.99° against 0.13°) and its JPEGs, which relight and RTIBuilder re
 their 256 levels. At 1/500 the frames are black (``signal_check``), which was already named.
 
 Judged by the brightest image's brightest pixels (:data:`~rti_rig.reconstruct.qa
-.PEAK_PERCENTILE` of the reduced frame), which any correctly exposed session puts near full
-scale: 0.39-0.81 on the shipped simulated dome, its arms and bands down to 15° over every
-scene (``python -m benchmarks.qa_underexposed``), 1.0 in the real acquisition of
-``tests/data/neuralrti_replay`` (and 0.16 in its darkest image). Only where a full scale is
-known (integer frames): float frames have none, and nothing is claimed there.
+.PEAK_PERCENTILE` of the reduced frame), which a correctly exposed session puts well up the
+camera's range: 0.067-1.0 on the shipped simulated dome and arms over every scene, with all
+their lights and with those up to 15° only (the least, a matte plate lit from the dome's 10°
+ring alone; next, 0.096), 1.0 in the real acquisition of ``tests/data/neuralrti_replay``
+(``python -m benchmarks.qa_underexposed``, docs/reconstruction.md). Not called: the dome's
+relief at 1/10 of its exposure (0.055). Only where a full scale is known (integer frames):
+float frames have none, and nothing is claimed there.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ UNDEREXPOSED = "under-exposed throughout"
 MORE_EXPOSURE = "reshoot with more exposure"
 #: A session whose brightest image's brightest pixels reach less than this share of full scale
 #: is under-exposed: 4 stops below :data:`AIM_PEAK`. The dimmest correct session measured (a
-#: matte plate lit only from the simulated dome's 10° ring) reaches 0.068, 2.2× above it; the
+#: matte plate lit only from the simulated dome's 10° ring) reaches 0.067, 2.1× above it; the
 #: 1/50-exposure one 0.011.
 UNDEREXPOSED_PEAK = 1.0 / 32.0
 #: The level the advice's factor aims the brightest pixels at: half of full scale, with room

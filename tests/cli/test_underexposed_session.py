@@ -109,3 +109,19 @@ def test_no_full_scale_or_a_black_session_claims_no_under_exposure() -> None:
     assert underexposed_problem(np.array([0.004, 0.2])) is None  # one image reaches the range
     words = underexposed_problem(np.array([0.004, 0.01]))
     assert words is not None and "reach 1.0% of full scale" in words and "about 50×" in words
+
+
+@pytest.mark.e2e
+def test_a_session_at_a_five_hundredth_blames_no_gloss(tmp_path: Path) -> None:
+    """At 1/500 of its exposure the shipped dome's frames are black (said once, as such), and
+    the light directions they cannot tell had been put down to "a glossy, saturated or
+    non-Lambertian surface" of a matte relief."""
+    config = shipped_variant(
+        tmp_path, "simulated_dome.toml", (("exposure_s = 0.05", "exposure_s = 0.0001"),)
+    )
+
+    text = _run(config, tmp_path / "black")
+
+    assert "(12 images: next to no light in any image" in text, text
+    assert "light directions not checked: images this dark tell no light" in text, text
+    assert "glossy" not in text and UNDEREXPOSED not in text, text

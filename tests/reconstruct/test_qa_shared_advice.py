@@ -26,3 +26,15 @@ def test_problems_led_by_several_words_keep_their_advice() -> None:
     # "the same picture as image_001, though … (…: …); reshoot it": no one-word label
     images = [[repeated_problem("image_001")] for _ in range(4)]
     assert _shared_advice(images) == {}
+
+
+def test_a_problem_of_several_words_keeps_advice_said_once_for_another_kind() -> None:
+    """Advice said once "for the 3 saturated images" is taken off those alone: a problem of
+    several words with the same advice ("a flat frame: …; LESS") is not counted in the 3, and
+    had lost its advice all the same."""
+    images = [[f"saturated: {k}% of pixels clipped; {LESS}"] for k in (9, 75, 90)]
+    flat = f"a flat frame: one level throughout; {LESS}"
+    shared = _shared_advice([*images, [flat]])
+    assert shared[LESS] == (3, "saturated")
+    assert _without_advice(flat, shared) == flat
+    assert _without_advice(images[1][0], shared) == "saturated: 75% of pixels clipped"

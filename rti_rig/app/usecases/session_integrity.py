@@ -94,6 +94,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         # unless what rti-rig writes beside them is still there
         traces = session_traces(source, lp)
         qa = _with_record_missing(qa, traces) if traces else _with_imported(qa)
+        qa = _with_unlisted_beside(qa, lp)
     if manifest is not None:
         qa = _with_relabelled(qa, lp, source, manifest)
     if manifest is not None:
@@ -456,9 +457,69 @@ def _with_imported(qa: QAReport) -> QAReport:
         "an imported acquisition (an .lp with no rti-rig session record beside it): the "
         "problems named are its images', kept as they are; reshoot only if the object can be "
         "photographed again (a clipped image with less exposure), else leave the images named "
-        "out of the .lp (or keep them and accept what they cost the fit)"
+        "out of the .lp and move their files out of its folder, which relight reads whole (or "
+        "keep them and accept what they cost the fit)"
     )
     return replace(_noted(qa, note), verdict_word="flawed")
+
+
+def unlisted_beside(lp: Path) -> list[str]:
+    """The image files beside ``lp`` that it does not list, of a kind it lists images of
+    (their extension), by name; [] where it lists none beside it or cannot be read. Hidden
+    files (``._IMG_0001.JPG``, what macOS leaves on a FAT card) are not images.
+
+    Why: an acquisition whose ``.lp`` had lost an image's line (its JPEG still beside it)
+    was fitted without it and judged "good"; relight's folder mode reads every JPEG beside
+    the ``.lp`` against its lines, in name order, and refuses a folder where their counts
+    differ (relight's ``ImageSet``)."""
+    try:
+        entries = read_lp(lp)
+    except (OSError, RtiRigError):
+        return []
+    folder = lp.parent
+    listed = {image_path(folder, e.name) for e in entries}
+    kinds = {p.suffix.lower() for p in listed if p.parent == folder}
+    if not kinds:
+        return []
+    try:
+        beside = sorted(folder.iterdir())
+    except OSError:
+        return []
+    return [
+        p.name
+        for p in beside
+        if p.suffix.lower() in kinds
+        and not p.name.startswith(".")
+        and p not in listed
+        and p.is_file()
+    ]
+
+
+def _with_unlisted_beside(qa: QAReport, lp: Path) -> QAReport:
+    """``qa`` with a caveat naming the images beside an acquisition's ``lp`` that it does not
+    list (:func:`unlisted_beside`): not fitted, and a folder relight would not open."""
+    unlisted = unlisted_beside(lp)
+    if not unlisted:
+        return qa
+    one = len(unlisted) == 1
+    shown = ", ".join(unlisted[:8]) + (
+        f" and {len(unlisted) - 8} more" if len(unlisted) > 8 else ""
+    )
+    jpeg = any(Path(n).suffix.lower() in (".jpg", ".jpeg") for n in unlisted)
+    relight = (
+        "; relight's folder mode reads every JPEG beside the .lp against its lines in name "
+        "order, and does not open a folder whose JPEGs outnumber them"
+        if jpeg
+        else ""
+    )
+    note = (
+        f"{shown}, beside {lp.name}, {'is' if one else 'are'} not listed in it, so not fitted "
+        f"(left out on purpose, or {'its line' if one else 'their lines'} lost?){relight}: "
+        f"add {'its line' if one else 'their lines'} to {lp.name} with "
+        f"{'its light' if one else 'their lights'}, or move {'it' if one else 'them'} out "
+        "of the folder"
+    )
+    return _integrity_noted(qa, note)
 
 
 def session_traces(source: Path, lp: Path) -> list[str]:
