@@ -1758,7 +1758,9 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
         kind = camera_kind(raw.get("kind"))
         known = table_keys(kind.settings, err["loc"]) if kind is not None else []
         model = kind.settings if kind is not None else None
-        said = _other_kinds_key(err, raw.get("kind")) or _error_text(err, known, model)
+        said = _other_kinds_key(err, raw.get("kind")) or _error_text(
+            err, known, model, ("camera", "device")
+        )
         raise ConfigError(rig.path, _key_of(("camera", "device", *err["loc"])), said) from None
     refuse_quoted_value(rig.path, raw, settings, ("camera", "device"))
     return settings

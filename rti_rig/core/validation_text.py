@@ -9,7 +9,7 @@ needs no pydantic import.
 from __future__ import annotations
 
 import difflib
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import Any, get_args
 
 #: what every table says of a key it does not know
@@ -101,24 +101,57 @@ def _bounds_text(err: Any, field: Any) -> str | None:
     return f"must be {said} (got {err['input']!r})" + (f": {about}" if about else "")
 
 
-def unknown_key_text(key: str, known: Iterable[str] = ()) -> str:
-    """What an unknown ``key`` is told, with the known key of its table it is closest to.
+def tables_with_key(model: Any, key: str, at: tuple[str, ...] = ()) -> list[tuple[str, ...]]:
+    """The tables below ``model`` (paths of field names, ``()`` for its own) that have a key
+    ``key``, nearest first: where a key written in the wrong table belongs."""
+    found: list[tuple[str, ...]] = []
+    fields = getattr(model, "model_fields", {})
+    if any((f.alias or name) == key for name, f in fields.items()):
+        found.append(at)
+    for name, f in fields.items():
+        for sub in _models_in(f.annotation):
+            if len(at) < 4:  # the config's tables nest 3 deep: no walk round a cycle
+                found += tables_with_key(sub, key, (*at, f.alias or name))
+    return sorted(dict.fromkeys(found), key=len)
+
+
+def unknown_key_text(key: str, known: Iterable[str] = (), elsewhere: Sequence[str] = ()) -> str:
+    """What an unknown ``key`` is told: the table it belongs to where it is a key of another
+    (``elsewhere``, the tables' names), else the known key of its own table it is closest to.
 
     Why: "check its spelling" left the user to find the slip (``exposur_s``) and the key it
-    stands for by reading the docs; the closest key is named where one is close."""
+    stands for by reading the docs; the closest key is named where one is close. A key spelt
+    right in the wrong table (``white_balance`` under ``[camera.device]``, whose place is
+    ``[camera.device.decode]``) had been asked "did you mean 'shutter_tolerance'?"."""
+    if elsewhere:
+        where = " or ".join(f"[{t}]" for t in elsewhere)
+        return (
+            f"unknown key in this table; '{key}' is a key of {where}: did you mean to put it there?"
+        )
     close = difflib.get_close_matches(key, list(known), n=1, cutoff=0.6)
     return UNKNOWN_KEY + (f"; did you mean '{close[0]}'?" if close else "")
 
 
-def error_text(err: Any, known: Iterable[str] = (), model: Any = None) -> str:
+def error_text(
+    err: Any, known: Iterable[str] = (), model: Any = None, prefix: tuple[str, ...] = ()
+) -> str:
     """One pydantic error in a user's words: what is wrong, the value given, and for a number
     where the driver wants the camera's own text (``iso = 100``), how to write it. ``known``:
     the keys of the table an unknown key was found in, the closest of them suggested;
-    ``model``: the model validated, whose field's whole range a bound error says."""
+    ``model``: the model validated, whose field's whole range a bound error says, and whose
+    other tables an unknown key is looked for in; ``prefix``: that model's table in the file
+    (``("camera", "device")``), to name them."""
     msg = str(err["msg"]).removeprefix("Value error, ")
     if err["type"] == "extra_forbidden":
-        last = err["loc"][-1] if err.get("loc") else ""
-        return unknown_key_text(str(last), known)
+        loc = tuple(str(p) for p in err.get("loc", ()) if not isinstance(p, int))
+        last = loc[-1] if loc else ""
+        here = loc[:-1]
+        elsewhere = [
+            ".".join((*prefix, *t))
+            for t in (tables_with_key(model, last) if model is not None and last else [])
+            if t != here and (prefix or t)  # the file's top level is no [table] to name
+        ]
+        return unknown_key_text(last, known, elsewhere)
     if err["type"] == "missing":
         # pydantic's "Field required" said nothing of what to write, nor where
         loc = [str(part) for part in err.get("loc", ()) if not isinstance(part, int)]

@@ -74,3 +74,38 @@ def test_a_key_like_none_is_told_no_guess(tmp_path: Path) -> None:
     assert r.exit_code == 2, said(r)
     assert "key 'camera.zzz': unknown key (check its spelling" in said(r), said(r)
     assert "did you mean" not in said(r)
+
+
+@pytest.mark.parametrize(
+    ("shipped", "old", "new", "key", "table"),
+    [
+        # a RAW decode key under the camera: it had been asked "did you mean
+        # 'shutter_tolerance'?" (the closest spelling of its own table)
+        (
+            "example_dome_48.toml",
+            '\niso = "100"',
+            '\niso = "100"\nwhite_balance = "camera"',
+            "camera.device.white_balance",
+            "camera.device.decode",
+        ),
+        (
+            "simulated_dome.toml",
+            "\nseed = 0",
+            "\nseed = 0\nexposure_s = 0.05",
+            "scene.exposure_s",
+            "camera",
+        ),
+    ],
+)
+def test_a_key_of_another_table_is_told_where_it_belongs(
+    tmp_path: Path, shipped: str, old: str, new: str, key: str, table: str
+) -> None:
+    config = _misspelled(tmp_path, shipped, old, new)
+    r = CliRunner().invoke(app, ["check", str(config)])
+    assert r.exit_code == 2, said(r)
+    name = key.rsplit(".", 1)[1]
+    assert (
+        f"key '{key}': unknown key in this table; '{name}' is a key of [{table}]: did you mean "
+        "to put it there?"
+    ) in said(r), said(r)
+    assert "did you mean '" not in said(r) and "Traceback" not in r.output
