@@ -673,7 +673,7 @@ class QAReport:
                     "lights): not named one by one, since wrong lights alone explain that"
                 )
             if named or self.lost_unfitted:
-                whatever = [f"{c.name} ({'; '.join(c.problems)})" for c in named]
+                whatever = _parts(named, _session_wide(named))
                 head += f"; {self.verdict_word} whatever the lights: " + ", ".join(whatever + lost)
             light = f"; {self.light_note}" if self.light_note else ""
             return head + light + tail
@@ -681,7 +681,7 @@ class QAReport:
             light = f"; {self.light_note}" if self.light_note else ""
             # what the checks against the lights found is said too, as found (evidence of
             # the defect, mostly: an image "wrong light" under the edited line)
-            named = [f"{c.name} ({'; '.join(c.problems)})" for c in self.reshoot]
+            named = _parts(self.reshoot, _session_wide(self.reshoot))
             named += [f"{n} (lost since capture, not fitted)" for n in self.lost_unfitted]
             also = f"; found as well: {', '.join(named)}" if named else ""
             return f"lights.lp wrong: {self.lp_defect}{also}{light}{tail}"
@@ -702,22 +702,9 @@ class QAReport:
         # advice again, and a run of 48 cut into pieces around it). So are images that do not
         # change with their light (:mod:`qa_unchanging`) and images all black: one fault of
         # the whole session (a black one had said "misfired, no light ..." once per image).
-        carriers: dict[str, list[ImageCheck]] = {}
-        for c in self.reshoot:
-            for p in c.problems:
-                if p.startswith((MOVED_FROM, UNCHANGING, BLACK_THROUGHOUT, UNDEREXPOSED)):
-                    carriers.setdefault(p, []).append(c)
-        ranged = {p: run for p, run in carriers.items() if len(run) >= 3}
+        ranged = _session_wide(self.reshoot)
         shared = _shared_advice([[p for p in c.problems if p not in ranged] for c in self.reshoot])
-        parts = []
-        for c in self.reshoot:
-            for p in c.problems:
-                if p in ranged and ranged[p][0] is c:
-                    run = ranged[p]
-                    parts.append(f"{run[0].name} ... {run[-1].name} ({len(run)} images: {p})")
-            rest = [_without_advice(p, shared) for p in c.problems if p not in ranged]
-            if rest:
-                parts.append(f"{c.name} ({'; '.join(rest)})")
+        parts = _parts(self.reshoot, ranged, shared)
         once = "".join(
             f"; for the {n} {kind} images: {advice}" for advice, (n, kind) in shared.items()
         )
@@ -793,6 +780,39 @@ class QAReport:
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
+
+
+def _session_wide(images: Sequence[ImageCheck]) -> dict[str, list[ImageCheck]]:
+    """``{problem: images}``: each problem of a whole session (a move part-way through, images
+    that do not change, black or under-exposed throughout) that at least 3 of ``images`` carry,
+    said once for their run. Why in every verdict: under lights likely wrong or an edited .lp
+    an under-exposed session had said its 340 characters once per image (6 000 in all)."""
+    carriers: dict[str, list[ImageCheck]] = {}
+    for c in images:
+        for p in c.problems:
+            if p.startswith((MOVED_FROM, UNCHANGING, BLACK_THROUGHOUT, UNDEREXPOSED)):
+                carriers.setdefault(p, []).append(c)
+    return {p: run for p, run in carriers.items() if len(run) >= 3}
+
+
+def _parts(
+    images: Sequence[ImageCheck],
+    ranged: Mapping[str, list[ImageCheck]],
+    shared: Mapping[str, tuple[int, str]] | None = None,
+) -> list[str]:
+    """The verdict's clauses for ``images``: each problem of ``ranged`` once, as the run of
+    images that carry it, and each image's other problems after its name (without the advice
+    said once for them all: ``shared``)."""
+    parts = []
+    for c in images:
+        for p in c.problems:
+            if p in ranged and ranged[p][0] is c:
+                run = ranged[p]
+                parts.append(f"{run[0].name} ... {run[-1].name} ({len(run)} images: {p})")
+        rest = [_without_advice(p, shared or {}) for p in c.problems if p not in ranged]
+        if rest:
+            parts.append(f"{c.name} ({'; '.join(rest)})")
+    return parts
 
 
 #: Images that must share a problem's advice before the verdict says it once for them all.
@@ -1660,6 +1680,13 @@ def assess(
     # the frame's mean level (qa_exposure) is the last the reduced images give: they are let
     # go before the crop is read, so the two stacks are never held at once
     level = small.reshape(n, -1).mean(axis=1, dtype=np.float64)
+    # how many reduced pixels of each image reach the under-exposure limit: a small object on
+    # black, under 0.1 % of the frame, is lit well where its frame's percentile is background
+    well_lit = (
+        (small >= np.float32(UNDEREXPOSED_PEAK * saturation)).reshape(n, -1).sum(axis=1)
+        if np.isfinite(saturation) and saturation > 0
+        else np.zeros(n, int)
+    )
     del small, small_sat
     # clipped where any channel is (a red object under a warm LED), as the first pass judges
     crop_arr, crop_sat = _crop_stack(frames, rs, cs, saturation)
@@ -1981,7 +2008,11 @@ def assess(
     )
     # every image far darker than the camera's range allows (qa_underexposed): the images
     # agree, so no check of one against the others finds it
-    underexposed = None if all_black else underexposed_problem(peak)
+    # (not said of images that do not change with their light: lights that never fired are
+    # no exposure to lengthen)
+    underexposed = (
+        None if all_black or unchanged is not None else underexposed_problem(peak, well_lit)
+    )
     for i in range(n):
         problems = []
         bright_claim: str | None = None  # the one problem that says "brighter", if any

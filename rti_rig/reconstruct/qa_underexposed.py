@@ -13,10 +13,10 @@ Judged by the brightest image's brightest pixels (:data:`~rti_rig.reconstruct.qa
 .PEAK_PERCENTILE` of the reduced frame), which a correctly exposed session puts well up the
 camera's range: 0.067-1.0 on the shipped simulated dome and arms over every scene, with all
 their lights and with those up to 15° only (the least, a matte plate lit from the dome's 10°
-ring alone; next, 0.096), 1.0 in the real acquisition of ``tests/data/neuralrti_replay``
-(``python -m benchmarks.qa_underexposed``, docs/reconstruction.md). Not called: the dome's
-relief at 1/10 of its exposure (0.055). Only where a full scale is known (integer frames):
-float frames have none, and nothing is claimed there.
+ring alone; next, 0.096: ``python -m benchmarks.qa_underexposed``, docs/reconstruction.md),
+and 1.0 in the real acquisition of ``tests/data/neuralrti_replay`` (its qa.json). Not called:
+the dome's relief at 1/10 of its exposure (0.055). Only where a full scale is known (integer
+frames): float frames have none, and nothing is claimed there.
 """
 
 from __future__ import annotations
@@ -36,19 +36,28 @@ MORE_EXPOSURE = "reshoot with more exposure"
 #: matte plate lit only from the simulated dome's 10° ring) reaches 0.067, 2.1× above it; the
 #: 1/50-exposure one 0.011.
 UNDEREXPOSED_PEAK = 1.0 / 32.0
+#: ... and none of whose images has this many pixels of the frame reduced by area (to about
+#: 256 px a side, 65 536 pixels: 0.024 % of it) at or above it: a small object on a black
+#: ground, under 0.1 % of the frame, correctly exposed, had its frame's 99.9th percentile in
+#: the background and was called 6 stops under (a sphere of radius 8 px in 512² frames).
+UNDEREXPOSED_MIN_PIXELS = 16
 #: The level the advice's factor aims the brightest pixels at: half of full scale, with room
 #: for the highlights of lights that were dimmer in the session measured.
 AIM_PEAK = 0.5
 
 
-def underexposed_problem(peak: NDArray) -> str | None:
+def underexposed_problem(peak: NDArray, well_lit: NDArray | None = None) -> str | None:
     """The problem every image of a session under-exposed throughout carries, or None.
 
     ``peak``: each image's brightest level as a share of full scale (NaN where there is no
-    full scale: float frames). None where any image's is unknown, or the brightest reaches
-    :data:`UNDEREXPOSED_PEAK` (pure)."""
+    full scale: float frames); ``well_lit``: how many pixels of each reduced image reach
+    :data:`UNDEREXPOSED_PEAK`. None where any image's level is unknown, the brightest reaches
+    :data:`UNDEREXPOSED_PEAK`, or any image has :data:`UNDEREXPOSED_MIN_PIXELS` pixels that
+    do (pure)."""
     values = np.asarray(peak, dtype=float)
     if values.size == 0 or not np.isfinite(values).all():
+        return None
+    if well_lit is not None and np.any(np.asarray(well_lit) >= UNDEREXPOSED_MIN_PIXELS):
         return None
     top = float(values.max())
     if top >= UNDEREXPOSED_PEAK:

@@ -53,3 +53,19 @@ def test_an_acquisition_listing_every_image_beside_it_says_nothing_of_it(tmp_pat
     text, _ = qa_of(REAL / "dirs.lp", tmp_path / "fit")
 
     assert "not listed in it" not in text, text
+
+
+@pytest.mark.e2e
+def test_images_another_lp_beside_it_lists_are_left_to_it(tmp_path: Path) -> None:
+    """A subset's .lp beside the whole one: the images it leaves out are the whole one's, and
+    moving them out of the folder (the advice) would break that one."""
+    acq = tmp_path / "acq"
+    shutil.copytree(REAL, acq)
+    lines = (acq / "dirs.lp").read_text(encoding="utf-8").splitlines()
+    subset = [line for line in lines[1:] if line.strip()][:10]
+    (acq / "subset.lp").write_text(f"{len(subset)}\n" + "\n".join(subset) + "\n")
+
+    text, qa = qa_of(acq / "subset.lp", tmp_path / "fit")
+
+    assert len(qa["images"]) == 10
+    assert "not listed in it" not in text, text

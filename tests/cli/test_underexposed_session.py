@@ -10,6 +10,7 @@ gives) and a real acquisition are not called so.
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -96,6 +97,9 @@ def test_an_imported_acquisition_under_exposed_is_named_as_the_acquisitions(
     assert "QA verdict: flawed: image01 ... image69 (18 images: under-exposed" in text, text
     assert "so they are in the acquisition: its fit is the noisier for it" in text, text
     assert "reshoot with more exposure" not in text and qa["good"] is False
+    # a fault of every image: leaving the images named out of the .lp leaves none
+    assert "mended only by photographing the object again, where it can be" in text, text
+    assert "leave the images named out" not in text, text
 
     as_recorded, _ = qa_of(REAL / "dirs.lp", tmp_path / "fit-real")
     assert UNDEREXPOSED not in as_recorded, as_recorded
@@ -125,3 +129,56 @@ def test_a_session_at_a_five_hundredth_blames_no_gloss(tmp_path: Path) -> None:
     assert "(12 images: next to no light in any image" in text, text
     assert "light directions not checked: images this dark tell no light" in text, text
     assert "glossy" not in text and UNDEREXPOSED not in text, text
+
+
+@pytest.fixture(scope="module")
+def dark_session(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The shipped dome at 1/50 of its exposure, 12 lights: a session under-exposed throughout."""
+    root = tmp_path_factory.mktemp("dark")
+    config = shipped_variant(
+        root, "simulated_dome.toml", (("exposure_s = 0.05", "exposure_s = 0.001"),)
+    )
+    _run(config, root / "s")
+    return root / "s"
+
+
+@pytest.mark.e2e
+def test_under_an_edited_lp_the_under_exposure_is_said_once(
+    dark_session: Path, tmp_path: Path
+) -> None:
+    """Two lines of lights.lp swapped: the verdict leads with the .lp and lists what it found
+    as well, where the under-exposure had been said once per image (6 000 characters)."""
+    session = tmp_path / "s"
+    shutil.copytree(dark_session, session)
+    lp = session / "lights.lp"
+    lines = lp.read_text(encoding="utf-8").splitlines()
+    lines[1], lines[2] = (
+        lines[1].split()[0] + " " + " ".join(lines[2].split()[1:]),
+        (lines[2].split()[0] + " " + " ".join(lines[1].split()[1:])),
+    )
+    lp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+    text, qa = qa_of(session, tmp_path / "fit")
+
+    assert text.count(UNDEREXPOSED) == 1, text
+    assert "image_001 ... image_012 (12 images: under-exposed throughout" in text, text
+    assert qa["good"] is False
+
+
+@pytest.mark.e2e
+def test_an_unfinished_under_exposed_session_is_not_offered_a_resume(
+    dark_session: Path, tmp_path: Path
+) -> None:
+    """A resume keeps the session's exposure: it had been offered beside the advice to shoot
+    a new session with a longer one."""
+    session = tmp_path / "s"
+    shutil.copytree(dark_session, session)
+    manifest = json.loads((session / "manifest.json").read_text(encoding="utf-8"))
+    manifest["runner"]["finish_reason"] = "cancelled"
+    (session / "manifest.json").write_text(json.dumps(manifest), encoding="utf-8")
+
+    text, _ = qa_of(session, tmp_path / "fit")
+
+    assert "the session is not finished" in text and UNDEREXPOSED in text, text
+    assert "--resume" not in text, text
+    assert "a resume keeps the session's exposure and the images taken so far" in text, text

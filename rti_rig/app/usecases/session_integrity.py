@@ -10,6 +10,7 @@ JPEGs in order) gave every later image the wrong light. The journal says what wa
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -23,11 +24,14 @@ from rti_rig.core.lp_format import image_path, lp_files_in, read_lp
 from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.reconstruct.qa import (
     BLACK_ADVICE,
+    BLACK_THROUGHOUT,
     FLAT_ADVICE,
     LESS_EXPOSURE,
     MORE_EXPOSURE,
     MOVED_ADVICE,
+    UNCHANGING,
     UNCHANGING_ADVICE,
+    UNDEREXPOSED,
     QAReport,
 )
 from rti_rig.runtime.session import (
@@ -453,14 +457,28 @@ def _with_imported(qa: QAReport) -> QAReport:
     qa = qa.with_advice(lambda _name, phrase: IMPORTED_ADVICE[phrase])
     if not qa.named and not qa.lost_unfitted:
         return qa
-    note = (
-        "an imported acquisition (an .lp with no rti-rig session record beside it): the "
-        "problems named are its images', kept as they are; reshoot only if the object can be "
-        "photographed again (a clipped image with less exposure), else leave the images named "
-        "out of the .lp and move their files out of its folder, which relight reads whole (or "
-        "keep them and accept what they cost the fit)"
-    )
+    whole = [c for c in qa.named if any(p.startswith(SESSION_WIDE) for p in c.problems)]
+    if qa.named and len(whole) == len(qa.named):
+        # a fault of every image (under-exposed, black, unchanging): leaving the images named
+        # out of the .lp had been the advice, which leaves nothing
+        note = (
+            "an imported acquisition (an .lp with no rti-rig session record beside it): the "
+            "problems named are its images', kept as they are; a fault of every image is "
+            "mended only by photographing the object again, where it can be"
+        )
+    else:
+        note = (
+            "an imported acquisition (an .lp with no rti-rig session record beside it): the "
+            "problems named are its images', kept as they are; reshoot only if the object can "
+            "be photographed again (a clipped image with less exposure), else leave the images "
+            "named out of the .lp and move their files out of its folder, which relight reads "
+            "whole (or keep them and accept what they cost the fit)"
+        )
     return replace(_noted(qa, note), verdict_word="flawed")
+
+
+#: The problems of a whole session, carried by every image (what no image left out mends).
+SESSION_WIDE = (UNDEREXPOSED, BLACK_THROUGHOUT, UNCHANGING)
 
 
 def unlisted_beside(lp: Path) -> list[str]:
@@ -477,10 +495,18 @@ def unlisted_beside(lp: Path) -> list[str]:
     except (OSError, RtiRigError):
         return []
     folder = lp.parent
-    listed = {image_path(folder, e.name) for e in entries}
-    kinds = {p.suffix.lower() for p in listed if p.parent == folder}
+    own = [image_path(folder, e.name) for e in entries]
+    kinds = {p.suffix.lower() for p in own if p.parent == folder}
     if not kinds:
         return []
+    # the images any .lp of the folder lists (a subset's .lp beside the whole one leaves the
+    # others to it), told by the file itself: on a case-insensitive disk IMG_0001.JPG lists
+    # img_0001.jpg
+    listed = {_file_id(p) for p in own}
+    for other in lp_files_in(folder):
+        if other != lp:
+            with contextlib.suppress(OSError, RtiRigError):
+                listed |= {_file_id(image_path(folder, e.name)) for e in read_lp(other)}
     try:
         beside = sorted(folder.iterdir())
     except OSError:
@@ -490,9 +516,19 @@ def unlisted_beside(lp: Path) -> list[str]:
         for p in beside
         if p.suffix.lower() in kinds
         and not p.name.startswith(".")
-        and p not in listed
         and p.is_file()
+        and _file_id(p) not in listed
     ]
+
+
+def _file_id(path: Path) -> tuple[int, int] | Path:
+    """The file ``path`` names, as (device, inode) where it exists (one file under two
+    spellings is one), else the path."""
+    try:
+        st = path.stat()
+    except OSError:
+        return path
+    return (st.st_dev, st.st_ino)
 
 
 def _with_unlisted_beside(qa: QAReport, lp: Path) -> QAReport:
@@ -505,7 +541,8 @@ def _with_unlisted_beside(qa: QAReport, lp: Path) -> QAReport:
     shown = ", ".join(unlisted[:8]) + (
         f" and {len(unlisted) - 8} more" if len(unlisted) > 8 else ""
     )
-    jpeg = any(Path(n).suffix.lower() in (".jpg", ".jpeg") for n in unlisted)
+    # relight's folder mode lists *.jpg and *.JPG (its ImageSet): no other extension
+    jpeg = any(Path(n).suffix.lower() == ".jpg" for n in unlisted)
     relight = (
         "; relight's folder mode reads every JPEG beside the .lp against its lines in name "
         "order, and does not open a folder whose JPEGs outnumber them"
@@ -679,6 +716,15 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
     lost = len(gone)
     since = f", {lost} of them lost since" if lost else ""
     instead = unresumable(source) or _adaptive_gap(manifest, source, gone, journal, total)
+    if instead is None and any(
+        p.startswith((UNDEREXPOSED, BLACK_THROUGHOUT)) for c in qa.images for p in c.problems
+    ):
+        # a resume keeps the session's exposure: it had been offered beside "shoot it again
+        # as a new session with a longer camera.exposure_s"
+        instead = (
+            "a resume keeps the session's exposure and the images taken so far, so it is not "
+            "offered: start a new session once that is mended"
+        )
     note = (
         f"the session is not finished ({taken} {of} images{since}; {how}): this verdict judges "
         "the images taken so far; "
