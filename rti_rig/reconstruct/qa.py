@@ -414,9 +414,9 @@ class ImageCheck:
     #: (``gain_judged``) rather than called a misfire that a reshoot would repeat.
     grazing_unjudged: bool = False
     #: The image's brightest level (:data:`PEAK_PERCENTILE` of the frame reduced by area) as a
-    #: share of full scale; NaN where there is none (float frames). The brightest image's
-    #: names a session under-exposed throughout (:mod:`qa_underexposed`); each image's shows
-    #: how much of the camera's range its light used.
+    #: share of full scale; NaN where there is none (float frames). The session's brightest
+    #: names it under-exposed throughout (:mod:`qa_underexposed`); each image's shows how much
+    #: of the camera's range its light used.
     peak_level: float = float("nan")
 
 

@@ -2,8 +2,8 @@
 
 Found by a QA sweep: a real acquisition (NeuralRTI's, ``tests/data/neuralrti_replay``) whose
 ``dirs.lp`` had lost image33's line, image33.jpg still beside it, was fitted without it and
-said nothing of it; relight's folder mode, which reads every JPEG beside the ``.lp`` against
-its lines, would not open that folder. The QA's own advice for an imported acquisition
+said nothing of it; relight's folder mode, which takes every JPEG beside the ``.lp`` with
+its lines in name order, would be put out of step. The QA's own advice for an imported acquisition
 ("leave the images named out of the .lp") made such a folder, and now says to move the
 files out too.
 """
@@ -39,7 +39,7 @@ def test_a_jpeg_whose_line_was_lost_is_named_with_what_to_do(tmp_path: Path) -> 
 
     assert (
         "image33.jpg, beside dirs.lp, is not listed in it, so not fitted (left out on purpose, "
-        "or its line lost?); relight's folder mode reads every JPEG beside the .lp"
+        "or its line lost?); relight's folder mode takes every JPEG beside the .lp"
     ) in text, text
     assert "add its line to dirs.lp with its light, or move it out of the folder" in text
     assert "._image01" not in text, text

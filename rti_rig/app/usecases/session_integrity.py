@@ -487,9 +487,9 @@ def unlisted_beside(lp: Path) -> list[str]:
     files (``._IMG_0001.JPG``, what macOS leaves on a FAT card) are not images.
 
     Why: an acquisition whose ``.lp`` had lost an image's line (its JPEG still beside it)
-    was fitted without it and judged "good"; relight's folder mode reads every JPEG beside
-    the ``.lp`` against its lines, in name order, and refuses a folder where their counts
-    differ (relight's ``ImageSet``)."""
+    was fitted without it and judged "good"; relight's folder mode takes every JPEG beside
+    the ``.lp`` with its lines, in name order (its ``ImageSet``, whose versions read refuse a
+    folder where the two counts differ)."""
     try:
         entries = read_lp(lp)
     except (OSError, RtiRigError):
@@ -533,7 +533,7 @@ def _file_id(path: Path) -> tuple[int, int] | Path:
 
 def _with_unlisted_beside(qa: QAReport, lp: Path) -> QAReport:
     """``qa`` with a caveat naming the images beside an acquisition's ``lp`` that it does not
-    list (:func:`unlisted_beside`): not fitted, and a folder relight would not open."""
+    list (:func:`unlisted_beside`): not fitted, and out of step in relight."""
     unlisted = unlisted_beside(lp)
     if not unlisted:
         return qa
@@ -544,8 +544,8 @@ def _with_unlisted_beside(qa: QAReport, lp: Path) -> QAReport:
     # relight's folder mode lists *.jpg and *.JPG (its ImageSet): no other extension
     jpeg = any(Path(n).suffix.lower() == ".jpg" for n in unlisted)
     relight = (
-        "; relight's folder mode reads every JPEG beside the .lp against its lines in name "
-        "order, and does not open a folder whose JPEGs outnumber them"
+        "; relight's folder mode takes every JPEG beside the .lp with its lines, in name "
+        "order, which an image not listed puts out of step"
         if jpeg
         else ""
     )
