@@ -81,7 +81,7 @@ def main(argv: list[str] | None = None) -> str:
     args = ap.parse_args(argv)
     from benchmarks.report import machine_line, write_section
     from rti_rig.reconstruct.qa_underexposed import UNDEREXPOSED_PEAK
-    from simulator.scenes import SCENE_NAMES
+    from rti_rig.simulator.scenes import SCENE_NAMES
 
     scenes = ("relief", *SCENE_NAMES)  # the shipped configs' built-in scene, and the library
     runs = [(rig, scene, band, 1.0) for rig in RIGS for scene in scenes for band in BANDS]
