@@ -241,6 +241,10 @@ PEAK_PERCENTILE = 99.9
 #: (``signal_check.BLACK_FRACTION``), not an absence: a dome session at 500x too short an
 #: exposure (8-bit frames of 0-5 DN) holds a picture of the object under its lights.
 BLACK_THROUGHOUT = "next to no light in any image"
+#: The faults every image of a session carries alike (images that do not change with their
+#: light, black or under-exposed throughout): said once for the run of them, independent of
+#: the recorded lights, and mended by no image left out or reshot alone.
+EVERY_IMAGE = (UNCHANGING, BLACK_THROUGHOUT, UNDEREXPOSED)
 #: A light is dim too when its image's median gain is at most this fraction of the median
 #: gain of its :data:`NEIGHBOUR_COUNT` nearest lights' images: the Lambertian prediction
 #: misjudges a glossy object's brightness light by light (bright-end gains of 0.8-5.4 on the
@@ -790,7 +794,7 @@ def _session_wide(images: Sequence[ImageCheck]) -> dict[str, list[ImageCheck]]:
     carriers: dict[str, list[ImageCheck]] = {}
     for c in images:
         for p in c.problems:
-            if p.startswith((MOVED_FROM, UNCHANGING, BLACK_THROUGHOUT, UNDEREXPOSED)):
+            if p.startswith((MOVED_FROM, *EVERY_IMAGE)):
                 carriers.setdefault(p, []).append(c)
     return {p: run for p, run in carriers.items() if len(run) >= 3}
 
@@ -866,9 +870,7 @@ def lights_independent(problem: str) -> bool:
     images that do not change, black throughout), where the others (wrong light, brighter or
     dimmer than predicted, exposure against its elevation, moved) are found against a fit of
     the recorded lights and follow from a wrong ``.lp`` alone."""
-    return problem.startswith(
-        ("saturated", FLAT_FRAME, UNCHANGING, BLACK_THROUGHOUT, REPEATED, UNDEREXPOSED)
-    )
+    return problem.startswith(("saturated", FLAT_FRAME, REPEATED, *EVERY_IMAGE))
 
 
 def _readvised(problem: str, name: str, advice: Callable[[str, str], str]) -> str:

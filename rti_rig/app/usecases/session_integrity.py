@@ -25,11 +25,11 @@ from rti_rig.core.shell_words import shell_word, shown_path
 from rti_rig.reconstruct.qa import (
     BLACK_ADVICE,
     BLACK_THROUGHOUT,
+    EVERY_IMAGE,
     FLAT_ADVICE,
     LESS_EXPOSURE,
     MORE_EXPOSURE,
     MOVED_ADVICE,
-    UNCHANGING,
     UNCHANGING_ADVICE,
     UNDEREXPOSED,
     QAReport,
@@ -457,7 +457,7 @@ def _with_imported(qa: QAReport) -> QAReport:
     qa = qa.with_advice(lambda _name, phrase: IMPORTED_ADVICE[phrase])
     if not qa.named and not qa.lost_unfitted:
         return qa
-    whole = [c for c in qa.named if any(p.startswith(SESSION_WIDE) for p in c.problems)]
+    whole = [c for c in qa.named if any(p.startswith(EVERY_IMAGE) for p in c.problems)]
     if qa.named and len(whole) == len(qa.named):
         # a fault of every image (under-exposed, black, unchanging): leaving the images named
         # out of the .lp had been the advice, which leaves nothing
@@ -475,10 +475,6 @@ def _with_imported(qa: QAReport) -> QAReport:
             "whole (or keep them and accept what they cost the fit)"
         )
     return replace(_noted(qa, note), verdict_word="flawed")
-
-
-#: The problems of a whole session, carried by every image (what no image left out mends).
-SESSION_WIDE = (UNDEREXPOSED, BLACK_THROUGHOUT, UNCHANGING)
 
 
 def unlisted_beside(lp: Path) -> list[str]:
