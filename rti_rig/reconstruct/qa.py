@@ -144,6 +144,17 @@ WRONG_LIGHT_SPREAD = 3.0
 #: painting at 256-1024 px); the brushed steel of the simulated industrial part 11° (1024 px,
 #: 24 lights), where lights right at 18-19° had been told "wrong light (swapped?)".
 DIRECTION_CHECK_MAX_TYPICAL_DEG = 8.0
+#: A swapped pair is named by its renderings (:func:`~rti_rig.reconstruct.qa_directions.
+#: swapped_pairs`) only where the images' best directions lie a median of at most this many
+#: degrees from their recorded lights: beyond, the fit places no light near where it was
+#: recorded, and which recorded light renders an image closer tells nothing. Measured
+#: 2026-12-07 (``rti-rig fit``, median over the images with a best direction): the brushed
+#: steel of the simulated industrial part, 24 lights, images 2 and 3 swapped, 19.5° at 512 px
+#: (the swap named) and 19.9° at 1024 px; with every light right 15-21° on the dome
+#: and the virtual arm; the black calibration sphere on the virtual arm, every light right,
+#: 21-25° at 36-48 lights and 56° at 24, where 4 pairs had been named "swapped?"; the
+#: real gilded icon (NeuralRTI, 18-72 lights) 46°.
+SWAP_MAX_PLACED_DEG = 40.0
 #: The session's typical direction error is this many times the lower quartile of its judged
 #: images' errors (a Rayleigh distribution's median over its lower quartile): an estimate of
 #: their median that holds while up to three quarters of the lights are right.
@@ -2202,6 +2213,7 @@ def assess(
         "mirror_ratio": MIRROR_RATIO,
         "likeness_ordered": LIKENESS_ORDERED,
         "likeness_unordered": LIKENESS_UNORDERED,
+        "swap_max_placed_deg": SWAP_MAX_PLACED_DEG,
         "underexposed_peak": UNDEREXPOSED_PEAK,
     }
     mirrored = mirror_ratio(ps.normals, ps.valid)
@@ -2557,7 +2569,9 @@ def _evidence(
     # is noise; the simulated flat plate, every light right, read 0.53-0.60 and was told its
     # lights were likely wrong)
     likeness = (
-        neighbour_likeness(crop_arr, lt) if spread_deg >= MIN_NORMAL_SPREAD_DEG else float("nan")
+        neighbour_likeness(crop_arr, lt, ~nodir)
+        if spread_deg >= MIN_NORMAL_SPREAD_DEG
+        else float("nan")
     )
     if spread_deg < MIN_NORMAL_SPREAD_DEG:
         note = (
@@ -2705,7 +2719,17 @@ def _evidence(
         # than predicted", "moved"): the lights' order against the images tells the two apart
         note = f"{note}; but {UNORDERED_SAID}" if note else UNORDERED_SAID
     swap_ratio = np.full(n, np.nan)
-    if not judged.any() and spread_deg >= MIN_NORMAL_SPREAD_DEG:
+    placed = ~nodir & np.isfinite(err)
+    # how far the fit places this object's images from their recorded lights: beyond
+    # SWAP_MAX_PLACED_DEG it places no light near where it was recorded, and which light
+    # renders an image closer tells nothing (the black sphere on the virtual arm, 24 lights,
+    # every light right, had 4 pairs named "swapped?" at a median 56°)
+    placed_deg = float(np.median(err[placed])) if placed.any() else float("inf")
+    if (
+        not judged.any()
+        and spread_deg >= MIN_NORMAL_SPREAD_DEG
+        and placed_deg <= SWAP_MAX_PLACED_DEG
+    ):
         # no direction judged by its angle: a swapped pair may still be plain (swapped_pairs)
         raws = [crop_arr[i].ravel() for i in range(n)]
         usable_raw = [vflat & ~crop_sat[i].ravel() & (raws[i] > dark) for i in range(n)]
