@@ -175,13 +175,15 @@ CLIPPED_DIRECTION_LIMIT = 0.5
 #: Where most images point away from their lights, the lights are said to belong to the
 #: images at or under this :func:`~rti_rig.reconstruct.qa_directions.neighbour_likeness`
 #: (NeuralRTI's gilded icon reads 0.0), and to be wrong at or over the other (its .lp
-#: shuffled reads 0.40-0.55). Measured 2026-12-07 with the images compared as square roots:
-#: 27 simulated sessions, every light right (the 7 scenes on the simulated dome at 24 and 48
-#: lights and on the virtual arm at 24; the black calibration sphere on the dome at 12 and 36
-#: and on the arm at 36 and 48; one scene on the simulated arm), read 0.00-0.05 but for the
-#: sphere on the dome at 12 lights (0.10) and on the arm at 24 (0.14); the gilded icon 0.00-0.06
-#: at 18-72 of its lights; shuffled .lp files 0.32-0.73; a new dome's sphere session recorded
-#: under its fibonacci stand-in (median 10° or more from its LEDs) 0.24.
+#: shuffled reads 0.40-0.55). Measured 2026-12-07 with the images compared as square roots
+#: (``python -m benchmarks.qa_likeness``, table in docs/reconstruction.md): 26 simulated
+#: sessions with every light right (the 7 scenes on the simulated dome at 24 and 48 lights
+#: and on the virtual arm at 24, the black calibration sphere on the dome at 12 and 36 and
+#: on the arm at 36 and 48, the simulated arm's tablet) read 0.00-0.05, but the sphere on the
+#: dome at 12 lights 0.10 and on the arm at 24 lights 0.14; 18 shuffled .lp files of the
+#: dome's sessions 0.45-0.77; a new dome's sphere session recorded under its fibonacci
+#: stand-in layout (its LEDs a median 10° or more away) 0.22. The gilded icon reads
+#: 0.00-0.06 at 18-72 of its lights, its .lp shuffled 0.34-0.64 (measured outside the QA).
 LIKENESS_ORDERED = 0.1
 LIKENESS_UNORDERED = 0.2
 #: The recorded lights are said to be mirrored where the fitted surface's curl as recorded is
