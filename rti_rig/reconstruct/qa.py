@@ -175,15 +175,16 @@ CLIPPED_DIRECTION_LIMIT = 0.5
 #: Where most images point away from their lights, the lights are said to belong to the
 #: images at or under this :func:`~rti_rig.reconstruct.qa_directions.neighbour_likeness`
 #: (NeuralRTI's gilded icon reads 0.0), and to be wrong at or over the other (its .lp
-#: shuffled reads 0.40-0.55). Measured 2026-12-07 with the images compared as square roots
-#: (``python -m benchmarks.qa_likeness``, table in docs/reconstruction.md): 26 simulated
-#: sessions with every light right (the 7 scenes on the simulated dome at 24 and 48 lights
-#: and on the virtual arm at 24, the black calibration sphere on the dome at 12 and 36 and
-#: on the arm at 36 and 48, the simulated arm's tablet) read 0.00-0.05, but the sphere on the
-#: dome at 12 lights 0.10 and on the arm at 24 lights 0.14; 18 shuffled .lp files of the
-#: dome's sessions 0.45-0.77; a new dome's sphere session recorded under its fibonacci
-#: stand-in layout (its LEDs a median 10° or more away) 0.22. The gilded icon reads
-#: 0.00-0.06 at 18-72 of its lights, its .lp shuffled 0.34-0.64 (measured outside the QA).
+#: shuffled read 0.40-0.55, both compared as linear levels). Measured 2026-12-07 with the
+#: images compared as square roots (``python -m benchmarks.qa_likeness``, its table in
+#: docs/reconstruction.md): 26 simulated sessions with every light right (the 7 scenes on the
+#: simulated dome at 24 and 48 lights and on the virtual arm at 24, the black calibration
+#: sphere on the dome at 12 and 36 and on the arm at 36 and 48, the simulated arm's tablet)
+#: read 0.00-0.05, but the sphere on the dome at 12 lights 0.10 and on the arm at 24 lights
+#: 0.14; 18 shuffled .lp files of the dome's sessions BENCH_SHUF; a new dome's sphere session
+#: recorded under its fibonacci stand-in layout (its LEDs a median 10° or more away)
+#: BENCH_STAND. The gilded icon reads 0.00-0.06 at 18-72 of its lights, its .lp shuffled
+#: 0.34-0.64 (measured outside the QA).
 LIKENESS_ORDERED = 0.1
 LIKENESS_UNORDERED = 0.2
 #: The recorded lights are said to be mirrored where the fitted surface's curl as recorded is
@@ -2568,10 +2569,10 @@ def _evidence(
     # and said whichever branch below the verdict takes (a shuffled .lp of a matte sphere, seed
     # 1 of 3, went down the judged branch and was said as images "brighter" and "moved" alone)
     # (not on a near-flat object: its images differ by their level alone, so which look alike
-    # is noise; the simulated flat plate, every light right, read 0.53-0.60 and was told its
-    # lights were likely wrong)
+    # is noise; the simulated flat plate, every light right, read 0.53-0.60 (as levels) and
+    # was told its lights were likely wrong)
     likeness = (
-        neighbour_likeness(crop_arr, lt, ~nodir)
+        neighbour_likeness(crop_arr, lt, ~nodir & ~blinded)
         if spread_deg >= MIN_NORMAL_SPREAD_DEG
         else float("nan")
     )

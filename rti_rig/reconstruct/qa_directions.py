@@ -241,11 +241,11 @@ def neighbour_likeness(
     order by chance), or lights further apart than :data:`LIKENESS_MAX_NEIGHBOUR_DEG`.
 
     ``keep``: the images to compare (all by default); the others are left out of it as if
-    not taken. An image with no picture of the object (a black or flat frame, named by its
-    own check) looks like no other, so it can neither confirm nor contradict the order, yet
-    it had counted against it: one black frame among a tilted relief's 12 grazing lights,
-    whose neighbouring images compared as roots correlate little, moved the likeness from
-    0.05 to 0.20 and the verdict from "misfired" to "lights likely wrong"."""
+    not taken. An image with no picture of the object (a black, flat or clipped frame, named
+    by its own check) looks like no other, so it can neither confirm nor contradict the
+    order, yet it counts against it where neighbouring images correlate little: among a
+    tilted relief's 12 grazing lights (0.05 as shot) one black frame read 0.15, 0.11 left
+    out."""
     rows = np.flatnonzero(np.ones(stack.shape[0], bool) if keep is None else keep)
     n = rows.size
     if n < LIKENESS_MIN_IMAGES:
@@ -257,31 +257,44 @@ def neighbour_likeness(
     nearest_deg = np.degrees(np.arccos(np.clip(near.max(axis=1), -1.0, 1.0)))
     if float(np.median(nearest_deg)) > LIKENESS_MAX_NEIGHBOUR_DEG:
         return float("nan")
+    like = root_correlations(stack, rows)
+    np.fill_diagonal(like, -np.inf)
+    mate = np.argmax(near, axis=1)
+    above = np.sum(like > like[np.arange(n), mate][:, None], axis=1)
+    return float(np.median(above) / (n - 2))
+
+
+def root_correlations(stack: NDArray, rows: NDArray[np.intp]) -> NDArray:
+    """The correlation matrix of the images ``stack[rows]`` over a strided sample of their
+    pixels (:data:`LIKENESS_SAMPLE`), each compared as the square roots of its levels
+    (:func:`neighbour_likeness` says why); 0 for an image of one level, which looks like
+    none."""
+    n = rows.size
     sample = stack.reshape(stack.shape[0], -1)[:, :: max(1, stack[0].size // LIKENESS_SAMPLE)]
-    # the images' Gram matrix summed over bands of the sample, each band made float64 alone
-    # (the whole sample in float64 had been a copy of every image's crop where the crop is
-    # small: 8 bytes a pixel at 96 px, the QA's memory test caught it), centred after the sum.
+
     # Compared as square roots of the linear levels (shot noise's variance-stabilising
     # transform): in linear light a glossy highlight's few pixels outweigh all the shading,
     # and two images whose highlights do not overlap look no more alike than any other two.
     # The simulated dome's black calibration sphere, every light right, read 0.34 (24
     # lights) and 0.43 (48) and was told its lights were likely wrong; as roots 0.05, 0.02.
+    # The images' Gram matrix is summed over bands of the sample, each band made float64
+    # alone (the whole sample in float64 had been a copy of every image's crop where the crop
+    # is small: 8 bytes a pixel at 96 px, the QA's memory test caught it), centred band by
+    # band on means taken in a first pass: centred after the sum, a frame of one level (a
+    # black or white frame) had kept rounding noise for its variance and read correlations of
+    # -37 to +4 with the others, which put a tilted relief with one white frame at 0.20.
+    def roots(start: int) -> NDArray:
+        part = sample[rows, start : start + _LIKENESS_BAND]
+        return np.sqrt(np.maximum(part, 0.0), dtype=np.float64)
+
+    starts = range(0, sample.shape[1], _LIKENESS_BAND)
+    mean = sum((roots(start).sum(axis=1) for start in starts), np.zeros(n)) / sample.shape[1]
     gram = np.zeros((n, n))
-    total = np.zeros(n)
-    for start in range(0, sample.shape[1], _LIKENESS_BAND):
-        band = np.sqrt(
-            np.maximum(sample[rows, start : start + _LIKENESS_BAND], 0.0), dtype=np.float64
-        )
-        total += band.sum(axis=1)
+    for start in starts:
+        band = roots(start) - mean[:, None]
         gram += band @ band.T
-    mean = total / sample.shape[1]
-    gram -= sample.shape[1] * np.outer(mean, mean)
-    norm = np.maximum(np.sqrt(np.maximum(np.diag(gram), 0.0)), 1e-12)
-    like = gram / np.outer(norm, norm)
-    np.fill_diagonal(like, -np.inf)
-    mate = np.argmax(near, axis=1)
-    above = np.sum(like > like[np.arange(n), mate][:, None], axis=1)
-    return float(np.median(above) / (n - 2))
+    norm = np.maximum(np.sqrt(np.diag(gram)), 1e-12)
+    return gram / np.outer(norm, norm)
 
 
 def mirror_ratio(normals: NDArray, valid: NDArray[np.bool_]) -> float:

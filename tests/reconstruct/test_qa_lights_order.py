@@ -19,7 +19,11 @@ from rti_rig.reconstruct.qa import (
     MIRRORED_SAID,
     assess,
 )
-from rti_rig.reconstruct.qa_directions import LIKENESS_MAX_NEIGHBOUR_DEG, neighbour_likeness
+from rti_rig.reconstruct.qa_directions import (
+    LIKENESS_MAX_NEIGHBOUR_DEG,
+    neighbour_likeness,
+    root_correlations,
+)
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 
 N = 24
@@ -97,3 +101,19 @@ def test_lights_far_apart_are_not_judged_by_likeness() -> None:
     )
     assert LIKENESS_MAX_NEIGHBOUR_DEG > 8.0
     assert not np.isnan(neighbour_likeness(stack, dense))
+
+
+@pytest.mark.parametrize("level", [0.0, 0.123, 0.7, 1.0])
+def test_a_frame_of_one_level_correlates_with_no_image(sphere, level: float) -> None:  # type: ignore[no-untyped-def]
+    """A frame of one level (black, grey or white) has no variance: it looks like no image.
+    Centred after the Gram matrix was summed, its variance was rounding noise and its
+    correlations with the others read -37 to +4 (review, 2026-12-07): a tilted relief with
+    one white frame went from 0.05 to 0.20, "lights likely wrong"."""
+    frames, _ = sphere
+    stack = np.stack([f.astype(np.float32) / 65535 for f in frames])
+    stack = np.concatenate([stack, np.full_like(stack[:1], level)])
+    like = root_correlations(stack, np.arange(stack.shape[0]))
+    assert np.abs(like[-1, :-1]).max() < 1e-6, like[-1]
+    assert np.abs(like[:-1, -1]).max() < 1e-6, like[:, -1]
+    # and the others' correlations are correlations
+    assert np.abs(like[:-1, :-1]).max() <= 1.0 + 1e-9
