@@ -181,9 +181,9 @@ CLIPPED_DIRECTION_LIMIT = 0.5
 #: simulated dome at 24 and 48 lights and on the virtual arm at 24, the black calibration
 #: sphere on the dome at 12 and 36 and on the arm at 36 and 48, the simulated arm's tablet)
 #: read 0.00-0.05, but the sphere on the dome at 12 lights 0.10 and on the arm at 24 lights
-#: 0.14; 18 shuffled .lp files of the dome's sessions BENCH_SHUF; a new dome's sphere session
+#: 0.14; 18 shuffled .lp files of the dome's sessions 0.45-0.77; a new dome's sphere session
 #: recorded under its fibonacci stand-in layout (its LEDs a median 10° or more away)
-#: BENCH_STAND. The gilded icon reads 0.00-0.06 at 18-72 of its lights, its .lp shuffled
+#: 0.22. The gilded icon reads 0.00-0.06 at 18-72 of its lights, its .lp shuffled
 #: 0.34-0.64 (measured outside the QA).
 LIKENESS_ORDERED = 0.1
 LIKENESS_UNORDERED = 0.2
