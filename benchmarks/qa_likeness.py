@@ -21,18 +21,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import re
 import shutil
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-CONFIGS = ROOT / "rig_configs"
+from benchmarks.front_door import CONFIGS, ROOT, rti_rig, shipped_with_scene
+
 DOC = ROOT / "docs" / "reconstruction.md"
 SHUFFLE_SEEDS = (1, 2, 3)
 #: The new dome's stand-in: the shipped emulated dome (real driver over a pty) with its LED
@@ -43,21 +39,10 @@ STAND_IN = (
 )
 
 
-def rti_rig(*args: str) -> subprocess.CompletedProcess[str]:
-    """``rti-rig ARGS`` in a new process (as a user runs it)."""
-    env = dict(os.environ, COLUMNS="400")
-    cmd = [sys.executable, "-m", "rti_rig", *args]
-    return subprocess.run(cmd, env=env, cwd=ROOT, capture_output=True, text=True, check=False)
-
-
 def with_scene(scratch: Path, rig: str, scene: str) -> Path:
     """``rig`` with its ``[scene]`` named ``scene``, in ``scratch``."""
-    text = (CONFIGS / rig).read_text(encoding="utf-8")
-    text, n_scene = re.subn(r'(?ms)(\[scene\].*?^name = )"[^"]*"', rf'\g<1>"{scene}"', text)
-    if n_scene != 1:
-        raise SystemExit(f"{rig}: no [scene] name to vary")
     path = scratch / f"{Path(rig).stem}_{scene}.toml"
-    path.write_text(text, encoding="utf-8")
+    path.write_text(shipped_with_scene(rig, scene), encoding="utf-8")
     return path
 
 

@@ -18,34 +18,22 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import re
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-CONFIGS = ROOT / "rig_configs"
+from benchmarks.front_door import ROOT, rti_rig, shipped_with_scene
+
 DOC = ROOT / "docs" / "reconstruction.md"
 RIGS = ("simulated_dome.toml", "virtual_arm.toml")
 BANDS = {"all": (), "up to 15°": ("--max-elevation-deg", "15")}
 SHIPPED_EXPOSURE = "exposure_s = 0.05"
 
 
-def rti_rig(*args: str) -> subprocess.CompletedProcess[str]:
-    """``rti-rig ARGS`` in a new process (as a user runs it)."""
-    env = dict(os.environ, COLUMNS="400")
-    cmd = [sys.executable, "-m", "rti_rig", *args]
-    return subprocess.run(cmd, env=env, cwd=ROOT, capture_output=True, text=True, check=False)
-
-
 def variant(scratch: Path, rig: str, scene: str, exposure_factor: float) -> Path:
     """``rig`` with ``scene`` and its exposure times ``exposure_factor``, in ``scratch``."""
-    text = (CONFIGS / rig).read_text(encoding="utf-8")
-    text, n_scene = re.subn(r'(?ms)(\[scene\].*?^name = )"[^"]*"', rf'\g<1>"{scene}"', text)
-    if n_scene != 1 or SHIPPED_EXPOSURE not in text:
-        raise SystemExit(f"{rig}: no [scene] name or no {SHIPPED_EXPOSURE!r} to vary")
+    text = shipped_with_scene(rig, scene)
+    if SHIPPED_EXPOSURE not in text:
+        raise SystemExit(f"{rig}: no {SHIPPED_EXPOSURE!r} to vary")
     text = text.replace(SHIPPED_EXPOSURE, f"exposure_s = {0.05 * exposure_factor:g}")
     path = scratch / f"{Path(rig).stem}_{scene}_{exposure_factor:g}.toml"
     path.write_text(text, encoding="utf-8")

@@ -1,0 +1,34 @@
+"""What the benchmarks that measure through the front door share: ``rti-rig`` run as a user
+runs it (a new process), and a shipped rig config with its scene changed.
+
+Why one module: benchmarks.qa_underexposed and benchmarks.qa_likeness had each written both
+(the scene's pattern twice over, to drift apart)."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIGS = ROOT / "rig_configs"
+
+
+def rti_rig(*args: str) -> subprocess.CompletedProcess[str]:
+    """``rti-rig ARGS`` in a new process (as a user runs it), its output kept."""
+    env = dict(os.environ, COLUMNS="400")
+    cmd = [sys.executable, "-m", "rti_rig", *args]
+    return subprocess.run(cmd, env=env, cwd=ROOT, capture_output=True, text=True, check=False)
+
+
+def shipped_with_scene(rig: str, scene: str) -> str:
+    """The text of ``rig_configs/<rig>`` with its ``[scene]`` named ``scene``; exits naming the
+    config where it has no ``[scene]`` name to change (a shipped config that changed must not
+    measure another scene quietly)."""
+    text = (CONFIGS / rig).read_text(encoding="utf-8")
+    text, n_scene = re.subn(r'(?ms)(\[scene\].*?^name = )"[^"]*"', rf'\g<1>"{scene}"', text)
+    if n_scene != 1:
+        raise SystemExit(f"{rig}: no [scene] name to vary")
+    return text
