@@ -87,8 +87,14 @@ from rti_rig.reconstruct.qa_exposure import (
     exposure_ratios,
     exposure_scatter,
 )
+from rti_rig.reconstruct.qa_other_object import (
+    OTHER_OBJECT_SHARE,
+    other_object_images,
+    other_object_problem,
+)
 from rti_rig.reconstruct.qa_repeated import REPEATED, repeated_pictures, repeated_problem
 from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
+from rti_rig.reconstruct.qa_turn import TURN_MIN_DEG, TURN_Z, Turn, edge_registration, find_turn
 from rti_rig.reconstruct.qa_unchanging import (
     FLAT_ADVICE,
     FLAT_FRAME,
@@ -549,6 +555,11 @@ class QAReport:
     #: recorded lights (NaN: not measured), the figure :data:`LIKENESS_UNORDERED` is read
     #: against: in qa.json so that its margins are measured from sessions, not guessed.
     neighbour_likeness: float = float("nan")
+    #: A turn about the view axis part-way through (:mod:`qa_turn`): ``first`` (the first
+    #: image turned), ``first_judged`` (the first judged so: later than ``first`` where the
+    #: images between had too few edges to tell), ``angle_deg`` (counter-clockwise as seen)
+    #: and ``corner_px`` (how far it moved the frame's corners); None where none was found.
+    turn: dict[str, Any] | None = None
 
     @property
     def caveats(self) -> list[str]:
@@ -792,6 +803,7 @@ class QAReport:
             "lights_mirrored": self.lights_mirrored,
             "mirror_ratio": self.mirror_ratio,
             "neighbour_likeness": self.neighbour_likeness,
+            "turn": self.turn,
             "session_complete": self.session_complete,
             "expected_normal_error_deg": self.expected_normal_error_deg,
             "noise_sigma": self.noise_sigma,
@@ -809,6 +821,25 @@ class QAReport:
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
+
+
+def turn_problem(turn: Turn, names: Sequence[str], height: int, width: int) -> str:
+    """The problem of each image from a turn on (:mod:`qa_turn`), the same words for all of
+    them so that the verdict says it once, as their range (:func:`_session_wide`)."""
+    way = "counter-clockwise" if turn.angle_deg > 0 else "clockwise"
+    began = (
+        ""
+        if turn.judged_first is None
+        else f" (the turn began between {names[turn.first - 1]} and {names[turn.judged_first]}: "
+        "the images between have too few edges to tell)"
+    )
+    first = names[turn.first]
+    return (
+        f"{MOVED_FROM} {first} on{began}: turned {abs(turn.angle_deg):.1f}° {way} about the view "
+        f"axis against the images before it (the frame's corners by about "
+        f"{turn.corner_px(height, width):.0f} px), as a knocked camera or object does; "
+        f"{MOVED_ADVICE}, or align those images to the earlier ones before fitting"
+    )
 
 
 def _session_wide(images: Sequence[ImageCheck]) -> dict[str, list[ImageCheck]]:
@@ -1700,13 +1731,28 @@ def assess(
     flat_mask = np.isin(np.arange(n), list(flat))  # no direction is judged in them (_evidence)
     # an image that is an earlier one again, pixel for pixel (qa_repeated)
     repeated = {} if all_black or unchanged is not None else repeated_pictures(small)
+    # the frame's mean level (qa_exposure, and which images are lit enough to judge below)
+    level = small.reshape(n, -1).mean(axis=1, dtype=np.float64)
+    # each image's edges registered onto the session's (qa_turn): the camera (or object)
+    # turned about the view axis part-way through, seen on the whole reduced frame since a
+    # turn moves the middle, where the crop below is, by nothing; and an image whose edges
+    # are not the object's (qa_other_object), named in place of the dim or bright claims
+    # its level against the fit would give it
+    turn: Turn | None = None
+    other: dict[int, tuple[float, float]] = {}
+    if not all_black and unchanged is None:
+        registered = edge_registration(small, small.reshape(n, -1).max(axis=1) > dark)
+        turn = find_turn(registered.angles)
+        other = {
+            i: found
+            for i, found in other_object_images(registered.correlations, level).items()
+            if i not in flat and i not in repeated
+        }
+        flat_mask[list(other)] = True  # no direction is judged in them either
 
     # per-image evidence on a full-resolution crop where the object has lit structure (a
     # second pass reads only its rows)
     rs, cs = _choose_crop(small, small_sat, dark, h, w)
-    # the frame's mean level (qa_exposure) is the last the reduced images give: they are let
-    # go before the crop is read, so the two stacks are never held at once
-    level = small.reshape(n, -1).mean(axis=1, dtype=np.float64)
     # how many reduced pixels of each image reach the under-exposure limit: a small object on
     # black, under 0.1 % of the frame, is lit well where its frame's percentile is background
     well_lit = (
@@ -2124,6 +2170,11 @@ def assess(
             problems = [p for p in problems if p.startswith("saturated")]
             problems.append(repeated_problem(names[repeated[i]]))
             bright_claim = None
+        if i in other:
+            # its level and direction against the fit are those of another object's picture
+            problems = [p for p in problems if p.startswith("saturated")]
+            problems.append(other_object_problem(*other[i]))
+            bright_claim = None
         if underexposed is not None:
             problems.append(underexposed)
         if step is not None and _in_open_range(step, i):
@@ -2143,6 +2194,10 @@ def assess(
                 f"{first} on keeps two positions unless the object is put back exactly), or "
                 "align those images to the earlier ones before fitting"
             )
+        elif turn is not None and step is None and i >= turn.first:
+            # said in place of the shift the edges read: a turn shifts every crop but the
+            # middle's, and the shift is the turn's
+            problems.append(turn_problem(turn, names, h, w))
         elif ev.moved[i]:
             dx, dy = ev.drift[i]
             problems.append(
@@ -2218,6 +2273,9 @@ def assess(
         "likeness_unordered": LIKENESS_UNORDERED,
         "swap_max_placed_deg": SWAP_MAX_PLACED_DEG,
         "underexposed_peak": UNDEREXPOSED_PEAK,
+        "turn_min_deg": TURN_MIN_DEG,
+        "other_object_share": OTHER_OBJECT_SHARE,
+        "turn_z": TURN_Z,
     }
     mirrored = mirror_ratio(ps.normals, ps.valid)
     return QAReport(
@@ -2255,6 +2313,19 @@ def assess(
         ),
         mirror_ratio=mirrored,
         neighbour_likeness=ev.likeness,
+        turn=(
+            {
+                "first": names[turn.first],
+                # the first image judged turned, where those from ``first`` were not judged
+                "first_judged": names[
+                    turn.first if turn.judged_first is None else turn.judged_first
+                ],
+                "angle_deg": turn.angle_deg,
+                "corner_px": turn.corner_px(h, w),
+            }
+            if turn is not None and step is None
+            else None
+        ),
     )
 
 

@@ -97,3 +97,27 @@ def moved_session_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -
         f.unlink()
         write_linear_tiff(f, np.roll(img, (dy, dx), axis=(0, 1)))
     return dst
+
+
+def turned_session_copy(session: Path, dst: Path, first: int, angle_deg: float) -> Path:
+    """A copy of ``session`` whose images from ``first`` (1-based) on are turned by
+    ``angle_deg`` (counter-clockwise as seen) about the frame's centre: a camera knocked once,
+    part-way through, rolling about its axis. Here, not in tests/, so that
+    benchmarks/qa_turn.py turns a session the same way the QA tests do."""
+    import shutil
+
+    import cv2
+
+    from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
+
+    shutil.copytree(session, dst)
+    for f in sorted((dst / "linear").glob("image_*.tif"))[first - 1 :]:
+        img = read_linear_tiff(f)
+        h, w = img.shape[:2]
+        m = cv2.getRotationMatrix2D((w / 2, h / 2), angle_deg, 1.0)
+        turned = cv2.warpAffine(
+            img, m, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+        )
+        f.unlink()
+        write_linear_tiff(f, turned.reshape(img.shape).astype(img.dtype))
+    return dst
