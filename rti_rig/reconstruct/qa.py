@@ -88,6 +88,7 @@ from rti_rig.reconstruct.qa_exposure import (
     exposure_scatter,
 )
 from rti_rig.reconstruct.qa_other_object import (
+    OTHER_OBJECT,
     OTHER_OBJECT_SHARE,
     other_object_images,
     other_object_problem,
@@ -823,6 +824,11 @@ class QAReport:
         }
 
 
+#: The words that tell a turn's problem (:func:`turn_problem`) from a shift's, which shares
+#: its start (:data:`MOVED_FROM`) but is found against a fit of the recorded lights.
+TURN_WORDS = "about the view axis"
+
+
 def turn_problem(turn: Turn, names: Sequence[str], height: int, width: int) -> str:
     """The problem of each image from a turn on (:mod:`qa_turn`), the same words for all of
     them so that the verdict says it once, as their range (:func:`_session_wide`)."""
@@ -835,8 +841,8 @@ def turn_problem(turn: Turn, names: Sequence[str], height: int, width: int) -> s
     )
     first = names[turn.first]
     return (
-        f"{MOVED_FROM} {first} on{began}: turned {abs(turn.angle_deg):.1f}° {way} about the view "
-        f"axis against the images before it (the frame's corners by about "
+        f"{MOVED_FROM} {first} on{began}: turned {abs(turn.angle_deg):.1f}° {way} {TURN_WORDS} "
+        f"against the images before it (the frame's corners by about "
         f"{turn.corner_px(height, width):.0f} px), as a knocked camera or object does; "
         f"{MOVED_ADVICE}, or align those images to the earlier ones before fitting"
     )
@@ -926,7 +932,12 @@ def lights_independent(problem: str) -> bool:
     images that do not change, black throughout), where the others (wrong light, brighter or
     dimmer than predicted, exposure against its elevation, moved) are found against a fit of
     the recorded lights and follow from a wrong ``.lp`` alone."""
-    return problem.startswith(("saturated", FLAT_FRAME, REPEATED, *EVERY_IMAGE))
+    # a turn and another object's picture are found from the images' edges alone (qa_turn,
+    # qa_other_object), with no fit: they stand whatever the lights
+    turned = problem.startswith(MOVED_FROM) and TURN_WORDS in problem
+    return turned or problem.startswith(
+        ("saturated", FLAT_FRAME, REPEATED, OTHER_OBJECT, *EVERY_IMAGE)
+    )
 
 
 def _readvised(problem: str, name: str, advice: Callable[[str, str], str]) -> str:
@@ -1748,7 +1759,8 @@ def assess(
             for i, found in other_object_images(registered.correlations, level).items()
             if i not in flat and i not in repeated
         }
-        flat_mask[list(other)] = True  # no direction is judged in them either
+    # no direction is judged in them, and no reference fit is made with them
+    other_mask = np.isin(np.arange(n), list(other))
 
     # per-image evidence on a full-resolution crop where the object has lit structure (a
     # second pass reads only its rows)
@@ -1831,7 +1843,16 @@ def assess(
 
     def evidence_of(fit: Any, still: NDArray[np.bool_] | None = None) -> _Evidence:
         ev = _evidence(
-            crop_arr, crop_sat, fit, lt, dark_level, names, still, object_error_limit, flat_mask
+            crop_arr,
+            crop_sat,
+            fit,
+            lt,
+            dark_level,
+            names,
+            still,
+            object_error_limit,
+            flat_mask,
+            other_mask,
         )
         for i in np.flatnonzero(edge_moved):
             ev.moved[i] = True
@@ -1865,11 +1886,15 @@ def assess(
         """``arr`` as the reference fits take it: the exposure-off images levelled."""
         return _exposure_levelled(arr, early_exposure, levelled, sat_level)
 
-    keep = np.ones(n, bool)
+    # another object's picture (qa_other_object) is in no reference fit: it would tilt the
+    # surface the others are judged against
+    keep = ~other_mask
     ps = (
         step_fit
         if step_fit is not None and not levelled.any()
-        else fit_photometric_stereo(fit_stack(crop_arr), lt, robust=True, saturation=sat_level)
+        else fit_photometric_stereo(
+            fit_stack(crop_arr)[keep], lt[keep], robust=True, saturation=sat_level
+        )
     )
     ev = evidence_of(ps)
     # the fit and evidence a refit replaced, kept only where they named a wrong light: the one
@@ -1904,6 +1929,7 @@ def assess(
                 score = np.full(n, np.inf)
                 score[ok] = _ranks(ev.misfit[ok]) + _ranks(ev.err[ok])
                 new_keep = ok & (score <= np.median(score[ok]))
+        new_keep &= ~other_mask
         if new_keep.sum() < 6 or np.array_equal(new_keep, keep):
             break
         try:
@@ -1925,7 +1951,7 @@ def assess(
         # brightness is judged against a fit that has them, as on the same object with no
         # light called wrong (left out, two of a brushed steel part with its lights right were
         # told "1.7x brighter than the other images predict")
-        unfaulted = ~ev.dim & ~(ev.moved & ~edge_moved)
+        unfaulted = ~ev.dim & ~(ev.moved & ~edge_moved) & ~other_mask
         if not np.array_equal(unfaulted, keep) and unfaulted.sum() >= 6:
             try:
                 ps = fit_photometric_stereo(
@@ -2198,7 +2224,7 @@ def assess(
             # said in place of the shift the edges read: a turn shifts every crop but the
             # middle's, and the shift is the turn's
             problems.append(turn_problem(turn, names, h, w))
-        elif ev.moved[i]:
+        elif ev.moved[i] and i not in other:  # its shift is against another object's edges
             dx, dy = ev.drift[i]
             problems.append(
                 f"object or camera moved: shifted ({dx:+.1f}, {dy:+.1f}) px against the others"
@@ -2452,6 +2478,7 @@ def _evidence(
     still: NDArray[np.bool_] | None = None,
     object_error_limit: float = float("inf"),
     pictureless: NDArray[np.bool_] | None = None,
+    foreign: NDArray[np.bool_] | None = None,
 ) -> _Evidence:
     """Every image judged against one fit ``ps``. Images in ``still`` are judged as captured,
     never moved back by a shift against the fit: one the verdict does not claim (see
@@ -2611,6 +2638,8 @@ def _evidence(
     # direction" beside "a flat frame", and counted among the images too far from any
     # rendering ("a glossy, saturated or non-Lambertian surface")
     nodir = dead | (pictureless if pictureless is not None else np.zeros(n, bool))
+    if foreign is not None:  # pictures of another object (qa_other_object): no direction
+        nodir = nodir | foreign
     # a wrong light can look dim (its recorded light predicts a brighter image): only a frame
     # with no light at all has no direction to judge
     # an image clipped over most of the object keeps only the pixels its light barely

@@ -44,6 +44,10 @@ MIN_TYPICAL = 0.4
 MIN_LEVEL_SHARE = 0.5
 #: Judged images needed for a typical correlation.
 MIN_JUDGED = 6
+#: Consecutive judged images named at once that are taken for a move, not stray files.
+MIN_RUN = 3
+#: The share of the judged images above which those named are taken for a move, not files.
+MAX_SHARE = 0.1
 
 
 def other_object_images(
@@ -59,10 +63,23 @@ def other_object_images(
     typical = float(np.median(correlations[judged]))
     if typical < MIN_TYPICAL:
         return {}
-    return {
-        int(i): (float(correlations[i]), typical)
-        for i in np.flatnonzero(judged & (correlations < OTHER_OBJECT_SHARE * typical))
-    }
+    found = judged & (correlations < OTHER_OBJECT_SHARE * typical)
+    # a stray file is one image, or two: a run of MIN_RUN images in capture order (judged
+    # ones; an unjudged image between does not break it), or more than MAX_SHARE of the
+    # judged, is the object or camera moved past what registration follows (a 24 px shift
+    # of a 512 px frame, a turn of 10°), which the move checks speak of, not a file
+    if found.sum() > max(2, MAX_SHARE * judged.sum()):
+        return {}
+    order = np.flatnonzero(judged)
+    flags = found[order]
+    keep = flags.copy()
+    start = 0
+    for k in range(1, flags.size + 1):
+        if k == flags.size or flags[k] != flags[start]:
+            if flags[start] and k - start >= MIN_RUN:
+                keep[start:k] = False
+            start = k
+    return {int(i): (float(correlations[i]), typical) for i in order[keep]}
 
 
 #: The start of the problem :func:`other_object_problem` says.

@@ -46,9 +46,14 @@ MIN_CORRELATION = 0.3
 MIN_SIDE = 3
 #: Edge images the median reference is made of, at most (spread over the capture order).
 REFERENCE_IMAGES = 64
+#: A side whose angles drift along the capture order by this share of the step is a slow
+#: roll, not a step: no turn from one image is claimed.
+DRIFT_SHARE = 0.5
 #: The share of each side's images that must sit nearer their own side's median angle.
 SIDE_AGREE = 0.75
-#: The smallest turn claimed (degrees): still sessions' sides differ by up to 0.2°.
+#: The smallest turn claimed (degrees): still sessions' sides differ by up to 0.2° (an
+#: ad-hoc probe of the shipped simulated dome and virtual arm, every scene, at 48 and 24
+#: lights; benchmarks.qa_turn shows none claimed on them).
 TURN_MIN_DEG = 0.5
 #: ... and by at least this many standard errors of the two sides' medians.
 TURN_Z = 8.0
@@ -104,7 +109,8 @@ def _register(ref: NDArray[np.float32], edge: NDArray[np.float32]) -> tuple[floa
 class Registration:
     """Each image's turn (degrees, counter-clockwise as seen; nan: not judged) and the
     correlation of its registered edges with the reference's (nan: a featureless image or
-    one not registered), in capture order."""
+    one not usable; 0 where ECC found no registration: nothing in common), in capture
+    order."""
 
     angles: NDArray[np.float64]
     correlations: NDArray[np.float64]
@@ -185,6 +191,13 @@ def find_turn(angles: NDArray[np.float64]) -> Turn | None:
     z = abs(step) / (1.2533 * spread * np.sqrt(1 / left.size + 1 / right.size))
     if z < TURN_Z or abs(step) < TURN_MIN_DEG:
         return None
+    # a step, not a slow roll: neither side's angles drift along the capture order by half
+    # the step (a roll of 1° spread evenly over 100 images, 0.03° noise, had been claimed as
+    # a 0.51° turn from image_051)
+    for side, where in ((left, judged[:k]), (right, judged[k:])):
+        slope = float(np.polyfit(where.astype(np.float64), side, 1)[0])
+        if abs(slope) * float(where[-1] - where[0]) > DRIFT_SHARE * abs(step):
+            return None
     # each side's images sit at its own angle, mostly: a later side of three whose median is
     # set by two images turned (or misread) is not a turn from the first of the three
     for side, other in ((left, right), (right, left)):

@@ -111,3 +111,21 @@ def test_a_step_is_claimed_only_with_enough_images_and_size() -> None:
     # as turned, and the first judged turned is said
     assert turn is not None and (turn.first, turn.judged_first) == (30, 32)
     assert find_turn(stepped).judged_first is None  # type: ignore[union-attr]
+
+
+def test_a_slow_roll_is_not_a_turn_from_one_image() -> None:
+    """A roll of 1° spread evenly over the session: no image where it began to name."""
+    rng = np.random.default_rng(1)
+    for n in (48, 100, 200):
+        assert find_turn(np.linspace(0.0, 1.0, n) + rng.normal(0.0, 0.03, n)) is None
+
+
+def test_a_turn_stands_whatever_the_lights() -> None:
+    """Found from edges alone, with no fit: under lights likely wrong it is still named, where
+    a shift against a fit of the recorded lights is not."""
+    from rti_rig.reconstruct.qa import MOVED_FROM, lights_independent, turn_problem
+    from rti_rig.reconstruct.qa_turn import Turn
+
+    names = [f"image_{i:03d}" for i in range(1, 49)]
+    assert lights_independent(turn_problem(Turn(first=20, angle_deg=-3.0), names, 512, 512))
+    assert not lights_independent(f"{MOVED_FROM} image_020 on: shifted (+1.0, -2.0) px")

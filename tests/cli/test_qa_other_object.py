@@ -20,6 +20,7 @@ from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.reconstruct.qa_other_object import (
+    MAX_SHARE,
     MIN_JUDGED,
     OTHER_OBJECT,
     OTHER_OBJECT_SHARE,
@@ -91,10 +92,34 @@ def test_only_a_lit_image_of_a_session_with_edges_is_judged() -> None:
     assert other_object_images(corr, dim) == {}
     # a featureless plate: no typical correlation to compare with
     assert other_object_images(np.where(corr > 0.5, 0.15, 0.01), levels) == {}
-    # an image ECC could not register reads 0; a featureless one (nan) is not judged
+    # an image ECC could not register reads 0 (nothing in common): named
+    corr[5] = 0.0
+    assert set(other_object_images(corr, levels)) == {5}
+    # a featureless one (nan) is not judged
     corr[5] = np.nan
     assert other_object_images(corr, levels) == {}
+    # a run of MIN_RUN in capture order is the object moved past what registration follows,
+    # not stray files (an unjudged image between does not break the run)
+    run = np.full(40, 0.8)
+    run[[10, 11, 13]] = 0.0
+    run[12] = np.nan
+    assert other_object_images(run, np.ones(40)) == {}
+    run[13] = 0.8
+    assert set(other_object_images(run, np.ones(40))) == {10, 11}
+    # ... and so are more than MAX_SHARE of the images, scattered
+    scattered = np.full(40, 0.8)
+    scattered[::8] = 0.0
+    assert other_object_images(scattered, np.ones(40)) == {}
+    assert MAX_SHARE * 40 < 5
     # too few judged images to know what is typical
     few = np.full(MIN_JUDGED - 1, 0.8)
     few[0] = 0.0
     assert other_object_images(few, np.ones(few.size)) == {}
+
+
+def test_it_stands_whatever_the_lights() -> None:
+    """Found from edges alone, with no fit: under lights likely wrong it is still named."""
+    from rti_rig.reconstruct.qa import lights_independent
+    from rti_rig.reconstruct.qa_other_object import other_object_problem
+
+    assert lights_independent(other_object_problem(0.1, 0.8))
