@@ -6,6 +6,7 @@ Why one module: benchmarks.qa_underexposed and benchmarks.qa_likeness had each w
 
 from __future__ import annotations
 
+import argparse
 import os
 import re
 import subprocess
@@ -32,3 +33,24 @@ def shipped_with_scene(rig: str, scene: str) -> str:
     if n_scene != 1:
         raise SystemExit(f"{rig}: no [scene] name to vary")
     return text
+
+
+def sessions_args(doc: str, argv: list[str] | None, lights: int) -> argparse.Namespace:
+    """The command line of a benchmark that shoots sessions of ``lights`` lights (``--lights``)
+    and writes its figures to docs/reconstruction.md when asked (``--write``); ``doc``: the
+    benchmark's docstring, whose first line ``--help`` says."""
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument(
+        "--lights", type=int, default=lights, help=f"lights per session (default {lights})"
+    )
+    ap.add_argument(
+        "--write", action="store_true", help="update the figures in docs/reconstruction.md"
+    )
+    return ap.parse_args(argv)
+
+
+def every_scene() -> tuple[str, ...]:
+    """The shipped configs' built-in scene (``relief``) and every scene of the library."""
+    from rti_rig.simulator.scenes import SCENE_NAMES
+
+    return ("relief", *SCENE_NAMES)

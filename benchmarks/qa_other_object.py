@@ -15,13 +15,12 @@ section ``qa_other_object`` of docs/reconstruction.md).
 
 from __future__ import annotations
 
-import argparse
 import json
 import shutil
 import tempfile
 from pathlib import Path
 
-from benchmarks.front_door import ROOT, rti_rig, shipped_with_scene
+from benchmarks.front_door import ROOT, every_scene, rti_rig, sessions_args, shipped_with_scene
 
 DOC = ROOT / "docs" / "reconstruction.md"
 RIGS = ("simulated_dome.toml", "virtual_arm.toml")
@@ -59,17 +58,11 @@ def said_of(folder: Path, fitted: Path, name: str) -> tuple[str, list[str]]:
 
 
 def main(argv: list[str] | None = None) -> str:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--lights", type=int, default=24, help="lights per session (default 24)")
-    ap.add_argument(
-        "--write", action="store_true", help="update the figures in docs/reconstruction.md"
-    )
-    args = ap.parse_args(argv)
+    args = sessions_args(__doc__, argv, 24)
     from benchmarks.report import machine_line, write_section
     from rti_rig.reconstruct.qa_other_object import OTHER_OBJECT_SHARE
-    from rti_rig.simulator.scenes import SCENE_NAMES
 
-    scenes = ("relief", *SCENE_NAMES)  # the shipped configs' built-in scene, and the library
+    scenes = every_scene()
     name = f"image_{args.lights * 2 // 3 + 1:03d}.jpg"
     rows = []
     with tempfile.TemporaryDirectory(prefix="qa_other_object_") as tmp:

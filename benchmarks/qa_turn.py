@@ -14,12 +14,11 @@ Run: ``python -m benchmarks.qa_turn [--lights N] [--write]`` (``--write`` replac
 
 from __future__ import annotations
 
-import argparse
 import json
 import tempfile
 from pathlib import Path
 
-from benchmarks.front_door import ROOT, rti_rig, shipped_with_scene
+from benchmarks.front_door import ROOT, every_scene, rti_rig, sessions_args, shipped_with_scene
 
 DOC = ROOT / "docs" / "reconstruction.md"
 RIGS = ("simulated_dome.toml", "virtual_arm.toml")
@@ -68,17 +67,11 @@ def row(scratch: Path, rig: str, scene: str, lights: int) -> str:
 
 
 def main(argv: list[str] | None = None) -> str:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--lights", type=int, default=24, help="lights per session (default 24)")
-    ap.add_argument(
-        "--write", action="store_true", help="update the figures in docs/reconstruction.md"
-    )
-    args = ap.parse_args(argv)
+    args = sessions_args(__doc__, argv, 24)
     from benchmarks.report import machine_line, write_section
     from rti_rig.reconstruct.qa_turn import TURN_MIN_DEG
-    from rti_rig.simulator.scenes import SCENE_NAMES
 
-    scenes = ("relief", *SCENE_NAMES)  # the shipped configs' built-in scene, and the library
+    scenes = every_scene()
     rows = []
     with tempfile.TemporaryDirectory(prefix="qa_turn_") as tmp:
         for rig in RIGS:

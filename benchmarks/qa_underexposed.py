@@ -16,12 +16,11 @@ section ``qa_underexposed`` of docs/reconstruction.md).
 
 from __future__ import annotations
 
-import argparse
 import json
 import tempfile
 from pathlib import Path
 
-from benchmarks.front_door import ROOT, rti_rig, shipped_with_scene
+from benchmarks.front_door import ROOT, every_scene, rti_rig, sessions_args, shipped_with_scene
 
 DOC = ROOT / "docs" / "reconstruction.md"
 RIGS = ("simulated_dome.toml", "virtual_arm.toml")
@@ -61,17 +60,11 @@ def one(scratch: Path, rig: str, scene: str, band: str, factor: float, lights: i
 
 
 def main(argv: list[str] | None = None) -> str:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--lights", type=int, default=12, help="lights per session (default 12)")
-    ap.add_argument(
-        "--write", action="store_true", help="update the figures in docs/reconstruction.md"
-    )
-    args = ap.parse_args(argv)
+    args = sessions_args(__doc__, argv, 12)
     from benchmarks.report import machine_line, write_section
     from rti_rig.reconstruct.qa_underexposed import UNDEREXPOSED_PEAK
-    from rti_rig.simulator.scenes import SCENE_NAMES
 
-    scenes = ("relief", *SCENE_NAMES)  # the shipped configs' built-in scene, and the library
+    scenes = every_scene()
     runs = [(rig, scene, band, 1.0) for rig in RIGS for scene in scenes for band in BANDS]
     # the emulated Dynamixel arm with its shipped scene (point lamps at 400 mm)
     runs += [("simulated_arm.toml", "tablet", band, 1.0) for band in BANDS]
