@@ -1,8 +1,10 @@
 """What the benchmarks that measure through the front door share: ``rti-rig`` run as a user
-runs it (a new process), and a shipped rig config with its scene changed.
+runs it (a new process), a shipped rig config with its scene changed, every scene, and the
+command line of a benchmark that shoots sessions.
 
-Why one module: benchmarks.qa_underexposed and benchmarks.qa_likeness had each written both
-(the scene's pattern twice over, to drift apart)."""
+Why one module: benchmarks.qa_underexposed and benchmarks.qa_likeness had each written the
+first two (the scene's pattern twice over, to drift apart), and qa_turn and qa_other_object
+the last two again."""
 
 from __future__ import annotations
 
