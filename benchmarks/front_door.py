@@ -3,7 +3,7 @@ runs it (a new process), a shipped rig config with its scene changed, every scen
 command line of a benchmark that shoots sessions.
 
 Why one module: benchmarks.qa_underexposed and benchmarks.qa_likeness had each written the
-first two (the scene's pattern twice over, to drift apart), and qa_turn and qa_other_object
+first two (the scene's pattern twice over, to drift apart), and qa_turn
 the last two again."""
 
 from __future__ import annotations

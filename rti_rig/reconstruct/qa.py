@@ -87,15 +87,9 @@ from rti_rig.reconstruct.qa_exposure import (
     exposure_ratios,
     exposure_scatter,
 )
-from rti_rig.reconstruct.qa_other_object import (
-    OTHER_OBJECT,
-    OTHER_OBJECT_SHARE,
-    other_object_images,
-    other_object_problem,
-)
 from rti_rig.reconstruct.qa_repeated import REPEATED, repeated_pictures, repeated_problem
 from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
-from rti_rig.reconstruct.qa_turn import TURN_MIN_DEG, TURN_Z, Turn, edge_registration, find_turn
+from rti_rig.reconstruct.qa_turn import TURN_MIN_DEG, TURN_Z, Turn, find_turn, image_angles
 from rti_rig.reconstruct.qa_unchanging import (
     FLAT_ADVICE,
     FLAT_FRAME,
@@ -932,12 +926,10 @@ def lights_independent(problem: str) -> bool:
     images that do not change, black throughout), where the others (wrong light, brighter or
     dimmer than predicted, exposure against its elevation, moved) are found against a fit of
     the recorded lights and follow from a wrong ``.lp`` alone."""
-    # a turn and another object's picture are found from the images' edges alone (qa_turn,
-    # qa_other_object), with no fit: they stand whatever the lights
+    # a turn is found from the images' edges alone (qa_turn), with no fit: it stands
+    # whatever the lights
     turned = problem.startswith(MOVED_FROM) and TURN_WORDS in problem
-    return turned or problem.startswith(
-        ("saturated", FLAT_FRAME, REPEATED, OTHER_OBJECT, *EVERY_IMAGE)
-    )
+    return turned or problem.startswith(("saturated", FLAT_FRAME, REPEATED, *EVERY_IMAGE))
 
 
 def _readvised(problem: str, name: str, advice: Callable[[str, str], str]) -> str:
@@ -1742,25 +1734,14 @@ def assess(
     flat_mask = np.isin(np.arange(n), list(flat))  # no direction is judged in them (_evidence)
     # an image that is an earlier one again, pixel for pixel (qa_repeated)
     repeated = {} if all_black or unchanged is not None else repeated_pictures(small)
-    # the frame's mean level (qa_exposure, and which images are lit enough to judge below)
+    # the frame's mean level (qa_exposure)
     level = small.reshape(n, -1).mean(axis=1, dtype=np.float64)
-    # each image's edges registered onto the session's (qa_turn): the camera (or object)
-    # turned about the view axis part-way through, seen on the whole reduced frame since a
-    # turn moves the middle, where the crop below is, by nothing; and an image whose edges
-    # are not the object's (qa_other_object), named in place of the dim or bright claims
-    # its level against the fit would give it
+    # the camera (or object) turned about the view axis part-way through (qa_turn): seen on
+    # the whole reduced frame, since a turn moves the middle, where the crop below is, by
+    # nothing
     turn: Turn | None = None
-    other: dict[int, tuple[float, float]] = {}
     if not all_black and unchanged is None:
-        registered = edge_registration(small, small.reshape(n, -1).max(axis=1) > dark)
-        turn = find_turn(registered.angles)
-        other = {
-            i: found
-            for i, found in other_object_images(registered.correlations, level).items()
-            if i not in flat and i not in repeated
-        }
-    # no direction is judged in them, and no reference fit is made with them
-    other_mask = np.isin(np.arange(n), list(other))
+        turn = find_turn(image_angles(small, small.reshape(n, -1).max(axis=1) > dark))
 
     # per-image evidence on a full-resolution crop where the object has lit structure (a
     # second pass reads only its rows)
@@ -1852,7 +1833,6 @@ def assess(
             still,
             object_error_limit,
             flat_mask,
-            other_mask,
         )
         for i in np.flatnonzero(edge_moved):
             ev.moved[i] = True
@@ -1886,15 +1866,11 @@ def assess(
         """``arr`` as the reference fits take it: the exposure-off images levelled."""
         return _exposure_levelled(arr, early_exposure, levelled, sat_level)
 
-    # another object's picture (qa_other_object) is in no reference fit: it would tilt the
-    # surface the others are judged against
-    keep = ~other_mask
+    keep = np.ones(n, bool)
     ps = (
         step_fit
         if step_fit is not None and not levelled.any()
-        else fit_photometric_stereo(
-            fit_stack(crop_arr)[keep], lt[keep], robust=True, saturation=sat_level
-        )
+        else fit_photometric_stereo(fit_stack(crop_arr), lt, robust=True, saturation=sat_level)
     )
     ev = evidence_of(ps)
     # the fit and evidence a refit replaced, kept only where they named a wrong light: the one
@@ -1929,7 +1905,6 @@ def assess(
                 score = np.full(n, np.inf)
                 score[ok] = _ranks(ev.misfit[ok]) + _ranks(ev.err[ok])
                 new_keep = ok & (score <= np.median(score[ok]))
-        new_keep &= ~other_mask
         if new_keep.sum() < 6 or np.array_equal(new_keep, keep):
             break
         try:
@@ -1951,7 +1926,7 @@ def assess(
         # brightness is judged against a fit that has them, as on the same object with no
         # light called wrong (left out, two of a brushed steel part with its lights right were
         # told "1.7x brighter than the other images predict")
-        unfaulted = ~ev.dim & ~(ev.moved & ~edge_moved) & ~other_mask
+        unfaulted = ~ev.dim & ~(ev.moved & ~edge_moved)
         if not np.array_equal(unfaulted, keep) and unfaulted.sum() >= 6:
             try:
                 ps = fit_photometric_stereo(
@@ -2196,11 +2171,6 @@ def assess(
             problems = [p for p in problems if p.startswith("saturated")]
             problems.append(repeated_problem(names[repeated[i]]))
             bright_claim = None
-        if i in other:
-            # its level and direction against the fit are those of another object's picture
-            problems = [p for p in problems if p.startswith("saturated")]
-            problems.append(other_object_problem(*other[i]))
-            bright_claim = None
         if underexposed is not None:
             problems.append(underexposed)
         if step is not None and _in_open_range(step, i):
@@ -2224,7 +2194,7 @@ def assess(
             # said in place of the shift the edges read: a turn shifts every crop but the
             # middle's, and the shift is the turn's
             problems.append(turn_problem(turn, names, h, w))
-        elif ev.moved[i] and i not in other:  # its shift is against another object's edges
+        elif ev.moved[i]:
             dx, dy = ev.drift[i]
             problems.append(
                 f"object or camera moved: shifted ({dx:+.1f}, {dy:+.1f}) px against the others"
@@ -2300,7 +2270,6 @@ def assess(
         "swap_max_placed_deg": SWAP_MAX_PLACED_DEG,
         "underexposed_peak": UNDEREXPOSED_PEAK,
         "turn_min_deg": TURN_MIN_DEG,
-        "other_object_share": OTHER_OBJECT_SHARE,
         "turn_z": TURN_Z,
     }
     mirrored = mirror_ratio(ps.normals, ps.valid)
@@ -2478,7 +2447,6 @@ def _evidence(
     still: NDArray[np.bool_] | None = None,
     object_error_limit: float = float("inf"),
     pictureless: NDArray[np.bool_] | None = None,
-    foreign: NDArray[np.bool_] | None = None,
 ) -> _Evidence:
     """Every image judged against one fit ``ps``. Images in ``still`` are judged as captured,
     never moved back by a shift against the fit: one the verdict does not claim (see
@@ -2638,8 +2606,6 @@ def _evidence(
     # direction" beside "a flat frame", and counted among the images too far from any
     # rendering ("a glossy, saturated or non-Lambertian surface")
     nodir = dead | (pictureless if pictureless is not None else np.zeros(n, bool))
-    if foreign is not None:  # pictures of another object (qa_other_object): no direction
-        nodir = nodir | foreign
     # a wrong light can look dim (its recorded light predicts a brighter image): only a frame
     # with no light at all has no direction to judge
     # an image clipped over most of the object keeps only the pixels its light barely

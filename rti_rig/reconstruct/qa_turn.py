@@ -87,33 +87,21 @@ def _turned(img: NDArray[np.float32], angle_deg: float) -> NDArray[np.float32]:
     return cv2.warpAffine(img, m, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
 
 
-def _register(ref: NDArray[np.float32], edge: NDArray[np.float32]) -> tuple[float, float]:
-    """``edge``'s turn against ``ref`` in degrees (counter-clockwise as seen; nan where ECC
-    does not converge or the registered edges correlate below :data:`MIN_CORRELATION`), and
-    that correlation (0 where ECC does not converge)."""
+def _angle_onto(ref: NDArray[np.float32], edge: NDArray[np.float32]) -> float:
+    """``edge``'s turn against ``ref`` in degrees (counter-clockwise as seen), or nan where
+    ECC does not converge or the registered edges correlate below :data:`MIN_CORRELATION`."""
     warp = np.eye(2, 3, dtype=np.float32)
     try:
         cc, warp = cv2.findTransformECC(
             ref, edge, warp, cv2.MOTION_EUCLIDEAN, _ECC_CRITERIA, None, 5
         )
-    except cv2.error:  # no convergence: no measurement, and nothing in common found
-        return float("nan"), 0.0
+    except cv2.error:  # no convergence: no measurement
+        return float("nan")
     if not cc >= MIN_CORRELATION:
-        return float("nan"), float(cc) if np.isfinite(cc) else 0.0
+        return float("nan")
     # the warp maps the reference's pixels onto the image's (rows run down): an image turned
     # counter-clockwise as seen reads a negative angle in those axes
-    return -float(np.degrees(np.arctan2(warp[1, 0], warp[0, 0]))), float(cc)
-
-
-@dataclass(frozen=True)
-class Registration:
-    """Each image's turn (degrees, counter-clockwise as seen; nan: not judged) and the
-    correlation of its registered edges with the reference's (nan: a featureless image or
-    one not usable; 0 where ECC found no registration: nothing in common), in capture
-    order."""
-
-    angles: NDArray[np.float64]
-    correlations: NDArray[np.float64]
+    return -float(np.degrees(np.arctan2(warp[1, 0], warp[0, 0])))
 
 
 def _edges(level: NDArray[np.float32]) -> NDArray[np.float32] | None:
@@ -124,17 +112,16 @@ def _edges(level: NDArray[np.float32]) -> NDArray[np.float32] | None:
     return edge_image(np.sqrt(np.maximum(level, 0.0, dtype=np.float32)))
 
 
-def edge_registration(small: NDArray[np.float32], usable: NDArray[np.bool_]) -> Registration:
-    """Each image's turn against the median of the edge images, and its correlation with it;
-    two rounds (module docstring). The median is of at most :data:`REFERENCE_IMAGES` of them,
-    spread over the capture order, so that a dense acquisition's edge images are never all
-    held at once (at 1000 lights, 260 MB)."""
+def image_angles(small: NDArray[np.float32], usable: NDArray[np.bool_]) -> NDArray[np.float64]:
+    """Each image's turn (degrees, counter-clockwise as seen; nan: not judged) against the
+    median of the edge images; two rounds (module docstring). The median is of at most
+    :data:`REFERENCE_IMAGES` of them, spread over the capture order, so that a dense
+    acquisition's edge images are never all held at once (at 1000 lights, 260 MB)."""
     n = small.shape[0]
     angles = np.full(n, np.nan)
-    correlations = np.full(n, np.nan)
     have = [i for i in range(n) if usable[i]]
     if len(have) < 2 * MIN_SIDE:
-        return Registration(angles, correlations)
+        return angles
     spaced = np.linspace(0, len(have) - 1, min(len(have), REFERENCE_IMAGES)).round().astype(int)
     kept = {i: _edges(small[i]) for i in dict.fromkeys(have[k] for k in spaced)}
     turn: Turn | None = None
@@ -145,19 +132,18 @@ def edge_registration(small: NDArray[np.float32], usable: NDArray[np.bool_]) -> 
             if e is not None
         ]
         if len(placed) < 2 * MIN_SIDE:
-            return Registration(angles, correlations)
+            return angles
         ref = median_of_images(placed).astype(np.float32)
         for i in have:
             edge = kept[i] if i in kept else _edges(small[i])
-            if edge is not None:
-                angles[i], correlations[i] = _register(ref, edge)
+            angles[i] = np.nan if edge is None else _angle_onto(ref, edge)
         # the second round's reference is of the session's earlier position (the later
         # side's edges turned back), so a turn of most of the session does not leave it a
         # blend of both; the angles are read as the images are
         turn = find_turn(angles)
         if turn is None:
             break
-    return Registration(angles, correlations)
+    return angles
 
 
 def _spread(values: NDArray[np.float64]) -> float:
