@@ -1824,15 +1824,7 @@ def assess(
 
     def evidence_of(fit: Any, still: NDArray[np.bool_] | None = None) -> _Evidence:
         ev = _evidence(
-            crop_arr,
-            crop_sat,
-            fit,
-            lt,
-            dark_level,
-            names,
-            still,
-            object_error_limit,
-            flat_mask,
+            crop_arr, crop_sat, fit, lt, dark_level, names, still, object_error_limit, flat_mask
         )
         for i in np.flatnonzero(edge_moved):
             ev.moved[i] = True

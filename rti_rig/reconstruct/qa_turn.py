@@ -7,22 +7,26 @@ from image_020 on turned 3° about the centre (an imported folder), was called "
 fitted normals were off by 1.7° at the 90th percentile against 0.19° as shot (0.67° at a 1°
 turn). Nothing a fit says shows it either: every image is a believable picture of the object.
 
-Measured here on the QA's reduced images (at most 256 px a side), on their edge strength as
-:func:`~rti_rig.reconstruct.qa_drift.edge_image` makes it (edges of relief and albedo stay put
-whatever the light; shading edges do not, which is why the tilted plane's images mostly go
-unjudged below). Each image's edge image is registered onto the median of all of them by
-OpenCV's ECC with a Euclidean motion (rotation and shift: a knock turns and shifts at once),
-whose angle is the image's turn; an image whose registered edges correlate with the median
-below :data:`MIN_CORRELATION` is not judged (a grazing light's shadows, a black frame). Two
-rounds: the images of the later side are turned back before the median is made again, so a
-turn of most of the session does not leave the reference a blend of both.
+Measured here on the QA's reduced images (at most 256 px a side), on the edge strength of
+their square roots as :func:`~rti_rig.reconstruct.qa_drift.edge_image` makes it (edges of
+relief and albedo stay put whatever the light; shading edges do not, which is why the tilted
+plane's images mostly go unjudged below; in linear levels a glossy coin's moving highlights
+outweigh its relief). Each image's edge image is registered onto the median of up to
+:data:`REFERENCE_IMAGES` of them by OpenCV's ECC with a Euclidean motion (rotation and shift:
+a knock turns and shifts at once), whose angle is the image's turn; an image whose registered
+edges correlate with the median below :data:`MIN_CORRELATION` is not judged (a grazing
+light's shadows, a black frame). Two rounds: the images of the later side are turned back
+before the median is made again, so a turn of most of the session does not leave the
+reference a blend of both.
 
-A turn is claimed as a step in capture order (the camera stays where the knock left it):
-the split whose two sides' median angles differ most against their spread, with at least
-:data:`MIN_SIDE` judged images on each side, differing by at least :data:`TURN_MIN_DEG` and by
-:data:`TURN_Z` standard errors. Figures (``python -m benchmarks.qa_turn``): still sessions of
-the shipped simulated dome and virtual arm over every scene, and the same turned by 0.5°, 1°
-and 3° from two thirds of the way on.
+A turn is claimed as a step in capture order (the camera stays where the knock left it): the
+split that leaves the least absolute deviation from each side's median angle, with at least
+:data:`MIN_SIDE` judged images on each side, the medians differing by at least
+:data:`TURN_MIN_DEG` and by :data:`TURN_Z` standard errors, :data:`SIDE_AGREE` of each side's
+images nearer its own median, and neither side drifting along the capture order by
+:data:`DRIFT_SHARE` of the step (a slow roll). Figures (``python -m benchmarks.qa_turn``):
+still sessions of the shipped simulated dome and virtual arm over every scene, and the same
+turned by 0.5°, 1° and 3° from two thirds of the way on.
 
 Not seen here: a turn under :data:`TURN_MIN_DEG` (at 0.5° a 512 px frame's corners move
 3 px, a 6000 × 4000 frame's 31 px), a single image turned and turned back (no step), and the
