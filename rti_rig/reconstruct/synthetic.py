@@ -6,6 +6,7 @@ Lambertian-plus-Blinn–Phong shader, enough to know what a fit must return.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -83,10 +84,11 @@ def sphere_frames(
     return frames, lights
 
 
-def moved_session_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -> Path:
-    """A copy of ``session`` whose images from ``first`` (1-based) on are shifted by
-    ``(dx, dy)`` px (x right, y down): the object nudged once, part-way through. Here, not in
-    tests/, so that benchmarks/qa_step_margin.py measures the same move the QA tests claim."""
+def _changed_session_copy(
+    session: Path, dst: Path, first: int, change: Callable[[NDArray], NDArray]
+) -> Path:
+    """A copy of ``session`` whose linear images from ``first`` (1-based) on are ``change``d:
+    what the object or camera did once, part-way through."""
     import shutil
 
     from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
@@ -95,8 +97,17 @@ def moved_session_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -
     for f in sorted((dst / "linear").glob("image_*.tif"))[first - 1 :]:
         img = read_linear_tiff(f)
         f.unlink()
-        write_linear_tiff(f, np.roll(img, (dy, dx), axis=(0, 1)))
+        write_linear_tiff(f, change(img))
     return dst
+
+
+def moved_session_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -> Path:
+    """A copy of ``session`` whose images from ``first`` (1-based) on are shifted by
+    ``(dx, dy)`` px (x right, y down): the object nudged once, part-way through. Here, not in
+    tests/, so that benchmarks/qa_step_margin.py measures the same move the QA tests claim."""
+    return _changed_session_copy(
+        session, dst, first, lambda img: np.roll(img, (dy, dx), axis=(0, 1))
+    )
 
 
 def turned_session_copy(session: Path, dst: Path, first: int, angle_deg: float) -> Path:
@@ -104,20 +115,14 @@ def turned_session_copy(session: Path, dst: Path, first: int, angle_deg: float) 
     ``angle_deg`` (counter-clockwise as seen) about the frame's centre: a camera knocked once,
     part-way through, rolling about its axis. Here, not in tests/, so that
     benchmarks/qa_turn.py turns a session the same way the QA tests do."""
-    import shutil
-
     import cv2
 
-    from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
-
-    shutil.copytree(session, dst)
-    for f in sorted((dst / "linear").glob("image_*.tif"))[first - 1 :]:
-        img = read_linear_tiff(f)
+    def turned(img: NDArray) -> NDArray:
         h, w = img.shape[:2]
         m = cv2.getRotationMatrix2D((w / 2, h / 2), angle_deg, 1.0)
-        turned = cv2.warpAffine(
+        out = cv2.warpAffine(
             img, m, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
         )
-        f.unlink()
-        write_linear_tiff(f, turned.reshape(img.shape).astype(img.dtype))
-    return dst
+        return out.reshape(img.shape).astype(img.dtype)
+
+    return _changed_session_copy(session, dst, first, turned)

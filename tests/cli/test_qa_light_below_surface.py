@@ -54,21 +54,22 @@ def test_a_light_below_the_tilted_surface_is_not_called_misfired(tmp_path: Path)
     # a real misfire of a light above the surface (image_006 lights the whole plane) is named
     tif = session / "linear" / "image_006.tif"
     black = np.full_like(read_linear_tiff(tif), 2)
-    tif.unlink()
-    write_linear_tiff(tif, black)
-    r = runner.invoke(app, ["fit", str(session), "--out", str(tmp_path / "fit")])
-    assert r.exit_code == 0, r.output
-    said = " ".join(r.output.split())
+    said = _fitted_with(tif, black, tmp_path / "fit")
     assert "reshoot: image_006 (misfired, no light" in said, said
 
     # a white frame in its place is named as clipped, and the lights are not doubted for it:
     # its correlations with the others had been rounding noise (-37 to +4), which put the
     # session at a likeness of 0.20, "lights likely wrong" (review, 2026-12-07)
-    white = np.full_like(black, 65535)
-    tif.unlink()
-    write_linear_tiff(tif, white)
-    r = runner.invoke(app, ["fit", str(session), "--out", str(tmp_path / "fit_white")])
-    assert r.exit_code == 0, r.output
-    said = " ".join(r.output.split())
+    said = _fitted_with(tif, np.full_like(black, 65535), tmp_path / "fit_white")
     assert "reshoot: image_006 (saturated: 100.0% of pixels clipped" in said, said
     assert "likely wrong" not in said.split("QA verdict: ")[1], said
+
+
+def _fitted_with(tif: Path, frame: np.ndarray, out: Path) -> str:
+    """What ``rti-rig fit`` says of the session of ``tif`` with ``frame`` in its place."""
+    tif.unlink()
+    write_linear_tiff(tif, frame)
+    session = tif.parent.parent
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    return " ".join(r.output.split())
