@@ -210,6 +210,16 @@ def fit(
             "as named.",
         ),
     ] = None,
+    white_level: Annotated[
+        int | None,
+        typer.Option(
+            "--white-level",
+            help="The code 16-bit images saturate at (their full scale), where it is not 65535: "
+            "4095 for a 12-bit camera's data stored unscaled. Default: 65535, or read from an "
+            "imported acquisition's images (clipped at one value, shifted up, or never above "
+            "a 10- or 12-bit top), as the fit says; --white-level 65535 keeps 65535.",
+        ),
+    ] = None,
     scheduler: Annotated[
         str | None,
         typer.Option(
@@ -255,6 +265,7 @@ def fit(
                 no_normals,
                 export_encoding,
                 hsh_order,
+                white_level,
                 scheduler,
             )
     except (KeyboardInterrupt, Terminated) as exc:
@@ -273,6 +284,7 @@ def _fit_command(  # type: ignore[no-untyped-def]
     no_normals: bool,
     export_encoding: str,
     hsh_order: int | None,
+    white_level: int | None,
     scheduler: str | None,
 ) -> None:
     """The body of :func:`fit`, run under its stop handling (``written`` gets True once every
@@ -319,6 +331,7 @@ def _fit_command(  # type: ignore[no-untyped-def]
             write_normals=not no_normals,
             export_encoding=export_encoding,
             hsh_order=hsh_order,
+            white_level=white_level,
         )
         if len(sources) > 1:
             if scheduler is None:

@@ -33,6 +33,7 @@ from threadpoolctl import threadpool_limits
 
 from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band, fit_warnings
 from rti_rig.app.usecases.fit_decode import imread_rgb
+from rti_rig.app.usecases.fit_full_scale import acquisition_full_scale, stored_8_bit
 from rti_rig.app.usecases.fit_inputs import (
     INPUTS_KEY,
     as_read,
@@ -87,6 +88,7 @@ from rti_rig.drivers.cameras.file_colour import (
 )
 from rti_rig.reconstruct import exporters, signal_check
 from rti_rig.reconstruct.errors import ReconstructionError
+from rti_rig.reconstruct.full_scale import FullScale
 from rti_rig.reconstruct.qa import ImageCheck, QAReport, assess
 from rti_rig.reconstruct.registry import model_spec
 from rti_rig.reconstruct.stack import ImageStack
@@ -183,6 +185,9 @@ class FitRequest:
     #: writes them and viewers show them) or "linear" (the fitted linear light: darker in a
     #: viewer, which applies no transfer curve). Normals are fitted to the linear light either way.
     export_encoding: str = "srgb"
+    #: --white-level: the code the 16-bit images saturate at (None: 65535, or read from an
+    #: imported acquisition's images, :mod:`rti_rig.app.usecases.fit_full_scale`)
+    white_level: int | None = None
 
 
 @dataclass
@@ -885,7 +890,7 @@ def load_acquisition(
                 "read_as": _read_as(frames[i]),
             }
     if notes is not None:
-        sixteen = {i for i in said if not _stored_8_bit(frames[i])}
+        sixteen = {i for i in said if not stored_8_bit(frames[i])}
         notes.extend(colour_notes(lp, said, len(paths), sixteen))
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
@@ -909,7 +914,7 @@ def load_acquisition(
 
 def _read_as(frame: Any) -> str:
     """How the fit read a colour image it did not convert (fit.json's ``image_colour``)."""
-    if _stored_8_bit(frame):
+    if stored_8_bit(frame):
         return "8-bit, decoded through the sRGB curve"
     return "16-bit, taken as linear (no curve undone, primaries kept)"
 
@@ -990,15 +995,10 @@ def _mixed_depth_note(lp: Path, frames: list[Any], paths: list[Path]) -> list[st
     beside JPEGs would be fitted several times too bright in its mid-tones, silently. Both
     readings are the documented ones, so the files are fitted; the user is told to check, in
     the words replay and check use (:func:`mixed_depth_words`)."""
-    eight = [p.name for f, p in zip(frames, paths, strict=True) if _stored_8_bit(f)]
-    sixteen = [p.name for f, p in zip(frames, paths, strict=True) if not _stored_8_bit(f)]
+    eight = [p.name for f, p in zip(frames, paths, strict=True) if stored_8_bit(f)]
+    sixteen = [p.name for f, p in zip(frames, paths, strict=True) if not stored_8_bit(f)]
     note = mixed_depth_words(lp, eight, sixteen, "fitted")
     return [note] if note else []
-
-
-def _stored_8_bit(frame: Any) -> bool:
-    """Whether a frame of :func:`_open_frames` holds 8-bit (sRGB-encoded) pixels."""
-    return bool(getattr(frame, "stored", np.dtype(frame.dtype)) == np.uint8)
 
 
 #: How the bands of a fit are computed: given the stack, the plan and the row tiles, yield each
@@ -1110,6 +1110,11 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     inputs = acquisition_inputs(req.source)  # before reading: a later change is a change
     colours: dict[str, dict[str, str]] = {}
     frames, lights, names, what = load_acquisition(req.source, notes, colours)
+    # an image converted from its file's colour space has no "read_as" (its record instead)
+    converted = [n for n, c in colours.items() if "read_as" not in c]
+    full = acquisition_full_scale(frames, names, Path(req.source), req.white_level, converted)
+    if full is not None:
+        notes.append(full.words(len(frames), shown_path(req.source)))
     said_at = len(notes)  # the repeated lights' note goes here, once what was fitted is known
     release_free_memory()  # the decode buffers
     out = req.out_dir
@@ -1138,6 +1143,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
             checksums,
             inputs=inputs,
             colours=colours,
+            full=full,
         )
     except BaseException as exc:
         stop.set()  # a failed or interrupted fit does not wait for the checksums
@@ -1208,11 +1214,18 @@ def _fit_into(  # type: ignore[no-untyped-def]
     *,
     inputs: dict[str, Any] | None = None,
     colours: dict[str, dict[str, str]] | None = None,
+    full: FullScale | None = None,
 ) -> FitResult:
     """Every output of :func:`run_fit` written into the prepared ``out`` (``checksums``: the
     session's files being checksummed meanwhile, awaited before the QA; ``inputs``: the record
-    of what was read, :func:`acquisition_inputs`, kept in ``fit.json`` for a batch's rerun)."""
-    stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
+    of what was read, :func:`acquisition_inputs`, kept in ``fit.json`` for a batch's rerun;
+    ``full``: the full scale the images are fitted and judged against, where not 65535)."""
+    # uint16, scaled on the fly; saturation at the top code, or at the full scale read
+    stack = (
+        ImageStack(frames)
+        if full is None
+        else ImageStack(frames, scale=1.0 / full.level, saturation_level=1.0)
+    )
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = _fit_all(req, stack, lights, out, bands or local_bands, names=names)
@@ -1244,7 +1257,10 @@ def _fit_into(  # type: ignore[no-untyped-def]
                 raise ReconstructionError(no_qa)
             with warnings.catch_warnings(record=True) as qa_caught:
                 warnings.simplefilter("always")
-                qa = assess(frames, lights, names)  # every row of every frame: checksummed too
+                # every row of every frame: checksummed too
+                qa = assess(
+                    frames, lights, names, saturation=None if full is None else float(full.level)
+                )
             _say_qa_trust_warnings(qa_caught, result.warnings)
             _remember_pixels(frames)
             result.qa = with_lost_files(qa, req.source)
@@ -1270,6 +1286,9 @@ def _fit_into(  # type: ignore[no-untyped-def]
         # what each colour image's file says of its space and what the fit did of it
         # (converted to linear sRGB, with its clipped pixels; or how it was read as it is)
         "image_colour": colours or None,
+        # the code read as white where not the files' 65535 (--white-level, or read from an
+        # imported acquisition's 10/12/14-bit data)
+        "full_scale": full.as_dict() if full is not None else None,
         "files": [p.name for p in result.files],
         "verdict": result.qa.verdict if result.qa else None,
         INPUTS_KEY: inputs,
