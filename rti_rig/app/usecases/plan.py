@@ -34,6 +34,7 @@ from rti_rig.app.output_files import (
     recorded_images,
     rig_inputs,
 )
+from rti_rig.app.preview_clipping import preview_clipped_note
 from rti_rig.app.preview_source import given_light_differs, resolve_preview
 from rti_rig.app.usecases.fit_outlook import fit_needs, fit_outlook, fit_without_normals
 from rti_rig.core.errors import RtiRigError
@@ -364,7 +365,11 @@ def _plan_lights(req: PlanLightsRequest, preview_rig: _PreviewRig | None) -> Pla
             differs = given_light_differs(req.preview, az_el, rig_lp)
             if differs is not None:
                 notes.append(differs)
-        image, colour_note = preview_in_its_space(source.image, read_preview_image(source.image))
+        stored = read_preview_image(source.image)
+        clipped = preview_clipped_note(source.image, stored)
+        if clipped is not None:
+            notes.append(clipped)
+        image, colour_note = preview_in_its_space(source.image, stored)
         if colour_note is not None:
             notes.append(colour_note)
         turned = preview_orientation_note(source.image)
