@@ -26,9 +26,14 @@ PREVIEW_CLIPPED_LIMIT = 0.05
 SAMPLE_PIXELS = 100_000
 
 
-def preview_clipped_note(path: Path, image: NDArray) -> str | None:
-    """The note on ``image`` (the preview's codes as its file stores them) when more than
-    :data:`PREVIEW_CLIPPED_LIMIT` of its pixels are clipped, else None."""
+def preview_clipped_note(path: Path, image: NDArray, meter: str | None = None) -> str | None:
+    """The note on ``image`` (the preview's codes as its file stores them, before any colour
+    conversion: the clip is the camera's) when more than :data:`PREVIEW_CLIPPED_LIMIT` of its
+    pixels are clipped in every channel, else None. ``meter``: the command that shoots a
+    metered preview on this rig (None: no rig config to name).
+
+    Every channel, not any: the planner reads brightness, a weighted sum of the channels, and a
+    vivid red object's red channel at its top code leaves the shading in green and blue."""
     img = np.asarray(image)
     if img.dtype == np.uint8:
         top = 255
@@ -40,13 +45,14 @@ def preview_clipped_note(path: Path, image: NDArray) -> str | None:
     else:
         return None  # float data: no clip level known
     at_top = img >= top
-    share = float((at_top.any(axis=2) if at_top.ndim == 3 else at_top).mean())
-    if share < PREVIEW_CLIPPED_LIMIT:
+    share = float((at_top.all(axis=2) if at_top.ndim == 3 else at_top).mean())
+    if share <= PREVIEW_CLIPPED_LIMIT:
         return None
+    metered = f" ({meter} meters one)" if meter else ""
     return (
-        f"{shown_path(path)}: {share:.0%} of the preview's pixels are clipped (at {top}): its "
-        "shading is lost there, so the relief read from it, which the lights and the expected "
-        "errors are reckoned on, is flat where the object is brightest; shoot the preview "
-        "with less exposure (on the rig, rti-rig preview RIG --auto-exposure meters one) and "
-        "plan again"
+        f"{shown_path(path)}: {share:.0%} of the preview's pixels are clipped (at {top} in "
+        "every channel), on the object or its background: where they are on the object its "
+        "shading is lost, so the relief read from it is flat there (the plan's expected "
+        "errors are reckoned on that relief, and with --method kmeans or optimal its lights "
+        f"too); shoot the preview with less exposure{metered} and plan again"
     )

@@ -56,7 +56,7 @@ def test_a_clipped_preview_is_said_at_its_clip_level(dome_relief: Path, tmp_path
     assert "of the preview's pixels are clipped" not in _plan(as_shot, tmp_path / "a.lp")
 
     bright = np.clip(lit * 3.0, 0.0, 1.0)
-    share = float((bright >= 1.0).any(axis=2).mean())
+    share = float((bright >= 1.0).all(axis=2).mean())
     assert share > PREVIEW_CLIPPED_LIMIT
     cases = {
         "16.tif": (np.round(bright * 65535).astype(np.uint16), 65535),
@@ -70,5 +70,18 @@ def test_a_clipped_preview_is_said_at_its_clip_level(dome_relief: Path, tmp_path
         else:
             tifffile.imwrite(path, pixels)
         text = _plan(path, tmp_path / f"{name}.lp")
-        assert f"{share:.0%} of the preview's pixels are clipped (at {top})" in text, text
-        assert "shoot the preview with less exposure" in text, text
+        # at 8 bits, linear values a hair under white round to 255 too
+        share = float((pixels >= top).all(axis=2).mean())
+        assert share > PREVIEW_CLIPPED_LIMIT
+        assert f"{share:.0%} of the preview's pixels are clipped (at {top} in every" in text, text
+        # the command offered runs as pasted: the rig's config and a preview folder
+        config = CONFIGS / "simulated_dome.toml"
+        assert f"shoot the preview with less exposure (rti-rig preview {config} --out " in text
+        assert "--auto-exposure meters one)" in text, text
+
+    # one channel at its top (a vivid red object) keeps its shading in the others: no note
+    red = np.round(lit * 65535).astype(np.uint16)
+    red[: red.shape[0] // 2, :, 0] = 65535
+    one_channel = tmp_path / "red.tif"
+    tifffile.imwrite(one_channel, red)
+    assert "of the preview's pixels are clipped" not in _plan(one_channel, tmp_path / "r.lp")

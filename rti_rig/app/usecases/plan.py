@@ -366,7 +366,14 @@ def _plan_lights(req: PlanLightsRequest, preview_rig: _PreviewRig | None) -> Pla
             if differs is not None:
                 notes.append(differs)
         stored = read_preview_image(source.image)
-        clipped = preview_clipped_note(source.image, stored)
+        rig_word = _config_shown(req.rig)
+        meter = (
+            None
+            if rig_word == "RIG.toml"
+            else f"rti-rig preview {rig_word} --out {_run_folder(req.out_file, 'preview')} "
+            "--auto-exposure"
+        )
+        clipped = preview_clipped_note(source.image, stored, meter)
         if clipped is not None:
             notes.append(clipped)
         image, colour_note = preview_in_its_space(source.image, stored)
