@@ -29,28 +29,6 @@ SCENES = ("relief", "painting", "coin")
 CASES = (("3× exposure", 3.0, 0), ("3× exposure, shifted up", 3.0, 4), ("½ exposure", 0.5, 0))
 
 
-def twelve_bit_copy(session: Path, out: Path, gain: float, shift: int) -> Path:
-    """``session``'s linear images as 12-bit data at ``gain`` × its exposure, clipped at 4095,
-    in 16-bit TIFFs (shifted up by ``shift``), with a lights.lp naming them (no session
-    record beside them: an acquisition from elsewhere)."""
-    import tifffile
-
-    from rti_rig.core.image_files import read_linear_tiff
-
-    out.mkdir()
-    lines = (session / "lights.lp").read_text(encoding="utf-8").splitlines()
-    listed = [lines[0]]
-    for line in lines[1:]:
-        name, *xyz = line.split()
-        stem = Path(name).stem
-        linear = read_linear_tiff(session / "linear" / f"{stem}.tif").astype(np.float64)
-        codes = np.clip(np.round(linear / 65535 * gain * 4095), 0, 4095).astype(np.uint32)
-        tifffile.imwrite(out / f"{stem}.tif", (codes << shift).astype(np.uint16))
-        listed.append(" ".join([f"{stem}.tif", *xyz]))
-    (out / "lights.lp").write_text("\n".join(listed) + "\n", encoding="utf-8")
-    return out
-
-
 def true_normals(scene: str) -> np.ndarray:
     """The shipped dome's scene (512 px, seed 0) as the simulator renders it."""
     from rti_rig.simulator.scenes import make_scene
@@ -86,6 +64,7 @@ def cell(source: Path, out: Path, truth: np.ndarray, *extra: str) -> str:
 def main(argv: list[str] | None = None) -> str:
     args = sessions_args(__doc__, argv, 48)
     from benchmarks.report import machine_line, write_section
+    from rti_rig.reconstruct.synthetic import camera_bits_copy
 
     rows = []
     with tempfile.TemporaryDirectory(prefix="full_scale_") as tmp:
@@ -103,7 +82,7 @@ def main(argv: list[str] | None = None) -> str:
                 continue
             truth = true_normals(scene)
             for k, (label, gain, shift) in enumerate(CASES):
-                copy = twelve_bit_copy(session, scratch / f"{scene}_{k}", gain, shift)
+                copy = camera_bits_copy(session, scratch / f"{scene}_{k}", gain, shift=shift)
                 now = cell(copy, scratch / f"{scene}_{k}_now", truth)
                 before = cell(copy, scratch / f"{scene}_{k}_65535", truth, "--white-level", "65535")
                 rows.append(f"| {scene} | {label} | {now} | {before} |")

@@ -126,3 +126,35 @@ def turned_session_copy(session: Path, dst: Path, first: int, angle_deg: float) 
         return out.reshape(img.shape).astype(img.dtype)
 
     return _changed_session_copy(session, dst, first, turned)
+
+
+def camera_bits_copy(
+    session: Path,
+    dst: Path,
+    gain: float,
+    bits: int = 12,
+    shift: int = 0,
+    icc: bytes | None = None,
+) -> Path:
+    """``session``'s linear images as a ``bits``-bit camera stores them in 16-bit TIFFs: at
+    ``gain`` × its exposure, clipped at the depth's top, shifted up by ``shift`` bits (with the
+    ICC profile ``icc``), and a lights.lp naming them — an acquisition from elsewhere (no
+    session record beside it). Here, not in tests/, so that benchmarks/full_scale.py measures
+    the files the fit tests read."""
+    import tifffile
+
+    from rti_rig.core.image_files import read_linear_tiff
+
+    dst.mkdir()
+    top = (1 << bits) - 1
+    lines = (session / "lights.lp").read_text(encoding="utf-8").splitlines()
+    listed = [lines[0]]
+    for line in lines[1:]:
+        name, *xyz = line.split()
+        stem = Path(name).stem
+        linear = read_linear_tiff(session / "linear" / f"{stem}.tif").astype(np.float64)
+        codes = np.clip(np.round(linear / 65535 * gain * top), 0, top).astype(np.uint32)
+        tifffile.imwrite(dst / f"{stem}.tif", (codes << shift).astype(np.uint16), iccprofile=icc)
+        listed.append(" ".join([f"{stem}.tif", *xyz]))
+    (dst / "lights.lp").write_text("\n".join(listed) + "\n", encoding="utf-8")
+    return dst

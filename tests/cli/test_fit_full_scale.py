@@ -19,42 +19,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import tifffile
 from colour_files import icc_profile
 from conftest import said, shipped_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.reconstruct.synthetic import camera_bits_copy
 
 runner = CliRunner()
-
-
-def _imported(
-    session: Path,
-    out: Path,
-    gain: float,
-    bits: int = 12,
-    shift: int = 0,
-    icc: bytes | None = None,
-) -> Path:
-    """``session``'s images as ``bits``-bit data at ``gain`` × its exposure, clipped at the
-    depth's top and stored in 16-bit TIFFs (shifted up by ``shift``; with the ICC profile
-    ``icc``), with its lights.lp naming them: an acquisition from elsewhere (no session record
-    beside it)."""
-    out.mkdir()
-    top = (1 << bits) - 1
-    lines = (session / "lights.lp").read_text().splitlines()
-    listed = [lines[0]]
-    for line in lines[1:]:
-        name, *xyz = line.split()
-        stem = Path(name).stem
-        linear = read_linear_tiff(session / "linear" / f"{stem}.tif").astype(np.float64)
-        codes = np.clip(np.round(linear / 65535 * gain * top), 0, top).astype(np.uint32)
-        tifffile.imwrite(out / f"{stem}.tif", (codes << shift).astype(np.uint16), iccprofile=icc)
-        listed.append(" ".join([f"{stem}.tif", *xyz]))
-    (out / "lights.lp").write_text("\n".join(listed) + "\n")
-    return out
 
 
 def _fit(source: Path, out: Path, *extra: str) -> tuple[str, dict, dict]:  # type: ignore[type-arg]
@@ -67,7 +40,7 @@ def _fit(source: Path, out: Path, *extra: str) -> tuple[str, dict, dict]:  # typ
 def test_twelve_bit_data_clipped_at_4095_is_named_saturated(
     dome_relief: Path, tmp_path: Path
 ) -> None:
-    acquisition = _imported(dome_relief, tmp_path / "acq", gain=3.0)
+    acquisition = camera_bits_copy(dome_relief, tmp_path / "acq", gain=3.0)
     text, fit, qa = _fit(acquisition, tmp_path / "f")
 
     assert qa["good"] is False, qa["verdict"]
@@ -84,7 +57,7 @@ def test_twelve_bit_data_shifted_up_and_clipped_is_named_saturated(
     dome_relief: Path, tmp_path: Path
 ) -> None:
     """Shifted up by 4 bits (every value a multiple of 16): the clip is at 65520."""
-    acquisition = _imported(dome_relief, tmp_path / "acq", gain=3.0, shift=4)
+    acquisition = camera_bits_copy(dome_relief, tmp_path / "acq", gain=3.0, shift=4)
     text, fit, qa = _fit(acquisition, tmp_path / "f")
 
     assert qa["good"] is False, qa["verdict"]
@@ -96,7 +69,7 @@ def test_twelve_bit_data_shifted_up_and_clipped_is_named_saturated(
 def test_twelve_bit_data_at_a_third_of_its_range_is_not_called_under_exposed(
     dome_relief: Path, tmp_path: Path
 ) -> None:
-    acquisition = _imported(dome_relief, tmp_path / "acq", gain=0.5)
+    acquisition = camera_bits_copy(dome_relief, tmp_path / "acq", gain=0.5)
     text, fit, qa = _fit(acquisition, tmp_path / "f")
 
     assert "under-exposed" not in qa["verdict"], qa["verdict"]
@@ -128,7 +101,7 @@ def test_twelve_bit_data_at_a_third_of_its_range_is_not_called_under_exposed(
 def test_a_white_level_below_the_images_values_is_refused_naming_the_image(
     dome_relief: Path, tmp_path: Path
 ) -> None:
-    acquisition = _imported(dome_relief, tmp_path / "acq", gain=0.5)
+    acquisition = camera_bits_copy(dome_relief, tmp_path / "acq", gain=0.5)
     out = tmp_path / "f"
     r = runner.invoke(app, ["fit", str(acquisition), "--out", str(out), "--white-level", "300"])
 
@@ -148,7 +121,7 @@ def test_images_converted_from_the_space_their_file_says_are_not_read(
     """Adobe RGB TIFFs are converted to linear sRGB on 65535: their values are no camera's
     codes, so no depth is read from them (nor can one be given). At a quarter of the relief's
     levels, encoded, their linear values stay under 4095: read, they would be "12-bit"."""
-    acquisition = _imported(
+    acquisition = camera_bits_copy(
         dome_relief, tmp_path / "acq", gain=0.25, bits=16, icc=icc_profile("Adobe RGB (1998)")
     )
     _, fit, _ = _fit(acquisition, tmp_path / "f")

@@ -1287,7 +1287,7 @@ def _fit_into(  # type: ignore[no-untyped-def]
         # (converted to linear sRGB, with its clipped pixels; or how it was read as it is)
         "image_colour": colours or None,
         # the code read as white where not the files' 65535 (--white-level, or read from an
-        # imported acquisition's 10/12/14-bit data)
+        # imported acquisition's images: a clip, shifted or 10/12-bit data)
         "full_scale": full.as_dict() if full is not None else None,
         "files": [p.name for p in result.files],
         "verdict": result.qa.verdict if result.qa else None,
