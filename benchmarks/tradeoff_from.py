@@ -27,8 +27,9 @@ every plan chosen among the lights not held out:
 Session time: N lights at the replayed dome's 1.17 s a light (the default dome timing), or at
 the step of the dome ``--rig`` gives (:func:`rig_facts`, its firmware's own hold
 window included where it times its LEDs itself). The
-images are read as the replay rig reads them (JPEG decoded and linearised, 16-bit as they are),
-averaged to grey, and shrunk to at most ``MAX_PX`` wide for speed.
+images are read as the replay rig reads them (JPEG decoded and linearised, 16-bit on their own
+white: 4095 for 12-bit camera data, read as the replay and the fit read it), averaged to grey,
+and shrunk to at most ``MAX_PX`` wide for speed.
 """
 
 from __future__ import annotations
@@ -210,14 +211,21 @@ def load_acquisition_colour(lp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarra
     directions, names), both shrunk to at most ``MAX_PX`` wide. The colour stack is for the
     choice of fit.rti's order, which `rti-rig fit` makes on colour pixels with the saturated
     ones left out (a grey mean hides a channel at its top code)."""
+    from rti_rig.app.usecases.fit_full_scale import recorded_full_scale
     from rti_rig.core.image_files import read_image_any
     from rti_rig.core.lp_format import read_lp
 
     entries = read_lp(lp, upper_hemisphere=True)
+    paths = _image_files(lp, entries)
+    # 16-bit files of 12-bit camera data judged against their own white (4095), as the
+    # replay and the fit read them: against 65535 a clip at 4095 was no clip to the choice
+    # of fit.rti's order
+    full = recorded_full_scale(lp.parent, paths, [e.name for e in entries])
+    white16 = 65535.0 if full is None else float(full.level)
     images, colour = [], []
-    for path in _image_files(lp, entries):
+    for path in paths:
         img = read_image_any(path)
-        x = img.astype(np.float32) / (255.0 if img.dtype == np.uint8 else 65535.0)
+        x = img.astype(np.float32) / (255.0 if img.dtype == np.uint8 else white16)
         if img.dtype == np.uint8:  # sRGB decoding
             x = np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
         g = x.mean(axis=-1) if x.ndim == 3 else x

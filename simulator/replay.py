@@ -24,13 +24,21 @@ planner (adaptive or not) can be rehearsed on real data. What the session then h
   sRGB as the session says; the byte-for-byte copies under ``raw/`` are untouched. Untagged or
   sRGB sources (and rti-rig's own linear TIFFs, whose profile is linear) are replayed as above.
 
+**The recorded codes' own white**: 16-bit files of 10- or 12-bit camera data (white 4095,
+or 65520 shifted up) are handed over as recorded, with the white level the application reads
+from the acquisition as the camera connects (``white_reading``, :func:`rti_rig.app.usecases.
+fit_full_scale.recorded_full_scale`; the simulator may not import the reading itself). The
+session's labels, previews, QA and fit then judge them against it; each frame says so among
+its notices. A resumed session keeps the white its images so far are labelled with
+(:meth:`ReplayCamera.bind_session`), unread: one session, one white level.
+
 Exposure is not modelled: the recorded image is returned whatever exposure is asked (it is
 noted in the frame's metadata). Capturing advances the injected clock as a camera would.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Protocol
 
@@ -40,7 +48,7 @@ from numpy.typing import NDArray
 from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, SessionError
-from rti_rig.core.image_files import linear_to_srgb8, read_image_any
+from rti_rig.core.image_files import linear_tiff_white_level, linear_to_srgb8, read_image_any
 from rti_rig.core.shell_words import shown_path
 from rti_rig.drivers.cameras.colour_convert import (
     Converted,
@@ -98,6 +106,16 @@ def linear_frame(
     return img.astype(np.uint16, copy=False), None
 
 
+def session_white_level(root: Path) -> int | None:
+    """The white level a session's linear TIFFs so far are labelled with (the first that says
+    one), or None for a session with none yet."""
+    for tiff in sorted((root / "linear").glob("*.tif")):
+        level = linear_tiff_white_level(tiff)
+        if level is not None:
+            return level
+    return None
+
+
 def _sha256(path: Path) -> str | None:
     """The file's SHA-256, or None where it cannot be read."""
     import hashlib
@@ -138,8 +156,14 @@ class ReplayCamera:
         transfer_s: float = 0.7,
         names: Sequence[str] | None = None,
         digests: Sequence[str | None] | None = None,
+        white_reading: Callable[[], tuple[int, str | None]] | None = None,
     ) -> None:
         self.name = "replay camera"
+        #: the recorded codes' white (65535 unless read otherwise) and what says so, read as
+        #: the camera connects by ``white_reading`` unless a resumed session's labels said it
+        self._white = WHITE
+        self._white_notice: str | None = None
+        self._white_reading = white_reading
         #: each recorded file's SHA-256 as the run began (None: not known)
         self._digests = list(digests) if digests is not None else [None] * len(images)
         self._images = [Path(p) for p in images]
@@ -155,10 +179,29 @@ class ReplayCamera:
         #: each recorded file's (size, mtime_ns, ctime_ns) as the run opened the camera
         self._stamps: list[tuple[int, int, int] | None] = []
 
+    def bind_session(self, root: Path) -> None:
+        """A resumed session keeps the white level its images so far are labelled with (the
+        acquisition is not read again): its fit and verdict judge every image against one."""
+        kept = session_white_level(Path(root))
+        if kept is None:
+            return
+        self._white_reading = None
+        self._white = kept
+        self._white_notice = (
+            None
+            if kept == WHITE
+            else f"replayed with white level {kept}, not 65535, as this session's images so far "
+            "are labelled; if the camera's white level is another, fit the session with "
+            "--white-level N"
+        )
+
     def connect(self) -> None:
         # taken as the rig opens, just after the session hashed the acquisition for its
         # manifest: a file rewritten since then is told at its step
         self._stamps = [_stamp(p) for p in self._images]
+        if self._white_reading is not None:
+            self._white, self._white_notice = self._white_reading()
+            self._white_reading = None
         self._connected = True
 
     def _refuse_changed(self, lit: int) -> None:
@@ -255,12 +298,12 @@ class ReplayCamera:
             # ("copy": the user's file, never moved, wherever it lies)
             name = self._names[lit] if self._names is not None else path.name
             metadata["originals"] = [{"path": source, "name": name, "copy": True}]
+            notices: list[str] = []
             if colour is not None:  # what the recorded file says of its colours, as said
                 metadata["file_colour"] = colour.as_dict()
                 said = file_colour_notice(
                     colour, "the replayed files", bits=8 * stored.dtype.itemsize
                 )
-                notices = []
                 if converted is not None:
                     metadata["file_colour"].update(converted.record)
                     if colour.space != "srgb":
@@ -269,13 +312,15 @@ class ReplayCamera:
                         notices.append(clipped_notice(colour))
                 if said:
                     notices.insert(0, said)
-                if notices:
-                    metadata["notices"] = notices
+            if self._white_notice:
+                notices.append(self._white_notice)
+            if notices:
+                metadata["notices"] = notices
         return Frame(
             pixels=pixels,
             exposure_s=exposure_s,
             gain=1.0,
-            white_level=WHITE,
+            white_level=self._white,
             timestamp_s=t0,
             metadata=metadata,
         )

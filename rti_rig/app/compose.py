@@ -528,8 +528,27 @@ def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
         # file of one name (RTIBuilder's ../jpeg-exports/… climbs out of assembly-files/)
         names=[lp_name_from(folder, p) for p in images],
         digests=[(stamped.get(name) or [None] * 4)[3] for name in geometry.names],
+        white_reading=lambda: _replay_white(loaded, images, list(geometry.names)),
     )
-    return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
+    rig = Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
+    rig.session_hooks.append(camera.bind_session)  # a resumed session keeps its white
+    return rig
+
+
+def _replay_white(
+    loaded: LoadedRig, images: list[Path], names: list[str]
+) -> tuple[int, str | None]:
+    """The white level the replay hands the recorded codes over with, and the notice that says
+    so (None at 65535): 16-bit files of 10- or 12-bit camera data keep their own white, read
+    from the files as ``rti-rig fit`` reads an imported acquisition's."""
+    from rti_rig.app.usecases.fit_full_scale import recorded_full_scale
+    from rti_rig.core.shell_words import shown_path
+
+    full = recorded_full_scale(Path(loaded.path).parent, images, names)
+    if full is None:
+        return 65535, None
+    said = full.words(len(images), shown_path(Path(loaded.path)), fit="fit the session")
+    return full.level, f"replayed with white level {full.level}, not 65535: {said}"
 
 
 def _build_simulated(loaded: LoadedRig, clock: Clock | None) -> Rig:

@@ -1944,7 +1944,7 @@ def rig_geometry(rig: LoadedRig) -> DomeGeometry | ArmGeometry:
     )
 
 
-def _converted_by_replay(path: Path) -> bool:
+def converted_by_replay(path: Path) -> bool:
     """Whether a replay converts ``path`` to linear sRGB by the space it says (the replay's
     rule: a colour file, :func:`needs_conversion`), read from its headers alone."""
     from rti_rig.core.image_files import header_bit_depth, header_layout
@@ -2022,7 +2022,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
         # two guesses (fit leaves it out of its note too): a 16-bit sRGB PNG among JPEGs had
         # been said "taken as linear" where the replay undoes its curve. Headers are read
         # again only where there is a mix
-        kept = [i for i, p in enumerate(found.paths) if not _converted_by_replay(p)]
+        kept = [i for i, p in enumerate(found.paths) if not converted_by_replay(p)]
         mixed = mixed_depth_note(
             lp_path, [names[i] for i in kept], [found.paths[i] for i in kept], "replayed"
         )

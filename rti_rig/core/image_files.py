@@ -10,6 +10,7 @@ import contextlib
 import functools
 import hashlib
 import os
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -360,6 +361,40 @@ def read_linear_tiff(path: Path) -> NDArray[np.uint16]:
     import tifffile
 
     return tifffile.imread(path)
+
+
+#: How rti-rig's own linear TIFFs begin their ImageDescription (a session's, or a kept-aside
+#: image's): what they say of their pixels follows.
+OWN_TIFF_LABEL = "rti-rig:"
+_WHITE_SAID = re.compile(r", 16-bit, white level (\d+)\b")
+
+
+def labelled_white_level(description: str) -> int | None:
+    """The white level an rti-rig linear TIFF's label states (``rti-rig: linear sRGB, 16-bit,
+    white level 4095 (...)``), or None where it states none (another writer's TIFF, a RAW's or
+    a mosaic's label).
+
+    Why: a session of a replayed 12-bit acquisition holds the recorded codes as they were
+    (white 4095), and its label is the only place that says so: every later reader of the
+    session (its fit and QA, an adaptive resume) takes its white from here."""
+    if not description.startswith(OWN_TIFF_LABEL):
+        return None
+    # the last one: a colour profile's name, said before it, is the file's own words
+    found = _WHITE_SAID.findall(description)
+    level = int(found[-1]) if found else 0
+    return level if 1 <= level <= 65535 else None  # a label edited to 0 states nothing
+
+
+def linear_tiff_white_level(path: Path) -> int | None:
+    """The white level ``path``'s label states (:func:`labelled_white_level`), read from its
+    main image's header alone; None where it states none or the file is no TIFF."""
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(path) as tif:
+            return labelled_white_level(str(tiff_main_image(tif).keyframe.description or ""))
+    except (OSError, ValueError, tifffile.TiffFileError):
+        return None
 
 
 def jpeg_truncation(path: Path) -> str | None:

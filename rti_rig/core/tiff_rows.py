@@ -90,6 +90,8 @@ class TiffRows:
                 and not self._reshaped
                 and not page.is_tiled
                 and self.dtype.itemsize in (1, 2)
+                # a sample of 10, 12 or 14 bits is packed: its rows are no array in place
+                and int(page.bitspersample) == 8 * self.dtype.itemsize
                 and tf.byteorder == "<"
                 and len(page.dataoffsets) >= 1
             )

@@ -8,7 +8,8 @@ fitted as light (a 12-bit session with two thirds of some images clipped at 4095
 "good"), and one exposed to half of its 4095 was called "4.9 stops under-exposed", with the
 advice to give it 29× the exposure. rti-rig's own sessions scale their camera's range to
 65535 as they are shot (``drivers.cameras.image_io.to_linear_uint16``), so this reading is for
-acquisitions from elsewhere.
+acquisitions from elsewhere (and for a replay of one, whose session keeps the codes as recorded
+and states their white in its labels).
 
 The reading, from a regular sample of every image's pixels:
 
@@ -57,10 +58,12 @@ MAX_SHIFT = 8
 class FullScale:
     """The code read as white (full scale) of an acquisition's 16-bit images, and why.
 
-    ``how``: ``"clipped"``, ``"shifted"``, ``"bits"`` (read from the data) or ``"given"``
-    (``--white-level``); ``bits``: the data's depth where read; ``brightest``: the brightest
-    sampled code; ``clipped_image``/``clipped_share``: the image with most sampled pixels at
-    ``level`` and their share (a clip reading)."""
+    ``how``: ``"clipped"``, ``"shifted"``, ``"bits"`` (read from the data), ``"given"``
+    (``--white-level``), ``"labelled"`` (an rti-rig session's own TIFF labels say it: a
+    replay of camera data kept as recorded) or ``"header"`` (TIFFs of 10, 12 or 14 bits a
+    sample, as a replay reads them); ``bits``: the data's depth where read;
+    ``brightest``: the brightest sampled code; ``clipped_image``/``clipped_share``: the image
+    with most sampled pixels at ``level`` and their share (a clip reading)."""
 
     level: int
     how: str
@@ -80,9 +83,24 @@ class FullScale:
             "clipped_share": round(self.clipped_share, 6),
         }
 
-    def words(self, images: int, label: str) -> str:
-        """What the fit says of it (``label``: the acquisition's .lp as shown)."""
+    def words(self, images: int, label: str, fit: str = "fit") -> str:
+        """What the fit says of it (``label``: the acquisition's .lp as shown; ``fit``: what
+        the user runs with ``--white-level``, "fit the session" where a replay says it)."""
         of = f"the {images} 16-bit images of {label}"
+        other = f"if the camera's white level is another, {fit} with --white-level N"
+        if self.how == "labelled":
+            depth = f" ({self.bits}-bit camera data kept as recorded)" if self.bits else ""
+            return (
+                f"{of} are labelled with white level {self.level} by the session that wrote "
+                f"them{depth}: fitted and judged with {self.level} as full scale (values there "
+                f"read as clipped); {other}"
+            )
+        if self.how == "header":
+            return (
+                f"the {images} images of {label} store {self.bits} bits a sample, as their files' headers say: fitted "
+                f"and judged with {self.level} as full scale (values there read as clipped); "
+                f"{other}"
+            )
         if self.how == "given":
             return (
                 f"{of} were fitted and judged with {self.level} as full scale (--white-level): "
@@ -97,21 +115,20 @@ class FullScale:
                 f"exactly {self.level}, the brightest value sampled in any image, far more "
                 "than at the value found below it, as a sensor's clip leaves them; fitted "
                 "and judged with "
-                f"{self.level} as full scale (values there read as clipped). If the camera's "
-                "white level is another, fit with --white-level N"
+                f"{self.level} as full scale (values there read as clipped); {other}"
             )
         if self.how == "shifted":
             return (
                 f"{of} hold {self.bits}-bit data shifted up (every value a multiple of "
                 f"{(65536 - self.level)}): fitted and judged with {self.level} as full scale; "
-                "if the camera's white level is another, fit with --white-level N"
+                f"{other}"
             )
         stops = np.log2(65535 / self.level)
         return (
             f"{of} hold no value above {self.level} (the brightest sampled: {self.brightest}): "
             f"read as {self.bits}-bit camera data stored unscaled, fitted and judged with "
             f"{self.level} as full scale. If they are 16-bit images (a RAW converter's), they "
-            f"are {stops:.0f} stops or more under-exposed: fit with --white-level 65535 to "
+            f"are {stops:.0f} stops or more under-exposed: {fit} with --white-level 65535 to "
             "judge them so"
         )
 
@@ -139,7 +156,7 @@ def full_scale_of(values: NDArray[np.uint16], names: Sequence[str]) -> FullScale
         return FullScale(
             brightest,
             "clipped",
-            _bits_of(brightest, shift),
+            bits_of(brightest, shift),
             brightest,
             str(names[worst]),
             float(at_top[worst] / per_image.shape[1]),
@@ -153,7 +170,7 @@ def full_scale_of(values: NDArray[np.uint16], names: Sequence[str]) -> FullScale
     return None
 
 
-def _bits_of(level: int, shift: int) -> int | None:
+def bits_of(level: int, shift: int = 0) -> int | None:
     """The depth a clip level shows where it is a depth's top code, unscaled or shifted up."""
     if shift >= 2 and level == 65536 - (1 << shift):
         return 16 - shift

@@ -1844,6 +1844,17 @@ def linear_tiff_labels(decode: dict[str, Any], frame: Frame) -> tuple[str, bytes
     return description, icc
 
 
+def labelled_white(frame: Frame) -> int:
+    """The white level ``frame``'s linear TIFF states in its label (:func:`linear_tiff_labels`;
+    65535 where it states none: a RAW's label, whose pixels are scaled to 65535, or a
+    mosaic's), as a reader of the session takes it (``core.image_files.labelled_white_level``).
+    Why: a live reader of the frame (an adaptive run's chooser) must weigh it as a resume
+    reading the TIFF back will, or the resume decides another light."""
+    if frame.metadata.get("decode") or not frame.white_level:
+        return 65535
+    return int(frame.white_level)
+
+
 def _file_colour(frame: Frame) -> dict[str, str]:
     """What the frame's camera file said of its colour space (empty: nothing recorded)."""
     said = frame.metadata.get("file_colour") or {}

@@ -51,7 +51,7 @@ from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
-from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.image_files import linear_tiff_white_level, read_linear_tiff
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, LampGeometry, in_band
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.core.shell_words import shell_word, shown_path
@@ -80,6 +80,7 @@ from rti_rig.planner.adaptive_until import (
 )
 from rti_rig.planner.objectives import ARM_CANDIDATES, candidates_for, snap_unique
 from rti_rig.planner.uniform import band_run_options, select_uniform_leds
+from rti_rig.runtime.session import labelled_white
 
 #: Width (px) of the grey copies the decisions are fitted on (a 24-MP image is shrunk once).
 FIT_PX = 128
@@ -1164,11 +1165,15 @@ class AdaptiveSteps:
         return self._step(candidate), evidence
 
     def observe(self, index: int, frame: Frame, record) -> None:  # type: ignore[no-untyped-def]
+        # in units of the white the TIFF's label states, as --resume reads it back (a replay
+        # of 12-bit data is weighed against 4095: against 65535 its clipped highlights had
+        # passed for light well within range)
+        white = labelled_white(frame)
         self.chooser.observe(
             self._pending.pop(index),
             np.asarray(record.actual_direction),
-            small_grey(frame.pixels),  # as --resume reads it back from the linear TIFF
-            camera_sample(frame.pixels),  # the stop's evidence at the camera's resolution
+            small_grey(frame.pixels, white),  # as --resume reads it back from the linear TIFF
+            camera_sample(frame.pixels, white),  # the stop's evidence at the camera's resolution
         )
 
     def replay(self, folder) -> None:  # type: ignore[no-untyped-def]
@@ -1215,12 +1220,14 @@ class AdaptiveSteps:
                     "those was changed, put it back as it was (the files from a backup copy of "
                     "the folder) and resume again, else start a new session"
                 )
-            pixels = read_linear_tiff(Path(folder.root) / rec.linear_image)
+            tiff = Path(folder.root) / rec.linear_image
+            pixels = read_linear_tiff(tiff)
+            white = linear_tiff_white_level(tiff) or 65535  # as the run weighed it
             self.chooser.observe(
                 candidate,
                 np.asarray(rec.actual_direction),
-                small_grey(pixels),
-                camera_sample(pixels),
+                small_grey(pixels, white),
+                camera_sample(pixels, white),
             )
         if other_rig:
             self._keep_start_unused(folder, len(done))

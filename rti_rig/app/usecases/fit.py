@@ -1932,7 +1932,9 @@ def verdict_for_session(session: Path) -> str:
     no_qa = qa_without_normals(lights, session)
     if no_qa is not None:
         raise RtiRigError(no_qa)
-    qa = assess(frames, lights, names)
+    # judged against the white its labels state (a replay of 12-bit data: 4095), as its fit is
+    full = acquisition_full_scale(frames, names, session, None)
+    qa = assess(frames, lights, names, saturation=None if full is None else float(full.level))
     _remember_pixels(frames)
     report = with_lost_files(qa, session)
     command = reshoot_in_place(session, report)

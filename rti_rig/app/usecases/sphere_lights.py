@@ -21,7 +21,7 @@ from rti_rig.app.light_calibration import refuse_unverified
 from rti_rig.app.output_files import check_output_file, session_rig_inputs
 from rti_rig.app.usecases.run_options import run_words
 from rti_rig.core.errors import RtiRigError, SessionError
-from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.image_files import linear_tiff_white_level, read_linear_tiff
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.core.out_folders import free_folder_beside
 from rti_rig.core.shell_words import shell_word, shown_path
@@ -141,6 +141,9 @@ def _grey_image(root: Path, step: dict[str, Any]) -> tuple[np.ndarray, float, st
     if pixels is None:
         raise SessionError(f"{shown_path(path)} cannot be read as an image: is it there?")
     white = float(np.iinfo(pixels.dtype).max) if pixels.dtype.kind in "ui" else 1.0
+    if path.suffix.lower() in (".tif", ".tiff"):
+        # a replay of 12-bit data keeps its codes: its label says the white (4095)
+        white = float(linear_tiff_white_level(path) or white)
     return as_grey(pixels), white, name
 
 
