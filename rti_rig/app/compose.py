@@ -635,6 +635,23 @@ def simulated_arm_motion(loaded: LoadedRig):  # type: ignore[no-untyped-def]
     )
 
 
+def _on_full_scale(img, path: Path):  # type: ignore[no-untyped-def]
+    """A session's linear TIFF labelled with a white below 65535 (a replay of 12-bit data keeps
+    its codes) scaled onto 65535, as the planner reads every 16-bit preview: it had planned
+    from the image 16x too dark."""
+    import numpy as np
+
+    from rti_rig.core.image_files import linear_tiff_white_level
+
+    if getattr(img, "dtype", None) != np.uint16 or path.suffix.lower() not in (".tif", ".tiff"):
+        return img
+    white = linear_tiff_white_level(path)
+    if white is None or white >= 65535:
+        return img
+    scaled = (img.astype(np.uint64) * 65535 + white // 2) // white
+    return np.minimum(scaled, 65535).astype(np.uint16)
+
+
 def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
     """The preview file as the planner takes it, RAW files included.
 
@@ -653,7 +670,8 @@ def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
 
     p = Path(path)
     if not is_camera_raw(p) or not p.is_file():
-        return read_preview(p)  # which also refuses a folder or a missing file, by name
+        # which also refuses a folder or a missing file, by name
+        return _on_full_scale(read_preview(p), p)
     from rti_rig.drivers.cameras.raw_decode import MonochromeRawError, decode_raw
     from rti_rig.drivers.cameras.settings import RawDecodeSettings
 

@@ -1952,9 +1952,10 @@ def converted_by_replay(path: Path) -> bool:
     from rti_rig.drivers.cameras.file_colour import file_colour
 
     layout, bits = header_layout(path), header_bit_depth(path)
-    if layout is None or not layout[2] or bits not in (8, 16):
+    if layout is None or not layout[2] or bits is None:
         return False
-    return needs_conversion(file_colour(path), np.dtype(np.uint16 if bits == 16 else np.uint8))
+    # a TIFF of 10, 12 or 14 bits a sample is decoded to uint16, as a 16-bit one is
+    return needs_conversion(file_colour(path), np.dtype(np.uint16 if bits > 8 else np.uint8))
 
 
 def load_replay_rig(lp_path: Path | str) -> LoadedRig:

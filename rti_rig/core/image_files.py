@@ -11,6 +11,7 @@ import functools
 import hashlib
 import os
 import re
+import struct
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -393,8 +394,8 @@ def linear_tiff_white_level(path: Path) -> int | None:
     try:
         with tifffile.TiffFile(path) as tif:
             return labelled_white_level(str(tiff_main_image(tif).keyframe.description or ""))
-    except (OSError, ValueError, tifffile.TiffFileError):
-        return None
+    except (OSError, ValueError, IndexError, KeyError, struct.error, tifffile.TiffFileError):
+        return None  # a file cut short or not a TIFF: no label said
 
 
 def jpeg_truncation(path: Path) -> str | None:

@@ -97,8 +97,9 @@ class FullScale:
             )
         if self.how == "header":
             return (
-                f"the {images} images of {label} store {self.bits} bits a sample, as their files' headers say: fitted "
-                f"and judged with {self.level} as full scale (values there read as clipped); "
+                f"the {images} images of {label} store {self.bits} bits a sample, as their "
+                f"files' headers say: fitted and judged with {self.level} as full scale "
+                "(values there read as clipped); "
                 f"{other}"
             )
         if self.how == "given":

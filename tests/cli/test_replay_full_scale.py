@@ -18,6 +18,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+from colour_files import icc_profile
 from conftest import decisions, interrupted, said
 from typer.testing import CliRunner
 
@@ -125,6 +126,9 @@ def _listing_linear(session: Path, dst: Path, scale: float) -> Path:
     import tifffile
 
     shutil.copytree(session, dst)
+    # without its record: the TIFFs' labels alone say whose they are
+    (dst / "manifest.json").unlink()
+    (dst / "journal.jsonl").unlink()
     lines = (dst / "lights.lp").read_text(encoding="utf-8").splitlines()
     listed = [lines[0]]
     for line in lines[1:]:
@@ -157,14 +161,65 @@ def test_a_dark_session_of_rti_rig_replayed_by_its_tiffs_keeps_65535(
     assert linear_tiff_white_level(session / "linear" / "image_001.tif") == 65535
 
 
-def _packed_12_bit(acquisition: Path) -> None:
+def _packed_12_bit(acquisition: Path, icc: bytes | None = None) -> None:
     """Rewrite ``acquisition``'s TIFFs as 12 bits a sample (packed, as some cameras store
-    them): the header says the depth."""
+    them), with the ICC profile ``icc``: the header says the depth."""
     import tifffile
 
     for tiff in acquisition.glob("*.tif"):
         codes = tifffile.imread(tiff)
-        tifffile.imwrite(tiff, codes, bitspersample=12, photometric="rgb")
+        tifffile.imwrite(tiff, codes, bitspersample=12, photometric="rgb", iccprofile=icc)
+
+
+def test_12_bit_tiffs_the_replay_converts_from_adobe_rgb_stay_at_65535(
+    dome_relief: Path, tmp_path: Path
+) -> None:
+    """Files the replay converts from the space they say become linear sRGB on 65535: no
+    white of their own is read (12 bits a sample had been left out of that rule, and the
+    converted frames were then labelled 4095, judged 16x too bright)."""
+    acquisition = camera_bits_copy(dome_relief, tmp_path / "acq", gain=0.5)
+    _packed_12_bit(acquisition, icc_profile("Adobe RGB (1998)"))
+    session = tmp_path / "s"
+    r = runner.invoke(
+        app,
+        ["run", str(acquisition / "lights.lp"), "--out", str(session), "--lights", "9"],
+        terminal_width=400,
+    )
+    assert r.exit_code == 0, r.output
+    assert "replayed with white level" not in said(r), said(r)
+    assert linear_tiff_white_level(session / "linear" / "image_001.tif") == 65535
+
+
+def test_a_lost_tiff_of_a_12_bit_replay_is_not_fitted_from_its_jpeg(
+    clipped_replay: tuple,  # type: ignore[type-arg]
+    tmp_path: Path,
+) -> None:
+    """The JPEG standing in for a lost linear TIFF was encoded against 4095 and decodes onto
+    65535: fitted with the other TIFFs' 4095 codes it would be 16x their scale."""
+    import shutil
+
+    _, session, _ = clipped_replay
+    copy = tmp_path / "copy"
+    shutil.copytree(session, copy)
+    (copy / "linear" / "image_005.tif").unlink()
+    r = runner.invoke(
+        app, ["fit", str(copy), "--out", str(tmp_path / "f"), *FIT_NORMALS], terminal_width=400
+    )
+    text = said(r)
+    assert r.exit_code != 0 and "Traceback" not in text, text
+    assert "image_005 is read from its 8-bit JPEG" in text, text
+    assert "put the linear TIFF back from a backup copy of the session" in text, text
+
+
+def test_a_replayed_tiff_is_planned_from_on_65535(clipped_replay: tuple) -> None:  # type: ignore[type-arg]
+    """``rti-rig plan`` reads a session's linear TIFF as a preview on 65535 (a 12-bit replay's
+    4095 codes had been planned from as an image 16x too dark)."""
+    from rti_rig.app.compose import read_preview_image
+
+    acquisition, session, _ = clipped_replay
+    recorded = read_linear_tiff(acquisition / "image_021.tif").astype(np.float64)
+    seen = read_preview_image(session / "linear" / "image_021.tif").astype(np.float64)
+    assert np.abs(seen - np.minimum(recorded * 65535 / 4095, 65535)).max() <= 1.0
 
 
 def test_tiffs_of_12_bits_a_sample_are_judged_at_4095_by_replay_and_fit(

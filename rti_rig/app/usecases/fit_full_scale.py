@@ -86,6 +86,8 @@ def acquisition_full_scale(
     ``converted``: the names of images converted from the colour space their file says (their
     values are rti-rig's linear sRGB on 65535, no longer the camera's codes)."""
     eight = [names[i] for i, f in enumerate(frames) if stored_8_bit(f)]
+    if eight and given is None and _own_session(source, frames):
+        _refuse_mixed_scales(frames, names, eight, source)
     if given is not None:
         if not 1 <= given <= 65535:
             raise RtiRigError(f"--white-level {given}: give a code value from 1 to 65535")
@@ -141,6 +143,29 @@ def _with_header(
     if len(known) != len(bits) or depth >= 16 or (full is not None and full.how != "bits"):
         return full
     return FullScale((1 << depth) - 1, "header", depth, int(codes.max()))
+
+
+def _refuse_mixed_scales(
+    frames: Sequence[Any], names: Sequence[str], eight: Sequence[str], source: Path
+) -> None:
+    """Refuse a session whose TIFFs are labelled with a white below 65535 (a replay of 12-bit
+    data) where an image's 8-bit JPEG stands in for its lost linear TIFF: the JPEG was encoded
+    against that white and decodes onto 65535, 16× the TIFFs' scale, and one fit of both would
+    judge neither right (nor see the clip at 4095)."""
+    wide = [(n, f) for n, f in zip(names, frames, strict=True) if not stored_8_bit(f)]
+    try:
+        level = labelled_full_scale_of([f for _, f in wide], [n for n, _ in wide], source)
+    except RtiRigError:
+        return  # two levels: said by the reading that follows
+    if level is None:
+        return
+    raise RtiRigError(
+        f"{shown_path(source)}: {eight[0]} is read from its 8-bit JPEG (its linear TIFF is "
+        f"missing or cut short), but the session's TIFFs hold codes on white {level} (their "
+        "labels say so: a replay of camera data kept as recorded), which the JPEG is not on; "
+        "put the linear TIFF back from a backup copy of the session, or replay the "
+        "acquisition again into a new session"
+    )
 
 
 def labelled_full_scale(
