@@ -117,6 +117,15 @@ def test_a_12_bit_replay_at_half_exposure_is_not_called_under_exposed(
     assert "fit the session with --white-level 65535" in text, text
 
 
+def _replayed(lp: Path, session: Path):  # type: ignore[no-untyped-def]
+    """``rti-rig run LP --out SESSION --lights 9``, which must succeed."""
+    r = runner.invoke(
+        app, ["run", str(lp), "--out", str(session), "--lights", "9"], terminal_width=400
+    )
+    assert r.exit_code == 0, r.output
+    return r
+
+
 def _listing_linear(session: Path, dst: Path, scale: float) -> Path:
     """``session`` copied to ``dst`` (its record with it) with a ``linear.lp`` listing its linear
     TIFFs, their codes times ``scale`` and their labels kept: an rti-rig session as a user may
@@ -153,10 +162,7 @@ def test_a_dark_session_of_rti_rig_replayed_by_its_tiffs_keeps_65535(
     its codes under 1400 had been taken for 12-bit data)."""
     lp = _listing_linear(dome_relief, tmp_path / "acq", 1 / 50)
     session = tmp_path / "s"
-    r = runner.invoke(
-        app, ["run", str(lp), "--out", str(session), "--lights", "9"], terminal_width=400
-    )
-    assert r.exit_code == 0, r.output
+    r = _replayed(lp, session)
     assert "replayed with white level" not in said(r), said(r)
     assert linear_tiff_white_level(session / "linear" / "image_001.tif") == 65535
 
@@ -180,12 +186,7 @@ def test_12_bit_tiffs_the_replay_converts_from_adobe_rgb_stay_at_65535(
     acquisition = camera_bits_copy(dome_relief, tmp_path / "acq", gain=0.5)
     _packed_12_bit(acquisition, icc_profile("Adobe RGB (1998)"))
     session = tmp_path / "s"
-    r = runner.invoke(
-        app,
-        ["run", str(acquisition / "lights.lp"), "--out", str(session), "--lights", "9"],
-        terminal_width=400,
-    )
-    assert r.exit_code == 0, r.output
+    r = _replayed(acquisition / "lights.lp", session)
     assert "replayed with white level" not in said(r), said(r)
     assert linear_tiff_white_level(session / "linear" / "image_001.tif") == 65535
 
@@ -231,12 +232,7 @@ def test_tiffs_of_12_bits_a_sample_are_judged_at_4095_by_replay_and_fit(
     acquisition = camera_bits_copy(dome_relief, tmp_path / "acq", gain=0.1)
     _packed_12_bit(acquisition)
     session = tmp_path / "s"
-    r = runner.invoke(
-        app,
-        ["run", str(acquisition / "lights.lp"), "--out", str(session), "--lights", "9"],
-        terminal_width=400,
-    )
-    assert r.exit_code == 0, r.output
+    r = _replayed(acquisition / "lights.lp", session)
     assert "replayed with white level 4095, not 65535" in said(r), said(r)
     assert "store 12 bits a sample, as their files' headers say" in said(r), said(r)
     out = tmp_path / "f"
