@@ -248,7 +248,8 @@ def mixed_depth_note(lp_path: Path, names: Sequence[str], paths: Sequence[Path],
     and the check before it had said nothing."""
     depths = [header_bit_depth(p) for p in paths]
     eight = [n for n, d in zip(names, depths, strict=True) if d == 8]
-    sixteen = [n for n, d in zip(names, depths, strict=True) if d == 16]
+    # a TIFF of 10, 12 or 14 bits a sample is decoded to 16-bit codes and taken as linear too
+    sixteen = [n for n, d in zip(names, depths, strict=True) if d is not None and d > 8]
     return mixed_depth_words(lp_path, eight, sixteen, use)
 
 

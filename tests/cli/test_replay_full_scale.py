@@ -13,6 +13,7 @@ session's fit, which trusts rti-rig's own labels, could not see the clip either.
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import cv2
@@ -127,11 +128,9 @@ def _replayed(lp: Path, session: Path):  # type: ignore[no-untyped-def]
 
 
 def _listing_linear(session: Path, dst: Path, scale: float) -> Path:
-    """``session`` copied to ``dst`` (its record with it) with a ``linear.lp`` listing its linear
-    TIFFs, their codes times ``scale`` and their labels kept: an rti-rig session as a user may
-    hand it to a replay, by its 16-bit images."""
-    import shutil
-
+    """``session`` copied to ``dst`` (without its record) with a ``linear.lp`` listing its
+    linear TIFFs, their codes times ``scale`` and their labels kept: an rti-rig session as a
+    user may hand it to a replay, by its 16-bit images."""
     import tifffile
 
     shutil.copytree(session, dst)
@@ -197,8 +196,6 @@ def test_a_lost_tiff_of_a_12_bit_replay_is_not_fitted_from_its_jpeg(
 ) -> None:
     """The JPEG standing in for a lost linear TIFF was encoded against 4095 and decodes onto
     65535: fitted with the other TIFFs' 4095 codes it would be 16x their scale."""
-    import shutil
-
     _, session, _ = clipped_replay
     copy = tmp_path / "copy"
     shutil.copytree(session, copy)
@@ -285,3 +282,23 @@ def test_the_live_white_is_the_one_the_label_states(
     description, _ = linear_tiff_labels(dict(meta.get("decode") or {}), frame)
     assert labelled_white(frame) == expected
     assert (labelled_white_level(description) or 65535) == expected
+
+
+def test_jpegs_beside_12_bit_tiffs_are_noted_as_a_mixed_acquisition(
+    dome_relief: Path, tmp_path: Path
+) -> None:
+    """A TIFF of 12 bits a sample is taken as linear, as a 16-bit one is: beside JPEGs, the
+    replay notes the mix as ``fit`` does (only headers of exactly 16 bits had counted)."""
+    acquisition = camera_bits_copy(dome_relief, tmp_path / "acq", gain=0.5)
+    _packed_12_bit(acquisition)
+    lp = acquisition / "lights.lp"
+    lines = lp.read_text(encoding="utf-8").splitlines()
+    name, *xyz = lines[1].split()
+    shutil.copy(dome_relief / "image_001.jpg", acquisition / "image_001.jpg")
+    (acquisition / name).unlink()
+    lines[1] = " ".join(["image_001.jpg", *xyz])
+    lp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    r = runner.invoke(app, ["check", str(lp)], terminal_width=400)
+    text = said(r)
+    assert "Traceback" not in text, text
+    assert "mixes 1 8-bit image(s), decoded as sRGB, with 47 16-bit one(s)" in text, text
