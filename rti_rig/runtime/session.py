@@ -74,6 +74,7 @@ from rti_rig.core.image_colour import (
 )
 from rti_rig.core.image_files import (
     MOSAIC_TIFF_LABEL,
+    labelled_white_level,
     linear_to_srgb8,
     pixels_sha256,
     tiff_pixels_sha256,
@@ -1845,14 +1846,13 @@ def linear_tiff_labels(decode: dict[str, Any], frame: Frame) -> tuple[str, bytes
 
 
 def labelled_white(frame: Frame) -> int:
-    """The white level ``frame``'s linear TIFF states in its label (:func:`linear_tiff_labels`;
-    65535 where it states none: a RAW's label, whose pixels are scaled to 65535, or a
-    mosaic's), as a reader of the session takes it (``core.image_files.labelled_white_level``).
-    Why: a live reader of the frame (an adaptive run's chooser) must weigh it as a resume
-    reading the TIFF back will, or the resume decides another light."""
-    if frame.metadata.get("decode") or not frame.white_level:
-        return 65535
-    return int(frame.white_level)
+    """The white level ``frame``'s linear TIFF states in its label, read from the label itself
+    (:func:`linear_tiff_labels`, :func:`labelled_white_level`; 65535 where it states none: a
+    RAW's label, whose pixels are scaled to 65535, or a mosaic's). Why: a live reader of the
+    frame (an adaptive run's chooser) must weigh it as a resume reading the TIFF back will, or
+    the resume decides another light; derived from the label, the two cannot drift apart."""
+    decode = dict(frame.metadata.get("decode") or {})
+    return labelled_white_level(linear_tiff_labels(decode, frame)[0]) or 65535
 
 
 def _file_colour(frame: Frame) -> dict[str, str]:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 import tifffile
 
 from rti_rig.core.clock import VirtualClock
@@ -54,26 +55,24 @@ def test_a_new_session_reads_the_white_as_the_camera_connects(tmp_path: Path) ->
     assert "replayed with white level 4095" in " ".join(frame.metadata["notices"])
 
 
-def test_a_resumed_session_keeps_the_white_its_images_are_labelled_with(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("white", "said"),
+    [(65535, None), (4095, "as this session's images so far are labelled")],
+)
+def test_a_resumed_session_keeps_the_white_its_images_are_labelled_with(
+    tmp_path: Path, white: int, said: str | None
+) -> None:
     calls: list[int] = []
     camera = _camera(tmp_path, calls)
     root = tmp_path / "s"
-    _session_with(root, "rti-rig: linear sRGB, 16-bit, white level 65535 (the camera's own)")
+    _session_with(root, f"rti-rig: linear sRGB, 16-bit, white level {white} (the camera's own)")
     camera.bind_session(root)
     camera.connect()
     frame = camera.capture(0.1)
     assert calls == []  # the acquisition is not read again
-    assert frame.white_level == 65535
-    assert "white level" not in " ".join(frame.metadata.get("notices") or [])
-
-
-def test_a_resumed_12_bit_session_keeps_4095_and_says_so(tmp_path: Path) -> None:
-    calls: list[int] = []
-    camera = _camera(tmp_path, calls)
-    root = tmp_path / "s"
-    _session_with(root, "rti-rig: linear sRGB, 16-bit, white level 4095 (the camera's own)")
-    camera.bind_session(root)
-    camera.connect()
-    frame = camera.capture(0.1)
-    assert calls == [] and frame.white_level == 4095
-    assert "as this session's images so far are labelled" in " ".join(frame.metadata["notices"])
+    assert frame.white_level == white
+    notices = " ".join(frame.metadata.get("notices") or [])
+    if said is None:
+        assert "white level" not in notices
+    else:
+        assert said in notices
